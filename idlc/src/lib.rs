@@ -1,0 +1,1 @@
+//! IDL 4.2 compiler: preprocess → parse → resolve → validate → emit.
