@@ -1,0 +1,160 @@
+//! `#[derive(DdsType)]` for one-field tuple structs: `transparent` (typedefs, bitset storage) and `bitmask`.
+
+use proc_macro2::TokenStream;
+use quote::quote;
+use syn::{DataStruct, DeriveInput, Fields, Result};
+
+use crate::attrs::{parse_field_attrs, TypeAttrs};
+use crate::util::impl_attrs;
+
+fn single_field<'a>(input: &'a DeriveInput, data: &'a DataStruct, what: &str) -> Result<&'a syn::Field> {
+    match &data.fields {
+        Fields::Unnamed(u) if u.unnamed.len() == 1 => Ok(&u.unnamed[0]),
+        _ => Err(syn::Error::new_spanned(
+            &input.ident,
+            format!("`#[dds({what})]` needs a tuple struct with exactly one field"),
+        )),
+    }
+}
+
+/// A typedef: encoded exactly as its field.
+pub fn derive_transparent(
+    input: &DeriveInput,
+    data: &DataStruct,
+    _ta: &TypeAttrs,
+    rt: &TokenStream,
+) -> Result<TokenStream> {
+    let cdr = quote!(#rt::cdr);
+    let name = &input.ident;
+    let f = single_field(input, data, "transparent")?;
+    let fa = parse_field_attrs(&f.attrs)?;
+    let ty = &f.ty;
+    let (enc, dec, bo) = match &fa.bound {
+        Some(b) => (
+            quote!(<#ty as #cdr::CdrType>::encode_bounded(&self.0, w, (#b) as usize)),
+            quote!(<#ty as #cdr::CdrType>::decode_bounded(r, (#b) as usize)),
+            quote!(::core::option::Option::Some((#b) as usize)),
+        ),
+        None => (
+            quote!(<#ty as #cdr::CdrType>::encode(&self.0, w)),
+            quote!(<#ty as #cdr::CdrType>::decode(r)),
+            quote!(bound),
+        ),
+    };
+    let (impl_g, ty_g, where_c) = input.generics.split_for_impl();
+    let attrs = impl_attrs();
+    Ok(quote! {
+        #attrs
+        impl #impl_g #cdr::CdrType for #name #ty_g #where_c {
+            const LAYOUT: #cdr::Layout = <#ty as #cdr::CdrType>::LAYOUT;
+            const MIN_SIZE: usize = <#ty as #cdr::CdrType>::MIN_SIZE;
+            const XCDR1_PLAIN: bool = <#ty as #cdr::CdrType>::XCDR1_PLAIN;
+            const KEY_FINAL: bool = <#ty as #cdr::CdrType>::KEY_FINAL;
+
+            #[inline]
+            fn encode(&self, w: &mut #cdr::CdrWriter<'_>) -> ::core::result::Result<(), #cdr::EncodeError> {
+                #enc
+            }
+
+            #[inline]
+            fn decode(r: &mut #cdr::CdrReader<'_>) -> ::core::result::Result<Self, #cdr::DecodeError> {
+                #dec.map(Self)
+            }
+
+            fn default_value() -> Self {
+                Self(<#ty as #cdr::CdrType>::default_value())
+            }
+
+            fn key_max_end(
+                start: usize,
+                version: #cdr::XcdrVersion,
+                bound: ::core::option::Option<usize>,
+            ) -> ::core::option::Option<usize> {
+                let _ = bound;
+                <#ty as #cdr::CdrType>::key_max_end(start, version, #bo)
+            }
+        }
+    })
+}
+
+/// A `bitflags` 2 struct: an unsigned integer sized by `bit_bound` (default 32) in both XCDR versions.
+pub fn derive_bitmask(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &TokenStream) -> Result<TokenStream> {
+    let cdr = quote!(#rt::cdr);
+    let name = &input.ident;
+    single_field(input, data, "bitmask")?;
+    let bit_bound = match ta.bit_bound {
+        Some((b, span)) if !(1..=64).contains(&b) => {
+            return Err(syn::Error::new(span, "a bitmask's bit_bound must be in 1..=64"));
+        }
+        Some((b, _)) => b,
+        None => 32,
+    };
+    let (size, write, read): (u8, TokenStream, TokenStream) = if bit_bound <= 8 {
+        (1, quote!(w.write_u8(v as u8)), quote!(u64::from(r.read_u8("bitmask")?)))
+    } else if bit_bound <= 16 {
+        (2, quote!(w.write_u16(v as u16)), quote!(u64::from(r.read_u16("bitmask")?)))
+    } else if bit_bound <= 32 {
+        (4, quote!(w.write_u32(v as u32)), quote!(u64::from(r.read_u32("bitmask")?)))
+    } else {
+        (8, quote!(w.write_u64(v)), quote!(r.read_u64("bitmask")?))
+    };
+    let size_usize = size as usize;
+    let type_name = ta.name.clone().unwrap_or_else(|| name.to_string());
+    let bf = quote!(#rt::__private::bitflags::Flags);
+    let attrs = impl_attrs();
+    Ok(quote! {
+        #attrs
+        impl #cdr::CdrType for #name {
+            const LAYOUT: #cdr::Layout = #cdr::Layout::Enumerated(#size);
+            const MIN_SIZE: usize = #size_usize;
+
+            #[inline]
+            fn encode(&self, w: &mut #cdr::CdrWriter<'_>) -> ::core::result::Result<(), #cdr::EncodeError> {
+                let v: u64 = ::core::convert::Into::<u64>::into(<Self as #bf>::bits(self));
+                #write;
+                ::core::result::Result::Ok(())
+            }
+
+            #[inline]
+            fn decode(r: &mut #cdr::CdrReader<'_>) -> ::core::result::Result<Self, #cdr::DecodeError> {
+                let at = r.offset();
+                let v: u64 = #read;
+                match ::core::convert::TryFrom::try_from(v) {
+                    ::core::result::Result::Ok(bits) => ::core::result::Result::Ok(<Self as #bf>::from_bits_retain(bits)),
+                    ::core::result::Result::Err(_) => ::core::result::Result::Err(#cdr::DecodeError::new(
+                        at,
+                        concat!("bits of ", #type_name),
+                        #cdr::DecodeErrorKind::InvalidValue { found: v },
+                    )),
+                }
+            }
+
+            fn default_value() -> Self {
+                <Self as #bf>::empty()
+            }
+
+            fn key_max_end(
+                start: usize,
+                version: #cdr::XcdrVersion,
+                _bound: ::core::option::Option<usize>,
+            ) -> ::core::option::Option<usize> {
+                ::core::option::Option::Some(#cdr::members::prim_end(start, #size_usize, version))
+            }
+        }
+
+        #attrs
+        impl #cdr::DdsType for #name {
+            const TYPE_NAME: &'static str = #type_name;
+            const EXTENSIBILITY: #cdr::Extensibility = #cdr::Extensibility::Final;
+            const IS_KEYED: bool = false;
+
+            fn type_descriptor() -> #cdr::TypeDescriptor {
+                #cdr::TypeDescriptor {
+                    type_name: #type_name,
+                    extensibility: #cdr::Extensibility::Final,
+                    members: &[],
+                }
+            }
+        }
+    })
+}

@@ -1,0 +1,413 @@
+//! `CdrType` for strings, sequences (`Vec`), arrays, maps and `Box`.
+
+use std::collections::BTreeMap;
+
+use super::error::{DecodeError, DecodeErrorKind, EncodeError};
+use super::header::XcdrVersion;
+use super::reader::CdrReader;
+use super::traits::{CdrType, Layout};
+use super::writer::CdrWriter;
+
+/// Stops key-size scans of recursive types: past this the key is hashed anyway.
+const KEY_SCAN_LIMIT: usize = 64;
+
+#[inline]
+const fn align4(p: usize) -> usize {
+    (p + 3) & !3
+}
+
+fn check_bound(what: &'static str, len: usize, bound: usize) -> Result<(), EncodeError> {
+    if len > bound {
+        Err(EncodeError::BoundExceeded { what, bound, len })
+    } else {
+        Ok(())
+    }
+}
+
+fn bound_error(r: &CdrReader<'_>, at: usize, expected: &'static str, len: usize, bound: usize) -> DecodeError {
+    let _ = r;
+    DecodeError::new(at, expected, DecodeErrorKind::BoundExceeded { bound, len })
+}
+
+/// Encodes a string body (length with NUL, bytes, NUL); shared by `String` and `BoundedString`.
+pub(crate) fn encode_str(s: &str, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
+    check_bound("string", s.len(), bound)?;
+    if let Some(i) = s.bytes().position(|b| b == 0) {
+        return Err(EncodeError::InvalidValue {
+            what: "NUL inside a string",
+            value: i as u64,
+        });
+    }
+    w.write_len(s.len() + 1, "string length")?;
+    w.write_bytes(s.as_bytes());
+    w.write_u8(0);
+    Ok(())
+}
+
+/// Decodes a string body with one allocation.
+pub(crate) fn decode_str(r: &mut CdrReader<'_>, bound: usize) -> Result<String, DecodeError> {
+    let at = r.offset();
+    let n = r.read_count(1, "string length")?;
+    if n == 0 {
+        // Some implementations send an empty string as length 0.
+        return Ok(String::new());
+    }
+    if n - 1 > bound {
+        return Err(bound_error(r, at, "string within its bound", n - 1, bound));
+    }
+    let body_at = r.offset();
+    let bytes = r.read_bytes(n, "string characters")?;
+    let (text, nul) = bytes.split_at(n - 1);
+    if nul[0] != 0 || text.contains(&0) {
+        return Err(DecodeError::new(
+            body_at,
+            "NUL-terminated string",
+            DecodeErrorKind::MalformedString,
+        ));
+    }
+    match std::str::from_utf8(text) {
+        Ok(s) => Ok(s.to_owned()),
+        Err(e) => Err(DecodeError::new(
+            body_at + e.valid_up_to(),
+            "UTF-8 string",
+            DecodeErrorKind::MalformedString,
+        )),
+    }
+}
+
+pub(crate) fn string_key_max_end(start: usize, bound: Option<usize>) -> Option<usize> {
+    bound.map(|b| align4(start) + 4 + b + 1)
+}
+
+impl CdrType for String {
+    const LAYOUT: Layout = Layout::String;
+    const MIN_SIZE: usize = 4;
+
+    #[inline]
+    fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
+        encode_str(self, w, usize::MAX)
+    }
+
+    #[inline]
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, DecodeError> {
+        decode_str(r, usize::MAX)
+    }
+
+    fn default_value() -> Self {
+        String::new()
+    }
+
+    fn encode_bounded(&self, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
+        encode_str(self, w, bound)
+    }
+
+    fn decode_bounded(r: &mut CdrReader<'_>, bound: usize) -> Result<Self, DecodeError> {
+        decode_str(r, bound)
+    }
+
+    fn key_max_end(start: usize, _version: XcdrVersion, bound: Option<usize>) -> Option<usize> {
+        string_key_max_end(start, bound)
+    }
+}
+
+/// Encodes a sequence body; shared by `Vec` and `BoundedSeq`.
+pub(crate) fn encode_seq<T: CdrType>(items: &[T], w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
+    check_bound("sequence", items.len(), bound)?;
+    if !T::LAYOUT.is_primitive() && w.is_xcdr2() {
+        w.enter()?;
+        let slot = w.begin_length();
+        w.write_len(items.len(), "sequence length")?;
+        T::encode_slice(items, w)?;
+        w.leave();
+        w.end_length(slot)
+    } else {
+        w.write_len(items.len(), "sequence length")?;
+        T::encode_slice(items, w)
+    }
+}
+
+/// Capacity to reserve for `n` elements: never more memory than a small multiple of the input left.
+fn capacity_for<T>(n: usize, remaining: usize) -> usize {
+    let elem = std::mem::size_of::<T>().max(1);
+    n.min((remaining.saturating_mul(8) / elem).max(16))
+}
+
+/// Decodes a sequence body; shared by `Vec` and `BoundedSeq`.
+pub(crate) fn decode_seq<T: CdrType>(r: &mut CdrReader<'_>, bound: usize) -> Result<Vec<T>, DecodeError> {
+    let limit = if !T::LAYOUT.is_primitive() && r.is_xcdr2() {
+        r.enter("sequence")?;
+        let len = r.read_u32("sequence DHEADER")? as usize;
+        Some(r.begin_limit(len, "sequence DHEADER")?)
+    } else {
+        None
+    };
+    let at = r.offset();
+    let n = r.read_count(T::MIN_SIZE, "sequence length")?;
+    if n > bound {
+        return Err(bound_error(r, at, "sequence within its bound", n, bound));
+    }
+    let mut v = Vec::with_capacity(capacity_for::<T>(n, r.remaining()));
+    T::decode_into(&mut v, n, r)?;
+    if let Some(l) = limit {
+        r.end_limit(l);
+        r.leave();
+    }
+    Ok(v)
+}
+
+pub(crate) fn seq_key_max_end<T: CdrType>(start: usize, version: XcdrVersion, bound: Option<usize>) -> Option<usize> {
+    let bound = bound?;
+    if start > KEY_SCAN_LIMIT || bound > KEY_SCAN_LIMIT {
+        return None;
+    }
+    let mut p = align4(start);
+    if !T::LAYOUT.is_primitive() && version == XcdrVersion::Xcdr2 {
+        p += 4;
+    }
+    p += 4;
+    for _ in 0..bound {
+        p = T::key_max_end(p, version, None)?;
+        if p > KEY_SCAN_LIMIT {
+            return None;
+        }
+    }
+    Some(p)
+}
+
+impl<T: CdrType> CdrType for Vec<T> {
+    const LAYOUT: Layout = match T::LAYOUT {
+        Layout::Primitive(n) => Layout::PrimitiveSequence(n),
+        _ => Layout::Delimited,
+    };
+    const MIN_SIZE: usize = 4;
+    const XCDR1_PLAIN: bool = T::XCDR1_PLAIN;
+    const KEY_FINAL: bool = T::KEY_FINAL;
+
+    #[inline]
+    fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
+        encode_seq(self, w, usize::MAX)
+    }
+
+    #[inline]
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, DecodeError> {
+        decode_seq(r, usize::MAX)
+    }
+
+    fn default_value() -> Self {
+        Vec::new()
+    }
+
+    fn encode_bounded(&self, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
+        encode_seq(self, w, bound)
+    }
+
+    fn decode_bounded(r: &mut CdrReader<'_>, bound: usize) -> Result<Self, DecodeError> {
+        decode_seq(r, bound)
+    }
+
+    fn key_max_end(start: usize, version: XcdrVersion, bound: Option<usize>) -> Option<usize> {
+        seq_key_max_end::<T>(start, version, bound)
+    }
+}
+
+impl<T: CdrType, const N: usize> CdrType for [T; N] {
+    const LAYOUT: Layout = match T::LAYOUT {
+        Layout::Primitive(_) | Layout::PrimitiveArray => Layout::PrimitiveArray,
+        _ => Layout::DelimitedArray,
+    };
+    const MIN_SIZE: usize = {
+        let m = T::MIN_SIZE.saturating_mul(N);
+        if m == 0 {
+            1
+        } else {
+            m
+        }
+    };
+    const XCDR1_PLAIN: bool = T::XCDR1_PLAIN;
+    const KEY_FINAL: bool = T::KEY_FINAL;
+
+    fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
+        if matches!(Self::LAYOUT, Layout::DelimitedArray) && w.is_xcdr2() {
+            w.enter()?;
+            let slot = w.begin_length();
+            self.encode_flat(w)?;
+            w.leave();
+            w.end_length(slot)
+        } else {
+            self.encode_flat(w)
+        }
+    }
+
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, DecodeError> {
+        if matches!(Self::LAYOUT, Layout::DelimitedArray) && r.is_xcdr2() {
+            r.enter("array")?;
+            let len = r.read_u32("array DHEADER")? as usize;
+            let l = r.begin_limit(len, "array DHEADER")?;
+            let v = Self::decode_flat(r)?;
+            r.end_limit(l);
+            r.leave();
+            Ok(v)
+        } else {
+            Self::decode_flat(r)
+        }
+    }
+
+    fn encode_flat(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
+        if T::LAYOUT.is_array() {
+            for x in self {
+                x.encode_flat(w)?;
+            }
+            Ok(())
+        } else {
+            T::encode_slice(self, w)
+        }
+    }
+
+    fn decode_flat(r: &mut CdrReader<'_>) -> Result<Self, DecodeError> {
+        if T::LAYOUT.is_array() {
+            let mut err = None;
+            let arr = std::array::from_fn(|_| {
+                if err.is_none() {
+                    match T::decode_flat(r) {
+                        Ok(v) => return v,
+                        Err(e) => err = Some(e),
+                    }
+                }
+                T::default_value()
+            });
+            match err {
+                None => Ok(arr),
+                Some(e) => Err(e),
+            }
+        } else {
+            T::decode_array::<N>(r)
+        }
+    }
+
+    fn default_value() -> Self {
+        std::array::from_fn(|_| T::default_value())
+    }
+
+    fn key_max_end(start: usize, version: XcdrVersion, _bound: Option<usize>) -> Option<usize> {
+        if start > KEY_SCAN_LIMIT || N > KEY_SCAN_LIMIT {
+            return None;
+        }
+        let mut p = start;
+        if matches!(Self::LAYOUT, Layout::DelimitedArray) && version == XcdrVersion::Xcdr2 {
+            p = align4(p) + 4;
+        }
+        for _ in 0..N {
+            p = T::key_max_end(p, version, None)?;
+            if p > KEY_SCAN_LIMIT {
+                return None;
+            }
+        }
+        Some(p)
+    }
+}
+
+impl<K: CdrType + Ord, V: CdrType> CdrType for BTreeMap<K, V> {
+    const LAYOUT: Layout = if K::LAYOUT.is_primitive() && V::LAYOUT.is_primitive() {
+        Layout::Other
+    } else {
+        Layout::Delimited
+    };
+    const MIN_SIZE: usize = 4;
+    const XCDR1_PLAIN: bool = K::XCDR1_PLAIN && V::XCDR1_PLAIN;
+    const KEY_FINAL: bool = K::KEY_FINAL && V::KEY_FINAL;
+
+    fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
+        self.encode_bounded(w, usize::MAX)
+    }
+
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, DecodeError> {
+        Self::decode_bounded(r, usize::MAX)
+    }
+
+    fn default_value() -> Self {
+        BTreeMap::new()
+    }
+
+    fn encode_bounded(&self, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
+        check_bound("map", self.len(), bound)?;
+        let delimited = matches!(Self::LAYOUT, Layout::Delimited) && w.is_xcdr2();
+        w.enter()?;
+        let slot = if delimited { Some(w.begin_length()) } else { None };
+        w.write_len(self.len(), "map length")?;
+        for (k, v) in self {
+            k.encode(w)?;
+            v.encode(w)?;
+        }
+        w.leave();
+        match slot {
+            Some(s) => w.end_length(s),
+            None => Ok(()),
+        }
+    }
+
+    fn decode_bounded(r: &mut CdrReader<'_>, bound: usize) -> Result<Self, DecodeError> {
+        r.enter("map")?;
+        let limit = if matches!(Self::LAYOUT, Layout::Delimited) && r.is_xcdr2() {
+            let len = r.read_u32("map DHEADER")? as usize;
+            Some(r.begin_limit(len, "map DHEADER")?)
+        } else {
+            None
+        };
+        let at = r.offset();
+        let n = r.read_count(K::MIN_SIZE + V::MIN_SIZE, "map length")?;
+        if n > bound {
+            return Err(bound_error(r, at, "map within its bound", n, bound));
+        }
+        let mut m = BTreeMap::new();
+        for _ in 0..n {
+            let k = K::decode(r)?;
+            let v = V::decode(r)?;
+            m.insert(k, v);
+        }
+        if let Some(l) = limit {
+            r.end_limit(l);
+        }
+        r.leave();
+        Ok(m)
+    }
+
+    fn key_max_end(_start: usize, _version: XcdrVersion, _bound: Option<usize>) -> Option<usize> {
+        None
+    }
+}
+
+/// `@external` members and recursion.
+impl<T: CdrType> CdrType for Box<T> {
+    const LAYOUT: Layout = T::LAYOUT;
+    // Not delegated: a recursive type would make these constants depend on themselves.
+    const MIN_SIZE: usize = 1;
+
+    #[inline]
+    fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
+        (**self).encode(w)
+    }
+
+    #[inline]
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, DecodeError> {
+        T::decode(r).map(Box::new)
+    }
+
+    fn default_value() -> Self {
+        Box::new(T::default_value())
+    }
+
+    fn encode_bounded(&self, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
+        (**self).encode_bounded(w, bound)
+    }
+
+    fn decode_bounded(r: &mut CdrReader<'_>, bound: usize) -> Result<Self, DecodeError> {
+        T::decode_bounded(r, bound).map(Box::new)
+    }
+
+    fn key_max_end(start: usize, version: XcdrVersion, bound: Option<usize>) -> Option<usize> {
+        if start > KEY_SCAN_LIMIT {
+            return None;
+        }
+        T::key_max_end(start, version, bound)
+    }
+}

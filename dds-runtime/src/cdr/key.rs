@@ -1,0 +1,67 @@
+//! Key-only serialization, the RTPS key hash (RTPS 2.5 §9.6.4.8, XTypes 1.3 §7.6.8) and instance identity.
+
+use md5::{Digest, Md5};
+
+use super::error::{DecodeError, EncodeError};
+use super::header::{ByteOrder, EncapsulationHeader, XcdrVersion};
+use super::reader::CdrReader;
+use super::traits::DdsType;
+use super::writer::{CdrWriter, EncodeMode};
+use super::{finish_payload, start_payload};
+
+/// Appends a key-only payload (encapsulation header, then the key members in declaration order, framed as the
+/// type's extensibility requires), as carried by DATA(K) and dispose/unregister messages.
+pub fn serialize_key<T: DdsType>(
+    sample: &T,
+    version: XcdrVersion,
+    order: ByteOrder,
+    out: &mut Vec<u8>,
+) -> Result<(), EncodeError> {
+    let start = start_payload::<T>(version, order, out);
+    let r = sample.encode(&mut CdrWriter::new(out, version, order, EncodeMode::Key));
+    finish_payload(start, r, out)
+}
+
+/// Decodes a key-only payload; members that are not keys get their default values.
+pub fn deserialize_key<T: DdsType>(payload: &[u8]) -> Result<T, DecodeError> {
+    let h = EncapsulationHeader::parse(payload)?;
+    let mut r = CdrReader::new(payload, EncapsulationHeader::SIZE, h.version()?, h.byte_order(), true);
+    T::decode(&mut r)
+}
+
+/// Writes the big-endian key stream Cyclone DDS hashes: key members in member-id order (XCDR2) or declaration
+/// order (XCDR1) when every aggregate on the key path is final; otherwise the key-only encoding with its headers.
+fn key_stream<T: DdsType>(sample: &T, version: XcdrVersion, out: &mut Vec<u8>) -> Result<(), EncodeError> {
+    let mode = if T::KEY_FINAL {
+        EncodeMode::KeyHash
+    } else {
+        EncodeMode::Key
+    };
+    sample.encode(&mut CdrWriter::new(out, version, ByteOrder::BigEndian, mode))
+}
+
+/// The 16-byte key hash of `sample` for a payload of XCDR version `version` (Cyclone uses the sample's version).
+/// The key stream is zero-padded to 16 bytes when the type's maximum key size is at most 16, else hashed with
+/// MD5. Unkeyed types hash to zeros. Use it on the wire only: instance identity is [`instance_key`].
+pub fn key_hash<T: DdsType>(sample: &T, version: XcdrVersion) -> Result<[u8; 16], EncodeError> {
+    let mut h = [0u8; 16];
+    if !T::IS_KEYED {
+        return Ok(h);
+    }
+    let mut buf = Vec::with_capacity(32);
+    key_stream(sample, version, &mut buf)?;
+    match T::key_max_end(0, version, None) {
+        Some(max) if max <= 16 && buf.len() <= 16 => h[..buf.len()].copy_from_slice(&buf),
+        _ => h.copy_from_slice(&Md5::digest(&buf)),
+    }
+    Ok(h)
+}
+
+/// Appends canonical identity bytes for the instance of `sample` (the XCDR2 big-endian key stream, never
+/// hashed): equal keys give equal bytes. Appends nothing for unkeyed types.
+pub fn instance_key<T: DdsType>(sample: &T, out: &mut Vec<u8>) -> Result<(), EncodeError> {
+    if !T::IS_KEYED {
+        return Ok(());
+    }
+    key_stream(sample, XcdrVersion::Xcdr2, out)
+}

@@ -1,0 +1,784 @@
+//! The reader's history cache: instances identified by their serialized key, samples with their states,
+//! and the reader-side QoS (history, resource limits, ownership, time-based filter, lifespan, reader data
+//! lifecycle, deadline). Pure data structure: no locking, no I/O, time comes in as arguments.
+
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::time::{Duration, Instant, SystemTime};
+
+use crate::qos::{DataReaderQos, History, Ownership, INFINITE};
+
+use super::sample::{
+    InstanceHandle, InstanceState, InstanceStateMask, Sample, SampleInfo, SampleState,
+    SampleStateMask, ViewState, ViewStateMask,
+};
+use super::status::SampleRejectedReason;
+
+/// What a change does to its instance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ChangeKindLocal {
+    Alive,
+    Dispose,
+    Unregister,
+    DisposeUnregister,
+}
+
+/// One decoded change arriving from a writer.
+pub(crate) struct Incoming<T> {
+    pub writer: [u8; 16],
+    pub kind: ChangeKindLocal,
+    pub data: Option<T>,
+    /// Serialized key (`cdr::instance_key`), or the 16-byte key hash when nothing better is known.
+    pub key: Vec<u8>,
+    /// A sample holding (at least) the key values, for `get_key_value`.
+    pub key_holder: Option<T>,
+    pub source_timestamp: SystemTime,
+    pub reception_timestamp: SystemTime,
+    pub strength: i32,
+    /// When the sample expires (writer's lifespan), if known.
+    pub expires: Option<Instant>,
+}
+
+/// What happened to an incoming change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Outcome {
+    /// Stored (or the instance state changed): data is available.
+    Accepted { handle: InstanceHandle },
+    /// Dropped on purpose (filter, ownership, time-based filter, unknown instance for unregister).
+    Filtered,
+    /// Rejected by a resource limit.
+    Rejected {
+        reason: SampleRejectedReason,
+        handle: InstanceHandle,
+    },
+}
+
+struct Stored<T> {
+    data: Option<T>,
+    read: bool,
+    source_timestamp: SystemTime,
+    reception_timestamp: SystemTime,
+    writer: [u8; 16],
+    disposed_gen: u32,
+    no_writers_gen: u32,
+    seq: u64,
+    expires: Option<Instant>,
+}
+
+struct Instance<T> {
+    key: Vec<u8>,
+    key_holder: Option<T>,
+    state: InstanceState,
+    view: ViewState,
+    disposed_gen: u32,
+    no_writers_gen: u32,
+    writers: HashMap<[u8; 16], i32>,
+    owner: Option<([u8; 16], i32)>,
+    samples: VecDeque<Stored<T>>,
+    last_accepted: Option<Instant>,
+    last_data: Instant,
+    not_alive_since: Option<Instant>,
+}
+
+/// Which samples a read/take returns.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Selection {
+    pub max_samples: Option<usize>,
+    pub sample_states: SampleStateMask,
+    pub view_states: ViewStateMask,
+    pub instance_states: InstanceStateMask,
+    pub instance: Option<InstanceHandle>,
+}
+
+type Filter<T> = Box<dyn Fn(&T) -> bool + Send + Sync>;
+
+pub(crate) struct ReaderCache<T> {
+    qos: DataReaderQos,
+    keyed: bool,
+    instances: BTreeMap<InstanceHandle, Instance<T>>,
+    by_key: HashMap<Vec<u8>, InstanceHandle>,
+    next_handle: u64,
+    next_seq: u64,
+    total: usize,
+    filter: Option<Filter<T>>,
+}
+
+fn finite(d: Duration) -> Option<Duration> {
+    (d != INFINITE && d < Duration::from_secs(100 * 365 * 86400)).then_some(d)
+}
+
+impl<T> ReaderCache<T> {
+    pub fn new(qos: DataReaderQos, keyed: bool) -> Self {
+        ReaderCache {
+            qos,
+            keyed,
+            instances: BTreeMap::new(),
+            by_key: HashMap::new(),
+            next_handle: 1,
+            next_seq: 0,
+            total: 0,
+            filter: None,
+        }
+    }
+
+    pub fn set_filter(&mut self, f: Option<Filter<T>>) {
+        self.filter = f;
+    }
+
+    pub fn lookup(&self, key: &[u8]) -> Option<InstanceHandle> {
+        self.by_key.get(key).copied()
+    }
+
+    pub fn len(&self) -> usize {
+        self.total
+    }
+
+    pub fn instance_count(&self) -> usize {
+        self.instances.len()
+    }
+
+    pub fn instance_state(&self, h: InstanceHandle) -> Option<InstanceState> {
+        self.instances.get(&h).map(|i| i.state)
+    }
+
+    fn new_instance(
+        &mut self,
+        key: Vec<u8>,
+        key_holder: Option<T>,
+        now: Instant,
+    ) -> Option<InstanceHandle> {
+        if let Some(max) = self.qos.resource_limits.max_instances {
+            if self.instances.len() >= max as usize {
+                return None;
+            }
+        }
+        let h = InstanceHandle(self.next_handle);
+        self.next_handle += 1;
+        self.by_key.insert(key.clone(), h);
+        self.instances.insert(
+            h,
+            Instance {
+                key,
+                key_holder,
+                state: InstanceState::Alive,
+                view: ViewState::New,
+                disposed_gen: 0,
+                no_writers_gen: 0,
+                writers: HashMap::new(),
+                owner: None,
+                samples: VecDeque::new(),
+                last_accepted: None,
+                last_data: now,
+                not_alive_since: None,
+            },
+        );
+        Some(h)
+    }
+
+    /// Applies one change. `now` is the monotonic time of reception.
+    pub fn insert(&mut self, mut inc: Incoming<T>, now: Instant) -> Outcome {
+        let alive = inc.kind == ChangeKindLocal::Alive;
+        if alive {
+            match (&inc.data, &self.filter) {
+                (None, _) => return Outcome::Filtered,
+                (Some(d), Some(f)) if !f(d) => return Outcome::Filtered,
+                _ => {}
+            }
+        }
+        let key = if self.keyed {
+            std::mem::take(&mut inc.key)
+        } else {
+            Vec::new()
+        };
+        let handle = match self.by_key.get(&key) {
+            Some(h) => *h,
+            None if !alive && inc.kind == ChangeKindLocal::Unregister => return Outcome::Filtered,
+            None => {
+                let holder = inc.key_holder.take();
+                match self.new_instance(key, holder, now) {
+                    Some(h) => h,
+                    None => {
+                        return Outcome::Rejected {
+                            reason: SampleRejectedReason::ByInstancesLimit,
+                            handle: InstanceHandle::NIL,
+                        }
+                    }
+                }
+            }
+        };
+        let exclusive = self.qos.ownership == Ownership::Exclusive;
+        let min_sep = self.qos.time_based_filter.minimum_separation;
+        let history = self.qos.history;
+        let limits = self.qos.resource_limits;
+        let total = self.total;
+        let Some(inst) = self.instances.get_mut(&handle) else {
+            return Outcome::Filtered;
+        };
+        if inst.key_holder.is_none() {
+            inst.key_holder = inc.key_holder.take();
+        }
+
+        // Exclusive ownership: only the strongest alive writer's changes count (ties: lowest GUID).
+        if exclusive {
+            inst.writers.insert(inc.writer, inc.strength);
+            let owner_ok = match inst.owner {
+                None => true,
+                Some((g, _)) if g == inc.writer => true,
+                Some((g, s)) => {
+                    !inst.writers.contains_key(&g)
+                        || inc.strength > s
+                        || (inc.strength == s && inc.writer < g)
+                }
+            };
+            if !owner_ok {
+                if matches!(
+                    inc.kind,
+                    ChangeKindLocal::Unregister | ChangeKindLocal::DisposeUnregister
+                ) {
+                    inst.writers.remove(&inc.writer);
+                }
+                return Outcome::Filtered;
+            }
+            inst.owner = Some((inc.writer, inc.strength));
+        }
+
+        if alive {
+            if !min_sep.is_zero() {
+                if let Some(t) = inst.last_accepted {
+                    if now.saturating_duration_since(t) < min_sep {
+                        return Outcome::Filtered;
+                    }
+                }
+            }
+            let per_instance = inst.samples.len();
+            if let History::KeepAll = history {
+                if limits
+                    .max_samples_per_instance
+                    .is_some_and(|m| per_instance >= m as usize)
+                {
+                    return Outcome::Rejected {
+                        reason: SampleRejectedReason::BySamplesPerInstanceLimit,
+                        handle,
+                    };
+                }
+            }
+            let evict =
+                matches!(history, History::KeepLast(d) if per_instance >= d.max(1) as usize);
+            if !evict && limits.max_samples.is_some_and(|m| total >= m as usize) {
+                return Outcome::Rejected {
+                    reason: SampleRejectedReason::BySamplesLimit,
+                    handle,
+                };
+            }
+            match inst.state {
+                InstanceState::Alive => {}
+                InstanceState::NotAliveDisposed => {
+                    inst.disposed_gen += 1;
+                    inst.view = ViewState::New;
+                }
+                InstanceState::NotAliveNoWriters => {
+                    inst.no_writers_gen += 1;
+                    inst.view = ViewState::New;
+                }
+            }
+            inst.state = InstanceState::Alive;
+            inst.not_alive_since = None;
+            inst.writers.insert(inc.writer, inc.strength);
+            inst.last_accepted = Some(now);
+            inst.last_data = now;
+            if evict {
+                if let Some(old) = inst.samples.pop_front() {
+                    drop(old);
+                    self.total -= 1;
+                }
+            }
+            let seq = self.next_seq;
+            self.next_seq += 1;
+            inst.samples.push_back(Stored {
+                data: inc.data,
+                read: false,
+                source_timestamp: inc.source_timestamp,
+                reception_timestamp: inc.reception_timestamp,
+                writer: inc.writer,
+                disposed_gen: inst.disposed_gen,
+                no_writers_gen: inst.no_writers_gen,
+                seq,
+                expires: inc.expires,
+            });
+            self.total += 1;
+            return Outcome::Accepted { handle };
+        }
+
+        // Dispose / unregister: a state change; visible through an invalid sample when no unread sample
+        // of the instance can carry it.
+        let before = inst.state;
+        if matches!(
+            inc.kind,
+            ChangeKindLocal::Dispose | ChangeKindLocal::DisposeUnregister
+        ) {
+            if inst.state == InstanceState::NotAliveNoWriters {
+                inst.no_writers_gen += 1;
+            }
+            inst.state = InstanceState::NotAliveDisposed;
+        }
+        if matches!(
+            inc.kind,
+            ChangeKindLocal::Unregister | ChangeKindLocal::DisposeUnregister
+        ) {
+            inst.writers.remove(&inc.writer);
+            if inst.owner.is_some_and(|(g, _)| g == inc.writer) {
+                inst.owner = None;
+            }
+            if inst.writers.is_empty() && inst.state == InstanceState::Alive {
+                inst.state = InstanceState::NotAliveNoWriters;
+            }
+        }
+        if inst.state == before {
+            return Outcome::Filtered;
+        }
+        inst.not_alive_since = Some(now);
+        let has_unread = inst.samples.iter().any(|s| !s.read);
+        if !has_unread {
+            let seq = self.next_seq;
+            self.next_seq += 1;
+            inst.samples.push_back(Stored {
+                data: None,
+                read: false,
+                source_timestamp: inc.source_timestamp,
+                reception_timestamp: inc.reception_timestamp,
+                writer: inc.writer,
+                disposed_gen: inst.disposed_gen,
+                no_writers_gen: inst.no_writers_gen,
+                seq,
+                expires: None,
+            });
+            self.total += 1;
+        }
+        Outcome::Accepted { handle }
+    }
+
+    /// A writer is gone (unmatched or lost): its instances lose it as if it had unregistered them.
+    /// Returns whether any instance changed state.
+    pub fn writer_gone(&mut self, writer: [u8; 16], now: Instant) -> bool {
+        let handles: Vec<InstanceHandle> = self
+            .instances
+            .iter()
+            .filter(|(_, i)| i.writers.contains_key(&writer))
+            .map(|(h, _)| *h)
+            .collect();
+        let mut changed = false;
+        for h in handles {
+            let Some(inst) = self.instances.get(&h) else {
+                continue;
+            };
+            let key = inst.key.clone();
+            let inc = Incoming {
+                writer,
+                kind: ChangeKindLocal::Unregister,
+                data: None,
+                key,
+                key_holder: None,
+                source_timestamp: SystemTime::now(),
+                reception_timestamp: SystemTime::now(),
+                strength: i32::MIN,
+                expires: None,
+            };
+            if let Outcome::Accepted { .. } = self.insert(inc, now) {
+                changed = true;
+            }
+        }
+        changed
+    }
+
+    fn matches(inst: &Instance<T>, s: &Stored<T>, sel: &Selection) -> bool {
+        sel.sample_states.contains(if s.read {
+            SampleState::Read
+        } else {
+            SampleState::NotRead
+        }) && sel.view_states.contains(inst.view)
+            && sel.instance_states.contains(inst.state)
+    }
+
+    /// Whether some sample matches the masks (ReadCondition trigger, DATA_AVAILABLE).
+    pub fn has_matching(&self, sel: &Selection) -> bool {
+        self.instances
+            .values()
+            .any(|i| i.samples.iter().any(|s| Self::matches(i, s, sel)))
+    }
+
+    /// The smallest instance handle above `prev` that has a matching sample.
+    pub fn next_instance(&self, prev: InstanceHandle, sel: &Selection) -> Option<InstanceHandle> {
+        use std::ops::Bound::{Excluded, Unbounded};
+        self.instances
+            .range((Excluded(prev), Unbounded))
+            .find(|(_, i)| i.samples.iter().any(|s| Self::matches(i, s, sel)))
+            .map(|(h, _)| *h)
+    }
+
+    /// Reads (`take == false`, data cloned by `copy`) or takes the selected samples, in reception order.
+    pub fn collect(
+        &mut self,
+        sel: &Selection,
+        take: bool,
+        copy: Option<fn(&T) -> T>,
+    ) -> Vec<Sample<T>> {
+        let limit = sel.max_samples.unwrap_or(usize::MAX);
+        // (seq, handle, index in instance)
+        let mut picked: Vec<(u64, InstanceHandle, usize)> = Vec::new();
+        let range: Box<dyn Iterator<Item = (&InstanceHandle, &Instance<T>)>> = match sel.instance {
+            Some(h) => Box::new(self.instances.range(h..=h)),
+            None => Box::new(self.instances.iter()),
+        };
+        for (h, inst) in range {
+            for (i, s) in inst.samples.iter().enumerate() {
+                if Self::matches(inst, s, sel) {
+                    picked.push((s.seq, *h, i));
+                }
+            }
+        }
+        picked.sort_unstable_by_key(|p| p.0);
+        picked.truncate(limit);
+
+        // Ranks need, per instance, the samples that are in the collection.
+        let mut per_instance: HashMap<InstanceHandle, Vec<usize>> = HashMap::new();
+        for (pos, (_, h, _)) in picked.iter().enumerate() {
+            per_instance.entry(*h).or_default().push(pos);
+        }
+        let mut out: Vec<Option<Sample<T>>> = Vec::with_capacity(picked.len());
+        for (pos, &(_, h, idx)) in picked.iter().enumerate() {
+            let Some(inst) = self.instances.get_mut(&h) else {
+                continue;
+            };
+            let positions = &per_instance[&h];
+            let my_rank_pos = positions.iter().position(|p| *p == pos).unwrap_or(0);
+            let sample_rank = (positions.len() - 1 - my_rank_pos) as u32;
+            let last_idx = picked[*positions.last().unwrap_or(&pos)].2;
+            let (mrs_dg, mrs_nw) = inst
+                .samples
+                .get(last_idx)
+                .map(|s| (s.disposed_gen, s.no_writers_gen))
+                .unwrap_or((0, 0));
+            let s = &mut inst.samples[idx];
+            let gen = s.disposed_gen + s.no_writers_gen;
+            let info = SampleInfo {
+                sample_state: if s.read {
+                    SampleState::Read
+                } else {
+                    SampleState::NotRead
+                },
+                view_state: inst.view,
+                instance_state: inst.state,
+                source_timestamp: s.source_timestamp,
+                reception_timestamp: s.reception_timestamp,
+                instance_handle: h,
+                publication_handle: InstanceHandle::from_guid_bytes(&s.writer),
+                publication_guid: s.writer,
+                disposed_generation_count: s.disposed_gen,
+                no_writers_generation_count: s.no_writers_gen,
+                sample_rank,
+                generation_rank: (mrs_dg + mrs_nw).saturating_sub(gen),
+                absolute_generation_rank: (inst.disposed_gen + inst.no_writers_gen)
+                    .saturating_sub(gen),
+                valid_data: s.data.is_some(),
+            };
+            let data = match (take, copy) {
+                (true, _) => s.data.take(),
+                (false, Some(f)) => s.data.as_ref().map(f),
+                (false, None) => None,
+            };
+            s.read = true;
+            out.push(Some(Sample { data, info }));
+        }
+        // View state becomes NOT_NEW for every instance touched.
+        for h in per_instance.keys() {
+            if let Some(inst) = self.instances.get_mut(h) {
+                inst.view = ViewState::NotNew;
+            }
+        }
+        if take {
+            let mut removed = 0;
+            for h in per_instance.keys() {
+                let Some(inst) = self.instances.get_mut(h) else {
+                    continue;
+                };
+                let mut idxs: Vec<usize> =
+                    picked.iter().filter(|p| p.1 == *h).map(|p| p.2).collect();
+                idxs.sort_unstable_by(|a, b| b.cmp(a));
+                for i in idxs {
+                    inst.samples.remove(i);
+                    removed += 1;
+                }
+            }
+            self.total -= removed;
+            let hs: Vec<InstanceHandle> = per_instance.keys().copied().collect();
+            for h in hs {
+                self.maybe_drop_instance(h);
+            }
+        }
+        out.into_iter().flatten().collect()
+    }
+
+    /// An instance with no samples, no writers and not alive is forgotten.
+    fn maybe_drop_instance(&mut self, h: InstanceHandle) {
+        let drop_it = self.instances.get(&h).is_some_and(|i| {
+            i.samples.is_empty() && i.writers.is_empty() && i.state != InstanceState::Alive
+        });
+        if drop_it {
+            if let Some(i) = self.instances.remove(&h) {
+                self.by_key.remove(&i.key);
+            }
+        }
+    }
+
+    /// Time-driven QoS: lifespan expiry, autopurge, deadline. Returns the instances whose deadline was missed.
+    pub fn tick(&mut self, now: Instant) -> Vec<InstanceHandle> {
+        let lc = self.qos.reader_data_lifecycle;
+        let nowriter = finite(lc.autopurge_nowriter_samples_delay);
+        let disposed = finite(lc.autopurge_disposed_samples_delay);
+        let deadline = finite(self.qos.deadline.0);
+        let mut missed = Vec::new();
+        let mut purge = Vec::new();
+        let mut removed = 0;
+        for (h, inst) in self.instances.iter_mut() {
+            let before = inst.samples.len();
+            inst.samples.retain(|s| s.expires.is_none_or(|e| e > now));
+            removed += before - inst.samples.len();
+            if let Some(since) = inst.not_alive_since {
+                let delay = match inst.state {
+                    InstanceState::NotAliveDisposed => disposed,
+                    InstanceState::NotAliveNoWriters => nowriter,
+                    InstanceState::Alive => None,
+                };
+                if delay.is_some_and(|d| now.saturating_duration_since(since) >= d) {
+                    removed += inst.samples.len();
+                    inst.samples.clear();
+                    purge.push(*h);
+                }
+            }
+            if let Some(d) = deadline {
+                if inst.state == InstanceState::Alive
+                    && now.saturating_duration_since(inst.last_data) >= d
+                {
+                    inst.last_data = now;
+                    missed.push(*h);
+                }
+            }
+        }
+        self.total -= removed;
+        for h in purge {
+            if let Some(i) = self.instances.get_mut(&h) {
+                i.writers.clear();
+            }
+            self.maybe_drop_instance(h);
+        }
+        missed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::qos::{ReaderDataLifecycle, ResourceLimits, TimeBasedFilter};
+
+    fn inc(w: u8, kind: ChangeKindLocal, key: u8, v: i32) -> Incoming<i32> {
+        Incoming {
+            writer: [w; 16],
+            kind,
+            data: (kind == ChangeKindLocal::Alive).then_some(v),
+            key: vec![key],
+            key_holder: None,
+            source_timestamp: SystemTime::now(),
+            reception_timestamp: SystemTime::now(),
+            strength: i32::from(w),
+            expires: None,
+        }
+    }
+
+    fn cp(x: &i32) -> i32 {
+        *x
+    }
+    const CP: Option<fn(&i32) -> i32> = Some(cp);
+
+    fn all() -> Selection {
+        Selection::default()
+    }
+
+    #[test]
+    fn keep_last_per_instance_and_states() {
+        let qos = DataReaderQos {
+            history: History::KeepLast(2),
+            ..Default::default()
+        };
+        let mut c = ReaderCache::new(qos, true);
+        let now = Instant::now();
+        for v in 0..5 {
+            c.insert(inc(1, ChangeKindLocal::Alive, 1, v), now);
+        }
+        c.insert(inc(1, ChangeKindLocal::Alive, 2, 100), now);
+        assert_eq!(c.len(), 3);
+        let r = c.collect(&all(), false, CP);
+        assert_eq!(
+            r.iter().map(|s| s.data.unwrap()).collect::<Vec<_>>(),
+            vec![3, 4, 100]
+        );
+        assert_eq!(r[0].info.sample_rank, 1);
+        assert_eq!(r[1].info.sample_rank, 0);
+        assert!(r.iter().all(|s| s.info.view_state == ViewState::New));
+        let r = c.collect(&all(), false, CP);
+        assert!(r.iter().all(|s| s.info.sample_state == SampleState::Read));
+        assert!(r.iter().all(|s| s.info.view_state == ViewState::NotNew));
+        // Dispose key 1: state visible on the retained samples.
+        c.insert(inc(1, ChangeKindLocal::Dispose, 1, 0), now);
+        let h1 = c.lookup(&[1]).unwrap();
+        let r = c.collect(
+            &Selection {
+                instance: Some(h1),
+                ..all()
+            },
+            true,
+            CP,
+        );
+        assert_eq!(r.len(), 3, "two read samples + invalid sample");
+        assert!(r
+            .iter()
+            .all(|s| s.info.instance_state == InstanceState::NotAliveDisposed));
+        assert!(!r[2].info.valid_data);
+        // Rebirth: new generation, view NEW again.
+        c.insert(inc(1, ChangeKindLocal::Alive, 1, 7), now);
+        let r = c.collect(
+            &Selection {
+                instance: Some(h1),
+                ..all()
+            },
+            true,
+            CP,
+        );
+        assert_eq!(r[0].info.disposed_generation_count, 1);
+        assert_eq!(r[0].info.view_state, ViewState::New);
+        // Unregister by the only writer: NOT_ALIVE_NO_WRITERS, then forgotten once taken.
+        c.insert(inc(1, ChangeKindLocal::Unregister, 1, 0), now);
+        let r = c.collect(
+            &Selection {
+                instance: Some(h1),
+                ..all()
+            },
+            true,
+            CP,
+        );
+        assert_eq!(r[0].info.instance_state, InstanceState::NotAliveNoWriters);
+        assert!(c.lookup(&[1]).is_none());
+    }
+
+    #[test]
+    fn exclusive_ownership_keeps_strongest() {
+        let qos = DataReaderQos {
+            ownership: Ownership::Exclusive,
+            history: History::KeepLast(10),
+            ..Default::default()
+        };
+        let mut c = ReaderCache::new(qos, true);
+        let now = Instant::now();
+        c.insert(inc(5, ChangeKindLocal::Alive, 1, 1), now);
+        assert_eq!(
+            c.insert(inc(2, ChangeKindLocal::Alive, 1, 2), now),
+            Outcome::Filtered
+        );
+        assert!(matches!(
+            c.insert(inc(9, ChangeKindLocal::Alive, 1, 3), now),
+            Outcome::Accepted { .. }
+        ));
+        assert_eq!(
+            c.insert(inc(5, ChangeKindLocal::Alive, 1, 4), now),
+            Outcome::Filtered
+        );
+        c.insert(inc(9, ChangeKindLocal::Unregister, 1, 0), now);
+        assert!(matches!(
+            c.insert(inc(5, ChangeKindLocal::Alive, 1, 5), now),
+            Outcome::Accepted { .. }
+        ));
+        let r: Vec<i32> = c
+            .collect(&all(), true, CP)
+            .into_iter()
+            .filter_map(|s| s.data)
+            .collect();
+        assert_eq!(r, vec![1, 3, 5]);
+    }
+
+    #[test]
+    fn limits_filter_and_autopurge() {
+        let qos = DataReaderQos {
+            history: History::KeepAll,
+            resource_limits: ResourceLimits {
+                max_samples: Some(3),
+                max_instances: Some(2),
+                max_samples_per_instance: None,
+            },
+            time_based_filter: TimeBasedFilter {
+                minimum_separation: Duration::from_millis(0),
+            },
+            reader_data_lifecycle: ReaderDataLifecycle {
+                autopurge_nowriter_samples_delay: Duration::from_millis(10),
+                autopurge_disposed_samples_delay: INFINITE,
+            },
+            ..Default::default()
+        };
+        let mut c = ReaderCache::new(qos, true);
+        let now = Instant::now();
+        c.insert(inc(1, ChangeKindLocal::Alive, 1, 1), now);
+        c.insert(inc(1, ChangeKindLocal::Alive, 2, 2), now);
+        assert!(matches!(
+            c.insert(inc(1, ChangeKindLocal::Alive, 3, 3), now),
+            Outcome::Rejected {
+                reason: SampleRejectedReason::ByInstancesLimit,
+                ..
+            }
+        ));
+        c.insert(inc(1, ChangeKindLocal::Alive, 2, 3), now);
+        assert!(matches!(
+            c.insert(inc(1, ChangeKindLocal::Alive, 2, 4), now),
+            Outcome::Rejected {
+                reason: SampleRejectedReason::BySamplesLimit,
+                ..
+            }
+        ));
+        c.set_filter(Some(Box::new(|x: &i32| *x > 10)));
+        assert_eq!(
+            c.insert(inc(1, ChangeKindLocal::Alive, 1, 5), now),
+            Outcome::Filtered
+        );
+        assert!(c.writer_gone([1; 16], now));
+        c.tick(now + Duration::from_millis(20));
+        assert_eq!(c.len(), 0);
+        assert_eq!(c.instance_count(), 0);
+    }
+
+    #[test]
+    fn time_based_filter_and_deadline() {
+        let qos = DataReaderQos {
+            history: History::KeepLast(10),
+            time_based_filter: TimeBasedFilter {
+                minimum_separation: Duration::from_millis(100),
+            },
+            deadline: crate::qos::Deadline(Duration::from_millis(50)),
+            ..Default::default()
+        };
+        let mut c = ReaderCache::new(qos, true);
+        let t0 = Instant::now();
+        c.insert(inc(1, ChangeKindLocal::Alive, 1, 1), t0);
+        assert_eq!(
+            c.insert(
+                inc(1, ChangeKindLocal::Alive, 1, 2),
+                t0 + Duration::from_millis(50)
+            ),
+            Outcome::Filtered
+        );
+        assert!(matches!(
+            c.insert(
+                inc(1, ChangeKindLocal::Alive, 1, 3),
+                t0 + Duration::from_millis(150)
+            ),
+            Outcome::Accepted { .. }
+        ));
+        assert_eq!(c.tick(t0 + Duration::from_millis(160)).len(), 0);
+        assert_eq!(c.tick(t0 + Duration::from_millis(210)).len(), 1);
+    }
+}

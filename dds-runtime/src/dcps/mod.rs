@@ -1,0 +1,54 @@
+//! The typed DCPS API (DDS 1.4 §2.2.2): [`DomainParticipant`], [`Topic`], [`Publisher`], [`Subscriber`],
+//! [`DataWriter`], [`DataReader`], conditions and waitsets, listeners and content filters.
+//!
+//! ```no_run
+//! use dds_runtime::prelude::*;
+//! # fn demo<T: DdsType + Clone>(sample: T) -> Result<(), DdsError> {
+//! let participant = DomainParticipant::builder().domain_id(0).build()?;
+//! let topic = participant.create_topic::<T>("Square", &TopicQos::default())?;
+//! let publisher = participant.create_publisher(&PublisherQos::default())?;
+//! let writer = publisher.create_datawriter(&topic, &DataWriterQos::default())?;
+//! writer.write(&sample)?;
+//! let subscriber = participant.create_subscriber(&SubscriberQos::default())?;
+//! let reader = subscriber.create_datareader(&topic, &DataReaderQos::default())?;
+//! if reader.wait_for_data(std::time::Duration::from_secs(1))? {
+//!     for s in reader.take()? {
+//!         println!("{:?} valid={}", s.info.instance_state, s.info.valid_data);
+//!     }
+//! }
+//! # Ok(()) }
+//! ```
+//!
+//! Threads: each participant runs one receive thread per socket and one timer thread. Writes send on the
+//! calling thread (the core lock is never held across a socket call). Listeners run on the receive or
+//! timer thread, with no internal lock held.
+//!
+//! Instances are identified by the serialized key ([`crate::cdr::instance_key`]), never by the key hash
+//! alone; a key-only dispose/unregister is mapped to its instance through its key payload, or through its
+//! key hash when a sample of that instance carrying the same hash was seen before.
+
+mod cache;
+pub mod condition;
+mod error;
+pub mod filter;
+pub mod listener;
+mod participant;
+mod publisher;
+pub mod sample;
+pub mod status;
+mod subscriber;
+mod topic;
+
+pub use condition::{Condition, GuardCondition, ReadCondition, StatusCondition, WaitSet};
+pub use error::{DdsError, DdsResult};
+pub use filter::{ContentFilter, FieldValue, FilterFields};
+pub use listener::{DataReaderListener, DataWriterListener};
+pub use participant::{DiscoveredParticipant, DomainParticipant, DomainParticipantBuilder};
+pub use publisher::{DataWriter, Publisher};
+pub use sample::{
+    InstanceHandle, InstanceState, InstanceStateMask, Sample, SampleInfo, SampleState,
+    SampleStateMask, ViewState, ViewStateMask,
+};
+pub use status::*;
+pub use subscriber::{DataReader, SampleStream, Selector, Subscriber};
+pub use topic::{ContentFilteredTopic, Topic, TopicDescription};

@@ -1,0 +1,184 @@
+//! Communication statuses (DDS 1.4 §2.2.4.1). Getters return the status and reset its `*_change` counts.
+
+use crate::qos::QosPolicyId;
+
+use super::sample::InstanceHandle;
+
+bitflags::bitflags! {
+    /// A set of status kinds (`StatusMask`), with the DDS bit values.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub struct StatusMask: u32 {
+        /// INCONSISTENT_TOPIC.
+        const INCONSISTENT_TOPIC = 1 << 0;
+        /// OFFERED_DEADLINE_MISSED.
+        const OFFERED_DEADLINE_MISSED = 1 << 1;
+        /// REQUESTED_DEADLINE_MISSED.
+        const REQUESTED_DEADLINE_MISSED = 1 << 2;
+        /// OFFERED_INCOMPATIBLE_QOS.
+        const OFFERED_INCOMPATIBLE_QOS = 1 << 5;
+        /// REQUESTED_INCOMPATIBLE_QOS.
+        const REQUESTED_INCOMPATIBLE_QOS = 1 << 6;
+        /// SAMPLE_LOST.
+        const SAMPLE_LOST = 1 << 7;
+        /// SAMPLE_REJECTED.
+        const SAMPLE_REJECTED = 1 << 8;
+        /// DATA_ON_READERS.
+        const DATA_ON_READERS = 1 << 9;
+        /// DATA_AVAILABLE.
+        const DATA_AVAILABLE = 1 << 10;
+        /// LIVELINESS_LOST.
+        const LIVELINESS_LOST = 1 << 11;
+        /// LIVELINESS_CHANGED.
+        const LIVELINESS_CHANGED = 1 << 12;
+        /// PUBLICATION_MATCHED.
+        const PUBLICATION_MATCHED = 1 << 13;
+        /// SUBSCRIPTION_MATCHED.
+        const SUBSCRIPTION_MATCHED = 1 << 14;
+    }
+}
+
+/// PUBLICATION_MATCHED.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct PublicationMatchedStatus {
+    /// Readers ever matched.
+    pub total_count: u32,
+    /// Change since the last get.
+    pub total_count_change: u32,
+    /// Readers matched now.
+    pub current_count: u32,
+    /// Change since the last get.
+    pub current_count_change: i32,
+    /// The reader of the last change.
+    pub last_subscription_handle: InstanceHandle,
+}
+
+/// SUBSCRIPTION_MATCHED.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SubscriptionMatchedStatus {
+    /// Writers ever matched.
+    pub total_count: u32,
+    /// Change since the last get.
+    pub total_count_change: u32,
+    /// Writers matched now.
+    pub current_count: u32,
+    /// Change since the last get.
+    pub current_count_change: i32,
+    /// The writer of the last change.
+    pub last_publication_handle: InstanceHandle,
+}
+
+/// OFFERED_INCOMPATIBLE_QOS and REQUESTED_INCOMPATIBLE_QOS.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct IncompatibleQosStatus {
+    /// Incompatible remote entities seen.
+    pub total_count: u32,
+    /// Change since the last get.
+    pub total_count_change: u32,
+    /// Policy of the last incompatibility.
+    pub last_policy_id: Option<QosPolicyId>,
+    /// Count per policy.
+    pub policies: Vec<(QosPolicyId, u32)>,
+}
+
+impl IncompatibleQosStatus {
+    pub(crate) fn record(&mut self, policy: QosPolicyId) {
+        self.total_count += 1;
+        self.total_count_change += 1;
+        self.last_policy_id = Some(policy);
+        match self.policies.iter_mut().find(|(p, _)| *p == policy) {
+            Some((_, n)) => *n += 1,
+            None => self.policies.push((policy, 1)),
+        }
+    }
+}
+
+/// OFFERED_INCOMPATIBLE_QOS.
+pub type OfferedIncompatibleQosStatus = IncompatibleQosStatus;
+/// REQUESTED_INCOMPATIBLE_QOS.
+pub type RequestedIncompatibleQosStatus = IncompatibleQosStatus;
+
+/// OFFERED_DEADLINE_MISSED and REQUESTED_DEADLINE_MISSED.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct DeadlineMissedStatus {
+    /// Missed deadlines.
+    pub total_count: u32,
+    /// Change since the last get.
+    pub total_count_change: u32,
+    /// Instance of the last miss.
+    pub last_instance_handle: InstanceHandle,
+}
+
+/// REQUESTED_DEADLINE_MISSED.
+pub type RequestedDeadlineMissedStatus = DeadlineMissedStatus;
+/// OFFERED_DEADLINE_MISSED.
+pub type OfferedDeadlineMissedStatus = DeadlineMissedStatus;
+
+/// SAMPLE_LOST.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SampleLostStatus {
+    /// Samples lost.
+    pub total_count: u32,
+    /// Change since the last get.
+    pub total_count_change: u32,
+}
+
+/// Why a sample was rejected.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum SampleRejectedReason {
+    /// Not rejected.
+    #[default]
+    NotRejected,
+    /// `max_instances` reached.
+    ByInstancesLimit,
+    /// `max_samples` reached.
+    BySamplesLimit,
+    /// `max_samples_per_instance` reached.
+    BySamplesPerInstanceLimit,
+}
+
+/// SAMPLE_REJECTED.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SampleRejectedStatus {
+    /// Samples rejected.
+    pub total_count: u32,
+    /// Change since the last get.
+    pub total_count_change: u32,
+    /// Reason of the last rejection.
+    pub last_reason: SampleRejectedReason,
+    /// Instance of the last rejection.
+    pub last_instance_handle: InstanceHandle,
+}
+
+/// LIVELINESS_CHANGED.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct LivelinessChangedStatus {
+    /// Matched writers currently alive.
+    pub alive_count: u32,
+    /// Matched writers currently not alive.
+    pub not_alive_count: u32,
+    /// Change since the last get.
+    pub alive_count_change: i32,
+    /// Change since the last get.
+    pub not_alive_count_change: i32,
+    /// Writer of the last change.
+    pub last_publication_handle: InstanceHandle,
+}
+
+/// The statuses of a data writer.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct WriterStatuses {
+    pub publication_matched: PublicationMatchedStatus,
+    pub offered_incompatible_qos: IncompatibleQosStatus,
+    pub offered_deadline_missed: DeadlineMissedStatus,
+}
+
+/// The statuses of a data reader.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ReaderStatuses {
+    pub subscription_matched: SubscriptionMatchedStatus,
+    pub requested_incompatible_qos: IncompatibleQosStatus,
+    pub requested_deadline_missed: DeadlineMissedStatus,
+    pub sample_lost: SampleLostStatus,
+    pub sample_rejected: SampleRejectedStatus,
+    pub liveliness_changed: LivelinessChangedStatus,
+}

@@ -1,0 +1,909 @@
+//! `Subscriber` and `DataReader<T>`.
+
+use std::collections::{HashMap, VecDeque};
+use std::pin::Pin;
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, Weak};
+use std::task::{Context, Poll, Waker};
+use std::time::{Duration, Instant, SystemTime};
+
+use crate::cdr::{self, DdsType};
+use crate::qos::{
+    DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos, XCDR2_DATA_REPRESENTATION,
+    XCDR_DATA_REPRESENTATION,
+};
+use crate::rtps::{ChangeKind, EntityId, Event, Guid, ReaderSpec, ReceivedSample};
+
+use super::cache::{ChangeKindLocal, Incoming, Outcome, ReaderCache, Selection};
+use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition, StatusCore};
+use super::error::{DdsError, DdsResult};
+use super::listener::DataReaderListener;
+use super::participant::{DomainParticipant, Pending, ReaderSink, Shared};
+use super::sample::{InstanceHandle, InstanceStateMask, Sample, SampleStateMask, ViewStateMask};
+use super::status::{
+    DeadlineMissedStatus, IncompatibleQosStatus, LivelinessChangedStatus, ReaderStatuses,
+    SampleLostStatus, SampleRejectedStatus, StatusMask, SubscriptionMatchedStatus,
+};
+use super::topic::{Topic, TopicDescription};
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Groups readers; carries the partition and presentation QoS.
+#[derive(Clone)]
+pub struct Subscriber {
+    participant: DomainParticipant,
+    qos: Arc<SubscriberQos>,
+}
+
+impl std::fmt::Debug for Subscriber {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Subscriber")
+            .field("qos", &self.qos)
+            .finish()
+    }
+}
+
+/// Most key hashes remembered per reader for mapping key-hash-only disposes to instances.
+const MAX_REMEMBERED_HASHES: usize = 65536;
+
+impl Subscriber {
+    pub(crate) fn new(participant: DomainParticipant, qos: SubscriberQos) -> Self {
+        Subscriber {
+            participant,
+            qos: Arc::new(qos),
+        }
+    }
+
+    /// The subscriber QoS.
+    pub fn qos(&self) -> &SubscriberQos {
+        &self.qos
+    }
+
+    /// The participant.
+    pub fn participant(&self) -> &DomainParticipant {
+        &self.participant
+    }
+
+    /// Creates a reader on a topic or content-filtered topic. An empty `data_representation` accepts XCDR1
+    /// and XCDR2.
+    pub fn create_datareader<T: DdsType, D: TopicDescription<T>>(
+        &self,
+        topic: &D,
+        qos: &DataReaderQos,
+    ) -> DdsResult<DataReader<T>> {
+        let shared = self.participant.shared.clone();
+        shared.check_alive()?;
+        let mut rq = qos.clone();
+        if rq.data_representation.0.is_empty() {
+            rq.data_representation =
+                DataRepresentation(vec![XCDR_DATA_REPRESENTATION, XCDR2_DATA_REPRESENTATION]);
+        }
+        if let crate::qos::History::KeepLast(0) = rq.history {
+            return Err(DdsError::BadParameter("history depth 0".into()));
+        }
+        let t = topic.topic();
+        let spec = ReaderSpec {
+            topic_name: t.name().to_string(),
+            type_name: T::TYPE_NAME.to_string(),
+            keyed: T::IS_KEYED,
+            qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
+            type_information: None,
+            entity_name: None,
+        };
+        let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
+        cache.set_filter(topic.sample_filter());
+        let inner = Arc::new(ReaderInner::<T> {
+            shared: shared.clone(),
+            id: Mutex::new(EntityId::UNKNOWN),
+            pending: Mutex::new(VecDeque::new()),
+            cache: Mutex::new(CacheState {
+                cache,
+                by_hash: HashMap::new(),
+            }),
+            data_cv: Condvar::new(),
+            wakers: Mutex::new(Vec::new()),
+            statuses: Mutex::new(ReaderStatuses::default()),
+            status_core: Arc::new(StatusCore::default()),
+            data_signal: Signal::default(),
+            listener: Mutex::new(None),
+            matched: Mutex::new(Vec::new()),
+            handle: Mutex::new(Weak::new()),
+        });
+        let sink: Arc<dyn ReaderSink> = inner.clone();
+        let id = shared.with_core(|c, now| {
+            let id = c.create_reader(now, spec)?;
+            *lock(&inner.id) = id;
+            shared.register_reader(id, sink);
+            Ok::<_, crate::rtps::CoreError>(id)
+        });
+        let id = id.map_err(|e| DdsError::Core(e.to_string()))?;
+        let handle = Arc::new(ReaderHandle {
+            participant: self.participant.clone(),
+            topic: t.clone(),
+            subscriber: self.clone(),
+            id,
+        });
+        *lock(&inner.handle) = Arc::downgrade(&handle);
+        tracing::info!(
+            topic = t.name(),
+            type_name = T::TYPE_NAME,
+            ?id,
+            "reader created"
+        );
+        Ok(DataReader { inner, handle })
+    }
+}
+
+struct CacheState<T> {
+    cache: ReaderCache<T>,
+    /// Key hash → serialized key, learnt from samples that carried both (for key-hash-only disposes).
+    by_hash: HashMap<[u8; 16], Vec<u8>>,
+}
+
+struct ReaderInner<T: DdsType> {
+    shared: Arc<Shared>,
+    id: Mutex<EntityId>,
+    pending: Mutex<VecDeque<Pending>>,
+    cache: Mutex<CacheState<T>>,
+    data_cv: Condvar,
+    wakers: Mutex<Vec<Waker>>,
+    statuses: Mutex<ReaderStatuses>,
+    status_core: Arc<StatusCore>,
+    data_signal: Signal,
+    listener: Mutex<Option<Arc<dyn DataReaderListener<T>>>>,
+    matched: Mutex<Vec<Guid>>,
+    handle: Mutex<Weak<ReaderHandle<T>>>,
+}
+
+struct ReaderHandle<T: DdsType> {
+    participant: DomainParticipant,
+    topic: Topic<T>,
+    subscriber: Subscriber,
+    id: EntityId,
+}
+
+impl<T: DdsType> Drop for ReaderHandle<T> {
+    fn drop(&mut self) {
+        let shared = &self.participant.shared;
+        shared.unregister_reader(self.id);
+        if shared.check_alive().is_ok() {
+            let id = self.id;
+            shared.with_core(|c, now| c.delete_reader(now, id));
+        }
+        tracing::debug!(id = ?self.id, "reader deleted");
+    }
+}
+
+/// Reads samples of type `T`. Cheap to clone; the reader is deleted when the last clone (and the last
+/// stream) is dropped.
+///
+/// Reader-side QoS enforced here: history (KEEP_LAST depth per instance, KEEP_ALL), resource limits
+/// (max_samples, max_instances, max_samples_per_instance), exclusive ownership (strongest writer, ties to
+/// the lowest GUID), time-based filter (per instance, no delayed delivery of the last filtered sample),
+/// reader data lifecycle (both autopurge delays), lifespan (from the writer's announced lifespan, counted
+/// from reception rather than the source timestamp), requested deadline missed (checked every 50 ms).
+/// Not enforced: destination order by source timestamp (reception order is used), presentation
+/// (coherent/ordered access), liveliness kinds other than what the core reports.
+pub struct DataReader<T: DdsType> {
+    inner: Arc<ReaderInner<T>>,
+    handle: Arc<ReaderHandle<T>>,
+}
+
+impl<T: DdsType> Clone for DataReader<T> {
+    fn clone(&self) -> Self {
+        DataReader {
+            inner: self.inner.clone(),
+            handle: self.handle.clone(),
+        }
+    }
+}
+
+impl<T: DdsType> std::fmt::Debug for DataReader<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DataReader")
+            .field("topic", &self.handle.topic.name())
+            .field("id", &self.handle.id)
+            .finish()
+    }
+}
+
+/// Chooses samples for a read or take: `reader.select().max_samples(10).instance_state(..).take()`.
+pub struct Selector<'a, T: DdsType> {
+    reader: &'a DataReader<T>,
+    sel: Selection,
+    next_after: Option<InstanceHandle>,
+}
+
+impl<'a, T: DdsType> Selector<'a, T> {
+    /// At most `n` samples.
+    pub fn max_samples(mut self, n: usize) -> Self {
+        self.sel.max_samples = Some(n);
+        self
+    }
+    /// Only samples in these sample states.
+    pub fn sample_state(mut self, m: SampleStateMask) -> Self {
+        self.sel.sample_states = m;
+        self
+    }
+    /// Only instances in these view states.
+    pub fn view_state(mut self, m: ViewStateMask) -> Self {
+        self.sel.view_states = m;
+        self
+    }
+    /// Only instances in these instance states.
+    pub fn instance_state(mut self, m: InstanceStateMask) -> Self {
+        self.sel.instance_states = m;
+        self
+    }
+    /// Only this instance.
+    pub fn instance(mut self, h: InstanceHandle) -> Self {
+        self.sel.instance = Some(h);
+        self
+    }
+    /// Only the next instance after `prev` (in handle order) that has matching samples.
+    pub fn next_instance(mut self, prev: InstanceHandle) -> Self {
+        self.next_after = Some(prev);
+        self
+    }
+    /// Takes the selected samples.
+    pub fn take(self) -> DdsResult<Vec<Sample<T>>> {
+        self.reader.collect(self.sel, self.next_after, true, None)
+    }
+    /// Reads (copies) the selected samples.
+    pub fn read(self) -> DdsResult<Vec<Sample<T>>>
+    where
+        T: Clone,
+    {
+        self.reader
+            .collect(self.sel, self.next_after, false, Some(T::clone))
+    }
+}
+
+impl<T: DdsType> DataReader<T> {
+    fn collect(
+        &self,
+        mut sel: Selection,
+        next_after: Option<InstanceHandle>,
+        take: bool,
+        copy: Option<fn(&T) -> T>,
+    ) -> DdsResult<Vec<Sample<T>>> {
+        self.inner.shared.check_alive()?;
+        let out = {
+            let mut st = lock(&self.inner.cache);
+            if let Some(prev) = next_after {
+                sel.instance = None;
+                match st.cache.next_instance(prev, &sel) {
+                    Some(h) => sel.instance = Some(h),
+                    None => return Ok(Vec::new()),
+                }
+            }
+            let out = st.cache.collect(&sel, take, copy);
+            let unread = Selection {
+                sample_states: SampleStateMask::NOT_READ,
+                ..Selection::default()
+            };
+            if !st.cache.has_matching(&unread) {
+                self.inner.status_core.clear(StatusMask::DATA_AVAILABLE);
+            }
+            out
+        };
+        // Read conditions may have stopped triggering.
+        self.inner.data_signal.notify();
+        Ok(out)
+    }
+
+    /// A selector for read/take with masks and limits.
+    pub fn select(&self) -> Selector<'_, T> {
+        Selector {
+            reader: self,
+            sel: Selection::default(),
+            next_after: None,
+        }
+    }
+
+    /// Reads (copies) all samples; they stay in the cache, marked read.
+    pub fn read(&self) -> DdsResult<Vec<Sample<T>>>
+    where
+        T: Clone,
+    {
+        self.select().read()
+    }
+
+    /// Takes all samples out of the cache.
+    pub fn take(&self) -> DdsResult<Vec<Sample<T>>> {
+        self.select().take()
+    }
+
+    /// Reads the oldest not-read sample.
+    pub fn read_next_sample(&self) -> DdsResult<Option<Sample<T>>>
+    where
+        T: Clone,
+    {
+        Ok(self
+            .select()
+            .sample_state(SampleStateMask::NOT_READ)
+            .max_samples(1)
+            .read()?
+            .pop())
+    }
+
+    /// Takes the oldest not-read sample.
+    pub fn take_next_sample(&self) -> DdsResult<Option<Sample<T>>> {
+        Ok(self
+            .select()
+            .sample_state(SampleStateMask::NOT_READ)
+            .max_samples(1)
+            .take()?
+            .pop())
+    }
+
+    /// Reads the samples of one instance.
+    pub fn read_instance(&self, h: InstanceHandle) -> DdsResult<Vec<Sample<T>>>
+    where
+        T: Clone,
+    {
+        self.check_instance(h)?;
+        self.select().instance(h).read()
+    }
+
+    /// Takes the samples of one instance.
+    pub fn take_instance(&self, h: InstanceHandle) -> DdsResult<Vec<Sample<T>>> {
+        self.check_instance(h)?;
+        self.select().instance(h).take()
+    }
+
+    fn check_instance(&self, h: InstanceHandle) -> DdsResult<()> {
+        if lock(&self.inner.cache).cache.instance_state(h).is_none() {
+            return Err(DdsError::BadParameter(format!("unknown instance {h:?}")));
+        }
+        Ok(())
+    }
+
+    /// Reads the samples of the next instance after `prev` (`InstanceHandle::NIL` for the first).
+    pub fn read_next_instance(&self, prev: InstanceHandle) -> DdsResult<Vec<Sample<T>>>
+    where
+        T: Clone,
+    {
+        self.select().next_instance(prev).read()
+    }
+
+    /// Takes the samples of the next instance after `prev`.
+    pub fn take_next_instance(&self, prev: InstanceHandle) -> DdsResult<Vec<Sample<T>>> {
+        self.select().next_instance(prev).take()
+    }
+
+    /// Reads with a read condition's masks.
+    pub fn read_w_condition(&self, c: &ReadCondition) -> DdsResult<Vec<Sample<T>>>
+    where
+        T: Clone,
+    {
+        self.select()
+            .sample_state(c.sample_states)
+            .view_state(c.view_states)
+            .instance_state(c.instance_states)
+            .read()
+    }
+
+    /// Takes with a read condition's masks.
+    pub fn take_w_condition(&self, c: &ReadCondition) -> DdsResult<Vec<Sample<T>>> {
+        self.select()
+            .sample_state(c.sample_states)
+            .view_state(c.view_states)
+            .instance_state(c.instance_states)
+            .take()
+    }
+
+    /// The handle of the instance whose key equals the key of `key_sample` (other members are ignored).
+    pub fn lookup_instance(&self, key_sample: &T) -> Option<InstanceHandle> {
+        let key = if T::IS_KEYED {
+            let mut k = Vec::new();
+            cdr::instance_key(key_sample, &mut k).ok()?;
+            k
+        } else {
+            Vec::new()
+        };
+        lock(&self.inner.cache).cache.lookup(&key)
+    }
+
+    /// Number of instances held.
+    pub fn instance_count(&self) -> usize {
+        lock(&self.inner.cache).cache.instance_count()
+    }
+
+    /// Number of samples held.
+    pub fn sample_count(&self) -> usize {
+        lock(&self.inner.cache).cache.len()
+    }
+
+    /// Blocks until a not-read sample is available (`Ok(true)`) or `timeout` passes (`Ok(false)`).
+    pub fn wait_for_data(&self, timeout: Duration) -> DdsResult<bool> {
+        let deadline = Instant::now().checked_add(timeout);
+        let unread = Selection {
+            sample_states: SampleStateMask::NOT_READ,
+            ..Selection::default()
+        };
+        let mut st = lock(&self.inner.cache);
+        loop {
+            if st.cache.has_matching(&unread) {
+                return Ok(true);
+            }
+            self.inner.shared.check_alive()?;
+            let left = match deadline {
+                Some(d) => match d.checked_duration_since(Instant::now()) {
+                    Some(l) if !l.is_zero() => l,
+                    _ => return Ok(false),
+                },
+                None => Duration::from_secs(1),
+            };
+            st = self
+                .inner
+                .data_cv
+                .wait_timeout(st, left.min(Duration::from_secs(1)))
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
+        }
+    }
+
+    /// An async stream of samples (each taken, oldest first). Runtime-agnostic: it registers the task's
+    /// waker and is woken by the receive thread. Ends when the participant shuts down.
+    pub fn stream(&self) -> SampleStream<T> {
+        SampleStream {
+            reader: self.clone(),
+        }
+    }
+
+    /// A read condition on this reader.
+    pub fn create_readcondition(
+        &self,
+        sample_states: SampleStateMask,
+        view_states: ViewStateMask,
+        instance_states: InstanceStateMask,
+    ) -> ReadCondition {
+        ReadCondition {
+            source: self.inner.clone(),
+            sample_states,
+            view_states,
+            instance_states,
+        }
+    }
+
+    /// The reader's status condition.
+    pub fn status_condition(&self) -> StatusCondition {
+        StatusCondition {
+            core: self.inner.status_core.clone(),
+        }
+    }
+
+    /// Installs a listener (replacing any previous one).
+    pub fn set_listener(&self, listener: Box<dyn DataReaderListener<T>>) {
+        *lock(&self.inner.listener) = Some(Arc::from(listener));
+    }
+
+    /// Removes the listener.
+    pub fn clear_listener(&self) {
+        *lock(&self.inner.listener) = None;
+    }
+
+    /// The topic.
+    pub fn topic(&self) -> &Topic<T> {
+        &self.handle.topic
+    }
+
+    /// The subscriber.
+    pub fn subscriber(&self) -> &Subscriber {
+        &self.handle.subscriber
+    }
+
+    /// The reader's GUID.
+    pub fn guid(&self) -> [u8; 16] {
+        Guid::new(self.inner.shared.guid_prefix, self.handle.id).to_bytes()
+    }
+
+    /// Handles of the matched writers.
+    pub fn matched_publications(&self) -> Vec<InstanceHandle> {
+        lock(&self.inner.matched)
+            .iter()
+            .map(|g| InstanceHandle::from_guid_bytes(&g.to_bytes()))
+            .collect()
+    }
+
+    /// SUBSCRIPTION_MATCHED (resets the change counts).
+    pub fn subscription_matched_status(&self) -> SubscriptionMatchedStatus {
+        let mut st = lock(&self.inner.statuses);
+        let s = st.subscription_matched.clone();
+        st.subscription_matched.total_count_change = 0;
+        st.subscription_matched.current_count_change = 0;
+        self.inner
+            .status_core
+            .clear(StatusMask::SUBSCRIPTION_MATCHED);
+        s
+    }
+
+    /// REQUESTED_INCOMPATIBLE_QOS (resets the change count).
+    pub fn requested_incompatible_qos_status(&self) -> IncompatibleQosStatus {
+        let mut st = lock(&self.inner.statuses);
+        let s = st.requested_incompatible_qos.clone();
+        st.requested_incompatible_qos.total_count_change = 0;
+        self.inner
+            .status_core
+            .clear(StatusMask::REQUESTED_INCOMPATIBLE_QOS);
+        s
+    }
+
+    /// SAMPLE_LOST (resets the change count).
+    pub fn sample_lost_status(&self) -> SampleLostStatus {
+        let mut st = lock(&self.inner.statuses);
+        let s = st.sample_lost.clone();
+        st.sample_lost.total_count_change = 0;
+        self.inner.status_core.clear(StatusMask::SAMPLE_LOST);
+        s
+    }
+
+    /// SAMPLE_REJECTED (resets the change count).
+    pub fn sample_rejected_status(&self) -> SampleRejectedStatus {
+        let mut st = lock(&self.inner.statuses);
+        let s = st.sample_rejected.clone();
+        st.sample_rejected.total_count_change = 0;
+        self.inner.status_core.clear(StatusMask::SAMPLE_REJECTED);
+        s
+    }
+
+    /// LIVELINESS_CHANGED (resets the change counts).
+    pub fn liveliness_changed_status(&self) -> LivelinessChangedStatus {
+        let mut st = lock(&self.inner.statuses);
+        let s = st.liveliness_changed.clone();
+        st.liveliness_changed.alive_count_change = 0;
+        st.liveliness_changed.not_alive_count_change = 0;
+        self.inner.status_core.clear(StatusMask::LIVELINESS_CHANGED);
+        s
+    }
+
+    /// REQUESTED_DEADLINE_MISSED (resets the change count).
+    pub fn requested_deadline_missed_status(&self) -> DeadlineMissedStatus {
+        let mut st = lock(&self.inner.statuses);
+        let s = st.requested_deadline_missed.clone();
+        st.requested_deadline_missed.total_count_change = 0;
+        self.inner
+            .status_core
+            .clear(StatusMask::REQUESTED_DEADLINE_MISSED);
+        s
+    }
+}
+
+fn system_time(t: Option<crate::rtps::Time>) -> Option<SystemTime> {
+    t.and_then(|t| t.to_unix())
+        .map(|d| SystemTime::UNIX_EPOCH + d)
+}
+
+impl<T: DdsType> ReaderInner<T> {
+    fn reader_handle(self: &Arc<Self>) -> Option<DataReader<T>> {
+        let handle = lock(&self.handle).upgrade()?;
+        Some(DataReader {
+            inner: self.clone(),
+            handle,
+        })
+    }
+
+    /// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped.
+    fn decode(
+        &self,
+        s: ReceivedSample,
+        by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
+        now: Instant,
+    ) -> Option<Incoming<T>> {
+        let rx_time = SystemTime::now();
+        let info = self.shared.remote_writer(&s.writer);
+        let kind = match s.kind {
+            ChangeKind::Alive => ChangeKindLocal::Alive,
+            ChangeKind::Dispose => ChangeKindLocal::Dispose,
+            ChangeKind::Unregister => ChangeKindLocal::Unregister,
+            ChangeKind::DisposeUnregister => ChangeKindLocal::DisposeUnregister,
+        };
+        let mut key = Vec::new();
+        let mut data = None;
+        let mut key_holder = None;
+        if kind == ChangeKindLocal::Alive {
+            let d = match cdr::deserialize::<T>(&s.payload) {
+                Ok(d) => d,
+                Err(e) => {
+                    tracing::warn!(writer = ?s.writer, seq = s.sequence.0, error = %e, "dropping undecodable sample");
+                    return None;
+                }
+            };
+            if T::IS_KEYED {
+                if let Err(e) = cdr::instance_key(&d, &mut key) {
+                    tracing::warn!(error = %e, "cannot compute the instance key");
+                    return None;
+                }
+                if let Some(kh) = s.key_hash {
+                    if by_hash.len() >= MAX_REMEMBERED_HASHES {
+                        by_hash.clear();
+                    }
+                    by_hash.entry(kh).or_insert_with(|| key.clone());
+                }
+            }
+            data = Some(d);
+        } else if T::IS_KEYED {
+            if !s.payload.is_empty() {
+                match cdr::deserialize_key::<T>(&s.payload) {
+                    Ok(k) => {
+                        if let Err(e) = cdr::instance_key(&k, &mut key) {
+                            tracing::warn!(error = %e, "cannot compute the instance key");
+                            return None;
+                        }
+                        key_holder = Some(k);
+                    }
+                    Err(e) => {
+                        tracing::debug!(error = %e, "undecodable key payload; trying the key hash")
+                    }
+                }
+            }
+            if key_holder.is_none() {
+                match s.key_hash.and_then(|kh| by_hash.get(&kh).cloned()) {
+                    Some(k) => key = k,
+                    None => {
+                        tracing::debug!(writer = ?s.writer, kind = ?s.kind, "key-only change for an unknown instance");
+                        return None;
+                    }
+                }
+            }
+        }
+        Some(Incoming {
+            writer: s.writer.to_bytes(),
+            kind,
+            data,
+            key,
+            key_holder,
+            source_timestamp: system_time(s.source_timestamp).unwrap_or(rx_time),
+            reception_timestamp: rx_time,
+            strength: info.strength,
+            expires: info.lifespan.and_then(|l| now.checked_add(l)),
+        })
+    }
+
+    fn notify_data(self: &Arc<Self>) {
+        self.data_cv.notify_all();
+        let wakers = std::mem::take(&mut *lock(&self.wakers));
+        for w in wakers {
+            w.wake();
+        }
+        self.status_core.raise(StatusMask::DATA_AVAILABLE);
+        self.data_signal.notify();
+        let listener = lock(&self.listener).clone();
+        if let (Some(l), Some(r)) = (listener, self.reader_handle()) {
+            l.on_data_available(&r);
+        }
+    }
+}
+
+impl<T: DdsType> ReaderSink for ReaderInner<T> {
+    fn enqueue(&self, item: Pending) {
+        lock(&self.pending).push_back(item);
+    }
+
+    fn process(self: Arc<Self>) {
+        let now = Instant::now();
+        let mut any = false;
+        let mut rejected = Vec::new();
+        {
+            let mut guard = lock(&self.cache);
+            let st = &mut *guard;
+            // Popping under the cache lock keeps the core's order even with several receive threads.
+            while let Some(item) = lock(&self.pending).pop_front() {
+                match item {
+                    Pending::Sample(s) => {
+                        let Some(inc) = self.decode(s, &mut st.by_hash, now) else {
+                            continue;
+                        };
+                        match st.cache.insert(inc, now) {
+                            Outcome::Accepted { .. } => any = true,
+                            Outcome::Filtered => {}
+                            Outcome::Rejected { reason, handle } => rejected.push((reason, handle)),
+                        }
+                    }
+                    Pending::WriterGone(g) => any |= st.cache.writer_gone(g.to_bytes(), now),
+                }
+            }
+        }
+        if !rejected.is_empty() {
+            let status = {
+                let mut st = lock(&self.statuses);
+                for (reason, handle) in &rejected {
+                    let sr = &mut st.sample_rejected;
+                    sr.total_count += 1;
+                    sr.total_count_change += 1;
+                    sr.last_reason = *reason;
+                    sr.last_instance_handle = *handle;
+                }
+                st.sample_rejected.clone()
+            };
+            tracing::debug!(
+                count = rejected.len(),
+                "samples rejected by resource limits"
+            );
+            self.status_core.raise(StatusMask::SAMPLE_REJECTED);
+            let listener = lock(&self.listener).clone();
+            if let (Some(l), Some(r)) = (listener, self.reader_handle()) {
+                l.on_sample_rejected(&r, status);
+            }
+        }
+        if any {
+            self.notify_data();
+        }
+    }
+
+    fn on_event(self: Arc<Self>, ev: &Event) {
+        let listener = lock(&self.listener).clone();
+        let me = self.reader_handle();
+        match ev {
+            Event::SubscriptionMatched {
+                writer, matched, ..
+            } => {
+                let status = {
+                    let mut m = lock(&self.matched);
+                    let mut st = lock(&self.statuses);
+                    let sm = &mut st.subscription_matched;
+                    if *matched {
+                        if !m.contains(writer) {
+                            m.push(*writer);
+                            sm.total_count += 1;
+                            sm.total_count_change += 1;
+                            sm.current_count_change += 1;
+                        }
+                    } else if let Some(p) = m.iter().position(|g| g == writer) {
+                        m.remove(p);
+                        sm.current_count_change -= 1;
+                    }
+                    sm.current_count = m.len() as u32;
+                    sm.last_publication_handle =
+                        InstanceHandle::from_guid_bytes(&writer.to_bytes());
+                    sm.clone()
+                };
+                tracing::info!(reader = ?lock(&self.id), ?writer, matched, "subscription matched");
+                self.status_core.raise(StatusMask::SUBSCRIPTION_MATCHED);
+                if let (Some(l), Some(r)) = (listener, me) {
+                    l.on_subscription_matched(&r, status);
+                }
+            }
+            Event::RequestedIncompatibleQos { policy, writer, .. } => {
+                let status = {
+                    let mut st = lock(&self.statuses);
+                    st.requested_incompatible_qos.record(*policy);
+                    st.requested_incompatible_qos.clone()
+                };
+                tracing::warn!(reader = ?lock(&self.id), ?writer, ?policy, "requested incompatible QoS");
+                self.status_core
+                    .raise(StatusMask::REQUESTED_INCOMPATIBLE_QOS);
+                if let (Some(l), Some(r)) = (listener, me) {
+                    l.on_requested_incompatible_qos(&r, status);
+                }
+            }
+            Event::LivelinessChanged { writer, alive, .. } => {
+                let status = {
+                    let mut st = lock(&self.statuses);
+                    let lc = &mut st.liveliness_changed;
+                    if *alive {
+                        lc.alive_count += 1;
+                        lc.alive_count_change += 1;
+                        if lc.not_alive_count > 0 {
+                            lc.not_alive_count -= 1;
+                            lc.not_alive_count_change -= 1;
+                        }
+                    } else {
+                        lc.not_alive_count += 1;
+                        lc.not_alive_count_change += 1;
+                        if lc.alive_count > 0 {
+                            lc.alive_count -= 1;
+                            lc.alive_count_change -= 1;
+                        }
+                    }
+                    lc.last_publication_handle =
+                        InstanceHandle::from_guid_bytes(&writer.to_bytes());
+                    lc.clone()
+                };
+                if !*alive {
+                    let changed = lock(&self.cache)
+                        .cache
+                        .writer_gone(writer.to_bytes(), Instant::now());
+                    if changed {
+                        self.notify_data();
+                    }
+                }
+                self.status_core.raise(StatusMask::LIVELINESS_CHANGED);
+                if let (Some(l), Some(r)) = (listener, me) {
+                    l.on_liveliness_changed(&r, status);
+                }
+            }
+            Event::SampleLost { count, .. } => {
+                let status = {
+                    let mut st = lock(&self.statuses);
+                    let n = u32::try_from(*count).unwrap_or(u32::MAX);
+                    st.sample_lost.total_count = st.sample_lost.total_count.saturating_add(n);
+                    st.sample_lost.total_count_change =
+                        st.sample_lost.total_count_change.saturating_add(n);
+                    st.sample_lost.clone()
+                };
+                self.status_core.raise(StatusMask::SAMPLE_LOST);
+                if let (Some(l), Some(r)) = (listener, me) {
+                    l.on_sample_lost(&r, status);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn tick(self: Arc<Self>, now: Instant) {
+        let missed = lock(&self.cache).cache.tick(now);
+        if missed.is_empty() {
+            return;
+        }
+        let status = {
+            let mut st = lock(&self.statuses);
+            let dm = &mut st.requested_deadline_missed;
+            dm.total_count += missed.len() as u32;
+            dm.total_count_change += missed.len() as u32;
+            dm.last_instance_handle = *missed.last().unwrap_or(&InstanceHandle::NIL);
+            dm.clone()
+        };
+        self.status_core
+            .raise(StatusMask::REQUESTED_DEADLINE_MISSED);
+        let listener = lock(&self.listener).clone();
+        if let (Some(l), Some(r)) = (listener, self.reader_handle()) {
+            l.on_requested_deadline_missed(&r, status);
+        }
+    }
+}
+
+impl<T: DdsType> ReadConditionSource for ReaderInner<T> {
+    fn has_matching(&self, s: SampleStateMask, v: ViewStateMask, i: InstanceStateMask) -> bool {
+        let sel = Selection {
+            sample_states: s,
+            view_states: v,
+            instance_states: i,
+            ..Selection::default()
+        };
+        lock(&self.cache).cache.has_matching(&sel)
+    }
+    fn data_signal(&self) -> &Signal {
+        &self.data_signal
+    }
+}
+
+/// The stream returned by [`DataReader::stream`].
+pub struct SampleStream<T: DdsType> {
+    reader: DataReader<T>,
+}
+
+impl<T: DdsType> SampleStream<T> {
+    /// The reader this stream takes from.
+    pub fn reader(&self) -> &DataReader<T> {
+        &self.reader
+    }
+}
+
+impl<T: DdsType> futures_core::Stream for SampleStream<T> {
+    type Item = Sample<T>;
+
+    fn poll_next(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<Option<Self::Item>> {
+        let r = &self.reader;
+        let take = || r.take_next_sample().ok().flatten();
+        if let Some(s) = take() {
+            return Poll::Ready(Some(s));
+        }
+        if r.inner.shared.check_alive().is_err() {
+            return Poll::Ready(None);
+        }
+        {
+            let mut w = lock(&r.inner.wakers);
+            if !w.iter().any(|x| x.will_wake(cx.waker())) {
+                w.push(cx.waker().clone());
+            }
+        }
+        // A sample may have arrived between the first check and the registration.
+        match take() {
+            Some(s) => Poll::Ready(Some(s)),
+            None => Poll::Pending,
+        }
+    }
+}

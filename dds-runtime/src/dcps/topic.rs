@@ -1,0 +1,175 @@
+//! `Topic<T>` and `ContentFilteredTopic<T>`.
+
+use std::marker::PhantomData;
+use std::sync::{Arc, RwLock};
+
+use crate::cdr::DdsType;
+use crate::qos::TopicQos;
+
+use super::error::{DdsError, DdsResult};
+use super::filter::{ContentFilter, FilterFields};
+use super::participant::DomainParticipant;
+
+struct TopicInner {
+    participant: DomainParticipant,
+    name: String,
+    qos: TopicQos,
+}
+
+/// A named topic of type `T` in a participant.
+pub struct Topic<T> {
+    inner: Arc<TopicInner>,
+    _t: PhantomData<fn() -> T>,
+}
+
+impl<T> Clone for Topic<T> {
+    fn clone(&self) -> Self {
+        Topic {
+            inner: self.inner.clone(),
+            _t: PhantomData,
+        }
+    }
+}
+
+impl<T: DdsType> std::fmt::Debug for Topic<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Topic")
+            .field("name", &self.inner.name)
+            .field("type", &T::TYPE_NAME)
+            .finish()
+    }
+}
+
+impl<T: DdsType> Topic<T> {
+    pub(crate) fn new(participant: DomainParticipant, name: &str, qos: TopicQos) -> Self {
+        Topic {
+            inner: Arc::new(TopicInner {
+                participant,
+                name: name.to_string(),
+                qos,
+            }),
+            _t: PhantomData,
+        }
+    }
+    /// The topic name.
+    pub fn name(&self) -> &str {
+        &self.inner.name
+    }
+    /// The IDL type name (`T::TYPE_NAME`).
+    pub fn type_name(&self) -> &'static str {
+        T::TYPE_NAME
+    }
+    /// The topic QoS.
+    pub fn qos(&self) -> &TopicQos {
+        &self.inner.qos
+    }
+    /// The participant.
+    pub fn participant(&self) -> &DomainParticipant {
+        &self.inner.participant
+    }
+}
+
+type SampleFilter<T> = Box<dyn Fn(&T) -> bool + Send + Sync>;
+
+/// What a reader can be created on: a [`Topic`] or a [`ContentFilteredTopic`].
+pub trait TopicDescription<T: DdsType> {
+    /// The underlying topic.
+    fn topic(&self) -> &Topic<T>;
+    /// The sample filter, if any.
+    #[doc(hidden)]
+    fn sample_filter(&self) -> Option<SampleFilter<T>> {
+        None
+    }
+}
+
+impl<T: DdsType> TopicDescription<T> for Topic<T> {
+    fn topic(&self) -> &Topic<T> {
+        self
+    }
+}
+
+/// A topic whose readers only see samples for which the filter expression holds. The filter runs in the
+/// reader (the writer still sends everything; no writer-side filtering is announced).
+pub struct ContentFilteredTopic<T> {
+    topic: Topic<T>,
+    name: String,
+    filter: Arc<RwLock<ContentFilter>>,
+}
+
+impl<T> Clone for ContentFilteredTopic<T> {
+    fn clone(&self) -> Self {
+        ContentFilteredTopic {
+            topic: self.topic.clone(),
+            name: self.name.clone(),
+            filter: self.filter.clone(),
+        }
+    }
+}
+
+impl<T: DdsType + FilterFields> ContentFilteredTopic<T> {
+    /// The name of this filtered topic.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// The filter expression.
+    pub fn filter_expression(&self) -> String {
+        self.filter
+            .read()
+            .unwrap_or_else(|e| e.into_inner())
+            .expression()
+            .to_string()
+    }
+    /// The current parameters.
+    pub fn expression_parameters(&self) -> Vec<String> {
+        self.filter
+            .read()
+            .unwrap_or_else(|e| e.into_inner())
+            .parameters()
+            .to_vec()
+    }
+    /// Changes the parameters; readers created on this topic apply them to samples received from now on.
+    pub fn set_expression_parameters<S: AsRef<str>>(&self, params: &[S]) -> DdsResult<()> {
+        let params: Vec<String> = params.iter().map(|s| s.as_ref().to_string()).collect();
+        self.filter
+            .write()
+            .unwrap_or_else(|e| e.into_inner())
+            .set_parameters(&params)
+    }
+}
+
+impl<T: DdsType + FilterFields> TopicDescription<T> for ContentFilteredTopic<T> {
+    fn topic(&self) -> &Topic<T> {
+        &self.topic
+    }
+    fn sample_filter(&self) -> Option<SampleFilter<T>> {
+        let f = self.filter.clone();
+        Some(Box::new(move |s: &T| {
+            f.read().unwrap_or_else(|e| e.into_inner()).matches(s)
+        }))
+    }
+}
+
+impl DomainParticipant {
+    /// A content-filtered view of `topic` (SQL subset, see [`crate::dcps::filter`]); `%N` in the expression
+    /// refers to `params[N]`.
+    pub fn create_content_filtered_topic<T: DdsType + FilterFields, S: AsRef<str>>(
+        &self,
+        name: &str,
+        topic: &Topic<T>,
+        expression: &str,
+        params: &[S],
+    ) -> DdsResult<ContentFilteredTopic<T>> {
+        if name.is_empty() {
+            return Err(DdsError::BadParameter(
+                "empty content-filtered topic name".into(),
+            ));
+        }
+        let params: Vec<String> = params.iter().map(|s| s.as_ref().to_string()).collect();
+        let filter = ContentFilter::new(expression, &params)?;
+        Ok(ContentFilteredTopic {
+            topic: topic.clone(),
+            name: name.to_string(),
+            filter: Arc::new(RwLock::new(filter)),
+        })
+    }
+}

@@ -1,0 +1,346 @@
+//! The public types of the core's API: configuration, specs, changes, transmits, events and errors.
+
+use std::fmt;
+use std::ops::Deref;
+use std::sync::Arc;
+use std::time::Duration;
+
+use super::discovery::{ParticipantData, ReaderData, WriterData};
+use super::types::*;
+use crate::qos::{QosPolicyId, ReaderQos, WriterQos};
+use crate::xtypes::TypeInformation;
+
+/// Immutable shared bytes (a sample's serialized form). Cloning is a reference-count increment.
+#[derive(Clone, Default)]
+pub struct Payload {
+    buf: Option<Arc<[u8]>>,
+    start: usize,
+    end: usize,
+}
+
+impl Payload {
+    pub fn new(bytes: impl Into<Arc<[u8]>>) -> Self {
+        let buf: Arc<[u8]> = bytes.into();
+        let end = buf.len();
+        Payload { buf: Some(buf), start: 0, end }
+    }
+    pub fn copy_from_slice(b: &[u8]) -> Self {
+        Payload::new(Arc::<[u8]>::from(b))
+    }
+    /// A sub-range sharing the same buffer; clamps out-of-range bounds.
+    pub fn slice(&self, range: std::ops::Range<usize>) -> Payload {
+        let end = (self.start + range.end).min(self.end);
+        let start = (self.start + range.start).min(end);
+        Payload { buf: self.buf.clone(), start, end }
+    }
+}
+
+impl Deref for Payload {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        match &self.buf {
+            Some(b) => &b[self.start..self.end],
+            None => &[],
+        }
+    }
+}
+impl AsRef<[u8]> for Payload {
+    fn as_ref(&self) -> &[u8] {
+        self
+    }
+}
+impl From<Vec<u8>> for Payload {
+    fn from(v: Vec<u8>) -> Self {
+        Payload::new(v)
+    }
+}
+impl From<&[u8]> for Payload {
+    fn from(v: &[u8]) -> Self {
+        Payload::copy_from_slice(v)
+    }
+}
+impl From<Arc<[u8]>> for Payload {
+    fn from(v: Arc<[u8]>) -> Self {
+        Payload::new(v)
+    }
+}
+impl PartialEq for Payload {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+impl Eq for Payload {}
+impl fmt::Debug for Payload {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Payload({} bytes)", self.len())
+    }
+}
+
+/// Everything the core needs to know about the local participant. Build with [`ParticipantConfig::new`], which
+/// fills in the standard ports for one unicast address, then adjust fields.
+#[derive(Debug, Clone)]
+pub struct ParticipantConfig {
+    pub domain_id: u32,
+    /// The participant index used in the port formula (chosen by the transport).
+    pub participant_id: u32,
+    pub guid_prefix: GuidPrefix,
+    /// Defaults to [`VendorId::THIS`] (0x01dd).
+    pub vendor_id: VendorId,
+    pub metatraffic_unicast: Vec<Locator>,
+    pub metatraffic_multicast: Vec<Locator>,
+    pub default_unicast: Vec<Locator>,
+    pub default_multicast: Vec<Locator>,
+    /// Period of SPDP announcements (default 3 s).
+    pub spdp_interval: Duration,
+    /// Lease announced to peers (default 10 s, like Cyclone).
+    pub lease_duration: Duration,
+    /// Unicast SPDP destinations in addition to the multicast ones.
+    pub initial_peers: Vec<Locator>,
+    /// Datagram payload limit for packing (default 14720, Cyclone's MaxMessageSize).
+    pub max_message_size: usize,
+    /// Samples larger than this go out as DATA_FRAG with fragments of this size (default 1344; ≤ 65535).
+    pub fragment_size: usize,
+    pub user_data: Vec<u8>,
+    pub entity_name: Option<String>,
+    pub properties: Vec<(String, String)>,
+    /// Period of heartbeats while data is unacknowledged (default 100 ms).
+    pub heartbeat_period: Duration,
+    /// Delay before answering a NACK, so that requests merge (default 5 ms).
+    pub nack_response_delay: Duration,
+    /// Delay before answering a HEARTBEAT with an ACKNACK (default 0).
+    pub heartbeat_response_delay: Duration,
+    /// Flow control: `write` refuses (WouldBlock) once this many bytes are unacknowledged (default 512 KiB) …
+    pub whc_high_watermark: usize,
+    /// … until they drop below this (default 128 KiB).
+    pub whc_low_watermark: usize,
+    /// Largest sample accepted from the network (default 64 MiB); bigger ones are dropped and acknowledged.
+    pub max_sample_size: usize,
+    /// Per remote writer: samples defragmented at once (default 8) and bytes held in fragments (default 16 MiB).
+    pub defrag_max_samples: usize,
+    pub defrag_max_bytes: usize,
+    /// Per remote writer: out-of-order samples held for reordering (default 1024).
+    pub reorder_max_samples: usize,
+    /// How long a deleted reliable writer lingers waiting for acknowledgements (default 1 s).
+    pub writer_linger_duration: Duration,
+    /// Upper bound on bytes retransmitted per repair round to one reader (default 256 KiB).
+    pub max_repair_bytes: usize,
+}
+
+impl ParticipantConfig {
+    /// A configuration for one IPv4 unicast address with the standard ports (PB 7400, DG 250, PG 2, d0..d3 =
+    /// 0, 10, 1, 11) and SPDP multicast to 239.255.0.1.
+    pub fn new(domain_id: u32, participant_id: u32, guid_prefix: GuidPrefix, unicast_ip: [u8; 4]) -> Self {
+        use super::discovery::ports;
+        let mc = [239, 255, 0, 1];
+        ParticipantConfig {
+            domain_id,
+            participant_id,
+            guid_prefix,
+            vendor_id: VendorId::THIS,
+            metatraffic_unicast: vec![Locator::udpv4(unicast_ip, ports::metatraffic_unicast(domain_id, participant_id))],
+            metatraffic_multicast: vec![Locator::udpv4(mc, ports::spdp_multicast(domain_id))],
+            default_unicast: vec![Locator::udpv4(unicast_ip, ports::user_unicast(domain_id, participant_id))],
+            default_multicast: vec![Locator::udpv4(mc, ports::user_multicast(domain_id))],
+            spdp_interval: Duration::from_secs(3),
+            lease_duration: Duration::from_secs(10),
+            initial_peers: Vec::new(),
+            max_message_size: 14720,
+            fragment_size: 1344,
+            user_data: Vec::new(),
+            entity_name: None,
+            properties: Vec::new(),
+            heartbeat_period: Duration::from_millis(100),
+            nack_response_delay: Duration::from_millis(5),
+            heartbeat_response_delay: Duration::ZERO,
+            whc_high_watermark: 512 * 1024,
+            whc_low_watermark: 128 * 1024,
+            max_sample_size: 64 * 1024 * 1024,
+            defrag_max_samples: 8,
+            defrag_max_bytes: 16 * 1024 * 1024,
+            reorder_max_samples: 1024,
+            writer_linger_duration: Duration::from_secs(1),
+            max_repair_bytes: 256 * 1024,
+        }
+    }
+}
+
+/// One datagram to send to every destination.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Transmit {
+    pub destinations: Vec<Locator>,
+    pub payload: Vec<u8>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ChangeKind {
+    Alive,
+    Dispose,
+    Unregister,
+    DisposeUnregister,
+}
+
+impl ChangeKind {
+    /// PID_STATUS_INFO flags (0x01 disposed, 0x02 unregistered).
+    pub fn status_info(self) -> u8 {
+        match self {
+            ChangeKind::Alive => 0,
+            ChangeKind::Dispose => 1,
+            ChangeKind::Unregister => 2,
+            ChangeKind::DisposeUnregister => 3,
+        }
+    }
+    pub fn from_status_info(flags: u8) -> Self {
+        match flags & 3 {
+            0 => ChangeKind::Alive,
+            1 => ChangeKind::Dispose,
+            2 => ChangeKind::Unregister,
+            _ => ChangeKind::DisposeUnregister,
+        }
+    }
+}
+
+/// One change to write.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WriteChange {
+    pub kind: ChangeKind,
+    /// Serialized sample (with encapsulation header); for non-Alive kinds the serialized key (may be empty).
+    pub payload: Payload,
+    /// Sent as PID_KEY_HASH inline QoS and used as the instance identity for KEEP_LAST history.
+    /// Required for keyed topics; `None` for keyless ones.
+    pub key_hash: Option<[u8; 16]>,
+    /// Sent in INFO_TS; `None` sends no timestamp.
+    pub source_timestamp: Option<Time>,
+}
+
+impl WriteChange {
+    pub fn alive(payload: impl Into<Payload>) -> Self {
+        WriteChange { kind: ChangeKind::Alive, payload: payload.into(), key_hash: None, source_timestamp: None }
+    }
+    pub fn with_key_hash(mut self, key_hash: [u8; 16]) -> Self {
+        self.key_hash = Some(key_hash);
+        self
+    }
+    pub fn with_timestamp(mut self, t: Time) -> Self {
+        self.source_timestamp = Some(t);
+        self
+    }
+    pub fn with_kind(mut self, kind: ChangeKind) -> Self {
+        self.kind = kind;
+        self
+    }
+}
+
+/// A local writer to create.
+#[derive(Debug, Clone)]
+pub struct WriterSpec {
+    pub topic_name: String,
+    pub type_name: String,
+    pub keyed: bool,
+    /// Writer, publisher and topic QoS as announced; the data representation is `qos.writer.data_representation`.
+    pub qos: WriterQos,
+    pub type_information: Option<TypeInformation>,
+    pub entity_name: Option<String>,
+}
+
+impl WriterSpec {
+    pub fn new(topic_name: impl Into<String>, type_name: impl Into<String>, keyed: bool, qos: impl Into<WriterQos>) -> Self {
+        WriterSpec {
+            topic_name: topic_name.into(),
+            type_name: type_name.into(),
+            keyed,
+            qos: qos.into(),
+            type_information: None,
+            entity_name: None,
+        }
+    }
+}
+
+/// A local reader to create.
+#[derive(Debug, Clone)]
+pub struct ReaderSpec {
+    pub topic_name: String,
+    pub type_name: String,
+    pub keyed: bool,
+    /// Reader, subscriber and topic QoS; accepted representations are `qos.reader.data_representation`.
+    pub qos: ReaderQos,
+    pub type_information: Option<TypeInformation>,
+    pub entity_name: Option<String>,
+}
+
+impl ReaderSpec {
+    pub fn new(topic_name: impl Into<String>, type_name: impl Into<String>, keyed: bool, qos: impl Into<ReaderQos>) -> Self {
+        ReaderSpec {
+            topic_name: topic_name.into(),
+            type_name: type_name.into(),
+            keyed,
+            qos: qos.into(),
+            type_information: None,
+            entity_name: None,
+        }
+    }
+}
+
+/// A received change delivered to a local reader.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ReceivedSample {
+    pub reader: EntityId,
+    pub writer: Guid,
+    pub sequence: SequenceNumber,
+    pub kind: ChangeKind,
+    /// Serialized sample, or serialized key (possibly empty) when `kind` is not Alive.
+    pub payload: Payload,
+    pub key_hash: Option<[u8; 16]>,
+    pub source_timestamp: Option<Time>,
+}
+
+/// What the core reports to the DCPS layer.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Event {
+    Sample(ReceivedSample),
+    PublicationMatched { writer: EntityId, reader: Guid, matched: bool },
+    SubscriptionMatched { reader: EntityId, writer: Guid, matched: bool },
+    OfferedIncompatibleQos { writer: EntityId, reader: Guid, policy: QosPolicyId },
+    RequestedIncompatibleQos { reader: EntityId, writer: Guid, policy: QosPolicyId },
+    ParticipantDiscovered(Box<ParticipantData>),
+    ParticipantLost { guid_prefix: GuidPrefix },
+    PublicationDiscovered(Box<WriterData>),
+    PublicationRemoved { guid: Guid },
+    SubscriptionDiscovered(Box<ReaderData>),
+    SubscriptionRemoved { guid: Guid },
+    /// A matched remote writer's liveliness changed (automatic: participant lease; manual: its messages).
+    LivelinessChanged { reader: EntityId, writer: Guid, alive: bool },
+    /// Samples from `writer` that `reader` will never get (writer no longer had them, or buffers overflowed).
+    SampleLost { reader: EntityId, writer: Guid, count: u64 },
+    /// A deleted writer finished lingering and is gone.
+    WriterDeleted { writer: EntityId },
+    /// Flow control released a writer that returned WouldBlock: unacknowledged bytes fell below the low watermark.
+    WriterUnblocked { writer: EntityId },
+    /// Every matched reliable reader acknowledged everything the writer wrote (wait_for_acknowledgments).
+    WriterAcknowledged { writer: EntityId },
+}
+
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum CoreError {
+    #[error("no such entity {0:?}")]
+    UnknownEntity(EntityId),
+    #[error("out of entity ids")]
+    OutOfEntityIds,
+    #[error("bad parameter: {0}")]
+    BadParameter(&'static str),
+}
+
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum WriteError {
+    /// Flow control or KEEP_ALL resource limits refuse the change for now; retry after acknowledgements
+    /// arrive (within the writer's max_blocking_time).
+    #[error("writer would block")]
+    WouldBlock,
+    #[error("no such writer {0:?}")]
+    UnknownWriter(EntityId),
+    #[error("writer is being deleted")]
+    Deleted,
+    #[error("sample of {0} bytes exceeds the maximum sample size")]
+    TooLarge(usize),
+    #[error("keyed writer needs a key hash")]
+    MissingKeyHash,
+}

@@ -1,0 +1,250 @@
+//! Parameter lists (§9.4.2.11): (pid, length, value) entries aligned to 4, ended by PID_SENTINEL.
+
+use super::cursor::Put;
+use super::{Cursor, WireError};
+use crate::rtps::types::*;
+
+/// Parameter ids used by this implementation (§9.6.2.2, XTypes §7.6.3).
+pub mod pid {
+    pub const PAD: u16 = 0x0000;
+    pub const SENTINEL: u16 = 0x0001;
+    pub const PARTICIPANT_LEASE_DURATION: u16 = 0x0002;
+    pub const TIME_BASED_FILTER: u16 = 0x0004;
+    pub const TOPIC_NAME: u16 = 0x0005;
+    pub const OWNERSHIP_STRENGTH: u16 = 0x0006;
+    pub const TYPE_NAME: u16 = 0x0007;
+    pub const DOMAIN_ID: u16 = 0x000f;
+    pub const PROTOCOL_VERSION: u16 = 0x0015;
+    pub const VENDORID: u16 = 0x0016;
+    pub const RELIABILITY: u16 = 0x001a;
+    pub const LIVELINESS: u16 = 0x001b;
+    pub const DURABILITY: u16 = 0x001d;
+    pub const DURABILITY_SERVICE: u16 = 0x001e;
+    pub const OWNERSHIP: u16 = 0x001f;
+    pub const PRESENTATION: u16 = 0x0021;
+    pub const DEADLINE: u16 = 0x0023;
+    pub const DESTINATION_ORDER: u16 = 0x0025;
+    pub const LATENCY_BUDGET: u16 = 0x0027;
+    pub const PARTITION: u16 = 0x0029;
+    pub const LIFESPAN: u16 = 0x002b;
+    pub const USER_DATA: u16 = 0x002c;
+    pub const GROUP_DATA: u16 = 0x002d;
+    pub const TOPIC_DATA: u16 = 0x002e;
+    pub const UNICAST_LOCATOR: u16 = 0x002f;
+    pub const MULTICAST_LOCATOR: u16 = 0x0030;
+    pub const DEFAULT_UNICAST_LOCATOR: u16 = 0x0031;
+    pub const METATRAFFIC_UNICAST_LOCATOR: u16 = 0x0032;
+    pub const METATRAFFIC_MULTICAST_LOCATOR: u16 = 0x0033;
+    pub const EXPECTS_INLINE_QOS: u16 = 0x0043;
+    pub const PARTICIPANT_MANUAL_LIVELINESS_COUNT: u16 = 0x0034;
+    pub const HISTORY: u16 = 0x0040;
+    pub const RESOURCE_LIMITS: u16 = 0x0041;
+    pub const DEFAULT_MULTICAST_LOCATOR: u16 = 0x0048;
+    pub const TRANSPORT_PRIORITY: u16 = 0x0049;
+    pub const PARTICIPANT_GUID: u16 = 0x0050;
+    pub const GROUP_GUID: u16 = 0x0052;
+    pub const BUILTIN_ENDPOINT_SET: u16 = 0x0058;
+    pub const PROPERTY_LIST: u16 = 0x0059;
+    pub const ENDPOINT_GUID: u16 = 0x005a;
+    pub const TYPE_MAX_SIZE_SERIALIZED: u16 = 0x0060;
+    pub const ENTITY_NAME: u16 = 0x0062;
+    pub const KEY_HASH: u16 = 0x0070;
+    pub const STATUS_INFO: u16 = 0x0071;
+    pub const DATA_REPRESENTATION: u16 = 0x0073;
+    pub const TYPE_CONSISTENCY: u16 = 0x0074;
+    pub const TYPE_INFORMATION: u16 = 0x0075;
+    pub const BUILTIN_ENDPOINT_QOS: u16 = 0x0077;
+    pub const DOMAIN_TAG: u16 = 0x4014;
+
+    /// Bit marking a vendor-specific parameter.
+    pub const VENDOR_SPECIFIC: u16 = 0x8000;
+    /// Bit marking a parameter the receiver must understand or drop the whole message/sample.
+    pub const MUST_UNDERSTAND: u16 = 0x4000;
+}
+
+/// One parameter, borrowed from the message.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Parameter<'a> {
+    pub id: u16,
+    pub value: &'a [u8],
+}
+
+/// A validated parameter list (the sentinel was found), borrowed from the message.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ParameterList<'a> {
+    /// The entries, without the sentinel.
+    pub data: &'a [u8],
+    pub little_endian: bool,
+}
+
+impl<'a> ParameterList<'a> {
+    /// Splits a parameter list off the front of `data`: returns the list and what follows the sentinel.
+    pub fn parse(data: &'a [u8], little_endian: bool) -> Result<(ParameterList<'a>, &'a [u8]), WireError> {
+        let mut c = Cursor::new(data, little_endian);
+        loop {
+            let start = c.pos();
+            let id = c.u16()?;
+            let len = c.u16()? as usize;
+            if id == pid::SENTINEL {
+                // The sentinel's length is ignored (§9.4.2.11), but its value, if any, must be present.
+                let _ = c.skip(len);
+                return Ok((ParameterList { data: &data[..start], little_endian }, c.rest()));
+            }
+            c.skip(len)?;
+        }
+    }
+
+    /// The entries in order (sentinel excluded, PID_PAD skipped).
+    pub fn iter(&self) -> impl Iterator<Item = Parameter<'a>> + 'a {
+        let mut c = Cursor::new(self.data, self.little_endian);
+        std::iter::from_fn(move || loop {
+            let id = c.u16().ok()?;
+            let len = c.u16().ok()? as usize;
+            let value = c.bytes(len).ok()?;
+            if id != pid::PAD {
+                return Some(Parameter { id, value });
+            }
+        })
+    }
+
+    pub fn get(&self, id: u16) -> Option<&'a [u8]> {
+        self.iter().find(|p| p.id == id).map(|p| p.value)
+    }
+
+    /// A cursor over one parameter's value in this list's byte order.
+    pub fn cursor(&self, value: &'a [u8]) -> Cursor<'a> {
+        Cursor::new(value, self.little_endian)
+    }
+
+    /// Finds the first parameter that is not vendor-specific, not in `understood`, and has the must-understand bit.
+    pub fn check_must_understand(&self, understood: impl Fn(u16) -> bool) -> Result<(), WireError> {
+        for p in self.iter() {
+            if p.id & pid::VENDOR_SPECIFIC != 0 {
+                continue;
+            }
+            if p.id & pid::MUST_UNDERSTAND != 0 && !understood(p.id) {
+                return Err(WireError::MustUnderstand(p.id));
+            }
+        }
+        Ok(())
+    }
+
+    /// Inline QoS: the key hash.
+    pub fn key_hash(&self) -> Option<[u8; 16]> {
+        self.get(pid::KEY_HASH).and_then(|v| v.get(..16)).map(|v| {
+            let mut k = [0u8; 16];
+            k.copy_from_slice(v);
+            k
+        })
+    }
+
+    /// Inline QoS: the status-info flags (last byte; 0x01 disposed, 0x02 unregistered).
+    pub fn status_info(&self) -> Option<u8> {
+        self.get(pid::STATUS_INFO).and_then(|v| v.get(3).copied())
+    }
+}
+
+/// Appends a parameter list in the given byte order. Call [`ParameterWriter::finish`] to add the sentinel.
+pub struct ParameterWriter<'a> {
+    put: Put<'a>,
+}
+
+impl<'a> ParameterWriter<'a> {
+    pub fn new(out: &'a mut Vec<u8>, little_endian: bool) -> Self {
+        ParameterWriter { put: Put { out, little_endian } }
+    }
+
+    /// Writes one parameter whose value `f` appends; pads to 4 and fills in the length.
+    pub fn param(&mut self, id: u16, f: impl FnOnce(&mut Put<'_>)) {
+        self.put.u16(id);
+        let len_at = self.put.out.len();
+        self.put.u16(0);
+        let start = self.put.out.len();
+        f(&mut self.put);
+        self.put.align_from(start, 4);
+        let len = (self.put.out.len() - start).min(u16::MAX as usize) as u16;
+        let b = if self.put.little_endian { len.to_le_bytes() } else { len.to_be_bytes() };
+        self.put.out[len_at..len_at + 2].copy_from_slice(&b);
+    }
+
+    pub fn raw(&mut self, id: u16, value: &[u8]) {
+        self.param(id, |p| p.bytes(value));
+    }
+    pub fn u32(&mut self, id: u16, v: u32) {
+        self.param(id, |p| p.u32(v));
+    }
+    pub fn i32(&mut self, id: u16, v: i32) {
+        self.param(id, |p| p.i32(v));
+    }
+    pub fn bool(&mut self, id: u16, v: bool) {
+        self.param(id, |p| p.u8(v as u8));
+    }
+    pub fn duration(&mut self, id: u16, d: std::time::Duration) {
+        self.param(id, |p| p.duration(d));
+    }
+    pub fn guid(&mut self, id: u16, g: &Guid) {
+        self.param(id, |p| p.bytes(&g.to_bytes()));
+    }
+    pub fn locator(&mut self, id: u16, l: &Locator) {
+        self.param(id, |p| p.locator(l));
+    }
+    pub fn string(&mut self, id: u16, s: &str) {
+        self.param(id, |p| put_string(p, s));
+    }
+    pub fn octets(&mut self, id: u16, b: &[u8]) {
+        self.param(id, |p| {
+            p.u32(b.len() as u32);
+            p.bytes(b);
+        });
+    }
+    pub fn finish(mut self) {
+        self.put.u16(pid::SENTINEL);
+        self.put.u16(0);
+    }
+}
+
+/// A CDR string (length with NUL, bytes, NUL), unaligned after.
+pub fn put_string(p: &mut Put<'_>, s: &str) {
+    p.u32(s.len() as u32 + 1);
+    p.bytes(s.as_bytes());
+    p.u8(0);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_both_orders() {
+        for le in [true, false] {
+            let mut buf = Vec::new();
+            let mut w = ParameterWriter::new(&mut buf, le);
+            w.string(pid::TOPIC_NAME, "abc");
+            w.u32(pid::DOMAIN_ID, 7);
+            w.raw(0x8001, &[1, 2, 3, 4]);
+            w.finish();
+            buf.extend_from_slice(b"tail");
+            let (pl, rest) = ParameterList::parse(&buf, le).unwrap();
+            assert_eq!(rest, b"tail");
+            let ps: Vec<_> = pl.iter().collect();
+            assert_eq!(ps.len(), 3);
+            assert_eq!(ps[0].id, pid::TOPIC_NAME);
+            assert_eq!(pl.cursor(ps[0].value).string().unwrap(), "abc");
+            assert_eq!(pl.cursor(pl.get(pid::DOMAIN_ID).unwrap()).u32().unwrap(), 7);
+            assert!(pl.check_must_understand(|_| false).is_ok());
+        }
+    }
+
+    #[test]
+    fn must_understand_and_truncation() {
+        let mut buf = Vec::new();
+        let mut w = ParameterWriter::new(&mut buf, true);
+        w.u32(0x4fff, 1);
+        w.finish();
+        let (pl, _) = ParameterList::parse(&buf, true).unwrap();
+        assert_eq!(pl.check_must_understand(|_| false), Err(WireError::MustUnderstand(0x4fff)));
+        for n in 0..buf.len() - 4 {
+            assert!(ParameterList::parse(&buf[..n], true).is_err(), "prefix {n}");
+        }
+    }
+}

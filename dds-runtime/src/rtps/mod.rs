@@ -1,0 +1,19 @@
+//! The sans-I/O RTPS 2.5 protocol core (quinn-proto style).
+//!
+//! Inputs are datagrams and the current time; outputs are datagrams to send ([`Transmit`]), the next timeout and
+//! [`Event`]s. Nothing here opens a socket, starts a thread or reads a clock, so the whole protocol is
+//! deterministic and testable in simulation. See `docs/rtps-core.md`.
+
+pub mod discovery;
+pub mod messages;
+mod outbox;
+mod participant;
+pub mod reader;
+pub mod types;
+pub mod writer;
+
+mod api;
+
+pub use api::*;
+pub use participant::Participant;
+pub use types::*;

@@ -1,0 +1,338 @@
+//! The participant: the sans-I/O state machine that owns every local endpoint and runs discovery.
+//!
+//! `receive` dispatches incoming submessages, `discovery` runs SPDP/SEDP/matching, `timers` the periodic work.
+
+mod discovery;
+mod receive;
+mod timers;
+
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet, VecDeque};
+use std::time::Instant;
+
+use super::api::*;
+use super::discovery::{ParticipantData, ReaderData, WriterData};
+use super::messages::Header;
+use super::outbox::Outbox;
+use super::reader::{Reader, ReaderParams};
+use super::types::*;
+use super::writer::{Writer, WriterParams};
+use crate::qos::{Durability, History, ResourceLimits};
+
+/// A discovered remote participant.
+#[derive(Debug)]
+struct ProxyParticipant {
+    data: ParticipantData,
+    lease_deadline: Instant,
+}
+
+/// A sans-I/O RTPS participant. See `docs/rtps-core.md`.
+#[derive(Debug)]
+pub struct Participant {
+    config: ParticipantConfig,
+    out: Outbox,
+    events: VecDeque<Event>,
+    /// Reused buffer for what readers deliver while a datagram is processed.
+    scratch: Vec<Event>,
+    writers: BTreeMap<EntityId, Writer>,
+    readers: BTreeMap<EntityId, Reader>,
+    /// User endpoints (builtin ones are only in `writers`/`readers`).
+    user_writers: BTreeSet<EntityId>,
+    user_readers: BTreeSet<EntityId>,
+    participants: HashMap<GuidPrefix, ProxyParticipant>,
+    /// Every known publication and subscription, remote and local (local ones match locally too).
+    known_writers: HashMap<Guid, WriterData>,
+    known_readers: HashMap<Guid, ReaderData>,
+    /// (local endpoint, remote endpoint) pairs already reported incompatible.
+    incompatible: HashSet<(EntityId, Guid)>,
+    next_entity_key: u32,
+    spdp_sn: SequenceNumber,
+    spdp_payload: Vec<u8>,
+    spdp_due: Instant,
+    pmd_due: Instant,
+}
+
+fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
+    WriterParams {
+        reliable: true,
+        durability: Durability::TransientLocal,
+        history: History::KeepLast(1),
+        limits: ResourceLimits::default(),
+        keyed: true,
+        heartbeat_period: c.heartbeat_period,
+        nack_response_delay: c.nack_response_delay,
+        fragment_size: c.fragment_size,
+        // Discovery data is never refused.
+        high_watermark: usize::MAX,
+        low_watermark: usize::MAX,
+        max_repair_bytes: c.max_repair_bytes,
+    }
+}
+
+fn reader_params(c: &ParticipantConfig, reliable: bool) -> ReaderParams {
+    ReaderParams {
+        reliable,
+        heartbeat_response_delay: c.heartbeat_response_delay,
+        max_sample_size: c.max_sample_size,
+        defrag_max_samples: c.defrag_max_samples.max(1),
+        defrag_max_bytes: c.defrag_max_bytes,
+        reorder_max_samples: c.reorder_max_samples.max(1),
+    }
+}
+
+impl Participant {
+    pub fn new(mut config: ParticipantConfig, now: Instant) -> Self {
+        // Fragments must fit the 16-bit fragmentSize field and leave room for headers in a datagram.
+        config.fragment_size = config.fragment_size.clamp(64, 65000);
+        let header = Header { version: ProtocolVersion::V2_5, vendor_id: config.vendor_id, guid_prefix: config.guid_prefix };
+        let mut p = Participant {
+            out: Outbox::new(header, config.max_message_size),
+            events: VecDeque::new(),
+            scratch: Vec::new(),
+            writers: BTreeMap::new(),
+            readers: BTreeMap::new(),
+            user_writers: BTreeSet::new(),
+            user_readers: BTreeSet::new(),
+            participants: HashMap::new(),
+            known_writers: HashMap::new(),
+            known_readers: HashMap::new(),
+            incompatible: HashSet::new(),
+            next_entity_key: 1,
+            spdp_sn: SequenceNumber(1),
+            spdp_payload: Vec::new(),
+            spdp_due: now,
+            pmd_due: now,
+            config,
+        };
+        let prefix = p.config.guid_prefix;
+        for (w, _, _) in super::discovery::builtin::WRITER_PAIRS {
+            p.writers.insert(w, Writer::new(Guid::new(prefix, w), builtin_writer_params(&p.config)));
+        }
+        for (r, _, _) in super::discovery::builtin::READER_PAIRS {
+            p.readers.insert(r, Reader::new(Guid::new(prefix, r), reader_params(&p.config, true)));
+        }
+        p.spdp_payload = p.participant_data().encode();
+        p.service(now);
+        p
+    }
+
+    pub fn config(&self) -> &ParticipantConfig {
+        &self.config
+    }
+    pub fn guid_prefix(&self) -> GuidPrefix {
+        self.config.guid_prefix
+    }
+
+    /// What we announce in SPDP.
+    pub fn participant_data(&self) -> ParticipantData {
+        let c = &self.config;
+        ParticipantData {
+            guid_prefix: c.guid_prefix,
+            protocol_version: ProtocolVersion::V2_5,
+            vendor_id: c.vendor_id,
+            domain_id: Some(c.domain_id),
+            domain_tag: String::new(),
+            expects_inline_qos: false,
+            metatraffic_unicast: c.metatraffic_unicast.clone(),
+            metatraffic_multicast: c.metatraffic_multicast.clone(),
+            default_unicast: c.default_unicast.clone(),
+            default_multicast: c.default_multicast.clone(),
+            lease_duration: c.lease_duration,
+            builtin_endpoints: super::discovery::builtin::OURS,
+            manual_liveliness_count: 0,
+            user_data: c.user_data.clone(),
+            properties: c.properties.clone(),
+            entity_name: c.entity_name.clone(),
+        }
+    }
+
+    pub fn poll_transmit(&mut self, _now: Instant) -> Option<Transmit> {
+        self.out.pop()
+    }
+
+    /// Gives a sent datagram's buffer back for reuse (optional; saves an allocation per datagram).
+    pub fn recycle(&mut self, buf: Vec<u8>) {
+        self.out.recycle(buf);
+    }
+
+    pub fn poll_event(&mut self) -> Option<Event> {
+        self.events.pop_front()
+    }
+
+    pub fn handle_timeout(&mut self, now: Instant) {
+        self.service(now);
+    }
+
+    fn alloc_entity(&mut self, kind: u8) -> Result<EntityId, CoreError> {
+        if self.next_entity_key >= 1 << 24 {
+            return Err(CoreError::OutOfEntityIds);
+        }
+        let k = self.next_entity_key.to_be_bytes();
+        self.next_entity_key += 1;
+        Ok(EntityId::new([k[1], k[2], k[3]], kind))
+    }
+
+    pub fn create_writer(&mut self, now: Instant, spec: WriterSpec) -> Result<EntityId, CoreError> {
+        if spec.topic_name.is_empty() || spec.type_name.is_empty() {
+            return Err(CoreError::BadParameter("empty topic or type name"));
+        }
+        let kind = if spec.keyed { entity_kind::USER_WRITER_WITH_KEY } else { entity_kind::USER_WRITER_NO_KEY };
+        let id = self.alloc_entity(kind)?;
+        let guid = Guid::new(self.config.guid_prefix, id);
+        let q = &spec.qos.writer;
+        let c = &self.config;
+        let params = WriterParams {
+            reliable: q.reliability.is_reliable(),
+            durability: q.durability,
+            history: q.history,
+            limits: q.resource_limits,
+            keyed: spec.keyed,
+            heartbeat_period: c.heartbeat_period,
+            nack_response_delay: c.nack_response_delay,
+            fragment_size: c.fragment_size,
+            high_watermark: c.whc_high_watermark.max(1),
+            low_watermark: c.whc_low_watermark.min(c.whc_high_watermark),
+            max_repair_bytes: c.max_repair_bytes,
+        };
+        self.writers.insert(id, Writer::new(guid, params));
+        self.user_writers.insert(id);
+        let data = WriterData {
+            guid,
+            participant_guid: Some(Guid::new(guid.prefix, EntityId::PARTICIPANT)),
+            topic_name: spec.topic_name,
+            type_name: spec.type_name,
+            qos: spec.qos,
+            unicast_locators: Vec::new(),
+            multicast_locators: Vec::new(),
+            type_information: spec.type_information,
+            entity_name: spec.entity_name,
+        };
+        self.announce(now, EntityId::SEDP_PUBLICATIONS_WRITER, guid, ChangeKind::Alive, data.encode());
+        self.on_writer_known(now, data);
+        self.service(now);
+        Ok(id)
+    }
+
+    pub fn create_reader(&mut self, now: Instant, spec: ReaderSpec) -> Result<EntityId, CoreError> {
+        if spec.topic_name.is_empty() || spec.type_name.is_empty() {
+            return Err(CoreError::BadParameter("empty topic or type name"));
+        }
+        let kind = if spec.keyed { entity_kind::USER_READER_WITH_KEY } else { entity_kind::USER_READER_NO_KEY };
+        let id = self.alloc_entity(kind)?;
+        let guid = Guid::new(self.config.guid_prefix, id);
+        let reliable = spec.qos.reader.reliability.is_reliable();
+        self.readers.insert(id, Reader::new(guid, reader_params(&self.config, reliable)));
+        self.user_readers.insert(id);
+        let data = ReaderData {
+            guid,
+            participant_guid: Some(Guid::new(guid.prefix, EntityId::PARTICIPANT)),
+            topic_name: spec.topic_name,
+            type_name: spec.type_name,
+            qos: spec.qos,
+            unicast_locators: Vec::new(),
+            multicast_locators: Vec::new(),
+            expects_inline_qos: false,
+            type_information: spec.type_information,
+            entity_name: spec.entity_name,
+        };
+        self.announce(now, EntityId::SEDP_SUBSCRIPTIONS_WRITER, guid, ChangeKind::Alive, data.encode());
+        self.on_reader_known(now, data);
+        self.service(now);
+        Ok(id)
+    }
+
+    /// Deletes a writer. A reliable writer with unacknowledged data lingers (still repairing, refusing writes)
+    /// until acknowledged or `writer_linger_duration` passes; then `Event::WriterDeleted`.
+    pub fn delete_writer(&mut self, now: Instant, id: EntityId) {
+        if !self.user_writers.contains(&id) {
+            return;
+        }
+        let Some(w) = self.writers.get_mut(&id) else { return };
+        if w.linger_until.is_some() {
+            return;
+        }
+        if w.is_acknowledged() {
+            self.finish_writer(now, id);
+        } else {
+            w.linger_until = Some(now + self.config.writer_linger_duration);
+        }
+        self.service(now);
+    }
+
+    pub fn delete_reader(&mut self, now: Instant, id: EntityId) {
+        if !self.user_readers.remove(&id) {
+            return;
+        }
+        let guid = Guid::new(self.config.guid_prefix, id);
+        if let Some(r) = self.readers.remove(&id) {
+            for w in r.matched() {
+                self.events.push_back(Event::SubscriptionMatched { reader: id, writer: *w, matched: false });
+            }
+        }
+        self.announce(now, EntityId::SEDP_SUBSCRIPTIONS_WRITER, guid, ChangeKind::DisposeUnregister, Vec::new());
+        self.forget_reader(guid);
+        self.service(now);
+    }
+
+    fn finish_writer(&mut self, now: Instant, id: EntityId) {
+        self.user_writers.remove(&id);
+        let guid = Guid::new(self.config.guid_prefix, id);
+        if let Some(w) = self.writers.remove(&id) {
+            for r in w.matched() {
+                self.events.push_back(Event::PublicationMatched { writer: id, reader: *r, matched: false });
+            }
+        }
+        self.announce(now, EntityId::SEDP_PUBLICATIONS_WRITER, guid, ChangeKind::DisposeUnregister, Vec::new());
+        self.forget_writer(guid);
+        self.events.push_back(Event::WriterDeleted { writer: id });
+    }
+
+    pub fn write(&mut self, now: Instant, writer: EntityId, change: WriteChange) -> Result<SequenceNumber, WriteError> {
+        if !self.user_writers.contains(&writer) {
+            return Err(WriteError::UnknownWriter(writer));
+        }
+        let Some(w) = self.writers.get_mut(&writer) else { return Err(WriteError::UnknownWriter(writer)) };
+        w.write(now, change, &mut self.out, &mut self.events)
+    }
+
+    pub fn is_acknowledged(&self, writer: EntityId) -> bool {
+        self.writers.get(&writer).is_none_or(|w| w.is_acknowledged())
+    }
+
+    /// Bytes written but not yet acknowledged by every reliable reader (what flow control looks at).
+    pub fn unacknowledged_bytes(&self, writer: EntityId) -> usize {
+        self.writers.get(&writer).map_or(0, |w| w.unacked_bytes())
+    }
+
+    pub fn writer_matches(&self, writer: EntityId) -> Vec<Guid> {
+        if !self.user_writers.contains(&writer) {
+            return Vec::new();
+        }
+        self.writers.get(&writer).map(|w| w.matched().copied().collect()).unwrap_or_default()
+    }
+
+    pub fn reader_matches(&self, reader: EntityId) -> Vec<Guid> {
+        if !self.user_readers.contains(&reader) {
+            return Vec::new();
+        }
+        self.readers.get(&reader).map(|r| r.matched().copied().collect()).unwrap_or_default()
+    }
+
+    /// Discovered remote participants.
+    pub fn discovered_participants(&self) -> impl Iterator<Item = &ParticipantData> {
+        self.participants.values().map(|p| &p.data)
+    }
+
+    /// A known publication (remote or local), e.g. for ownership strength or builtin topics.
+    pub fn publication(&self, guid: &Guid) -> Option<&WriterData> {
+        self.known_writers.get(guid)
+    }
+    pub fn subscription(&self, guid: &Guid) -> Option<&ReaderData> {
+        self.known_readers.get(guid)
+    }
+
+    /// Announces our departure: SPDP dispose to everyone, so peers drop us without waiting for the lease.
+    /// Drain `poll_transmit` afterwards.
+    pub fn shutdown(&mut self, _now: Instant) {
+        self.send_spdp_dispose();
+    }
+}

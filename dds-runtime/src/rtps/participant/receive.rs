@@ -1,0 +1,128 @@
+//! Incoming datagrams: the receiver state (§8.3.4) and dispatch of submessages to writers and readers.
+
+use std::time::Instant;
+
+use tracing::{debug, trace};
+
+use super::Participant;
+use crate::rtps::api::Event;
+use crate::rtps::messages::{MessageIter, Submessage};
+use crate::rtps::reader::Reader;
+use crate::rtps::types::*;
+
+impl Participant {
+    /// Processes one datagram. Never panics; malformed input is dropped with a `tracing` event.
+    pub fn handle_datagram(&mut self, now: Instant, data: &[u8]) {
+        let (header, subs) = match MessageIter::parse(data) {
+            Ok(x) => x,
+            Err(e) => {
+                trace!(error = %e, len = data.len(), "dropping datagram");
+                return;
+            }
+        };
+        let ours = self.config.guid_prefix;
+        let mut src = header.guid_prefix;
+        let mut for_us = true;
+        let mut ts: Option<Time> = None;
+        self.refresh_lease(now, src);
+        for sub in subs {
+            let sub = match sub {
+                Ok(s) => s,
+                Err(e) => {
+                    debug!(error = %e, source = ?src, "invalid submessage; ignoring the rest of the message");
+                    break;
+                }
+            };
+            match sub {
+                Submessage::InfoTs(t) => ts = t,
+                Submessage::InfoSrc(s) => {
+                    src = s.guid_prefix;
+                    for_us = true;
+                    ts = None;
+                }
+                Submessage::InfoDst(p) => for_us = p == ours || p == GuidPrefix::UNKNOWN,
+                _ if !for_us => {}
+                Submessage::Data(d) => {
+                    let wguid = Guid::new(src, d.writer_id);
+                    if d.writer_id == EntityId::SPDP_WRITER {
+                        self.on_spdp(now, src, &d);
+                    } else {
+                        let scratch = &mut self.scratch;
+                        for_readers(&mut self.readers, d.reader_id, wguid, |r| r.on_data(wguid, &d, ts, scratch));
+                    }
+                }
+                Submessage::DataFrag(d) => {
+                    let wguid = Guid::new(src, d.writer_id);
+                    let scratch = &mut self.scratch;
+                    for_readers(&mut self.readers, d.reader_id, wguid, |r| r.on_data_frag(wguid, &d, ts, scratch));
+                }
+                Submessage::Heartbeat(h) => {
+                    let wguid = Guid::new(src, h.writer_id);
+                    let scratch = &mut self.scratch;
+                    for_readers(&mut self.readers, h.reader_id, wguid, |r| r.on_heartbeat(now, wguid, &h, scratch));
+                }
+                Submessage::Gap(g) => {
+                    let wguid = Guid::new(src, g.writer_id);
+                    let scratch = &mut self.scratch;
+                    for_readers(&mut self.readers, g.reader_id, wguid, |r| r.on_gap(wguid, &g, scratch));
+                }
+                Submessage::HeartbeatFrag(h) => {
+                    let wguid = Guid::new(src, h.writer_id);
+                    for_readers(&mut self.readers, h.reader_id, wguid, |r| r.on_heartbeat_frag(now, wguid, &h));
+                }
+                Submessage::AckNack(a) => {
+                    if let Some(w) = self.writers.get_mut(&a.writer_id) {
+                        w.on_acknack(now, Guid::new(src, a.reader_id), &a, &mut self.events);
+                    }
+                }
+                Submessage::NackFrag(n) => {
+                    if let Some(w) = self.writers.get_mut(&n.writer_id) {
+                        w.on_nack_frag(now, Guid::new(src, n.reader_id), &n);
+                    }
+                }
+                Submessage::Pad | Submessage::InfoReply(_) | Submessage::InfoReplyIp4(_) => {}
+                Submessage::Unknown { id, .. } => trace!(id, "skipping unknown submessage"),
+            }
+            self.route_deliveries(now);
+        }
+        self.service(now);
+    }
+
+    /// Hands what readers delivered to discovery (builtin readers) or to the application (events).
+    fn route_deliveries(&mut self, now: Instant) {
+        if self.scratch.is_empty() {
+            return;
+        }
+        let mut batch = std::mem::take(&mut self.scratch);
+        for ev in batch.drain(..) {
+            match ev {
+                Event::Sample(s) if s.reader.is_builtin() => self.on_builtin_sample(now, s),
+                Event::SampleLost { reader, .. } if reader.is_builtin() => {}
+                e => self.events.push_back(e),
+            }
+        }
+        self.scratch = batch;
+    }
+}
+
+/// Runs `f` on the addressed reader, or on every reader matched with `writer` when the reader id is UNKNOWN.
+fn for_readers(
+    readers: &mut std::collections::BTreeMap<EntityId, Reader>,
+    reader_id: EntityId,
+    writer: Guid,
+    mut f: impl FnMut(&mut Reader),
+) {
+    if reader_id != EntityId::UNKNOWN {
+        if let Some(r) = readers.get_mut(&reader_id) {
+            if r.has_proxy(&writer) {
+                f(r);
+            }
+        }
+        return;
+    }
+    for r in readers.values_mut() {
+        if r.has_proxy(&writer) {
+            f(r);
+        }
+    }
+}

@@ -1,0 +1,136 @@
+//! Periodic work: SPDP announcements, liveliness messages, leases, writer and reader timers, lingering.
+
+use std::time::Instant;
+
+use tracing::debug;
+
+use super::Participant;
+use crate::rtps::api::{ChangeKind, WriteChange};
+use crate::rtps::discovery::builtin;
+use crate::rtps::messages::parameter::{pid, ParameterWriter};
+use crate::rtps::messages::{Data, ParameterList, Submessage};
+use crate::rtps::outbox::Ts;
+use crate::rtps::types::*;
+
+impl Participant {
+    /// When `handle_timeout` must be called next.
+    pub fn poll_timeout(&self) -> Option<Instant> {
+        let mut t = self.spdp_due.min(self.pmd_due);
+        for p in self.participants.values() {
+            t = t.min(p.lease_deadline);
+        }
+        for w in self.writers.values() {
+            if let Some(x) = w.next_timeout() {
+                t = t.min(x);
+            }
+            if let Some(x) = w.linger_until {
+                t = t.min(x);
+            }
+        }
+        for r in self.readers.values() {
+            if let Some(x) = r.next_timeout() {
+                t = t.min(x);
+            }
+        }
+        Some(t)
+    }
+
+    /// Runs everything due at `now`.
+    pub(super) fn service(&mut self, now: Instant) {
+        if now >= self.spdp_due {
+            self.send_spdp(None);
+            self.spdp_due = now + self.config.spdp_interval;
+        }
+        if now >= self.pmd_due {
+            // Automatic liveliness: one ParticipantMessageData per interval keeps our lease alive at peers that
+            // only count builtin liveliness traffic.
+            let prefix = self.config.guid_prefix;
+            let change = WriteChange::alive(builtin::encode_participant_message(&prefix, builtin::PMD_KIND_AUTOMATIC, &[]))
+                .with_key_hash(builtin::participant_message_key(&prefix, builtin::PMD_KIND_AUTOMATIC));
+            if let Some(w) = self.writers.get_mut(&EntityId::P2P_MESSAGE_WRITER) {
+                let _ = w.write(now, change, &mut self.out, &mut self.events);
+            }
+            self.pmd_due = now + self.config.spdp_interval;
+        }
+        let expired: Vec<GuidPrefix> =
+            self.participants.iter().filter(|(_, p)| p.lease_deadline <= now).map(|(k, _)| *k).collect();
+        for prefix in expired {
+            debug!(participant = ?prefix, "lease expired");
+            self.remove_participant(prefix);
+        }
+        let lingering: Vec<EntityId> = self
+            .writers
+            .iter()
+            .filter(|(_, w)| w.linger_until.is_some_and(|t| t <= now || w.is_acknowledged()))
+            .map(|(k, _)| *k)
+            .collect();
+        for id in lingering {
+            self.finish_writer(now, id);
+        }
+        for w in self.writers.values_mut() {
+            if w.next_timeout().is_some_and(|t| t <= now) {
+                w.on_timeout(now, &mut self.out);
+            }
+        }
+        for r in self.readers.values_mut() {
+            if r.next_timeout().is_some_and(|t| t <= now) {
+                r.on_timeout(now, &mut self.out);
+            }
+        }
+    }
+
+    /// Sends our SPDP announcement to the SPDP multicast locators and initial peers, or to `to` only.
+    pub(super) fn send_spdp(&mut self, to: Option<Vec<Locator>>) {
+        let dest = to.unwrap_or_else(|| {
+            let mut d = self.config.metatraffic_multicast.clone();
+            d.extend(self.config.initial_peers.iter().copied());
+            d.sort();
+            d.dedup();
+            d
+        });
+        let sn = self.spdp_sn;
+        self.spdp_sn = sn.next();
+        let data = Submessage::Data(Data {
+            reader_id: EntityId::SPDP_READER,
+            writer_id: EntityId::SPDP_WRITER,
+            writer_sn: sn,
+            inline_qos: None,
+            payload: Some(&self.spdp_payload),
+            key_flag: false,
+            non_standard_flag: false,
+        });
+        self.out.push(&dest, None, Ts::Set(None), &data);
+    }
+
+    pub(super) fn send_spdp_dispose(&mut self) {
+        let guid = Guid::new(self.config.guid_prefix, EntityId::PARTICIPANT);
+        let mut qos = Vec::with_capacity(32);
+        let mut w = ParameterWriter::new(&mut qos, true);
+        w.raw(pid::KEY_HASH, &guid.to_bytes());
+        w.raw(pid::STATUS_INFO, &[0, 0, 0, ChangeKind::DisposeUnregister.status_info()]);
+        drop(w);
+        let mut key = crate::rtps::discovery::PL_CDR_LE.to_vec();
+        let mut kw = ParameterWriter::new(&mut key, true);
+        kw.guid(pid::PARTICIPANT_GUID, &guid);
+        kw.finish();
+        let mut dest = self.config.metatraffic_multicast.clone();
+        dest.extend(self.config.initial_peers.iter().copied());
+        for p in self.participants.values() {
+            dest.extend(p.data.metatraffic_unicast.first().copied());
+        }
+        dest.sort();
+        dest.dedup();
+        let sn = self.spdp_sn;
+        self.spdp_sn = sn.next();
+        let data = Submessage::Data(Data {
+            reader_id: EntityId::SPDP_READER,
+            writer_id: EntityId::SPDP_WRITER,
+            writer_sn: sn,
+            inline_qos: Some(ParameterList { data: &qos, little_endian: true }),
+            payload: Some(&key),
+            key_flag: true,
+            non_standard_flag: false,
+        });
+        self.out.push(&dest, None, Ts::Set(None), &data);
+    }
+}

@@ -1,0 +1,84 @@
+//! Reassembly of DATA_FRAG samples. Memory is what was received, never what a sender claims.
+
+use std::collections::BTreeMap;
+
+use crate::rtps::api::Payload;
+
+/// One sample being reassembled.
+#[derive(Debug)]
+pub struct Defrag {
+    pub sample_size: u32,
+    pub fragment_size: u16,
+    /// Fragments received, by 1-based number.
+    frags: BTreeMap<u32, Vec<u8>>,
+    pub bytes: usize,
+    /// Inline QoS of the first fragment seen: (status info, key hash).
+    pub status_info: Option<u8>,
+    pub key_hash: Option<[u8; 16]>,
+    pub key_flag: bool,
+}
+
+impl Defrag {
+    pub fn new(sample_size: u32, fragment_size: u16) -> Self {
+        Defrag {
+            sample_size,
+            fragment_size,
+            frags: BTreeMap::new(),
+            bytes: 0,
+            status_info: None,
+            key_hash: None,
+            key_flag: false,
+        }
+    }
+
+    pub fn total(&self) -> u32 {
+        self.sample_size.div_ceil(self.fragment_size as u32)
+    }
+
+    /// Adds fragment `num` (its bytes); returns the bytes newly held. Inconsistent fragments are ignored.
+    pub fn add(&mut self, num: u32, data: &[u8]) -> usize {
+        if num == 0 || num > self.total() || self.frags.contains_key(&num) {
+            return 0;
+        }
+        let start = (num as u64 - 1) * self.fragment_size as u64;
+        let expect = (self.sample_size as u64 - start).min(self.fragment_size as u64) as usize;
+        if data.len() != expect {
+            return 0;
+        }
+        self.frags.insert(num, data.to_vec());
+        self.bytes += data.len();
+        data.len()
+    }
+
+    pub fn is_complete(&self) -> bool {
+        self.frags.len() as u64 == self.total() as u64
+    }
+
+    /// The missing fragment numbers up to `last` (at most 256, from the first missing one).
+    pub fn missing(&self, last: u32) -> Vec<u32> {
+        let last = last.min(self.total());
+        let mut v = Vec::new();
+        let mut n = 1;
+        while n <= last && v.len() < 256 {
+            if !self.frags.contains_key(&n) {
+                if let Some(&first) = v.first() {
+                    if n - first >= 256 {
+                        break;
+                    }
+                }
+                v.push(n);
+            }
+            n += 1;
+        }
+        v
+    }
+
+    /// Concatenates the fragments (only call when complete).
+    pub fn assemble(self) -> Payload {
+        let mut v = Vec::with_capacity(self.sample_size as usize);
+        for f in self.frags.into_values() {
+            v.extend_from_slice(&f);
+        }
+        Payload::from(v)
+    }
+}

@@ -1,0 +1,347 @@
+//! Readers: per-writer proxies, reordering, duplicate suppression, defragmentation and acknowledgement
+//! (§8.4.10, §8.4.12).
+
+mod defrag;
+mod writer_proxy;
+
+pub use writer_proxy::{PendingChange, Slot, WriterProxy};
+
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+use crate::rtps::api::{ChangeKind, Event, Payload, ReceivedSample};
+use crate::rtps::messages::{AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, NackFrag, Submessage};
+use crate::rtps::outbox::{Outbox, Ts};
+use crate::rtps::types::*;
+use defrag::Defrag;
+
+/// Protocol parameters of one reader.
+#[derive(Debug, Clone, Copy)]
+pub struct ReaderParams {
+    pub reliable: bool,
+    pub heartbeat_response_delay: Duration,
+    pub max_sample_size: usize,
+    pub defrag_max_samples: usize,
+    pub defrag_max_bytes: usize,
+    pub reorder_max_samples: usize,
+}
+
+/// A local reader's protocol state.
+#[derive(Debug)]
+pub struct Reader {
+    pub guid: Guid,
+    params: ReaderParams,
+    proxies: BTreeMap<Guid, WriterProxy>,
+}
+
+impl Reader {
+    pub fn new(guid: Guid, params: ReaderParams) -> Self {
+        Reader { guid, params, proxies: BTreeMap::new() }
+    }
+
+    pub fn params(&self) -> &ReaderParams {
+        &self.params
+    }
+    pub fn matched(&self) -> impl Iterator<Item = &Guid> {
+        self.proxies.keys()
+    }
+    pub fn has_proxy(&self, g: &Guid) -> bool {
+        self.proxies.contains_key(g)
+    }
+    pub fn proxy(&self, g: &Guid) -> Option<&WriterProxy> {
+        self.proxies.get(g)
+    }
+
+    pub fn add_proxy(&mut self, now: Instant, mut proxy: WriterProxy) {
+        proxy.reliable &= self.params.reliable;
+        if proxy.reliable {
+            // Pre-emptive ACKNACK: prompts the writer to tell us what it has.
+            proxy.acknack_due = Some(now);
+        }
+        self.proxies.insert(proxy.guid, proxy);
+    }
+
+    pub fn remove_proxy(&mut self, g: &Guid) -> bool {
+        self.proxies.remove(g).is_some()
+    }
+
+    fn deliver(reader: EntityId, p: &mut WriterProxy, sn: SequenceNumber, slot: Slot, out: &mut Vec<Event>) {
+        if let Slot::Change(c) = slot {
+            out.push(Event::Sample(ReceivedSample {
+                reader,
+                writer: p.guid,
+                sequence: sn,
+                kind: c.kind,
+                payload: c.payload,
+                key_hash: c.key_hash,
+                source_timestamp: c.source_timestamp,
+            }));
+        }
+    }
+
+    fn drain(reader: EntityId, p: &mut WriterProxy, out: &mut Vec<Event>) {
+        while let Some(e) = p.reorder.first_entry() {
+            if *e.key() > p.next_expected {
+                break;
+            }
+            let (sn, slot) = e.remove_entry();
+            if sn == p.next_expected {
+                Self::deliver(reader, p, sn, slot, out);
+                p.next_expected = sn.next();
+            }
+        }
+    }
+
+    /// Puts one received change (or irrelevant number) into sequence.
+    fn accept(&self, p: &mut WriterProxy, sn: SequenceNumber, slot: Slot, out: &mut Vec<Event>) {
+        let rid = self.guid.entity_id;
+        if p.reliable {
+            if p.has(sn) {
+                return;
+            }
+            p.synced = true;
+            if sn == p.next_expected {
+                Self::deliver(rid, p, sn, slot, out);
+                p.next_expected = sn.next();
+                Self::drain(rid, p, out);
+            } else if p.reorder.len() < self.params.reorder_max_samples {
+                p.reorder.insert(sn, slot);
+            }
+        } else {
+            if sn < p.next_expected {
+                return;
+            }
+            if p.synced && sn > p.next_expected {
+                out.push(Event::SampleLost { reader: rid, writer: p.guid, count: (sn.0 - p.next_expected.0) as u64 });
+            }
+            p.synced = true;
+            Self::deliver(rid, p, sn, slot, out);
+            p.next_expected = sn.next();
+        }
+        p.drop_stale_defrag();
+    }
+
+    pub fn on_data(&mut self, writer: Guid, d: &Data<'_>, ts: Option<Time>, out: &mut Vec<Event>) {
+        let Some(mut p) = self.proxies.remove(&writer) else { return };
+        let status = d.inline_qos.and_then(|q| q.status_info());
+        let kind = status.map_or(ChangeKind::Alive, ChangeKind::from_status_info);
+        let key_hash = d.inline_qos.and_then(|q| q.key_hash());
+        let slot = match d.payload {
+            Some(b) if b.len() > self.params.max_sample_size => {
+                out.push(Event::SampleLost { reader: self.guid.entity_id, writer, count: 1 });
+                Slot::Irrelevant
+            }
+            // Alive data needs a payload; a dispose/unregister may come with only inline QoS.
+            None if kind == ChangeKind::Alive => Slot::Irrelevant,
+            b => Slot::Change(PendingChange {
+                kind,
+                payload: b.map(Payload::copy_from_slice).unwrap_or_default(),
+                key_hash,
+                source_timestamp: ts,
+            }),
+        };
+        self.accept(&mut p, d.writer_sn, slot, out);
+        self.proxies.insert(writer, p);
+    }
+
+    pub fn on_data_frag(&mut self, writer: Guid, d: &DataFrag<'_>, ts: Option<Time>, out: &mut Vec<Event>) {
+        let Some(mut p) = self.proxies.remove(&writer) else { return };
+        self.data_frag(&mut p, d, ts, out);
+        self.proxies.insert(writer, p);
+    }
+
+    fn data_frag(&self, p: &mut WriterProxy, d: &DataFrag<'_>, ts: Option<Time>, out: &mut Vec<Event>) {
+        let sn = d.writer_sn;
+        if p.has(sn) {
+            return;
+        }
+        if d.sample_size as usize > self.params.max_sample_size {
+            out.push(Event::SampleLost { reader: self.guid.entity_id, writer: p.guid, count: 1 });
+            self.accept(p, sn, Slot::Irrelevant, out);
+            return;
+        }
+        if !p.defrag.contains_key(&sn) {
+            if p.defrag.len() >= self.params.defrag_max_samples {
+                // Reliable: keep the oldest (they unblock delivery); best effort: keep the newest.
+                let victim = if p.reliable { p.defrag.last_key_value() } else { p.defrag.first_key_value() };
+                let Some((&v, _)) = victim else { return };
+                if p.reliable && v < sn {
+                    return;
+                }
+                if let Some(old) = p.defrag.remove(&v) {
+                    p.defrag_bytes -= old.bytes;
+                }
+            }
+            let mut df = Defrag::new(d.sample_size, d.fragment_size);
+            df.status_info = d.inline_qos.and_then(|q| q.status_info());
+            df.key_hash = d.inline_qos.and_then(|q| q.key_hash());
+            df.key_flag = d.key_flag;
+            p.defrag.insert(sn, df);
+        }
+        let Some(df) = p.defrag.get_mut(&sn) else { return };
+        if df.sample_size != d.sample_size || df.fragment_size != d.fragment_size {
+            return;
+        }
+        let fs = d.fragment_size as usize;
+        for (i, chunk) in d.payload.chunks(fs).enumerate() {
+            if p.defrag_bytes + chunk.len() > self.params.defrag_max_bytes {
+                break;
+            }
+            p.defrag_bytes += df.add(d.fragment_starting_num.saturating_add(i as u32), chunk);
+        }
+        if df.is_complete() {
+            let Some(df) = p.defrag.remove(&sn) else { return };
+            p.defrag_bytes -= df.bytes;
+            let kind = df.status_info.map_or(ChangeKind::Alive, ChangeKind::from_status_info);
+            let key_hash = df.key_hash;
+            let payload = df.assemble();
+            let slot = Slot::Change(PendingChange { kind, payload, key_hash, source_timestamp: ts });
+            self.accept(p, sn, slot, out);
+        }
+    }
+
+    pub fn on_gap(&mut self, writer: Guid, g: &Gap, out: &mut Vec<Event>) {
+        let rid = self.guid.entity_id;
+        let cap = self.params.reorder_max_samples;
+        let Some(p) = self.proxies.get_mut(&writer) else { return };
+        p.synced = true;
+        let base = g.gap_list.base;
+        if g.gap_start <= p.next_expected && base > p.next_expected {
+            // Everything up to base is irrelevant or was buffered: buffered data in the range is delivered.
+            while let Some(e) = p.reorder.first_entry() {
+                if *e.key() >= base {
+                    break;
+                }
+                let (sn, slot) = e.remove_entry();
+                if matches!(slot, Slot::Change(_)) && sn >= p.next_expected {
+                    // The writer says sn is irrelevant; honour the GAP.
+                }
+            }
+            p.next_expected = base;
+        } else if g.gap_start > p.next_expected && base.0 - g.gap_start.0 <= 256 {
+            let mut sn = g.gap_start;
+            while sn < base && p.reorder.len() < cap {
+                p.reorder.entry(sn).or_insert(Slot::Irrelevant);
+                sn = sn.next();
+            }
+        }
+        for sn in g.gap_list.iter() {
+            if sn >= p.next_expected && p.reorder.len() < cap {
+                p.reorder.entry(sn).or_insert(Slot::Irrelevant);
+            }
+        }
+        Self::drain(rid, p, out);
+        p.drop_stale_defrag();
+    }
+
+    pub fn on_heartbeat(&mut self, now: Instant, writer: Guid, hb: &Heartbeat, out: &mut Vec<Event>) {
+        let rid = self.guid.entity_id;
+        let delay = self.params.heartbeat_response_delay;
+        let Some(p) = self.proxies.get_mut(&writer) else { return };
+        if !p.reliable {
+            return;
+        }
+        if p.last_hb_count.is_some_and(|c| hb.count.wrapping_sub(c) <= 0) {
+            return;
+        }
+        p.last_hb_count = Some(hb.count);
+        p.hb_last = p.hb_last.max(hb.last_sn);
+        if hb.first_sn > p.next_expected {
+            // The writer no longer has [next_expected, first): deliver what we hold of it, count the rest lost.
+            let mut lost = 0u64;
+            let mut sn = p.next_expected;
+            while let Some(e) = p.reorder.first_entry() {
+                if *e.key() >= hb.first_sn {
+                    break;
+                }
+                let (k, slot) = e.remove_entry();
+                if matches!(slot, Slot::Change(_)) {
+                    lost += (k.0 - sn.0) as u64;
+                    Self::deliver(rid, p, k, slot, out);
+                    sn = k.next();
+                }
+            }
+            lost += (hb.first_sn.0 - sn.0).max(0) as u64;
+            if p.synced && lost > 0 {
+                out.push(Event::SampleLost { reader: rid, writer, count: lost });
+            }
+            p.next_expected = hb.first_sn;
+            Self::drain(rid, p, out);
+            p.drop_stale_defrag();
+        }
+        p.synced = true;
+        let missing = p.hb_last >= p.next_expected;
+        if !hb.final_flag || missing {
+            p.acknack_due.get_or_insert(now + delay);
+        }
+    }
+
+    pub fn on_heartbeat_frag(&mut self, now: Instant, writer: Guid, hf: &HeartbeatFrag) {
+        let delay = self.params.heartbeat_response_delay;
+        let Some(p) = self.proxies.get_mut(&writer) else { return };
+        if !p.reliable || p.last_hbfrag_count.is_some_and(|c| hf.count.wrapping_sub(c) <= 0) {
+            return;
+        }
+        p.last_hbfrag_count = Some(hf.count);
+        p.hb_last = p.hb_last.max(hf.writer_sn);
+        if !p.has(hf.writer_sn) {
+            p.acknack_due.get_or_insert(now + delay);
+        }
+    }
+
+    pub fn next_timeout(&self) -> Option<Instant> {
+        self.proxies.values().filter_map(|p| p.acknack_due).min()
+    }
+
+    /// Sends due ACKNACKs (and NACK_FRAGs for partly received samples).
+    pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
+        let rid = self.guid.entity_id;
+        for p in self.proxies.values_mut() {
+            if !p.acknack_due.is_some_and(|t| t <= now) {
+                continue;
+            }
+            p.acknack_due = None;
+            let base = p.next_expected;
+            let mut set = SequenceNumberSet::empty(base);
+            let upper = p.hb_last.min(base + 255);
+            let mut sn = base;
+            while sn <= upper {
+                if !p.reorder.contains_key(&sn) && !p.defrag.contains_key(&sn) {
+                    set.insert(sn);
+                }
+                sn = sn.next();
+            }
+            p.acknack_count = p.acknack_count.wrapping_add(1);
+            let dest = p.destination().to_vec();
+            let dst = Some(p.guid.prefix);
+            let ack = Submessage::AckNack(AckNack {
+                reader_id: rid,
+                writer_id: p.guid.entity_id,
+                reader_sn_state: set,
+                count: p.acknack_count,
+                final_flag: set.num_bits == 0 && p.synced,
+            });
+            out.push(&dest, dst, Ts::Any, &ack);
+            for (sn, d) in p.defrag.range(base..) {
+                if *sn > p.hb_last {
+                    break;
+                }
+                let missing = d.missing(d.total());
+                let Some(&first) = missing.first() else { continue };
+                let mut fs = FragmentNumberSet::empty(first);
+                missing.iter().for_each(|&f| {
+                    fs.insert(f);
+                });
+                p.nackfrag_count = p.nackfrag_count.wrapping_add(1);
+                let nf = Submessage::NackFrag(NackFrag {
+                    reader_id: rid,
+                    writer_id: p.guid.entity_id,
+                    writer_sn: *sn,
+                    fragment_number_state: fs,
+                    count: p.nackfrag_count,
+                });
+                out.push(&dest, dst, Ts::Any, &nf);
+            }
+        }
+    }
+}

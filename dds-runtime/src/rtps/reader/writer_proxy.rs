@@ -1,0 +1,82 @@
+//! What a reader knows about one matched writer (§8.4.10.4): ordering, gaps, fragments, acknowledgement.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use super::defrag::Defrag;
+use crate::rtps::api::{ChangeKind, Payload};
+use crate::rtps::types::*;
+
+/// A received change waiting for its turn (or an irrelevant sequence number from a GAP).
+#[derive(Debug, Clone)]
+pub enum Slot {
+    Change(PendingChange),
+    Irrelevant,
+}
+
+#[derive(Debug, Clone)]
+pub struct PendingChange {
+    pub kind: ChangeKind,
+    pub payload: Payload,
+    pub key_hash: Option<[u8; 16]>,
+    pub source_timestamp: Option<Time>,
+}
+
+#[derive(Debug)]
+pub struct WriterProxy {
+    pub guid: Guid,
+    pub locators: Vec<Locator>,
+    /// Reliable protocol with this writer (both sides reliable).
+    pub reliable: bool,
+    /// Every sequence number below this was delivered or skipped.
+    pub next_expected: SequenceNumber,
+    /// Something (data, gap or heartbeat) was received from this writer.
+    pub synced: bool,
+    pub reorder: BTreeMap<SequenceNumber, Slot>,
+    pub hb_last: SequenceNumber,
+    pub last_hb_count: Option<i32>,
+    pub last_hbfrag_count: Option<i32>,
+    pub acknack_due: Option<Instant>,
+    pub acknack_count: i32,
+    pub nackfrag_count: i32,
+    pub defrag: BTreeMap<SequenceNumber, Defrag>,
+    pub defrag_bytes: usize,
+}
+
+impl WriterProxy {
+    pub fn new(guid: Guid, locators: Vec<Locator>, reliable: bool) -> Self {
+        WriterProxy {
+            guid,
+            locators,
+            reliable,
+            next_expected: SequenceNumber(1),
+            synced: false,
+            reorder: BTreeMap::new(),
+            hb_last: SequenceNumber(0),
+            last_hb_count: None,
+            last_hbfrag_count: None,
+            acknack_due: None,
+            acknack_count: 0,
+            nackfrag_count: 0,
+            defrag: BTreeMap::new(),
+            defrag_bytes: 0,
+        }
+    }
+
+    pub fn destination(&self) -> &[Locator] {
+        &self.locators[..self.locators.len().min(1)]
+    }
+
+    /// Drops defragmentation state below `next_expected`.
+    pub fn drop_stale_defrag(&mut self) {
+        let keep = self.defrag.split_off(&self.next_expected);
+        for d in self.defrag.values() {
+            self.defrag_bytes -= d.bytes;
+        }
+        self.defrag = keep;
+    }
+
+    pub fn has(&self, sn: SequenceNumber) -> bool {
+        sn < self.next_expected || self.reorder.contains_key(&sn)
+    }
+}

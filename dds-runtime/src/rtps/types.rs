@@ -1,0 +1,380 @@
+//! Basic RTPS value types (DDSI-RTPS 2.5 §8.2, §9.3).
+
+use std::fmt;
+use std::time::Duration;
+
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+pub struct GuidPrefix(pub [u8; 12]);
+
+impl GuidPrefix {
+    pub const UNKNOWN: GuidPrefix = GuidPrefix([0; 12]);
+}
+
+impl fmt::Debug for GuidPrefix {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, b) in self.0.iter().enumerate() {
+            if i > 0 && i % 4 == 0 {
+                f.write_str(":")?;
+            }
+            write!(f, "{b:02x}")?;
+        }
+        Ok(())
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+pub struct EntityId(pub [u8; 4]);
+
+impl fmt::Debug for EntityId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:08x}", u32::from_be_bytes(self.0))
+    }
+}
+
+/// Entity kinds: the last byte of an [`EntityId`].
+pub mod entity_kind {
+    pub const USER_WRITER_WITH_KEY: u8 = 0x02;
+    pub const USER_WRITER_NO_KEY: u8 = 0x03;
+    pub const USER_READER_NO_KEY: u8 = 0x04;
+    pub const USER_READER_WITH_KEY: u8 = 0x07;
+    pub const BUILTIN_PARTICIPANT: u8 = 0xc1;
+    pub const BUILTIN_WRITER_WITH_KEY: u8 = 0xc2;
+    pub const BUILTIN_WRITER_NO_KEY: u8 = 0xc3;
+    pub const BUILTIN_READER_NO_KEY: u8 = 0xc4;
+    pub const BUILTIN_READER_WITH_KEY: u8 = 0xc7;
+}
+
+impl EntityId {
+    pub const UNKNOWN: EntityId = EntityId([0, 0, 0, 0]);
+    pub const PARTICIPANT: EntityId = EntityId([0, 0, 1, 0xc1]);
+    pub const SEDP_TOPICS_WRITER: EntityId = EntityId([0, 0, 2, 0xc2]);
+    pub const SEDP_TOPICS_READER: EntityId = EntityId([0, 0, 2, 0xc7]);
+    pub const SEDP_PUBLICATIONS_WRITER: EntityId = EntityId([0, 0, 3, 0xc2]);
+    pub const SEDP_PUBLICATIONS_READER: EntityId = EntityId([0, 0, 3, 0xc7]);
+    pub const SEDP_SUBSCRIPTIONS_WRITER: EntityId = EntityId([0, 0, 4, 0xc2]);
+    pub const SEDP_SUBSCRIPTIONS_READER: EntityId = EntityId([0, 0, 4, 0xc7]);
+    pub const SPDP_WRITER: EntityId = EntityId([0, 1, 0, 0xc2]);
+    pub const SPDP_READER: EntityId = EntityId([0, 1, 0, 0xc7]);
+    pub const P2P_MESSAGE_WRITER: EntityId = EntityId([0, 2, 0, 0xc2]);
+    pub const P2P_MESSAGE_READER: EntityId = EntityId([0, 2, 0, 0xc7]);
+    pub const TYPELOOKUP_REQUEST_WRITER: EntityId = EntityId([0, 3, 0, 0xc3]);
+    pub const TYPELOOKUP_REQUEST_READER: EntityId = EntityId([0, 3, 0, 0xc4]);
+    pub const TYPELOOKUP_REPLY_WRITER: EntityId = EntityId([0, 3, 1, 0xc3]);
+    pub const TYPELOOKUP_REPLY_READER: EntityId = EntityId([0, 3, 1, 0xc4]);
+
+    pub fn new(key: [u8; 3], kind: u8) -> Self {
+        EntityId([key[0], key[1], key[2], kind])
+    }
+    pub fn kind(&self) -> u8 {
+        self.0[3]
+    }
+    pub fn is_builtin(&self) -> bool {
+        self.0[3] & 0xc0 == 0xc0
+    }
+    pub fn is_writer(&self) -> bool {
+        matches!(self.0[3] & 0x3f, 0x02 | 0x03)
+    }
+    pub fn is_reader(&self) -> bool {
+        matches!(self.0[3] & 0x3f, 0x04 | 0x07)
+    }
+    pub fn is_keyed(&self) -> bool {
+        matches!(self.0[3] & 0x3f, 0x02 | 0x07)
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+pub struct Guid {
+    pub prefix: GuidPrefix,
+    pub entity_id: EntityId,
+}
+
+impl Guid {
+    pub const UNKNOWN: Guid = Guid { prefix: GuidPrefix::UNKNOWN, entity_id: EntityId::UNKNOWN };
+
+    pub fn new(prefix: GuidPrefix, entity_id: EntityId) -> Self {
+        Guid { prefix, entity_id }
+    }
+    pub fn to_bytes(&self) -> [u8; 16] {
+        let mut b = [0u8; 16];
+        b[..12].copy_from_slice(&self.prefix.0);
+        b[12..].copy_from_slice(&self.entity_id.0);
+        b
+    }
+    pub fn from_bytes(b: [u8; 16]) -> Self {
+        let mut p = [0u8; 12];
+        p.copy_from_slice(&b[..12]);
+        Guid { prefix: GuidPrefix(p), entity_id: EntityId([b[12], b[13], b[14], b[15]]) }
+    }
+}
+
+impl fmt::Debug for Guid {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:?}:{:?}", self.prefix, self.entity_id)
+    }
+}
+
+/// Vendor ids (DDSI-RTPS §8.3.3.1 and the OMG vendor list).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default)]
+pub struct VendorId(pub [u8; 2]);
+
+impl VendorId {
+    pub const UNKNOWN: VendorId = VendorId([0, 0]);
+    pub const RTI: VendorId = VendorId([1, 1]);
+    pub const OPENDDS: VendorId = VendorId([1, 3]);
+    pub const FASTDDS: VendorId = VendorId([1, 0x0f]);
+    pub const CYCLONE: VendorId = VendorId([1, 0x10]);
+    /// Ours. The OMG list assigns 0x0101..=0x0121 (as of 2025; RustDDS 0x0112, Dust DDS 0x0121 among them);
+    /// 0x01dd ("DDs") is far above the last assigned id and is not known to be used by anyone.
+    pub const THIS: VendorId = VendorId([0x01, 0xdd]);
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Debug)]
+pub struct ProtocolVersion {
+    pub major: u8,
+    pub minor: u8,
+}
+
+impl ProtocolVersion {
+    pub const V2_5: ProtocolVersion = ProtocolVersion { major: 2, minor: 5 };
+}
+
+/// A locator. `address` holds IPv4 addresses in its last 4 bytes.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Locator {
+    pub kind: i32,
+    pub port: u32,
+    pub address: [u8; 16],
+}
+
+impl Locator {
+    pub const KIND_INVALID: i32 = -1;
+    pub const KIND_RESERVED: i32 = 0;
+    pub const KIND_UDPV4: i32 = 1;
+    pub const KIND_UDPV6: i32 = 2;
+
+    pub fn udpv4(ip: [u8; 4], port: u16) -> Self {
+        let mut address = [0u8; 16];
+        address[12..].copy_from_slice(&ip);
+        Locator { kind: Self::KIND_UDPV4, port: port as u32, address }
+    }
+    /// The IPv4 address when this is a UDPv4 locator.
+    pub fn ipv4(&self) -> Option<[u8; 4]> {
+        (self.kind == Self::KIND_UDPV4).then(|| [self.address[12], self.address[13], self.address[14], self.address[15]])
+    }
+    pub fn is_multicast(&self) -> bool {
+        match self.kind {
+            Self::KIND_UDPV4 => (224..=239).contains(&self.address[12]),
+            Self::KIND_UDPV6 => self.address[0] == 0xff,
+            _ => false,
+        }
+    }
+    pub fn to_socket_addr(&self) -> Option<std::net::SocketAddr> {
+        let port = u16::try_from(self.port).ok()?;
+        match self.kind {
+            Self::KIND_UDPV4 => Some(std::net::SocketAddr::from((self.ipv4()?, port))),
+            Self::KIND_UDPV6 => Some(std::net::SocketAddr::from((self.address, port))),
+            _ => None,
+        }
+    }
+    pub fn from_socket_addr(a: std::net::SocketAddr) -> Self {
+        match a {
+            std::net::SocketAddr::V4(v4) => Locator::udpv4(v4.ip().octets(), v4.port()),
+            std::net::SocketAddr::V6(v6) => {
+                Locator { kind: Self::KIND_UDPV6, port: v6.port() as u32, address: v6.ip().octets() }
+            }
+        }
+    }
+}
+
+impl fmt::Debug for Locator {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.to_socket_addr() {
+            Some(a) => write!(f, "udp/{a}"),
+            None => write!(f, "locator(kind {}, port {})", self.kind, self.port),
+        }
+    }
+}
+
+/// A 64-bit sequence number; valid ones start at 1.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug, Default)]
+pub struct SequenceNumber(pub i64);
+
+impl SequenceNumber {
+    pub const UNKNOWN: SequenceNumber = SequenceNumber(((-1i64) << 32) as i64);
+    pub fn from_parts(high: i32, low: u32) -> Self {
+        SequenceNumber(((high as i64) << 32) | low as i64)
+    }
+    pub fn high(self) -> i32 {
+        (self.0 >> 32) as i32
+    }
+    pub fn low(self) -> u32 {
+        self.0 as u32
+    }
+    pub fn next(self) -> Self {
+        SequenceNumber(self.0.saturating_add(1))
+    }
+}
+
+impl std::ops::Add<i64> for SequenceNumber {
+    type Output = SequenceNumber;
+    fn add(self, rhs: i64) -> SequenceNumber {
+        SequenceNumber(self.0.saturating_add(rhs))
+    }
+}
+
+/// Bitmap set over a window of 256 numbers starting at `base` (§9.4.2.6). Used for sequence and fragment numbers.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub struct NumberSet<T> {
+    pub base: T,
+    pub num_bits: u32,
+    pub bitmap: [u32; 8],
+}
+
+pub type SequenceNumberSet = NumberSet<SequenceNumber>;
+pub type FragmentNumberSet = NumberSet<u32>;
+
+impl<T: Copy> NumberSet<T> {
+    pub const MAX_BITS: u32 = 256;
+
+    pub fn empty(base: T) -> Self {
+        NumberSet { base, num_bits: 0, bitmap: [0; 8] }
+    }
+    /// Sets bit `offset` (0-based from base), growing num_bits; ignores offsets >= 256.
+    pub fn insert_offset(&mut self, offset: u32) {
+        if offset < Self::MAX_BITS {
+            self.bitmap[(offset / 32) as usize] |= 1 << (31 - offset % 32);
+            self.num_bits = self.num_bits.max(offset + 1);
+        }
+    }
+    pub fn contains_offset(&self, offset: u32) -> bool {
+        offset < self.num_bits && self.bitmap[(offset / 32) as usize] & (1 << (31 - offset % 32)) != 0
+    }
+    /// Offsets of the set bits, ascending.
+    pub fn offsets(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.num_bits.min(Self::MAX_BITS)).filter(move |&o| self.contains_offset(o))
+    }
+    pub fn words(&self) -> &[u32] {
+        &self.bitmap[..self.num_bits.div_ceil(32) as usize]
+    }
+}
+
+impl SequenceNumberSet {
+    pub fn iter(&self) -> impl Iterator<Item = SequenceNumber> + '_ {
+        let base = self.base;
+        self.offsets().map(move |o| base + o as i64)
+    }
+    /// Adds `sn` if it lies in the window; returns whether it did.
+    pub fn insert(&mut self, sn: SequenceNumber) -> bool {
+        let off = sn.0.wrapping_sub(self.base.0);
+        if (0..256).contains(&off) {
+            self.insert_offset(off as u32);
+            true
+        } else {
+            false
+        }
+    }
+}
+
+impl FragmentNumberSet {
+    pub fn iter(&self) -> impl Iterator<Item = u32> + '_ {
+        let base = self.base;
+        self.offsets().map(move |o| base.wrapping_add(o))
+    }
+    pub fn insert(&mut self, n: u32) -> bool {
+        let off = n.wrapping_sub(self.base);
+        if off < 256 {
+            self.insert_offset(off);
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// RTPS wire time: seconds and 2^-32 fractions since the Unix epoch.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug, Default)]
+pub struct Time {
+    pub seconds: i32,
+    pub fraction: u32,
+}
+
+impl Time {
+    pub const ZERO: Time = Time { seconds: 0, fraction: 0 };
+    pub const INVALID: Time = Time { seconds: -1, fraction: 0xffff_ffff };
+    pub const INFINITE: Time = Time { seconds: 0x7fff_ffff, fraction: 0xffff_ffff };
+
+    /// From a duration since the Unix epoch (what `SystemTime::now().duration_since(UNIX_EPOCH)` gives).
+    pub fn from_unix(d: Duration) -> Self {
+        let secs = d.as_secs().min(0x7fff_ffff) as i32;
+        let fraction = ((d.subsec_nanos() as u64) << 32) / 1_000_000_000;
+        Time { seconds: secs, fraction: fraction as u32 }
+    }
+    pub fn to_unix(self) -> Option<Duration> {
+        if self.seconds < 0 || self == Time::INFINITE {
+            return None;
+        }
+        let nanos = ((self.fraction as u64) * 1_000_000_000) >> 32;
+        Some(Duration::new(self.seconds as u64, nanos as u32))
+    }
+}
+
+/// Converts a QoS/lease duration to the RTPS Duration_t wire form {seconds, fraction}; `Duration::MAX` and
+/// anything beyond i32 seconds is DURATION_INFINITE.
+pub fn duration_to_wire(d: Duration) -> (i32, u32) {
+    if d.as_secs() >= 0x7fff_ffff {
+        return (0x7fff_ffff, 0xffff_ffff);
+    }
+    // Round up so a non-zero duration never becomes zero.
+    let frac = ((d.subsec_nanos() as u64) << 32).div_ceil(1_000_000_000);
+    if frac >= 1 << 32 {
+        (d.as_secs() as i32 + 1, 0)
+    } else {
+        (d.as_secs() as i32, frac as u32)
+    }
+}
+
+/// The inverse of [`duration_to_wire`]; negative values become zero.
+pub fn duration_from_wire(seconds: i32, fraction: u32) -> Duration {
+    if seconds == 0x7fff_ffff && fraction == 0xffff_ffff {
+        return Duration::MAX;
+    }
+    if seconds < 0 {
+        return Duration::ZERO;
+    }
+    let nanos = ((fraction as u64) * 1_000_000_000) >> 32;
+    Duration::new(seconds as u64, nanos as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sn_parts() {
+        let sn = SequenceNumber::from_parts(1, 5);
+        assert_eq!(sn.0, (1 << 32) + 5);
+        assert_eq!((sn.high(), sn.low()), (1, 5));
+    }
+
+    #[test]
+    fn durations() {
+        assert_eq!(duration_to_wire(Duration::MAX), (0x7fff_ffff, 0xffff_ffff));
+        assert_eq!(duration_from_wire(0x7fff_ffff, 0xffff_ffff), Duration::MAX);
+        let d = Duration::from_millis(100);
+        let (s, f) = duration_to_wire(d);
+        assert_eq!((s, f), (0, 0x1999_999a));
+        let back = duration_from_wire(s, f);
+        assert!(back.abs_diff(d) < Duration::from_nanos(2));
+    }
+
+    #[test]
+    fn sets() {
+        let mut s = SequenceNumberSet::empty(SequenceNumber(10));
+        assert!(s.insert(SequenceNumber(10)));
+        assert!(s.insert(SequenceNumber(45)));
+        assert!(!s.insert(SequenceNumber(300)));
+        assert_eq!(s.iter().collect::<Vec<_>>(), vec![SequenceNumber(10), SequenceNumber(45)]);
+        assert_eq!(s.num_bits, 36);
+        assert_eq!(s.words().len(), 2);
+    }
+}

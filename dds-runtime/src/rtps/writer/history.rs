@@ -1,0 +1,193 @@
+//! The writer history cache: changes by sequence number, with KEEP_LAST per instance and resource limits.
+
+use std::collections::{BTreeMap, HashMap, VecDeque};
+
+use crate::qos::{History, ResourceLimits};
+use crate::rtps::api::{ChangeKind, Payload};
+use crate::rtps::types::*;
+
+/// One change in the history.
+#[derive(Debug, Clone)]
+pub struct CacheChange {
+    pub sn: SequenceNumber,
+    pub kind: ChangeKind,
+    pub payload: Payload,
+    pub key_hash: Option<[u8; 16]>,
+    pub source_timestamp: Option<Time>,
+}
+
+/// Why a change cannot be added now.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HistoryFull {
+    /// KEEP_ALL (or max_samples) limit reached by changes that may not be dropped yet.
+    Full,
+}
+
+#[derive(Debug)]
+pub struct HistoryCache {
+    changes: BTreeMap<SequenceNumber, CacheChange>,
+    instances: HashMap<[u8; 16], VecDeque<SequenceNumber>>,
+    history: History,
+    limits: ResourceLimits,
+    bytes: usize,
+}
+
+impl HistoryCache {
+    pub fn new(history: History, limits: ResourceLimits) -> Self {
+        HistoryCache { changes: BTreeMap::new(), instances: HashMap::new(), history, limits, bytes: 0 }
+    }
+
+    pub fn len(&self) -> usize {
+        self.changes.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.changes.is_empty()
+    }
+    pub fn bytes(&self) -> usize {
+        self.bytes
+    }
+    pub fn get(&self, sn: SequenceNumber) -> Option<&CacheChange> {
+        self.changes.get(&sn)
+    }
+    pub fn first_sn(&self) -> Option<SequenceNumber> {
+        self.changes.keys().next().copied()
+    }
+    pub fn range(&self, from: SequenceNumber) -> impl Iterator<Item = &CacheChange> {
+        self.changes.range(from..).map(|(_, c)| c)
+    }
+
+    /// Whether adding a change for `key` needs room that only acknowledged changes below `acked` could give.
+    /// Returns the sequence numbers that must be dropped to make room, or Full.
+    pub fn make_room(&mut self, key: &[u8; 16], acked: SequenceNumber) -> Result<(), HistoryFull> {
+        let max_total = self.limits.max_samples.map(|m| m.max(1) as usize);
+        let per_instance = match self.history {
+            History::KeepLast(d) => Some(d.max(1) as usize),
+            History::KeepAll => self.limits.max_samples_per_instance.map(|m| m.max(1) as usize),
+        };
+        let keep_last = matches!(self.history, History::KeepLast(_));
+        if let Some(limit) = per_instance {
+            let n = self.instances.get(key).map_or(0, |q| q.len());
+            if n >= limit {
+                let oldest = self.instances.get(key).and_then(|q| q.front().copied());
+                match oldest {
+                    // KEEP_LAST replaces the oldest sample of the instance, acknowledged or not.
+                    Some(sn) if keep_last || sn < acked => {
+                        self.remove(sn);
+                    }
+                    _ => return Err(HistoryFull::Full),
+                }
+            }
+        }
+        if let Some(limit) = max_total {
+            if self.changes.len() >= limit {
+                let oldest = self.first_sn();
+                match oldest {
+                    Some(sn) if keep_last || sn < acked => {
+                        self.remove(sn);
+                    }
+                    _ => return Err(HistoryFull::Full),
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds a change (call [`make_room`](Self::make_room) first).
+    pub fn add(&mut self, change: CacheChange) {
+        let key = change.key_hash.unwrap_or_default();
+        self.bytes += change.payload.len();
+        self.instances.entry(key).or_default().push_back(change.sn);
+        self.changes.insert(change.sn, change);
+    }
+
+    pub fn remove(&mut self, sn: SequenceNumber) -> Option<CacheChange> {
+        let c = self.changes.remove(&sn)?;
+        self.bytes -= c.payload.len();
+        let key = c.key_hash.unwrap_or_default();
+        if let Some(q) = self.instances.get_mut(&key) {
+            if let Some(pos) = q.iter().position(|s| *s == sn) {
+                q.remove(pos);
+            }
+            if q.is_empty() {
+                self.instances.remove(&key);
+            }
+        }
+        Some(c)
+    }
+
+    /// Drops every change below `sn` (volatile writers, once acknowledged by all).
+    pub fn remove_below(&mut self, sn: SequenceNumber) {
+        while let Some(first) = self.first_sn() {
+            if first >= sn {
+                break;
+            }
+            self.remove(first);
+        }
+    }
+
+    /// Bytes of the changes at or above `sn`.
+    pub fn bytes_from(&self, sn: SequenceNumber) -> usize {
+        self.changes.range(sn..).map(|(_, c)| c.payload.len()).sum()
+    }
+
+    /// Drops disposed+unregistered instances' history beyond their last change (keeps memory bounded for
+    /// transient-local writers whose instances come and go).
+    pub fn prune_unregistered(&mut self, acked: SequenceNumber) {
+        let dead: Vec<SequenceNumber> = self
+            .instances
+            .values()
+            .filter_map(|q| {
+                let last = *q.back()?;
+                let c = self.changes.get(&last)?;
+                (matches!(c.kind, ChangeKind::Unregister | ChangeKind::DisposeUnregister) && last < acked)
+                    .then(|| q.iter().copied().collect::<Vec<_>>())
+            })
+            .flatten()
+            .collect();
+        for sn in dead {
+            self.remove(sn);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ch(sn: i64, key: u8) -> CacheChange {
+        CacheChange {
+            sn: SequenceNumber(sn),
+            kind: ChangeKind::Alive,
+            payload: vec![0u8; 10].into(),
+            key_hash: Some([key; 16]),
+            source_timestamp: None,
+        }
+    }
+
+    #[test]
+    fn keep_last_per_instance() {
+        let mut h = HistoryCache::new(History::KeepLast(2), ResourceLimits::default());
+        for (sn, k) in [(1, 1), (2, 2), (3, 1), (4, 1)] {
+            h.make_room(&[k; 16], SequenceNumber(1)).unwrap();
+            h.add(ch(sn, k));
+        }
+        assert_eq!(h.changes.keys().map(|s| s.0).collect::<Vec<_>>(), vec![2, 3, 4]);
+        assert_eq!(h.bytes(), 30);
+    }
+
+    #[test]
+    fn keep_all_limit() {
+        let mut h = HistoryCache::new(
+            History::KeepAll,
+            ResourceLimits { max_samples: Some(2), max_instances: None, max_samples_per_instance: None },
+        );
+        h.make_room(&[0; 16], SequenceNumber(1)).unwrap();
+        h.add(ch(1, 0));
+        h.make_room(&[0; 16], SequenceNumber(1)).unwrap();
+        h.add(ch(2, 0));
+        assert_eq!(h.make_room(&[0; 16], SequenceNumber(1)), Err(HistoryFull::Full));
+        // Once 1 is acknowledged it can go.
+        assert_eq!(h.make_room(&[0; 16], SequenceNumber(2)), Ok(()));
+        assert_eq!(h.len(), 1);
+    }
+}

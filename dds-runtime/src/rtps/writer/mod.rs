@@ -1,0 +1,468 @@
+//! Writers: history cache, per-reader state and the reliable/best-effort protocol (§8.4.7, §8.4.9).
+
+mod history;
+mod reader_proxy;
+
+pub use history::{CacheChange, HistoryCache};
+pub use reader_proxy::ReaderProxy;
+
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
+use std::time::{Duration, Instant};
+
+use crate::qos::{Durability, History, ResourceLimits};
+use crate::rtps::api::{ChangeKind, Event, WriteChange, WriteError};
+use crate::rtps::messages::parameter::pid;
+use crate::rtps::messages::{Data, DataFrag, Gap, Heartbeat, ParameterList, Submessage};
+use crate::rtps::outbox::{Outbox, Ts};
+use crate::rtps::types::*;
+use reader_proxy::{MAX_REQUESTED, MAX_REQUESTED_FRAG_SAMPLES};
+
+/// Protocol parameters of one writer.
+#[derive(Debug, Clone, Copy)]
+pub struct WriterParams {
+    pub reliable: bool,
+    pub durability: Durability,
+    pub history: History,
+    pub limits: ResourceLimits,
+    pub keyed: bool,
+    pub heartbeat_period: Duration,
+    pub nack_response_delay: Duration,
+    pub fragment_size: usize,
+    pub high_watermark: usize,
+    pub low_watermark: usize,
+    pub max_repair_bytes: usize,
+}
+
+/// A local writer's protocol state.
+#[derive(Debug)]
+pub struct Writer {
+    pub guid: Guid,
+    params: WriterParams,
+    history: HistoryCache,
+    next_sn: SequenceNumber,
+    proxies: BTreeMap<Guid, ReaderProxy>,
+    /// One locator per matched reader, deduplicated: where new data goes.
+    data_dest: Vec<Locator>,
+    hb_count: i32,
+    hb_due: Option<Instant>,
+    bytes_since_nonfinal_hb: usize,
+    unacked_bytes: usize,
+    blocked: bool,
+    /// Set when deleted: lingers until acknowledged or this deadline.
+    pub linger_until: Option<Instant>,
+}
+
+impl Writer {
+    pub fn new(guid: Guid, params: WriterParams) -> Self {
+        Writer {
+            guid,
+            history: HistoryCache::new(params.history, params.limits),
+            params,
+            next_sn: SequenceNumber(1),
+            proxies: BTreeMap::new(),
+            data_dest: Vec::new(),
+            hb_count: 0,
+            hb_due: None,
+            bytes_since_nonfinal_hb: 0,
+            unacked_bytes: 0,
+            blocked: false,
+            linger_until: None,
+        }
+    }
+
+    pub fn params(&self) -> &WriterParams {
+        &self.params
+    }
+    fn durable(&self) -> bool {
+        self.params.durability >= Durability::TransientLocal
+    }
+    pub fn last_sn(&self) -> SequenceNumber {
+        SequenceNumber(self.next_sn.0 - 1)
+    }
+    pub fn history(&self) -> &HistoryCache {
+        &self.history
+    }
+    pub fn unacked_bytes(&self) -> usize {
+        self.unacked_bytes
+    }
+    pub fn matched(&self) -> impl Iterator<Item = &Guid> {
+        self.proxies.keys()
+    }
+    pub fn has_proxy(&self, g: &Guid) -> bool {
+        self.proxies.contains_key(g)
+    }
+    pub fn proxy(&self, g: &Guid) -> Option<&ReaderProxy> {
+        self.proxies.get(g)
+    }
+
+    /// Every change acknowledged by every reliable reader.
+    pub fn is_acknowledged(&self) -> bool {
+        self.proxies.values().filter(|p| p.reliable).all(|p| p.acked >= self.next_sn)
+    }
+
+    fn acked_floor(&self) -> SequenceNumber {
+        self.proxies.values().filter(|p| p.reliable).map(|p| p.acked).min().unwrap_or(self.next_sn)
+    }
+
+    fn has_reliable_proxy(&self) -> bool {
+        self.params.reliable && self.proxies.values().any(|p| p.reliable)
+    }
+
+    fn rebuild_dest(&mut self) {
+        let mut d: Vec<Locator> = self.proxies.values().filter_map(|p| p.destination().first().copied()).collect();
+        d.sort();
+        d.dedup();
+        self.data_dest = d;
+    }
+
+    /// After acknowledgements or a change of readers: drop what nobody needs, update flow control.
+    fn update_acked(&mut self, ev: &mut VecDeque<Event>) {
+        let floor = self.acked_floor();
+        if !self.durable() {
+            self.history.remove_below(floor);
+        } else {
+            self.history.prune_unregistered(floor);
+        }
+        self.unacked_bytes = if self.has_reliable_proxy() { self.history.bytes_from(floor) } else { 0 };
+        if self.blocked && self.unacked_bytes <= self.params.low_watermark {
+            self.blocked = false;
+            ev.push_back(Event::WriterUnblocked { writer: self.guid.entity_id });
+        }
+    }
+
+    /// Queues a change and sends it to every matched reader.
+    pub(crate) fn write(&mut self, now: Instant, change: WriteChange, out: &mut Outbox, ev: &mut VecDeque<Event>) -> Result<SequenceNumber, WriteError> {
+        if self.linger_until.is_some() {
+            return Err(WriteError::Deleted);
+        }
+        if self.params.keyed && change.key_hash.is_none() {
+            return Err(WriteError::MissingKeyHash);
+        }
+        let len = change.payload.len();
+        if self.has_reliable_proxy() {
+            if self.blocked {
+                self.update_acked(ev);
+                if self.blocked {
+                    return Err(WriteError::WouldBlock);
+                }
+            }
+            if self.unacked_bytes > 0 && self.unacked_bytes + len > self.params.high_watermark {
+                self.blocked = true;
+                return Err(WriteError::WouldBlock);
+            }
+        }
+        let key = change.key_hash.unwrap_or_default();
+        if self.history.make_room(&key, self.acked_floor()).is_err() {
+            return Err(WriteError::WouldBlock);
+        }
+        let sn = self.next_sn;
+        self.next_sn = sn.next();
+        let cc = CacheChange {
+            sn,
+            kind: change.kind,
+            payload: change.payload,
+            key_hash: change.key_hash,
+            source_timestamp: change.source_timestamp,
+        };
+        if !self.data_dest.is_empty() {
+            let dest = std::mem::take(&mut self.data_dest);
+            send_change(out, &dest, None, EntityId::UNKNOWN, self.guid.entity_id, &cc, self.params.fragment_size, None);
+            if self.has_reliable_proxy() {
+                self.bytes_since_nonfinal_hb += len;
+                // Ask for acknowledgements now and then so flow control keeps moving without waiting for the
+                // periodic heartbeat; otherwise the piggy-backed heartbeat only announces.
+                let final_flag = self.bytes_since_nonfinal_hb < self.params.low_watermark / 4;
+                if !final_flag {
+                    self.bytes_since_nonfinal_hb = 0;
+                }
+                let hb = self.heartbeat(EntityId::UNKNOWN, final_flag);
+                out.push(&dest, None, Ts::Any, &hb);
+            }
+            self.data_dest = dest;
+        }
+        self.history.add(cc);
+        if self.has_reliable_proxy() {
+            self.unacked_bytes += len;
+            self.hb_due.get_or_insert(now + self.params.heartbeat_period);
+        } else if !self.durable() {
+            self.history.remove_below(self.next_sn);
+        }
+        Ok(sn)
+    }
+
+    fn heartbeat(&mut self, reader_id: EntityId, final_flag: bool) -> Submessage<'static> {
+        self.hb_count = self.hb_count.wrapping_add(1);
+        Submessage::Heartbeat(Heartbeat {
+            reader_id,
+            writer_id: self.guid.entity_id,
+            first_sn: self.history.first_sn().unwrap_or(self.next_sn),
+            last_sn: self.last_sn(),
+            count: self.hb_count,
+            final_flag,
+            liveliness_flag: false,
+        })
+    }
+
+    /// Matches a reader. Durable writers serve their history to it; volatile ones answer older requests with GAP.
+    pub fn add_proxy(&mut self, now: Instant, mut proxy: ReaderProxy, reader_durable: bool, ev: &mut VecDeque<Event>) {
+        proxy.reliable &= self.params.reliable;
+        if !(self.durable() && reader_durable) {
+            proxy.floor = self.next_sn;
+            proxy.acked = self.next_sn;
+        } else if !self.history.is_empty() {
+            if proxy.reliable {
+                // Announce the history; the reader asks for what it lacks.
+                proxy.repair_due = Some(now);
+            } else {
+                // Best effort: push the history once.
+                proxy.requested = self.history.range(SequenceNumber(1)).map(|c| c.sn).take(MAX_REQUESTED).collect();
+                proxy.repair_due = Some(now);
+            }
+        }
+        self.proxies.insert(proxy.guid, proxy);
+        self.rebuild_dest();
+        self.update_acked(ev);
+    }
+
+    pub fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
+        let had = self.proxies.remove(guid).is_some();
+        if had {
+            self.rebuild_dest();
+            self.update_acked(ev);
+        }
+        had
+    }
+
+    pub fn on_acknack(&mut self, now: Instant, reader: Guid, ack: &crate::rtps::messages::AckNack, ev: &mut VecDeque<Event>) {
+        let next_sn = self.next_sn;
+        let delay = self.params.nack_response_delay;
+        let Some(p) = self.proxies.get_mut(&reader) else { return };
+        if !p.reliable {
+            return;
+        }
+        if p.last_acknack.is_some_and(|c| ack.count.wrapping_sub(c) <= 0) {
+            return;
+        }
+        p.last_acknack = Some(ack.count);
+        let base = ack.reader_sn_state.base.min(next_sn);
+        let progressed = base > p.acked;
+        if progressed {
+            p.acked = base;
+        }
+        for sn in ack.reader_sn_state.iter() {
+            if sn >= p.acked && sn < next_sn && p.requested.len() < MAX_REQUESTED {
+                p.requested.insert(sn);
+            }
+        }
+        let acked = p.acked;
+        p.requested = p.requested.split_off(&acked);
+        p.requested_frags = p.requested_frags.split_off(&acked);
+        // A request, or a reader that is behind without knowing it (e.g. a pre-emptive ACKNACK): answer soon.
+        if !p.requested.is_empty() || (ack.reader_sn_state.num_bits == 0 && base < next_sn && !ack.final_flag) {
+            p.repair_due.get_or_insert(now + delay);
+        }
+        if progressed {
+            self.update_acked(ev);
+            if self.is_acknowledged() {
+                self.hb_due = None;
+                ev.push_back(Event::WriterAcknowledged { writer: self.guid.entity_id });
+            }
+        }
+    }
+
+    pub fn on_nack_frag(&mut self, now: Instant, reader: Guid, nf: &crate::rtps::messages::NackFrag) {
+        let delay = self.params.nack_response_delay;
+        let in_history = self.history.get(nf.writer_sn).is_some();
+        let Some(p) = self.proxies.get_mut(&reader) else { return };
+        if !p.reliable || nf.writer_sn < p.acked {
+            return;
+        }
+        if p.last_nackfrag.is_some_and(|c| nf.count.wrapping_sub(c) <= 0) {
+            return;
+        }
+        p.last_nackfrag = Some(nf.count);
+        if in_history {
+            if p.requested_frags.len() < MAX_REQUESTED_FRAG_SAMPLES || p.requested_frags.contains_key(&nf.writer_sn) {
+                p.requested_frags.entry(nf.writer_sn).or_default().extend(nf.fragment_number_state.iter());
+            }
+        } else if p.requested.len() < MAX_REQUESTED {
+            p.requested.insert(nf.writer_sn);
+        }
+        p.repair_due.get_or_insert(now + delay);
+    }
+
+    pub fn next_timeout(&self) -> Option<Instant> {
+        let r = self.proxies.values().filter_map(|p| p.repair_due).min();
+        match (r, self.hb_due) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
+        let due: Vec<Guid> = self.proxies.values().filter(|p| p.repair_due.is_some_and(|t| t <= now)).map(|p| p.guid).collect();
+        for g in due {
+            self.repair(now, g, out);
+        }
+        if self.hb_due.is_some_and(|t| t <= now) {
+            if self.has_reliable_proxy() && !self.is_acknowledged() {
+                let dest: Vec<Locator> = {
+                    let mut d: Vec<Locator> = self
+                        .proxies
+                        .values()
+                        .filter(|p| p.reliable && p.acked < self.next_sn)
+                        .filter_map(|p| p.destination().first().copied())
+                        .collect();
+                    d.sort();
+                    d.dedup();
+                    d
+                };
+                let hb = self.heartbeat(EntityId::UNKNOWN, false);
+                self.bytes_since_nonfinal_hb = 0;
+                out.push(&dest, None, Ts::Any, &hb);
+                self.hb_due = Some(now + self.params.heartbeat_period);
+            } else {
+                self.hb_due = None;
+            }
+        }
+    }
+
+    /// Sends what one reader asked for (bounded per round), GAPs for what is gone, then a heartbeat to it.
+    fn repair(&mut self, now: Instant, g: Guid, out: &mut Outbox) {
+        let frag = self.params.fragment_size;
+        let wid = self.guid.entity_id;
+        let Some(p) = self.proxies.get_mut(&g) else { return };
+        p.repair_due = None;
+        let dest: Vec<Locator> = p.destination().to_vec();
+        let dst = Some(g.prefix);
+        let mut budget = self.params.max_repair_bytes as isize;
+        let mut gaps: Vec<SequenceNumber> = Vec::new();
+        while budget > 0 {
+            let Some(sn) = p.requested.pop_first() else { break };
+            p.requested_frags.remove(&sn);
+            match self.history.get(sn) {
+                Some(c) if sn >= p.floor => {
+                    send_change(out, &dest, dst, g.entity_id, wid, c, frag, None);
+                    budget -= c.payload.len() as isize + 64;
+                }
+                _ => gaps.push(sn),
+            }
+        }
+        while budget > 0 {
+            let Some((sn, frags)) = p.requested_frags.pop_first() else { break };
+            if let Some(c) = self.history.get(sn) {
+                send_change(out, &dest, dst, g.entity_id, wid, c, frag, Some(&frags));
+                budget -= (frags.len() * frag) as isize;
+            }
+        }
+        send_gaps(out, &dest, dst, g.entity_id, wid, &gaps);
+        let more = !p.requested.is_empty() || !p.requested_frags.is_empty();
+        let reliable = p.reliable;
+        if more {
+            p.repair_due = Some(now + self.params.nack_response_delay);
+        }
+        if reliable {
+            let hb = self.heartbeat(g.entity_id, false);
+            out.push(&dest, dst, Ts::Any, &hb);
+        }
+    }
+}
+
+/// Runs of consecutive sequence numbers as GAP submessages.
+fn send_gaps(out: &mut Outbox, dest: &[Locator], dst: Option<GuidPrefix>, rid: EntityId, wid: EntityId, gaps: &[SequenceNumber]) {
+    let mut i = 0;
+    while i < gaps.len() {
+        let start = gaps[i];
+        let mut end = start;
+        while i + 1 < gaps.len() && gaps[i + 1] == end.next() {
+            i += 1;
+            end = gaps[i];
+        }
+        i += 1;
+        let gap = Submessage::Gap(Gap {
+            reader_id: rid,
+            writer_id: wid,
+            gap_start: start,
+            gap_list: SequenceNumberSet::empty(end.next()),
+        });
+        out.push(dest, dst, Ts::Any, &gap);
+    }
+}
+
+/// Inline QoS for a change: key hash when keyed, status info when not alive. Built on the stack.
+fn inline_qos(c: &CacheChange, buf: &mut [u8; 28]) -> usize {
+    let mut n = 0;
+    if let Some(k) = &c.key_hash {
+        buf[0..2].copy_from_slice(&pid::KEY_HASH.to_le_bytes());
+        buf[2..4].copy_from_slice(&16u16.to_le_bytes());
+        buf[4..20].copy_from_slice(k);
+        n = 20;
+    }
+    if c.kind != ChangeKind::Alive {
+        buf[n..n + 2].copy_from_slice(&pid::STATUS_INFO.to_le_bytes());
+        buf[n + 2..n + 4].copy_from_slice(&4u16.to_le_bytes());
+        buf[n + 4..n + 8].copy_from_slice(&[0, 0, 0, c.kind.status_info()]);
+        n += 8;
+    }
+    n
+}
+
+/// Sends one change as DATA, or as DATA_FRAGs (all, or the listed fragments) when larger than `frag`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn send_change(
+    out: &mut Outbox,
+    dest: &[Locator],
+    dst: Option<GuidPrefix>,
+    rid: EntityId,
+    wid: EntityId,
+    c: &CacheChange,
+    frag: usize,
+    only: Option<&BTreeSet<u32>>,
+) {
+    let mut qbuf = [0u8; 28];
+    let qn = inline_qos(c, &mut qbuf);
+    let inline_qos = (qn > 0).then_some(ParameterList { data: &qbuf[..qn], little_endian: true });
+    let ts = Ts::Set(c.source_timestamp);
+    let len = c.payload.len();
+    if len <= frag || frag == 0 {
+        let alive = c.kind == ChangeKind::Alive;
+        let payload = (alive || len > 0).then_some(&c.payload[..]);
+        let d = Submessage::Data(Data {
+            reader_id: rid,
+            writer_id: wid,
+            writer_sn: c.sn,
+            inline_qos,
+            payload,
+            key_flag: !alive,
+            non_standard_flag: false,
+        });
+        out.push(dest, dst, ts, &d);
+        return;
+    }
+    let total = len.div_ceil(frag) as u32;
+    let mut send = |f: u32| {
+        if f == 0 || f > total {
+            return;
+        }
+        let start = (f as usize - 1) * frag;
+        let end = (start + frag).min(len);
+        let d = Submessage::DataFrag(DataFrag {
+            reader_id: rid,
+            writer_id: wid,
+            writer_sn: c.sn,
+            fragment_starting_num: f,
+            fragments_in_submessage: 1,
+            fragment_size: frag as u16,
+            sample_size: len as u32,
+            inline_qos,
+            payload: &c.payload[start..end],
+            key_flag: c.kind != ChangeKind::Alive,
+            non_standard_flag: false,
+        });
+        out.push(dest, dst, ts, &d);
+    };
+    match only {
+        Some(set) => set.iter().for_each(|&f| send(f)),
+        None => (1..=total).for_each(send),
+    }
+}

@@ -1,0 +1,155 @@
+//! Network interface discovery and selection (IPv4 only).
+
+use std::ffi::CStr;
+use std::io;
+use std::net::Ipv4Addr;
+
+use crate::config::InterfaceSelection;
+
+/// One IPv4 address of one network interface.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Interface {
+    /// Interface name, e.g. `lo`.
+    pub name: String,
+    /// Kernel interface index.
+    pub index: u32,
+    /// The IPv4 address.
+    pub addr: Ipv4Addr,
+    /// IFF_UP.
+    pub up: bool,
+    /// IFF_LOOPBACK.
+    pub loopback: bool,
+    /// IFF_MULTICAST.
+    pub multicast: bool,
+}
+
+/// All IPv4 interface addresses of this host (of this network namespace).
+pub fn list() -> io::Result<Vec<Interface>> {
+    let mut out = Vec::new();
+    let mut head: *mut libc::ifaddrs = std::ptr::null_mut();
+    // SAFETY: getifaddrs fills `head` with a list we free below with freeifaddrs.
+    if unsafe { libc::getifaddrs(&mut head) } != 0 {
+        return Err(io::Error::last_os_error());
+    }
+    let mut cur = head;
+    while !cur.is_null() {
+        // SAFETY: `cur` is a node of the list returned by getifaddrs, valid until freeifaddrs.
+        let ifa = unsafe { &*cur };
+        cur = ifa.ifa_next;
+        if ifa.ifa_addr.is_null() || ifa.ifa_name.is_null() {
+            continue;
+        }
+        // SAFETY: ifa_addr is non-null and points to a sockaddr of the family it declares.
+        let family = unsafe { (*ifa.ifa_addr).sa_family } as i32;
+        if family != libc::AF_INET {
+            continue;
+        }
+        // SAFETY: family is AF_INET, so the address is a sockaddr_in.
+        let sin = unsafe { &*(ifa.ifa_addr as *const libc::sockaddr_in) };
+        let addr = Ipv4Addr::from(u32::from_be(sin.sin_addr.s_addr));
+        // SAFETY: ifa_name is a NUL-terminated C string owned by the list.
+        let name = unsafe { CStr::from_ptr(ifa.ifa_name) }
+            .to_string_lossy()
+            .into_owned();
+        let flags = ifa.ifa_flags;
+        // SAFETY: ifa_name is a valid C string.
+        let index = unsafe { libc::if_nametoindex(ifa.ifa_name) };
+        out.push(Interface {
+            name,
+            index,
+            addr,
+            up: flags & libc::IFF_UP as u32 != 0,
+            loopback: flags & libc::IFF_LOOPBACK as u32 != 0,
+            multicast: flags & libc::IFF_MULTICAST as u32 != 0,
+        });
+    }
+    // SAFETY: `head` came from getifaddrs and is freed once.
+    unsafe { libc::freeifaddrs(head) };
+    Ok(out)
+}
+
+/// Picks the interface described by `sel` from `all`.
+pub fn select(sel: &InterfaceSelection, all: &[Interface]) -> io::Result<Interface> {
+    let found = match sel {
+        InterfaceSelection::Name(n) => all.iter().find(|i| &i.name == n),
+        InterfaceSelection::Address(a) => all.iter().find(|i| &i.addr == a),
+        InterfaceSelection::Auto => all
+            .iter()
+            .find(|i| i.up && i.multicast && !i.loopback)
+            .or_else(|| all.iter().find(|i| i.up && i.loopback))
+            .or_else(|| all.first()),
+    };
+    found.cloned().ok_or_else(|| {
+        io::Error::new(
+            io::ErrorKind::NotFound,
+            format!("no IPv4 interface matches {sel:?} (have: {:?})", names(all)),
+        )
+    })
+}
+
+fn names(all: &[Interface]) -> Vec<String> {
+    all.iter()
+        .map(|i| format!("{}={}", i.name, i.addr))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ifs() -> Vec<Interface> {
+        vec![
+            Interface {
+                name: "lo".into(),
+                index: 1,
+                addr: Ipv4Addr::LOCALHOST,
+                up: true,
+                loopback: true,
+                multicast: false,
+            },
+            Interface {
+                name: "eth0".into(),
+                index: 2,
+                addr: Ipv4Addr::new(10, 0, 0, 5),
+                up: true,
+                loopback: false,
+                multicast: true,
+            },
+        ]
+    }
+
+    #[test]
+    fn selects_by_name_address_and_auto() {
+        let all = ifs();
+        assert_eq!(
+            select(&InterfaceSelection::Name("lo".into()), &all)
+                .unwrap()
+                .index,
+            1
+        );
+        assert_eq!(
+            select(
+                &InterfaceSelection::Address(Ipv4Addr::new(10, 0, 0, 5)),
+                &all
+            )
+            .unwrap()
+            .name,
+            "eth0"
+        );
+        assert_eq!(
+            select(&InterfaceSelection::Auto, &all).unwrap().name,
+            "eth0"
+        );
+        assert_eq!(
+            select(&InterfaceSelection::Auto, &all[..1]).unwrap().name,
+            "lo"
+        );
+        assert!(select(&InterfaceSelection::Name("wlan9".into()), &all).is_err());
+    }
+
+    #[test]
+    fn host_has_some_ipv4_interface() {
+        let all = list().unwrap();
+        assert!(all.iter().any(|i| i.loopback), "{all:?}");
+    }
+}

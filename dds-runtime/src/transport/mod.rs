@@ -1,0 +1,23 @@
+//! UDPv4 transport: interface selection, the RTPS port formula, participant index probing, the shared
+//! SPDP multicast socket and receive threads.
+//!
+//! The transport knows nothing of RTPS messages. Receive threads hand every datagram to a
+//! [`Receiver`] callback (the DCPS layer feeds it to the sans-I/O core); sending happens on whichever
+//! thread drained the core's transmit queue, through [`UdpTransport::send_to`].
+//!
+//! Sockets:
+//! - metatraffic unicast and user unicast, bound to `0.0.0.0` on the index's ports (or ephemeral ports when
+//!   the participant index is `none`) and announced with the selected interface's address; the metatraffic
+//!   socket also sends, with `IP_MULTICAST_IF` set to the interface and `IP_MULTICAST_LOOP` on so that
+//!   participants on the same host see each other;
+//! - when multicast is on, the SPDP multicast socket: `SO_REUSEADDR` + `SO_REUSEPORT` on the domain's
+//!   discovery port, joined to 239.255.0.1 on the selected interface only (`IP_MULTICAST_ALL` off).
+//!
+//! Batched sends (`sendmmsg`) and receives (`recvmmsg`) are not used yet.
+
+pub mod iface;
+pub mod ports;
+mod udp;
+
+pub use iface::Interface;
+pub use udp::{Channel, Receiver, TransportStats, UdpTransport};

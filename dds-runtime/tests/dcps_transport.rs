@@ -1,0 +1,90 @@
+//! Transport: participant index probing, ephemeral ports, multicast on the selected interface.
+mod dcps_util;
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use dcps_util::*;
+use dds_runtime::config::{Config, InterfaceSelection, ParticipantIndex};
+use dds_runtime::transport::{ports, Channel, UdpTransport};
+
+fn cfg(domain: u32, index: ParticipantIndex) -> Config {
+    Config {
+        domain_id: domain,
+        interface: InterfaceSelection::Name("lo".into()),
+        participant_index: index,
+        ..Config::default()
+    }
+}
+
+#[test]
+fn auto_index_probes_and_multicast_reaches_every_participant() {
+    require_netns();
+    let a = UdpTransport::bind(&cfg(51, ParticipantIndex::Auto)).unwrap();
+    let b = UdpTransport::bind(&cfg(51, ParticipantIndex::Auto)).unwrap();
+    let c = UdpTransport::bind(&cfg(51, ParticipantIndex::None)).unwrap();
+    assert_eq!(a.participant_index(), Some(0));
+    assert_eq!(b.participant_index(), Some(1));
+    assert_eq!(c.participant_index(), None);
+    assert_eq!(
+        a.metatraffic_unicast().port(),
+        ports::metatraffic_unicast(51, 0).unwrap()
+    );
+    assert_eq!(b.user_unicast().port(), ports::user_unicast(51, 1).unwrap());
+    assert_eq!(a.metatraffic_unicast().ip().octets(), [127, 0, 0, 1]);
+    assert!(Config {
+        participant_index: ParticipantIndex::Fixed(0),
+        ..cfg(51, ParticipantIndex::Auto)
+    }
+    .validate()
+    .is_ok());
+    assert!(
+        UdpTransport::bind(&cfg(51, ParticipantIndex::Fixed(0))).is_err(),
+        "index 0 is taken"
+    );
+
+    let counts: Vec<Arc<AtomicUsize>> = (0..3).map(|_| Arc::new(AtomicUsize::new(0))).collect();
+    for (t, n) in [&a, &b, &c].into_iter().zip(&counts) {
+        let n = n.clone();
+        t.start(Arc::new(move |ch, data, _from| {
+            if ch == Channel::SpdpMulticast && data == b"hello" {
+                n.fetch_add(1, Ordering::SeqCst);
+            }
+        }))
+        .unwrap();
+    }
+    a.send_to(b"hello", a.spdp_multicast().unwrap());
+    assert!(wait_until(Duration::from_secs(5), || counts
+        .iter()
+        .all(|n| n.load(Ordering::SeqCst) == 1)));
+
+    // Unicast to the metatraffic port reaches only that participant.
+    let got = Arc::new(AtomicUsize::new(0));
+    drop(c);
+    let d = UdpTransport::bind(&cfg(51, ParticipantIndex::None)).unwrap();
+    let g = got.clone();
+    d.start(Arc::new(move |ch, _data, _from| {
+        if ch == Channel::MetaUnicast {
+            g.fetch_add(1, Ordering::SeqCst);
+        }
+    }))
+    .unwrap();
+    a.send_to(b"x", d.metatraffic_unicast());
+    assert!(wait_until(Duration::from_secs(5), || got
+        .load(Ordering::SeqCst)
+        == 1));
+    d.shutdown();
+    a.shutdown();
+    b.shutdown();
+}
+
+#[test]
+fn multicast_off_binds_no_group_socket() {
+    require_netns();
+    let mut c = cfg(52, ParticipantIndex::Auto);
+    c.multicast = false;
+    let t = UdpTransport::bind(&c).unwrap();
+    assert!(t.spdp_multicast().is_none());
+    assert!(!t.multicast_enabled());
+}

@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""Tiny Cyclone DDS (python cyclonedds 11) peer for the dcps interop scratch test.
+
+  cyclone_shapes.py pub TOPIC COLOR COUNT   -- writes COUNT samples (x = 0..COUNT-1), then disposes COLOR
+  cyclone_shapes.py sub TOPIC COUNT         -- prints each received sample as one JSON line, exits after COUNT
+Both wait up to 20 s for a match. Reliable, transient-local, keep-last 100.
+"""
+import json
+import sys
+import time
+from dataclasses import dataclass
+
+from cyclonedds.core import Policy, Qos
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.idl import IdlStruct
+from cyclonedds.idl.annotations import appendable, key
+from cyclonedds.idl.types import int32
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+
+
+@dataclass
+@appendable
+class ShapeType(IdlStruct, typename="ShapeType"):
+    color: str
+    key("color")
+    x: int32
+    y: int32
+    shapesize: int32
+
+
+QOS = Qos(
+    Policy.Reliability.Reliable(duration(seconds=1)),
+    Policy.Durability.TransientLocal,
+    Policy.History.KeepLast(100),
+)
+
+
+def log(*a):
+    print(*a, file=sys.stderr, flush=True)
+
+
+def main():
+    dp = DomainParticipant(int(__import__("os").environ.get("DDS_DOMAIN_ID", "0")))
+    mode, topic_name = sys.argv[1], sys.argv[2]
+    tp = Topic(dp, topic_name, ShapeType)
+    deadline = time.time() + 20
+    if mode == "pub":
+        color, count = sys.argv[3], int(sys.argv[4])
+        w = DataWriter(dp, tp, qos=QOS)
+        while w.get_publication_matched_status().current_count == 0:
+            if time.time() > deadline:
+                log("pub: no match")
+                sys.exit(2)
+            time.sleep(0.05)
+        log("pub: matched")
+        for i in range(count):
+            w.write(ShapeType(color=color, x=i, y=2 * i, shapesize=30))
+            time.sleep(0.01)
+        w.dispose(ShapeType(color=color, x=0, y=0, shapesize=0))
+        w.wait_for_acks(duration(seconds=5))
+        time.sleep(0.5)
+        log("pub: done")
+    else:
+        count = int(sys.argv[3])
+        r = DataReader(dp, tp, qos=QOS)
+        got = 0
+        while got < count and time.time() < deadline:
+            for s in r.take(N=100):
+                info = s.sample_info
+                if info.valid_data:
+                    print(json.dumps({"color": s.color, "x": s.x, "y": s.y, "shapesize": s.shapesize}), flush=True)
+                    got += 1
+                else:
+                    print(json.dumps({"state": str(info.instance_state)}), flush=True)
+            time.sleep(0.01)
+        log(f"sub: got {got}")
+        sys.exit(0 if got >= count else 3)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,96 @@
+//! Shared helpers of the `dcps_*` socket tests. They must run inside `scripts/isolated` (loopback only).
+#![allow(dead_code)]
+
+use std::time::{Duration, Instant};
+
+use dds_runtime::prelude::*;
+
+/// The shapes demo type (@appendable, keyed on color), as the OMG interop suite uses it.
+#[derive(DdsType, Debug, Clone, PartialEq, Default)]
+#[dds(name = "ShapeType", appendable)]
+pub struct ShapeType {
+    #[dds(key)]
+    pub color: String,
+    pub x: i32,
+    pub y: i32,
+    pub shapesize: i32,
+}
+
+impl FilterFields for ShapeType {
+    fn field(&self, path: &str) -> Option<FieldValue> {
+        Some(match path {
+            "color" => self.color.clone().into(),
+            "x" => self.x.into(),
+            "y" => self.y.into(),
+            "shapesize" => self.shapesize.into(),
+            _ => return None,
+        })
+    }
+}
+
+pub fn shape(color: &str, x: i32) -> ShapeType {
+    ShapeType {
+        color: color.into(),
+        x,
+        y: 2 * x,
+        shapesize: 30,
+    }
+}
+
+/// A @final keyed type with a large unbounded member (fragmentation).
+#[derive(DdsType, Debug, Clone, PartialEq, Default)]
+#[dds(name = "test::Blob", final)]
+pub struct Blob {
+    #[dds(key)]
+    pub id: u32,
+    pub data: Vec<u8>,
+}
+
+/// Refuses to open sockets outside the private network namespace.
+pub fn require_netns() {
+    assert_eq!(
+        std::env::var("DDS_IN_NETNS").as_deref(),
+        Ok("1"),
+        "socket tests must run inside scripts/isolated (loopback-only network namespace)"
+    );
+}
+
+pub fn init_tracing() {
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::from_env("DDS_LOG"))
+        .with_test_writer()
+        .try_init();
+}
+
+/// A participant on `lo` in `domain`, with fast discovery.
+pub fn participant(domain: u32) -> DomainParticipant {
+    require_netns();
+    init_tracing();
+    DomainParticipant::builder()
+        .domain_id(domain)
+        .interface("lo")
+        .spdp_interval(Duration::from_millis(200))
+        .lease_duration(Duration::from_secs(5))
+        .build()
+        .expect("participant")
+}
+
+/// Polls `f` until it holds or `timeout` passes.
+pub fn wait_until(timeout: Duration, mut f: impl FnMut() -> bool) -> bool {
+    let end = Instant::now() + timeout;
+    while Instant::now() < end {
+        if f() {
+            return true;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    f()
+}
+
+pub fn reliable() -> Reliability {
+    Reliability::Reliable {
+        max_blocking_time: Duration::from_secs(1),
+    }
+}
+
+pub const MATCH_TIMEOUT: Duration = Duration::from_secs(10);

@@ -1,0 +1,142 @@
+//! WaitSet wakeups from read conditions, status conditions and guard conditions; listeners.
+mod dcps_util;
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use dcps_util::*;
+use dds_runtime::prelude::*;
+
+#[test]
+fn waitset_wakes_on_data_status_and_guard() {
+    let p1 = participant(41);
+    let p2 = participant(41);
+    let t1 = p1
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(
+            &t2,
+            &DataReaderQos::builder().reliability(reliable()).build(),
+        )
+        .unwrap();
+
+    let ws = WaitSet::new();
+    let sc = r.status_condition();
+    sc.set_enabled_statuses(StatusMask::SUBSCRIPTION_MATCHED);
+    ws.attach_condition(sc.clone());
+    let rc = r.create_readcondition(
+        SampleStateMask::NOT_READ,
+        ViewStateMask::ANY,
+        InstanceStateMask::ANY,
+    );
+    ws.attach_condition(rc.clone());
+    let guard = GuardCondition::new();
+    ws.attach_condition(guard.clone());
+    assert!(matches!(
+        ws.wait(Duration::from_millis(50)),
+        Err(DdsError::Timeout)
+    ));
+
+    // Status condition: the writer appears.
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(
+            &t1,
+            &DataWriterQos::builder().reliability(reliable()).build(),
+        )
+        .unwrap();
+    let got = ws.wait(MATCH_TIMEOUT).unwrap();
+    assert!(got.iter().any(|c| matches!(c, Condition::Status(_))));
+    assert_eq!(r.subscription_matched_status().current_count, 1);
+    assert!(!sc.trigger_value(), "reading the status resets the trigger");
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+
+    // Read condition: data arrives from another thread while we wait.
+    let w2 = w.clone();
+    let t = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(100));
+        w2.write(&shape("RED", 1)).unwrap();
+    });
+    let start = Instant::now();
+    let got = ws.wait(Duration::from_secs(10)).unwrap();
+    assert!(start.elapsed() < Duration::from_secs(9));
+    assert!(got.iter().any(|c| matches!(c, Condition::Read(_))));
+    t.join().unwrap();
+    assert_eq!(r.take_w_condition(&rc).unwrap().len(), 1);
+    assert!(!rc.trigger_value());
+
+    // Guard condition.
+    guard.set_trigger_value(true);
+    let got = ws.wait(Duration::from_secs(1)).unwrap();
+    assert!(got.iter().any(|c| matches!(c, Condition::Guard(_))));
+}
+
+struct Counter(Arc<AtomicUsize>, Arc<AtomicUsize>);
+
+impl DataReaderListener<ShapeType> for Counter {
+    fn on_data_available(&self, reader: &DataReader<ShapeType>) {
+        let n = reader.take().unwrap().len();
+        self.0.fetch_add(n, Ordering::SeqCst);
+    }
+    fn on_subscription_matched(&self, _r: &DataReader<ShapeType>, s: SubscriptionMatchedStatus) {
+        self.1.store(s.current_count as usize, Ordering::SeqCst);
+    }
+}
+
+#[test]
+fn listener_sees_matches_and_data() {
+    let p1 = participant(42);
+    let p2 = participant(42);
+    let t1 = p1
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(
+            &t2,
+            &DataReaderQos::builder()
+                .reliability(reliable())
+                .history(History::KeepAll)
+                .build(),
+        )
+        .unwrap();
+    let (data, matched) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
+    r.set_listener(Box::new(Counter(data.clone(), matched.clone())));
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(
+            &t1,
+            &DataWriterQos::builder()
+                .reliability(reliable())
+                .history(History::KeepAll)
+                .build(),
+        )
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || matched.load(Ordering::SeqCst) == 1));
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    for i in 0..10 {
+        w.write(&shape("GREEN", i)).unwrap();
+    }
+    assert!(wait_until(Duration::from_secs(10), || data
+        .load(Ordering::SeqCst)
+        == 10));
+}

@@ -1,0 +1,270 @@
+//! A deterministic network simulator for the sans-I/O core: a clock we advance, a queue of datagrams with
+//! seeded loss, duplication and reordering (random delay), and several participants wired through it.
+#![allow(dead_code)]
+
+use std::collections::BinaryHeap;
+use std::cmp::Reverse;
+use std::time::{Duration, Instant};
+
+use dds_runtime::rtps::*;
+
+/// xorshift64*: small, seeded, deterministic.
+#[derive(Debug, Clone)]
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        let mut x = self.0;
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        self.0 = x;
+        x.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n.max(1)
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct Faults {
+    pub loss: f64,
+    pub duplicate: f64,
+    /// Each datagram gets a delay uniform in [latency, latency + jitter]: jitter reorders.
+    pub latency: Duration,
+    pub jitter: Duration,
+}
+
+impl Faults {
+    pub const NONE: Faults = Faults { loss: 0.0, duplicate: 0.0, latency: Duration::from_micros(100), jitter: Duration::ZERO };
+    pub fn lossy(loss: f64) -> Faults {
+        Faults { loss, duplicate: 0.1, latency: Duration::from_micros(100), jitter: Duration::from_millis(2) }
+    }
+}
+
+pub struct Node {
+    pub p: Participant,
+    pub events: Vec<Event>,
+    /// Whether this node receives (false = crashed/partitioned away).
+    pub up: bool,
+}
+
+#[derive(PartialEq, Eq, PartialOrd, Ord)]
+struct InFlight {
+    at: Instant,
+    seq: u64,
+    to: usize,
+    payload: Vec<u8>,
+}
+
+pub struct Sim {
+    pub start: Instant,
+    pub now: Instant,
+    pub nodes: Vec<Node>,
+    pub rng: Rng,
+    pub faults: Faults,
+    queue: BinaryHeap<Reverse<InFlight>>,
+    seq: u64,
+    pub datagrams_sent: u64,
+    /// Faults apply only to user traffic when set (discovery then completes quickly).
+    pub faults_on_discovery: bool,
+}
+
+pub fn prefix(i: usize) -> GuidPrefix {
+    let mut p = [0u8; 12];
+    p[0] = 0xaa;
+    p[11] = i as u8 + 1;
+    GuidPrefix(p)
+}
+
+pub fn config(i: usize) -> ParticipantConfig {
+    let mut c = ParticipantConfig::new(0, 0, prefix(i), [10, 0, 0, i as u8 + 1]);
+    c.spdp_interval = Duration::from_millis(500);
+    c.lease_duration = Duration::from_secs(3);
+    c
+}
+
+impl Sim {
+    pub fn new(seed: u64, faults: Faults) -> Self {
+        let start = Instant::now();
+        Sim {
+            start,
+            now: start,
+            nodes: Vec::new(),
+            rng: Rng::new(seed),
+            faults,
+            queue: BinaryHeap::new(),
+            seq: 0,
+            datagrams_sent: 0,
+            faults_on_discovery: true,
+        }
+    }
+
+    pub fn add(&mut self, config: ParticipantConfig) -> usize {
+        let p = Participant::new(config, self.now);
+        self.nodes.push(Node { p, events: Vec::new(), up: true });
+        self.nodes.len() - 1
+    }
+
+    pub fn with_participants(seed: u64, faults: Faults, n: usize) -> Self {
+        let mut s = Sim::new(seed, faults);
+        for i in 0..n {
+            s.add(config(i));
+        }
+        s
+    }
+
+    fn receivers(&self, l: &Locator) -> Vec<usize> {
+        self.nodes
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| {
+                let c = n.p.config();
+                if l.is_multicast() {
+                    c.metatraffic_multicast.contains(l) || c.default_multicast.contains(l)
+                } else {
+                    c.metatraffic_unicast.contains(l) || c.default_unicast.contains(l)
+                }
+            })
+            .map(|(i, _)| i)
+            .collect()
+    }
+
+    /// Moves every pending transmit into the network and every event into the nodes' logs.
+    pub fn pump(&mut self) {
+        for i in 0..self.nodes.len() {
+            while let Some(t) = self.nodes[i].p.poll_transmit(self.now) {
+                self.datagrams_sent += 1;
+                let mut targets: Vec<usize> = t.destinations.iter().flat_map(|l| self.receivers(l)).collect();
+                targets.sort();
+                targets.dedup();
+                let user = is_user_traffic(&t.payload);
+                for to in targets {
+                    let f = if user || self.faults_on_discovery { self.faults } else { Faults::NONE };
+                    if self.rng.unit() < f.loss {
+                        continue;
+                    }
+                    let copies = if self.rng.unit() < f.duplicate { 2 } else { 1 };
+                    for _ in 0..copies {
+                        let jitter = if f.jitter.is_zero() { 0 } else { self.rng.below(f.jitter.as_nanos() as u64) };
+                        let at = self.now + f.latency + Duration::from_nanos(jitter);
+                        self.seq += 1;
+                        self.queue.push(Reverse(InFlight { at, seq: self.seq, to, payload: t.payload.clone() }));
+                    }
+                }
+                self.nodes[i].p.recycle(t.payload);
+            }
+            while let Some(e) = self.nodes[i].p.poll_event() {
+                self.nodes[i].events.push(e);
+            }
+        }
+    }
+
+    /// Advances to the next datagram or timeout; returns false when nothing is scheduled.
+    pub fn step(&mut self) -> bool {
+        self.pump();
+        let next_dgram = self.queue.peek().map(|r| r.0.at);
+        let next_timer = self.nodes.iter().filter_map(|n| n.p.poll_timeout()).min();
+        let next = match (next_dgram, next_timer) {
+            (Some(a), Some(b)) => a.min(b),
+            (a, b) => match a.or(b) {
+                Some(x) => x,
+                None => return false,
+            },
+        };
+        if next > self.now {
+            self.now = next;
+        }
+        while let Some(r) = self.queue.peek() {
+            if r.0.at > self.now {
+                break;
+            }
+            let Reverse(d) = self.queue.pop().unwrap();
+            if self.nodes[d.to].up {
+                self.nodes[d.to].p.handle_datagram(self.now, &d.payload);
+            }
+        }
+        for n in &mut self.nodes {
+            if n.p.poll_timeout().is_some_and(|t| t <= self.now) {
+                n.p.handle_timeout(self.now);
+            }
+        }
+        self.pump();
+        true
+    }
+
+    /// Runs until `cond` holds or `limit` of simulated time passes; returns whether `cond` held.
+    pub fn run_until(&mut self, limit: Duration, mut cond: impl FnMut(&mut Sim) -> bool) -> bool {
+        let end = self.now + limit;
+        loop {
+            self.pump();
+            if cond(self) {
+                return true;
+            }
+            if self.now >= end || !self.step() {
+                return cond(self);
+            }
+        }
+    }
+
+    pub fn run_for(&mut self, d: Duration) {
+        let end = self.now + d;
+        self.run_until(d, |s| s.now >= end);
+    }
+
+    pub fn elapsed(&self) -> Duration {
+        self.now - self.start
+    }
+
+    pub fn guid(&self, node: usize, id: EntityId) -> Guid {
+        Guid::new(self.nodes[node].p.guid_prefix(), id)
+    }
+
+    /// Takes the samples delivered to `reader` at `node` so far.
+    pub fn take_samples(&mut self, node: usize, reader: EntityId) -> Vec<ReceivedSample> {
+        let mut out = Vec::new();
+        self.nodes[node].events.retain(|e| match e {
+            Event::Sample(s) if s.reader == reader => {
+                out.push(s.clone());
+                false
+            }
+            _ => true,
+        });
+        out
+    }
+
+    pub fn has_event(&self, node: usize, f: impl Fn(&Event) -> bool) -> bool {
+        self.nodes[node].events.iter().any(f)
+    }
+}
+
+/// User traffic: a message that carries a submessage from/to a user entity. Checked crudely by scanning the
+/// entity ids in DATA/HEARTBEAT/ACKNACK/GAP submessages' fixed positions is overkill; instead we treat messages
+/// whose every writer/reader id is builtin as discovery.
+fn is_user_traffic(msg: &[u8]) -> bool {
+    use dds_runtime::rtps::messages::{MessageIter, Submessage};
+    let Ok((_, it)) = MessageIter::parse(msg) else { return true };
+    for s in it.flatten() {
+        let ids = match s {
+            Submessage::Data(d) => [d.reader_id, d.writer_id],
+            Submessage::DataFrag(d) => [d.reader_id, d.writer_id],
+            Submessage::Heartbeat(h) => [h.reader_id, h.writer_id],
+            Submessage::AckNack(a) => [a.reader_id, a.writer_id],
+            Submessage::Gap(g) => [g.reader_id, g.writer_id],
+            Submessage::NackFrag(n) => [n.reader_id, n.writer_id],
+            Submessage::HeartbeatFrag(h) => [h.reader_id, h.writer_id],
+            _ => continue,
+        };
+        if ids.iter().any(|e| *e != EntityId::UNKNOWN && !e.is_builtin()) {
+            return true;
+        }
+    }
+    false
+}

@@ -1,0 +1,582 @@
+//! Command line of `shape_main`, the OMG interoperability suite's test program (omg-dds/dds-rtps,
+//! `srcCxx/shape_main.cxx`): same flags, same defaults, same validation messages.
+
+use std::fmt;
+use std::time::Duration;
+
+/// DURABILITY kinds selectable with `-D`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DurabilityArg {
+    /// `v`
+    Volatile,
+    /// `l`
+    TransientLocal,
+    /// `t`
+    Transient,
+    /// `p`
+    Persistent,
+}
+
+/// What a publisher does with its instances before it exits (`--final-instance-state`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FinalInstanceState {
+    /// `u`: unregister (and do not autodispose).
+    Unregister,
+    /// `d`: dispose.
+    Dispose,
+}
+
+/// Presentation access scope (`--access-scope`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AccessScope {
+    /// `i`
+    Instance,
+    /// `t`
+    Topic,
+    /// `g`
+    Group,
+}
+
+/// All options of shape_main, with its defaults.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShapeOptions {
+    pub debug: bool,
+    pub domain_id: u32,
+    pub publish: bool,
+    pub subscribe: bool,
+    pub reliable: bool,
+    pub durability: DurabilityArg,
+    /// 1 or 2.
+    pub xcdr: u8,
+    /// `None`: the default; `Some(0)`: KEEP_ALL; `Some(n)`: KEEP_LAST n.
+    pub history_depth: Option<u32>,
+    /// `None`: shared ownership.
+    pub ownership_strength: Option<i32>,
+    pub topic: Option<String>,
+    pub color: Option<String>,
+    pub partition: Option<String>,
+    pub time_filter: Duration,
+    pub deadline: Duration,
+    pub lifespan: Duration,
+    pub print_writer_samples: bool,
+    pub shapesize: i32,
+    pub use_read: bool,
+    pub write_period: Duration,
+    pub read_period: Duration,
+    /// 0: run until interrupted.
+    pub num_iterations: u32,
+    pub num_instances: u32,
+    pub num_topics: u32,
+    pub final_instance_state: Option<FinalInstanceState>,
+    pub access_scope: Option<AccessScope>,
+    pub coherent: bool,
+    pub ordered: bool,
+    pub coherent_sample_count: u32,
+    pub additional_payload_size: u32,
+    /// `true` unless `--take-read`: use take/read_next_instance.
+    pub take_read_next_instance: bool,
+    pub periodic_announcement: Duration,
+    pub datafrag_size: u32,
+    pub cft_expression: Option<String>,
+    pub size_modulo: i32,
+}
+
+impl Default for ShapeOptions {
+    fn default() -> Self {
+        ShapeOptions {
+            debug: false,
+            domain_id: 0,
+            publish: false,
+            subscribe: false,
+            reliable: true,
+            durability: DurabilityArg::Volatile,
+            xcdr: 1,
+            history_depth: None,
+            ownership_strength: None,
+            topic: None,
+            color: None,
+            partition: None,
+            time_filter: Duration::ZERO,
+            deadline: Duration::ZERO,
+            lifespan: Duration::ZERO,
+            print_writer_samples: false,
+            shapesize: 20,
+            use_read: false,
+            write_period: Duration::from_millis(33),
+            read_period: Duration::from_millis(100),
+            num_iterations: 0,
+            num_instances: 1,
+            num_topics: 1,
+            final_instance_state: None,
+            access_scope: None,
+            coherent: false,
+            ordered: false,
+            coherent_sample_count: 0,
+            additional_payload_size: 0,
+            take_read_next_instance: true,
+            periodic_announcement: Duration::ZERO,
+            datafrag_size: 0,
+            cft_expression: None,
+            size_modulo: 0,
+        }
+    }
+}
+
+/// What the command line asked for.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Parsed {
+    /// Run with these options; `warnings` are printed first (shape_main prints them as errors but runs).
+    Run { options: ShapeOptions, warnings: Vec<String> },
+    /// `-h`/`--help`.
+    Help,
+}
+
+/// A command-line error: the message shape_main prints before the usage text (exit code 1).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ParseError(pub Vec<String>);
+
+impl fmt::Display for ParseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0.join("\n"))
+    }
+}
+
+impl std::error::Error for ParseError {}
+
+/// The usage text.
+pub fn usage(prog: &str) -> String {
+    format!(
+        "{prog}: 
+   --help, -h      : print this menu
+   -v [e|d]        : set log message verbosity [e: ERROR, d: DEBUG]
+   -P              : publish samples
+   -S              : subscribe samples
+   -d <int>        : domain id (default: 0)
+   -b              : BEST_EFFORT reliability
+   -r              : RELIABLE reliability
+   -k <depth>      : keep history depth [0: KEEP_ALL]
+   -f <interval>   : set a 'deadline' with interval (ms) [0: OFF]
+   -s <strength>   : set ownership strength [-1: SHARED]
+   -t <topic_name> : set the topic name
+   -c <color>      : set color to publish (filter if subscriber)
+   -p <partition>  : set a 'partition' string
+   -D [v|l|t|p]    : set durability [v: VOLATILE,  l: TRANSIENT_LOCAL]
+                                     t: TRANSIENT, p: PERSISTENT]
+   -x [1|2]        : set data representation [1: XCDR, 2: XCDR2]
+   -w              : print Publisher's samples
+   -z <int>        : set shapesize (0: increase the size for every sample)
+   -R              : use 'read()' instead of 'take()'
+   --write-period <ms>: waiting period between 'write()' operations in ms. Default: 33ms
+   --read-period <ms> : waiting period between 'read()' or 'take()' operations in ms. Default: 100ms
+   --time-filter <interval> : apply 'time based filter' with interval in ms [0: OFF]
+   --lifespan <int>      : indicates the lifespan of a sample in ms
+   --num-iterations <int>: indicates the number of iterations of the main loop
+   --num-instances <int>: indicates the number of instances a DataWriter writes
+   --num-topics <int>: indicates the number of topics created (using the same type)
+   --final-instance-state [u|d]: unregister or dispose the instances before exiting
+   --access-scope [i|t|g]: sets Presentation.access_scope to INSTANCE, TOPIC or GROUP
+   --coherent            : sets Presentation.coherent_access = true
+   --ordered             : sets Presentation.ordered_access = true
+   --coherent-sample-count <int>: samples per coherent set
+   --additional-payload-size <bytes>: bytes added to the samples written
+   --take-read           : uses take()/read() instead of take_next_instance()/read_next_instance()
+   --periodic-announcement <ms> : periodic participant announcement period in ms. Default 0 (off)
+   --datafrag-size <bytes> : set the data fragment size (default: 0, means not set)
+   --cft <expression> : ContentFilteredTopic filter expression
+   --size-modulo <int> : applies a modulo to the increasing shapesize (-z 0)
+"
+    )
+}
+
+/// Short options that take an argument (getopt string "hPSbrRwc:d:D:f:k:p:s:x:t:v:z:").
+const SHORT_WITH_ARG: &str = "cdDfkpsxtvz";
+const SHORT_FLAGS: &str = "hPSbrRw";
+const LONG_WITH_ARG: &[&str] = &[
+    "write-period",
+    "read-period",
+    "final-instance-state",
+    "access-scope",
+    "coherent-sample-count",
+    "additional-payload-size",
+    "num-topics",
+    "lifespan",
+    "num-instances",
+    "num-iterations",
+    "time-filter",
+    "periodic-announcement",
+    "datafrag-size",
+    "cft",
+    "size-modulo",
+];
+const LONG_FLAGS: &[&str] = &["help", "coherent", "ordered", "take-read"];
+
+/// Splits argv (without the program name) into (option, value) pairs the way getopt_long does:
+/// `-x2`, `-x 2`, `-Pw`, `--num-iterations=5`, `--num-iterations 5`, unambiguous long prefixes.
+fn tokenize(args: &[String]) -> Result<Vec<(String, Option<String>)>, String> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < args.len() {
+        let a = &args[i];
+        i += 1;
+        if let Some(long) = a.strip_prefix("--") {
+            let (name, inline) = match long.split_once('=') {
+                Some((n, v)) => (n, Some(v.to_string())),
+                None => (long, None),
+            };
+            let all = LONG_WITH_ARG.iter().chain(LONG_FLAGS.iter());
+            let exact = all.clone().find(|n| **n == name);
+            let candidates: Vec<&&str> = all.filter(|n| n.starts_with(name)).collect();
+            let full = match (exact, candidates.as_slice()) {
+                (Some(n), _) => *n,
+                (None, [one]) => **one,
+                (None, []) => return Err(format!("unrecognized option '--{name}'")),
+                (None, _) => return Err(format!("option '--{name}' is ambiguous")),
+            };
+            if LONG_WITH_ARG.contains(&full) {
+                let v = match inline {
+                    Some(v) => v,
+                    None => {
+                        let v = args.get(i).cloned().ok_or_else(|| format!("option '--{full}' requires an argument"))?;
+                        i += 1;
+                        v
+                    }
+                };
+                out.push((format!("--{full}"), Some(v)));
+            } else {
+                if inline.is_some() {
+                    return Err(format!("option '--{full}' doesn't allow an argument"));
+                }
+                out.push((format!("--{full}"), None));
+            }
+        } else if let Some(shorts) = a.strip_prefix('-').filter(|s| !s.is_empty()) {
+            let chars: Vec<char> = shorts.chars().collect();
+            let mut j = 0;
+            while j < chars.len() {
+                let c = chars[j];
+                j += 1;
+                if SHORT_WITH_ARG.contains(c) {
+                    let rest: String = chars[j..].iter().collect();
+                    let v = if !rest.is_empty() {
+                        rest
+                    } else {
+                        let v = args.get(i).cloned().ok_or_else(|| format!("option requires an argument -- '{c}'"))?;
+                        i += 1;
+                        v
+                    };
+                    out.push((format!("-{c}"), Some(v)));
+                    break;
+                } else if SHORT_FLAGS.contains(c) {
+                    out.push((format!("-{c}"), None));
+                } else {
+                    return Err(format!("invalid option -- '{c}'"));
+                }
+            }
+        } else {
+            // getopt permutes non-options to the end; shape_main ignores them.
+        }
+    }
+    Ok(out)
+}
+
+/// sscanf("%d")-like: leading integer, rest ignored; `None` when there is no number.
+fn leading_int(s: &str) -> Option<i64> {
+    let t = s.trim_start();
+    let end = t
+        .char_indices()
+        .take_while(|(i, c)| c.is_ascii_digit() || (*i == 0 && (*c == '-' || *c == '+')))
+        .map(|(i, c)| i + c.len_utf8())
+        .last()?;
+    t[..end].parse().ok()
+}
+
+fn first_char(s: &str) -> char {
+    s.chars().next().unwrap_or('\0')
+}
+
+/// Parses shape_main's command line (argv without the program name).
+pub fn parse(args: &[String]) -> Result<Parsed, ParseError> {
+    let tokens = tokenize(args).map_err(|e| ParseError(vec![e]))?;
+    let mut o = ShapeOptions::default();
+    let mut errors = Vec::new();
+    let mut access_scope_set = false;
+    for (opt, val) in tokens {
+        let v = val.unwrap_or_default();
+        let c0 = first_char(&v);
+        let num = leading_int(&v);
+        let ms = |errors: &mut Vec<String>, what: &str| -> Duration {
+            match num {
+                None => {
+                    errors.push(format!("unrecognized value for {what} {c0}"));
+                    Duration::ZERO
+                }
+                Some(n) if n < 0 => {
+                    errors.push(format!("incorrect value for {what} {n}"));
+                    Duration::ZERO
+                }
+                Some(n) => Duration::from_millis(n as u64),
+            }
+        };
+        let positive = |errors: &mut Vec<String>, what: &str| -> u32 {
+            match num {
+                None => {
+                    errors.push(format!("unrecognized value for {what} {c0}"));
+                    1
+                }
+                Some(n) if n < 1 => {
+                    errors.push(format!("incorrect value for {what}, it must be >=1 {n}"));
+                    1
+                }
+                Some(n) => n.min(i64::from(u32::MAX)) as u32,
+            }
+        };
+        match opt.as_str() {
+            "-h" | "--help" => return Ok(Parsed::Help),
+            "-v" => match c0 {
+                'd' => o.debug = true,
+                'e' => o.debug = false,
+                _ => errors.push(format!("unrecognized value for verbosity {c0}")),
+            },
+            "-w" => o.print_writer_samples = true,
+            "-b" => o.reliable = false,
+            "-r" => o.reliable = true,
+            "-R" => o.use_read = true,
+            "-P" => o.publish = true,
+            "-S" => o.subscribe = true,
+            "-c" => o.color = Some(v),
+            "-t" => o.topic = Some(v),
+            "-p" => o.partition = Some(v),
+            "-d" => match num {
+                Some(n) if (0..=i64::from(u32::MAX)).contains(&n) => o.domain_id = n as u32,
+                Some(n) => errors.push(format!("incorrect value for domain_id {n}")),
+                None => errors.push(format!("unrecognized value for domain_id {c0}")),
+            },
+            "-D" => match c0 {
+                'v' => o.durability = DurabilityArg::Volatile,
+                'l' => o.durability = DurabilityArg::TransientLocal,
+                't' => o.durability = DurabilityArg::Transient,
+                'p' => o.durability = DurabilityArg::Persistent,
+                _ => errors.push(format!("unrecognized value for durability {c0}")),
+            },
+            "-x" => match c0 {
+                '1' => o.xcdr = 1,
+                '2' => o.xcdr = 2,
+                _ => errors.push(format!("unrecognized value for data representation {c0}")),
+            },
+            "-k" => match num {
+                Some(n) if n >= 0 => o.history_depth = Some(n.min(i64::from(u32::MAX)) as u32),
+                Some(n) => errors.push(format!("incorrect value for history_depth {n}")),
+                None => errors.push(format!("unrecognized value for history_depth {c0}")),
+            },
+            "-s" => match num {
+                Some(-1) => o.ownership_strength = None,
+                Some(n) if n >= 0 => o.ownership_strength = Some(n.min(i64::from(i32::MAX)) as i32),
+                Some(n) => errors.push(format!("incorrect value for ownership_strength {n}")),
+                None => errors.push(format!("unrecognized value for ownership_strength {c0}")),
+            },
+            "-z" => match num {
+                Some(n) if n >= 0 => o.shapesize = n.min(i64::from(i32::MAX)) as i32,
+                Some(n) => errors.push(format!("incorrect value for shapesize {n}")),
+                None => errors.push(format!("unrecognized value for shapesize {c0}")),
+            },
+            "-f" => o.deadline = ms(&mut errors, "deadline_interval"),
+            "--time-filter" => o.time_filter = ms(&mut errors, "timebasedfilter_interval"),
+            "--write-period" => o.write_period = ms(&mut errors, "write-period"),
+            "--read-period" => o.read_period = ms(&mut errors, "read-period"),
+            "--lifespan" => o.lifespan = ms(&mut errors, "lifespan"),
+            "--periodic-announcement" => o.periodic_announcement = ms(&mut errors, "periodic-announcement"),
+            "--num-iterations" => o.num_iterations = positive(&mut errors, "num-iterations"),
+            "--num-instances" => o.num_instances = positive(&mut errors, "num-instances"),
+            "--num-topics" => o.num_topics = positive(&mut errors, "num-topics"),
+            "--additional-payload-size" => o.additional_payload_size = positive(&mut errors, "additional-payload-size"),
+            "--coherent-sample-count" => match num {
+                Some(n) if n >= 2 => o.coherent_sample_count = n.min(i64::from(u32::MAX)) as u32,
+                Some(n) => errors.push(format!("incorrect value for coherent-sample-count, it must be >=2 {n}")),
+                None => errors.push(format!("unrecognized value for coherent-sample-count {c0}")),
+            },
+            "--final-instance-state" => {
+                let new = match c0 {
+                    'u' => Some(FinalInstanceState::Unregister),
+                    'd' => Some(FinalInstanceState::Dispose),
+                    _ => {
+                        errors.push(format!("unrecognized value for final-instance-state {c0}"));
+                        None
+                    }
+                };
+                if let (Some(old), Some(new)) = (o.final_instance_state, new) {
+                    if old != new {
+                        errors.push("error, cannot configure unregister and dispose at the same time".into());
+                    }
+                }
+                o.final_instance_state = new.or(o.final_instance_state);
+            }
+            "--access-scope" => {
+                access_scope_set = true;
+                o.access_scope = match c0 {
+                    'i' => Some(AccessScope::Instance),
+                    't' => Some(AccessScope::Topic),
+                    'g' => Some(AccessScope::Group),
+                    _ => {
+                        errors.push(format!("unrecognized value for coherent-sets {c0}"));
+                        None
+                    }
+                };
+            }
+            "--coherent" => o.coherent = true,
+            "--ordered" => o.ordered = true,
+            "--take-read" => o.take_read_next_instance = false,
+            "--datafrag-size" => match num {
+                Some(n) if (0..=65535).contains(&n) => o.datafrag_size = n as u32,
+                Some(n) => errors.push(format!("incorrect value for datafrag-size, it must be <= 65535 bytes{n}")),
+                None => errors.push(format!("unrecognized value for datafrag-size {c0}")),
+            },
+            "--cft" => o.cft_expression = Some(v),
+            "--size-modulo" => match num {
+                Some(n) if n >= 1 => o.size_modulo = n.min(i64::from(i32::MAX)) as i32,
+                _ => errors.push("incorrect value for size-modulo, must be >=1".into()),
+            },
+            _ => errors.push(format!("unhandled option {opt}")),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(ParseError(errors));
+    }
+    let mut warnings = Vec::new();
+    validate(&mut o, access_scope_set, &mut warnings)?;
+    Ok(Parsed::Run { options: o, warnings })
+}
+
+/// shape_main's `validate()`: fatal combinations are errors, the rest warnings.
+fn validate(o: &mut ShapeOptions, access_scope_set: bool, w: &mut Vec<String>) -> Result<(), ParseError> {
+    if o.topic.is_none() {
+        return Err(ParseError(vec!["please specify topic name [-t]".into()]));
+    }
+    if !o.publish && !o.subscribe {
+        return Err(ParseError(vec!["please specify publish [-P] or subscribe [-S]".into()]));
+    }
+    if o.publish && o.subscribe {
+        return Err(ParseError(vec!["please specify only one of: publish [-P] or subscribe [-S]".into()]));
+    }
+    if o.publish && o.color.is_none() {
+        o.color = Some("BLUE".into());
+        w.push("warning: color was not specified, defaulting to \"BLUE\"".into());
+    }
+    if o.publish && !o.time_filter.is_zero() {
+        w.push("warning: time base filter [--time-filter] ignored on publisher applications".into());
+    }
+    if o.publish && o.use_read {
+        w.push("warning: use read [-R] ignored on publisher applications".into());
+    }
+    if o.publish && !o.take_read_next_instance {
+        w.push("warning: --take-read ignored on publisher applications".into());
+    }
+    if o.publish && o.cft_expression.is_some() {
+        w.push("warning: --cft ignored on publisher applications".into());
+    }
+    if o.subscribe && o.shapesize != 20 {
+        w.push("warning: shapesize [-z] ignored on subscriber applications".into());
+    }
+    if o.subscribe && !o.lifespan.is_zero() {
+        w.push("warning: --lifespan ignored on subscriber applications".into());
+    }
+    if o.subscribe && o.num_instances > 1 {
+        w.push("warning: --num-instances ignored on subscriber applications".into());
+    }
+    if o.subscribe && o.final_instance_state.is_some() {
+        w.push("warning: --final-instance-state ignored on subscriber applications".into());
+    }
+    if o.subscribe && o.coherent_sample_count > 0 {
+        w.push("warning: --coherent-sample-count ignored on subscriber applications".into());
+    }
+    if !o.coherent && !o.ordered && o.coherent_sample_count > 0 {
+        w.push("warning: --coherent-sample-count ignored because not coherent, or ordered access enabled".into());
+    }
+    if o.subscribe && o.additional_payload_size > 0 {
+        w.push("warning: --additional-payload-size ignored on subscriber applications".into());
+    }
+    if !o.coherent && !o.ordered && access_scope_set {
+        w.push("warning: --access-scope set but not coherent, or ordered access enabled".into());
+    }
+    if o.size_modulo > 0 && o.shapesize != 0 {
+        w.push("warning: --size-modulo has no effect unless shapesize (-z) is set to 0".into());
+    }
+    if o.subscribe && o.color.is_some() && o.cft_expression.is_some() {
+        return Err(ParseError(vec!["error: cannot specify both --cft and -c for subscriber applications".into()]));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(s: &str) -> Vec<String> {
+        s.split_whitespace().map(String::from).collect()
+    }
+
+    fn run(s: &str) -> (ShapeOptions, Vec<String>) {
+        match parse(&args(s)).expect("parses") {
+            Parsed::Run { options, warnings } => (options, warnings),
+            Parsed::Help => panic!("help"),
+        }
+    }
+
+    #[test]
+    fn defaults_match_shape_main() {
+        let (o, w) = run("-P -t Square");
+        assert_eq!(o.color.as_deref(), Some("BLUE"));
+        assert_eq!(w, vec!["warning: color was not specified, defaulting to \"BLUE\"".to_string()]);
+        assert!(o.reliable);
+        assert_eq!(o.xcdr, 1);
+        assert_eq!(o.durability, DurabilityArg::Volatile);
+        assert_eq!(o.write_period, Duration::from_millis(33));
+        assert_eq!(o.read_period, Duration::from_millis(100));
+        assert_eq!(o.shapesize, 20);
+        assert!(o.take_read_next_instance);
+    }
+
+    #[test]
+    fn short_options_attached_and_separate() {
+        let (o, _) = run("-S -tCircle -x2 -d 17 -b -k 0 -D l -p A* -c RED");
+        assert!(o.subscribe);
+        assert_eq!(o.topic.as_deref(), Some("Circle"));
+        assert_eq!(o.xcdr, 2);
+        assert_eq!(o.domain_id, 17);
+        assert!(!o.reliable);
+        assert_eq!(o.history_depth, Some(0));
+        assert_eq!(o.durability, DurabilityArg::TransientLocal);
+        assert_eq!(o.partition.as_deref(), Some("A*"));
+        assert_eq!(o.color.as_deref(), Some("RED"));
+    }
+
+    #[test]
+    fn grouped_flags_and_long_options() {
+        let (o, _) = run("-Pw -t Square --write-period=5 --num-iterations 10 --final-instance-state d --additional-payload-size 100000 --num-inst 3");
+        assert!(o.publish && o.print_writer_samples);
+        assert_eq!(o.write_period, Duration::from_millis(5));
+        assert_eq!(o.num_iterations, 10);
+        assert_eq!(o.final_instance_state, Some(FinalInstanceState::Dispose));
+        assert_eq!(o.additional_payload_size, 100_000);
+        assert_eq!(o.num_instances, 3);
+    }
+
+    #[test]
+    fn errors_are_reported() {
+        assert!(parse(&args("-P")).is_err());
+        assert!(parse(&args("-t Square")).is_err());
+        assert!(parse(&args("-P -S -t Square")).is_err());
+        assert!(parse(&args("-P -t Square -x 3")).is_err());
+        assert!(parse(&args("-P -t Square -d -1")).is_err());
+        assert!(parse(&args("-P -t Square --num-iterations 0")).is_err());
+        assert!(parse(&args("-P -t Square --bogus")).is_err());
+        assert!(parse(&args("-P -t Square --final-instance-state u --final-instance-state d")).is_err());
+        assert!(parse(&args("-S -t Square -c RED --cft x")).is_err());
+        assert_eq!(parse(&args("-h")), Ok(Parsed::Help));
+    }
+
+    #[test]
+    fn subscriber_warnings() {
+        let (_, w) = run("-S -t Square -z 30 --num-instances 2");
+        assert!(w.iter().any(|l| l.contains("shapesize [-z] ignored")));
+        assert!(w.iter().any(|l| l.contains("--num-instances ignored")));
+    }
+}

@@ -1,0 +1,101 @@
+//! Rendering through miette: a snippet of the right file, carets, labels, help and the code.
+use super::{Diagnostic, Severity};
+use crate::source::SourceDb;
+use miette::{GraphicalReportHandler, GraphicalTheme, LabeledSpan, NamedSource};
+use std::fmt;
+
+#[derive(Clone, Copy, Debug)]
+pub struct RenderOptions {
+    pub color: bool,
+    pub width: usize,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions { color: false, width: 100 }
+    }
+}
+
+struct Report<'a> {
+    diag: &'a Diagnostic,
+    source: Option<NamedSource<String>>,
+    file: Option<crate::source::FileId>,
+    help: Option<String>,
+}
+
+impl fmt::Debug for Report<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.diag.message)
+    }
+}
+impl fmt::Display for Report<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.diag.message)
+    }
+}
+impl std::error::Error for Report<'_> {}
+
+impl miette::Diagnostic for Report<'_> {
+    fn code<'b>(&'b self) -> Option<Box<dyn fmt::Display + 'b>> {
+        Some(Box::new(self.diag.code.as_str()))
+    }
+    fn severity(&self) -> Option<miette::Severity> {
+        Some(match self.diag.severity {
+            Severity::Error => miette::Severity::Error,
+            Severity::Warning => miette::Severity::Warning,
+        })
+    }
+    fn help<'b>(&'b self) -> Option<Box<dyn fmt::Display + 'b>> {
+        self.help.as_ref().map(|h| Box::new(h) as Box<dyn fmt::Display>)
+    }
+    fn source_code(&self) -> Option<&dyn miette::SourceCode> {
+        self.source.as_ref().map(|s| s as &dyn miette::SourceCode)
+    }
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
+        let file = self.file?;
+        Some(Box::new(self.diag.labels.iter().filter(move |l| l.loc.file == file).map(|l| {
+            let span = (l.loc.start as usize, l.loc.len());
+            if l.primary {
+                LabeledSpan::new_primary_with_span(l.message.clone(), span)
+            } else {
+                LabeledSpan::new_with_span(l.message.clone(), span)
+            }
+        })))
+    }
+}
+
+/// Renders one diagnostic as text.
+pub fn render(db: &SourceDb, diag: &Diagnostic, opts: RenderOptions) -> String {
+    let file = diag.primary_loc().map(|l| l.file);
+    let source = file.map(|f| {
+        let sf = db.get(f);
+        NamedSource::new(sf.name.clone(), sf.text.to_string())
+    });
+    // Labels in other files cannot share a snippet: say where they are instead.
+    let mut extra: Vec<String> = diag
+        .labels
+        .iter()
+        .filter(|l| Some(l.loc.file) != file)
+        .map(|l| format!("note: {} at {}", l.message.as_deref().unwrap_or("see"), db.describe(l.loc)))
+        .collect();
+    extra.extend(diag.notes.iter().map(|n| format!("note: {n}")));
+    let help = match (&diag.help, extra.is_empty()) {
+        (Some(h), true) => Some(h.clone()),
+        (Some(h), false) => Some(format!("{h}\n{}", extra.join("\n"))),
+        (None, false) => Some(extra.join("\n")),
+        (None, true) => None,
+    };
+    let report = Report { diag, source, file, help };
+    let theme = if opts.color { GraphicalTheme::unicode() } else { GraphicalTheme::unicode_nocolor() };
+    let handler = GraphicalReportHandler::new_themed(theme).with_width(opts.width).with_links(false);
+    let mut out = String::new();
+    if handler.render_report(&mut out, &report).is_err() {
+        out = format!("{}: {}", diag.code.as_str(), diag.message);
+    }
+    out
+}
+
+/// Renders several diagnostics, separated by blank lines.
+pub fn render_all<'a>(db: &SourceDb, diags: impl IntoIterator<Item = &'a Diagnostic>, opts: RenderOptions) -> String {
+    diags.into_iter().map(|d| render(db, d, opts)).collect::<Vec<_>>().join("\n")
+}

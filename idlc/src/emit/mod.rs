@@ -1,0 +1,3 @@
+//! Back ends: Rust source (askama templates, formatted with prettyplease) and the JSON type model.
+pub mod json;
+pub mod rust;

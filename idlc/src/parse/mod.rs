@@ -1,0 +1,186 @@
+//! Parsing: the pest grammar in `idl.pest`, syntax-error reporting, and AST construction (`build.rs`).
+mod build;
+pub mod literal;
+
+use crate::ast::Spec;
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::preprocess::Output;
+use pest::error::InputLocation;
+use pest::Parser as _;
+
+#[derive(pest_derive::Parser)]
+#[grammar = "parse/idl.pest"]
+pub struct IdlParser;
+
+/// Deepest bracket nesting accepted; deeper input is refused before pest recurses into it.
+pub const MAX_NESTING: usize = 100;
+
+/// Parses preprocessed text into an AST. Syntax errors are reported into `diags`; the result is then empty.
+pub fn parse(pp: &Output, diags: &mut Diagnostics) -> Spec {
+    if let Some(off) = too_deep(&pp.text) {
+        diags.push(
+            Diagnostic::error(Code::Limit, format!("brackets nested more than {MAX_NESTING} deep"))
+                .at(pp.map.loc(off, off + 1), "nesting limit reached here"),
+        );
+        return Spec::default();
+    }
+    match IdlParser::parse(Rule::specification, &pp.text) {
+        Ok(mut pairs) => {
+            let spec = pairs.next().expect("specification rule always produces a pair");
+            build::Builder::new(pp, diags).specification(spec)
+        }
+        Err(e) => {
+            diags.push(syntax_error(pp, &e));
+            Spec::default()
+        }
+    }
+}
+
+/// Offset where bracket nesting first exceeds [`MAX_NESTING`], skipping comments and literals.
+fn too_deep(text: &str) -> Option<usize> {
+    let b = text.as_bytes();
+    let mut depth = 0usize;
+    let mut i = 0;
+    while i < b.len() {
+        match b[i] {
+            b'/' if b.get(i + 1) == Some(&b'/') => {
+                i = b[i..].iter().position(|&c| c == b'\n').map_or(b.len(), |p| i + p);
+            }
+            b'/' if b.get(i + 1) == Some(&b'*') => {
+                i = text[i + 2..].find("*/").map_or(b.len(), |p| i + 2 + p + 2);
+                continue;
+            }
+            b'"' | b'\'' => {
+                let q = b[i];
+                i += 1;
+                while i < b.len() && b[i] != q && b[i] != b'\n' {
+                    i += if b[i] == b'\\' { 2 } else { 1 };
+                }
+            }
+            b'(' | b'{' | b'[' => depth += 1,
+            b'<' if b.get(i + 1) != Some(&b'<') && (i == 0 || b[i - 1] != b'<') => depth += 1,
+            b')' | b'}' | b']' | b'>' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        if depth > MAX_NESTING {
+            return Some(i);
+        }
+        i += 1;
+    }
+    None
+}
+
+/// Human names of grammar rules, for "expected X".
+fn rule_name(r: Rule) -> Option<&'static str> {
+    use Rule::*;
+    Some(match r {
+        identifier => "identifier",
+        scoped_name => "name",
+        type_spec | base_type | template_type | integer_type | floating_type | switch_type | const_type => "type",
+        const_expr | primary_expr | unary_expr | literal | int_lit | float_lit => "expression",
+        annotation_appl => "annotation",
+        definition => "definition",
+        member => "member",
+        declarator | declarators => "declarator",
+        case_stmt | case_label | K_CASE => "`case`",
+        default_label | K_DEFAULT => "`default`",
+        enumerator => "enumerator",
+        bitfield | bitfield_spec | K_BITFIELD => "`bitfield`",
+        array_size => "`[`",
+        EOI => "end of file",
+        K_MODULE => "`module`",
+        K_STRUCT => "`struct`",
+        K_UNION => "`union`",
+        K_SWITCH => "`switch`",
+        K_ENUM => "`enum`",
+        K_TYPEDEF => "`typedef`",
+        K_CONST => "`const`",
+        or_op | xor_op | and_op | shift_op | add_op | mult_op => "operator",
+        named_param => "parameter",
+        _ => return None,
+    })
+}
+
+fn syntax_error(pp: &Output, e: &pest::error::Error<Rule>) -> Diagnostic {
+    let pos = match e.location {
+        InputLocation::Pos(p) => p,
+        InputLocation::Span((s, _)) => s,
+    };
+    let mut expected: Vec<String> = Vec::new();
+    if let pest::error::ErrorVariant::ParsingError { positives, .. } = &e.variant {
+        for r in positives {
+            if let Some(n) = rule_name(*r) {
+                expected.push(n.to_string());
+            }
+        }
+    }
+    if let Some(att) = e.parse_attempts() {
+        for t in att.expected_tokens() {
+            // `ParsingToken` is not exported; its Display is the token text.
+            let token = t.to_string();
+            if !token.is_empty() && token.chars().all(|c| c.is_ascii_punctuation()) && token != "_" && token != "#" {
+                expected.push(format!("`{token}`"));
+            }
+        }
+    }
+    expected.sort();
+    expected.dedup();
+    // The closing brace is usually the meaningful alternative; the list of "definition", "type", etc. is noise.
+    let found = found_token(&pp.text, pos);
+    let msg = match expected.len() {
+        0 => format!("unexpected {found}"),
+        1 => format!("expected {}, found {found}", expected[0]),
+        _ => {
+            let last = expected.pop().unwrap_or_default();
+            format!("expected one of {} or {last}, found {found}", expected.join(", "))
+        }
+    };
+    let len = found_len(&pp.text, pos).max(1);
+    let loc = pp.map.loc(pos, (pos + len).min(pp.text.len().max(pos + 1)));
+    let mut d = Diagnostic::error(Code::Syntax, msg).at(loc, "unexpected here");
+    let word = &pp.text[pos..pos + found_len(&pp.text, pos)];
+    if KEYWORDS.contains(&word) {
+        d = d.help(format!("`{word}` is a keyword; to use it as a name write `_{word}`"));
+    } else if let Some(kw) = KEYWORDS.iter().find(|k| !word.is_empty() && k.eq_ignore_ascii_case(word)) {
+        d = d.help(format!("`{word}` differs only in case from the keyword `{kw}`; escape it as `_{word}`"));
+    }
+    d
+}
+
+/// Keywords that can never be identifiers (IDL 4.2 §7.2.4, the subset this grammar reserves).
+pub const KEYWORDS: &[&str] = &[
+    "any", "bitfield", "bitmask", "bitset", "boolean", "case", "char", "const", "default", "double", "enum",
+    "exception", "FALSE", "fixed", "float", "int8", "int16", "int32", "int64", "interface", "long", "map", "module",
+    "native", "Object", "octet", "sequence", "short", "string", "struct", "switch", "TRUE", "typedef", "uint8",
+    "uint16", "uint32", "uint64", "union", "unsigned", "valuetype", "wchar", "wstring",
+];
+
+fn found_len(text: &str, pos: usize) -> usize {
+    let b = &text.as_bytes()[pos.min(text.len())..];
+    match b.first() {
+        None => 0,
+        Some(c) if c.is_ascii_alphanumeric() || *c == b'_' => {
+            b.iter().take_while(|c| c.is_ascii_alphanumeric() || **c == b'_').count().min(64)
+        }
+        Some(_) => text[pos..].chars().next().map_or(1, char::len_utf8),
+    }
+}
+
+fn found_token(text: &str, pos: usize) -> String {
+    let n = found_len(text, pos);
+    if n == 0 {
+        return "end of file".into();
+    }
+    let t = &text[pos..pos + n];
+    if t.as_bytes()[0].is_ascii_digit() {
+        format!("number `{t}`")
+    } else if t.as_bytes()[0].is_ascii_alphabetic() || t.starts_with('_') {
+        if KEYWORDS.contains(&t) {
+            format!("keyword `{t}`")
+        } else {
+            format!("`{t}`")
+        }
+    } else {
+        format!("`{t}`")
+    }
+}
