@@ -98,7 +98,12 @@ pub fn parse_type_attrs(attrs: &[Attribute]) -> Result<TypeAttrs> {
                 t.autoid_hash = match s.value().as_str() {
                     "sequential" => false,
                     "hash" => true,
-                    _ => return Err(syn::Error::new_spanned(&s, "autoid must be \"sequential\" or \"hash\"")),
+                    _ => {
+                        return Err(syn::Error::new_spanned(
+                            &s,
+                            "autoid must be \"sequential\" or \"hash\"",
+                        ))
+                    }
                 };
             } else if p.is_ident("bit_bound") {
                 let l: LitInt = m.value()?.parse()?;
@@ -190,7 +195,8 @@ pub fn parse_variant_attrs(attrs: &[Attribute]) -> Result<VariantAttrs> {
 pub fn parse_int_expr(e: &Expr) -> Result<i64> {
     match e {
         Expr::Lit(syn::ExprLit {
-            lit: syn::Lit::Int(l), ..
+            lit: syn::Lit::Int(l),
+            ..
         }) => l.base10_parse::<i64>(),
         Expr::Unary(syn::ExprUnary {
             op: syn::UnOp::Neg(_),

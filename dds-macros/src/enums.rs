@@ -8,21 +8,35 @@ use crate::attrs::{parse_field_attrs, parse_int_expr, parse_variant_attrs, Ext, 
 use crate::util::{ext_tokens, impl_attrs, mentions};
 
 /// IDL enum.
-pub fn derive_enum(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &TokenStream) -> Result<TokenStream> {
+pub fn derive_enum(
+    input: &DeriveInput,
+    data: &DataEnum,
+    ta: &TypeAttrs,
+    rt: &TokenStream,
+) -> Result<TokenStream> {
     let cdr = quote!(#rt::cdr);
     let name = &input.ident;
     if !input.generics.params.is_empty() {
-        return Err(syn::Error::new_spanned(&input.generics, "DdsType enums cannot be generic"));
+        return Err(syn::Error::new_spanned(
+            &input.generics,
+            "DdsType enums cannot be generic",
+        ));
     }
     if ta.ext == Some(Ext::Mutable) {
         return Err(syn::Error::new_spanned(name, "an enum cannot be mutable"));
     }
     if data.variants.is_empty() {
-        return Err(syn::Error::new_spanned(name, "an IDL enum needs at least one enumerator"));
+        return Err(syn::Error::new_spanned(
+            name,
+            "an IDL enum needs at least one enumerator",
+        ));
     }
     let bit_bound = match ta.bit_bound {
         Some((b, span)) if !(1..=32).contains(&b) => {
-            return Err(syn::Error::new(span, "an enum's bit_bound must be in 1..=32"));
+            return Err(syn::Error::new(
+                span,
+                "an enum's bit_bound must be in 1..=32",
+            ));
         }
         Some((b, _)) => b,
         None => 32,
@@ -41,15 +55,24 @@ pub fn derive_enum(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &To
     for v in &data.variants {
         let va = parse_variant_attrs(&v.attrs)?;
         if !va.cases.is_empty() || va.default || va.id.is_some() {
-            return Err(syn::Error::new_spanned(v, "`case`, `default` and `id` belong to union variants"));
+            return Err(syn::Error::new_spanned(
+                v,
+                "`case`, `default` and `id` belong to union variants",
+            ));
         }
         let value = match (va.value, &v.discriminant) {
             (Some(x), _) => x,
             (None, Some((_, e))) => parse_int_expr(e)?,
             (None, None) => next,
         };
-        if value < 0 || value >= (1i64 << bit_bound.min(32)) && bit_bound < 32 || value > i64::from(u32::MAX) {
-            return Err(syn::Error::new_spanned(v, "enumerator value out of range for the bit_bound"));
+        if value < 0
+            || value >= (1i64 << bit_bound.min(32)) && bit_bound < 32
+            || value > i64::from(u32::MAX)
+        {
+            return Err(syn::Error::new_spanned(
+                v,
+                "enumerator value out of range for the bit_bound",
+            ));
         }
         next = value + 1;
         idents.push(v.ident.clone());
@@ -57,7 +80,12 @@ pub fn derive_enum(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &To
         names.push(va.name.unwrap_or_else(|| v.ident.to_string()));
     }
     let values_i64: Vec<i64> = values.iter().map(|&v| i64::from(v)).collect();
-    let first = &idents[0];
+    // `#[default]` (IDL @default_literal) picks the default enumerator, else the first one.
+    let first = data
+        .variants
+        .iter()
+        .find(|v| v.attrs.iter().any(|a| a.path().is_ident("default")))
+        .map_or(&idents[0], |v| &v.ident);
     let type_name = ta.name.clone().unwrap_or_else(|| name.to_string());
     let attrs = impl_attrs();
     let ext_t = ext_tokens(&cdr, ta.ext.unwrap_or(Ext::Final));
@@ -80,14 +108,14 @@ pub fn derive_enum(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &To
             #[inline]
             fn encode(&self, w: &mut #cdr::CdrWriter<'_>) -> ::core::result::Result<(), #cdr::EncodeError> {
                 let v: u32 = match self { #(Self::#idents => #values,)* };
-                if w.is_xcdr2() { #write_v2; } else { w.write_u32(v); }
+                #write_v2;
                 ::core::result::Result::Ok(())
             }
 
             #[inline]
             fn decode(r: &mut #cdr::CdrReader<'_>) -> ::core::result::Result<Self, #cdr::DecodeError> {
                 let at = r.offset();
-                let v: u32 = if r.is_xcdr2() { #read_v2 } else { r.read_u32("enum")? };
+                let v: u32 = #read_v2;
                 match v {
                     #(#values => ::core::result::Result::Ok(Self::#idents),)*
                     other => ::core::result::Result::Err(#cdr::DecodeError::new(
@@ -107,7 +135,7 @@ pub fn derive_enum(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &To
                 version: #cdr::XcdrVersion,
                 _bound: ::core::option::Option<usize>,
             ) -> ::core::option::Option<usize> {
-                let size = if version == #cdr::XcdrVersion::Xcdr2 { #size_usize } else { 4 };
+                let size = #size_usize;
                 ::core::option::Option::Some(#cdr::members::prim_end(start, size, version))
             }
         }
@@ -122,12 +150,12 @@ pub fn derive_enum(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &To
 
             fn write_raw(w: &mut #cdr::CdrWriter<'_>, raw: i64) -> ::core::result::Result<(), #cdr::EncodeError> {
                 let v = raw as u32;
-                if w.is_xcdr2() { #write_v2; } else { w.write_u32(v); }
+                #write_v2;
                 ::core::result::Result::Ok(())
             }
 
             fn read_raw(r: &mut #cdr::CdrReader<'_>) -> ::core::result::Result<i64, #cdr::DecodeError> {
-                let v: u32 = if r.is_xcdr2() { #read_v2 } else { r.read_u32("enum")? };
+                let v: u32 = #read_v2;
                 ::core::result::Result::Ok(i64::from(v))
             }
 
@@ -156,11 +184,19 @@ pub fn derive_enum(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &To
 }
 
 /// IDL union.
-pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &TokenStream) -> Result<TokenStream> {
+pub fn derive_union(
+    input: &DeriveInput,
+    data: &DataEnum,
+    ta: &TypeAttrs,
+    rt: &TokenStream,
+) -> Result<TokenStream> {
     let cdr = quote!(#rt::cdr);
     let name = &input.ident;
     if !input.generics.params.is_empty() {
-        return Err(syn::Error::new_spanned(&input.generics, "DdsType unions cannot be generic"));
+        return Err(syn::Error::new_spanned(
+            &input.generics,
+            "DdsType unions cannot be generic",
+        ));
     }
     let Some(disc) = &ta.discriminator else {
         return Err(syn::Error::new_spanned(
@@ -176,13 +212,17 @@ pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &T
     let mut default_arm = None;
     let mut default_value = None;
     let mut plain_terms = Vec::new();
+    let mut mut_terms = Vec::new();
     let mut descs = Vec::new();
     let mut next_id: u32 = 1;
     let mut scan_terms = Vec::new();
     for v in &data.variants {
         let va = parse_variant_attrs(&v.attrs)?;
         if va.value.is_some() {
-            return Err(syn::Error::new_spanned(v, "`value` belongs to enumerators, not union cases"));
+            return Err(syn::Error::new_spanned(
+                v,
+                "`value` belongs to enumerators, not union cases",
+            ));
         }
         if va.cases.is_empty() && !va.default {
             return Err(syn::Error::new_spanned(
@@ -209,7 +249,7 @@ pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &T
         match &v.fields {
             Fields::Unit => {
                 enc_arms.push(quote!(Self::#vi => {
-                    #cdr::members::encode_discriminator::<#disc>(w, #ext_t, #disc_expr)?;
+                    #cdr::members::encode_discriminator::<#disc>(w, ext, #disc_expr)?;
                 }));
                 let build = quote!(Self::#vi);
                 if va.default {
@@ -225,7 +265,12 @@ pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &T
             Fields::Unnamed(u) if u.unnamed.len() == 1 => {
                 let f = &u.unnamed[0];
                 let fa = parse_field_attrs(&f.attrs)?;
-                if fa.key.is_some() || fa.optional || fa.base || fa.non_serialized || fa.id.is_some() {
+                if fa.key.is_some()
+                    || fa.optional
+                    || fa.base
+                    || fa.non_serialized
+                    || fa.id.is_some()
+                {
                     return Err(syn::Error::new_spanned(
                         f,
                         "a union case accepts only `bound`, `external`, `name` and `must_understand`",
@@ -238,8 +283,8 @@ pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &T
                 };
                 let mu = fa.must_understand;
                 enc_arms.push(quote!(Self::#vi(v) => {
-                    #cdr::members::encode_discriminator::<#disc>(w, #ext_t, #disc_expr)?;
-                    #cdr::members::encode_member::<#ty>(w, #ext_t, #id, #mu, v, #bound)?;
+                    #cdr::members::encode_discriminator::<#disc>(w, ext, #disc_expr)?;
+                    #cdr::members::encode_member::<#ty>(w, ext, #id, #mu, v, #bound)?;
                 }));
                 let build = quote!(Self::#vi(#cdr::members::decode_union_member::<#ty>(r, &mut st, #bound)?));
                 if va.default {
@@ -253,13 +298,14 @@ pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &T
                     None => quote!(::core::option::Option::None),
                 };
                 scan_terms.push(quote!({
-                    let e = #cdr::members::key_member_header_end(p, version, #ext_t, <#ty as #cdr::CdrType>::LAYOUT);
-                    end = end.max(<#ty as #cdr::CdrType>::key_max_end(e, version, #bo)?);
+                    end = end.max(<#ty as #cdr::CdrType>::key_max_end(p, version, #bo)?);
                 }));
                 if !mentions(ty, name) {
                     plain_terms.push(quote!(<#ty as #cdr::CdrType>::XCDR1_PLAIN));
+                    mut_terms.push(quote!(<#ty as #cdr::CdrType>::KEY_HAS_MUTABLE));
                     if default_value.is_none() {
-                        default_value = Some(quote!(Self::#vi(<#ty as #cdr::CdrType>::default_value())));
+                        default_value =
+                            Some(quote!(Self::#vi(<#ty as #cdr::CdrType>::default_value())));
                     }
                 }
             }
@@ -273,7 +319,12 @@ pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &T
     }
     let default_value = match default_value {
         Some(d) => d,
-        None => return Err(syn::Error::new_spanned(name, "a union needs a variant that is not recursive")),
+        None => {
+            return Err(syn::Error::new_spanned(
+                name,
+                "a union needs a variant that is not recursive",
+            ))
+        }
     };
     let type_name = ta.name.clone().unwrap_or_else(|| name.to_string());
     let type_name_lit = &type_name;
@@ -288,6 +339,7 @@ pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &T
         }),
     };
     let is_final = ext == Ext::Final;
+    let is_mutable = ext == Ext::Mutable;
     let attrs = impl_attrs();
     let n_labels = all_labels.len();
     Ok(quote! {
@@ -295,13 +347,20 @@ pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &T
         impl #cdr::CdrType for #name {
             const LAYOUT: #cdr::Layout = #cdr::Layout::Other;
             const XCDR1_PLAIN: bool = #is_final && <#disc as #cdr::CdrType>::XCDR1_PLAIN #(&& #plain_terms)*;
+            const KEY_HAS_MUTABLE: bool = #is_mutable #(|| #mut_terms)*;
 
             fn encode(&self, w: &mut #cdr::CdrWriter<'_>) -> ::core::result::Result<(), #cdr::EncodeError> {
                 let labels: [i64; #n_labels] = [#(#all_labels),*];
                 #[allow(non_snake_case)]
                 let LABELS: &[i64] = &labels;
                 let _ = LABELS;
-                let st = #cdr::members::begin_encode(w, #ext_t)?;
+                // The hashed key stream is plain whatever the extensibility.
+                let ext = if w.mode() == #cdr::EncodeMode::KeyHash {
+                    #cdr::Extensibility::Final
+                } else {
+                    #ext_t
+                };
+                let st = #cdr::members::begin_encode(w, ext)?;
                 match self { #(#enc_arms)* }
                 #cdr::members::end_encode(w, st)
             }
@@ -331,17 +390,10 @@ pub fn derive_union(input: &DeriveInput, data: &DataEnum, ta: &TypeAttrs, rt: &T
                 if start > 64 {
                     return ::core::option::Option::None;
                 }
-                let mut p = start;
-                if version == #cdr::XcdrVersion::Xcdr2 && #ext_t != #cdr::Extensibility::Final {
-                    p = ((p + 3) & !3) + 4;
-                }
-                p = #cdr::members::key_member_header_end(p, version, #ext_t, <#disc as #cdr::CdrType>::LAYOUT);
-                p = <#disc as #cdr::CdrType>::key_max_end(p, version, ::core::option::Option::None)?;
+                // The hashed key stream is plain: no DHEADER or member headers.
+                let p = <#disc as #cdr::CdrType>::key_max_end(start, version, ::core::option::Option::None)?;
                 let mut end = p;
                 #(#scan_terms)*
-                if version == #cdr::XcdrVersion::Xcdr1 && #ext_t == #cdr::Extensibility::Mutable {
-                    end = ((end + 3) & !3) + 4;
-                }
                 ::core::option::Option::Some(end)
             }
         }

@@ -7,7 +7,11 @@ use syn::{DataStruct, DeriveInput, Fields, Result};
 use crate::attrs::{parse_field_attrs, TypeAttrs};
 use crate::util::impl_attrs;
 
-fn single_field<'a>(input: &'a DeriveInput, data: &'a DataStruct, what: &str) -> Result<&'a syn::Field> {
+fn single_field<'a>(
+    input: &'a DeriveInput,
+    data: &'a DataStruct,
+    what: &str,
+) -> Result<&'a syn::Field> {
     match &data.fields {
         Fields::Unnamed(u) if u.unnamed.len() == 1 => Ok(&u.unnamed[0]),
         _ => Err(syn::Error::new_spanned(
@@ -49,7 +53,7 @@ pub fn derive_transparent(
             const LAYOUT: #cdr::Layout = <#ty as #cdr::CdrType>::LAYOUT;
             const MIN_SIZE: usize = <#ty as #cdr::CdrType>::MIN_SIZE;
             const XCDR1_PLAIN: bool = <#ty as #cdr::CdrType>::XCDR1_PLAIN;
-            const KEY_FINAL: bool = <#ty as #cdr::CdrType>::KEY_FINAL;
+            const KEY_HAS_MUTABLE: bool = <#ty as #cdr::CdrType>::KEY_HAS_MUTABLE;
 
             #[inline]
             fn encode(&self, w: &mut #cdr::CdrWriter<'_>) -> ::core::result::Result<(), #cdr::EncodeError> {
@@ -78,23 +82,43 @@ pub fn derive_transparent(
 }
 
 /// A `bitflags` 2 struct: an unsigned integer sized by `bit_bound` (default 32) in both XCDR versions.
-pub fn derive_bitmask(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &TokenStream) -> Result<TokenStream> {
+pub fn derive_bitmask(
+    input: &DeriveInput,
+    data: &DataStruct,
+    ta: &TypeAttrs,
+    rt: &TokenStream,
+) -> Result<TokenStream> {
     let cdr = quote!(#rt::cdr);
     let name = &input.ident;
     single_field(input, data, "bitmask")?;
     let bit_bound = match ta.bit_bound {
         Some((b, span)) if !(1..=64).contains(&b) => {
-            return Err(syn::Error::new(span, "a bitmask's bit_bound must be in 1..=64"));
+            return Err(syn::Error::new(
+                span,
+                "a bitmask's bit_bound must be in 1..=64",
+            ));
         }
         Some((b, _)) => b,
         None => 32,
     };
     let (size, write, read): (u8, TokenStream, TokenStream) = if bit_bound <= 8 {
-        (1, quote!(w.write_u8(v as u8)), quote!(u64::from(r.read_u8("bitmask")?)))
+        (
+            1,
+            quote!(w.write_u8(v as u8)),
+            quote!(u64::from(r.read_u8("bitmask")?)),
+        )
     } else if bit_bound <= 16 {
-        (2, quote!(w.write_u16(v as u16)), quote!(u64::from(r.read_u16("bitmask")?)))
+        (
+            2,
+            quote!(w.write_u16(v as u16)),
+            quote!(u64::from(r.read_u16("bitmask")?)),
+        )
     } else if bit_bound <= 32 {
-        (4, quote!(w.write_u32(v as u32)), quote!(u64::from(r.read_u32("bitmask")?)))
+        (
+            4,
+            quote!(w.write_u32(v as u32)),
+            quote!(u64::from(r.read_u32("bitmask")?)),
+        )
     } else {
         (8, quote!(w.write_u64(v)), quote!(r.read_u64("bitmask")?))
     };

@@ -25,7 +25,12 @@ struct Field {
     self_ref: bool,
 }
 
-pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &TokenStream) -> Result<TokenStream> {
+pub fn derive(
+    input: &DeriveInput,
+    data: &DataStruct,
+    ta: &TypeAttrs,
+    rt: &TokenStream,
+) -> Result<TokenStream> {
     let cdr = quote!(#rt::cdr);
     let name = &input.ident;
     let Fields::Named(named) = &data.fields else {
@@ -53,7 +58,10 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
         let attrs = parse_field_attrs(&f.attrs)?;
         if attrs.base {
             if i != 0 {
-                return Err(syn::Error::new_spanned(f, "`#[dds(base)]` must be the first field"));
+                return Err(syn::Error::new_spanned(
+                    f,
+                    "`#[dds(base)]` must be the first field",
+                ));
             }
             if attrs.key.is_some() || attrs.optional || attrs.id.is_some() || attrs.non_serialized {
                 return Err(syn::Error::new_spanned(
@@ -75,10 +83,16 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
         let optional = opt_inner.is_some();
         if let Some(span) = attrs.key {
             if optional {
-                return Err(syn::Error::new(span, "`#[dds(key)]` cannot be applied to an optional member"));
+                return Err(syn::Error::new(
+                    span,
+                    "`#[dds(key)]` cannot be applied to an optional member",
+                ));
             }
             if attrs.non_serialized {
-                return Err(syn::Error::new(span, "`#[dds(key)]` cannot be applied to a non_serialized member"));
+                return Err(syn::Error::new(
+                    span,
+                    "`#[dds(key)]` cannot be applied to a non_serialized member",
+                ));
             }
         }
         let inner = opt_inner.unwrap_or_else(|| f.ty.clone());
@@ -88,32 +102,45 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
                 "`#[dds(external)]` needs a field of type `Box<T>` or `Option<Box<T>>`",
             ));
         }
-        let wire_name = attrs.name.clone().unwrap_or_else(|| ident.to_string().trim_start_matches("r#").to_owned());
+        let wire_name = attrs
+            .name
+            .clone()
+            .unwrap_or_else(|| ident.to_string().trim_start_matches("r#").to_owned());
         let (id, id_order) = if let Some(id) = attrs.id {
             relative = false;
             next_rel = id + 1;
             (quote!(#id), u64::from(id))
-        } else if let Some(h) = &attrs.hashid {
+        } else if attrs.hashid.is_some() || ta.autoid_hash {
+            let h = attrs.hashid.clone().flatten();
             let id = hash_id(h.as_deref().unwrap_or(&wire_name));
-            (quote!(#id), u64::from(id))
-        } else if ta.autoid_hash {
-            let id = hash_id(&wire_name);
+            // A later member without an id continues from this one (XTypes 7.3.1.2.1.1), as libddsc does.
+            relative = false;
+            next_rel = id + 1;
             (quote!(#id), u64::from(id))
         } else {
             let k = next_rel;
             next_rel += 1;
             if relative {
                 let (_, bt) = base.as_ref().expect("relative ids need a base");
-                (quote!((<#bt as #cdr::CdrType>::NEXT_MEMBER_ID + #k)), u64::from(k))
+                (
+                    quote!((<#bt as #cdr::CdrType>::NEXT_MEMBER_ID + #k)),
+                    u64::from(k),
+                )
             } else {
                 (quote!(#k), u64::from(k))
             }
         };
         if id_order > 0x0fff_ffff {
-            return Err(syn::Error::new_spanned(f, "member ids are limited to 28 bits"));
+            return Err(syn::Error::new_spanned(
+                f,
+                "member ids are limited to 28 bits",
+            ));
         }
         let (bound, bound_opt) = match &attrs.bound {
-            Some(b) => (quote!((#b) as usize), quote!(::core::option::Option::Some((#b) as usize))),
+            Some(b) => (
+                quote!((#b) as usize),
+                quote!(::core::option::Option::Some((#b) as usize)),
+            ),
             None => (quote!(usize::MAX), quote!(::core::option::Option::None)),
         };
         let self_ref = mentions(&f.ty, name);
@@ -164,20 +191,24 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
         }
     };
     let enc_all: Vec<TokenStream> = ser.iter().map(|f| enc_field(f)).collect();
+    let mut ser_by_id = ser.clone();
+    ser_by_id.sort_by_key(|f| f.id_order);
+    let enc_all_by_id: Vec<TokenStream> = ser_by_id.iter().map(|f| enc_field(f)).collect();
     let enc_keys: Vec<TokenStream> = keys.iter().map(|f| enc_field(f)).collect();
     let enc_keys_by_id: Vec<TokenStream> = keys_by_id.iter().map(|f| enc_field(f)).collect();
-    let (enc_base_all, enc_base_keys, base_has_keys, base_partial_field, base_partial_default) = match &base {
-        Some((bi, bt)) => (
-            quote!(<#bt as #cdr::StructMembers>::encode_members(&self.#bi, w, ext)?;),
-            quote!(if <#bt as #cdr::StructMembers>::HAS_KEYS {
-                <#bt as #cdr::StructMembers>::encode_members(&self.#bi, w, ext)?;
-            }),
-            quote!(<#bt as #cdr::StructMembers>::HAS_KEYS),
-            quote!(#bi: <#bt as #cdr::StructMembers>::Partial,),
-            quote!(#bi: ::core::default::Default::default(),),
-        ),
-        None => (quote!(), quote!(), quote!(false), quote!(), quote!()),
-    };
+    let (enc_base_all, enc_base_keys, base_has_keys, base_partial_field, base_partial_default) =
+        match &base {
+            Some((bi, bt)) => (
+                quote!(<#bt as #cdr::StructMembers>::encode_members(&self.#bi, w, ext)?;),
+                quote!(if <#bt as #cdr::StructMembers>::HAS_KEYS {
+                    <#bt as #cdr::StructMembers>::encode_members(&self.#bi, w, ext)?;
+                }),
+                quote!(<#bt as #cdr::StructMembers>::HAS_KEYS),
+                quote!(#bi: <#bt as #cdr::StructMembers>::Partial,),
+                quote!(#bi: ::core::default::Default::default(),),
+            ),
+            None => (quote!(), quote!(), quote!(false), quote!(), quote!()),
+        };
 
     // ---- decode ----
     let dec_in_order = |f: &Field| {
@@ -228,7 +259,9 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
         })
         .collect();
     let by_id_fallback = match &base {
-        Some((bi, bt)) => quote!(_ => <#bt as #cdr::StructMembers>::decode_member_by_id(r, id, &mut p.#bi),),
+        Some((bi, bt)) => {
+            quote!(_ => <#bt as #cdr::StructMembers>::decode_member_by_id(r, id, &mut p.#bi),)
+        }
         None => quote!(_ => ::core::result::Result::Ok(false),),
     };
 
@@ -301,13 +334,12 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
             quote!()
         };
         quote!(
-            p = #cdr::members::key_member_header_end(p, version, ext, <#t as #cdr::CdrType>::LAYOUT);
             #presence
             p = <#t as #cdr::CdrType>::key_max_end(p, version, #bo)?;
         )
     };
     let scan_keys: Vec<TokenStream> = keys_by_id.iter().map(|f| scan(f)).collect();
-    let scan_all: Vec<TokenStream> = ser.iter().map(|f| scan(f)).collect();
+    let scan_all: Vec<TokenStream> = ser_by_id.iter().map(|f| scan(f)).collect();
     let (scan_base_all, scan_base_keys) = match &base {
         Some((_, bt)) => (
             quote!(p = <#bt as #cdr::StructMembers>::key_members_max_end(p, version, ext)?;),
@@ -351,18 +383,19 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
         .iter()
         .map(|f| {
             let t = &f.inner;
-            quote!(<#t as #cdr::CdrType>::KEY_FINAL)
+            quote!(<#t as #cdr::CdrType>::KEY_HAS_MUTABLE)
         })
         .collect();
     let (base_min, base_plain, base_key_final) = match &base {
         Some((_, bt)) if !mentions(bt, name) => (
             quote!(+ <#bt as #cdr::CdrType>::MIN_SIZE),
             quote!(&& <#bt as #cdr::CdrType>::XCDR1_PLAIN),
-            quote!(&& <#bt as #cdr::CdrType>::KEY_FINAL),
+            quote!(|| <#bt as #cdr::CdrType>::KEY_HAS_MUTABLE),
         ),
         _ => (quote!(), quote!(), quote!()),
     };
     let is_final = ext == Ext::Final;
+    let is_mutable = ext == Ext::Mutable;
     let min_size = if is_final {
         quote!({
             let m = 0usize #(+ #min_terms)* #base_min;
@@ -434,11 +467,14 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
             ) -> ::core::result::Result<(), #cdr::EncodeError> {
                 if w.key_only() && <Self as #cdr::StructMembers>::HAS_KEYS {
                     #enc_base_keys
-                    if w.mode() == #cdr::EncodeMode::KeyHash && w.is_xcdr2() {
+                    if w.mode() == #cdr::EncodeMode::KeyHash {
                         #(#enc_keys_by_id)*
                     } else {
                         #(#enc_keys)*
                     }
+                } else if w.mode() == #cdr::EncodeMode::KeyHash {
+                    #enc_base_all
+                    #(#enc_all_by_id)*
                 } else {
                     #enc_base_all
                     #(#enc_all)*
@@ -503,12 +539,18 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
             const LAYOUT: #cdr::Layout = #cdr::Layout::Other;
             const MIN_SIZE: usize = #min_size;
             const XCDR1_PLAIN: bool = #is_final #(&& #plain_terms)* #base_plain;
-            const KEY_FINAL: bool = #is_final #(&& #key_final_terms)* #base_key_final;
+            const KEY_HAS_MUTABLE: bool = #is_mutable #(|| #key_final_terms)* #base_key_final;
             const NEXT_MEMBER_ID: u32 = #next_id;
 
             fn encode(&self, w: &mut #cdr::CdrWriter<'_>) -> ::core::result::Result<(), #cdr::EncodeError> {
-                let st = #cdr::members::begin_encode(w, #ext_t)?;
-                <Self as #cdr::StructMembers>::encode_members(self, w, #ext_t)?;
+                // The hashed key stream is plain whatever the extensibility.
+                let ext = if w.mode() == #cdr::EncodeMode::KeyHash {
+                    #cdr::Extensibility::Final
+                } else {
+                    #ext_t
+                };
+                let st = #cdr::members::begin_encode(w, ext)?;
+                <Self as #cdr::StructMembers>::encode_members(self, w, ext)?;
                 #cdr::members::end_encode(w, st)
             }
 
@@ -542,15 +584,8 @@ pub fn derive(input: &DeriveInput, data: &DataStruct, ta: &TypeAttrs, rt: &Token
                 if start > 64 {
                     return ::core::option::Option::None;
                 }
-                let mut p = start;
-                if version == #cdr::XcdrVersion::Xcdr2 && #ext_t != #cdr::Extensibility::Final {
-                    p = ((p + 3) & !3) + 4;
-                }
-                p = <Self as #cdr::StructMembers>::key_members_max_end(p, version, #ext_t)?;
-                if version == #cdr::XcdrVersion::Xcdr1 && #ext_t == #cdr::Extensibility::Mutable {
-                    p = ((p + 3) & !3) + 4;
-                }
-                ::core::option::Option::Some(p)
+                // The hashed key stream is plain: no DHEADER, EMHEADER or parameter list.
+                <Self as #cdr::StructMembers>::key_members_max_end(start, version, #ext_t)
             }
         }
 

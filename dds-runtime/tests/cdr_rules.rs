@@ -3,16 +3,18 @@
 use std::collections::BTreeMap;
 
 use dds_runtime::cdr::{
-    deserialize, serialize, BoundedSeq, BoundedString, ByteOrder, CdrType, DdsType, DecodeErrorKind, EncodeError,
-    Extensibility, LongDouble, WChar, WString, XcdrVersion,
+    deserialize, serialize, BoundedSeq, BoundedString, ByteOrder, CdrType, DdsType,
+    DecodeErrorKind, EncodeError, Extensibility, LongDouble, WChar, WString, XcdrVersion,
 };
 use dds_runtime::DdsType;
 
-use XcdrVersion::{Xcdr1, Xcdr2};
 use ByteOrder::{BigEndian as BE, LittleEndian as LE};
+use XcdrVersion::{Xcdr1, Xcdr2};
 
 fn hex(s: &str) -> Vec<u8> {
-    s.split_whitespace().map(|b| u8::from_str_radix(b, 16).unwrap()).collect()
+    s.split_whitespace()
+        .map(|b| u8::from_str_radix(b, 16).unwrap())
+        .collect()
 }
 
 fn enc<T: DdsType>(v: &T, version: XcdrVersion, order: ByteOrder) -> Vec<u8> {
@@ -22,7 +24,12 @@ fn enc<T: DdsType>(v: &T, version: XcdrVersion, order: ByteOrder) -> Vec<u8> {
 }
 
 /// Encodes, compares the full payload (header included) and decodes back.
-fn check<T: DdsType + PartialEq + std::fmt::Debug>(v: &T, version: XcdrVersion, order: ByteOrder, expected: &str) {
+fn check<T: DdsType + PartialEq + std::fmt::Debug>(
+    v: &T,
+    version: XcdrVersion,
+    order: ByteOrder,
+    expected: &str,
+) {
     let out = enc(v, version, order);
     assert_eq!(out, hex(expected), "{version:?} {order:?}");
     assert_eq!(&deserialize::<T>(&out).unwrap(), v);
@@ -48,7 +55,10 @@ fn header_carries_padding_count() {
     check(&Tiny { a: 1 }, Xcdr2, LE, "00 07 00 03 01 00 00 00");
     check(&Tiny { a: 1 }, Xcdr1, BE, "00 00 00 03 01 00 00 00");
     // Unpadded input is accepted too.
-    assert_eq!(deserialize::<Tiny>(&hex("00 07 00 00 01")).unwrap(), Tiny { a: 1 });
+    assert_eq!(
+        deserialize::<Tiny>(&hex("00 07 00 00 01")).unwrap(),
+        Tiny { a: 1 }
+    );
     assert_eq!(Tiny::DEFAULT_VERSION, Xcdr1);
 }
 
@@ -68,8 +78,18 @@ fn wchar_and_wstring_are_utf16_with_a_byte_count() {
         ws: WString::from("hé"),
     };
     // char8 Latin-1, wchar 2 bytes, wstring: u32 byte count then UTF-16, no terminator; same in XCDR1 and 2.
-    check(&v, Xcdr1, LE, "00 01 00 00 e9 00 ac 20 04 00 00 00 68 00 e9 00");
-    check(&v, Xcdr2, BE, "00 06 00 00 e9 00 20 ac 00 00 00 04 00 68 00 e9");
+    check(
+        &v,
+        Xcdr1,
+        LE,
+        "00 01 00 00 e9 00 ac 20 04 00 00 00 68 00 e9 00",
+    );
+    check(
+        &v,
+        Xcdr2,
+        BE,
+        "00 06 00 00 e9 00 20 ac 00 00 00 04 00 68 00 e9",
+    );
     let bad = Wide {
         c: '€',
         wc: WChar(0),
@@ -80,7 +100,10 @@ fn wchar_and_wstring_are_utf16_with_a_byte_count() {
         serialize(&bad, Xcdr2, LE, &mut out),
         Err(EncodeError::InvalidValue { .. })
     ));
-    assert!(out.is_empty(), "a failed encode leaves the buffer as it was");
+    assert!(
+        out.is_empty(),
+        "a failed encode leaves the buffer as it was"
+    );
     // Unpaired surrogate.
     let e = deserialize::<Wide>(&hex("00 07 00 00 41 00 00 00 02 00 00 00 00 d8")).unwrap_err();
     assert_eq!(e.kind, DecodeErrorKind::MalformedString);
@@ -99,9 +122,22 @@ fn long_double_is_16_bytes_aligned_like_a_double() {
     let mut b = [0u8; 16];
     b[0] = 0x40;
     b[15] = 0x01;
-    let v = LongD { a: 1, l: LongDouble(b) };
-    check(&v, Xcdr1, BE, "00 00 00 00 01 00 00 00 00 00 00 00 40 00 00 00 00 00 00 00 00 00 00 00 00 00 00 01");
-    check(&v, Xcdr2, LE, "00 07 00 00 01 00 00 00 01 00 00 00 00 00 00 00 00 00 00 00 00 00 00 40");
+    let v = LongD {
+        a: 1,
+        l: LongDouble(b),
+    };
+    check(
+        &v,
+        Xcdr1,
+        BE,
+        "00 00 00 00 01 00 00 00 00 00 00 00 40 00 00 00 00 00 00 00 00 00 00 00 00 00 00 01",
+    );
+    check(
+        &v,
+        Xcdr2,
+        LE,
+        "00 07 00 00 01 00 00 00 01 00 00 00 00 00 00 00 00 00 00 00 00 00 00 40",
+    );
 }
 
 #[derive(DdsType, Debug, PartialEq)]
@@ -173,7 +209,12 @@ fn maps_count_entries_and_take_a_dheader_when_not_primitive() {
         s: BTreeMap::from([(3, "x".to_owned())]),
     };
     check(&v, Xcdr2, LE, "00 07 00 02 01 00 00 00 01 00 02 00 0e 00 00 00 01 00 00 00 03 00 00 00 02 00 00 00 78 00 00 00");
-    check(&v, Xcdr1, LE, "00 01 00 02 01 00 00 00 01 00 02 00 01 00 00 00 03 00 00 00 02 00 00 00 78 00 00 00");
+    check(
+        &v,
+        Xcdr1,
+        LE,
+        "00 01 00 02 01 00 00 00 01 00 02 00 01 00 00 00 03 00 00 00 02 00 00 00 78 00 00 00",
+    );
 }
 
 #[derive(DdsType, Debug, PartialEq)]
@@ -285,8 +326,13 @@ fn inheritance_puts_base_members_first_in_one_frame() {
         base: Base { id: 1, a: 2 },
         b: 3,
     };
-    check(&v, Xcdr2, LE, "00 09 00 00 08 00 00 00 01 00 00 00 02 00 03 00");
-    assert!(Derived::IS_KEYED);
+    check(
+        &v,
+        Xcdr2,
+        LE,
+        "00 09 00 00 08 00 00 00 01 00 00 00 02 00 03 00",
+    );
+    const { assert!(Derived::IS_KEYED) };
     let v = MDerived {
         base: MBase { x: 1, y: 2 },
         z: 3,
@@ -379,7 +425,10 @@ fn mutable_types_skip_unknown_members_unless_must_understand() {
         assert_eq!(deserialize::<M2>(&bytes).unwrap(), M2 { a: 4, b: 0 });
     }
     // The must-understand flag is on the wire.
-    assert_eq!(enc(&M2Mu { a: 1, b: 2 }, Xcdr2, BE)[16..20], [0xa0, 0, 0, 1]);
+    assert_eq!(
+        enc(&M2Mu { a: 1, b: 2 }, Xcdr2, BE)[16..20],
+        [0xa0, 0, 0, 1]
+    );
 }
 
 #[test]
@@ -388,7 +437,8 @@ fn readers_accept_every_length_code_and_short_parameter_headers() {
     let lc4 = hex("00 0b 00 00 18 00 00 00 00 00 00 30 01 00 00 00 00 00 00 00 01 00 00 40 04 00 00 00 2a 00 00 00");
     assert_eq!(deserialize::<M2>(&lc4).unwrap(), M2 { a: 1, b: 42 });
     // XCDR1 short parameter header (id < 0x3f00), PID_IGNORE, and a list end without the M bit.
-    let short = hex("00 03 00 00 03 3f 00 00 00 00 04 00 07 00 00 00 01 00 04 00 2a 00 00 00 02 3f 00 00");
+    let short =
+        hex("00 03 00 00 03 3f 00 00 00 00 04 00 07 00 00 00 01 00 04 00 2a 00 00 00 02 3f 00 00");
     assert_eq!(deserialize::<M2>(&short).unwrap(), M2 { a: 7, b: 42 });
 }
 
@@ -406,14 +456,22 @@ fn optional_members_in_appendable_types() {
         a: None,
         b: Some("hi".into()),
     };
-    check(&v, Xcdr2, LE, "00 09 00 01 0b 00 00 00 00 01 00 00 03 00 00 00 68 69 00 00");
+    check(
+        &v,
+        Xcdr2,
+        LE,
+        "00 09 00 01 0b 00 00 00 00 01 00 00 03 00 00 00 68 69 00 00",
+    );
     check(
         &v,
         Xcdr1,
         LE,
         "00 01 00 00 01 7f 08 00 00 00 00 00 00 00 00 00 01 7f 08 00 01 00 00 00 08 00 00 00 03 00 00 00 68 69 00 00",
     );
-    let v = AppOpt { a: Some(3), b: None };
+    let v = AppOpt {
+        a: Some(3),
+        b: None,
+    };
     roundtrip_all(&v);
     let mut out = Vec::new();
     assert!(serialize(
@@ -446,7 +504,10 @@ fn enumerator_values_and_unknown_values() {
     check(&C { c: Color::Blue }, Xcdr2, BE, "00 06 00 00 00 00 00 0b");
     check(&C { c: Color::Red }, Xcdr1, LE, "00 01 00 00 03 00 00 00");
     let e = deserialize::<C>(&hex("00 07 00 00 04 00 00 00")).unwrap_err();
-    assert_eq!((e.offset, e.kind.clone()), (4, DecodeErrorKind::InvalidValue { found: 4 }));
+    assert_eq!(
+        (e.offset, e.kind.clone()),
+        (4, DecodeErrorKind::InvalidValue { found: 4 })
+    );
     assert!(e.to_string().contains("enumerator"), "{e}");
     assert_eq!(<Color as CdrType>::default_value(), Color::Red);
 }
@@ -506,7 +567,12 @@ fn union_discriminators_and_defaults() {
         c: ByChar::Other(1),
     };
     // bool default: false (true is used); u8: 0 and 1, 2 used -> 3; char: 0.
-    check(&v, Xcdr2, LE, "00 07 00 02 00 00 05 00 00 03 00 00 ff ff ff ff 00 01 00 00");
+    check(
+        &v,
+        Xcdr2,
+        LE,
+        "00 07 00 02 00 00 05 00 00 03 00 00 ff ff ff ff 00 01 00 00",
+    );
     let v = All {
         b: ByBool::Yes(1),
         o: ByOctet::Small(2),
@@ -523,7 +589,12 @@ fn union_discriminators_and_defaults() {
     let v = HasMut {
         u: MutUnion::Two("z".into()),
     };
-    check(&v, Xcdr2, LE, "00 07 00 02 12 00 00 00 00 00 00 a0 02 00 00 00 09 00 00 50 02 00 00 00 7a 00 00 00");
+    check(
+        &v,
+        Xcdr2,
+        LE,
+        "00 07 00 02 12 00 00 00 00 00 00 a0 02 00 00 00 09 00 00 50 02 00 00 00 7a 00 00 00",
+    );
     roundtrip_all(&v);
 }
 
@@ -557,7 +628,14 @@ fn metadata_crate_override_hashid_and_non_serialized() {
     };
     let out = enc(&v, Xcdr1, LE);
     assert_eq!(out, hex("00 01 00 00 01 00 00 00 02 00 00 00"));
-    assert_eq!(deserialize::<ViaAlias>(&out).unwrap(), ViaAlias { cache: vec![], x: 1, y: 2 });
+    assert_eq!(
+        deserialize::<ViaAlias>(&out).unwrap(),
+        ViaAlias {
+            cache: vec![],
+            x: 1,
+            y: 2
+        }
+    );
 }
 
 #[derive(DdsType, Debug, PartialEq)]
@@ -580,7 +658,14 @@ fn errors_say_where_and_what() {
     assert_eq!(e.offset, 4);
     assert_eq!(e.expected, "DHEADER");
     let e = deserialize::<Tiny>(&hex("00 42 00 00 01")).unwrap_err();
-    assert_eq!((e.offset, e.kind), (0, DecodeErrorKind::InvalidValue { found: 0x42 }));
+    assert_eq!(
+        (e.offset, e.kind),
+        (0, DecodeErrorKind::InvalidValue { found: 0x42 })
+    );
     let e = deserialize::<Tiny>(&hex("00 01")).unwrap_err();
-    assert!(e.to_string().starts_with("at offset 0: expected encapsulation header"), "{e}");
+    assert!(
+        e.to_string()
+            .starts_with("at offset 0: expected encapsulation header"),
+        "{e}"
+    );
 }

@@ -48,7 +48,7 @@ fn rust_writer_to_cyclone_reader() {
         .unwrap()
         .create_datawriter(&t, &tl_reliable_writer())
         .unwrap();
-    let mut child = python(61, &["sub", "Square", "10"]);
+    let mut child = python(61, &["sub", "Square", "10", "dispose"]);
     assert!(
         wait_until(Duration::from_secs(20), || w
             .publication_matched_status()
@@ -59,6 +59,7 @@ fn rust_writer_to_cyclone_reader() {
     for i in 0..10 {
         w.write(&shape("RED", i)).unwrap();
     }
+    w.dispose(&shape("RED", 0)).unwrap();
     w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
     let out = BufReader::new(child.stdout.take().unwrap());
     let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
@@ -70,6 +71,7 @@ fn rust_writer_to_cyclone_reader() {
         .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
         .collect();
     assert_eq!(xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
+    assert!(lines.iter().any(|l| l.contains("\"disposed\": true")), "no dispose seen by Cyclone: {lines:?}");
 }
 
 #[test]

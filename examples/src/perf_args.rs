@@ -480,7 +480,7 @@ mod tests {
         assert_eq!(o.pub_rate, Some(10_000.0));
         assert_eq!(o.burst, 3);
         assert!((o.ping_fraction - 0.5).abs() < 1e-9);
-        assert_eq!(run("pub 100Hz ping 10%").pub_rate, Some(100.0));
+        assert_eq!(run("pub 100Hz 10%").pub_rate, Some(100.0));
     }
 
     #[test]

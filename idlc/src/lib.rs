@@ -10,3 +10,7 @@ pub mod model;
 pub mod resolve;
 pub mod validate;
 pub mod emit;
+pub mod driver;
+pub mod builder;
+
+pub use builder::{Builder, Error};

@@ -22,7 +22,7 @@ from cyclonedds.idl import IdlStruct, IdlUnion, IdlEnum, IdlBitmask
 from cyclonedds.idl.annotations import (key, member_id, member_hash_id, external, must_understand, autoid,
                                         final, appendable, mutable, bit_bound, position)
 from cyclonedds.idl.types import (int8, int16, int32, int64, uint8, uint16, uint32, uint64, byte, char, wchar,
-                                  float32, float64, sequence, array, bounded_str, case, default)
+                                  float32, float64, sequence, array, bounded_str, case, default, typedef)
 
 I32_MIN, I32_MAX = -2**31, 2**31 - 1
 I64_MIN, I64_MAX = -2**63, 2**63 - 1
@@ -794,6 +794,81 @@ class KeyAllPrims(IdlStruct, typename="Golden::KeyAllPrims"):
     key("f64")
 
 
+# ---------------------------------------------------------------- more shapes
+
+@dataclass
+@final
+class NestedBounds(IdlStruct, typename="Golden::NestedBounds"):
+    """Bounds the member attribute cannot reach: inside sequences and arrays."""
+    names: sequence[bounded_str[4]]
+    pairs: sequence[sequence[int16, 2]]
+    tags: array[bounded_str[3], 2]
+    limited: sequence[sequence[str, 2], 3]
+
+
+@dataclass
+@appendable
+class Large(IdlStruct, typename="Golden::Large"):
+    blob: sequence[byte]
+    text: str
+    longs: sequence[int32]
+    points: sequence[Point]
+
+
+@dataclass
+@mutable
+class MutableNested(IdlStruct, typename="Golden::MutableNested"):
+    inner: PointM
+    maybe: Optional[PointM]
+    list: sequence[PointM]
+    grid: array[PointM, 2]
+    tail: Optional[sequence[int64]]
+
+
+MyLong = typedef["Golden::MyLong", int32]
+Names = typedef["Golden::Names", sequence[str]]
+
+
+@dataclass
+@appendable
+class Typedefs(IdlStruct, typename="Golden::Typedefs"):
+    id: MyLong
+    key("id")
+    names: Names
+    more: sequence[MyLong]
+
+
+@dataclass
+@final
+class Chars(IdlStruct, typename="Golden::Chars"):
+    cs: array[char, 3]
+    flags: array[bool, 3]
+    sc: sequence[char]
+    ws: sequence[wchar]
+
+
+@dataclass
+@mutable
+class BigIds(IdlStruct, typename="Golden::BigIds"):
+    """Member ids at the edges of the XCDR1 short parameter id range and of the 28-bit id space."""
+    low: uint8
+    member_id("low", 0x3eff)
+    edge: uint16
+    member_id("edge", 0x3f00)
+    over: int32
+    member_id("over", 0x3f01)
+    top: str
+    member_id("top", 0x0ffffffe)
+
+
+@dataclass
+@mutable
+class AllOptional(IdlStruct, typename="Golden::AllOptional"):
+    a: Optional[int32]
+    b: Optional[str]
+    c: Optional[Point]
+
+
 # ---------------------------------------------------------------- samples
 
 def _prims(fill):
@@ -975,4 +1050,56 @@ CORPUS += [
     (KeyAppendableNested, [("basic", KeyAppendableNested(inner=KeyAppendableInner(x=1, y=2), other=3))]),
     (KeyMutableNested, [("basic", KeyMutableNested(id=7, inner=KeyMutableInner(x=1, tag="tg", y=2)))]),
     (KeyAllPrims, [("basic", KeyAllPrims(b=True, o=2, c='c', i16=-4, u32=5, i64=-6, f64=7.5))]),
+]
+
+CORPUS += [
+    (NestedBounds, [
+        ("full", NestedBounds(names=["", "abcd"], pairs=[[1, 2], [], [-3]], tags=["abc", ""],
+                              limited=[["a", "b"], [], ["c"]])),
+        ("empty", NestedBounds(names=[], pairs=[], tags=["", ""], limited=[]))]),
+    (Large, [("big", Large(blob=list(range(256)) * 4, text="0123456789" * 40, longs=list(range(-150, 150)),
+                           points=[Point(x=i, y=-i) for i in range(70)]))]),
+    (MutableNested, [
+        ("set", MutableNested(inner=PointM(x=1, label="in"), maybe=PointM(x=2, label="opt"),
+                              list=[PointM(x=3, label=""), PointM(x=4, label="four")],
+                              grid=[PointM(x=5, label="g0"), PointM(x=6, label="g1")], tail=[I64_MIN, I64_MAX])),
+        ("unset", MutableNested(inner=PointM(x=0, label=""), maybe=None, list=[],
+                                grid=[PointM(x=0, label=""), PointM(x=0, label="")], tail=None))]),
+    (Typedefs, [("basic", Typedefs(id=7, names=["x", "y"], more=[1, 2, 3]))]),
+]
+
+
+CORPUS += [
+    (Chars, [("basic", Chars(cs=['a', 'b', 'c'], flags=[True, False, True], sc=['x', '\0'], ws=[0x41, 0x20ac, 0x7fff])),
+             ("empty", Chars(cs=['\0', '\0', '\0'], flags=[False, False, False], sc=[], ws=[]))]),
+    (BigIds, [("basic", BigIds(low=1, edge=2, over=3, top="top"))]),
+    (AllOptional, [("none", AllOptional(a=None, b=None, c=None)),
+                   ("all", AllOptional(a=1, b="b", c=Point(x=1, y=2)))]),
+]
+
+
+# Unions as topic types.
+CORPUS += [
+    (UnionLongLast, [("text", UnionLongLast(text="hello")), ("point", UnionLongLast(point=Point(x=1, y=2))),
+                     ("default", UnionLongLast(other=9))]),
+    (UnionAppendable, [("p", UnionAppendable(p=PointA(x=3, label="pa"))), ("d", UnionAppendable(d=2.5))]),
+]
+
+
+# Probes: byte strings whose acceptance by libddsc is itself the finding (recorded in manifest.json "probes").
+PROBES = [
+    (UnionHolder, "enum union default, discriminator 4 (the binding's rule: first non-enumerator)",
+     UnionHolder(id=3, e=UnionEnum(red=1), c=UnionOctet(small=1), b=UnionBool(yes=1), l=UnionLong(text="x"),
+                 el=UnionEnumLast(other="green"), ll=UnionLongLast(text="y"))),
+    (UnionHolder, "enum union default, discriminator GREEN (first enumerator no label uses)",
+     UnionHolder(id=3, e=UnionEnum(red=1), c=UnionOctet(small=1), b=UnionBool(yes=1), l=UnionLong(text="x"),
+                 el=UnionEnumLast(discriminator=Color.GREEN, value="green"), ll=UnionLongLast(text="y"))),
+    (UnionHolder, "default placed between the cases, selected (UnionLong, discriminator -1)",
+     UnionHolder(id=3, e=UnionEnum(red=1), c=UnionOctet(small=1), b=UnionBool(yes=1), l=UnionLong(other=7),
+                 el=UnionEnumLast(red=1), ll=UnionLongLast(text="y"))),
+    (UnionHolder, "default placed last, selected (UnionLongLast, discriminator -1)",
+     UnionHolder(id=3, e=UnionEnum(red=1), c=UnionOctet(small=1), b=UnionBool(yes=1), l=UnionLong(text="x"),
+                 el=UnionEnumLast(red=1), ll=UnionLongLast(other=7))),
+    (Enums, "XCDR1 with 4-byte @bit_bound enums (the binding's XCDR1 form)",
+     Enums(c=Color.YELLOW, s=Small.S7, m=Medium.M300, cs=[Color.BLUE], ss=[Small.S1], sa=[Small.S7, Small.S1, Small.S0])),
 ]

@@ -92,7 +92,7 @@ def one_type(oracle, cls, samples, problems):
     idl.populate()
     ann = get_idl_annotations(cls)
     ct_ = oracle.ctype(cls)
-    keyed = not idl.keyless
+    keyed = ct_.nkeys > 0  # libddsc's view; the binding calls every union keyed
     doc = {
         "type": cls.__name__,
         "typename": idl.idl_transformed_typename,
@@ -105,6 +105,7 @@ def one_type(oracle, cls, samples, problems):
     }
     refused_write = set()
     bad_be = set()
+    default_versions = set()
     for name, sample in samples:
         s = {"name": name, "value": jvalue(sample), "data": {}, "python": {}, "notes": []}
         if keyed:
@@ -124,6 +125,10 @@ def one_type(oracle, cls, samples, problems):
             else:
                 reads[ver] = (mem, text)
         s["c_accepts"] = [f"xcdr{v}_le" for v in sorted(reads)]
+        if reads:
+            dv = ct_.default_version((reads.get(2) or reads[1])[0])
+            if dv is not None:
+                default_versions.add(dv)
         if not reads:
             problems.append(f"{cls.__name__}/{name}: the C core rejects every encoding the binding produces")
         for ver in (1, 2):
@@ -217,6 +222,10 @@ def one_type(oracle, cls, samples, problems):
     for ver in sorted(refused_write):
         doc["refused"].append(f"XCDR{ver}: the C core reads the binding's XCDR{ver} bytes but will not write "
                               f"XCDR{ver} for this type (non-mutable type with @optional members)")
+    if len(default_versions) == 1:
+        doc["libddsc_default_version"] = default_versions.pop()
+    elif default_versions:
+        problems.append(f"{cls.__name__}: libddsc's default version differs between samples")
     for ver in sorted(bad_be):
         doc["refused"].append(f"XCDR{ver} BE for some samples: the C core's BE writer output is contradicted by "
                               "the binding or by its own reader (see the sample notes)")
@@ -241,6 +250,13 @@ def main():
             "encodings": sorted({k for s in doc["samples"] for k in s["data"]}),
             "refused": doc["refused"],
         })
+    manifest["probes"] = []
+    for cls, what, sample in corpus.PROBES:
+        ver = 1 if "XCDR1" in what else 2
+        data = sample.serialize(use_version_2=(ver == 2), endianness=Endianness.Little)
+        mem, text = oracle.ctype(cls).read(data)
+        manifest["probes"].append({"type": cls.__name__, "what": what, "bytes": data.hex(),
+                                   "accepted_by_libddsc": mem is not None, "libddsc_reads": text})
     manifest["problems"] = problems
     (OUT / "manifest.json").write_text(json.dumps(manifest, indent=1, ensure_ascii=False) + "\n")
     written.add("manifest.json")

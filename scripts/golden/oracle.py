@@ -81,7 +81,9 @@ class CType:
         rc = lib.dds_create_topic_descriptor(DDS_FIND_SCOPE_LOCAL_DOMAIN, oracle.dp._ref, ti, 0, ct.byref(self.desc))
         if rc != 0:
             raise OracleError(f"dds_create_topic_descriptor: {rc}")
-        self.sample_size = ct.cast(self.desc, ct.POINTER(ct.c_uint32))[0]  # dds_topic_descriptor_t.m_size
+        head = ct.cast(self.desc, ct.POINTER(ct.c_uint32))  # dds_topic_descriptor_t: m_size, m_align, m_flagset, m_nkeys
+        self.sample_size = head[0]
+        self.nkeys = head[3]
         self.cdrdesc = ct.create_string_buffer(512)  # struct dds_cdrstream_desc is far smaller
         lib.dds_cdrstream_desc_from_topic_desc(self.cdrdesc, self.desc)
         self.pysertype = self._sertype(self.pytopic._ref)
@@ -98,6 +100,20 @@ class CType:
                                     f"XCDR{ver} ({why})"
             else:
                 self.sertype[ver] = self._sertype(tp)
+
+    def default_version(self, mem):
+        """XCDR version libddsc writes for this type when the topic QoS names no data representation."""
+        lib = self.o.lib
+        if not hasattr(self, "_default_st"):
+            self.o.n += 1
+            tp = lib.dds_create_topic(self.o.dp._ref, self.desc, f"golden_cdef_{self.o.n}".encode(), None, None)
+            self._default_st = self._sertype(tp) if tp >= 0 else None
+        if self._default_st is None:
+            return None
+        sd = lib.ddsi_serdata_from_sample(self._default_st, SDK_DATA, mem)
+        if not sd:
+            return None
+        return 2 if self._to_ser(sd)[1] > 3 else 1
 
     def _sertype(self, entity):
         st = vp()

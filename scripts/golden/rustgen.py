@@ -200,9 +200,10 @@ def rust_str(s):
 INT_LIMITS = {"i8": 8, "i16": 16, "i32": 32, "i64": 64}
 
 
-def rust_value(t, v, external=False):
+def rust_value(t, v, external=False, nested=True):
+    """Rust expression for value `v` of IDL type `t`; `nested` as in rust_type (False only for struct fields)."""
     if external:
-        return f"Box::new({rust_value(t, v)})"
+        return f"Box::new({rust_value(t, v, nested=nested)})"
     p = prim(t)
     if p == "bool":
         return "true" if v else "false"
@@ -228,13 +229,14 @@ def rust_value(t, v, external=False):
     if isinstance(t, WrapOpt):
         return "None" if v is None else f"Some({rust_value(t.inner, v)})"
     if isinstance(t, bounded_str):
-        return f"String::from({rust_str(v)})"
+        return f"BoundedString(String::from({rust_str(v)}))" if nested else f"String::from({rust_str(v)})"
     if isinstance(t, sequence):
-        return "vec![" + ", ".join(rust_value(t.subtype, x) for x in v) + "]"
+        items = "vec![" + ", ".join(rust_value(t.subtype, x) for x in v) + "]"
+        return f"BoundedSeq({items})" if (nested and t.max_length) else items
     if isinstance(t, array):
         return "[" + ", ".join(rust_value(t.subtype, x) for x in v) + "]"
     if isinstance(t, typedef):
-        return rust_value(t.subtype, v)
+        return rust_value(t.subtype, v, nested=nested)
     if isclass(t) and issubclass(t, enum.Enum):
         return f"{t.__name__}::{camel(v.name)}"
     if isclass(t) and issubclass(t, IdlBitmask):
@@ -260,7 +262,7 @@ def rust_value(t, v, external=False):
             if ext and isinstance(ft, WrapOpt):
                 parts.append(f"{fname}: " + ("None" if val is None else f"Some(Box::new({rust_value(ft.inner, val)}))"))
             else:
-                parts.append(f"{fname}: {rust_value(ft, val, ext)}")
+                parts.append(f"{fname}: {rust_value(ft, val, ext, nested=False)}")
         return f"{t.__name__} {{ " + ", ".join(parts) + " }"
     raise TypeError(f"no Rust value for {t!r}")
 

@@ -4,7 +4,9 @@
 //! - `serialize` gives exactly libddsc's bytes, for each XCDR version and byte order the fixture holds;
 //! - `deserialize` of libddsc's bytes (and of other bytes libddsc accepts, listed in `decode_also`) gives
 //!   back the sample;
-//! - for keyed types, `serialize_key` and `key_hash` give libddsc's key and key hash.
+//! - for keyed types, `serialize_key` and `key_hash` give libddsc's key and key hash, and `deserialize_key` of
+//!   libddsc's key payload re-encodes to the same key;
+//! - `DEFAULT_VERSION` is the version libddsc writes when the topic QoS names no data representation.
 //!
 //! Each type is one test; it reports every mismatch by sample and encoding, then fails.
 
@@ -18,14 +20,19 @@ use dds_runtime::cdr::{self, ByteOrder, DdsType, Extensibility, XcdrVersion};
 use serde_json::Value;
 
 fn fixture(name: &str) -> Value {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/golden").join(format!("{name}.json"));
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/golden")
+        .join(format!("{name}.json"));
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 fn unhex(s: &str) -> Vec<u8> {
-    assert!(s.len() % 2 == 0, "odd hex length");
-    (0..s.len()).step_by(2).map(|i| u8::from_str_radix(&s[i..i + 2], 16).expect("hex digit")).collect()
+    assert!(s.len() & 1 == 0, "odd hex length");
+    (0..s.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&s[i..i + 2], 16).expect("hex digit"))
+        .collect()
 }
 
 fn hex(b: &[u8]) -> String {
@@ -34,7 +41,11 @@ fn hex(b: &[u8]) -> String {
 
 /// "xcdr2_be" -> (Xcdr2, BigEndian)
 fn encoding(tag: &str) -> (XcdrVersion, Option<ByteOrder>) {
-    let version = if tag.starts_with("xcdr1") { XcdrVersion::Xcdr1 } else { XcdrVersion::Xcdr2 };
+    let version = if tag.starts_with("xcdr1") {
+        XcdrVersion::Xcdr1
+    } else {
+        XcdrVersion::Xcdr2
+    };
     let order = if tag.ends_with("_le") {
         Some(ByteOrder::LittleEndian)
     } else if tag.ends_with("_be") {
@@ -46,7 +57,11 @@ fn encoding(tag: &str) -> (XcdrVersion, Option<ByteOrder>) {
 }
 
 fn describe(expected: &[u8], got: &[u8]) -> String {
-    let at = expected.iter().zip(got).position(|(a, b)| a != b).unwrap_or(expected.len().min(got.len()));
+    let at = expected
+        .iter()
+        .zip(got)
+        .position(|(a, b)| a != b)
+        .unwrap_or(expected.len().min(got.len()));
     format!(
         "first difference at byte {at} (lengths {} vs {})\n      expected {}\n      got      {}",
         expected.len(),
@@ -58,7 +73,11 @@ fn describe(expected: &[u8], got: &[u8]) -> String {
 
 fn entries(v: &Value) -> Vec<(String, String)> {
     v.as_object()
-        .map(|m| m.iter().map(|(k, v)| (k.clone(), v.as_str().unwrap_or_default().to_owned())).collect())
+        .map(|m| {
+            m.iter()
+                .map(|(k, v)| (k.clone(), v.as_str().unwrap_or_default().to_owned()))
+                .collect()
+        })
         .unwrap_or_default()
 }
 
@@ -69,7 +88,11 @@ pub fn check<T: DdsType + PartialEq + Debug>(name: &str, samples: Vec<(&str, T)>
     let mut checked = 0usize;
 
     if T::TYPE_NAME != fx["typename"].as_str().unwrap_or_default() {
-        bad.push(format!("TYPE_NAME {:?}, fixture {}", T::TYPE_NAME, fx["typename"]));
+        bad.push(format!(
+            "TYPE_NAME {:?}, fixture {}",
+            T::TYPE_NAME,
+            fx["typename"]
+        ));
     }
     let ext = match fx["extensibility"].as_str() {
         Some("final") => Extensibility::Final,
@@ -77,7 +100,23 @@ pub fn check<T: DdsType + PartialEq + Debug>(name: &str, samples: Vec<(&str, T)>
         _ => Extensibility::Mutable,
     };
     if T::EXTENSIBILITY != ext {
-        bad.push(format!("EXTENSIBILITY {:?}, fixture {ext:?}", T::EXTENSIBILITY));
+        bad.push(format!(
+            "EXTENSIBILITY {:?}, fixture {ext:?}",
+            T::EXTENSIBILITY
+        ));
+    }
+    if let Some(v) = fx["libddsc_default_version"].as_u64() {
+        let want = if v == 1 {
+            XcdrVersion::Xcdr1
+        } else {
+            XcdrVersion::Xcdr2
+        };
+        if T::DEFAULT_VERSION != want {
+            bad.push(format!(
+                "DEFAULT_VERSION {:?}, libddsc writes {want:?} by default",
+                T::DEFAULT_VERSION
+            ));
+        }
     }
     let keyed = fx["keyed"].as_bool().unwrap_or_default();
     if T::IS_KEYED != keyed {
@@ -85,9 +124,17 @@ pub fn check<T: DdsType + PartialEq + Debug>(name: &str, samples: Vec<(&str, T)>
     }
 
     let fixture_samples = fx["samples"].as_array().cloned().unwrap_or_default();
-    assert_eq!(fixture_samples.len(), samples.len(), "{name}: sample count differs from the fixture");
+    assert_eq!(
+        fixture_samples.len(),
+        samples.len(),
+        "{name}: sample count differs from the fixture"
+    );
     for ((sname, value), fs) in samples.iter().zip(&fixture_samples) {
-        assert_eq!(fs["name"].as_str(), Some(*sname), "{name}: sample order differs from the fixture");
+        assert_eq!(
+            fs["name"].as_str(),
+            Some(*sname),
+            "{name}: sample order differs from the fixture"
+        );
         let here = format!("{name}/{sname}");
 
         for (tag, want) in entries(&fs["data"]) {
@@ -129,8 +176,26 @@ pub fn check<T: DdsType + PartialEq + Debug>(name: &str, samples: Vec<(&str, T)>
             checked += 1;
             match cdr::serialize_key(value, version, order, &mut out) {
                 Ok(()) if out == want => {}
-                Ok(()) => bad.push(format!("{here} {tag} serialize_key: {}", describe(&want, &out))),
+                Ok(()) => bad.push(format!(
+                    "{here} {tag} serialize_key: {}",
+                    describe(&want, &out)
+                )),
                 Err(e) => bad.push(format!("{here} {tag} serialize_key: error {e}")),
+            }
+            // libddsc's key payload decodes to a key-only sample whose key encoding is libddsc's again.
+            checked += 1;
+            let mut again = Vec::new();
+            match cdr::deserialize_key::<T>(&want)
+                .map_err(|e| e.to_string())
+                .and_then(|k| {
+                    cdr::serialize_key(&k, version, order, &mut again).map_err(|e| e.to_string())
+                }) {
+                Ok(()) if again == want => {}
+                Ok(()) => bad.push(format!(
+                    "{here} {tag} deserialize_key+serialize_key: {}",
+                    describe(&want, &again)
+                )),
+                Err(e) => bad.push(format!("{here} {tag} deserialize_key: error {e}")),
             }
         }
         for (tag, want) in entries(&fs["key_hash"]) {
@@ -138,7 +203,10 @@ pub fn check<T: DdsType + PartialEq + Debug>(name: &str, samples: Vec<(&str, T)>
             checked += 1;
             match cdr::key_hash(value, version) {
                 Ok(h) if h.as_slice() == unhex(&want).as_slice() => {}
-                Ok(h) => bad.push(format!("{here} {tag} key_hash: expected {want}, got {}", hex(&h))),
+                Ok(h) => bad.push(format!(
+                    "{here} {tag} key_hash: expected {want}, got {}",
+                    hex(&h)
+                )),
                 Err(e) => bad.push(format!("{here} {tag} key_hash: error {e}")),
             }
         }
@@ -146,6 +214,10 @@ pub fn check<T: DdsType + PartialEq + Debug>(name: &str, samples: Vec<(&str, T)>
 
     assert!(checked > 0, "{name}: the fixture holds nothing to check");
     if !bad.is_empty() {
-        panic!("{name}: {} of {checked} checks failed:\n  {}", bad.len(), bad.join("\n  "));
+        panic!(
+            "{name}: {} of {checked} checks failed:\n  {}",
+            bad.len(),
+            bad.join("\n  ")
+        );
     }
 }

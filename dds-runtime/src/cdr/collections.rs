@@ -24,7 +24,13 @@ fn check_bound(what: &'static str, len: usize, bound: usize) -> Result<(), Encod
     }
 }
 
-fn bound_error(r: &CdrReader<'_>, at: usize, expected: &'static str, len: usize, bound: usize) -> DecodeError {
+fn bound_error(
+    r: &CdrReader<'_>,
+    at: usize,
+    expected: &'static str,
+    len: usize,
+    bound: usize,
+) -> DecodeError {
     let _ = r;
     DecodeError::new(at, expected, DecodeErrorKind::BoundExceeded { bound, len })
 }
@@ -111,7 +117,11 @@ impl CdrType for String {
 }
 
 /// Encodes a sequence body; shared by `Vec` and `BoundedSeq`.
-pub(crate) fn encode_seq<T: CdrType>(items: &[T], w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
+pub(crate) fn encode_seq<T: CdrType>(
+    items: &[T],
+    w: &mut CdrWriter<'_>,
+    bound: usize,
+) -> Result<(), EncodeError> {
     check_bound("sequence", items.len(), bound)?;
     if !T::LAYOUT.is_primitive() && w.is_xcdr2() {
         w.enter()?;
@@ -133,7 +143,10 @@ fn capacity_for<T>(n: usize, remaining: usize) -> usize {
 }
 
 /// Decodes a sequence body; shared by `Vec` and `BoundedSeq`.
-pub(crate) fn decode_seq<T: CdrType>(r: &mut CdrReader<'_>, bound: usize) -> Result<Vec<T>, DecodeError> {
+pub(crate) fn decode_seq<T: CdrType>(
+    r: &mut CdrReader<'_>,
+    bound: usize,
+) -> Result<Vec<T>, DecodeError> {
     let limit = if !T::LAYOUT.is_primitive() && r.is_xcdr2() {
         r.enter("sequence")?;
         let len = r.read_u32("sequence DHEADER")? as usize;
@@ -155,16 +168,17 @@ pub(crate) fn decode_seq<T: CdrType>(r: &mut CdrReader<'_>, bound: usize) -> Res
     Ok(v)
 }
 
-pub(crate) fn seq_key_max_end<T: CdrType>(start: usize, version: XcdrVersion, bound: Option<usize>) -> Option<usize> {
+pub(crate) fn seq_key_max_end<T: CdrType>(
+    start: usize,
+    version: XcdrVersion,
+    bound: Option<usize>,
+) -> Option<usize> {
     let bound = bound?;
     if start > KEY_SCAN_LIMIT || bound > KEY_SCAN_LIMIT {
         return None;
     }
-    let mut p = align4(start);
-    if !T::LAYOUT.is_primitive() && version == XcdrVersion::Xcdr2 {
-        p += 4;
-    }
-    p += 4;
+    // The hashed key stream carries no DHEADER.
+    let mut p = align4(start) + 4;
     for _ in 0..bound {
         p = T::key_max_end(p, version, None)?;
         if p > KEY_SCAN_LIMIT {
@@ -181,7 +195,7 @@ impl<T: CdrType> CdrType for Vec<T> {
     };
     const MIN_SIZE: usize = 4;
     const XCDR1_PLAIN: bool = T::XCDR1_PLAIN;
-    const KEY_FINAL: bool = T::KEY_FINAL;
+    const KEY_HAS_MUTABLE: bool = T::KEY_HAS_MUTABLE;
 
     #[inline]
     fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
@@ -224,7 +238,7 @@ impl<T: CdrType, const N: usize> CdrType for [T; N] {
         }
     };
     const XCDR1_PLAIN: bool = T::XCDR1_PLAIN;
-    const KEY_FINAL: bool = T::KEY_FINAL;
+    const KEY_HAS_MUTABLE: bool = T::KEY_HAS_MUTABLE;
 
     fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
         if matches!(Self::LAYOUT, Layout::DelimitedArray) && w.is_xcdr2() {
@@ -293,9 +307,6 @@ impl<T: CdrType, const N: usize> CdrType for [T; N] {
             return None;
         }
         let mut p = start;
-        if matches!(Self::LAYOUT, Layout::DelimitedArray) && version == XcdrVersion::Xcdr2 {
-            p = align4(p) + 4;
-        }
         for _ in 0..N {
             p = T::key_max_end(p, version, None)?;
             if p > KEY_SCAN_LIMIT {
@@ -314,7 +325,7 @@ impl<K: CdrType + Ord, V: CdrType> CdrType for BTreeMap<K, V> {
     };
     const MIN_SIZE: usize = 4;
     const XCDR1_PLAIN: bool = K::XCDR1_PLAIN && V::XCDR1_PLAIN;
-    const KEY_FINAL: bool = K::KEY_FINAL && V::KEY_FINAL;
+    const KEY_HAS_MUTABLE: bool = K::KEY_HAS_MUTABLE || V::KEY_HAS_MUTABLE;
 
     fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
         self.encode_bounded(w, usize::MAX)
@@ -332,7 +343,11 @@ impl<K: CdrType + Ord, V: CdrType> CdrType for BTreeMap<K, V> {
         check_bound("map", self.len(), bound)?;
         let delimited = matches!(Self::LAYOUT, Layout::Delimited) && w.is_xcdr2();
         w.enter()?;
-        let slot = if delimited { Some(w.begin_length()) } else { None };
+        let slot = if delimited {
+            Some(w.begin_length())
+        } else {
+            None
+        };
         w.write_len(self.len(), "map length")?;
         for (k, v) in self {
             k.encode(w)?;
@@ -379,8 +394,10 @@ impl<K: CdrType + Ord, V: CdrType> CdrType for BTreeMap<K, V> {
 /// `@external` members and recursion.
 impl<T: CdrType> CdrType for Box<T> {
     const LAYOUT: Layout = T::LAYOUT;
-    // Not delegated: a recursive type would make these constants depend on themselves.
+    // Not delegated: a recursive type would make its own minimum size depend on itself.
     const MIN_SIZE: usize = 1;
+    const XCDR1_PLAIN: bool = T::XCDR1_PLAIN;
+    const KEY_HAS_MUTABLE: bool = T::KEY_HAS_MUTABLE;
 
     #[inline]
     fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {

@@ -43,7 +43,8 @@ impl ByteOrder {
     pub const fn is_native(self) -> bool {
         matches!(
             (self, ByteOrder::NATIVE),
-            (ByteOrder::BigEndian, ByteOrder::BigEndian) | (ByteOrder::LittleEndian, ByteOrder::LittleEndian)
+            (ByteOrder::BigEndian, ByteOrder::BigEndian)
+                | (ByteOrder::LittleEndian, ByteOrder::LittleEndian)
         )
     }
 }

@@ -25,24 +25,35 @@ pub fn serialize_key<T: DdsType>(
 /// Decodes a key-only payload; members that are not keys get their default values.
 pub fn deserialize_key<T: DdsType>(payload: &[u8]) -> Result<T, DecodeError> {
     let h = EncapsulationHeader::parse(payload)?;
-    let mut r = CdrReader::new(payload, EncapsulationHeader::SIZE, h.version()?, h.byte_order(), true);
+    let mut r = CdrReader::new(
+        payload,
+        EncapsulationHeader::SIZE,
+        h.version()?,
+        h.byte_order(),
+        true,
+    );
     T::decode(&mut r)
 }
 
-/// Writes the big-endian key stream Cyclone DDS hashes: key members in member-id order (XCDR2) or declaration
-/// order (XCDR1) when every aggregate on the key path is final; otherwise the key-only encoding with its headers.
-fn key_stream<T: DdsType>(sample: &T, version: XcdrVersion, out: &mut Vec<u8>) -> Result<(), EncodeError> {
-    let mode = if T::KEY_FINAL {
-        EncodeMode::KeyHash
-    } else {
-        EncodeMode::Key
-    };
-    sample.encode(&mut CdrWriter::new(out, version, ByteOrder::BigEndian, mode))
+/// Writes the big-endian key stream libddsc hashes: key members only, in member-id order, plain (no DHEADER,
+/// EMHEADER or parameter header, whatever the extensibility), aligned as `version` says.
+fn key_stream<T: DdsType>(
+    sample: &T,
+    version: XcdrVersion,
+    out: &mut Vec<u8>,
+) -> Result<(), EncodeError> {
+    sample.encode(&mut CdrWriter::new(
+        out,
+        version,
+        ByteOrder::BigEndian,
+        EncodeMode::KeyHash,
+    ))
 }
 
 /// The 16-byte key hash of `sample` for a payload of XCDR version `version` (Cyclone uses the sample's version).
-/// The key stream is zero-padded to 16 bytes when the type's maximum key size is at most 16, else hashed with
-/// MD5. Unkeyed types hash to zeros. Use it on the wire only: instance identity is [`instance_key`].
+/// The key stream is zero-padded to 16 bytes when the type's maximum key-stream size is at most 16 (in XCDR1
+/// only if no @mutable type is on the key path, as libddsc decides), else hashed with MD5 as it is. Unkeyed
+/// types hash to zeros. Use it on the wire only: instance identity is [`instance_key`].
 pub fn key_hash<T: DdsType>(sample: &T, version: XcdrVersion) -> Result<[u8; 16], EncodeError> {
     let mut h = [0u8; 16];
     if !T::IS_KEYED {
@@ -50,9 +61,14 @@ pub fn key_hash<T: DdsType>(sample: &T, version: XcdrVersion) -> Result<[u8; 16]
     }
     let mut buf = Vec::with_capacity(32);
     key_stream(sample, version, &mut buf)?;
-    match T::key_max_end(0, version, None) {
-        Some(max) if max <= 16 && buf.len() <= 16 => h[..buf.len()].copy_from_slice(&buf),
-        _ => h.copy_from_slice(&Md5::digest(&buf)),
+    let fixed = match T::key_max_end(0, version, None) {
+        Some(max) => max <= 16 && !(version == XcdrVersion::Xcdr1 && T::KEY_HAS_MUTABLE),
+        None => false,
+    };
+    if fixed && buf.len() <= 16 {
+        h[..buf.len()].copy_from_slice(&buf);
+    } else {
+        h.copy_from_slice(&Md5::digest(&buf));
     }
     Ok(h)
 }

@@ -2,9 +2,9 @@
 //! members and union discriminators. Generated code calls these; their names are not part of the user API.
 
 use super::error::{DecodeError, DecodeErrorKind, EncodeError};
-use super::header::{Extensibility, XcdrVersion};
+use super::header::Extensibility;
 use super::reader::{CdrReader, Limit};
-use super::traits::{CdrType, Layout};
+use super::traits::CdrType;
 use super::writer::{CdrWriter, LengthSlot};
 use super::{PID_EXTENDED, PID_IGNORE, PID_LIST_END};
 
@@ -20,7 +20,10 @@ pub struct StructEncoder {
 
 /// Starts a struct or union: depth check, and the DHEADER of XCDR2 appendable/mutable types.
 #[inline]
-pub fn begin_encode(w: &mut CdrWriter<'_>, ext: Extensibility) -> Result<StructEncoder, EncodeError> {
+pub fn begin_encode(
+    w: &mut CdrWriter<'_>,
+    ext: Extensibility,
+) -> Result<StructEncoder, EncodeError> {
     w.enter()?;
     let slot = if w.is_xcdr2() && ext != Extensibility::Final {
         Some(w.begin_length())
@@ -125,7 +128,10 @@ pub struct MemberHeader {
 
 /// Starts decoding a struct or union (depth check, XCDR2 DHEADER).
 #[inline]
-pub fn begin_decode(r: &mut CdrReader<'_>, ext: Extensibility) -> Result<StructDecoder, DecodeError> {
+pub fn begin_decode(
+    r: &mut CdrReader<'_>,
+    ext: Extensibility,
+) -> Result<StructDecoder, DecodeError> {
     r.enter("struct")?;
     let limit = if r.is_xcdr2() && ext != Extensibility::Final {
         let len = r.read_u32("DHEADER")? as usize;
@@ -144,7 +150,10 @@ impl StructDecoder {
     }
 
     /// Reads the next member header of a mutable encoding, or `None` at the end of the list.
-    pub fn next_member(&mut self, r: &mut CdrReader<'_>) -> Result<Option<MemberHeader>, DecodeError> {
+    pub fn next_member(
+        &mut self,
+        r: &mut CdrReader<'_>,
+    ) -> Result<Option<MemberHeader>, DecodeError> {
         debug_assert_eq!(self.ext, Extensibility::Mutable);
         if r.is_xcdr2() {
             if r.remaining() == 0 {
@@ -166,16 +175,18 @@ impl StructDecoder {
                         6 => 4,
                         _ => 8,
                     };
-                    n.checked_mul(unit).and_then(|b| b.checked_add(4)).ok_or_else(|| {
-                        DecodeError::new(
-                            at,
-                            "EMHEADER member length",
-                            DecodeErrorKind::LengthTooLarge {
-                                length: n as u64,
-                                remaining: r.remaining(),
-                            },
-                        )
-                    })?
+                    n.checked_mul(unit)
+                        .and_then(|b| b.checked_add(4))
+                        .ok_or_else(|| {
+                            DecodeError::new(
+                                at,
+                                "EMHEADER member length",
+                                DecodeErrorKind::LengthTooLarge {
+                                    length: n as u64,
+                                    remaining: r.remaining(),
+                                },
+                            )
+                        })?
                 }
             };
             let limit = r.begin_limit(len, "member body")?;
@@ -255,7 +266,10 @@ pub fn skip_member(r: &mut CdrReader<'_>, m: MemberHeader) -> Result<(), DecodeE
 }
 
 /// Decodes an optional member of a final/appendable type (presence byte in XCDR2, parameter in XCDR1).
-pub fn decode_optional<T: CdrType>(r: &mut CdrReader<'_>, bound: usize) -> Result<Option<T>, DecodeError> {
+pub fn decode_optional<T: CdrType>(
+    r: &mut CdrReader<'_>,
+    bound: usize,
+) -> Result<Option<T>, DecodeError> {
     if r.is_xcdr2() {
         let at = r.offset();
         match r.read_u8("optional presence flag")? {
@@ -264,7 +278,9 @@ pub fn decode_optional<T: CdrType>(r: &mut CdrReader<'_>, bound: usize) -> Resul
             b => Err(DecodeError::new(
                 at,
                 "optional presence flag (0 or 1)",
-                DecodeErrorKind::InvalidValue { found: u64::from(b) },
+                DecodeErrorKind::InvalidValue {
+                    found: u64::from(b),
+                },
             )),
         }
     } else {
@@ -298,20 +314,9 @@ pub const fn member_min_size(layout_min: usize, ext: Extensibility, optional: bo
     }
 }
 
-/// End offset of the XCDR2 member framing a key-size scan adds before a member.
-pub fn key_member_header_end(p: usize, version: XcdrVersion, ext: Extensibility, layout: Layout) -> usize {
-    match (ext, version) {
-        (Extensibility::Mutable, XcdrVersion::Xcdr2) => {
-            ((p + 3) & !3) + if layout.length_code() == 4 { 8 } else { 4 }
-        }
-        (Extensibility::Mutable, XcdrVersion::Xcdr1) => ((p + 3) & !3) + 12,
-        _ => p,
-    }
-}
-
 /// A union discriminator type: integers, `bool`, `char` and enums deriving `DdsType`.
 pub trait Discriminator: CdrType + Copy {
-    /// How the default discriminator value is searched (Cyclone Python's rule).
+    /// How the default discriminator value is searched (libddsc's rule).
     const SEARCH: DefaultSearch;
     /// The label value as an integer.
     fn to_raw(&self) -> i64;
@@ -334,7 +339,7 @@ pub enum DefaultSearch {
     Up(i64),
     /// `true` first, then `false`.
     Bool,
-    /// The first non-negative integer that is not an enumerator value (may lie outside the enum).
+    /// The first enumerator (in declaration order) that no label uses, as libddsc requires.
     Enum,
 }
 
@@ -375,14 +380,11 @@ pub fn default_discriminator<D: Discriminator>(labels: &[i64]) -> Result<i64, En
                 Err(none)
             }
         }
-        DefaultSearch::Enum => {
-            let used = D::enumerators();
-            let mut v = 0i64;
-            while used.contains(&v) {
-                v += 1;
-            }
-            Ok(v)
-        }
+        DefaultSearch::Enum => D::enumerators()
+            .iter()
+            .copied()
+            .find(|v| !labels.contains(v))
+            .ok_or(none),
     }
 }
 
@@ -502,6 +504,20 @@ impl Discriminator for bool {
     }
     fn read_raw(r: &mut CdrReader<'_>) -> Result<i64, DecodeError> {
         bool::decode(r).map(i64::from)
+    }
+}
+
+impl Discriminator for super::WChar {
+    const SEARCH: DefaultSearch = DefaultSearch::Up(0xffff);
+    fn to_raw(&self) -> i64 {
+        i64::from(self.0)
+    }
+    fn write_raw(w: &mut CdrWriter<'_>, raw: i64) -> Result<(), EncodeError> {
+        w.write_u16(raw as u16);
+        Ok(())
+    }
+    fn read_raw(r: &mut CdrReader<'_>) -> Result<i64, DecodeError> {
+        r.read_u16("wchar discriminator").map(i64::from)
     }
 }
 

@@ -24,8 +24,10 @@ pub use traits::{CdrType, DdsType, Layout, MemberDescriptor, StructMembers, Type
 pub use wrappers::{BoundedSeq, BoundedString, LongDouble, WChar, WString};
 pub use writer::{CdrWriter, EncodeMode, LengthSlot, ParamSlot};
 
-/// Deepest nesting of aggregates and collections accepted on decode (and produced on encode).
-pub const MAX_DEPTH: u32 = 128;
+/// Deepest nesting accepted on decode and produced on encode: structs and unions count one level each, and in
+/// XCDR2 so do DHEADER-delimited collections. 64 keeps a debug build of a large recursive type within a 2 MiB
+/// thread stack.
+pub const MAX_DEPTH: u32 = 64;
 /// XCDR1 parameter id announcing a 32-bit member id and length.
 pub const PID_EXTENDED: u16 = 0x3f01;
 /// XCDR1 parameter id closing a parameter list.
@@ -33,15 +35,25 @@ pub const PID_LIST_END: u16 = 0x3f02;
 /// XCDR1 parameter id to skip.
 pub const PID_IGNORE: u16 = 0x3f03;
 
-pub(crate) fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut Vec<u8>) -> usize {
+pub(crate) fn start_payload<T: DdsType>(
+    version: XcdrVersion,
+    order: ByteOrder,
+    out: &mut Vec<u8>,
+) -> usize {
     let start = out.len();
-    out.extend_from_slice(&EncapsulationHeader::for_type(version, T::EXTENSIBILITY, order).to_bytes());
+    out.extend_from_slice(
+        &EncapsulationHeader::for_type(version, T::EXTENSIBILITY, order).to_bytes(),
+    );
     start
 }
 
 /// Pads the payload to a multiple of 4 and records the padding in the header options, as Cyclone DDS does;
 /// on error removes what was appended.
-pub(crate) fn finish_payload(start: usize, r: Result<(), EncodeError>, out: &mut Vec<u8>) -> Result<(), EncodeError> {
+pub(crate) fn finish_payload(
+    start: usize,
+    r: Result<(), EncodeError>,
+    out: &mut Vec<u8>,
+) -> Result<(), EncodeError> {
     if let Err(e) = r {
         out.truncate(start);
         return Err(e);
@@ -68,6 +80,12 @@ pub fn serialize<T: DdsType>(
 /// Decodes a payload that starts with its encapsulation header. Never panics; see [`DecodeError`].
 pub fn deserialize<T: DdsType>(payload: &[u8]) -> Result<T, DecodeError> {
     let h = EncapsulationHeader::parse(payload)?;
-    let mut r = CdrReader::new(payload, EncapsulationHeader::SIZE, h.version()?, h.byte_order(), false);
+    let mut r = CdrReader::new(
+        payload,
+        EncapsulationHeader::SIZE,
+        h.version()?,
+        h.byte_order(),
+        false,
+    );
     T::decode(&mut r)
 }

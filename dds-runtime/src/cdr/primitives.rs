@@ -9,9 +9,13 @@ use super::writer::CdrWriter;
 /// End offset of a primitive of `size` bytes written at `start` (key-size scans).
 #[inline]
 pub const fn prim_end(start: usize, size: usize, version: XcdrVersion) -> usize {
-    let a = if size < version.max_align() { size } else { version.max_align() };
+    let a = if size < version.max_align() {
+        size
+    } else {
+        version.max_align()
+    };
     let a = if a == 0 { 1 } else { a };
-    (start + a - 1) / a * a + size
+    start.div_ceil(a) * a + size
 }
 
 macro_rules! numeric {
@@ -38,7 +42,11 @@ macro_rules! numeric {
                 <$t>::default()
             }
 
-            fn key_max_end(start: usize, version: XcdrVersion, _bound: Option<usize>) -> Option<usize> {
+            fn key_max_end(
+                start: usize,
+                version: XcdrVersion,
+                _bound: Option<usize>,
+            ) -> Option<usize> {
                 Some(prim_end(start, $n, version))
             }
 
@@ -51,7 +59,10 @@ macro_rules! numeric {
                 if w.order().is_native() {
                     // SAFETY: a numeric slice is initialized memory without padding; viewing it as bytes is sound.
                     let bytes = unsafe {
-                        std::slice::from_raw_parts(items.as_ptr().cast::<u8>(), std::mem::size_of_val(items))
+                        std::slice::from_raw_parts(
+                            items.as_ptr().cast::<u8>(),
+                            std::mem::size_of_val(items),
+                        )
                     };
                     w.write_bytes(bytes);
                 } else {
@@ -63,7 +74,9 @@ macro_rules! numeric {
                 Ok(())
             }
 
-            fn decode_array<const N: usize>(r: &mut CdrReader<'_>) -> Result<[Self; N], DecodeError> {
+            fn decode_array<const N: usize>(
+                r: &mut CdrReader<'_>,
+            ) -> Result<[Self; N], DecodeError> {
                 let mut a = [<$t>::default(); N];
                 if N == 0 {
                     return Ok(a);
@@ -73,7 +86,11 @@ macro_rules! numeric {
                 if r.order().is_native() {
                     // SAFETY: `a` holds exactly N * $n bytes and every bit pattern is a valid value.
                     unsafe {
-                        std::ptr::copy_nonoverlapping(bytes.as_ptr(), a.as_mut_ptr().cast::<u8>(), N * $n);
+                        std::ptr::copy_nonoverlapping(
+                            bytes.as_ptr(),
+                            a.as_mut_ptr().cast::<u8>(),
+                            N * $n,
+                        );
                     }
                 } else {
                     for (d, c) in a.iter_mut().zip(bytes.chunks_exact($n)) {
@@ -89,7 +106,11 @@ macro_rules! numeric {
             }
 
             #[inline]
-            fn decode_into(out: &mut Vec<Self>, n: usize, r: &mut CdrReader<'_>) -> Result<(), DecodeError> {
+            fn decode_into(
+                out: &mut Vec<Self>,
+                n: usize,
+                r: &mut CdrReader<'_>,
+            ) -> Result<(), DecodeError> {
                 if n == 0 {
                     return Ok(());
                 }
@@ -122,14 +143,86 @@ macro_rules! numeric {
     };
 }
 
-numeric!(u16, u16, 2, write_u16, read_u16, |v: u16| v, |v: u16| v, "uint16");
-numeric!(i16, u16, 2, write_u16, read_u16, |v: i16| v as u16, |v: u16| v as i16, "int16");
-numeric!(u32, u32, 4, write_u32, read_u32, |v: u32| v, |v: u32| v, "uint32");
-numeric!(i32, u32, 4, write_u32, read_u32, |v: i32| v as u32, |v: u32| v as i32, "int32");
-numeric!(u64, u64, 8, write_u64, read_u64, |v: u64| v, |v: u64| v, "uint64");
-numeric!(i64, u64, 8, write_u64, read_u64, |v: i64| v as u64, |v: u64| v as i64, "int64");
-numeric!(f32, u32, 4, write_u32, read_u32, f32::to_bits, f32::from_bits, "float32");
-numeric!(f64, u64, 8, write_u64, read_u64, f64::to_bits, f64::from_bits, "float64");
+numeric!(
+    u16,
+    u16,
+    2,
+    write_u16,
+    read_u16,
+    |v: u16| v,
+    |v: u16| v,
+    "uint16"
+);
+numeric!(
+    i16,
+    u16,
+    2,
+    write_u16,
+    read_u16,
+    |v: i16| v as u16,
+    |v: u16| v as i16,
+    "int16"
+);
+numeric!(
+    u32,
+    u32,
+    4,
+    write_u32,
+    read_u32,
+    |v: u32| v,
+    |v: u32| v,
+    "uint32"
+);
+numeric!(
+    i32,
+    u32,
+    4,
+    write_u32,
+    read_u32,
+    |v: i32| v as u32,
+    |v: u32| v as i32,
+    "int32"
+);
+numeric!(
+    u64,
+    u64,
+    8,
+    write_u64,
+    read_u64,
+    |v: u64| v,
+    |v: u64| v,
+    "uint64"
+);
+numeric!(
+    i64,
+    u64,
+    8,
+    write_u64,
+    read_u64,
+    |v: i64| v as u64,
+    |v: u64| v as i64,
+    "int64"
+);
+numeric!(
+    f32,
+    u32,
+    4,
+    write_u32,
+    read_u32,
+    f32::to_bits,
+    f32::from_bits,
+    "float32"
+);
+numeric!(
+    f64,
+    u64,
+    8,
+    write_u64,
+    read_u64,
+    f64::to_bits,
+    f64::from_bits,
+    "float64"
+);
 
 macro_rules! byte_like {
     ($t:ty, $what:expr) => {
@@ -152,19 +245,26 @@ macro_rules! byte_like {
                 0
             }
 
-            fn key_max_end(start: usize, _version: XcdrVersion, _bound: Option<usize>) -> Option<usize> {
+            fn key_max_end(
+                start: usize,
+                _version: XcdrVersion,
+                _bound: Option<usize>,
+            ) -> Option<usize> {
                 Some(start + 1)
             }
 
             #[inline]
             fn encode_slice(items: &[Self], w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
                 // SAFETY: u8/i8 slices are plain bytes.
-                let bytes = unsafe { std::slice::from_raw_parts(items.as_ptr().cast::<u8>(), items.len()) };
+                let bytes =
+                    unsafe { std::slice::from_raw_parts(items.as_ptr().cast::<u8>(), items.len()) };
                 w.write_bytes(bytes);
                 Ok(())
             }
 
-            fn decode_array<const N: usize>(r: &mut CdrReader<'_>) -> Result<[Self; N], DecodeError> {
+            fn decode_array<const N: usize>(
+                r: &mut CdrReader<'_>,
+            ) -> Result<[Self; N], DecodeError> {
                 let bytes = r.read_bytes(N, $what)?;
                 let mut a = [0 as $t; N];
                 for (d, &b) in a.iter_mut().zip(bytes) {
@@ -174,7 +274,11 @@ macro_rules! byte_like {
             }
 
             #[inline]
-            fn decode_into(out: &mut Vec<Self>, n: usize, r: &mut CdrReader<'_>) -> Result<(), DecodeError> {
+            fn decode_into(
+                out: &mut Vec<Self>,
+                n: usize,
+                r: &mut CdrReader<'_>,
+            ) -> Result<(), DecodeError> {
                 let bytes = r.read_bytes(n, $what)?;
                 out.extend(bytes.iter().map(|&b| b as $t));
                 Ok(())
@@ -203,7 +307,9 @@ impl CdrType for bool {
             b => Err(DecodeError::new(
                 r.offset() - 1,
                 "boolean (0 or 1)",
-                DecodeErrorKind::InvalidValue { found: u64::from(b) },
+                DecodeErrorKind::InvalidValue {
+                    found: u64::from(b),
+                },
             )),
         }
     }
@@ -216,7 +322,11 @@ impl CdrType for bool {
         Some(start + 1)
     }
 
-    fn decode_into(out: &mut Vec<Self>, n: usize, r: &mut CdrReader<'_>) -> Result<(), DecodeError> {
+    fn decode_into(
+        out: &mut Vec<Self>,
+        n: usize,
+        r: &mut CdrReader<'_>,
+    ) -> Result<(), DecodeError> {
         let at = r.offset();
         let bytes = r.read_bytes(n, "boolean")?;
         if let Some(i) = bytes.iter().position(|&b| b > 1) {

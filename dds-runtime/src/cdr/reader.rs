@@ -40,7 +40,13 @@ macro_rules! get {
 
 impl<'a> CdrReader<'a> {
     /// A reader over `data` starting at `start`, which is also the alignment origin.
-    pub fn new(data: &'a [u8], start: usize, version: XcdrVersion, order: ByteOrder, key_only: bool) -> Self {
+    pub fn new(
+        data: &'a [u8],
+        start: usize,
+        version: XcdrVersion,
+        order: ByteOrder,
+        key_only: bool,
+    ) -> Self {
         let start = start.min(data.len());
         CdrReader {
             data,
@@ -122,7 +128,11 @@ impl<'a> CdrReader<'a> {
 
     /// Takes `n` raw bytes.
     #[inline]
-    pub fn read_bytes(&mut self, n: usize, expected: &'static str) -> Result<&'a [u8], DecodeError> {
+    pub fn read_bytes(
+        &mut self,
+        n: usize,
+        expected: &'static str,
+    ) -> Result<&'a [u8], DecodeError> {
         if n > self.remaining() {
             return Err(self.eof(expected, n));
         }
@@ -170,7 +180,11 @@ impl<'a> CdrReader<'a> {
     /// Reads a u32 element count and checks that `count * min_elem_size` bytes can still follow, so a hostile
     /// length fails before anything is allocated.
     #[inline]
-    pub fn read_count(&mut self, min_elem_size: usize, expected: &'static str) -> Result<usize, DecodeError> {
+    pub fn read_count(
+        &mut self,
+        min_elem_size: usize,
+        expected: &'static str,
+    ) -> Result<usize, DecodeError> {
         let at = self.pos;
         let n = self.read_u32(expected)? as usize;
         let need = n.saturating_mul(min_elem_size.max(1));
@@ -188,7 +202,11 @@ impl<'a> CdrReader<'a> {
     }
 
     /// Restricts reading to the next `len` bytes (a DHEADER, EMHEADER or parameter body).
-    pub fn begin_limit(&mut self, len: usize, expected: &'static str) -> Result<Limit, DecodeError> {
+    pub fn begin_limit(
+        &mut self,
+        len: usize,
+        expected: &'static str,
+    ) -> Result<Limit, DecodeError> {
         if len > self.remaining() {
             return Err(self.error(
                 expected,
@@ -207,7 +225,11 @@ impl<'a> CdrReader<'a> {
     }
 
     /// Like [`begin_limit`](Self::begin_limit), and the body is its own alignment origin (XCDR1 parameters).
-    pub fn begin_param_limit(&mut self, len: usize, expected: &'static str) -> Result<Limit, DecodeError> {
+    pub fn begin_param_limit(
+        &mut self,
+        len: usize,
+        expected: &'static str,
+    ) -> Result<Limit, DecodeError> {
         let saved = self.begin_limit(len, expected)?;
         self.origin = self.pos;
         Ok(saved)
@@ -224,7 +246,10 @@ impl<'a> CdrReader<'a> {
     #[inline]
     pub fn enter(&mut self, expected: &'static str) -> Result<(), DecodeError> {
         if self.depth >= MAX_DEPTH {
-            return Err(self.error(expected, DecodeErrorKind::DepthExceeded { limit: MAX_DEPTH }));
+            return Err(self.error(
+                expected,
+                DecodeErrorKind::DepthExceeded { limit: MAX_DEPTH },
+            ));
         }
         self.depth += 1;
         Ok(())

@@ -66,9 +66,8 @@ pub trait CdrType: Sized {
     const LAYOUT: Layout;
     /// Lower bound of the encoded size (used to reject hostile lengths before allocating). At least 1.
     const MIN_SIZE: usize = 1;
-    /// Whether every aggregate on the key path is @final (Cyclone then hashes keys in member-id order without
-    /// headers; otherwise the key-only encoding, headers included, is hashed).
-    const KEY_FINAL: bool = true;
+    /// Whether a @mutable aggregate lies on the key path (Cyclone then never zero-pads an XCDR1 key hash).
+    const KEY_HAS_MUTABLE: bool = false;
     /// The member id after this struct's last one (a derived struct's ids continue from its base).
     #[doc(hidden)]
     const NEXT_MEMBER_ID: u32 = 0;
@@ -99,8 +98,9 @@ pub trait CdrType: Sized {
         Self::decode(r)
     }
 
-    /// End offset of the largest key-mode encoding of this type starting at `start`, or `None` when unbounded
-    /// (decides between zero-padding and MD5 for the key hash). `bound` is the member's IDL bound, if any.
+    /// End offset of the largest key-hash stream of this type (key members only, plain, no DHEADER/EMHEADER)
+    /// starting at `start`, or `None` when unbounded; decides between zero-padding and MD5 for the key hash.
+    /// `bound` is the member's IDL bound, if any.
     fn key_max_end(start: usize, version: XcdrVersion, bound: Option<usize>) -> Option<usize>;
 
     /// Decodes an array of `N` values; primitives override this with a bulk copy.
@@ -146,7 +146,11 @@ pub trait CdrType: Sized {
 
     /// Decodes `n` values into `out` (already reserved); primitives override this with a bulk copy.
     #[inline]
-    fn decode_into(out: &mut Vec<Self>, n: usize, r: &mut CdrReader<'_>) -> Result<(), DecodeError> {
+    fn decode_into(
+        out: &mut Vec<Self>,
+        n: usize,
+        r: &mut CdrReader<'_>,
+    ) -> Result<(), DecodeError> {
         for _ in 0..n {
             out.push(Self::decode(r)?);
         }
@@ -171,11 +175,16 @@ pub trait StructMembers: CdrType {
         p: &mut Self::Partial,
     ) -> Result<(), DecodeError>;
     /// Decodes the member with this id from a mutable encoding; `false` if the id is not a member.
-    fn decode_member_by_id(r: &mut CdrReader<'_>, id: u32, p: &mut Self::Partial) -> Result<bool, DecodeError>;
+    fn decode_member_by_id(
+        r: &mut CdrReader<'_>,
+        id: u32,
+        p: &mut Self::Partial,
+    ) -> Result<bool, DecodeError>;
     /// Builds the value, defaulting members that were not read.
     fn finish(p: Self::Partial) -> Self;
     /// Key-size scan over the members.
-    fn key_members_max_end(start: usize, version: XcdrVersion, ext: Extensibility) -> Option<usize>;
+    fn key_members_max_end(start: usize, version: XcdrVersion, ext: Extensibility)
+        -> Option<usize>;
 }
 
 /// Type metadata for the XTypes TypeObject generator (filled in later; the hook is here so the derive can grow

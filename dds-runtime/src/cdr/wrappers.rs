@@ -3,7 +3,9 @@
 
 use std::ops::{Deref, DerefMut};
 
-use super::collections::{decode_seq, decode_str, encode_seq, encode_str, seq_key_max_end, string_key_max_end};
+use super::collections::{
+    decode_seq, decode_str, encode_seq, encode_str, seq_key_max_end, string_key_max_end,
+};
 use super::error::{DecodeError, DecodeErrorKind, EncodeError};
 use super::header::{ByteOrder, XcdrVersion};
 use super::primitives::prim_end;
@@ -25,10 +27,12 @@ impl TryFrom<char> for WChar {
     type Error = EncodeError;
     /// Characters outside the Basic Multilingual Plane need two code units and do not fit.
     fn try_from(c: char) -> Result<Self, EncodeError> {
-        u16::try_from(u32::from(c)).map(WChar).map_err(|_| EncodeError::InvalidValue {
-            what: "wchar outside the BMP",
-            value: u64::from(u32::from(c)),
-        })
+        u16::try_from(u32::from(c))
+            .map(WChar)
+            .map_err(|_| EncodeError::InvalidValue {
+                what: "wchar outside the BMP",
+                value: u64::from(u32::from(c)),
+            })
     }
 }
 
@@ -152,7 +156,11 @@ impl CdrType for WString {
             match c {
                 Ok(c) => s.push(c),
                 Err(_) => {
-                    return Err(DecodeError::new(body, "UTF-16 wstring", DecodeErrorKind::MalformedString));
+                    return Err(DecodeError::new(
+                        body,
+                        "UTF-16 wstring",
+                        DecodeErrorKind::MalformedString,
+                    ));
                 }
             }
         }
@@ -202,7 +210,7 @@ impl CdrType for LongDouble {
 
     fn key_max_end(start: usize, version: XcdrVersion, _bound: Option<usize>) -> Option<usize> {
         let a = version.max_align();
-        Some((start + a - 1) / a * a + 16)
+        Some(start.div_ceil(a) * a + 16)
     }
 }
 
@@ -277,7 +285,7 @@ impl<T: CdrType, const N: usize> CdrType for BoundedSeq<T, N> {
     const LAYOUT: Layout = <Vec<T> as CdrType>::LAYOUT;
     const MIN_SIZE: usize = 4;
     const XCDR1_PLAIN: bool = T::XCDR1_PLAIN;
-    const KEY_FINAL: bool = T::KEY_FINAL;
+    const KEY_HAS_MUTABLE: bool = T::KEY_HAS_MUTABLE;
 
     fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {
         encode_seq(&self.0, w, N)

@@ -11,7 +11,7 @@ pub enum EncodeMode {
     Sample,
     /// Key members only, in declaration order (the serialized key).
     Key,
-    /// Key members only, as hashed: XCDR2 takes them in member-id order.
+    /// Key members only, as hashed: member-id order, no DHEADER/EMHEADER/parameter headers.
     KeyHash,
 }
 
@@ -54,7 +54,12 @@ macro_rules! put {
 
 impl<'a> CdrWriter<'a> {
     /// A writer whose alignment origin is the current end of `buf`.
-    pub fn new(buf: &'a mut Vec<u8>, version: XcdrVersion, order: ByteOrder, mode: EncodeMode) -> Self {
+    pub fn new(
+        buf: &'a mut Vec<u8>,
+        version: XcdrVersion,
+        order: ByteOrder,
+        mode: EncodeMode,
+    ) -> Self {
         let origin = buf.len();
         CdrWriter {
             buf,
@@ -189,7 +194,12 @@ impl<'a> CdrWriter<'a> {
     }
 
     /// Writes an XCDR2 EMHEADER with length code `lc`; for LC 4 it also reserves NEXTINT, returned as a slot.
-    pub fn write_emheader(&mut self, id: u32, must_understand: bool, lc: u8) -> Result<Option<LengthSlot>, EncodeError> {
+    pub fn write_emheader(
+        &mut self,
+        id: u32,
+        must_understand: bool,
+        lc: u8,
+    ) -> Result<Option<LengthSlot>, EncodeError> {
         if id > 0x0fff_ffff {
             return Err(EncodeError::TooLarge {
                 what: "member id",
@@ -201,12 +211,20 @@ impl<'a> CdrWriter<'a> {
             h |= 0x8000_0000;
         }
         self.write_u32(h);
-        Ok(if lc == 4 { Some(self.begin_length()) } else { None })
+        Ok(if lc == 4 {
+            Some(self.begin_length())
+        } else {
+            None
+        })
     }
 
     /// Starts an XCDR1 parameter (PID_EXTENDED form, as Cyclone writes it). The member body's alignment origin
     /// is its first byte.
-    pub fn begin_param(&mut self, id: u32, must_understand: bool) -> Result<ParamSlot, EncodeError> {
+    pub fn begin_param(
+        &mut self,
+        id: u32,
+        must_understand: bool,
+    ) -> Result<ParamSlot, EncodeError> {
         if id > 0x0fff_ffff {
             return Err(EncodeError::TooLarge {
                 what: "member id",

@@ -421,6 +421,26 @@ impl<T> ReaderCache<T> {
         take: bool,
         copy: Option<fn(&T) -> T>,
     ) -> Vec<Sample<T>> {
+        let mut out = Vec::new();
+        self.collect_with(sel, take, |slot, info| {
+            let data = match (take, copy) {
+                (true, _) => slot.take(),
+                (false, Some(f)) => slot.as_ref().map(f),
+                (false, None) => None,
+            };
+            out.push(Sample { data, info });
+        });
+        out
+    }
+
+    /// Core of read/take: calls `emit` with each selected sample's data slot and info, in reception order;
+    /// with `take` the samples are removed afterwards (whatever `emit` left in the slot is dropped).
+    pub fn collect_with(
+        &mut self,
+        sel: &Selection,
+        take: bool,
+        mut emit: impl FnMut(&mut Option<T>, SampleInfo),
+    ) {
         let limit = sel.max_samples.unwrap_or(usize::MAX);
         // (seq, handle, index in instance)
         let mut picked: Vec<(u64, InstanceHandle, usize)> = Vec::new();
@@ -443,7 +463,6 @@ impl<T> ReaderCache<T> {
         for (pos, (_, h, _)) in picked.iter().enumerate() {
             per_instance.entry(*h).or_default().push(pos);
         }
-        let mut out: Vec<Option<Sample<T>>> = Vec::with_capacity(picked.len());
         for (pos, &(_, h, idx)) in picked.iter().enumerate() {
             let Some(inst) = self.instances.get_mut(&h) else {
                 continue;
@@ -480,13 +499,8 @@ impl<T> ReaderCache<T> {
                     .saturating_sub(gen),
                 valid_data: s.data.is_some(),
             };
-            let data = match (take, copy) {
-                (true, _) => s.data.take(),
-                (false, Some(f)) => s.data.as_ref().map(f),
-                (false, None) => None,
-            };
             s.read = true;
-            out.push(Some(Sample { data, info }));
+            emit(&mut s.data, info);
         }
         // View state becomes NOT_NEW for every instance touched.
         for h in per_instance.keys() {
@@ -514,7 +528,6 @@ impl<T> ReaderCache<T> {
                 self.maybe_drop_instance(h);
             }
         }
-        out.into_iter().flatten().collect()
     }
 
     /// An instance with no samples, no writers and not alive is forgotten.

@@ -78,12 +78,19 @@ pub(crate) struct Shared {
     /// wait_for_acknowledgments wait on it.
     progress: Mutex<u64>,
     progress_cv: Condvar,
-    /// Bumped when the core's next timeout may have moved earlier.
-    timer_gen: Mutex<u64>,
+    /// Bumped when the core's next timeout may have moved earlier than what the timer thread waits for.
+    timer_gen: Mutex<TimerState>,
     timer_cv: Condvar,
     pub(crate) stopped: AtomicBool,
     timer_thread: Mutex<Option<JoinHandle<()>>>,
     pub(crate) status: Arc<StatusCore>,
+}
+
+#[derive(Default)]
+struct TimerState {
+    generation: u64,
+    /// `Some(t)` while the timer thread sleeps until `t`; `None` while it works.
+    waiting_until: Option<Instant>,
 }
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
@@ -128,7 +135,7 @@ impl Shared {
         let mut batch: Vec<Transmit> = Vec::new();
         let mut deferred: Vec<Event> = Vec::new();
         let mut touched: Vec<Arc<dyn ReaderSink>> = Vec::new();
-        let r = {
+        let (r, next_timeout) = {
             let mut core = lock(&self.core);
             let r = f(&mut core, now);
             while let Some(t) = core.poll_transmit(now) {
@@ -137,10 +144,10 @@ impl Shared {
             while let Some(ev) = core.poll_event() {
                 self.route_locked(ev, &mut deferred, &mut touched);
             }
-            r
+            (r, core.poll_timeout())
         };
         self.send_batch(&batch);
-        self.after_unlock(deferred, touched);
+        self.after_unlock(deferred, touched, next_timeout);
         r
     }
 
@@ -189,16 +196,29 @@ impl Shared {
         }
     }
 
-    fn after_unlock(&self, deferred: Vec<Event>, touched: Vec<Arc<dyn ReaderSink>>) {
+    fn after_unlock(
+        &self,
+        deferred: Vec<Event>,
+        touched: Vec<Arc<dyn ReaderSink>>,
+        next_timeout: Option<Instant>,
+    ) {
         {
             let mut p = lock(&self.progress);
             *p = p.wrapping_add(1);
             self.progress_cv.notify_all();
         }
         {
-            let mut g = lock(&self.timer_gen);
-            *g = g.wrapping_add(1);
-            self.timer_cv.notify_all();
+            // Wake the timer thread only when it sleeps past the core's new deadline; when it is busy, the
+            // generation bump makes it re-read the deadline before sleeping.
+            let mut t = lock(&self.timer_gen);
+            match (t.waiting_until, next_timeout) {
+                (None, _) => t.generation = t.generation.wrapping_add(1),
+                (Some(w), Some(n)) if n < w => {
+                    t.generation = t.generation.wrapping_add(1);
+                    self.timer_cv.notify_all();
+                }
+                _ => {}
+            }
         }
         for ev in deferred {
             self.dispatch_event(ev);
@@ -363,7 +383,7 @@ impl Shared {
         const READER_TICK: Duration = Duration::from_millis(50);
         let mut next_tick = Instant::now() + READER_TICK;
         while !self.stopped.load(Ordering::Acquire) {
-            let seen = *lock(&self.timer_gen);
+            let seen = lock(&self.timer_gen).generation;
             let next_core = lock(&self.core).poll_timeout();
             let now = Instant::now();
             if next_core.is_some_and(|t| t <= now) {
@@ -385,14 +405,17 @@ impl Shared {
                 continue;
             }
             let until = next_core.map_or(next_tick, |t| t.min(next_tick));
-            let g = lock(&self.timer_gen);
-            if *g != seen {
+            let mut g = lock(&self.timer_gen);
+            if g.generation != seen {
                 continue;
             }
-            let _g = self
+            g.waiting_until = Some(until);
+            let mut g = self
                 .timer_cv
                 .wait_timeout(g, until.saturating_duration_since(now))
-                .unwrap_or_else(|e| e.into_inner());
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
+            g.waiting_until = None;
         }
     }
 
@@ -405,7 +428,7 @@ impl Shared {
         self.with_core(|c, now| c.shutdown(now));
         {
             let mut g = lock(&self.timer_gen);
-            *g = g.wrapping_add(1);
+            g.generation = g.generation.wrapping_add(1);
             self.timer_cv.notify_all();
         }
         {
@@ -649,7 +672,7 @@ impl DomainParticipantBuilder {
             participants: Mutex::new(HashMap::new()),
             progress: Mutex::new(0),
             progress_cv: Condvar::new(),
-            timer_gen: Mutex::new(0),
+            timer_gen: Mutex::new(TimerState::default()),
             timer_cv: Condvar::new(),
             stopped: AtomicBool::new(false),
             timer_thread: Mutex::new(None),

@@ -18,7 +18,9 @@ use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusConditi
 use super::error::{DdsError, DdsResult};
 use super::listener::DataReaderListener;
 use super::participant::{DomainParticipant, Pending, ReaderSink, Shared};
-use super::sample::{InstanceHandle, InstanceStateMask, Sample, SampleStateMask, ViewStateMask};
+use super::sample::{
+    InstanceHandle, InstanceStateMask, Sample, SampleInfo, SampleStateMask, ViewStateMask,
+};
 use super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, LivelinessChangedStatus, ReaderStatuses,
     SampleLostStatus, SampleRejectedStatus, StatusMask, SubscriptionMatchedStatus,
@@ -250,6 +252,18 @@ impl<'a, T: DdsType> Selector<'a, T> {
     pub fn take(self) -> DdsResult<Vec<Sample<T>>> {
         self.reader.collect(self.sel, self.next_after, true, None)
     }
+    /// Zero-copy read (a loan in callback form): calls `f` with a reference to each selected sample in the
+    /// cache, marks them read and returns how many there were. The cache lock is held during the calls:
+    /// keep `f` short and do not call back into this reader from it.
+    pub fn read_with(self, mut f: impl FnMut(Option<&T>, &SampleInfo)) -> DdsResult<usize> {
+        let mut n = 0;
+        self.reader.visit(self.sel, self.next_after, |slot, info| {
+            n += 1;
+            f(slot.as_ref(), &info);
+        })?;
+        Ok(n)
+    }
+
     /// Reads (copies) the selected samples.
     pub fn read(self) -> DdsResult<Vec<Sample<T>>>
     where
@@ -261,6 +275,40 @@ impl<'a, T: DdsType> Selector<'a, T> {
 }
 
 impl<T: DdsType> DataReader<T> {
+    fn visit(
+        &self,
+        mut sel: Selection,
+        next_after: Option<InstanceHandle>,
+        emit: impl FnMut(&mut Option<T>, SampleInfo),
+    ) -> DdsResult<()> {
+        self.inner.shared.check_alive()?;
+        {
+            let mut st = lock(&self.inner.cache);
+            if let Some(prev) = next_after {
+                sel.instance = None;
+                match st.cache.next_instance(prev, &sel) {
+                    Some(h) => sel.instance = Some(h),
+                    None => return Ok(()),
+                }
+            }
+            st.cache.collect_with(&sel, false, emit);
+            let unread = Selection {
+                sample_states: SampleStateMask::NOT_READ,
+                ..Selection::default()
+            };
+            if !st.cache.has_matching(&unread) {
+                self.inner.status_core.clear(StatusMask::DATA_AVAILABLE);
+            }
+        }
+        self.inner.data_signal.notify();
+        Ok(())
+    }
+
+    /// Zero-copy read of all samples, see [`Selector::read_with`].
+    pub fn read_with(&self, f: impl FnMut(Option<&T>, &SampleInfo)) -> DdsResult<usize> {
+        self.select().read_with(f)
+    }
+
     fn collect(
         &self,
         mut sel: Selection,

@@ -27,7 +27,10 @@ impl WriterQos {
 
 impl From<DataWriterQos> for WriterQos {
     fn from(writer: DataWriterQos) -> Self {
-        WriterQos { writer, ..Default::default() }
+        WriterQos {
+            writer,
+            ..Default::default()
+        }
     }
 }
 
@@ -55,7 +58,10 @@ impl ReaderQos {
 
 impl From<DataReaderQos> for ReaderQos {
     fn from(reader: DataReaderQos) -> Self {
-        ReaderQos { reader, ..Default::default() }
+        ReaderQos {
+            reader,
+            ..Default::default()
+        }
     }
 }
 
@@ -85,13 +91,18 @@ pub fn check_compatible(offered: &WriterQos, requested: &ReaderQos) -> Result<()
     if w.ownership != r.ownership {
         return Err(QosPolicyId::Ownership);
     }
-    if w.liveliness.kind < r.liveliness.kind || w.liveliness.lease_duration > r.liveliness.lease_duration {
+    if w.liveliness.kind < r.liveliness.kind
+        || w.liveliness.lease_duration > r.liveliness.lease_duration
+    {
         return Err(QosPolicyId::Liveliness);
     }
     if w.destination_order < r.destination_order {
         return Err(QosPolicyId::DestinationOrder);
     }
-    if !r.data_representation.accepts(w.data_representation.offered()) {
+    if !r
+        .data_representation
+        .accepts(w.data_representation.offered())
+    {
         return Err(QosPolicyId::DataRepresentation);
     }
     Ok(())
@@ -103,7 +114,8 @@ pub fn partitions_match(a: &Partition, b: &Partition) -> bool {
     const DEFAULT: &[String] = &[String::new()];
     let a: &[String] = if a.0.is_empty() { DEFAULT } else { &a.0 };
     let b: &[String] = if b.0.is_empty() { DEFAULT } else { &b.0 };
-    a.iter().any(|x| b.iter().any(|y| partition_names_match(x, y)))
+    a.iter()
+        .any(|x| b.iter().any(|y| partition_names_match(x, y)))
 }
 
 fn is_pattern(s: &str) -> bool {
@@ -230,12 +242,30 @@ mod tests {
 
     #[test]
     fn partitions() {
-        assert!(partitions_match(&Partition::default(), &Partition::default()));
-        assert!(partitions_match(&Partition::new([""]), &Partition::default()));
-        assert!(!partitions_match(&Partition::new(["A"]), &Partition::default()));
-        assert!(partitions_match(&Partition::new(["A", "B*"]), &Partition::new(["Bx"])));
-        assert!(!partitions_match(&Partition::new(["A*"]), &Partition::new(["B*"])));
-        assert!(partitions_match(&Partition::new(["A*"]), &Partition::new(["A*"])));
+        assert!(partitions_match(
+            &Partition::default(),
+            &Partition::default()
+        ));
+        assert!(partitions_match(
+            &Partition::new([""]),
+            &Partition::default()
+        ));
+        assert!(!partitions_match(
+            &Partition::new(["A"]),
+            &Partition::default()
+        ));
+        assert!(partitions_match(
+            &Partition::new(["A", "B*"]),
+            &Partition::new(["Bx"])
+        ));
+        assert!(!partitions_match(
+            &Partition::new(["A*"]),
+            &Partition::new(["B*"])
+        ));
+        assert!(partitions_match(
+            &Partition::new(["A*"]),
+            &Partition::new(["A*"])
+        ));
     }
 
     #[test]
@@ -243,20 +273,52 @@ mod tests {
         let w = WriterQos::from(DataWriterQos::default());
         let r = ReaderQos::from(DataReaderQos::default());
         assert_eq!(check_compatible(&w, &r), Ok(()));
-        let w_be = WriterQos::from(DataWriterQos::builder().reliability(Reliability::BestEffort).build());
-        let r_rel = ReaderQos::from(DataReaderQos::builder().reliability(Reliability::RELIABLE).build());
-        assert_eq!(check_compatible(&w_be, &r_rel), Err(QosPolicyId::Reliability));
-        let r_tl = ReaderQos::from(DataReaderQos::builder().durability(Durability::TransientLocal).build());
+        let w_be = WriterQos::from(
+            DataWriterQos::builder()
+                .reliability(Reliability::BestEffort)
+                .build(),
+        );
+        let r_rel = ReaderQos::from(
+            DataReaderQos::builder()
+                .reliability(Reliability::RELIABLE)
+                .build(),
+        );
+        assert_eq!(
+            check_compatible(&w_be, &r_rel),
+            Err(QosPolicyId::Reliability)
+        );
+        let r_tl = ReaderQos::from(
+            DataReaderQos::builder()
+                .durability(Durability::TransientLocal)
+                .build(),
+        );
         assert_eq!(check_compatible(&w, &r_tl), Err(QosPolicyId::Durability));
-        let r_dl = ReaderQos::from(DataReaderQos::builder().deadline(Duration::from_secs(1)).build());
+        let r_dl = ReaderQos::from(
+            DataReaderQos::builder()
+                .deadline(Duration::from_secs(1))
+                .build(),
+        );
         assert_eq!(check_compatible(&w, &r_dl), Err(QosPolicyId::Deadline));
-        let w2 = WriterQos::from(DataWriterQos::builder().data_representation(DataRepresentation::xcdr2()).build());
-        assert_eq!(check_compatible(&w2, &r), Err(QosPolicyId::DataRepresentation));
+        let w2 = WriterQos::from(
+            DataWriterQos::builder()
+                .data_representation(DataRepresentation::xcdr2())
+                .build(),
+        );
+        assert_eq!(
+            check_compatible(&w2, &r),
+            Err(QosPolicyId::DataRepresentation)
+        );
         let r2 = ReaderQos::from(
-            DataReaderQos::builder().data_representation(vec![XCDR_DATA_REPRESENTATION, XCDR2_DATA_REPRESENTATION]).build(),
+            DataReaderQos::builder()
+                .data_representation(vec![XCDR_DATA_REPRESENTATION, XCDR2_DATA_REPRESENTATION])
+                .build(),
         );
         assert_eq!(check_compatible(&w2, &r2), Ok(()));
-        let r_own = ReaderQos::from(DataReaderQos::builder().ownership(Ownership::Exclusive).build());
+        let r_own = ReaderQos::from(
+            DataReaderQos::builder()
+                .ownership(Ownership::Exclusive)
+                .build(),
+        );
         assert_eq!(check_compatible(&w, &r_own), Err(QosPolicyId::Ownership));
     }
 }

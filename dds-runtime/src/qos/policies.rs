@@ -43,7 +43,9 @@ pub enum Reliability {
 
 impl Reliability {
     /// Reliable with the spec's default max_blocking_time of 100 ms.
-    pub const RELIABLE: Reliability = Reliability::Reliable { max_blocking_time: Duration::from_millis(100) };
+    pub const RELIABLE: Reliability = Reliability::Reliable {
+        max_blocking_time: Duration::from_millis(100),
+    };
 
     pub fn is_reliable(&self) -> bool {
         matches!(self, Reliability::Reliable { .. })
@@ -115,7 +117,10 @@ pub struct Liveliness {
 }
 impl Default for Liveliness {
     fn default() -> Self {
-        Liveliness { kind: LivelinessKind::Automatic, lease_duration: INFINITE }
+        Liveliness {
+            kind: LivelinessKind::Automatic,
+            lease_duration: INFINITE,
+        }
     }
 }
 
@@ -177,7 +182,9 @@ pub struct WriterDataLifecycle {
 }
 impl Default for WriterDataLifecycle {
     fn default() -> Self {
-        WriterDataLifecycle { autodispose_unregistered_instances: true }
+        WriterDataLifecycle {
+            autodispose_unregistered_instances: true,
+        }
     }
 }
 
@@ -188,7 +195,10 @@ pub struct ReaderDataLifecycle {
 }
 impl Default for ReaderDataLifecycle {
     fn default() -> Self {
-        ReaderDataLifecycle { autopurge_nowriter_samples_delay: INFINITE, autopurge_disposed_samples_delay: INFINITE }
+        ReaderDataLifecycle {
+            autopurge_nowriter_samples_delay: INFINITE,
+            autopurge_disposed_samples_delay: INFINITE,
+        }
     }
 }
 

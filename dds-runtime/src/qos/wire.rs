@@ -39,6 +39,7 @@ fn write_reliability(w: &mut ParameterWriter<'_>, r: Reliability) {
     });
 }
 
+#[allow(clippy::too_many_arguments)]
 fn write_common(
     w: &mut ParameterWriter<'_>,
     durability: Durability,
@@ -61,7 +62,13 @@ fn write_common(
     w.u32(pid::OWNERSHIP, ownership as u32);
 }
 
-fn write_group(w: &mut ParameterWriter<'_>, pres: Presentation, part: &Partition, group: &GroupData, topic: &TopicData) {
+fn write_group(
+    w: &mut ParameterWriter<'_>,
+    pres: Presentation,
+    part: &Partition,
+    group: &GroupData,
+    topic: &TopicData,
+) {
     w.param(pid::PRESENTATION, |p| {
         p.u32(pres.access_scope as u32);
         p.u8(pres.coherent_access as u8);
@@ -75,7 +82,7 @@ fn write_group(w: &mut ParameterWriter<'_>, pres: Presentation, part: &Partition
                 let _ = start;
                 put_string(p, s);
                 // Each string is 4-aligned relative to the parameter value; the value starts 4-aligned.
-                while p.out.len() % 4 != 0 {
+                while !p.out.len().is_multiple_of(4) {
                     p.u8(0);
                 }
             }
@@ -117,7 +124,16 @@ fn write_data_representation(w: &mut ParameterWriter<'_>, d: &DataRepresentation
 /// Appends the QoS parameters of a publication (DiscoveredWriterData).
 pub fn write_writer_qos(w: &mut ParameterWriter<'_>, q: &WriterQos) {
     let d = &q.writer;
-    write_common(w, d.durability, d.deadline, d.latency_budget, d.liveliness, d.reliability, d.destination_order, d.ownership);
+    write_common(
+        w,
+        d.durability,
+        d.deadline,
+        d.latency_budget,
+        d.liveliness,
+        d.reliability,
+        d.destination_order,
+        d.ownership,
+    );
     let ds = d.durability_service;
     let (hk, hd) = history_kind(ds.history);
     w.param(pid::DURABILITY_SERVICE, |p| {
@@ -138,14 +154,32 @@ pub fn write_writer_qos(w: &mut ParameterWriter<'_>, q: &WriterQos) {
         w.octets(pid::USER_DATA, &d.user_data.0);
     }
     write_data_representation(w, &d.data_representation);
-    write_group(w, q.presentation, &q.partition, &q.group_data, &q.topic_data);
+    write_group(
+        w,
+        q.presentation,
+        &q.partition,
+        &q.group_data,
+        &q.topic_data,
+    );
 }
 
 /// Appends the QoS parameters of a subscription (DiscoveredReaderData).
 pub fn write_reader_qos(w: &mut ParameterWriter<'_>, q: &ReaderQos) {
     let d = &q.reader;
-    write_common(w, d.durability, d.deadline, d.latency_budget, d.liveliness, d.reliability, d.destination_order, d.ownership);
-    w.duration(pid::TIME_BASED_FILTER, d.time_based_filter.minimum_separation);
+    write_common(
+        w,
+        d.durability,
+        d.deadline,
+        d.latency_budget,
+        d.liveliness,
+        d.reliability,
+        d.destination_order,
+        d.ownership,
+    );
+    w.duration(
+        pid::TIME_BASED_FILTER,
+        d.time_based_filter.minimum_separation,
+    );
     write_history(w, d.history, &d.resource_limits);
     if !d.user_data.0.is_empty() {
         w.octets(pid::USER_DATA, &d.user_data.0);
@@ -167,7 +201,13 @@ pub fn write_reader_qos(w: &mut ParameterWriter<'_>, q: &ReaderQos) {
             p.u8(b as u8);
         }
     });
-    write_group(w, q.presentation, &q.partition, &q.group_data, &q.topic_data);
+    write_group(
+        w,
+        q.presentation,
+        &q.partition,
+        &q.group_data,
+        &q.topic_data,
+    );
 }
 
 /// The policies both endpoint kinds share, as decoded.
@@ -210,7 +250,10 @@ fn read_common(id: u16, c: &mut Cursor<'_>, q: Common<'_>) -> Result<bool, WireE
                 2 => crate::qos::LivelinessKind::ManualByTopic,
                 _ => return Err(WireError::Invalid("liveliness kind")),
             };
-            *q.liveliness = Liveliness { kind, lease_duration: c.duration()? };
+            *q.liveliness = Liveliness {
+                kind,
+                lease_duration: c.duration()?,
+            };
         }
         pid::RELIABILITY => {
             let kind = c.u32()?;
@@ -218,14 +261,26 @@ fn read_common(id: u16, c: &mut Cursor<'_>, q: Common<'_>) -> Result<bool, WireE
             *q.reliability = match kind {
                 1 => Reliability::BestEffort,
                 // 3 was RELIABLE in some pre-2.0 implementations.
-                2 | 3 => Reliability::Reliable { max_blocking_time: mbt },
+                2 | 3 => Reliability::Reliable {
+                    max_blocking_time: mbt,
+                },
                 _ => return Err(WireError::Invalid("reliability kind")),
             };
         }
         pid::DESTINATION_ORDER => {
-            *q.order = if c.u32()? == 1 { DestinationOrder::BySourceTimestamp } else { DestinationOrder::ByReceptionTimestamp }
+            *q.order = if c.u32()? == 1 {
+                DestinationOrder::BySourceTimestamp
+            } else {
+                DestinationOrder::ByReceptionTimestamp
+            }
         }
-        pid::OWNERSHIP => *q.ownership = if c.u32()? == 1 { Ownership::Exclusive } else { Ownership::Shared },
+        pid::OWNERSHIP => {
+            *q.ownership = if c.u32()? == 1 {
+                Ownership::Exclusive
+            } else {
+                Ownership::Shared
+            }
+        }
         pid::HISTORY => {
             let k = c.u32()?;
             let d = c.i32()?;
@@ -260,7 +315,11 @@ fn read_common(id: u16, c: &mut Cursor<'_>, q: Common<'_>) -> Result<bool, WireE
                 2 => crate::qos::PresentationAccessScope::Group,
                 _ => return Err(WireError::Invalid("presentation scope")),
             };
-            *q.presentation = Presentation { access_scope: scope, coherent_access: c.u8()? != 0, ordered_access: c.u8()? != 0 };
+            *q.presentation = Presentation {
+                access_scope: scope,
+                coherent_access: c.u8()? != 0,
+                ordered_access: c.u8()? != 0,
+            };
         }
         pid::PARTITION => {
             let n = c.u32()? as usize;
@@ -280,7 +339,12 @@ fn read_common(id: u16, c: &mut Cursor<'_>, q: Common<'_>) -> Result<bool, WireE
 }
 
 /// Decodes one publication QoS parameter into `q`. Ok(false): not a QoS parameter this function knows.
-pub fn read_writer_qos(id: u16, value: &[u8], little_endian: bool, q: &mut WriterQos) -> Result<bool, WireError> {
+pub fn read_writer_qos(
+    id: u16,
+    value: &[u8],
+    little_endian: bool,
+    q: &mut WriterQos,
+) -> Result<bool, WireError> {
     let mut c = Cursor::new(value, little_endian);
     let d = &mut q.writer;
     match id {
@@ -334,7 +398,12 @@ pub fn read_writer_qos(id: u16, value: &[u8], little_endian: bool, q: &mut Write
 }
 
 /// Decodes one subscription QoS parameter into `q`. Ok(false): not a QoS parameter this function knows.
-pub fn read_reader_qos(id: u16, value: &[u8], little_endian: bool, q: &mut ReaderQos) -> Result<bool, WireError> {
+pub fn read_reader_qos(
+    id: u16,
+    value: &[u8],
+    little_endian: bool,
+    q: &mut ReaderQos,
+) -> Result<bool, WireError> {
     let mut c = Cursor::new(value, little_endian);
     let d = &mut q.reader;
     match id {
@@ -355,12 +424,32 @@ pub fn read_reader_qos(id: u16, value: &[u8], little_endian: bool, q: &mut Reade
             let dflt = TypeConsistencyEnforcement::default();
             let full = value.len() >= 7;
             d.type_consistency = TypeConsistencyEnforcement {
-                kind: if kind == 0 { TypeConsistencyKind::DisallowTypeCoercion } else { TypeConsistencyKind::AllowTypeCoercion },
-                ignore_sequence_bounds: if full { b[0] } else { dflt.ignore_sequence_bounds },
-                ignore_string_bounds: if full { b[1] } else { dflt.ignore_string_bounds },
+                kind: if kind == 0 {
+                    TypeConsistencyKind::DisallowTypeCoercion
+                } else {
+                    TypeConsistencyKind::AllowTypeCoercion
+                },
+                ignore_sequence_bounds: if full {
+                    b[0]
+                } else {
+                    dflt.ignore_sequence_bounds
+                },
+                ignore_string_bounds: if full {
+                    b[1]
+                } else {
+                    dflt.ignore_string_bounds
+                },
                 ignore_member_names: if full { b[2] } else { dflt.ignore_member_names },
-                prevent_type_widening: if full { b[3] } else { dflt.prevent_type_widening },
-                force_type_validation: if full { b[4] } else { dflt.force_type_validation },
+                prevent_type_widening: if full {
+                    b[3]
+                } else {
+                    dflt.prevent_type_widening
+                },
+                force_type_validation: if full {
+                    b[4]
+                } else {
+                    dflt.force_type_validation
+                },
             };
             Ok(true)
         }

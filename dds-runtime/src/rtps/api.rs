@@ -22,7 +22,11 @@ impl Payload {
     pub fn new(bytes: impl Into<Arc<[u8]>>) -> Self {
         let buf: Arc<[u8]> = bytes.into();
         let end = buf.len();
-        Payload { buf: Some(buf), start: 0, end }
+        Payload {
+            buf: Some(buf),
+            start: 0,
+            end,
+        }
     }
     pub fn copy_from_slice(b: &[u8]) -> Self {
         Payload::new(Arc::<[u8]>::from(b))
@@ -31,7 +35,11 @@ impl Payload {
     pub fn slice(&self, range: std::ops::Range<usize>) -> Payload {
         let end = (self.start + range.end).min(self.end);
         let start = (self.start + range.start).min(end);
-        Payload { buf: self.buf.clone(), start, end }
+        Payload {
+            buf: self.buf.clone(),
+            start,
+            end,
+        }
     }
 }
 
@@ -129,7 +137,12 @@ pub struct ParticipantConfig {
 impl ParticipantConfig {
     /// A configuration for one IPv4 unicast address with the standard ports (PB 7400, DG 250, PG 2, d0..d3 =
     /// 0, 10, 1, 11) and SPDP multicast to 239.255.0.1.
-    pub fn new(domain_id: u32, participant_id: u32, guid_prefix: GuidPrefix, unicast_ip: [u8; 4]) -> Self {
+    pub fn new(
+        domain_id: u32,
+        participant_id: u32,
+        guid_prefix: GuidPrefix,
+        unicast_ip: [u8; 4],
+    ) -> Self {
         use super::discovery::ports;
         let mc = [239, 255, 0, 1];
         ParticipantConfig {
@@ -137,9 +150,15 @@ impl ParticipantConfig {
             participant_id,
             guid_prefix,
             vendor_id: VendorId::THIS,
-            metatraffic_unicast: vec![Locator::udpv4(unicast_ip, ports::metatraffic_unicast(domain_id, participant_id))],
+            metatraffic_unicast: vec![Locator::udpv4(
+                unicast_ip,
+                ports::metatraffic_unicast(domain_id, participant_id),
+            )],
             metatraffic_multicast: vec![Locator::udpv4(mc, ports::spdp_multicast(domain_id))],
-            default_unicast: vec![Locator::udpv4(unicast_ip, ports::user_unicast(domain_id, participant_id))],
+            default_unicast: vec![Locator::udpv4(
+                unicast_ip,
+                ports::user_unicast(domain_id, participant_id),
+            )],
             default_multicast: vec![Locator::udpv4(mc, ports::user_multicast(domain_id))],
             spdp_interval: Duration::from_secs(3),
             lease_duration: Duration::from_secs(10),
@@ -214,7 +233,12 @@ pub struct WriteChange {
 
 impl WriteChange {
     pub fn alive(payload: impl Into<Payload>) -> Self {
-        WriteChange { kind: ChangeKind::Alive, payload: payload.into(), key_hash: None, source_timestamp: None }
+        WriteChange {
+            kind: ChangeKind::Alive,
+            payload: payload.into(),
+            key_hash: None,
+            source_timestamp: None,
+        }
     }
     pub fn with_key_hash(mut self, key_hash: [u8; 16]) -> Self {
         self.key_hash = Some(key_hash);
@@ -243,7 +267,12 @@ pub struct WriterSpec {
 }
 
 impl WriterSpec {
-    pub fn new(topic_name: impl Into<String>, type_name: impl Into<String>, keyed: bool, qos: impl Into<WriterQos>) -> Self {
+    pub fn new(
+        topic_name: impl Into<String>,
+        type_name: impl Into<String>,
+        keyed: bool,
+        qos: impl Into<WriterQos>,
+    ) -> Self {
         WriterSpec {
             topic_name: topic_name.into(),
             type_name: type_name.into(),
@@ -268,7 +297,12 @@ pub struct ReaderSpec {
 }
 
 impl ReaderSpec {
-    pub fn new(topic_name: impl Into<String>, type_name: impl Into<String>, keyed: bool, qos: impl Into<ReaderQos>) -> Self {
+    pub fn new(
+        topic_name: impl Into<String>,
+        type_name: impl Into<String>,
+        keyed: bool,
+        qos: impl Into<ReaderQos>,
+    ) -> Self {
         ReaderSpec {
             topic_name: topic_name.into(),
             type_name: type_name.into(),
@@ -297,26 +331,62 @@ pub struct ReceivedSample {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Event {
     Sample(ReceivedSample),
-    PublicationMatched { writer: EntityId, reader: Guid, matched: bool },
-    SubscriptionMatched { reader: EntityId, writer: Guid, matched: bool },
-    OfferedIncompatibleQos { writer: EntityId, reader: Guid, policy: QosPolicyId },
-    RequestedIncompatibleQos { reader: EntityId, writer: Guid, policy: QosPolicyId },
+    PublicationMatched {
+        writer: EntityId,
+        reader: Guid,
+        matched: bool,
+    },
+    SubscriptionMatched {
+        reader: EntityId,
+        writer: Guid,
+        matched: bool,
+    },
+    OfferedIncompatibleQos {
+        writer: EntityId,
+        reader: Guid,
+        policy: QosPolicyId,
+    },
+    RequestedIncompatibleQos {
+        reader: EntityId,
+        writer: Guid,
+        policy: QosPolicyId,
+    },
     ParticipantDiscovered(Box<ParticipantData>),
-    ParticipantLost { guid_prefix: GuidPrefix },
+    ParticipantLost {
+        guid_prefix: GuidPrefix,
+    },
     PublicationDiscovered(Box<WriterData>),
-    PublicationRemoved { guid: Guid },
+    PublicationRemoved {
+        guid: Guid,
+    },
     SubscriptionDiscovered(Box<ReaderData>),
-    SubscriptionRemoved { guid: Guid },
+    SubscriptionRemoved {
+        guid: Guid,
+    },
     /// A matched remote writer's liveliness changed (automatic: participant lease; manual: its messages).
-    LivelinessChanged { reader: EntityId, writer: Guid, alive: bool },
+    LivelinessChanged {
+        reader: EntityId,
+        writer: Guid,
+        alive: bool,
+    },
     /// Samples from `writer` that `reader` will never get (writer no longer had them, or buffers overflowed).
-    SampleLost { reader: EntityId, writer: Guid, count: u64 },
+    SampleLost {
+        reader: EntityId,
+        writer: Guid,
+        count: u64,
+    },
     /// A deleted writer finished lingering and is gone.
-    WriterDeleted { writer: EntityId },
+    WriterDeleted {
+        writer: EntityId,
+    },
     /// Flow control released a writer that returned WouldBlock: unacknowledged bytes fell below the low watermark.
-    WriterUnblocked { writer: EntityId },
+    WriterUnblocked {
+        writer: EntityId,
+    },
     /// Every matched reliable reader acknowledged everything the writer wrote (wait_for_acknowledgments).
-    WriterAcknowledged { writer: EntityId },
+    WriterAcknowledged {
+        writer: EntityId,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -3,7 +3,7 @@
 use std::collections::VecDeque;
 
 use super::api::Transmit;
-use super::messages::{Header, Submessage};
+use super::messages::{append, Header, Submessage};
 use super::types::*;
 
 /// Whether a submessage depends on the INFO_TS in force.
@@ -23,6 +23,8 @@ struct Pending {
     /// The INFO_TS state the receiver will be in: None = nothing sent yet in this message.
     ts: Option<Option<Time>>,
     preamble: usize,
+    /// Start of the last submessage, whose length grows when the next one needs alignment padding.
+    last_header: Option<usize>,
 }
 
 /// Output queue: open messages being packed and finished datagrams.
@@ -37,45 +39,78 @@ pub(crate) struct Outbox {
 
 impl Outbox {
     pub fn new(header: Header, max_message_size: usize) -> Self {
-        Outbox { header, max: max_message_size.max(128), pending: Vec::new(), ready: VecDeque::new(), pool: Vec::new() }
+        Outbox {
+            header,
+            max: max_message_size.max(128),
+            pending: Vec::new(),
+            ready: VecDeque::new(),
+            pool: Vec::new(),
+        }
     }
 
     fn open(&mut self, destinations: &[Locator], dst: Option<GuidPrefix>) -> usize {
-        if let Some(i) = self.pending.iter().position(|p| p.dst == dst && p.destinations == destinations) {
+        if let Some(i) = self
+            .pending
+            .iter()
+            .position(|p| p.dst == dst && p.destinations == destinations)
+        {
             return i;
         }
         let mut buf = self.pool.pop().unwrap_or_default();
         buf.clear();
         self.header.write(&mut buf);
+        let mut last_header = None;
         if let Some(d) = dst {
-            Submessage::InfoDst(d).encode(&mut buf, true);
+            append(&mut buf, &mut last_header, &Submessage::InfoDst(d), true);
         }
         let preamble = buf.len();
-        self.pending.push(Pending { destinations: destinations.to_vec(), dst, buf, ts: None, preamble });
+        self.pending.push(Pending {
+            destinations: destinations.to_vec(),
+            dst,
+            buf,
+            ts: None,
+            preamble,
+            last_header,
+        });
         self.pending.len() - 1
     }
 
     /// Appends `sub` to the message for (destinations, dst); starts a new datagram when it would not fit.
-    pub fn push(&mut self, destinations: &[Locator], dst: Option<GuidPrefix>, ts: Ts, sub: &Submessage<'_>) {
+    pub fn push(
+        &mut self,
+        destinations: &[Locator],
+        dst: Option<GuidPrefix>,
+        ts: Ts,
+        sub: &Submessage<'_>,
+    ) {
         if destinations.is_empty() {
             return;
         }
         let i = self.open(destinations, dst);
         let p = &mut self.pending[i];
         let before = p.buf.len();
-        let ts_before = p.ts;
+        let (ts_before, header_before) = (p.ts, p.last_header);
+        let saved_len = header_before.map(|h| (h, [p.buf[h + 2], p.buf[h + 3]]));
         write_ts(p, ts);
-        sub.encode(&mut p.buf, true);
+        append(&mut p.buf, &mut p.last_header, sub, true);
         if p.buf.len() > self.max && before > p.preamble {
-            // Did not fit: close the message without it and put it first in a fresh one.
+            // Did not fit: close the message without it (undoing the alignment padding of the previous
+            // submessage) and put it first in a fresh one.
             p.buf.truncate(before);
+            if let Some((h, len)) = saved_len {
+                p.buf[h + 2..h + 4].copy_from_slice(&len);
+            }
             p.ts = ts_before;
+            p.last_header = header_before;
             let done = self.pending.swap_remove(i);
-            self.ready.push_back(Transmit { destinations: done.destinations, payload: done.buf });
+            self.ready.push_back(Transmit {
+                destinations: done.destinations,
+                payload: done.buf,
+            });
             let i = self.open(destinations, dst);
             let p = &mut self.pending[i];
             write_ts(p, ts);
-            sub.encode(&mut p.buf, true);
+            append(&mut p.buf, &mut p.last_header, sub, true);
         }
     }
 
@@ -83,7 +118,10 @@ impl Outbox {
     pub fn flush(&mut self) {
         for p in self.pending.drain(..) {
             if p.buf.len() > p.preamble {
-                self.ready.push_back(Transmit { destinations: p.destinations, payload: p.buf });
+                self.ready.push_back(Transmit {
+                    destinations: p.destinations,
+                    payload: p.buf,
+                });
             } else {
                 self.pool.push(p.buf);
             }
@@ -109,7 +147,7 @@ fn write_ts(p: &mut Pending, ts: Ts) {
     if let Ts::Set(t) = ts {
         // Nothing sent yet means no timestamp in force at the receiver.
         if p.ts.unwrap_or(None) != t {
-            Submessage::InfoTs(t).encode(&mut p.buf, true);
+            append(&mut p.buf, &mut p.last_header, &Submessage::InfoTs(t), true);
             p.ts = Some(t);
         }
     }

@@ -83,7 +83,11 @@ impl Participant {
     pub fn new(mut config: ParticipantConfig, now: Instant) -> Self {
         // Fragments must fit the 16-bit fragmentSize field and leave room for headers in a datagram.
         config.fragment_size = config.fragment_size.clamp(64, 65000);
-        let header = Header { version: ProtocolVersion::V2_5, vendor_id: config.vendor_id, guid_prefix: config.guid_prefix };
+        let header = Header {
+            version: ProtocolVersion::V2_5,
+            vendor_id: config.vendor_id,
+            guid_prefix: config.guid_prefix,
+        };
         let mut p = Participant {
             out: Outbox::new(header, config.max_message_size),
             events: VecDeque::new(),
@@ -105,10 +109,16 @@ impl Participant {
         };
         let prefix = p.config.guid_prefix;
         for (w, _, _) in super::discovery::builtin::WRITER_PAIRS {
-            p.writers.insert(w, Writer::new(Guid::new(prefix, w), builtin_writer_params(&p.config)));
+            p.writers.insert(
+                w,
+                Writer::new(Guid::new(prefix, w), builtin_writer_params(&p.config)),
+            );
         }
         for (r, _, _) in super::discovery::builtin::READER_PAIRS {
-            p.readers.insert(r, Reader::new(Guid::new(prefix, r), reader_params(&p.config, true)));
+            p.readers.insert(
+                r,
+                Reader::new(Guid::new(prefix, r), reader_params(&p.config, true)),
+            );
         }
         p.spdp_payload = p.participant_data().encode();
         p.service(now);
@@ -155,7 +165,16 @@ impl Participant {
     }
 
     pub fn poll_event(&mut self) -> Option<Event> {
-        self.events.pop_front()
+        loop {
+            let e = self.events.pop_front()?;
+            // Builtin writers' flow-control notes are internal.
+            if let Event::WriterAcknowledged { writer } | Event::WriterUnblocked { writer } = &e {
+                if writer.is_builtin() {
+                    continue;
+                }
+            }
+            return Some(e);
+        }
     }
 
     pub fn handle_timeout(&mut self, now: Instant) {
@@ -175,7 +194,11 @@ impl Participant {
         if spec.topic_name.is_empty() || spec.type_name.is_empty() {
             return Err(CoreError::BadParameter("empty topic or type name"));
         }
-        let kind = if spec.keyed { entity_kind::USER_WRITER_WITH_KEY } else { entity_kind::USER_WRITER_NO_KEY };
+        let kind = if spec.keyed {
+            entity_kind::USER_WRITER_WITH_KEY
+        } else {
+            entity_kind::USER_WRITER_NO_KEY
+        };
         let id = self.alloc_entity(kind)?;
         let guid = Guid::new(self.config.guid_prefix, id);
         let q = &spec.qos.writer;
@@ -206,7 +229,13 @@ impl Participant {
             type_information: spec.type_information,
             entity_name: spec.entity_name,
         };
-        self.announce(now, EntityId::SEDP_PUBLICATIONS_WRITER, guid, ChangeKind::Alive, data.encode());
+        self.announce(
+            now,
+            EntityId::SEDP_PUBLICATIONS_WRITER,
+            guid,
+            ChangeKind::Alive,
+            data.encode(),
+        );
         self.on_writer_known(now, data);
         self.service(now);
         Ok(id)
@@ -216,11 +245,16 @@ impl Participant {
         if spec.topic_name.is_empty() || spec.type_name.is_empty() {
             return Err(CoreError::BadParameter("empty topic or type name"));
         }
-        let kind = if spec.keyed { entity_kind::USER_READER_WITH_KEY } else { entity_kind::USER_READER_NO_KEY };
+        let kind = if spec.keyed {
+            entity_kind::USER_READER_WITH_KEY
+        } else {
+            entity_kind::USER_READER_NO_KEY
+        };
         let id = self.alloc_entity(kind)?;
         let guid = Guid::new(self.config.guid_prefix, id);
         let reliable = spec.qos.reader.reliability.is_reliable();
-        self.readers.insert(id, Reader::new(guid, reader_params(&self.config, reliable)));
+        self.readers
+            .insert(id, Reader::new(guid, reader_params(&self.config, reliable)));
         self.user_readers.insert(id);
         let data = ReaderData {
             guid,
@@ -234,7 +268,13 @@ impl Participant {
             type_information: spec.type_information,
             entity_name: spec.entity_name,
         };
-        self.announce(now, EntityId::SEDP_SUBSCRIPTIONS_WRITER, guid, ChangeKind::Alive, data.encode());
+        self.announce(
+            now,
+            EntityId::SEDP_SUBSCRIPTIONS_WRITER,
+            guid,
+            ChangeKind::Alive,
+            data.encode(),
+        );
         self.on_reader_known(now, data);
         self.service(now);
         Ok(id)
@@ -246,7 +286,9 @@ impl Participant {
         if !self.user_writers.contains(&id) {
             return;
         }
-        let Some(w) = self.writers.get_mut(&id) else { return };
+        let Some(w) = self.writers.get_mut(&id) else {
+            return;
+        };
         if w.linger_until.is_some() {
             return;
         }
@@ -265,10 +307,20 @@ impl Participant {
         let guid = Guid::new(self.config.guid_prefix, id);
         if let Some(r) = self.readers.remove(&id) {
             for w in r.matched() {
-                self.events.push_back(Event::SubscriptionMatched { reader: id, writer: *w, matched: false });
+                self.events.push_back(Event::SubscriptionMatched {
+                    reader: id,
+                    writer: *w,
+                    matched: false,
+                });
             }
         }
-        self.announce(now, EntityId::SEDP_SUBSCRIPTIONS_WRITER, guid, ChangeKind::DisposeUnregister, Vec::new());
+        self.announce(
+            now,
+            EntityId::SEDP_SUBSCRIPTIONS_WRITER,
+            guid,
+            ChangeKind::DisposeUnregister,
+            Vec::new(),
+        );
         self.forget_reader(guid);
         self.service(now);
     }
@@ -278,24 +330,43 @@ impl Participant {
         let guid = Guid::new(self.config.guid_prefix, id);
         if let Some(w) = self.writers.remove(&id) {
             for r in w.matched() {
-                self.events.push_back(Event::PublicationMatched { writer: id, reader: *r, matched: false });
+                self.events.push_back(Event::PublicationMatched {
+                    writer: id,
+                    reader: *r,
+                    matched: false,
+                });
             }
         }
-        self.announce(now, EntityId::SEDP_PUBLICATIONS_WRITER, guid, ChangeKind::DisposeUnregister, Vec::new());
+        self.announce(
+            now,
+            EntityId::SEDP_PUBLICATIONS_WRITER,
+            guid,
+            ChangeKind::DisposeUnregister,
+            Vec::new(),
+        );
         self.forget_writer(guid);
         self.events.push_back(Event::WriterDeleted { writer: id });
     }
 
-    pub fn write(&mut self, now: Instant, writer: EntityId, change: WriteChange) -> Result<SequenceNumber, WriteError> {
+    pub fn write(
+        &mut self,
+        now: Instant,
+        writer: EntityId,
+        change: WriteChange,
+    ) -> Result<SequenceNumber, WriteError> {
         if !self.user_writers.contains(&writer) {
             return Err(WriteError::UnknownWriter(writer));
         }
-        let Some(w) = self.writers.get_mut(&writer) else { return Err(WriteError::UnknownWriter(writer)) };
+        let Some(w) = self.writers.get_mut(&writer) else {
+            return Err(WriteError::UnknownWriter(writer));
+        };
         w.write(now, change, &mut self.out, &mut self.events)
     }
 
     pub fn is_acknowledged(&self, writer: EntityId) -> bool {
-        self.writers.get(&writer).is_none_or(|w| w.is_acknowledged())
+        self.writers
+            .get(&writer)
+            .is_none_or(|w| w.is_acknowledged())
     }
 
     /// Bytes written but not yet acknowledged by every reliable reader (what flow control looks at).
@@ -307,14 +378,20 @@ impl Participant {
         if !self.user_writers.contains(&writer) {
             return Vec::new();
         }
-        self.writers.get(&writer).map(|w| w.matched().copied().collect()).unwrap_or_default()
+        self.writers
+            .get(&writer)
+            .map(|w| w.matched().copied().collect())
+            .unwrap_or_default()
     }
 
     pub fn reader_matches(&self, reader: EntityId) -> Vec<Guid> {
         if !self.user_readers.contains(&reader) {
             return Vec::new();
         }
-        self.readers.get(&reader).map(|r| r.matched().copied().collect()).unwrap_or_default()
+        self.readers
+            .get(&reader)
+            .map(|r| r.matched().copied().collect())
+            .unwrap_or_default()
     }
 
     /// Discovered remote participants.

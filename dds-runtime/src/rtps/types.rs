@@ -89,7 +89,10 @@ pub struct Guid {
 }
 
 impl Guid {
-    pub const UNKNOWN: Guid = Guid { prefix: GuidPrefix::UNKNOWN, entity_id: EntityId::UNKNOWN };
+    pub const UNKNOWN: Guid = Guid {
+        prefix: GuidPrefix::UNKNOWN,
+        entity_id: EntityId::UNKNOWN,
+    };
 
     pub fn new(prefix: GuidPrefix, entity_id: EntityId) -> Self {
         Guid { prefix, entity_id }
@@ -103,7 +106,10 @@ impl Guid {
     pub fn from_bytes(b: [u8; 16]) -> Self {
         let mut p = [0u8; 12];
         p.copy_from_slice(&b[..12]);
-        Guid { prefix: GuidPrefix(p), entity_id: EntityId([b[12], b[13], b[14], b[15]]) }
+        Guid {
+            prefix: GuidPrefix(p),
+            entity_id: EntityId([b[12], b[13], b[14], b[15]]),
+        }
     }
 }
 
@@ -155,11 +161,22 @@ impl Locator {
     pub fn udpv4(ip: [u8; 4], port: u16) -> Self {
         let mut address = [0u8; 16];
         address[12..].copy_from_slice(&ip);
-        Locator { kind: Self::KIND_UDPV4, port: port as u32, address }
+        Locator {
+            kind: Self::KIND_UDPV4,
+            port: port as u32,
+            address,
+        }
     }
     /// The IPv4 address when this is a UDPv4 locator.
     pub fn ipv4(&self) -> Option<[u8; 4]> {
-        (self.kind == Self::KIND_UDPV4).then(|| [self.address[12], self.address[13], self.address[14], self.address[15]])
+        (self.kind == Self::KIND_UDPV4).then(|| {
+            [
+                self.address[12],
+                self.address[13],
+                self.address[14],
+                self.address[15],
+            ]
+        })
     }
     pub fn is_multicast(&self) -> bool {
         match self.kind {
@@ -179,9 +196,11 @@ impl Locator {
     pub fn from_socket_addr(a: std::net::SocketAddr) -> Self {
         match a {
             std::net::SocketAddr::V4(v4) => Locator::udpv4(v4.ip().octets(), v4.port()),
-            std::net::SocketAddr::V6(v6) => {
-                Locator { kind: Self::KIND_UDPV6, port: v6.port() as u32, address: v6.ip().octets() }
-            }
+            std::net::SocketAddr::V6(v6) => Locator {
+                kind: Self::KIND_UDPV6,
+                port: v6.port() as u32,
+                address: v6.ip().octets(),
+            },
         }
     }
 }
@@ -200,7 +219,7 @@ impl fmt::Debug for Locator {
 pub struct SequenceNumber(pub i64);
 
 impl SequenceNumber {
-    pub const UNKNOWN: SequenceNumber = SequenceNumber(((-1i64) << 32) as i64);
+    pub const UNKNOWN: SequenceNumber = SequenceNumber((-1i64) << 32);
     pub fn from_parts(high: i32, low: u32) -> Self {
         SequenceNumber(((high as i64) << 32) | low as i64)
     }
@@ -237,7 +256,11 @@ impl<T: Copy> NumberSet<T> {
     pub const MAX_BITS: u32 = 256;
 
     pub fn empty(base: T) -> Self {
-        NumberSet { base, num_bits: 0, bitmap: [0; 8] }
+        NumberSet {
+            base,
+            num_bits: 0,
+            bitmap: [0; 8],
+        }
     }
     /// Sets bit `offset` (0-based from base), growing num_bits; ignores offsets >= 256.
     pub fn insert_offset(&mut self, offset: u32) {
@@ -247,7 +270,8 @@ impl<T: Copy> NumberSet<T> {
         }
     }
     pub fn contains_offset(&self, offset: u32) -> bool {
-        offset < self.num_bits && self.bitmap[(offset / 32) as usize] & (1 << (31 - offset % 32)) != 0
+        offset < self.num_bits
+            && self.bitmap[(offset / 32) as usize] & (1 << (31 - offset % 32)) != 0
     }
     /// Offsets of the set bits, ascending.
     pub fn offsets(&self) -> impl Iterator<Item = u32> + '_ {
@@ -299,15 +323,28 @@ pub struct Time {
 }
 
 impl Time {
-    pub const ZERO: Time = Time { seconds: 0, fraction: 0 };
-    pub const INVALID: Time = Time { seconds: -1, fraction: 0xffff_ffff };
-    pub const INFINITE: Time = Time { seconds: 0x7fff_ffff, fraction: 0xffff_ffff };
+    pub const ZERO: Time = Time {
+        seconds: 0,
+        fraction: 0,
+    };
+    pub const INVALID: Time = Time {
+        seconds: -1,
+        fraction: 0xffff_ffff,
+    };
+    pub const INFINITE: Time = Time {
+        seconds: 0x7fff_ffff,
+        fraction: 0xffff_ffff,
+    };
 
     /// From a duration since the Unix epoch (what `SystemTime::now().duration_since(UNIX_EPOCH)` gives).
     pub fn from_unix(d: Duration) -> Self {
         let secs = d.as_secs().min(0x7fff_ffff) as i32;
-        let fraction = ((d.subsec_nanos() as u64) << 32) / 1_000_000_000;
-        Time { seconds: secs, fraction: fraction as u32 }
+        // Rounded up so that to_unix() gives back the same nanosecond (ddsperf flags pings in the lsb).
+        let fraction = ((d.subsec_nanos() as u64) << 32).div_ceil(1_000_000_000);
+        Time {
+            seconds: secs,
+            fraction: fraction as u32,
+        }
     }
     pub fn to_unix(self) -> Option<Duration> {
         if self.seconds < 0 || self == Time::INFINITE {
@@ -373,7 +410,10 @@ mod tests {
         assert!(s.insert(SequenceNumber(10)));
         assert!(s.insert(SequenceNumber(45)));
         assert!(!s.insert(SequenceNumber(300)));
-        assert_eq!(s.iter().collect::<Vec<_>>(), vec![SequenceNumber(10), SequenceNumber(45)]);
+        assert_eq!(
+            s.iter().collect::<Vec<_>>(),
+            vec![SequenceNumber(10), SequenceNumber(45)]
+        );
         assert_eq!(s.num_bits, 36);
         assert_eq!(s.words().len(), 2);
     }

@@ -2,7 +2,8 @@
 """Tiny Cyclone DDS (python cyclonedds 11) peer for the dcps interop scratch test.
 
   cyclone_shapes.py pub TOPIC COLOR COUNT   -- writes COUNT samples (x = 0..COUNT-1), then disposes COLOR
-  cyclone_shapes.py sub TOPIC COUNT         -- prints each received sample as one JSON line, exits after COUNT
+  cyclone_shapes.py sub TOPIC COUNT [dispose] -- prints each received sample as one JSON line, exits after COUNT
+                                               valid samples (and, with `dispose`, a NOT_ALIVE_DISPOSED one)
 Both wait up to 20 s for a match. Reliable, transient-local, keep-last 100.
 """
 import json
@@ -10,7 +11,7 @@ import sys
 import time
 from dataclasses import dataclass
 
-from cyclonedds.core import Policy, Qos
+from cyclonedds.core import InstanceState, Policy, Qos
 from cyclonedds.domain import DomainParticipant
 from cyclonedds.idl import IdlStruct
 from cyclonedds.idl.annotations import appendable, key
@@ -65,19 +66,24 @@ def main():
         log("pub: done")
     else:
         count = int(sys.argv[3])
+        want_dispose = len(sys.argv) > 4 and sys.argv[4] == "dispose"
+        disposed = False
         r = DataReader(dp, tp, qos=QOS)
         got = 0
-        while got < count and time.time() < deadline:
+        while (got < count or (want_dispose and not disposed)) and time.time() < deadline:
             for s in r.take(N=100):
                 info = s.sample_info
+                # Cyclone reports the dispose on the retained valid samples when it has some.
+                disposed |= info.instance_state == InstanceState.NotAliveDisposed
                 if info.valid_data:
-                    print(json.dumps({"color": s.color, "x": s.x, "y": s.y, "shapesize": s.shapesize}), flush=True)
+                    print(json.dumps({"color": s.color, "x": s.x, "y": s.y, "shapesize": s.shapesize,
+                                      "disposed": disposed}), flush=True)
                     got += 1
                 else:
-                    print(json.dumps({"state": str(info.instance_state)}), flush=True)
+                    print(json.dumps({"state": int(info.instance_state), "disposed": disposed}), flush=True)
             time.sleep(0.01)
         log(f"sub: got {got}")
-        sys.exit(0 if got >= count else 3)
+        sys.exit(0 if got >= count and (disposed or not want_dispose) else 3)
 
 
 if __name__ == "__main__":

@@ -2,8 +2,8 @@
 //! seeded loss, duplication and reordering (random delay), and several participants wired through it.
 #![allow(dead_code)]
 
-use std::collections::BinaryHeap;
 use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 use std::time::{Duration, Instant};
 
 use dds_runtime::rtps::*;
@@ -43,16 +43,26 @@ pub struct Faults {
 }
 
 impl Faults {
-    pub const NONE: Faults = Faults { loss: 0.0, duplicate: 0.0, latency: Duration::from_micros(100), jitter: Duration::ZERO };
+    pub const NONE: Faults = Faults {
+        loss: 0.0,
+        duplicate: 0.0,
+        latency: Duration::from_micros(100),
+        jitter: Duration::ZERO,
+    };
     pub fn lossy(loss: f64) -> Faults {
-        Faults { loss, duplicate: 0.1, latency: Duration::from_micros(100), jitter: Duration::from_millis(2) }
+        Faults {
+            loss,
+            duplicate: 0.1,
+            latency: Duration::from_micros(100),
+            jitter: Duration::from_millis(2),
+        }
     }
 }
 
 pub struct Node {
     pub p: Participant,
     pub events: Vec<Event>,
-    /// Whether this node receives (false = crashed/partitioned away).
+    /// Whether this node is connected: false = it neither receives nor gets anything out (crashed or cut off).
     pub up: bool,
 }
 
@@ -109,7 +119,11 @@ impl Sim {
 
     pub fn add(&mut self, config: ParticipantConfig) -> usize {
         let p = Participant::new(config, self.now);
-        self.nodes.push(Node { p, events: Vec::new(), up: true });
+        self.nodes.push(Node {
+            p,
+            events: Vec::new(),
+            up: true,
+        });
         self.nodes.len() - 1
     }
 
@@ -142,21 +156,41 @@ impl Sim {
         for i in 0..self.nodes.len() {
             while let Some(t) = self.nodes[i].p.poll_transmit(self.now) {
                 self.datagrams_sent += 1;
-                let mut targets: Vec<usize> = t.destinations.iter().flat_map(|l| self.receivers(l)).collect();
+                let mut targets: Vec<usize> = t
+                    .destinations
+                    .iter()
+                    .flat_map(|l| self.receivers(l))
+                    .collect();
                 targets.sort();
                 targets.dedup();
                 let user = is_user_traffic(&t.payload);
+                if !self.nodes[i].up {
+                    targets.clear();
+                }
                 for to in targets {
-                    let f = if user || self.faults_on_discovery { self.faults } else { Faults::NONE };
+                    let f = if user || self.faults_on_discovery {
+                        self.faults
+                    } else {
+                        Faults::NONE
+                    };
                     if self.rng.unit() < f.loss {
                         continue;
                     }
                     let copies = if self.rng.unit() < f.duplicate { 2 } else { 1 };
                     for _ in 0..copies {
-                        let jitter = if f.jitter.is_zero() { 0 } else { self.rng.below(f.jitter.as_nanos() as u64) };
+                        let jitter = if f.jitter.is_zero() {
+                            0
+                        } else {
+                            self.rng.below(f.jitter.as_nanos() as u64)
+                        };
                         let at = self.now + f.latency + Duration::from_nanos(jitter);
                         self.seq += 1;
-                        self.queue.push(Reverse(InFlight { at, seq: self.seq, to, payload: t.payload.clone() }));
+                        self.queue.push(Reverse(InFlight {
+                            at,
+                            seq: self.seq,
+                            to,
+                            payload: t.payload.clone(),
+                        }));
                     }
                 }
                 self.nodes[i].p.recycle(t.payload);
@@ -169,6 +203,11 @@ impl Sim {
 
     /// Advances to the next datagram or timeout; returns false when nothing is scheduled.
     pub fn step(&mut self) -> bool {
+        self.step_until(None)
+    }
+
+    /// Like `step`, but never moves the clock past `cap`.
+    pub fn step_until(&mut self, cap: Option<Instant>) -> bool {
         self.pump();
         let next_dgram = self.queue.peek().map(|r| r.0.at);
         let next_timer = self.nodes.iter().filter_map(|n| n.p.poll_timeout()).min();
@@ -179,6 +218,7 @@ impl Sim {
                 None => return false,
             },
         };
+        let next = cap.map_or(next, |c| next.min(c));
         if next > self.now {
             self.now = next;
         }
@@ -208,7 +248,7 @@ impl Sim {
             if cond(self) {
                 return true;
             }
-            if self.now >= end || !self.step() {
+            if self.now >= end || !self.step_until(Some(end)) {
                 return cond(self);
             }
         }
@@ -250,7 +290,9 @@ impl Sim {
 /// whose every writer/reader id is builtin as discovery.
 fn is_user_traffic(msg: &[u8]) -> bool {
     use dds_runtime::rtps::messages::{MessageIter, Submessage};
-    let Ok((_, it)) = MessageIter::parse(msg) else { return true };
+    let Ok((_, it)) = MessageIter::parse(msg) else {
+        return true;
+    };
     for s in it.flatten() {
         let ids = match s {
             Submessage::Data(d) => [d.reader_id, d.writer_id],
@@ -262,7 +304,10 @@ fn is_user_traffic(msg: &[u8]) -> bool {
             Submessage::HeartbeatFrag(h) => [h.reader_id, h.writer_id],
             _ => continue,
         };
-        if ids.iter().any(|e| *e != EntityId::UNKNOWN && !e.is_builtin()) {
+        if ids
+            .iter()
+            .any(|e| *e != EntityId::UNKNOWN && !e.is_builtin())
+        {
             return true;
         }
     }

@@ -447,7 +447,7 @@ impl<'a> Builder<'a> {
             }
             Rule::scoped_name => TypeSpec::Named(self.scoped_name(p)),
             Rule::sequence_type => {
-                let mut it = p.into_inner().skip(1);
+                let mut it = p.into_inner().skip(1).filter(|x| x.as_rule() != Rule::annotation_appl);
                 let elem = Box::new(self.type_spec(it.next().expect("element type")));
                 let bound = it.next().map(|b| self.const_expr(b));
                 TypeSpec::Sequence { elem, bound, loc }
@@ -458,7 +458,7 @@ impl<'a> Builder<'a> {
                 TypeSpec::String { wide, bound, loc }
             }
             Rule::map_type => {
-                let mut it = p.into_inner().skip(1);
+                let mut it = p.into_inner().skip(1).filter(|x| x.as_rule() != Rule::annotation_appl);
                 let key = Box::new(self.type_spec(it.next().expect("key type")));
                 let value = Box::new(self.type_spec(it.next().expect("value type")));
                 let bound = it.next().map(|b| self.const_expr(b));
@@ -562,7 +562,7 @@ impl<'a> Builder<'a> {
             },
             Rule::float_lit => Literal::Float(s.parse().unwrap_or(f64::INFINITY)),
             Rule::fixed_lit => Literal::Fixed(s[..s.len() - 1].to_string()),
-            Rule::bool_lit => Literal::Bool(s == "TRUE"),
+            Rule::bool_lit => Literal::Bool(s.eq_ignore_ascii_case("TRUE")),
             Rule::char_lit | Rule::wchar_lit => {
                 let wide = p.as_rule() == Rule::wchar_lit;
                 let body = &s[if wide { 2 } else { 1 }..s.len() - 1];

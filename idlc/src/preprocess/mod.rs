@@ -173,6 +173,10 @@ pub fn preprocess_file(db: &mut SourceDb, vfs: &dyn Vfs, opts: &Options, file: F
 impl<'a> Preprocessor<'a> {
     fn new(db: &'a mut SourceDb, vfs: &'a dyn Vfs, opts: &'a Options, diags: &'a mut Diagnostics) -> Self {
         let mut macros = MacroTable::default();
+        // Cyclone's idlc defines __IDLC__ and IDL in the wild relies on it to hide C code from the compiler.
+        for pre in ["__IDLC__ 1", "__IDLC_RS__ 1"] {
+            let _ = macros.define(pre);
+        }
         for d in &opts.defines {
             let text = match d.split_once('=') {
                 Some((n, v)) => format!("{n} {v}"),

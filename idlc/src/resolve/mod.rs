@@ -406,7 +406,7 @@ impl<'a> Resolver<'a> {
                 key: anns.key,
                 optional: anns.optional,
                 external: anns.external,
-                must_understand: anns.must_understand || anns.key,
+                must_understand: anns.must_understand,
                 non_serialized: anns.non_serialized,
                 id: anns.id.filter(|_| m.declarators.len() == 1 || out.is_empty()),
                 hashid: anns.hashid.clone(),
@@ -578,8 +578,9 @@ impl<'a> Resolver<'a> {
                 Some(Value::Int(v)) => v as i64,
                 _ => next,
             };
-            if let Some(b) = bit_bound.filter(|b| *b < 32) {
-                if value < 0 || value >= 1i64 << b {
+            // XTypes encodes an enum with @bit_bound(b) as a signed integer of that width.
+            if let Some(b) = bit_bound.filter(|b| (1..32).contains(b)) {
+                if value < -(1i64 << (b - 1)) || value >= 1i64 << (b - 1) {
                     let msg = format!("enumerator value {value} does not fit in @bit_bound({b})");
                     self.diags.push(Diagnostic::error(Code::BitBound, msg).at(en.name.loc, "too large"));
                 }
@@ -752,10 +753,7 @@ impl<'a> Resolver<'a> {
         for k in keys {
             let first = &k[0];
             match st.fields.iter_mut().find(|f| f.name == first.name) {
-                Some(f) => {
-                    f.key = true;
-                    f.must_understand = true;
-                }
+                Some(f) => f.key = true,
                 None => missing.push(first.clone()),
             }
         }

@@ -25,16 +25,40 @@ pub const OURS: u32 = PARTICIPANT_ANNOUNCER
 
 /// (our writer, the remote reader it serves, the bit the remote must announce for that reader).
 pub const WRITER_PAIRS: [(EntityId, EntityId, u32); 3] = [
-    (EntityId::SEDP_PUBLICATIONS_WRITER, EntityId::SEDP_PUBLICATIONS_READER, PUBLICATIONS_DETECTOR),
-    (EntityId::SEDP_SUBSCRIPTIONS_WRITER, EntityId::SEDP_SUBSCRIPTIONS_READER, SUBSCRIPTIONS_DETECTOR),
-    (EntityId::P2P_MESSAGE_WRITER, EntityId::P2P_MESSAGE_READER, PARTICIPANT_MESSAGE_READER),
+    (
+        EntityId::SEDP_PUBLICATIONS_WRITER,
+        EntityId::SEDP_PUBLICATIONS_READER,
+        PUBLICATIONS_DETECTOR,
+    ),
+    (
+        EntityId::SEDP_SUBSCRIPTIONS_WRITER,
+        EntityId::SEDP_SUBSCRIPTIONS_READER,
+        SUBSCRIPTIONS_DETECTOR,
+    ),
+    (
+        EntityId::P2P_MESSAGE_WRITER,
+        EntityId::P2P_MESSAGE_READER,
+        PARTICIPANT_MESSAGE_READER,
+    ),
 ];
 
 /// (our reader, the remote writer it listens to, the bit the remote must announce for that writer).
 pub const READER_PAIRS: [(EntityId, EntityId, u32); 3] = [
-    (EntityId::SEDP_PUBLICATIONS_READER, EntityId::SEDP_PUBLICATIONS_WRITER, PUBLICATIONS_ANNOUNCER),
-    (EntityId::SEDP_SUBSCRIPTIONS_READER, EntityId::SEDP_SUBSCRIPTIONS_WRITER, SUBSCRIPTIONS_ANNOUNCER),
-    (EntityId::P2P_MESSAGE_READER, EntityId::P2P_MESSAGE_WRITER, PARTICIPANT_MESSAGE_WRITER),
+    (
+        EntityId::SEDP_PUBLICATIONS_READER,
+        EntityId::SEDP_PUBLICATIONS_WRITER,
+        PUBLICATIONS_ANNOUNCER,
+    ),
+    (
+        EntityId::SEDP_SUBSCRIPTIONS_READER,
+        EntityId::SEDP_SUBSCRIPTIONS_WRITER,
+        SUBSCRIPTIONS_ANNOUNCER,
+    ),
+    (
+        EntityId::P2P_MESSAGE_READER,
+        EntityId::P2P_MESSAGE_WRITER,
+        PARTICIPANT_MESSAGE_WRITER,
+    ),
 ];
 
 /// ParticipantMessageData kinds (§9.6.2.1).

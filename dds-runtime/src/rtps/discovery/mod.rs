@@ -6,8 +6,8 @@ pub mod ports;
 mod sedp;
 mod spdp;
 
-pub use sedp::{ReaderData, WriterData};
 pub(crate) use sedp::{encode_endpoint_key, endpoint_guid as endpoint_guid_of};
+pub use sedp::{ReaderData, WriterData};
 pub use spdp::ParticipantData;
 
 /// Encapsulation of discovery payloads: PL_CDR little-endian (0x0003) and big-endian (0x0002).
@@ -15,7 +15,9 @@ pub(crate) const PL_CDR_LE: [u8; 4] = [0x00, 0x03, 0x00, 0x00];
 pub(crate) const PL_CDR_BE_ID: [u8; 2] = [0x00, 0x02];
 
 /// Splits a discovery payload into its parameter list and byte order.
-pub(crate) fn pl_payload(payload: &[u8]) -> Result<crate::rtps::messages::ParameterList<'_>, crate::rtps::messages::WireError> {
+pub(crate) fn pl_payload(
+    payload: &[u8],
+) -> Result<crate::rtps::messages::ParameterList<'_>, crate::rtps::messages::WireError> {
     use crate::rtps::messages::{ParameterList, WireError};
     if payload.len() < 4 {
         return Err(WireError::Truncated);

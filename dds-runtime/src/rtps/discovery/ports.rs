@@ -29,7 +29,9 @@ pub fn user_unicast(domain: u32, participant: u32) -> u16 {
 
 /// Whether the domain and participant index give valid (≤ 65535) ports.
 pub fn valid(domain: u32, participant: u32) -> bool {
-    domain <= 232 && (PB as u64 + DG as u64 * domain as u64 + D3 as u64 + PG as u64 * participant as u64) <= 65535
+    domain <= 232
+        && (PB as u64 + DG as u64 * domain as u64 + D3 as u64 + PG as u64 * participant as u64)
+            <= 65535
 }
 
 fn checked(p: u32) -> u16 {

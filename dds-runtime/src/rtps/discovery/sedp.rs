@@ -53,7 +53,12 @@ struct Common {
     entity_name: Option<String>,
 }
 
-fn read_common(pl: &ParameterList<'_>, id: u16, value: &[u8], c: &mut Common) -> Result<bool, WireError> {
+fn read_common(
+    pl: &ParameterList<'_>,
+    id: u16,
+    value: &[u8],
+    c: &mut Common,
+) -> Result<bool, WireError> {
     let mut cur = pl.cursor(value);
     match id {
         pid::ENDPOINT_GUID => c.guid = Some(cur.guid()?),
@@ -76,7 +81,11 @@ fn read_common(pl: &ParameterList<'_>, id: u16, value: &[u8], c: &mut Common) ->
         pid::TYPE_INFORMATION => c.type_information = Some(TypeInformation(value.to_vec())),
         pid::ENTITY_NAME => c.entity_name = Some(cur.string()?.to_owned()),
         // Known and deliberately unused.
-        pid::KEY_HASH | pid::GROUP_GUID | pid::TYPE_MAX_SIZE_SERIALIZED | pid::PROTOCOL_VERSION | pid::VENDORID => {}
+        pid::KEY_HASH
+        | pid::GROUP_GUID
+        | pid::TYPE_MAX_SIZE_SERIALIZED
+        | pid::PROTOCOL_VERSION
+        | pid::VENDORID => {}
         _ => return Ok(false),
     }
     Ok(true)
@@ -89,6 +98,7 @@ pub(crate) fn endpoint_guid(payload: &[u8]) -> Option<Guid> {
     pl.cursor(v).guid().ok()
 }
 
+#[allow(clippy::too_many_arguments)]
 fn write_common(
     w: &mut ParameterWriter<'_>,
     guid: &Guid,
@@ -100,7 +110,10 @@ fn write_common(
     name: &Option<String>,
 ) {
     w.guid(pid::ENDPOINT_GUID, guid);
-    w.guid(pid::PARTICIPANT_GUID, &Guid::new(guid.prefix, EntityId::PARTICIPANT));
+    w.guid(
+        pid::PARTICIPANT_GUID,
+        &Guid::new(guid.prefix, EntityId::PARTICIPANT),
+    );
     w.string(pid::TOPIC_NAME, topic);
     w.string(pid::TYPE_NAME, type_name);
     for l in uc {
@@ -145,16 +158,23 @@ impl WriterData {
             if p.id & pid::VENDOR_SPECIFIC != 0 {
                 continue;
             }
-            let known = read_common(&pl, p.id, p.value, &mut c)? || read_writer_qos(p.id, p.value, pl.little_endian, &mut qos)?;
+            let known = read_common(&pl, p.id, p.value, &mut c)?
+                || read_writer_qos(p.id, p.value, pl.little_endian, &mut qos)?;
             if !known && p.id & pid::MUST_UNDERSTAND != 0 {
                 return Err(WireError::MustUnderstand(p.id));
             }
         }
         Ok(WriterData {
-            guid: c.guid.ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
+            guid: c
+                .guid
+                .ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
             participant_guid: c.participant_guid,
-            topic_name: c.topic_name.ok_or(WireError::Invalid("SEDP without topic name"))?,
-            type_name: c.type_name.ok_or(WireError::Invalid("SEDP without type name"))?,
+            topic_name: c
+                .topic_name
+                .ok_or(WireError::Invalid("SEDP without topic name"))?,
+            type_name: c
+                .type_name
+                .ok_or(WireError::Invalid("SEDP without type name"))?,
             qos,
             unicast_locators: c.unicast,
             multicast_locators: c.multicast,
@@ -195,16 +215,23 @@ impl ReaderData {
             if p.id & pid::VENDOR_SPECIFIC != 0 {
                 continue;
             }
-            let known = read_common(&pl, p.id, p.value, &mut c)? || read_reader_qos(p.id, p.value, pl.little_endian, &mut qos)?;
+            let known = read_common(&pl, p.id, p.value, &mut c)?
+                || read_reader_qos(p.id, p.value, pl.little_endian, &mut qos)?;
             if !known && p.id & pid::MUST_UNDERSTAND != 0 {
                 return Err(WireError::MustUnderstand(p.id));
             }
         }
         Ok(ReaderData {
-            guid: c.guid.ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
+            guid: c
+                .guid
+                .ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
             participant_guid: c.participant_guid,
-            topic_name: c.topic_name.ok_or(WireError::Invalid("SEDP without topic name"))?,
-            type_name: c.type_name.ok_or(WireError::Invalid("SEDP without type name"))?,
+            topic_name: c
+                .topic_name
+                .ok_or(WireError::Invalid("SEDP without topic name"))?,
+            type_name: c
+                .type_name
+                .ok_or(WireError::Invalid("SEDP without type name"))?,
             qos,
             unicast_locators: c.unicast,
             multicast_locators: c.multicast,
@@ -234,16 +261,25 @@ mod tests {
     #[test]
     fn round_trip_all_policies() {
         let wq = DataWriterQos::builder()
-            .reliability(Reliability::Reliable { max_blocking_time: Duration::from_millis(250) })
+            .reliability(Reliability::Reliable {
+                max_blocking_time: Duration::from_millis(250),
+            })
             .durability(Durability::TransientLocal)
             .deadline(Duration::from_secs(2))
             .latency_budget(Duration::from_millis(3))
-            .liveliness(Liveliness { kind: LivelinessKind::ManualByTopic, lease_duration: Duration::from_secs(4) })
+            .liveliness(Liveliness {
+                kind: LivelinessKind::ManualByTopic,
+                lease_duration: Duration::from_secs(4),
+            })
             .ownership(Ownership::Exclusive)
             .ownership_strength(7)
             .destination_order(DestinationOrder::BySourceTimestamp)
             .history(History::KeepAll)
-            .resource_limits(ResourceLimits { max_samples: Some(10), max_instances: None, max_samples_per_instance: Some(3) })
+            .resource_limits(ResourceLimits {
+                max_samples: Some(10),
+                max_instances: None,
+                max_samples_per_instance: Some(3),
+            })
             .lifespan(Duration::from_secs(9))
             .user_data(vec![1, 2])
             .transport_priority(5)
@@ -252,7 +288,11 @@ mod tests {
         let pubq = PublisherQos::builder()
             .partition(["A", "B*"])
             .group_data(vec![9])
-            .presentation(Presentation { access_scope: PresentationAccessScope::Topic, coherent_access: true, ordered_access: false })
+            .presentation(Presentation {
+                access_scope: PresentationAccessScope::Topic,
+                coherent_access: true,
+                ordered_access: false,
+            })
             .build();
         let tq = TopicQos::builder().topic_data(vec![4, 5, 6]).build();
         let w = WriterData {
@@ -274,15 +314,25 @@ mod tests {
         assert_eq!(back.qos.partition, Partition::new(["A", "B*"]));
         assert_eq!(back.qos.writer.ownership_strength.0, 7);
         assert_eq!(back.qos.writer.history, History::KeepAll);
-        assert_eq!(back.qos.writer.data_representation, DataRepresentation::xcdr2());
+        assert_eq!(
+            back.qos.writer.data_representation,
+            DataRepresentation::xcdr2()
+        );
         assert_eq!(back.qos.topic_data.0, vec![4, 5, 6]);
-        assert_eq!(back.qos.presentation.access_scope, PresentationAccessScope::Topic);
+        assert_eq!(
+            back.qos.presentation.access_scope,
+            PresentationAccessScope::Topic
+        );
         assert_eq!(back.type_information, w.type_information);
-        assert!(back.qos.writer.deadline.0.abs_diff(Duration::from_secs(2)) < Duration::from_nanos(2));
+        assert!(
+            back.qos.writer.deadline.0.abs_diff(Duration::from_secs(2)) < Duration::from_nanos(2)
+        );
 
         let rq = DataReaderQos::builder()
             .reliability(Reliability::RELIABLE)
-            .time_based_filter(TimeBasedFilter { minimum_separation: Duration::from_millis(10) })
+            .time_based_filter(TimeBasedFilter {
+                minimum_separation: Duration::from_millis(10),
+            })
             .data_representation(vec![0, 2])
             .build();
         let r = ReaderData {
@@ -297,7 +347,10 @@ mod tests {
         assert_eq!(back.qos.reader.data_representation.0, vec![0, 2]);
         assert!(back.expects_inline_qos);
         assert!(back.qos.reader.reliability.is_reliable());
-        assert_eq!(back.qos.reader.type_consistency, TypeConsistencyEnforcement::default());
+        assert_eq!(
+            back.qos.reader.type_consistency,
+            TypeConsistencyEnforcement::default()
+        );
         let enc = r.encode();
         for n in 0..enc.len() {
             let _ = ReaderData::decode(&enc[..n]);
@@ -308,7 +361,10 @@ mod tests {
     fn unknown_and_must_understand() {
         let mut out = PL_CDR_LE.to_vec();
         let mut w = ParameterWriter::new(&mut out, true);
-        w.guid(pid::ENDPOINT_GUID, &Guid::new(GuidPrefix([3; 12]), EntityId([0, 0, 1, 7])));
+        w.guid(
+            pid::ENDPOINT_GUID,
+            &Guid::new(GuidPrefix([3; 12]), EntityId([0, 0, 1, 7])),
+        );
         w.string(pid::TOPIC_NAME, "t");
         w.string(pid::TYPE_NAME, "T");
         w.u32(0x0fff, 1); // unknown: ignored
@@ -319,6 +375,9 @@ mod tests {
         let mut w = ParameterWriter::new(&mut out2, true);
         w.u32(0x4fff, 1);
         w.finish();
-        assert_eq!(ReaderData::decode(&out2), Err(WireError::MustUnderstand(0x4fff)));
+        assert_eq!(
+            ReaderData::decode(&out2),
+            Err(WireError::MustUnderstand(0x4fff))
+        );
     }
 }

@@ -95,7 +95,10 @@ impl ParticipantData {
         }
         w.duration(pid::PARTICIPANT_LEASE_DURATION, self.lease_duration);
         if self.manual_liveliness_count != 0 {
-            w.i32(pid::PARTICIPANT_MANUAL_LIVELINESS_COUNT, self.manual_liveliness_count);
+            w.i32(
+                pid::PARTICIPANT_MANUAL_LIVELINESS_COUNT,
+                self.manual_liveliness_count,
+            );
         }
         if !self.user_data.is_empty() {
             w.octets(pid::USER_DATA, &self.user_data);
@@ -105,13 +108,13 @@ impl ParticipantData {
                 p.u32(self.properties.len() as u32);
                 for (k, v) in &self.properties {
                     for s in [k, v] {
-                        while p.out.len() % 4 != 0 {
+                        while !p.out.len().is_multiple_of(4) {
                             p.u8(0);
                         }
                         put_string(p, s);
                     }
                 }
-                while p.out.len() % 4 != 0 {
+                while !p.out.len().is_multiple_of(4) {
                     p.u8(0);
                 }
                 // No binary properties.
@@ -138,7 +141,10 @@ impl ParticipantData {
             let mut c = pl.cursor(p.value);
             match p.id {
                 pid::PROTOCOL_VERSION => {
-                    d.protocol_version = ProtocolVersion { major: c.u8()?, minor: c.u8()? };
+                    d.protocol_version = ProtocolVersion {
+                        major: c.u8()?,
+                        minor: c.u8()?,
+                    };
                 }
                 pid::VENDORID => d.vendor_id = VendorId(c.array()?),
                 pid::PARTICIPANT_GUID => {
@@ -149,10 +155,16 @@ impl ParticipantData {
                 pid::DOMAIN_ID => d.domain_id = Some(c.u32()?),
                 pid::DOMAIN_TAG => d.domain_tag = c.string()?.to_owned(),
                 pid::EXPECTS_INLINE_QOS => d.expects_inline_qos = c.u8()? != 0,
-                pid::METATRAFFIC_UNICAST_LOCATOR => push_locator(&mut d.metatraffic_unicast, c.locator()?),
-                pid::METATRAFFIC_MULTICAST_LOCATOR => push_locator(&mut d.metatraffic_multicast, c.locator()?),
+                pid::METATRAFFIC_UNICAST_LOCATOR => {
+                    push_locator(&mut d.metatraffic_unicast, c.locator()?)
+                }
+                pid::METATRAFFIC_MULTICAST_LOCATOR => {
+                    push_locator(&mut d.metatraffic_multicast, c.locator()?)
+                }
                 pid::DEFAULT_UNICAST_LOCATOR => push_locator(&mut d.default_unicast, c.locator()?),
-                pid::DEFAULT_MULTICAST_LOCATOR => push_locator(&mut d.default_multicast, c.locator()?),
+                pid::DEFAULT_MULTICAST_LOCATOR => {
+                    push_locator(&mut d.default_multicast, c.locator()?)
+                }
                 pid::PARTICIPANT_LEASE_DURATION => d.lease_duration = c.duration()?,
                 pid::PARTICIPANT_MANUAL_LIVELINESS_COUNT => d.manual_liveliness_count = c.i32()?,
                 pid::USER_DATA => d.user_data = c.octets()?.to_vec(),

@@ -13,7 +13,10 @@ pub struct MessageIter<'a> {
 
 impl<'a> MessageIter<'a> {
     pub fn new(submessages: &'a [u8]) -> Self {
-        MessageIter { rest: submessages, done: false }
+        MessageIter {
+            rest: submessages,
+            done: false,
+        }
     }
 
     /// Parses the header and returns it with an iterator over the submessages.
@@ -37,11 +40,19 @@ impl<'a> Iterator for MessageIter<'a> {
         let sid = self.rest[0];
         let flags = self.rest[1];
         let raw = [self.rest[2], self.rest[3]];
-        let len = if flags & 1 != 0 { u16::from_le_bytes(raw) } else { u16::from_be_bytes(raw) } as usize;
+        let len = if flags & 1 != 0 {
+            u16::from_le_bytes(raw)
+        } else {
+            u16::from_be_bytes(raw)
+        } as usize;
         let after = &self.rest[4..];
         // octetsToNextHeader == 0: the submessage runs to the end of the message, except PAD and INFO_TS
         // which are legitimately empty (§9.4.5.1.3).
-        let body_len = if len == 0 && sid != super::id::PAD && sid != super::id::INFO_TS { after.len() } else { len };
+        let body_len = if len == 0 && sid != super::id::PAD && sid != super::id::INFO_TS {
+            after.len()
+        } else {
+            len
+        };
         if body_len > after.len() {
             self.done = true;
             return Some(Err(WireError::Truncated));
@@ -60,6 +71,7 @@ impl<'a> Iterator for MessageIter<'a> {
 #[derive(Debug, Clone)]
 pub struct MessageBuilder {
     buf: Vec<u8>,
+    last_header: Option<usize>,
 }
 
 impl MessageBuilder {
@@ -70,10 +82,13 @@ impl MessageBuilder {
     pub fn with_buffer(header: &Header, mut buf: Vec<u8>) -> Self {
         buf.clear();
         header.write(&mut buf);
-        MessageBuilder { buf }
+        MessageBuilder {
+            buf,
+            last_header: None,
+        }
     }
     pub fn push(&mut self, sub: &Submessage<'_>) {
-        sub.encode(&mut self.buf, true);
+        super::append(&mut self.buf, &mut self.last_header, sub, true);
     }
     pub fn len(&self) -> usize {
         self.buf.len()
@@ -81,9 +96,6 @@ impl MessageBuilder {
     /// True when only the header has been written.
     pub fn is_empty(&self) -> bool {
         self.buf.len() <= HEADER_LEN
-    }
-    pub fn buffer_mut(&mut self) -> &mut Vec<u8> {
-        &mut self.buf
     }
     pub fn finish(self) -> Vec<u8> {
         self.buf

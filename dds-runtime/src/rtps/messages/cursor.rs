@@ -13,7 +13,11 @@ pub struct Cursor<'a> {
 
 impl<'a> Cursor<'a> {
     pub fn new(data: &'a [u8], little_endian: bool) -> Self {
-        Cursor { data, pos: 0, little_endian }
+        Cursor {
+            data,
+            pos: 0,
+            little_endian,
+        }
     }
     pub fn pos(&self) -> usize {
         self.pos
@@ -50,14 +54,22 @@ impl<'a> Cursor<'a> {
     }
     pub fn u16(&mut self) -> Result<u16, WireError> {
         let a = self.array::<2>()?;
-        Ok(if self.little_endian { u16::from_le_bytes(a) } else { u16::from_be_bytes(a) })
+        Ok(if self.little_endian {
+            u16::from_le_bytes(a)
+        } else {
+            u16::from_be_bytes(a)
+        })
     }
     pub fn i16(&mut self) -> Result<i16, WireError> {
         Ok(self.u16()? as i16)
     }
     pub fn u32(&mut self) -> Result<u32, WireError> {
         let a = self.array::<4>()?;
-        Ok(if self.little_endian { u32::from_le_bytes(a) } else { u32::from_be_bytes(a) })
+        Ok(if self.little_endian {
+            u32::from_le_bytes(a)
+        } else {
+            u32::from_be_bytes(a)
+        })
     }
     pub fn i32(&mut self) -> Result<i32, WireError> {
         Ok(self.u32()? as i32)
@@ -77,7 +89,10 @@ impl<'a> Cursor<'a> {
         Ok(SequenceNumber::from_parts(high, low))
     }
     pub fn time(&mut self) -> Result<Time, WireError> {
-        Ok(Time { seconds: self.i32()?, fraction: self.u32()? })
+        Ok(Time {
+            seconds: self.i32()?,
+            fraction: self.u32()?,
+        })
     }
     pub fn duration(&mut self) -> Result<std::time::Duration, WireError> {
         let s = self.i32()?;
@@ -87,7 +102,11 @@ impl<'a> Cursor<'a> {
     pub fn locator(&mut self) -> Result<Locator, WireError> {
         let kind = self.i32()?;
         let port = self.u32()?;
-        Ok(Locator { kind, port, address: self.array()? })
+        Ok(Locator {
+            kind,
+            port,
+            address: self.array()?,
+        })
     }
     fn number_set_bits(&mut self) -> Result<(u32, [u32; 8]), WireError> {
         let num_bits = self.u32()?;
@@ -99,7 +118,7 @@ impl<'a> Cursor<'a> {
             *w = self.u32()?;
         }
         // Bits beyond numBits are meaningless; clear them so sets compare equal.
-        if num_bits % 32 != 0 {
+        if !num_bits.is_multiple_of(32) {
             let last = (num_bits / 32) as usize;
             bitmap[last] &= !(u32::MAX >> (num_bits % 32));
         }
@@ -108,12 +127,20 @@ impl<'a> Cursor<'a> {
     pub fn sequence_number_set(&mut self) -> Result<SequenceNumberSet, WireError> {
         let base = self.sequence_number()?;
         let (num_bits, bitmap) = self.number_set_bits()?;
-        Ok(SequenceNumberSet { base, num_bits, bitmap })
+        Ok(SequenceNumberSet {
+            base,
+            num_bits,
+            bitmap,
+        })
     }
     pub fn fragment_number_set(&mut self) -> Result<FragmentNumberSet, WireError> {
         let base = self.u32()?;
         let (num_bits, bitmap) = self.number_set_bits()?;
-        Ok(FragmentNumberSet { base, num_bits, bitmap })
+        Ok(FragmentNumberSet {
+            base,
+            num_bits,
+            bitmap,
+        })
     }
     /// A CDR string: u32 length including the NUL, the bytes, the NUL. Returns the bytes without the NUL.
     pub fn string(&mut self) -> Result<&'a str, WireError> {
@@ -144,10 +171,18 @@ impl Put<'_> {
         self.out.push(v);
     }
     pub fn u16(&mut self, v: u16) {
-        self.out.extend_from_slice(&if self.little_endian { v.to_le_bytes() } else { v.to_be_bytes() });
+        self.out.extend_from_slice(&if self.little_endian {
+            v.to_le_bytes()
+        } else {
+            v.to_be_bytes()
+        });
     }
     pub fn u32(&mut self, v: u32) {
-        self.out.extend_from_slice(&if self.little_endian { v.to_le_bytes() } else { v.to_be_bytes() });
+        self.out.extend_from_slice(&if self.little_endian {
+            v.to_le_bytes()
+        } else {
+            v.to_be_bytes()
+        });
     }
     pub fn i32(&mut self, v: i32) {
         self.u32(v as u32)
@@ -189,7 +224,7 @@ impl Put<'_> {
     }
     /// Pads with zeros to a multiple of `n` measured from `origin`.
     pub fn align_from(&mut self, origin: usize, n: usize) {
-        while (self.out.len() - origin) % n != 0 {
+        while (self.out.len() - !origin).is_multiple_of(n) {
             self.out.push(0);
         }
     }

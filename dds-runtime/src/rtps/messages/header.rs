@@ -28,7 +28,14 @@ impl Header {
         }
         let vendor_id = VendorId(c.array()?);
         let guid_prefix = c.guid_prefix()?;
-        Ok((Header { version: ProtocolVersion { major, minor }, vendor_id, guid_prefix }, c.rest()))
+        Ok((
+            Header {
+                version: ProtocolVersion { major, minor },
+                vendor_id,
+                guid_prefix,
+            },
+            c.rest(),
+        ))
     }
 
     pub fn write(&self, out: &mut Vec<u8>) {

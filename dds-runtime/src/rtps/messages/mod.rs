@@ -12,7 +12,7 @@ mod submessages;
 pub use codec::{MessageBuilder, MessageIter};
 pub use cursor::Cursor;
 pub use header::{Header, HEADER_LEN};
-pub use parameter::{ParameterList, ParameterWriter, Parameter};
+pub use parameter::{Parameter, ParameterList, ParameterWriter};
 pub use submessages::*;
 
 /// Submessage ids (§9.4.5.1.1).

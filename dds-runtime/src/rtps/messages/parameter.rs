@@ -79,7 +79,10 @@ pub struct ParameterList<'a> {
 
 impl<'a> ParameterList<'a> {
     /// Splits a parameter list off the front of `data`: returns the list and what follows the sentinel.
-    pub fn parse(data: &'a [u8], little_endian: bool) -> Result<(ParameterList<'a>, &'a [u8]), WireError> {
+    pub fn parse(
+        data: &'a [u8],
+        little_endian: bool,
+    ) -> Result<(ParameterList<'a>, &'a [u8]), WireError> {
         let mut c = Cursor::new(data, little_endian);
         loop {
             let start = c.pos();
@@ -88,7 +91,13 @@ impl<'a> ParameterList<'a> {
             if id == pid::SENTINEL {
                 // The sentinel's length is ignored (§9.4.2.11), but its value, if any, must be present.
                 let _ = c.skip(len);
-                return Ok((ParameterList { data: &data[..start], little_endian }, c.rest()));
+                return Ok((
+                    ParameterList {
+                        data: &data[..start],
+                        little_endian,
+                    },
+                    c.rest(),
+                ));
             }
             c.skip(len)?;
         }
@@ -151,7 +160,9 @@ pub struct ParameterWriter<'a> {
 
 impl<'a> ParameterWriter<'a> {
     pub fn new(out: &'a mut Vec<u8>, little_endian: bool) -> Self {
-        ParameterWriter { put: Put { out, little_endian } }
+        ParameterWriter {
+            put: Put { out, little_endian },
+        }
     }
 
     /// Writes one parameter whose value `f` appends; pads to 4 and fills in the length.
@@ -163,7 +174,11 @@ impl<'a> ParameterWriter<'a> {
         f(&mut self.put);
         self.put.align_from(start, 4);
         let len = (self.put.out.len() - start).min(u16::MAX as usize) as u16;
-        let b = if self.put.little_endian { len.to_le_bytes() } else { len.to_be_bytes() };
+        let b = if self.put.little_endian {
+            len.to_le_bytes()
+        } else {
+            len.to_be_bytes()
+        };
         self.put.out[len_at..len_at + 2].copy_from_slice(&b);
     }
 
@@ -197,6 +212,9 @@ impl<'a> ParameterWriter<'a> {
             p.bytes(b);
         });
     }
+    /// Ends the list without a sentinel: the form [`ParameterList::data`] holds (encoders add the sentinel).
+    pub fn without_sentinel(self) {}
+
     pub fn finish(mut self) {
         self.put.u16(pid::SENTINEL);
         self.put.u16(0);
@@ -242,7 +260,10 @@ mod tests {
         w.u32(0x4fff, 1);
         w.finish();
         let (pl, _) = ParameterList::parse(&buf, true).unwrap();
-        assert_eq!(pl.check_must_understand(|_| false), Err(WireError::MustUnderstand(0x4fff)));
+        assert_eq!(
+            pl.check_must_understand(|_| false),
+            Err(WireError::MustUnderstand(0x4fff))
+        );
         for n in 0..buf.len() - 4 {
             assert!(ParameterList::parse(&buf[..n], true).is_err(), "prefix {n}");
         }

@@ -53,13 +53,22 @@ pub struct InfoSource {
     pub guid_prefix: GuidPrefix,
 }
 
-/// INFO_REPLY: locator lists borrowed from the message (24 bytes each).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// INFO_REPLY: locator lists borrowed from the message (24 bytes each). Equality compares the locators.
+#[derive(Debug, Clone, Copy)]
 pub struct InfoReply<'a> {
     unicast: &'a [u8],
     multicast: Option<&'a [u8]>,
     little_endian: bool,
 }
+
+impl PartialEq for InfoReply<'_> {
+    fn eq(&self, o: &Self) -> bool {
+        self.unicast().eq(o.unicast())
+            && self.multicast.is_some() == o.multicast.is_some()
+            && self.multicast().eq(o.multicast())
+    }
+}
+impl Eq for InfoReply<'_> {}
 
 impl<'a> InfoReply<'a> {
     pub fn unicast(&self) -> impl Iterator<Item = Locator> + 'a {
@@ -71,7 +80,8 @@ impl<'a> InfoReply<'a> {
 }
 
 fn locators(b: &[u8], le: bool) -> impl Iterator<Item = Locator> + '_ {
-    b.chunks_exact(24).filter_map(move |c| Cursor::new(c, le).locator().ok())
+    b.chunks_exact(24)
+        .filter_map(move |c| Cursor::new(c, le).locator().ok())
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -153,7 +163,11 @@ pub enum Submessage<'a> {
     HeartbeatFrag(HeartbeatFrag),
     NackFrag(NackFrag),
     /// Unknown or vendor-specific (id >= 0x80) submessages, skipped by the receiver.
-    Unknown { id: u8, flags: u8, body: &'a [u8] },
+    Unknown {
+        id: u8,
+        flags: u8,
+        body: &'a [u8],
+    },
 }
 
 impl<'a> Submessage<'a> {
@@ -168,7 +182,13 @@ impl<'a> Submessage<'a> {
                 let writer_id = c.entity_id()?;
                 let reader_sn_state = c.sequence_number_set()?;
                 let count = c.i32()?;
-                Submessage::AckNack(AckNack { reader_id, writer_id, reader_sn_state, count, final_flag: flags & 0x02 != 0 })
+                Submessage::AckNack(AckNack {
+                    reader_id,
+                    writer_id,
+                    reader_sn_state,
+                    count,
+                    final_flag: flags & 0x02 != 0,
+                })
             }
             id::HEARTBEAT => {
                 let reader_id = c.entity_id()?;
@@ -198,7 +218,12 @@ impl<'a> Submessage<'a> {
                 if gap_start.0 < 1 || gap_list.base < gap_start {
                     return Err(WireError::Invalid("GAP range"));
                 }
-                Submessage::Gap(Gap { reader_id, writer_id, gap_start, gap_list })
+                Submessage::Gap(Gap {
+                    reader_id,
+                    writer_id,
+                    gap_start,
+                    gap_list,
+                })
             }
             id::INFO_TS => {
                 if flags & 0x02 != 0 {
@@ -213,17 +238,33 @@ impl<'a> Submessage<'a> {
                 let minor = c.u8()?;
                 let vendor_id = VendorId(c.array()?);
                 let guid_prefix = c.guid_prefix()?;
-                Submessage::InfoSrc(InfoSource { version: ProtocolVersion { major, minor }, vendor_id, guid_prefix })
+                Submessage::InfoSrc(InfoSource {
+                    version: ProtocolVersion { major, minor },
+                    vendor_id,
+                    guid_prefix,
+                })
             }
             id::INFO_DST => Submessage::InfoDst(c.guid_prefix()?),
             id::INFO_REPLY => {
                 let unicast = locator_list(&mut c)?;
-                let multicast = if flags & 0x02 != 0 { Some(locator_list(&mut c)?) } else { None };
-                Submessage::InfoReply(InfoReply { unicast, multicast, little_endian: le })
+                let multicast = if flags & 0x02 != 0 {
+                    Some(locator_list(&mut c)?)
+                } else {
+                    None
+                };
+                Submessage::InfoReply(InfoReply {
+                    unicast,
+                    multicast,
+                    little_endian: le,
+                })
             }
             id::INFO_REPLY_IP4 => {
                 let unicast = ip4_locator(&mut c)?;
-                let multicast = if flags & 0x02 != 0 { Some(ip4_locator(&mut c)?) } else { None };
+                let multicast = if flags & 0x02 != 0 {
+                    Some(ip4_locator(&mut c)?)
+                } else {
+                    None
+                };
                 Submessage::InfoReplyIp4(InfoReplyIp4 { unicast, multicast })
             }
             id::DATA => Submessage::Data(decode_data(flags, c)?),
@@ -237,7 +278,13 @@ impl<'a> Submessage<'a> {
                 if writer_sn.0 < 1 || last_fragment_num == 0 {
                     return Err(WireError::Invalid("HEARTBEAT_FRAG"));
                 }
-                Submessage::HeartbeatFrag(HeartbeatFrag { reader_id, writer_id, writer_sn, last_fragment_num, count })
+                Submessage::HeartbeatFrag(HeartbeatFrag {
+                    reader_id,
+                    writer_id,
+                    writer_sn,
+                    last_fragment_num,
+                    count,
+                })
             }
             id::NACK_FRAG => {
                 let reader_id = c.entity_id()?;
@@ -248,13 +295,24 @@ impl<'a> Submessage<'a> {
                 if writer_sn.0 < 1 {
                     return Err(WireError::Invalid("NACK_FRAG sequence number"));
                 }
-                Submessage::NackFrag(NackFrag { reader_id, writer_id, writer_sn, fragment_number_state, count })
+                Submessage::NackFrag(NackFrag {
+                    reader_id,
+                    writer_id,
+                    writer_sn,
+                    fragment_number_state,
+                    count,
+                })
             }
-            _ => Submessage::Unknown { id: sid, flags, body },
+            _ => Submessage::Unknown {
+                id: sid,
+                flags,
+                body,
+            },
         })
     }
 
-    /// Appends this submessage (header included) in the given byte order.
+    /// Appends this submessage (header included) in the given byte order, unpadded. Use [`append`] to add it
+    /// to a message that may already hold submessages.
     pub fn encode(&self, out: &mut Vec<u8>, little_endian: bool) {
         let start = out.len();
         let e = if little_endian { FLAG_E } else { 0 };
@@ -269,8 +327,14 @@ impl<'a> Submessage<'a> {
             Submessage::InfoTs(t) => (id::INFO_TS, e | if t.is_none() { 0x02 } else { 0 }),
             Submessage::InfoSrc(_) => (id::INFO_SRC, e),
             Submessage::InfoDst(_) => (id::INFO_DST, e),
-            Submessage::InfoReply(r) => (id::INFO_REPLY, e | if r.multicast.is_some() { 0x02 } else { 0 }),
-            Submessage::InfoReplyIp4(r) => (id::INFO_REPLY_IP4, e | if r.multicast.is_some() { 0x02 } else { 0 }),
+            Submessage::InfoReply(r) => (
+                id::INFO_REPLY,
+                e | if r.multicast.is_some() { 0x02 } else { 0 },
+            ),
+            Submessage::InfoReplyIp4(r) => (
+                id::INFO_REPLY_IP4,
+                e | if r.multicast.is_some() { 0x02 } else { 0 },
+            ),
             Submessage::Data(d) => {
                 let mut f = e;
                 if d.inline_qos.is_some() {
@@ -394,12 +458,43 @@ impl<'a> Submessage<'a> {
             }
             Submessage::Unknown { body, .. } => p.bytes(body),
         }
-        // Submessages start 4-aligned; pad the payload and count the padding in octetsToNextHeader.
-        p.align_from(start, 4);
-        let len = (out.len() - body_start).min(u16::MAX as usize) as u16;
-        let b = if little_endian { len.to_le_bytes() } else { len.to_be_bytes() };
+        // No trailing padding: the exact length lets a last submessage carry an unpadded payload. Whoever
+        // appends another submessage pads first and extends this length ([`append`]).
+        // Too long for the field: 0 means "to the end of the message" (valid for a last submessage).
+        let len = u16::try_from(out.len() - body_start).unwrap_or(0);
+        let b = if little_endian {
+            len.to_le_bytes()
+        } else {
+            len.to_be_bytes()
+        };
         out[start + 2..start + 4].copy_from_slice(&b);
     }
+}
+
+/// Appends `sub` to a message: first pads the previous submessage (at `last_header`) to a 4-byte boundary and
+/// extends its octetsToNextHeader, so every submessage starts aligned (§9.4.1). Updates `last_header`.
+pub fn append(
+    out: &mut Vec<u8>,
+    last_header: &mut Option<usize>,
+    sub: &Submessage<'_>,
+    little_endian: bool,
+) {
+    if !out.len().is_multiple_of(4) {
+        while !out.len().is_multiple_of(4) {
+            out.push(0);
+        }
+        if let Some(h) = *last_header {
+            let le = out[h + 1] & FLAG_E != 0;
+            let len = u16::try_from(out.len() - h - 4).unwrap_or(0);
+            out[h + 2..h + 4].copy_from_slice(&if le {
+                len.to_le_bytes()
+            } else {
+                len.to_be_bytes()
+            });
+        }
+    }
+    *last_header = Some(out.len());
+    sub.encode(out, little_endian);
 }
 
 /// Re-encodes a parameter list in the target byte order (values copied verbatim when the order matches).
@@ -434,7 +529,10 @@ fn ip4_locator(c: &mut Cursor<'_>) -> Result<Locator, WireError> {
 }
 
 /// Reads extraFlags/octetsToInlineQos and positions at the inline QoS; returns (reader, writer, sn, cursor).
-fn data_prefix<'a>(c: &mut Cursor<'a>, fixed: usize) -> Result<(EntityId, EntityId, SequenceNumber), WireError> {
+fn data_prefix<'a>(
+    c: &mut Cursor<'a>,
+    fixed: usize,
+) -> Result<(EntityId, EntityId, SequenceNumber), WireError> {
     let _extra_flags = c.u16()?;
     let otiq = c.u16()? as usize;
     let reader_id = c.entity_id()?;
@@ -444,7 +542,9 @@ fn data_prefix<'a>(c: &mut Cursor<'a>, fixed: usize) -> Result<(EntityId, Entity
         return Err(WireError::Invalid("writerSN < 1"));
     }
     // Inline QoS starts octetsToInlineQos bytes after that field (position 4); it may skip unknown fields.
-    let skip = (4 + otiq).checked_sub(c.pos()).ok_or(WireError::Invalid("octetsToInlineQos"))?;
+    let skip = (4 + otiq)
+        .checked_sub(c.pos())
+        .ok_or(WireError::Invalid("octetsToInlineQos"))?;
     let _ = fixed;
     c.skip(skip)?;
     Ok((reader_id, writer_id, sn))
@@ -453,7 +553,12 @@ fn data_prefix<'a>(c: &mut Cursor<'a>, fixed: usize) -> Result<(EntityId, Entity
 fn decode_data<'a>(flags: u8, mut c: Cursor<'a>) -> Result<Data<'a>, WireError> {
     let le = c.little_endian;
     let (reader_id, writer_id, writer_sn) = data_prefix(&mut c, 20)?;
-    let (q, d, k, n) = (flags & 0x02 != 0, flags & 0x04 != 0, flags & 0x08 != 0, flags & 0x10 != 0);
+    let (q, d, k, n) = (
+        flags & 0x02 != 0,
+        flags & 0x04 != 0,
+        flags & 0x08 != 0,
+        flags & 0x10 != 0,
+    );
     if d && k {
         return Err(WireError::Invalid("DATA with both D and K"));
     }
@@ -466,7 +571,15 @@ fn decode_data<'a>(flags: u8, mut c: Cursor<'a>) -> Result<Data<'a>, WireError> 
         None
     };
     let payload = if d || k { Some(rest) } else { None };
-    Ok(Data { reader_id, writer_id, writer_sn, inline_qos, payload, key_flag: k, non_standard_flag: n })
+    Ok(Data {
+        reader_id,
+        writer_id,
+        writer_sn,
+        inline_qos,
+        payload,
+        key_flag: k,
+        non_standard_flag: n,
+    })
 }
 
 fn decode_data_frag<'a>(flags: u8, mut c: Cursor<'a>) -> Result<DataFrag<'a>, WireError> {
@@ -500,7 +613,8 @@ fn decode_data_frag<'a>(flags: u8, mut c: Cursor<'a>) -> Result<DataFrag<'a>, Wi
         None
     };
     // The fragments' bytes: fragmentsInSubmessage * fragmentSize, cut at the sample's end; trailing padding dropped.
-    let want = (fragments_in_submessage as u64 * fragment_size as u64).min(sample_size as u64 - first_byte) as usize;
+    let want = (fragments_in_submessage as u64 * fragment_size as u64)
+        .min(sample_size as u64 - first_byte) as usize;
     if rest.len() < want {
         return Err(WireError::Truncated);
     }

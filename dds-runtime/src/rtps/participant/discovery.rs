@@ -27,9 +27,25 @@ impl Participant {
     }
 
     /// Writes a SEDP announcement (or its dispose) for a local endpoint.
-    pub(super) fn announce(&mut self, now: Instant, sedp_writer: EntityId, guid: Guid, kind: ChangeKind, payload: Vec<u8>) {
-        let payload = if kind == ChangeKind::Alive { payload } else { crate::rtps::discovery::encode_endpoint_key(&guid) };
-        let change = WriteChange { kind, payload: payload.into(), key_hash: Some(guid.to_bytes()), source_timestamp: None };
+    pub(super) fn announce(
+        &mut self,
+        now: Instant,
+        sedp_writer: EntityId,
+        guid: Guid,
+        kind: ChangeKind,
+        payload: Vec<u8>,
+    ) {
+        let payload = if kind == ChangeKind::Alive {
+            payload
+        } else {
+            crate::rtps::discovery::encode_endpoint_key(&guid)
+        };
+        let change = WriteChange {
+            kind,
+            payload: payload.into(),
+            key_hash: Some(guid.to_bytes()),
+            source_timestamp: None,
+        };
         if let Some(w) = self.writers.get_mut(&sedp_writer) {
             let _ = w.write(now, change, &mut self.out, &mut self.events);
         }
@@ -61,7 +77,8 @@ impl Participant {
         if data.guid_prefix == self.config.guid_prefix {
             return;
         }
-        if data.domain_id.is_some_and(|d| d != self.config.domain_id) || !data.domain_tag.is_empty() {
+        if data.domain_id.is_some_and(|d| d != self.config.domain_id) || !data.domain_tag.is_empty()
+        {
             trace!(participant = ?data.guid_prefix, "SPDP from another domain");
             return;
         }
@@ -84,8 +101,15 @@ impl Participant {
             data.metatraffic_unicast.clone()
         };
         let bits = data.builtin_endpoints;
-        self.events.push_back(Event::ParticipantDiscovered(Box::new(data.clone())));
-        self.participants.insert(prefix, ProxyParticipant { data, lease_deadline });
+        self.events
+            .push_back(Event::ParticipantDiscovered(Box::new(data.clone())));
+        self.participants.insert(
+            prefix,
+            ProxyParticipant {
+                data,
+                lease_deadline,
+            },
+        );
         for (ours, theirs, bit) in builtin::WRITER_PAIRS {
             if bits & bit != 0 {
                 if let Some(w) = self.writers.get_mut(&ours) {
@@ -97,7 +121,10 @@ impl Participant {
         for (ours, theirs, bit) in builtin::READER_PAIRS {
             if bits & bit != 0 {
                 if let Some(r) = self.readers.get_mut(&ours) {
-                    r.add_proxy(now, WriterProxy::new(Guid::new(prefix, theirs), meta.clone(), true));
+                    r.add_proxy(
+                        now,
+                        WriterProxy::new(Guid::new(prefix, theirs), meta.clone(), true),
+                    );
                 }
             }
         }
@@ -121,23 +148,44 @@ impl Participant {
                 r.remove_proxy(&Guid::new(prefix, theirs));
             }
         }
-        let writers: Vec<Guid> = self.known_writers.keys().filter(|g| g.prefix == prefix).copied().collect();
+        let writers: Vec<Guid> = self
+            .known_writers
+            .keys()
+            .filter(|g| g.prefix == prefix)
+            .copied()
+            .collect();
         for g in writers {
-            for (id, r) in self.readers.iter().filter(|(id, _)| self.user_readers.contains(id)) {
+            for (id, r) in self
+                .readers
+                .iter()
+                .filter(|(id, _)| self.user_readers.contains(id))
+            {
                 if r.has_proxy(&g) {
-                    self.events.push_back(Event::LivelinessChanged { reader: *id, writer: g, alive: false });
+                    self.events.push_back(Event::LivelinessChanged {
+                        reader: *id,
+                        writer: g,
+                        alive: false,
+                    });
                 }
             }
             self.forget_writer(g);
             self.events.push_back(Event::PublicationRemoved { guid: g });
         }
-        let readers: Vec<Guid> = self.known_readers.keys().filter(|g| g.prefix == prefix).copied().collect();
+        let readers: Vec<Guid> = self
+            .known_readers
+            .keys()
+            .filter(|g| g.prefix == prefix)
+            .copied()
+            .collect();
         for g in readers {
             self.forget_reader(g);
-            self.events.push_back(Event::SubscriptionRemoved { guid: g });
+            self.events
+                .push_back(Event::SubscriptionRemoved { guid: g });
         }
         self.incompatible.retain(|(_, g)| g.prefix != prefix);
-        self.events.push_back(Event::ParticipantLost { guid_prefix: prefix });
+        self.events.push_back(Event::ParticipantLost {
+            guid_prefix: prefix,
+        });
     }
 
     pub(super) fn on_builtin_sample(&mut self, now: Instant, s: ReceivedSample) {
@@ -146,15 +194,21 @@ impl Participant {
                 if s.kind == ChangeKind::Alive {
                     match WriterData::decode(&s.payload) {
                         Ok(d) if d.guid.prefix == s.writer.prefix => {
-                            if self.known_writers.len() < MAX_ENDPOINTS || self.known_writers.contains_key(&d.guid) {
+                            if self.known_writers.len() < MAX_ENDPOINTS
+                                || self.known_writers.contains_key(&d.guid)
+                            {
                                 let new = !self.known_writers.contains_key(&d.guid);
                                 if new {
-                                    self.events.push_back(Event::PublicationDiscovered(Box::new(d.clone())));
+                                    self.events.push_back(Event::PublicationDiscovered(Box::new(
+                                        d.clone(),
+                                    )));
                                 }
                                 self.on_writer_known(now, d);
                             }
                         }
-                        Ok(_) => debug!("SEDP publication for another participant's endpoint ignored"),
+                        Ok(_) => {
+                            debug!("SEDP publication for another participant's endpoint ignored")
+                        }
                         Err(e) => debug!(error = %e, "dropping SEDP publication"),
                     }
                 } else if let Some(g) = endpoint_of(&s) {
@@ -168,20 +222,28 @@ impl Participant {
                 if s.kind == ChangeKind::Alive {
                     match ReaderData::decode(&s.payload) {
                         Ok(d) if d.guid.prefix == s.writer.prefix => {
-                            if self.known_readers.len() < MAX_ENDPOINTS || self.known_readers.contains_key(&d.guid) {
+                            if self.known_readers.len() < MAX_ENDPOINTS
+                                || self.known_readers.contains_key(&d.guid)
+                            {
                                 if !self.known_readers.contains_key(&d.guid) {
-                                    self.events.push_back(Event::SubscriptionDiscovered(Box::new(d.clone())));
+                                    self.events
+                                        .push_back(Event::SubscriptionDiscovered(Box::new(
+                                            d.clone(),
+                                        )));
                                 }
                                 self.on_reader_known(now, d);
                             }
                         }
-                        Ok(_) => debug!("SEDP subscription for another participant's endpoint ignored"),
+                        Ok(_) => {
+                            debug!("SEDP subscription for another participant's endpoint ignored")
+                        }
                         Err(e) => debug!(error = %e, "dropping SEDP subscription"),
                     }
                 } else if let Some(g) = endpoint_of(&s) {
                     if g.prefix == s.writer.prefix && self.known_readers.contains_key(&g) {
                         self.forget_reader(g);
-                        self.events.push_back(Event::SubscriptionRemoved { guid: g });
+                        self.events
+                            .push_back(Event::SubscriptionRemoved { guid: g });
                     }
                 }
             }
@@ -197,7 +259,12 @@ impl Participant {
     }
 
     /// Where to reach a known endpoint: its own unicast locators, else its participant's defaults.
-    fn endpoint_locators(&self, prefix: GuidPrefix, uc: &[Locator], mc: &[Locator]) -> Vec<Locator> {
+    fn endpoint_locators(
+        &self,
+        prefix: GuidPrefix,
+        uc: &[Locator],
+        mc: &[Locator],
+    ) -> Vec<Locator> {
         if !uc.is_empty() {
             return uc.to_vec();
         }
@@ -250,15 +317,31 @@ impl Participant {
 
     fn match_writer_with(&mut self, now: Instant, wid: EntityId, reader: Guid) {
         let wguid = Guid::new(self.config.guid_prefix, wid);
-        let (Some(wd), Some(rd)) = (self.known_writers.get(&wguid), self.known_readers.get(&reader)) else { return };
+        let (Some(wd), Some(rd)) = (
+            self.known_writers.get(&wguid),
+            self.known_readers.get(&reader),
+        ) else {
+            return;
+        };
         let res = match_endpoints(
-            WriterView { topic_name: &wd.topic_name, type_name: &wd.type_name, qos: &wd.qos },
-            ReaderView { topic_name: &rd.topic_name, type_name: &rd.type_name, qos: &rd.qos },
+            WriterView {
+                topic_name: &wd.topic_name,
+                type_name: &wd.type_name,
+                qos: &wd.qos,
+            },
+            ReaderView {
+                topic_name: &rd.topic_name,
+                type_name: &rd.type_name,
+                qos: &rd.qos,
+            },
         );
         let reliable = rd.qos.reader.reliability.is_reliable();
         let durable = rd.qos.reader.durability >= Durability::TransientLocal;
-        let locators = self.endpoint_locators(reader.prefix, &rd.unicast_locators, &rd.multicast_locators);
-        let Some(w) = self.writers.get_mut(&wid) else { return };
+        let locators =
+            self.endpoint_locators(reader.prefix, &rd.unicast_locators, &rd.multicast_locators);
+        let Some(w) = self.writers.get_mut(&wid) else {
+            return;
+        };
         if w.linger_until.is_some() {
             return;
         }
@@ -266,19 +349,36 @@ impl Participant {
         match res {
             MatchResult::Match => {
                 if !has {
-                    w.add_proxy(now, ReaderProxy::new(reader, locators, reliable), durable, &mut self.events);
-                    self.events.push_back(Event::PublicationMatched { writer: wid, reader, matched: true });
+                    w.add_proxy(
+                        now,
+                        ReaderProxy::new(reader, locators, reliable),
+                        durable,
+                        &mut self.events,
+                    );
+                    self.events.push_back(Event::PublicationMatched {
+                        writer: wid,
+                        reader,
+                        matched: true,
+                    });
                 }
                 self.incompatible.remove(&(wid, reader));
             }
             other => {
                 if has {
                     w.remove_proxy(&reader, &mut self.events);
-                    self.events.push_back(Event::PublicationMatched { writer: wid, reader, matched: false });
+                    self.events.push_back(Event::PublicationMatched {
+                        writer: wid,
+                        reader,
+                        matched: false,
+                    });
                 }
                 if let MatchResult::Incompatible(policy) = other {
                     if self.incompatible.insert((wid, reader)) {
-                        self.events.push_back(Event::OfferedIncompatibleQos { writer: wid, reader, policy });
+                        self.events.push_back(Event::OfferedIncompatibleQos {
+                            writer: wid,
+                            reader,
+                            policy,
+                        });
                     }
                 }
             }
@@ -287,31 +387,59 @@ impl Participant {
 
     fn match_reader_with(&mut self, now: Instant, rid: EntityId, writer: Guid) {
         let rguid = Guid::new(self.config.guid_prefix, rid);
-        let (Some(rd), Some(wd)) = (self.known_readers.get(&rguid), self.known_writers.get(&writer)) else { return };
+        let (Some(rd), Some(wd)) = (
+            self.known_readers.get(&rguid),
+            self.known_writers.get(&writer),
+        ) else {
+            return;
+        };
         let res = match_endpoints(
-            WriterView { topic_name: &wd.topic_name, type_name: &wd.type_name, qos: &wd.qos },
-            ReaderView { topic_name: &rd.topic_name, type_name: &rd.type_name, qos: &rd.qos },
+            WriterView {
+                topic_name: &wd.topic_name,
+                type_name: &wd.type_name,
+                qos: &wd.qos,
+            },
+            ReaderView {
+                topic_name: &rd.topic_name,
+                type_name: &rd.type_name,
+                qos: &rd.qos,
+            },
         );
         let reliable = wd.qos.writer.reliability.is_reliable();
-        let locators = self.endpoint_locators(writer.prefix, &wd.unicast_locators, &wd.multicast_locators);
-        let Some(r) = self.readers.get_mut(&rid) else { return };
+        let locators =
+            self.endpoint_locators(writer.prefix, &wd.unicast_locators, &wd.multicast_locators);
+        let Some(r) = self.readers.get_mut(&rid) else {
+            return;
+        };
         let has = r.has_proxy(&writer);
         match res {
             MatchResult::Match => {
                 if !has {
                     r.add_proxy(now, WriterProxy::new(writer, locators, reliable));
-                    self.events.push_back(Event::SubscriptionMatched { reader: rid, writer, matched: true });
+                    self.events.push_back(Event::SubscriptionMatched {
+                        reader: rid,
+                        writer,
+                        matched: true,
+                    });
                 }
                 self.incompatible.remove(&(rid, writer));
             }
             other => {
                 if has {
                     r.remove_proxy(&writer);
-                    self.events.push_back(Event::SubscriptionMatched { reader: rid, writer, matched: false });
+                    self.events.push_back(Event::SubscriptionMatched {
+                        reader: rid,
+                        writer,
+                        matched: false,
+                    });
                 }
                 if let MatchResult::Incompatible(policy) = other {
                     if self.incompatible.insert((rid, writer)) {
-                        self.events.push_back(Event::RequestedIncompatibleQos { reader: rid, writer, policy });
+                        self.events.push_back(Event::RequestedIncompatibleQos {
+                            reader: rid,
+                            writer,
+                            policy,
+                        });
                     }
                 }
             }
@@ -323,7 +451,11 @@ impl Participant {
         self.known_writers.remove(&g);
         for (id, r) in self.readers.iter_mut() {
             if self.user_readers.contains(id) && r.remove_proxy(&g) {
-                self.events.push_back(Event::SubscriptionMatched { reader: *id, writer: g, matched: false });
+                self.events.push_back(Event::SubscriptionMatched {
+                    reader: *id,
+                    writer: g,
+                    matched: false,
+                });
             }
         }
         self.incompatible.retain(|(_, x)| *x != g);
@@ -334,7 +466,11 @@ impl Participant {
         self.known_readers.remove(&g);
         for (id, w) in self.writers.iter_mut() {
             if self.user_writers.contains(id) && w.remove_proxy(&g, &mut self.events) {
-                self.events.push_back(Event::PublicationMatched { writer: *id, reader: g, matched: false });
+                self.events.push_back(Event::PublicationMatched {
+                    writer: *id,
+                    reader: g,
+                    matched: false,
+                });
             }
         }
         self.incompatible.retain(|(_, x)| *x != g);
@@ -343,7 +479,9 @@ impl Participant {
 
 /// The endpoint GUID of a SEDP dispose/unregister: the key hash (the GUID itself) or the key payload.
 fn endpoint_of(s: &ReceivedSample) -> Option<Guid> {
-    s.key_hash.map(Guid::from_bytes).or_else(|| crate::rtps::discovery::endpoint_guid_of(&s.payload))
+    s.key_hash
+        .map(Guid::from_bytes)
+        .or_else(|| crate::rtps::discovery::endpoint_guid_of(&s.payload))
 }
 
 /// The participant prefix in an SPDP key-only payload.

@@ -48,27 +48,37 @@ impl Participant {
                         self.on_spdp(now, src, &d);
                     } else {
                         let scratch = &mut self.scratch;
-                        for_readers(&mut self.readers, d.reader_id, wguid, |r| r.on_data(wguid, &d, ts, scratch));
+                        for_readers(&mut self.readers, d.reader_id, wguid, |r| {
+                            r.on_data(wguid, &d, ts, scratch)
+                        });
                     }
                 }
                 Submessage::DataFrag(d) => {
                     let wguid = Guid::new(src, d.writer_id);
                     let scratch = &mut self.scratch;
-                    for_readers(&mut self.readers, d.reader_id, wguid, |r| r.on_data_frag(wguid, &d, ts, scratch));
+                    for_readers(&mut self.readers, d.reader_id, wguid, |r| {
+                        r.on_data_frag(wguid, &d, ts, scratch)
+                    });
                 }
                 Submessage::Heartbeat(h) => {
                     let wguid = Guid::new(src, h.writer_id);
                     let scratch = &mut self.scratch;
-                    for_readers(&mut self.readers, h.reader_id, wguid, |r| r.on_heartbeat(now, wguid, &h, scratch));
+                    for_readers(&mut self.readers, h.reader_id, wguid, |r| {
+                        r.on_heartbeat(now, wguid, &h, scratch)
+                    });
                 }
                 Submessage::Gap(g) => {
                     let wguid = Guid::new(src, g.writer_id);
                     let scratch = &mut self.scratch;
-                    for_readers(&mut self.readers, g.reader_id, wguid, |r| r.on_gap(wguid, &g, scratch));
+                    for_readers(&mut self.readers, g.reader_id, wguid, |r| {
+                        r.on_gap(wguid, &g, scratch)
+                    });
                 }
                 Submessage::HeartbeatFrag(h) => {
                     let wguid = Guid::new(src, h.writer_id);
-                    for_readers(&mut self.readers, h.reader_id, wguid, |r| r.on_heartbeat_frag(now, wguid, &h));
+                    for_readers(&mut self.readers, h.reader_id, wguid, |r| {
+                        r.on_heartbeat_frag(now, wguid, &h)
+                    });
                 }
                 Submessage::AckNack(a) => {
                     if let Some(w) = self.writers.get_mut(&a.writer_id) {

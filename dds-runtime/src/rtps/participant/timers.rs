@@ -45,15 +45,26 @@ impl Participant {
             // Automatic liveliness: one ParticipantMessageData per interval keeps our lease alive at peers that
             // only count builtin liveliness traffic.
             let prefix = self.config.guid_prefix;
-            let change = WriteChange::alive(builtin::encode_participant_message(&prefix, builtin::PMD_KIND_AUTOMATIC, &[]))
-                .with_key_hash(builtin::participant_message_key(&prefix, builtin::PMD_KIND_AUTOMATIC));
+            let change = WriteChange::alive(builtin::encode_participant_message(
+                &prefix,
+                builtin::PMD_KIND_AUTOMATIC,
+                &[],
+            ))
+            .with_key_hash(builtin::participant_message_key(
+                &prefix,
+                builtin::PMD_KIND_AUTOMATIC,
+            ));
             if let Some(w) = self.writers.get_mut(&EntityId::P2P_MESSAGE_WRITER) {
                 let _ = w.write(now, change, &mut self.out, &mut self.events);
             }
             self.pmd_due = now + self.config.spdp_interval;
         }
-        let expired: Vec<GuidPrefix> =
-            self.participants.iter().filter(|(_, p)| p.lease_deadline <= now).map(|(k, _)| *k).collect();
+        let expired: Vec<GuidPrefix> = self
+            .participants
+            .iter()
+            .filter(|(_, p)| p.lease_deadline <= now)
+            .map(|(k, _)| *k)
+            .collect();
         for prefix in expired {
             debug!(participant = ?prefix, "lease expired");
             self.remove_participant(prefix);
@@ -61,7 +72,10 @@ impl Participant {
         let lingering: Vec<EntityId> = self
             .writers
             .iter()
-            .filter(|(_, w)| w.linger_until.is_some_and(|t| t <= now || w.is_acknowledged()))
+            .filter(|(_, w)| {
+                w.linger_until
+                    .is_some_and(|t| t <= now || w.is_acknowledged())
+            })
             .map(|(k, _)| *k)
             .collect();
         for id in lingering {
@@ -107,8 +121,11 @@ impl Participant {
         let mut qos = Vec::with_capacity(32);
         let mut w = ParameterWriter::new(&mut qos, true);
         w.raw(pid::KEY_HASH, &guid.to_bytes());
-        w.raw(pid::STATUS_INFO, &[0, 0, 0, ChangeKind::DisposeUnregister.status_info()]);
-        drop(w);
+        w.raw(
+            pid::STATUS_INFO,
+            &[0, 0, 0, ChangeKind::DisposeUnregister.status_info()],
+        );
+        w.without_sentinel();
         let mut key = crate::rtps::discovery::PL_CDR_LE.to_vec();
         let mut kw = ParameterWriter::new(&mut key, true);
         kw.guid(pid::PARTICIPANT_GUID, &guid);
@@ -126,7 +143,10 @@ impl Participant {
             reader_id: EntityId::SPDP_READER,
             writer_id: EntityId::SPDP_WRITER,
             writer_sn: sn,
-            inline_qos: Some(ParameterList { data: &qos, little_endian: true }),
+            inline_qos: Some(ParameterList {
+                data: &qos,
+                little_endian: true,
+            }),
             payload: Some(&key),
             key_flag: true,
             non_standard_flag: false,

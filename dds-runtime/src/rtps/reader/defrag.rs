@@ -4,6 +4,10 @@ use std::collections::BTreeMap;
 
 use crate::rtps::api::Payload;
 
+/// What one stored fragment costs beyond its bytes (map node, vector header), charged against the limits so
+/// that tiny fragments cannot make us hold far more memory than their payload suggests.
+pub const FRAGMENT_OVERHEAD: usize = 64;
+
 /// One sample being reassembled.
 #[derive(Debug)]
 pub struct Defrag {
@@ -16,6 +20,8 @@ pub struct Defrag {
     pub status_info: Option<u8>,
     pub key_hash: Option<[u8; 16]>,
     pub key_flag: bool,
+    /// Source timestamp in force for the first fragment that carried one.
+    pub source_timestamp: Option<crate::rtps::types::Time>,
 }
 
 impl Defrag {
@@ -28,6 +34,7 @@ impl Defrag {
             status_info: None,
             key_hash: None,
             key_flag: false,
+            source_timestamp: None,
         }
     }
 
@@ -35,7 +42,8 @@ impl Defrag {
         self.sample_size.div_ceil(self.fragment_size as u32)
     }
 
-    /// Adds fragment `num` (its bytes); returns the bytes newly held. Inconsistent fragments are ignored.
+    /// Adds fragment `num` (its bytes); returns the memory newly held (bytes plus overhead). Inconsistent
+    /// fragments are ignored.
     pub fn add(&mut self, num: u32, data: &[u8]) -> usize {
         if num == 0 || num > self.total() || self.frags.contains_key(&num) {
             return 0;
@@ -46,8 +54,9 @@ impl Defrag {
             return 0;
         }
         self.frags.insert(num, data.to_vec());
-        self.bytes += data.len();
-        data.len()
+        let cost = data.len() + FRAGMENT_OVERHEAD;
+        self.bytes += cost;
+        cost
     }
 
     pub fn is_complete(&self) -> bool {

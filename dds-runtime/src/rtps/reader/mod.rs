@@ -10,10 +10,26 @@ use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use crate::rtps::api::{ChangeKind, Event, Payload, ReceivedSample};
-use crate::rtps::messages::{AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, NackFrag, Submessage};
+use crate::rtps::messages::{
+    AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, NackFrag, Submessage,
+};
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
 use defrag::Defrag;
+
+/// Whether every must-understand inline QoS parameter is one we know.
+fn inline_qos_understood(q: Option<&crate::rtps::messages::ParameterList<'_>>) -> bool {
+    use crate::rtps::messages::parameter::pid;
+    q.is_none_or(|q| {
+        q.check_must_understand(|id| {
+            matches!(
+                id & !pid::MUST_UNDERSTAND,
+                pid::KEY_HASH | pid::STATUS_INFO | pid::TOPIC_NAME
+            )
+        })
+        .is_ok()
+    })
+}
 
 /// Protocol parameters of one reader.
 #[derive(Debug, Clone, Copy)]
@@ -36,7 +52,11 @@ pub struct Reader {
 
 impl Reader {
     pub fn new(guid: Guid, params: ReaderParams) -> Self {
-        Reader { guid, params, proxies: BTreeMap::new() }
+        Reader {
+            guid,
+            params,
+            proxies: BTreeMap::new(),
+        }
     }
 
     pub fn params(&self) -> &ReaderParams {
@@ -65,7 +85,13 @@ impl Reader {
         self.proxies.remove(g).is_some()
     }
 
-    fn deliver(reader: EntityId, p: &mut WriterProxy, sn: SequenceNumber, slot: Slot, out: &mut Vec<Event>) {
+    fn deliver(
+        reader: EntityId,
+        p: &mut WriterProxy,
+        sn: SequenceNumber,
+        slot: Slot,
+        out: &mut Vec<Event>,
+    ) {
         if let Slot::Change(c) = slot {
             out.push(Event::Sample(ReceivedSample {
                 reader,
@@ -112,7 +138,11 @@ impl Reader {
                 return;
             }
             if p.synced && sn > p.next_expected {
-                out.push(Event::SampleLost { reader: rid, writer: p.guid, count: (sn.0 - p.next_expected.0) as u64 });
+                out.push(Event::SampleLost {
+                    reader: rid,
+                    writer: p.guid,
+                    count: (sn.0 - p.next_expected.0) as u64,
+                });
             }
             p.synced = true;
             Self::deliver(rid, p, sn, slot, out);
@@ -122,13 +152,26 @@ impl Reader {
     }
 
     pub fn on_data(&mut self, writer: Guid, d: &Data<'_>, ts: Option<Time>, out: &mut Vec<Event>) {
-        let Some(mut p) = self.proxies.remove(&writer) else { return };
+        let Some(mut p) = self.proxies.remove(&writer) else {
+            return;
+        };
+        if !inline_qos_understood(d.inline_qos.as_ref()) {
+            // §9.4.2.11: a sample with a must-understand parameter we do not know is dropped; the sequence
+            // number is consumed so a reliable stream does not stall on it.
+            self.accept(&mut p, d.writer_sn, Slot::Irrelevant, out);
+            self.proxies.insert(writer, p);
+            return;
+        }
         let status = d.inline_qos.and_then(|q| q.status_info());
         let kind = status.map_or(ChangeKind::Alive, ChangeKind::from_status_info);
         let key_hash = d.inline_qos.and_then(|q| q.key_hash());
         let slot = match d.payload {
             Some(b) if b.len() > self.params.max_sample_size => {
-                out.push(Event::SampleLost { reader: self.guid.entity_id, writer, count: 1 });
+                out.push(Event::SampleLost {
+                    reader: self.guid.entity_id,
+                    writer,
+                    count: 1,
+                });
                 Slot::Irrelevant
             }
             // Alive data needs a payload; a dispose/unregister may come with only inline QoS.
@@ -144,26 +187,52 @@ impl Reader {
         self.proxies.insert(writer, p);
     }
 
-    pub fn on_data_frag(&mut self, writer: Guid, d: &DataFrag<'_>, ts: Option<Time>, out: &mut Vec<Event>) {
-        let Some(mut p) = self.proxies.remove(&writer) else { return };
+    pub fn on_data_frag(
+        &mut self,
+        writer: Guid,
+        d: &DataFrag<'_>,
+        ts: Option<Time>,
+        out: &mut Vec<Event>,
+    ) {
+        let Some(mut p) = self.proxies.remove(&writer) else {
+            return;
+        };
         self.data_frag(&mut p, d, ts, out);
         self.proxies.insert(writer, p);
     }
 
-    fn data_frag(&self, p: &mut WriterProxy, d: &DataFrag<'_>, ts: Option<Time>, out: &mut Vec<Event>) {
+    fn data_frag(
+        &self,
+        p: &mut WriterProxy,
+        d: &DataFrag<'_>,
+        ts: Option<Time>,
+        out: &mut Vec<Event>,
+    ) {
         let sn = d.writer_sn;
         if p.has(sn) {
             return;
         }
+        if !inline_qos_understood(d.inline_qos.as_ref()) {
+            self.accept(p, sn, Slot::Irrelevant, out);
+            return;
+        }
         if d.sample_size as usize > self.params.max_sample_size {
-            out.push(Event::SampleLost { reader: self.guid.entity_id, writer: p.guid, count: 1 });
+            out.push(Event::SampleLost {
+                reader: self.guid.entity_id,
+                writer: p.guid,
+                count: 1,
+            });
             self.accept(p, sn, Slot::Irrelevant, out);
             return;
         }
         if !p.defrag.contains_key(&sn) {
             if p.defrag.len() >= self.params.defrag_max_samples {
                 // Reliable: keep the oldest (they unblock delivery); best effort: keep the newest.
-                let victim = if p.reliable { p.defrag.last_key_value() } else { p.defrag.first_key_value() };
+                let victim = if p.reliable {
+                    p.defrag.last_key_value()
+                } else {
+                    p.defrag.first_key_value()
+                };
                 let Some((&v, _)) = victim else { return };
                 if p.reliable && v < sn {
                     return;
@@ -178,24 +247,41 @@ impl Reader {
             df.key_flag = d.key_flag;
             p.defrag.insert(sn, df);
         }
-        let Some(df) = p.defrag.get_mut(&sn) else { return };
+        let Some(df) = p.defrag.get_mut(&sn) else {
+            return;
+        };
         if df.sample_size != d.sample_size || df.fragment_size != d.fragment_size {
             return;
         }
+        if df.source_timestamp.is_none() {
+            df.source_timestamp = ts;
+        }
         let fs = d.fragment_size as usize;
         for (i, chunk) in d.payload.chunks(fs).enumerate() {
-            if p.defrag_bytes + chunk.len() > self.params.defrag_max_bytes {
+            if p.defrag_bytes + chunk.len() + defrag::FRAGMENT_OVERHEAD
+                > self.params.defrag_max_bytes
+            {
                 break;
             }
             p.defrag_bytes += df.add(d.fragment_starting_num.saturating_add(i as u32), chunk);
         }
         if df.is_complete() {
-            let Some(df) = p.defrag.remove(&sn) else { return };
+            let Some(df) = p.defrag.remove(&sn) else {
+                return;
+            };
             p.defrag_bytes -= df.bytes;
-            let kind = df.status_info.map_or(ChangeKind::Alive, ChangeKind::from_status_info);
+            let kind = df
+                .status_info
+                .map_or(ChangeKind::Alive, ChangeKind::from_status_info);
             let key_hash = df.key_hash;
+            let source_timestamp = df.source_timestamp;
             let payload = df.assemble();
-            let slot = Slot::Change(PendingChange { kind, payload, key_hash, source_timestamp: ts });
+            let slot = Slot::Change(PendingChange {
+                kind,
+                payload,
+                key_hash,
+                source_timestamp,
+            });
             self.accept(p, sn, slot, out);
         }
     }
@@ -203,7 +289,9 @@ impl Reader {
     pub fn on_gap(&mut self, writer: Guid, g: &Gap, out: &mut Vec<Event>) {
         let rid = self.guid.entity_id;
         let cap = self.params.reorder_max_samples;
-        let Some(p) = self.proxies.get_mut(&writer) else { return };
+        let Some(p) = self.proxies.get_mut(&writer) else {
+            return;
+        };
         p.synced = true;
         let base = g.gap_list.base;
         if g.gap_start <= p.next_expected && base > p.next_expected {
@@ -234,14 +322,24 @@ impl Reader {
         p.drop_stale_defrag();
     }
 
-    pub fn on_heartbeat(&mut self, now: Instant, writer: Guid, hb: &Heartbeat, out: &mut Vec<Event>) {
+    pub fn on_heartbeat(
+        &mut self,
+        now: Instant,
+        writer: Guid,
+        hb: &Heartbeat,
+        out: &mut Vec<Event>,
+    ) {
         let rid = self.guid.entity_id;
         let delay = self.params.heartbeat_response_delay;
-        let Some(p) = self.proxies.get_mut(&writer) else { return };
+        let Some(p) = self.proxies.get_mut(&writer) else {
+            return;
+        };
         if !p.reliable {
             return;
         }
-        if p.last_hb_count.is_some_and(|c| hb.count.wrapping_sub(c) <= 0) {
+        if p.last_hb_count
+            .is_some_and(|c| hb.count.wrapping_sub(c) <= 0)
+        {
             return;
         }
         p.last_hb_count = Some(hb.count);
@@ -263,7 +361,11 @@ impl Reader {
             }
             lost += (hb.first_sn.0 - sn.0).max(0) as u64;
             if p.synced && lost > 0 {
-                out.push(Event::SampleLost { reader: rid, writer, count: lost });
+                out.push(Event::SampleLost {
+                    reader: rid,
+                    writer,
+                    count: lost,
+                });
             }
             p.next_expected = hb.first_sn;
             Self::drain(rid, p, out);
@@ -278,8 +380,13 @@ impl Reader {
 
     pub fn on_heartbeat_frag(&mut self, now: Instant, writer: Guid, hf: &HeartbeatFrag) {
         let delay = self.params.heartbeat_response_delay;
-        let Some(p) = self.proxies.get_mut(&writer) else { return };
-        if !p.reliable || p.last_hbfrag_count.is_some_and(|c| hf.count.wrapping_sub(c) <= 0) {
+        let Some(p) = self.proxies.get_mut(&writer) else {
+            return;
+        };
+        if !p.reliable
+            || p.last_hbfrag_count
+                .is_some_and(|c| hf.count.wrapping_sub(c) <= 0)
+        {
             return;
         }
         p.last_hbfrag_count = Some(hf.count);
@@ -297,7 +404,7 @@ impl Reader {
     pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
         let rid = self.guid.entity_id;
         for p in self.proxies.values_mut() {
-            if !p.acknack_due.is_some_and(|t| t <= now) {
+            if p.acknack_due.is_none_or(|t| t > now) {
                 continue;
             }
             p.acknack_due = None;
@@ -327,7 +434,9 @@ impl Reader {
                     break;
                 }
                 let missing = d.missing(d.total());
-                let Some(&first) = missing.first() else { continue };
+                let Some(&first) = missing.first() else {
+                    continue;
+                };
                 let mut fs = FragmentNumberSet::empty(first);
                 missing.iter().for_each(|&f| {
                     fs.insert(f);

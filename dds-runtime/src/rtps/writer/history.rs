@@ -34,7 +34,13 @@ pub struct HistoryCache {
 
 impl HistoryCache {
     pub fn new(history: History, limits: ResourceLimits) -> Self {
-        HistoryCache { changes: BTreeMap::new(), instances: HashMap::new(), history, limits, bytes: 0 }
+        HistoryCache {
+            changes: BTreeMap::new(),
+            instances: HashMap::new(),
+            history,
+            limits,
+            bytes: 0,
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -62,7 +68,10 @@ impl HistoryCache {
         let max_total = self.limits.max_samples.map(|m| m.max(1) as usize);
         let per_instance = match self.history {
             History::KeepLast(d) => Some(d.max(1) as usize),
-            History::KeepAll => self.limits.max_samples_per_instance.map(|m| m.max(1) as usize),
+            History::KeepAll => self
+                .limits
+                .max_samples_per_instance
+                .map(|m| m.max(1) as usize),
         };
         let keep_last = matches!(self.history, History::KeepLast(_));
         if let Some(limit) = per_instance {
@@ -139,7 +148,10 @@ impl HistoryCache {
             .filter_map(|q| {
                 let last = *q.back()?;
                 let c = self.changes.get(&last)?;
-                (matches!(c.kind, ChangeKind::Unregister | ChangeKind::DisposeUnregister) && last < acked)
+                (matches!(
+                    c.kind,
+                    ChangeKind::Unregister | ChangeKind::DisposeUnregister
+                ) && last < acked)
                     .then(|| q.iter().copied().collect::<Vec<_>>())
             })
             .flatten()
@@ -171,7 +183,10 @@ mod tests {
             h.make_room(&[k; 16], SequenceNumber(1)).unwrap();
             h.add(ch(sn, k));
         }
-        assert_eq!(h.changes.keys().map(|s| s.0).collect::<Vec<_>>(), vec![2, 3, 4]);
+        assert_eq!(
+            h.changes.keys().map(|s| s.0).collect::<Vec<_>>(),
+            vec![2, 3, 4]
+        );
         assert_eq!(h.bytes(), 30);
     }
 
@@ -179,13 +194,20 @@ mod tests {
     fn keep_all_limit() {
         let mut h = HistoryCache::new(
             History::KeepAll,
-            ResourceLimits { max_samples: Some(2), max_instances: None, max_samples_per_instance: None },
+            ResourceLimits {
+                max_samples: Some(2),
+                max_instances: None,
+                max_samples_per_instance: None,
+            },
         );
         h.make_room(&[0; 16], SequenceNumber(1)).unwrap();
         h.add(ch(1, 0));
         h.make_room(&[0; 16], SequenceNumber(1)).unwrap();
         h.add(ch(2, 0));
-        assert_eq!(h.make_room(&[0; 16], SequenceNumber(1)), Err(HistoryFull::Full));
+        assert_eq!(
+            h.make_room(&[0; 16], SequenceNumber(1)),
+            Err(HistoryFull::Full)
+        );
         // Once 1 is acknowledged it can go.
         assert_eq!(h.make_room(&[0; 16], SequenceNumber(2)), Ok(()));
         assert_eq!(h.len(), 1);

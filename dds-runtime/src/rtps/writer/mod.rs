@@ -97,11 +97,19 @@ impl Writer {
 
     /// Every change acknowledged by every reliable reader.
     pub fn is_acknowledged(&self) -> bool {
-        self.proxies.values().filter(|p| p.reliable).all(|p| p.acked >= self.next_sn)
+        self.proxies
+            .values()
+            .filter(|p| p.reliable)
+            .all(|p| p.acked >= self.next_sn)
     }
 
     fn acked_floor(&self) -> SequenceNumber {
-        self.proxies.values().filter(|p| p.reliable).map(|p| p.acked).min().unwrap_or(self.next_sn)
+        self.proxies
+            .values()
+            .filter(|p| p.reliable)
+            .map(|p| p.acked)
+            .min()
+            .unwrap_or(self.next_sn)
     }
 
     fn has_reliable_proxy(&self) -> bool {
@@ -109,7 +117,11 @@ impl Writer {
     }
 
     fn rebuild_dest(&mut self) {
-        let mut d: Vec<Locator> = self.proxies.values().filter_map(|p| p.destination().first().copied()).collect();
+        let mut d: Vec<Locator> = self
+            .proxies
+            .values()
+            .filter_map(|p| p.destination().first().copied())
+            .collect();
         d.sort();
         d.dedup();
         self.data_dest = d;
@@ -123,15 +135,27 @@ impl Writer {
         } else {
             self.history.prune_unregistered(floor);
         }
-        self.unacked_bytes = if self.has_reliable_proxy() { self.history.bytes_from(floor) } else { 0 };
+        self.unacked_bytes = if self.has_reliable_proxy() {
+            self.history.bytes_from(floor)
+        } else {
+            0
+        };
         if self.blocked && self.unacked_bytes <= self.params.low_watermark {
             self.blocked = false;
-            ev.push_back(Event::WriterUnblocked { writer: self.guid.entity_id });
+            ev.push_back(Event::WriterUnblocked {
+                writer: self.guid.entity_id,
+            });
         }
     }
 
     /// Queues a change and sends it to every matched reader.
-    pub(crate) fn write(&mut self, now: Instant, change: WriteChange, out: &mut Outbox, ev: &mut VecDeque<Event>) -> Result<SequenceNumber, WriteError> {
+    pub(crate) fn write(
+        &mut self,
+        now: Instant,
+        change: WriteChange,
+        out: &mut Outbox,
+        ev: &mut VecDeque<Event>,
+    ) -> Result<SequenceNumber, WriteError> {
         if self.linger_until.is_some() {
             return Err(WriteError::Deleted);
         }
@@ -164,9 +188,21 @@ impl Writer {
             key_hash: change.key_hash,
             source_timestamp: change.source_timestamp,
         };
+        self.history.add(cc);
         if !self.data_dest.is_empty() {
             let dest = std::mem::take(&mut self.data_dest);
-            send_change(out, &dest, None, EntityId::UNKNOWN, self.guid.entity_id, &cc, self.params.fragment_size, None);
+            if let Some(c) = self.history.get(sn) {
+                send_change(
+                    out,
+                    &dest,
+                    None,
+                    EntityId::UNKNOWN,
+                    self.guid.entity_id,
+                    c,
+                    self.params.fragment_size,
+                    None,
+                );
+            }
             if self.has_reliable_proxy() {
                 self.bytes_since_nonfinal_hb += len;
                 // Ask for acknowledgements now and then so flow control keeps moving without waiting for the
@@ -180,10 +216,10 @@ impl Writer {
             }
             self.data_dest = dest;
         }
-        self.history.add(cc);
         if self.has_reliable_proxy() {
             self.unacked_bytes += len;
-            self.hb_due.get_or_insert(now + self.params.heartbeat_period);
+            self.hb_due
+                .get_or_insert(now + self.params.heartbeat_period);
         } else if !self.durable() {
             self.history.remove_below(self.next_sn);
         }
@@ -204,7 +240,13 @@ impl Writer {
     }
 
     /// Matches a reader. Durable writers serve their history to it; volatile ones answer older requests with GAP.
-    pub fn add_proxy(&mut self, now: Instant, mut proxy: ReaderProxy, reader_durable: bool, ev: &mut VecDeque<Event>) {
+    pub fn add_proxy(
+        &mut self,
+        now: Instant,
+        mut proxy: ReaderProxy,
+        reader_durable: bool,
+        ev: &mut VecDeque<Event>,
+    ) {
         proxy.reliable &= self.params.reliable;
         if !(self.durable() && reader_durable) {
             proxy.floor = self.next_sn;
@@ -215,13 +257,24 @@ impl Writer {
                 proxy.repair_due = Some(now);
             } else {
                 // Best effort: push the history once.
-                proxy.requested = self.history.range(SequenceNumber(1)).map(|c| c.sn).take(MAX_REQUESTED).collect();
+                proxy.requested = self
+                    .history
+                    .range(SequenceNumber(1))
+                    .map(|c| c.sn)
+                    .take(MAX_REQUESTED)
+                    .collect();
                 proxy.repair_due = Some(now);
             }
         }
+        let behind = proxy.reliable && proxy.acked < self.next_sn;
         self.proxies.insert(proxy.guid, proxy);
         self.rebuild_dest();
         self.update_acked(ev);
+        if behind {
+            // Keep heartbeating until it has caught up, whatever happens to the first one.
+            self.hb_due
+                .get_or_insert(now + self.params.heartbeat_period);
+        }
     }
 
     pub fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
@@ -233,14 +286,24 @@ impl Writer {
         had
     }
 
-    pub fn on_acknack(&mut self, now: Instant, reader: Guid, ack: &crate::rtps::messages::AckNack, ev: &mut VecDeque<Event>) {
+    pub fn on_acknack(
+        &mut self,
+        now: Instant,
+        reader: Guid,
+        ack: &crate::rtps::messages::AckNack,
+        ev: &mut VecDeque<Event>,
+    ) {
         let next_sn = self.next_sn;
         let delay = self.params.nack_response_delay;
-        let Some(p) = self.proxies.get_mut(&reader) else { return };
+        let Some(p) = self.proxies.get_mut(&reader) else {
+            return;
+        };
         if !p.reliable {
             return;
         }
-        if p.last_acknack.is_some_and(|c| ack.count.wrapping_sub(c) <= 0) {
+        if p.last_acknack
+            .is_some_and(|c| ack.count.wrapping_sub(c) <= 0)
+        {
             return;
         }
         p.last_acknack = Some(ack.count);
@@ -258,32 +321,50 @@ impl Writer {
         p.requested = p.requested.split_off(&acked);
         p.requested_frags = p.requested_frags.split_off(&acked);
         // A request, or a reader that is behind without knowing it (e.g. a pre-emptive ACKNACK): answer soon.
-        if !p.requested.is_empty() || (ack.reader_sn_state.num_bits == 0 && base < next_sn && !ack.final_flag) {
+        if !p.requested.is_empty()
+            || (ack.reader_sn_state.num_bits == 0 && base < next_sn && !ack.final_flag)
+        {
             p.repair_due.get_or_insert(now + delay);
         }
         if progressed {
             self.update_acked(ev);
             if self.is_acknowledged() {
                 self.hb_due = None;
-                ev.push_back(Event::WriterAcknowledged { writer: self.guid.entity_id });
+                ev.push_back(Event::WriterAcknowledged {
+                    writer: self.guid.entity_id,
+                });
             }
         }
     }
 
-    pub fn on_nack_frag(&mut self, now: Instant, reader: Guid, nf: &crate::rtps::messages::NackFrag) {
+    pub fn on_nack_frag(
+        &mut self,
+        now: Instant,
+        reader: Guid,
+        nf: &crate::rtps::messages::NackFrag,
+    ) {
         let delay = self.params.nack_response_delay;
         let in_history = self.history.get(nf.writer_sn).is_some();
-        let Some(p) = self.proxies.get_mut(&reader) else { return };
+        let Some(p) = self.proxies.get_mut(&reader) else {
+            return;
+        };
         if !p.reliable || nf.writer_sn < p.acked {
             return;
         }
-        if p.last_nackfrag.is_some_and(|c| nf.count.wrapping_sub(c) <= 0) {
+        if p.last_nackfrag
+            .is_some_and(|c| nf.count.wrapping_sub(c) <= 0)
+        {
             return;
         }
         p.last_nackfrag = Some(nf.count);
         if in_history {
-            if p.requested_frags.len() < MAX_REQUESTED_FRAG_SAMPLES || p.requested_frags.contains_key(&nf.writer_sn) {
-                p.requested_frags.entry(nf.writer_sn).or_default().extend(nf.fragment_number_state.iter());
+            if p.requested_frags.len() < MAX_REQUESTED_FRAG_SAMPLES
+                || p.requested_frags.contains_key(&nf.writer_sn)
+            {
+                p.requested_frags
+                    .entry(nf.writer_sn)
+                    .or_default()
+                    .extend(nf.fragment_number_state.iter());
             }
         } else if p.requested.len() < MAX_REQUESTED {
             p.requested.insert(nf.writer_sn);
@@ -300,7 +381,12 @@ impl Writer {
     }
 
     pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
-        let due: Vec<Guid> = self.proxies.values().filter(|p| p.repair_due.is_some_and(|t| t <= now)).map(|p| p.guid).collect();
+        let due: Vec<Guid> = self
+            .proxies
+            .values()
+            .filter(|p| p.repair_due.is_some_and(|t| t <= now))
+            .map(|p| p.guid)
+            .collect();
         for g in due {
             self.repair(now, g, out);
         }
@@ -331,14 +417,18 @@ impl Writer {
     fn repair(&mut self, now: Instant, g: Guid, out: &mut Outbox) {
         let frag = self.params.fragment_size;
         let wid = self.guid.entity_id;
-        let Some(p) = self.proxies.get_mut(&g) else { return };
+        let Some(p) = self.proxies.get_mut(&g) else {
+            return;
+        };
         p.repair_due = None;
         let dest: Vec<Locator> = p.destination().to_vec();
         let dst = Some(g.prefix);
         let mut budget = self.params.max_repair_bytes as isize;
         let mut gaps: Vec<SequenceNumber> = Vec::new();
         while budget > 0 {
-            let Some(sn) = p.requested.pop_first() else { break };
+            let Some(sn) = p.requested.pop_first() else {
+                break;
+            };
             p.requested_frags.remove(&sn);
             match self.history.get(sn) {
                 Some(c) if sn >= p.floor => {
@@ -349,7 +439,9 @@ impl Writer {
             }
         }
         while budget > 0 {
-            let Some((sn, frags)) = p.requested_frags.pop_first() else { break };
+            let Some((sn, frags)) = p.requested_frags.pop_first() else {
+                break;
+            };
             if let Some(c) = self.history.get(sn) {
                 send_change(out, &dest, dst, g.entity_id, wid, c, frag, Some(&frags));
                 budget -= (frags.len() * frag) as isize;
@@ -369,7 +461,14 @@ impl Writer {
 }
 
 /// Runs of consecutive sequence numbers as GAP submessages.
-fn send_gaps(out: &mut Outbox, dest: &[Locator], dst: Option<GuidPrefix>, rid: EntityId, wid: EntityId, gaps: &[SequenceNumber]) {
+fn send_gaps(
+    out: &mut Outbox,
+    dest: &[Locator],
+    dst: Option<GuidPrefix>,
+    rid: EntityId,
+    wid: EntityId,
+    gaps: &[SequenceNumber],
+) {
     let mut i = 0;
     while i < gaps.len() {
         let start = gaps[i];
@@ -421,7 +520,10 @@ pub(crate) fn send_change(
 ) {
     let mut qbuf = [0u8; 28];
     let qn = inline_qos(c, &mut qbuf);
-    let inline_qos = (qn > 0).then_some(ParameterList { data: &qbuf[..qn], little_endian: true });
+    let inline_qos = (qn > 0).then_some(ParameterList {
+        data: &qbuf[..qn],
+        little_endian: true,
+    });
     let ts = Ts::Set(c.source_timestamp);
     let len = c.payload.len();
     if len <= frag || frag == 0 {

@@ -103,7 +103,8 @@ impl Emitter<'_> {
 
     fn eq_hash_in(&self, t: &Type, visiting: &mut Vec<DeclId>) -> bool {
         match t {
-            Type::Prim { prim } => !matches!(prim, Prim::F32 | Prim::F64 | Prim::F128),
+            // LongDouble is a byte carrier with Eq and Hash.
+            Type::Prim { prim } => !matches!(prim, Prim::F32 | Prim::F64),
             Type::String { .. } | Type::Fixed { .. } | Type::Error => true,
             Type::Sequence { elem, .. } | Type::Array { elem, .. } => self.eq_hash_in(elem, visiting),
             Type::Map { key, value, .. } => self.eq_hash_in(key, visiting) && self.eq_hash_in(value, visiting),

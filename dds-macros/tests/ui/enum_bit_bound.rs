@@ -1,0 +1,10 @@
+use dds_macros::DdsType;
+
+#[derive(DdsType)]
+#[dds(bit_bound = 40)]
+enum E {
+    A,
+    B,
+}
+
+fn main() {}

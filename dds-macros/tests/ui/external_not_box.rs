@@ -1,0 +1,9 @@
+use dds_macros::DdsType;
+
+#[derive(DdsType)]
+struct S {
+    #[dds(external)]
+    a: u32,
+}
+
+fn main() {}

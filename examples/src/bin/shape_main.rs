@@ -1,0 +1,417 @@
+//! `shape_main`: the OMG DDS interoperability suite's test program (omg-dds/dds-rtps) on our DCPS API.
+//! Same command line, same printed lines, same exit codes (1: bad arguments, 2: initialisation failed,
+//! 3: run failed). Options the stack cannot honour yet print a line containing `not supported`.
+
+use std::collections::HashMap;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use dds_examples::shape_opts::{self, AccessScope, DurabilityArg, FinalInstanceState, Parsed, ShapeOptions};
+use dds_examples::shape_output::{self, NotAlive};
+use dds_examples::shutdown;
+use dds_examples::topic_types::ShapeType;
+use dds_runtime::prelude::*;
+
+const ERROR_PARSING_ARGUMENTS: u8 = 1;
+const ERROR_INITIALIZING: u8 = 2;
+const ERROR_RUNNING: u8 = 3;
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let prog = std::env::args().next().unwrap_or_else(|| "shape_main".into());
+    let options = match shape_opts::parse(&args) {
+        Ok(Parsed::Help) => {
+            print!("{}", shape_opts::usage(&prog));
+            return ExitCode::SUCCESS;
+        }
+        Ok(Parsed::Run { options, warnings }) => {
+            for w in warnings {
+                println!("{w}");
+            }
+            options
+        }
+        Err(e) => {
+            println!("{e}");
+            print!("{}", shape_opts::usage(&prog));
+            return ExitCode::from(ERROR_PARSING_ARGUMENTS);
+        }
+    };
+    shutdown::install();
+    if let Some(line) = unsupported(&options) {
+        println!("{line}");
+        return ExitCode::from(ERROR_INITIALIZING);
+    }
+    let app = match App::init(&options) {
+        Ok(app) => app,
+        Err(e) => {
+            println!("failed to initialize: {e}");
+            return ExitCode::from(ERROR_INITIALIZING);
+        }
+    };
+    let result = match &app.role {
+        Role::Publisher(writers) => run_publisher(&options, writers),
+        Role::Subscriber(readers) => run_subscriber(&options, readers),
+    };
+    match result {
+        Ok(()) => {
+            println!("Done.");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            println!("run failed: {e}");
+            ExitCode::from(ERROR_RUNNING)
+        }
+    }
+}
+
+/// The first option this implementation cannot honour, as shape_main's `... = not supported` line.
+fn unsupported(o: &ShapeOptions) -> Option<String> {
+    if o.coherent {
+        return Some("    Presentation Coherent Access = not supported".into());
+    }
+    if o.ordered {
+        return Some("    Presentation Ordered Access = not supported".into());
+    }
+    if matches!(o.access_scope, Some(AccessScope::Topic | AccessScope::Group)) {
+        return Some("    Presentation Access Scope = not supported".into());
+    }
+    if o.cft_expression.is_some() {
+        return Some("    ContentFilteredTopic expression (--cft) = not supported".into());
+    }
+    if matches!(o.durability, DurabilityArg::Transient | DurabilityArg::Persistent) {
+        return Some("    Durability TRANSIENT/PERSISTENT = not supported".into());
+    }
+    None
+}
+
+enum Role {
+    Publisher(Vec<DataWriter<ShapeType>>),
+    Subscriber(Vec<DataReader<ShapeType>>),
+}
+
+struct App {
+    // Kept alive for the run; dropping it stops the stack's threads.
+    _participant: DomainParticipant,
+    role: Role,
+}
+
+/// Prints the listener lines shape_main's participant listener prints.
+struct Printer {
+    topic: String,
+}
+
+impl DataWriterListener<ShapeType> for Printer {
+    fn on_publication_matched(&self, w: &DataWriter<ShapeType>, st: PublicationMatchedStatus) {
+        println!(
+            "{}",
+            shape_output::publication_matched_line(&self.topic, w.topic().type_name(), st.current_count, st.current_count_change)
+        );
+    }
+    fn on_offered_incompatible_qos(&self, w: &DataWriter<ShapeType>, st: IncompatibleQosStatus) {
+        println!("{}", shape_output::offered_incompatible_line(&self.topic, w.topic().type_name(), st.last_policy_id));
+    }
+}
+
+impl DataReaderListener<ShapeType> for Printer {
+    fn on_subscription_matched(&self, r: &DataReader<ShapeType>, st: SubscriptionMatchedStatus) {
+        println!(
+            "{}",
+            shape_output::subscription_matched_line(&self.topic, r.topic().type_name(), st.current_count, st.current_count_change)
+        );
+    }
+    fn on_requested_incompatible_qos(&self, r: &DataReader<ShapeType>, st: IncompatibleQosStatus) {
+        println!("{}", shape_output::requested_incompatible_line(&self.topic, r.topic().type_name(), st.last_policy_id));
+    }
+}
+
+fn topic_names(o: &ShapeOptions) -> Vec<String> {
+    let base = o.topic.clone().unwrap_or_default();
+    (0..o.num_topics).map(|i| if i == 0 { base.clone() } else { format!("{base}{i}") }).collect()
+}
+
+fn reliability(o: &ShapeOptions) -> Reliability {
+    if o.reliable {
+        Reliability::RELIABLE
+    } else {
+        Reliability::BestEffort
+    }
+}
+
+fn durability(o: &ShapeOptions) -> Durability {
+    match o.durability {
+        DurabilityArg::Volatile => Durability::Volatile,
+        DurabilityArg::TransientLocal => Durability::TransientLocal,
+        DurabilityArg::Transient => Durability::Transient,
+        DurabilityArg::Persistent => Durability::Persistent,
+    }
+}
+
+fn representation(o: &ShapeOptions) -> DataRepresentation {
+    if o.xcdr == 2 {
+        DataRepresentation::xcdr2()
+    } else {
+        DataRepresentation::xcdr1()
+    }
+}
+
+/// `None` keeps the default history.
+fn history(o: &ShapeOptions) -> Option<History> {
+    match o.history_depth {
+        None => None,
+        Some(0) => Some(History::KeepAll),
+        Some(n) => Some(History::KeepLast(n)),
+    }
+}
+
+fn partition(p: &Option<String>) -> Partition {
+    match p {
+        Some(p) => Partition::new([p.as_str()]),
+        None => Partition::default(),
+    }
+}
+
+impl App {
+    fn init(o: &ShapeOptions) -> DdsResult<App> {
+        let mut builder = DomainParticipant::builder().domain_id(o.domain_id);
+        if !o.periodic_announcement.is_zero() {
+            builder = builder.spdp_interval(o.periodic_announcement);
+        }
+        if o.datafrag_size > 0 {
+            builder = builder.fragment_size(o.datafrag_size as usize);
+        }
+        let participant = builder.build()?;
+        let mut topics = Vec::new();
+        for name in topic_names(o) {
+            println!("Create topic: {name}");
+            topics.push(participant.create_topic::<ShapeType>(&name, &TopicQos::default())?);
+        }
+        let role = if o.publish {
+            let publisher = participant.create_publisher(&PublisherQos::builder().partition(partition(&o.partition)).build())?;
+            let mut qos = DataWriterQos::builder()
+                .reliability(reliability(o))
+                .durability(durability(o))
+                .data_representation(representation(o));
+            if let Some(h) = history(o) {
+                qos = qos.history(h);
+            }
+            if let Some(s) = o.ownership_strength {
+                qos = qos.ownership(Ownership::Exclusive).ownership_strength(OwnershipStrength(s));
+            }
+            if !o.deadline.is_zero() {
+                qos = qos.deadline(Deadline(o.deadline));
+            }
+            if !o.lifespan.is_zero() {
+                qos = qos.lifespan(Lifespan(o.lifespan));
+            }
+            if o.final_instance_state == Some(FinalInstanceState::Unregister) {
+                qos = qos.writer_data_lifecycle(WriterDataLifecycle { autodispose_unregistered_instances: false });
+            }
+            let qos = qos.build();
+            let mut writers = Vec::new();
+            for t in &topics {
+                println!("Create writer for topic: {} color: {}", t.name(), o.color.as_deref().unwrap_or("BLUE"));
+                let w = publisher.create_datawriter(t, &qos)?;
+                w.set_listener(Box::new(Printer { topic: t.name().to_string() }));
+                writers.push(w);
+            }
+            Role::Publisher(writers)
+        } else {
+            let subscriber =
+                participant.create_subscriber(&SubscriberQos::builder().partition(partition(&o.partition)).build())?;
+            let mut qos = DataReaderQos::builder()
+                .reliability(reliability(o))
+                .durability(durability(o))
+                .data_representation(representation(o));
+            if let Some(h) = history(o) {
+                qos = qos.history(h);
+            }
+            if o.ownership_strength.is_some() {
+                qos = qos.ownership(Ownership::Exclusive);
+            }
+            if !o.deadline.is_zero() {
+                qos = qos.deadline(Deadline(o.deadline));
+            }
+            if !o.time_filter.is_zero() {
+                qos = qos.time_based_filter(TimeBasedFilter { minimum_separation: o.time_filter });
+            }
+            let qos = qos.build();
+            let mut readers = Vec::new();
+            for t in &topics {
+                // shape_main reads a content-filtered topic "<topic>_filtered" on `color` when -c is
+                // given; the filter is applied when printing (same output).
+                let shown = if o.color.is_some() { format!("{}_filtered", t.name()) } else { t.name().to_string() };
+                println!("Create reader for topic: {shown}");
+                let r = subscriber.create_datareader(t, &qos)?;
+                r.set_listener(Box::new(Printer { topic: t.name().to_string() }));
+                readers.push(r);
+            }
+            Role::Subscriber(readers)
+        };
+        Ok(App { _participant: participant, role })
+    }
+}
+
+/// The interop suite's bouncing shape (shape_main's moveShape).
+struct Mover {
+    xvel: i32,
+    yvel: i32,
+}
+
+const DA_WIDTH: i32 = 240;
+const DA_HEIGHT: i32 = 270;
+
+impl Mover {
+    fn step(&mut self, s: &mut ShapeType) {
+        s.x += self.xvel;
+        s.y += self.yvel;
+        if s.x < 0 {
+            s.x = 0;
+            self.xvel = -self.xvel;
+        }
+        if s.x > DA_WIDTH {
+            s.x = DA_WIDTH;
+            self.xvel = -self.xvel;
+        }
+        if s.y < 0 {
+            s.y = 0;
+            self.yvel = -self.yvel;
+        }
+        if s.y > DA_HEIGHT {
+            s.y = DA_HEIGHT;
+            self.yvel = -self.yvel;
+        }
+    }
+}
+
+/// A small xorshift generator seeded from the clock and pid: positions only need to differ per run.
+fn seed_rng() -> impl FnMut() -> u32 {
+    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(1);
+    let mut state = (nanos as u64) ^ (u64::from(std::process::id()) << 32) | 1;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 16) as u32
+    }
+}
+
+fn instance_colors(o: &ShapeOptions) -> Vec<String> {
+    let base = o.color.clone().unwrap_or_else(|| "BLUE".into());
+    (0..o.num_instances).map(|j| if j == 0 { base.clone() } else { format!("{base}{j}") }).collect()
+}
+
+fn run_publisher(o: &ShapeOptions, writers: &[DataWriter<ShapeType>]) -> DdsResult<()> {
+    let mut rng = seed_rng();
+    let mut shape = ShapeType {
+        color: o.color.clone().unwrap_or_else(|| "BLUE".into()),
+        x: (rng() % DA_WIDTH as u32) as i32,
+        y: (rng() % DA_HEIGHT as u32) as i32,
+        shapesize: o.shapesize,
+        additional_payload_size: vec![255; o.additional_payload_size as usize],
+    };
+    // Velocities 1..=5 in either direction, like shape_main.
+    let mut velocity = || (1 + (rng() % 5) as i32) * if rng() % 2 == 1 { -1 } else { 1 };
+    let mut mover = Mover { xvel: velocity(), yvel: velocity() };
+    let colors = instance_colors(o);
+    let mut n = 0u32;
+    while !shutdown::requested() {
+        mover.step(&mut shape);
+        if o.shapesize == 0 {
+            shape.shapesize = if o.size_modulo > 0 { shape.shapesize % o.size_modulo + 1 } else { shape.shapesize + 1 };
+        }
+        for w in writers {
+            for c in &colors {
+                shape.color.clone_from(c);
+                match w.write(&shape) {
+                    Ok(()) | Err(DdsError::Timeout) => {}
+                    Err(e) => println!("write failed: {e}"),
+                }
+                if o.print_writer_samples {
+                    println!(
+                        "{}",
+                        shape_output::sample_line(
+                            w.topic().name(),
+                            &shape.color,
+                            shape.x,
+                            shape.y,
+                            shape.shapesize,
+                            &shape.additional_payload_size
+                        )
+                    );
+                }
+            }
+        }
+        shutdown::sleep(o.write_period);
+        n += 1;
+        if o.num_iterations != 0 && n >= o.num_iterations {
+            break;
+        }
+    }
+    for w in writers {
+        for c in &colors {
+            shape.color.clone_from(c);
+            match o.final_instance_state {
+                Some(FinalInstanceState::Unregister) => w.unregister_instance(&shape)?,
+                Some(FinalInstanceState::Dispose) => w.dispose(&shape)?,
+                None => {}
+            }
+        }
+    }
+    // Let the readers see the last updates before the process goes away.
+    for w in writers {
+        let _ = w.wait_for_acknowledgments(Duration::from_secs(1));
+    }
+    Ok(())
+}
+
+fn run_subscriber(o: &ShapeOptions, readers: &[DataReader<ShapeType>]) -> DdsResult<()> {
+    // Key of each instance seen with data, to name instances in NOT_ALIVE lines.
+    let mut colors: HashMap<(usize, InstanceHandle), String> = HashMap::new();
+    let mut n = 0u32;
+    while !shutdown::requested() {
+        for (i, r) in readers.iter().enumerate() {
+            let topic = r.topic().name().to_string();
+            let mut previous = InstanceHandle::NIL;
+            loop {
+                let samples = match (o.use_read, o.take_read_next_instance) {
+                    (false, true) => r.take_next_instance(previous)?,
+                    (true, true) => r.read_next_instance(previous)?,
+                    (false, false) => r.take()?,
+                    (true, false) => r.read()?,
+                };
+                let Some(first) = samples.first() else { break };
+                previous = first.info.instance_handle;
+                for s in &samples {
+                    let handle = s.info.instance_handle;
+                    if let Some(d) = &s.data {
+                        colors.insert((i, handle), d.color.clone());
+                        if o.color.as_ref().is_none_or(|c| *c == d.color) {
+                            println!(
+                                "{}",
+                                shape_output::sample_line(&topic, &d.color, d.x, d.y, d.shapesize, &d.additional_payload_size)
+                            );
+                        }
+                    }
+                    let state = match s.info.instance_state {
+                        InstanceState::Alive => continue,
+                        InstanceState::NotAliveDisposed => NotAlive::Disposed,
+                        InstanceState::NotAliveNoWriters => NotAlive::NoWriters,
+                    };
+                    let color = colors.get(&(i, handle)).cloned().unwrap_or_default();
+                    if o.color.as_ref().is_none_or(|c| *c == color) {
+                        println!("{}", shape_output::instance_state_line(&topic, &color, state));
+                    }
+                }
+                if !o.take_read_next_instance {
+                    break;
+                }
+            }
+        }
+        n += 1;
+        if o.num_iterations != 0 && n >= o.num_iterations {
+            break;
+        }
+        shutdown::sleep(o.read_period);
+    }
+    Ok(())
+}

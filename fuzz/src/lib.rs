@@ -1,0 +1,9 @@
+//! Shared code of the fuzz targets (`fuzz_targets/`) and the seed generator (`examples/gen_seeds.rs`).
+
+pub mod cdr;
+mod idl;
+mod rtps;
+
+pub use cdr::cdr_one;
+pub use idl::idl_one;
+pub use rtps::rtps_one;

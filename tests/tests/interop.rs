@@ -1,0 +1,14 @@
+//! Interoperability tests: our release binaries (`shape_main`, `dds-perf`) against Cyclone DDS (python
+//! `cyclonedds` 11), Fast DDS 2.9 (C++ peer in tests/peers/fastdds) and Cyclone's `ddsperf` 0.10.2, plus a
+//! tshark dissection check of our traffic.
+//!
+//! Run (after `cargo build --release --bins`): `scripts/isolated cargo nextest run --profile interop`.
+//! Each test uses its own domain ids; every child process is killed when its test ends. A missing peer
+//! fails the test when `CI=true` and skips it otherwise.
+
+mod interop {
+    pub mod ddsperf;
+    pub mod harness;
+    pub mod shapes;
+    pub mod tshark;
+}
