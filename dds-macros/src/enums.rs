@@ -65,18 +65,28 @@ pub fn derive_enum(
             (None, Some((_, e))) => parse_int_expr(e)?,
             (None, None) => next,
         };
-        if value < 0
-            || value >= (1i64 << bit_bound.min(32)) && bit_bound < 32
-            || value > i64::from(u32::MAX)
-        {
+        // IDL enumerators are signed (int8/int16/int32 holders); accept the unsigned range of the bit bound too.
+        let lo = -(1i64 << (bit_bound - 1));
+        let hi = (1i64 << bit_bound) - 1;
+        if value < lo || value > hi {
             return Err(syn::Error::new_spanned(
                 v,
                 "enumerator value out of range for the bit_bound",
             ));
         }
         next = value + 1;
+        // The value on the wire, in the enum's size (two's complement for negative values).
+        let mask = if size == 4 {
+            u64::from(u32::MAX)
+        } else {
+            (1u64 << (8 * size)) - 1
+        };
+        let wire = (value as u64 & mask) as u32;
+        if values.contains(&wire) {
+            return Err(syn::Error::new_spanned(v, "duplicate enumerator value"));
+        }
         idents.push(v.ident.clone());
-        values.push(value as u32);
+        values.push(wire);
         names.push(va.name.unwrap_or_else(|| v.ident.to_string()));
     }
     let values_i64: Vec<i64> = values.iter().map(|&v| i64::from(v)).collect();
@@ -206,6 +216,7 @@ pub fn derive_union(
     };
     let ext = ta.ext.unwrap_or(Ext::Appendable);
     let ext_t = ext_tokens(&cdr, ext);
+    let disc_is_wchar = matches!(disc, syn::Type::Path(p) if p.path.segments.last().is_some_and(|s| s.ident == "WChar"));
     let mut enc_arms = Vec::new();
     let mut dec_arms = Vec::new();
     let mut all_labels = Vec::new();
@@ -236,7 +247,21 @@ pub fn derive_union(
         let labels: Vec<TokenStream> = va
             .cases
             .iter()
-            .map(|c| quote!(<#disc as #cdr::Discriminator>::to_raw(&(#c))))
+            .map(|c| {
+                // idlc writes wchar labels as char literals.
+                let is_char_lit = matches!(
+                    c,
+                    syn::Expr::Lit(syn::ExprLit {
+                        lit: syn::Lit::Char(_),
+                        ..
+                    })
+                );
+                if is_char_lit && disc_is_wchar {
+                    quote!(<#disc as #cdr::Discriminator>::to_raw(&#cdr::WChar((#c) as u16)))
+                } else {
+                    quote!(<#disc as #cdr::Discriminator>::to_raw(&(#c)))
+                }
+            })
             .collect();
         all_labels.extend(labels.iter().cloned());
         let vname = va.name.clone().unwrap_or_else(|| vi.to_string());

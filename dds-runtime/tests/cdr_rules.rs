@@ -669,3 +669,47 @@ fn errors_say_where_and_what() {
         "{e}"
     );
 }
+
+#[derive(DdsType, Debug, PartialEq, Clone, Copy, Default)]
+#[dds(bit_bound = 16)]
+enum Signed {
+    Low = -32000,
+    #[default]
+    Zero = 0,
+    High = 40000,
+}
+
+#[derive(DdsType, Debug, PartialEq)]
+#[dds(final, discriminator = WChar)]
+enum ByWChar {
+    #[dds(case = 'a')]
+    A(u8),
+    #[dds(default)]
+    Other(u16),
+}
+
+#[test]
+fn negative_enumerators_and_wchar_labels() {
+    #[derive(DdsType, Debug, PartialEq)]
+    #[dds(final)]
+    struct H {
+        s: Signed,
+        t: Signed,
+        w: ByWChar,
+    }
+    // -32000 as a 16-bit two's complement value; 40000 fits the unsigned range of the bound.
+    let v = H {
+        s: Signed::Low,
+        t: Signed::High,
+        w: ByWChar::A(7),
+    };
+    check(&v, Xcdr1, BE, "00 00 00 01 83 00 9c 40 00 61 07 00");
+    check(&v, Xcdr2, LE, "00 07 00 01 00 83 40 9c 61 00 07 00");
+    assert_eq!(<Signed as CdrType>::default_value(), Signed::Zero);
+    let v = H {
+        s: Signed::Zero,
+        t: Signed::Zero,
+        w: ByWChar::Other(1),
+    };
+    check(&v, Xcdr2, LE, "00 07 00 00 00 00 00 00 00 00 01 00");
+}

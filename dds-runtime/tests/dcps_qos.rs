@@ -163,3 +163,88 @@ fn keep_last_depth_applies_per_instance() {
     assert_eq!(red.len(), 3);
     assert!(r.take().unwrap().is_empty());
 }
+
+#[test]
+fn deleting_a_writer_disposes_its_instances() {
+    let p1 = participant(73);
+    let p2 = participant(73);
+    let t1 = p1
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(
+            &t1,
+            &DataWriterQos::builder().reliability(reliable()).build(),
+        )
+        .unwrap();
+    let rq = DataReaderQos::builder()
+        .reliability(reliable())
+        .history(History::KeepLast(5))
+        .build();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&t2, &rq)
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    w.write(&shape("RED", 1)).unwrap();
+    w.write(&shape("BLUE", 1)).unwrap();
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    assert_eq!(r.take().unwrap().len(), 2);
+    drop(w);
+    let mut states = Vec::new();
+    assert!(wait_until(Duration::from_secs(5), || {
+        states.extend(r.take().unwrap().into_iter().map(|s| s.info.instance_state));
+        states.len() >= 2
+    }));
+    assert!(
+        states.iter().all(|s| *s == InstanceState::NotAliveDisposed),
+        "{states:?}"
+    );
+}
+
+#[test]
+fn lifespan_expires_samples_in_the_reader() {
+    let p1 = participant(74);
+    let p2 = participant(74);
+    let t1 = p1
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let wq = DataWriterQos::builder()
+        .reliability(reliable())
+        .lifespan(Duration::from_millis(300))
+        .build();
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(&t1, &wq)
+        .unwrap();
+    let rq = DataReaderQos::builder().reliability(reliable()).build();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&t2, &rq)
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    w.write(&shape("RED", 1)).unwrap();
+    assert!(r.wait_for_data(Duration::from_secs(5)).unwrap());
+    assert_eq!(r.sample_count(), 1);
+    assert!(
+        wait_until(Duration::from_secs(3), || r.sample_count() == 0),
+        "sample did not expire"
+    );
+}

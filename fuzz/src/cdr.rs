@@ -54,11 +54,12 @@ pub enum SmallUnion {
     Other(bool),
 }
 
-/// A mutable struct with optionals, explicit ids and a must-understand member.
+/// A mutable struct with optionals, explicit ids and a must-understand member. Unannotated ids follow the
+/// previous member's (d = 8, e = 9, ...), so the explicit ones must stay clear of them.
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(mutable, name = "Fuzz::Mut")]
 pub struct MutOpt {
-    #[dds(key, id = 10)]
+    #[dds(key, id = 100)]
     pub id: u32,
     #[dds(id = 3)]
     pub a: Option<i16>,

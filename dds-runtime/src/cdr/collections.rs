@@ -394,10 +394,9 @@ impl<K: CdrType + Ord, V: CdrType> CdrType for BTreeMap<K, V> {
 /// `@external` members and recursion.
 impl<T: CdrType> CdrType for Box<T> {
     const LAYOUT: Layout = T::LAYOUT;
-    // Not delegated: a recursive type would make its own minimum size depend on itself.
+    // Not delegated: `@external` is where IDL recursion lives (A -> Box<B> -> A), and constants that looked
+    // through the box would depend on themselves. So an external member counts as final and plain here.
     const MIN_SIZE: usize = 1;
-    const XCDR1_PLAIN: bool = T::XCDR1_PLAIN;
-    const KEY_HAS_MUTABLE: bool = T::KEY_HAS_MUTABLE;
 
     #[inline]
     fn encode(&self, w: &mut CdrWriter<'_>) -> Result<(), EncodeError> {

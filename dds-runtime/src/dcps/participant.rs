@@ -47,6 +47,8 @@ pub(crate) trait ReaderSink: Send + Sync {
 /// The type-erased side of a typed writer.
 pub(crate) trait WriterSink: Send + Sync {
     fn on_event(self: Arc<Self>, ev: &Event);
+    /// Time-driven writer QoS (offered deadline).
+    fn tick(self: Arc<Self>, now: Instant);
 }
 
 /// What we learnt about a remote writer in SEDP that the reader-side QoS needs.
@@ -399,6 +401,16 @@ impl Shared {
                     .values()
                     .cloned()
                     .collect();
+                let writers: Vec<Arc<dyn WriterSink>> = self
+                    .writers
+                    .read()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .values()
+                    .cloned()
+                    .collect();
+                for w in writers {
+                    w.tick(now);
+                }
                 for r in readers {
                     r.tick(now);
                 }

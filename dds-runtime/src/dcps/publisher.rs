@@ -125,6 +125,7 @@ impl Publisher {
         });
         let id = id.map_err(|e| DdsError::Core(e.to_string()))?;
         let handle = Arc::new(WriterHandle {
+            inner: inner.clone(),
             participant: self.participant.clone(),
             topic: topic.clone(),
             publisher: self.clone(),
@@ -142,11 +143,23 @@ impl Publisher {
     }
 }
 
+/// One instance the writer knows (registered or written).
+struct WriterInstance {
+    key: Vec<u8>,
+    /// `cdr::serialize_key` output, sent with dispose/unregister.
+    key_payload: Payload,
+    key_hash: Option<[u8; 16]>,
+    /// Last write, for the offered deadline.
+    last_write: Instant,
+}
+
 #[derive(Default)]
 struct WriterInstances {
     by_key: HashMap<Vec<u8>, InstanceHandle>,
-    by_handle: HashMap<InstanceHandle, (Payload, Option<[u8; 16]>)>,
+    by_handle: HashMap<InstanceHandle, WriterInstance>,
     next: u64,
+    /// Last write of a keyless topic (its single instance), for the offered deadline.
+    keyless_last_write: Option<Instant>,
 }
 
 struct WriterInner<T: DdsType> {
@@ -164,6 +177,7 @@ struct WriterInner<T: DdsType> {
 }
 
 struct WriterHandle<T: DdsType> {
+    inner: Arc<WriterInner<T>>,
     participant: DomainParticipant,
     topic: Topic<T>,
     publisher: Publisher,
@@ -176,7 +190,28 @@ impl<T: DdsType> Drop for WriterHandle<T> {
         shared.unregister_writer(self.id);
         if shared.check_alive().is_ok() {
             let id = self.id;
-            shared.with_core(|c, now| c.delete_writer(now, id));
+            // Like Cyclone: a deleted writer unregisters its instances (disposing them too with
+            // autodispose_unregistered_instances), so readers see the state change, not just the unmatch.
+            let kind = self.inner.unregister_kind();
+            let ts = Some(wire_time(SystemTime::now()));
+            let changes: Vec<WriteChange> = lock(&self.inner.instances)
+                .by_handle
+                .values()
+                .map(|i| WriteChange {
+                    kind,
+                    payload: i.key_payload.clone(),
+                    key_hash: i.key_hash,
+                    source_timestamp: ts,
+                })
+                .collect();
+            shared.with_core(|c, now| {
+                for ch in changes {
+                    if let Err(e) = c.write(now, id, ch) {
+                        tracing::debug!(error = %e, "unregister on delete not sent");
+                    }
+                }
+                c.delete_writer(now, id)
+            });
         }
         tracing::debug!(id = ?self.id, "writer deleted");
     }
@@ -186,9 +221,9 @@ impl<T: DdsType> Drop for WriterHandle<T> {
 /// reliable writer lingers in the core until its data is acknowledged).
 ///
 /// QoS enforced on the writer side by the RTPS core: reliability, durability (volatile, transient-local),
-/// history, resource limits, partitions, ownership strength (announced). Not enforced locally: lifespan
-/// (announced; readers of this crate apply it from reception time), deadline (offered deadline missed is
-/// never raised), liveliness other than automatic.
+/// history, resource limits, partitions, ownership strength (announced). Here: writer data lifecycle
+/// (autodispose on unregister and on deletion), offered deadline missed (checked every 50 ms per instance).
+/// Lifespan is announced and applied by readers. Liveliness other than automatic is not implemented.
 pub struct DataWriter<T: DdsType> {
     inner: Arc<WriterInner<T>>,
     handle: Arc<WriterHandle<T>>,
@@ -313,22 +348,42 @@ impl<T: DdsType> DataWriter<T> {
     /// Publishes `sample` with the given source timestamp.
     pub fn write_w_timestamp(&self, sample: &T, timestamp: SystemTime) -> DdsResult<()> {
         let payload = self.serialize(sample)?;
+        // Keyed writes register the instance, so that deleting the writer can unregister it.
+        let key_hash = if T::IS_KEYED {
+            self.instance_of(sample, true, false)?
+                .and_then(|(_, kh)| kh)
+        } else {
+            None
+        };
         let change = WriteChange {
             kind: ChangeKind::Alive,
             payload: Payload::from(payload),
-            key_hash: self.key_hash(sample)?,
+            key_hash,
             source_timestamp: Some(wire_time(timestamp)),
         };
         tracing::trace!(writer = ?self.id(), "write");
         self.submit(change)
     }
 
-    fn instance_of(&self, sample: &T, create: bool) -> DdsResult<Option<InstanceHandle>> {
+    /// The instance of `sample` (by serialized key) and its key hash; registers it when `create`, and
+    /// records a write when `written`.
+    fn instance_of(
+        &self,
+        sample: &T,
+        create: bool,
+        written: bool,
+    ) -> DdsResult<Option<(InstanceHandle, Option<[u8; 16]>)>> {
         let mut key = Vec::new();
         cdr::instance_key(sample, &mut key)?;
+        let now = Instant::now();
         let mut inst = lock(&self.inner.instances);
-        if let Some(h) = inst.by_key.get(&key) {
-            return Ok(Some(*h));
+        if let Some(h) = inst.by_key.get(&key).copied() {
+            if let Some(i) = inst.by_handle.get_mut(&h) {
+                if written {
+                    i.last_write = now;
+                }
+                return Ok(Some((h, i.key_hash)));
+            }
         }
         if !create {
             return Ok(None);
@@ -338,9 +393,17 @@ impl<T: DdsType> DataWriter<T> {
         let kh = self.key_hash(sample)?;
         inst.next += 1;
         let h = InstanceHandle(inst.next);
-        inst.by_key.insert(key, h);
-        inst.by_handle.insert(h, (Payload::from(kp), kh));
-        Ok(Some(h))
+        inst.by_key.insert(key.clone(), h);
+        inst.by_handle.insert(
+            h,
+            WriterInstance {
+                key,
+                key_payload: Payload::from(kp),
+                key_hash: kh,
+                last_write: now,
+            },
+        );
+        Ok(Some((h, kh)))
     }
 
     /// Registers the instance of `sample` and returns its handle (nothing is sent).
@@ -349,13 +412,13 @@ impl<T: DdsType> DataWriter<T> {
             return Ok(InstanceHandle::NIL);
         }
         Ok(self
-            .instance_of(sample, true)?
-            .unwrap_or(InstanceHandle::NIL))
+            .instance_of(sample, true, false)?
+            .map_or(InstanceHandle::NIL, |(h, _)| h))
     }
 
     /// The handle of the instance of `sample`, if registered (or written through a handle operation).
     pub fn lookup_instance(&self, sample: &T) -> DdsResult<Option<InstanceHandle>> {
-        self.instance_of(sample, false)
+        Ok(self.instance_of(sample, false, false)?.map(|(h, _)| h))
     }
 
     fn key_change(
@@ -369,13 +432,15 @@ impl<T: DdsType> DataWriter<T> {
             return Err(DdsError::PreconditionNotMet("the topic type has no key"));
         }
         let h = match sample {
-            Some(s) => self.instance_of(s, true)?.unwrap_or(InstanceHandle::NIL),
+            Some(s) => self
+                .instance_of(s, true, false)?
+                .map_or(InstanceHandle::NIL, |(h, _)| h),
             None => handle,
         };
         let (payload, key_hash) = {
             let inst = lock(&self.inner.instances);
             match inst.by_handle.get(&h) {
-                Some(v) => v.clone(),
+                Some(i) => (i.key_payload.clone(), i.key_hash),
                 None => {
                     return Err(DdsError::BadParameter(format!(
                         "unknown instance handle {h:?}"
@@ -392,30 +457,18 @@ impl<T: DdsType> DataWriter<T> {
         self.submit(change)?;
         if matches!(kind, ChangeKind::Unregister | ChangeKind::DisposeUnregister) {
             let mut inst = lock(&self.inner.instances);
-            inst.by_handle.remove(&h);
-            inst.by_key.retain(|_, v| *v != h);
+            if let Some(i) = inst.by_handle.remove(&h) {
+                inst.by_key.remove(&i.key);
+            }
         }
         Ok(())
-    }
-
-    fn unregister_kind(&self) -> ChangeKind {
-        if self
-            .inner
-            .qos
-            .writer_data_lifecycle
-            .autodispose_unregistered_instances
-        {
-            ChangeKind::DisposeUnregister
-        } else {
-            ChangeKind::Unregister
-        }
     }
 
     /// Unregisters the instance of `sample`; with `autodispose_unregistered_instances` (the default) it is
     /// disposed too.
     pub fn unregister_instance(&self, sample: &T) -> DdsResult<()> {
         self.key_change(
-            self.unregister_kind(),
+            self.inner.unregister_kind(),
             Some(sample),
             InstanceHandle::NIL,
             SystemTime::now(),
@@ -424,7 +477,12 @@ impl<T: DdsType> DataWriter<T> {
 
     /// Unregisters by handle.
     pub fn unregister_instance_w_handle(&self, handle: InstanceHandle) -> DdsResult<()> {
-        self.key_change(self.unregister_kind(), None, handle, SystemTime::now())
+        self.key_change(
+            self.inner.unregister_kind(),
+            None,
+            handle,
+            SystemTime::now(),
+        )
     }
 
     /// Disposes the instance of `sample`.
@@ -484,9 +542,15 @@ impl<T: DdsType> DataWriter<T> {
         s
     }
 
-    /// OFFERED_DEADLINE_MISSED: not computed yet, always zero.
+    /// OFFERED_DEADLINE_MISSED (resets the change count). Checked every 50 ms per written instance.
     pub fn offered_deadline_missed_status(&self) -> DeadlineMissedStatus {
-        lock(&self.inner.statuses).offered_deadline_missed.clone()
+        let mut st = lock(&self.inner.statuses);
+        let s = st.offered_deadline_missed.clone();
+        st.offered_deadline_missed.total_count_change = 0;
+        self.inner
+            .status_core
+            .clear(StatusMask::OFFERED_DEADLINE_MISSED);
+        s
     }
 
     /// Handles of the matched readers.
@@ -524,6 +588,18 @@ impl<T: DdsType> DataWriter<T> {
 }
 
 impl<T: DdsType> WriterInner<T> {
+    fn unregister_kind(&self) -> ChangeKind {
+        if self
+            .qos
+            .writer_data_lifecycle
+            .autodispose_unregistered_instances
+        {
+            ChangeKind::DisposeUnregister
+        } else {
+            ChangeKind::Unregister
+        }
+    }
+
     fn writer_handle(self: &Arc<Self>) -> Option<DataWriter<T>> {
         let handle = lock(&self.handle).upgrade()?;
         Some(DataWriter {
@@ -534,6 +610,45 @@ impl<T: DdsType> WriterInner<T> {
 }
 
 impl<T: DdsType> WriterSink for WriterInner<T> {
+    fn tick(self: Arc<Self>, now: Instant) {
+        let period = self.qos.deadline.0;
+        if period == crate::qos::INFINITE || period.is_zero() {
+            return;
+        }
+        let mut missed = Vec::new();
+        {
+            let mut inst = lock(&self.instances);
+            for (h, i) in inst.by_handle.iter_mut() {
+                if now.saturating_duration_since(i.last_write) >= period {
+                    i.last_write = now;
+                    missed.push(*h);
+                }
+            }
+            if let Some(t) = inst.keyless_last_write.as_mut() {
+                if now.saturating_duration_since(*t) >= period {
+                    *t = now;
+                    missed.push(InstanceHandle::NIL);
+                }
+            }
+        }
+        if missed.is_empty() {
+            return;
+        }
+        let status = {
+            let mut st = lock(&self.statuses);
+            let dm = &mut st.offered_deadline_missed;
+            dm.total_count += missed.len() as u32;
+            dm.total_count_change += missed.len() as u32;
+            dm.last_instance_handle = *missed.last().unwrap_or(&InstanceHandle::NIL);
+            dm.clone()
+        };
+        self.status_core.raise(StatusMask::OFFERED_DEADLINE_MISSED);
+        let listener = lock(&self.listener).clone();
+        if let (Some(l), Some(w)) = (listener, self.writer_handle()) {
+            l.on_offered_deadline_missed(&w, status);
+        }
+    }
+
     fn on_event(self: Arc<Self>, ev: &Event) {
         let listener = lock(&self.listener).clone();
         match ev {

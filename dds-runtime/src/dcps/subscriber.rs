@@ -184,7 +184,7 @@ impl<T: DdsType> Drop for ReaderHandle<T> {
 /// (max_samples, max_instances, max_samples_per_instance), exclusive ownership (strongest writer, ties to
 /// the lowest GUID), time-based filter (per instance, no delayed delivery of the last filtered sample),
 /// reader data lifecycle (both autopurge delays), lifespan (from the writer's announced lifespan, counted
-/// from reception rather than the source timestamp), requested deadline missed (checked every 50 ms).
+/// from the source timestamp), requested deadline missed (checked every 50 ms).
 /// Not enforced: destination order by source timestamp (reception order is used), presentation
 /// (coherent/ordered access), liveliness kinds other than what the core reports.
 pub struct DataReader<T: DdsType> {
@@ -641,6 +641,7 @@ impl<T: DdsType> ReaderInner<T> {
         now: Instant,
     ) -> Option<Incoming<T>> {
         let rx_time = SystemTime::now();
+        let source_timestamp = system_time(s.source_timestamp);
         let info = self.shared.remote_writer(&s.writer);
         let kind = match s.kind {
             ChangeKind::Alive => ChangeKindLocal::Alive,
@@ -703,10 +704,16 @@ impl<T: DdsType> ReaderInner<T> {
             data,
             key,
             key_holder,
-            source_timestamp: system_time(s.source_timestamp).unwrap_or(rx_time),
+            source_timestamp: source_timestamp.unwrap_or(rx_time),
             reception_timestamp: rx_time,
             strength: info.strength,
-            expires: info.lifespan.and_then(|l| now.checked_add(l)),
+            expires: info.lifespan.and_then(|l| {
+                // Lifespan counts from the source timestamp; its age so far is spent already.
+                let age = source_timestamp
+                    .and_then(|t| rx_time.duration_since(t).ok())
+                    .unwrap_or_default();
+                now.checked_add(l.saturating_sub(age))
+            }),
         })
     }
 

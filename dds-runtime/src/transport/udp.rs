@@ -75,12 +75,43 @@ fn new_udp() -> io::Result<Socket> {
 }
 
 fn set_buffers(s: &Socket, size: usize) {
-    // The kernel caps these at rmem_max/wmem_max; a smaller buffer is not an error, only slower.
+    // The kernel caps SO_RCVBUF/SO_SNDBUF at rmem_max/wmem_max; with CAP_NET_ADMIN the *FORCE variants
+    // go beyond. A smaller buffer is not an error, only lossier under bursts.
     if let Err(e) = s.set_recv_buffer_size(size) {
         tracing::debug!(error = %e, "SO_RCVBUF not applied");
     }
     if let Err(e) = s.set_send_buffer_size(size) {
         tracing::debug!(error = %e, "SO_SNDBUF not applied");
+    }
+    // Linux reports twice the requested value.
+    if s.recv_buffer_size().unwrap_or(0) < size {
+        force_buffer(s, libc::SO_RCVBUFFORCE, size);
+    }
+    if s.send_buffer_size().unwrap_or(0) < size {
+        force_buffer(s, libc::SO_SNDBUFFORCE, size);
+    }
+    tracing::debug!(
+        rcvbuf = s.recv_buffer_size().unwrap_or(0),
+        sndbuf = s.send_buffer_size().unwrap_or(0),
+        "socket buffers"
+    );
+}
+
+fn force_buffer(s: &Socket, opt: libc::c_int, size: usize) {
+    use std::os::fd::AsRawFd;
+    let v = libc::c_int::try_from(size).unwrap_or(libc::c_int::MAX);
+    // SAFETY: plain setsockopt on a valid descriptor with a c_int option value of the right length.
+    let r = unsafe {
+        libc::setsockopt(
+            s.as_raw_fd(),
+            libc::SOL_SOCKET,
+            opt,
+            (&v as *const libc::c_int).cast(),
+            std::mem::size_of::<libc::c_int>() as libc::socklen_t,
+        )
+    };
+    if r != 0 {
+        tracing::trace!(error = %io::Error::last_os_error(), opt, "forced socket buffer size not applied");
     }
 }
 

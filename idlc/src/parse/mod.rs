@@ -29,8 +29,14 @@ pub fn parse(pp: &Output, diags: &mut Diagnostics) -> Spec {
             let spec = pairs.next().expect("specification rule always produces a pair");
             build::Builder::new(pp, diags).specification(spec)
         }
-        Err(e) => {
-            diags.push(syntax_error(pp, &e));
+        Err(_) => {
+            // Parse again with pest's detailed tracking of expected tokens, which costs time only on failure.
+            pest::set_error_detail(true);
+            let detailed = IdlParser::parse(Rule::specification, &pp.text);
+            pest::set_error_detail(false);
+            if let Err(e) = detailed {
+                diags.push(syntax_error(pp, &e));
+            }
             Spec::default()
         }
     }
@@ -102,7 +108,7 @@ fn rule_name(r: Rule) -> Option<&'static str> {
 }
 
 fn syntax_error(pp: &Output, e: &pest::error::Error<Rule>) -> Diagnostic {
-    let pos = match e.location {
+    let mut pos = match e.location {
         InputLocation::Pos(p) => p,
         InputLocation::Span((s, _)) => s,
     };
@@ -115,23 +121,42 @@ fn syntax_error(pp: &Output, e: &pest::error::Error<Rule>) -> Diagnostic {
         }
     }
     if let Some(att) = e.parse_attempts() {
+        // Literal tokens (`;`, `}`) can fail further right than any rule: report the furthest point.
+        let mut further = Vec::new();
+        for cs in att.call_stacks() {
+            if let Some(n) = cs.parent.and_then(rule_name) {
+                further.push(n.to_string());
+            }
+        }
         for t in att.expected_tokens() {
             // `ParsingToken` is not exported; its Display is the token text.
             let token = t.to_string();
-            if !token.is_empty() && token.chars().all(|c| c.is_ascii_punctuation()) && token != "_" && token != "#" {
-                expected.push(format!("`{token}`"));
+            let punct = token.chars().all(|c| c.is_ascii_punctuation());
+            if !token.is_empty() && punct && !matches!(token.as_str(), "_" | "#" | "/*" | "//") {
+                further.push(format!("`{token}`"));
             }
+        }
+        if att.max_position > pos && !further.is_empty() {
+            expected = further;
+            pos = att.max_position;
+        } else if att.max_position == pos {
+            expected.extend(further);
         }
     }
     expected.sort();
     expected.dedup();
     // The closing brace is usually the meaningful alternative; the list of "definition", "type", etc. is noise.
     let found = found_token(&pp.text, pos);
+    let mut last_is_ident = false;
     let msg = match expected.len() {
         0 => format!("unexpected {found}"),
-        1 => format!("expected {}, found {found}", expected[0]),
+        1 => {
+            last_is_ident = expected[0] == "identifier";
+            format!("expected {}, found {found}", expected[0])
+        }
         _ => {
             let last = expected.pop().unwrap_or_default();
+            last_is_ident = last == "identifier";
             format!("expected one of {} or {last}, found {found}", expected.join(", "))
         }
     };
@@ -139,6 +164,10 @@ fn syntax_error(pp: &Output, e: &pest::error::Error<Rule>) -> Diagnostic {
     let loc = pp.map.loc(pos, (pos + len).min(pp.text.len().max(pos + 1)));
     let mut d = Diagnostic::error(Code::Syntax, msg).at(loc, "unexpected here");
     let word = &pp.text[pos..pos + found_len(&pp.text, pos)];
+    let wants_name = expected.iter().any(|e| e == "identifier" || e == "declarator") || last_is_ident;
+    if !wants_name {
+        return d;
+    }
     if KEYWORDS.contains(&word) {
         d = d.help(format!("`{word}` is a keyword; to use it as a name write `_{word}`"));
     } else if let Some(kw) = KEYWORDS.iter().find(|k| !word.is_empty() && k.eq_ignore_ascii_case(word)) {

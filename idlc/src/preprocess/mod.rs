@@ -19,6 +19,9 @@ use std::path::{Path, PathBuf};
 
 const MAX_INCLUDE_DEPTH: usize = 64;
 const MAX_OUTPUT: usize = 256 << 20;
+/// Longest single token (identifier, number, literal). Real IDL never comes close; the parser's cost per
+/// byte is high, so longer tokens are refused up front.
+const MAX_TOKEN: usize = 1 << 20;
 
 #[derive(Clone, Debug, Default)]
 pub struct Options {
@@ -337,6 +340,7 @@ impl<'a> Preprocessor<'a> {
                 i += 2;
             } else if c == b'"' || c == b'\'' {
                 match lex::literal_len(&b[i..to]) {
+                    Some(n) if n > MAX_TOKEN => return self.token_too_long(file, i, n),
                     Some(n) => i += n,
                     None => {
                         let what = if c == b'"' { "string literal" } else { "character literal" };
@@ -345,11 +349,18 @@ impl<'a> Preprocessor<'a> {
                     }
                 }
             } else if c.is_ascii_digit() {
-                i += lex::number_len(&b[i..to]);
+                let n = lex::number_len(&b[i..to]);
+                if n > MAX_TOKEN {
+                    return self.token_too_long(file, i, n);
+                }
+                i += n;
             } else if is_ident_start(c) {
                 let mut j = i + 1;
                 while j < to && is_ident_char(b[j]) {
                     j += 1;
+                }
+                if j - i > MAX_TOKEN {
+                    return self.token_too_long(file, i, j - i);
                 }
                 let name = &text[i..j];
                 if self.macros.is_defined(name) {
@@ -394,6 +405,11 @@ impl<'a> Preprocessor<'a> {
             }
         }
         self.emit_copy(file, text, copy_from, to);
+    }
+
+    fn token_too_long(&mut self, file: FileId, at: usize, len: usize) {
+        self.err(Code::Limit, Loc::new(file, at, at + 16), format!("token of {len} bytes exceeds the {MAX_TOKEN}-byte limit"), "this token");
+        self.too_big = true;
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -85,7 +85,7 @@ impl<'a> Resolver<'a> {
                 let (code, msg) = if prev.name == name.name {
                     (Code::Duplicate, format!("`{}` is declared twice in this scope", name.name))
                 } else {
-                    (Code::CaseCollision, format!("`{}` collides with `{}`: IDL names differ by more than case", name.name, prev.name))
+                    (Code::CaseCollision, format!("`{}` collides with `{}`: IDL names must differ by more than case", name.name, prev.name))
                 };
                 self.diags.push(Diagnostic::error(code, msg).at(name.loc, "redeclared here").also(prev.loc, "first declared here"));
                 false

@@ -69,7 +69,7 @@ fn check_struct(model: &Model, _id: DeclId, s: &Struct, diags: &mut Diagnostics)
             let (code, msg) = if prev.name == f.name {
                 (Code::DuplicateMember, format!("member `{}` is declared twice", f.name))
             } else {
-                (Code::CaseCollision, format!("member `{}` collides with `{}`: names differ by more than case", f.name, prev.name))
+                (Code::CaseCollision, format!("member `{}` collides with `{}`: names must differ by more than case", f.name, prev.name))
             };
             diags.push(Diagnostic::error(code, msg).at(f.loc, "redeclared here").also(prev.loc, "first declared here"));
         } else {

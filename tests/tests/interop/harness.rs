@@ -44,9 +44,11 @@ pub fn require_netns() -> Result<(), Skip> {
     )
 }
 
-/// One of our release binaries (`cargo build --release` first).
+/// One of our release binaries (`cargo build --release` first); `INTEROP_BIN_DIR` points elsewhere
+/// (e.g. target/debug) when iterating.
 pub fn our_bin(name: &str) -> Result<PathBuf, Skip> {
-    let p = root().join("target/release").join(name);
+    let dir = std::env::var_os("INTEROP_BIN_DIR").map(PathBuf::from).unwrap_or_else(|| root().join("target/release"));
+    let p = dir.join(name);
     require(p.is_file(), &format!("{} not built (cargo build --release --bins)", p.display()))?;
     Ok(p)
 }

@@ -525,7 +525,8 @@ impl<'a> Emitter<'a> {
     fn label_expr(&self, v: &Value) -> String {
         match v {
             Value::Int(i) => i.to_string(),
-            Value::Char(c) | Value::WChar(c) => format!("{c:?}"),
+            Value::Char(c) => format!("{c:?}"),
+            Value::WChar(c) => format!("{}::cdr::WChar({})", self.opts.runtime_crate, *c as u32),
             Value::Bool(b) => b.to_string(),
             Value::Enum(d, i) => self.enumerator_path(*d, *i),
             other => format!("{other:?}"),
