@@ -5,11 +5,11 @@
 //! The corpus lives outside the repository, so everything here is optional: without it nothing is generated and
 //! the test prints that it skipped. A file idlc rejects does not break the build (the other test binaries of this
 //! crate share this script): its diagnostics go to `$OUT_DIR/<stem>.idlc-error` and the test for its types fails
-//! with them. Each accepted file gets `--cfg idlc_ok="<stem>"`.
+//! with them. Each accepted file gets `--cfg idlc_ok="<stem>"` (`"final/<stem>"` for the second compilation).
 use std::path::{Path, PathBuf};
 
-/// (include root relative to the corpus, file relative to that root). Stems must be unique: idlc writes
-/// `<stem>.rs`.
+/// (include root relative to the corpus, file relative to that root). idlc writes `<stem>.rs`, so stems must be
+/// unique.
 const FILES: &[(&str, &str)] = &[
     ("omg-dds-rtps/srcCxx", "shape.idl"),
     ("cyclonedds/src/tools/ddsperf", "ddsperf_types.idl"),
@@ -23,6 +23,24 @@ const FILES: &[(&str, &str)] = &[
     ("eprosima-dds-types-test/IDL", "optional.idl"),
     ("eprosima-dds-types-test/IDL", "arrays.idl"),
     ("eprosima-dds-types-test/IDL", "sequences.idl"),
+    ("cyclonedds/src/core/ddsc/tests", "CdrStreamKeyExt.idl"),
+    ("cyclonedds/src/core/ddsc/tests", "CdrStreamSignedUnion.idl"),
+    ("cyclonedds/src/tools/idlc/xtests", "test_struct_keys.idl"),
+    (
+        "cyclonedds/src/tools/idlc/xtests",
+        "test_struct_inherit_mutable_keys.idl",
+    ),
+    ("rti-ros-data-types", "geometry_msgs/msg/PoseStamped.idl"),
+    ("rti-ros-data-types", "sensor_msgs/msg/Imu.idl"),
+    (
+        "rti-ros-data-types",
+        "diagnostic_msgs/msg/DiagnosticStatus.idl",
+    ),
+];
+
+/// Compiled a second time with unannotated types @final (Cyclone idlc's default, so what a ROS 2 node on
+/// rmw_cyclonedds uses), into `$OUT_DIR/final/`.
+const FINAL_FILES: &[(&str, &str)] = &[
     ("rti-ros-data-types", "geometry_msgs/msg/PoseStamped.idl"),
     ("rti-ros-data-types", "sensor_msgs/msg/Imu.idl"),
     (
@@ -49,15 +67,46 @@ fn stem(file: &str) -> String {
         .unwrap_or_default()
 }
 
+/// Compiles one file; `key` (`<stem>` or `final/<stem>`) names its output under `$OUT_DIR` and its cfg value.
+fn compile(corpus: &Path, out: &Path, (root, file): (&str, &str), key: &str, final_default: bool) {
+    let root = corpus.join(root);
+    let path = root.join(file);
+    let err_path = out.join(format!("{key}.idlc-error"));
+    let _ = std::fs::remove_file(&err_path);
+    let out_dir = err_path.parent().unwrap_or(out).to_path_buf();
+    let _ = std::fs::create_dir_all(&out_dir);
+    let mut builder = idlc::Builder::new().include_dir(&root).out_dir(&out_dir);
+    if final_default {
+        builder = builder.default_extensibility(idlc::model::Extensibility::Final);
+    }
+    match builder.compile(&[&path]) {
+        Ok(()) => println!("cargo::rustc-cfg=idlc_ok={key:?}"),
+        Err(e) => {
+            println!(
+                "cargo::warning=idlc rejects {}: see {}",
+                path.display(),
+                err_path.display()
+            );
+            let _ = std::fs::write(&err_path, e.to_string());
+        }
+    }
+}
+
 fn main() {
-    println!("cargo::rustc-check-cfg=cfg(idl_corpus)");
-    let stems: Vec<String> = FILES
+    let keys: Vec<String> = FILES
         .iter()
-        .map(|(_, f)| format!("{:?}", stem(f)))
+        .map(|(_, f)| stem(f))
+        .chain(
+            FINAL_FILES
+                .iter()
+                .map(|(_, f)| format!("final/{}", stem(f))),
+        )
         .collect();
+    let values: Vec<String> = keys.iter().map(|k| format!("{k:?}")).collect();
+    println!("cargo::rustc-check-cfg=cfg(idl_corpus)");
     println!(
         "cargo::rustc-check-cfg=cfg(idlc_ok, values({}))",
-        stems.join(", ")
+        values.join(", ")
     );
     println!("cargo::rerun-if-env-changed=DDS_IDL_CORPUS");
     println!("cargo::rerun-if-changed=build.rs");
@@ -73,23 +122,17 @@ fn main() {
     }
     println!("cargo::rustc-cfg=idl_corpus");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
-    for (root, file) in FILES {
-        let root = corpus.join(root);
-        let path = root.join(file);
-        let stem = stem(file);
-        let err_path = out.join(format!("{stem}.idlc-error"));
-        let _ = std::fs::remove_file(&err_path);
-        // Each file alone, so one rejected file does not hide the others.
-        match idlc::Builder::new().include_dir(&root).compile(&[&path]) {
-            Ok(()) => println!("cargo::rustc-cfg=idlc_ok={stem:?}"),
-            Err(e) => {
-                println!(
-                    "cargo::warning=idlc rejects {}: see {}",
-                    path.display(),
-                    err_path.display()
-                );
-                let _ = std::fs::write(&err_path, e.to_string());
-            }
-        }
+    // Each file alone, so that one rejected file does not hide the others.
+    for &entry in FILES {
+        compile(&corpus, &out, entry, &stem(entry.1), false);
+    }
+    for &entry in FINAL_FILES {
+        compile(
+            &corpus,
+            &out,
+            entry,
+            &format!("final/{}", stem(entry.1)),
+            true,
+        );
     }
 }

@@ -45,7 +45,10 @@ macro_rules! key_props {
             let mut w = v.clone();
             w.s.push('x');
             w.o = w.o.wrapping_add(1);
-            prop_assert_eq!(key_hash(&v, version).unwrap(), key_hash(&w, version).unwrap());
+            prop_assert_eq!(
+                key_hash(&v, version).unwrap(),
+                key_hash(&w, version).unwrap()
+            );
             let (mut a, mut b) = (Vec::new(), Vec::new());
             instance_key(&v, &mut a).unwrap();
             instance_key(&w, &mut b).unwrap();
@@ -97,4 +100,74 @@ struct Seqs {
     b: Vec<i16>,
     c: Vec<u8>,
     d: Vec<f32>,
+}
+
+#[derive(dds_runtime::DdsType, Debug, PartialEq, Clone)]
+#[dds(mutable)]
+struct Base {
+    #[dds(key)]
+    id: u16,
+    name: String,
+}
+
+#[derive(dds_runtime::DdsType, Debug, PartialEq, Clone)]
+#[dds(mutable)]
+struct Derived {
+    #[dds(base)]
+    base: Base,
+    extra: Option<Vec<i8>>,
+    #[dds(id = 40)]
+    late: u64,
+}
+
+#[derive(dds_runtime::DdsType, Debug, PartialEq, Clone)]
+#[dds(appendable)]
+struct Tree {
+    label: u8,
+    kids: Vec<Tree>,
+    #[dds(external)]
+    link: Option<Box<Tree>>,
+}
+
+fn tree() -> impl Strategy<Value = Tree> {
+    let leaf = any::<u8>().prop_map(|label| Tree {
+        label,
+        kids: vec![],
+        link: None,
+    });
+    leaf.prop_recursive(4, 24, 3, |inner| {
+        (
+            any::<u8>(),
+            proptest::collection::vec(inner.clone(), 0..3),
+            proptest::option::of(inner),
+        )
+            .prop_map(|(label, kids, link)| Tree {
+                label,
+                kids,
+                link: link.map(Box::new),
+            })
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn inheritance_and_recursion_round_trip(
+        id in any::<u16>(),
+        name in "[a-z]{0,6}",
+        extra in proptest::option::of(proptest::collection::vec(any::<i8>(), 0..4)),
+        late in any::<u64>(),
+        t in tree(),
+    ) {
+        let d = Derived { base: Base { id, name }, extra, late };
+        all_encodings(&d)?;
+        all_encodings(&t)?;
+        let mut k = Vec::new();
+        serialize_key(&d, XcdrVersion::Xcdr2, ByteOrder::BigEndian, &mut k).unwrap();
+        let back: Derived = deserialize_key(&k).unwrap();
+        prop_assert_eq!(back.base.id, id);
+        let h = key_hash(&d, XcdrVersion::Xcdr2).unwrap();
+        prop_assert_eq!(&h[..2], &id.to_be_bytes()[..]);
+    }
 }

@@ -363,3 +363,141 @@ fn content_filtered_topic_filters_on_the_reader() {
         .collect();
     assert_eq!(xs, vec![("RED".to_string(), 11), ("RED".to_string(), 20)]);
 }
+
+#[test]
+fn data_representation_xcdr1_and_xcdr2_both_reach_a_default_reader() {
+    let p1 = participant(28);
+    let p2 = participant(28);
+    let t1 = p1
+        .create_topic::<Blob>("Reps", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<Blob>("Reps", &TopicQos::default())
+        .unwrap();
+    let publ = p1.create_publisher(&PublisherQos::default()).unwrap();
+    let q = |rep: DataRepresentation| {
+        DataWriterQos::builder()
+            .reliability(reliable())
+            .data_representation(rep)
+            .build()
+    };
+    let w1 = publ
+        .create_datawriter(&t1, &q(DataRepresentation::xcdr1()))
+        .unwrap();
+    let w2 = publ
+        .create_datawriter(&t1, &q(DataRepresentation::xcdr2()))
+        .unwrap();
+    let wd = publ
+        .create_datawriter(&t1, &q(DataRepresentation::default()))
+        .unwrap();
+    assert_eq!(w1.data_representation(), XcdrVersion::Xcdr1);
+    assert_eq!(w2.data_representation(), XcdrVersion::Xcdr2);
+    assert_eq!(
+        wd.data_representation(),
+        XcdrVersion::Xcdr1,
+        "@final without optionals: XCDR1 like Cyclone"
+    );
+    let rq = DataReaderQos::builder()
+        .reliability(reliable())
+        .history(History::KeepAll)
+        .build();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&t2, &rq)
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || r
+        .subscription_matched_status()
+        .current_count
+        == 3));
+    for (i, w) in [&w1, &w2].into_iter().enumerate() {
+        assert!(wait_until(MATCH_TIMEOUT, || w
+            .publication_matched_status()
+            .current_count
+            == 1));
+        w.write(&Blob {
+            id: i as u32,
+            data: vec![i as u8; 3],
+        })
+        .unwrap();
+    }
+    let mut got = Vec::new();
+    assert!(wait_until(Duration::from_secs(5), || {
+        got.extend(r.take().unwrap().into_iter().filter_map(|s| s.data));
+        got.len() == 2
+    }));
+    got.sort_by_key(|b| b.id);
+    assert_eq!(
+        got,
+        vec![
+            Blob {
+                id: 0,
+                data: vec![0; 3]
+            },
+            Blob {
+                id: 1,
+                data: vec![1; 3]
+            }
+        ]
+    );
+}
+
+#[test]
+fn flow_control_blocks_and_resumes_without_loss() {
+    let p1 = participant(29);
+    let p2 = participant(29);
+    let t1 = p1
+        .create_topic::<Blob>("Flow", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<Blob>("Flow", &TopicQos::default())
+        .unwrap();
+    let q = DataWriterQos::builder()
+        .reliability(Reliability::Reliable {
+            max_blocking_time: Duration::from_secs(5),
+        })
+        .history(History::KeepAll)
+        .build();
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(&t1, &q)
+        .unwrap();
+    let rq = DataReaderQos::builder()
+        .reliability(reliable())
+        .history(History::KeepAll)
+        .build();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&t2, &rq)
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    // 4 MB in 1 KiB samples: well above the writer's unacknowledged-bytes high watermark.
+    const N: u32 = 4000;
+    let reader = std::thread::spawn(move || {
+        let mut next = 0u32;
+        while next < N && r.wait_for_data(Duration::from_secs(10)).unwrap() {
+            for s in r.take().unwrap() {
+                let b = s.data.unwrap();
+                assert_eq!(b.id, next, "in order, no loss");
+                next += 1;
+            }
+        }
+        next
+    });
+    let start = std::time::Instant::now();
+    for i in 0..N {
+        w.write(&Blob {
+            id: i,
+            data: vec![(i % 251) as u8; 1024],
+        })
+        .unwrap();
+    }
+    w.wait_for_acknowledgments(Duration::from_secs(20)).unwrap();
+    assert_eq!(reader.join().unwrap(), N);
+    eprintln!("{N} x 1 KiB reliable in {:?}", start.elapsed());
+}

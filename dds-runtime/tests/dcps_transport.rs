@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use dcps_util::*;
 use dds_runtime::config::{Config, InterfaceSelection, ParticipantIndex};
-use dds_runtime::transport::{ports, Channel, UdpTransport};
+use dds_runtime::transport::{ports, Channel, Datagram, UdpTransport};
 
 fn cfg(domain: u32, index: ParticipantIndex) -> Config {
     Config {
@@ -47,9 +47,11 @@ fn auto_index_probes_and_multicast_reaches_every_participant() {
     let counts: Vec<Arc<AtomicUsize>> = (0..3).map(|_| Arc::new(AtomicUsize::new(0))).collect();
     for (t, n) in [&a, &b, &c].into_iter().zip(&counts) {
         let n = n.clone();
-        t.start(Arc::new(move |ch, data, _from| {
-            if ch == Channel::SpdpMulticast && data == b"hello" {
-                n.fetch_add(1, Ordering::SeqCst);
+        t.start(Arc::new(move |ch, batch: &[Datagram<'_>]| {
+            for d in batch {
+                if ch == Channel::SpdpMulticast && d.data == b"hello" {
+                    n.fetch_add(1, Ordering::SeqCst);
+                }
             }
         }))
         .unwrap();
@@ -64,9 +66,9 @@ fn auto_index_probes_and_multicast_reaches_every_participant() {
     drop(c);
     let d = UdpTransport::bind(&cfg(51, ParticipantIndex::None)).unwrap();
     let g = got.clone();
-    d.start(Arc::new(move |ch, _data, _from| {
+    d.start(Arc::new(move |ch, batch: &[Datagram<'_>]| {
         if ch == Channel::MetaUnicast {
-            g.fetch_add(1, Ordering::SeqCst);
+            g.fetch_add(batch.len(), Ordering::SeqCst);
         }
     }))
     .unwrap();

@@ -1,3 +1,4 @@
+#![deny(warnings)]
 //! Byte-exact vectors produced by Cyclone DDS 11.0.1's Python serializer (`IdlStruct.serialize`,
 //! `__idl__.serialize_key`). Our payloads are padded to 4 bytes with the count in the header options (as
 //! Cyclone's C core writes them); the Python serializer leaves them unpadded, so bodies are compared.
@@ -222,7 +223,12 @@ fn enums_and_bitmasks_by_bit_bound() {
         sb: vec![B8::X],
     };
     // XCDR1 as libddsc writes it: e8 1 byte, e16 2 bytes (aligned 2), b8, b40 aligned to 8.
-    check(&v, XcdrVersion::Xcdr1, ByteOrder::LittleEndian, "00 01 00 00 01 00 01 00 03 00 00 00 01 00 00 00 00 00 00 00 01 00 00 00 01");
+    check(
+        &v,
+        XcdrVersion::Xcdr1,
+        ByteOrder::LittleEndian,
+        "00 01 00 00 01 00 01 00 03 00 00 00 01 00 00 00 00 00 00 00 01 00 00 00 01",
+    );
     check(
         &v,
         XcdrVersion::Xcdr2,
@@ -327,7 +333,12 @@ fn unions_with_cases_and_default_discriminators() {
         m: Um::D(1),
         x: Ua::A(3),
     };
-    check(&v, XcdrVersion::Xcdr1, ByteOrder::LittleEndian, "00 01 00 00 01 00 00 00 02 00 00 00 71 00 ff ff 01 01 00 00 03 00 00 00");
+    check(
+        &v,
+        XcdrVersion::Xcdr1,
+        ByteOrder::LittleEndian,
+        "00 01 00 00 01 00 00 00 02 00 00 00 71 00 ff ff 01 01 00 00 03 00 00 00",
+    );
     check(&v, XcdrVersion::Xcdr2, ByteOrder::LittleEndian, "00 07 00 00 01 00 00 00 02 00 00 00 71 00 ff ff 01 00 00 00 08 00 00 00 01 00 00 00 03 00 00 00");
     let python = hex("00 07 00 00 03 00 00 00 02 00 00 00 71 00 ff ff 01 00 00 00 08 00 00 00 01 00 00 00 03 00 00 00");
     assert_eq!(deserialize::<Unions>(&python).unwrap(), v);
@@ -502,15 +513,30 @@ fn key_hashes_follow_cyclone() {
         z: KeyIn2 { p: 3, q: 4 },
         s: "x".into(),
     };
-    assert_eq!(key_hash(&n, XcdrVersion::Xcdr2).unwrap(), padded("00 02 03 00 00 04"));
+    assert_eq!(
+        key_hash(&n, XcdrVersion::Xcdr2).unwrap(),
+        padded("00 02 03 00 00 04")
+    );
     // Member-id order in both versions.
     let k2 = KeyIdOrder { a: 5, b: 7 };
-    assert_eq!(key_hash(&k2, XcdrVersion::Xcdr1).unwrap(), padded("00 00 00 07 05"));
-    assert_eq!(key_hash(&k2, XcdrVersion::Xcdr2).unwrap(), padded("00 00 00 07 05"));
+    assert_eq!(
+        key_hash(&k2, XcdrVersion::Xcdr1).unwrap(),
+        padded("00 00 00 07 05")
+    );
+    assert_eq!(
+        key_hash(&k2, XcdrVersion::Xcdr2).unwrap(),
+        padded("00 00 00 07 05")
+    );
     // Unbounded key: MD5 over the key bytes as they are (not zero-padded first, unlike the Python sertype).
     let sk = KeyString { s: "abc".into() };
-    assert_eq!(key_hash(&sk, XcdrVersion::Xcdr1).unwrap(), md5("00 00 00 04 61 62 63 00"));
+    assert_eq!(
+        key_hash(&sk, XcdrVersion::Xcdr1).unwrap(),
+        md5("00 00 00 04 61 62 63 00")
+    );
     // Unkeyed types hash to zero.
-    assert_eq!(key_hash(&Appendable { a: 1, b: 2 }, XcdrVersion::Xcdr2).unwrap(), [0; 16]);
+    assert_eq!(
+        key_hash(&Appendable { a: 1, b: 2 }, XcdrVersion::Xcdr2).unwrap(),
+        [0; 16]
+    );
     const { assert!(!Appendable::IS_KEYED && KeyString::IS_KEYED) };
 }

@@ -536,3 +536,43 @@ fn deleted_writer_lingers_until_acknowledged() {
                 matched: false
             })));
 }
+
+#[test]
+fn keep_last_writer_under_loss_converges_to_the_latest() {
+    for seed in 0..100u64 {
+        let wq = DataWriterQos::builder()
+            .history(History::KeepLast(1))
+            .build();
+        let rq = DataReaderQos::builder()
+            .reliability(Reliability::RELIABLE)
+            .build();
+        let mut s = setup(seed, Faults::lossy(0.3), wq, rq);
+        let now = s.sim.now;
+        for i in 0..30 {
+            // All the same instance (keyless): only the last one must survive.
+            s.sim.nodes[0]
+                .p
+                .write(now, s.w, WriteChange::alive(sample(i, 24)))
+                .unwrap();
+        }
+        let (w, r) = (s.w, s.r);
+        let mut got = Vec::new();
+        assert!(
+            s.sim.run_until(Duration::from_secs(30), |sim| {
+                got.extend(sim.take_samples(1, r));
+                sim.nodes[0].p.is_acknowledged(w)
+            }),
+            "seed {seed}"
+        );
+        got.extend(s.sim.take_samples(1, r));
+        assert!(
+            got.windows(2).all(|x| x[0].sequence < x[1].sequence),
+            "seed {seed}"
+        );
+        assert_eq!(
+            got.last().map(|x| index_of(&x.payload)),
+            Some(29),
+            "seed {seed}"
+        );
+    }
+}

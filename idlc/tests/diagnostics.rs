@@ -55,6 +55,7 @@ diag_test!(zero_string_bound, "E0304", "struct A { string<0> s; };\n");
 // ---- types ----
 diag_test!(duplicate_union_label, "E0401", "union U switch (long) {\n  case 1: long a;\n  case 2: case 1: short b;\n};\n");
 diag_test!(several_default_labels, "E0402", "union U switch (long) {\n  default: long a;\n  case 1: default: short b;\n};\n");
+diag_test!(unreachable_default, "E0415", "enum Bit { ZERO, ONE };\nunion U switch (Bit) {\n  case ZERO: long a;\n  case ONE: short b;\n  default: octet c;\n};\n");
 diag_test!(label_of_wrong_enum, "E0403", "enum Color { RED, GREEN };\nenum Shape { SQUARE, CIRCLE };\nunion U switch (Color) {\n  case SQUARE: long a;\n};\n");
 diag_test!(label_out_of_range, "E0403", "union U switch (octet) {\n  case 300: long a;\n};\n");
 diag_test!(float_discriminator, "E0404", "union U switch (float) {\n  case 1: long a;\n};\n");

@@ -28,27 +28,57 @@ I64_MIN, I64_MAX = -2**63, 2**63 - 1
 T = std_msgs_msg_Time
 
 
-def header(sec, nsec, frame):
+def header(sec, nsec, frame, final_=False):
+    if final_:
+        return std_msgs_msg_Header_F(stamp=std_msgs_msg_Time_F(sec=sec, nanosec=nsec), frame_id=frame)
     return std_msgs_msg_Header(stamp=T(sec=sec, nanosec=nsec), frame_id=frame)
+
+
+def ros_samples(final_):
+    """The ROS samples, as @appendable types (our idlc's default) or @final ones (Cyclone idlc's default)."""
+    f = "_F" if final_ else ""
+    g = globals()
+    Point, Quaternion, Vector3 = (g[f"geometry_msgs_msg_{n}{f}"] for n in ("Point", "Quaternion", "Vector3"))
+    Pose, PoseStamped, Imu = g[f"geometry_msgs_msg_Pose{f}"], g[f"geometry_msgs_msg_PoseStamped{f}"], g[f"sensor_msgs_msg_Imu{f}"]
+    KeyValue, DiagnosticStatus = g[f"diagnostic_msgs_msg_KeyValue{f}"], g[f"diagnostic_msgs_msg_DiagnosticStatus{f}"]
+    suffix = ".final" if final_ else ""
+    return [
+        (f"geometry_msgs.msg.PoseStamped{suffix}", f"{ROS}/geometry_msgs/msg/PoseStamped.idl",
+         "geometry_msgs::msg::PoseStamped", PoseStamped, [
+             ("basic", PoseStamped(
+                 header=header(1700000000, 123456789, "map", final_),
+                 pose=Pose(position=Point(x=1.0, y=-2.0, z=3.5),
+                           orientation=Quaternion(x=0.0, y=0.0, z=math.sqrt(0.5), w=math.sqrt(0.5)))))]),
+        (f"sensor_msgs.msg.Imu{suffix}", f"{ROS}/sensor_msgs/msg/Imu.idl", "sensor_msgs::msg::Imu", Imu, [
+            ("basic", Imu(
+                header=header(-1, 999999999, "imu_link", final_),
+                orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
+                orientation_covariance=[float(i) for i in range(9)],
+                angular_velocity=Vector3(x=0.1, y=0.2, z=0.3),
+                angular_velocity_covariance=[-1.0] + [0.0] * 8,
+                linear_acceleration=Vector3(x=0.0, y=0.0, z=9.81),
+                linear_acceleration_covariance=[0.5 ** i for i in range(9)]))]),
+        (f"diagnostic_msgs.msg.DiagnosticStatus{suffix}", f"{ROS}/diagnostic_msgs/msg/DiagnosticStatus.idl",
+         "diagnostic_msgs::msg::DiagnosticStatus", DiagnosticStatus, [
+             ("basic", DiagnosticStatus(
+                 level=2, name="motor", message="overheat", hardware_id="hw-7",
+                 values=[KeyValue(key="temp", value="97"), KeyValue(key="limit", value="90")])),
+             ("empty", DiagnosticStatus(level=0, name="", message="", hardware_id="", values=[]))]),
+    ]
 
 
 def bm(cls, *on):
     return cls(**{f: (f in on) for f in cls.__dataclass_fields__})
 
 
-def negative_enum_sample():
-    """EnumWithValuesStructure holding ENUM_VALUE1 (-3). The binding packs enums unsigned and cannot encode a
-    negative enumerator, so its bytes for ENUM_VALUE2 (0) get the value patched in: the enum is the last 4 bytes
-    of the body in every encoding the binding writes. libddsc then reads them like any other input."""
-    sample = EnumWithValuesStructure(var_enumwithvalues=EnumWithValues.ENUM_VALUE1)
-    proxy = EnumWithValuesStructure(var_enumwithvalues=EnumWithValues.ENUM_VALUE2)
+def via(sample, standin):
+    """`sample`, with the bytes libddsc reads taken from `standin`, a value of a type with the same wire form.
 
-    def serialize(use_version_2=None, endianness=None):
-        data = proxy.serialize(use_version_2=use_version_2, endianness=endianness)
-        little = data[1] & 1
-        assert data[-4:] == bytes(4)
-        return data[:-4] + (-3).to_bytes(4, "little" if little else "big", signed=True)
-    object.__setattr__(sample, "serialize", serialize)
+    For values the binding cannot encode: negative enumerators (it packs enums unsigned) and enums with a
+    @bit_bound of 9..16 (it writes them as 1 byte in XCDR2 and 4 in XCDR1; libddsc, XTypes and we use 2). libddsc
+    reads the stand-in's bytes as the real type (its topic comes from the real type's TypeInformation) and
+    encodes the vectors itself, as for every other sample."""
+    object.__setattr__(sample, "serialize", standin.serialize)
     return sample
 
 
@@ -85,7 +115,8 @@ ENTRIES = [
                                 var_scoped_InnerEnumHelper=Test_InnerEnumHelper.ENUM_VALUE_1))]),
     ("EnumWithValuesStructure", f"{EPROSIMA}/enumerations.idl", "EnumWithValuesStructure",
      EnumWithValuesStructure, [
-         ("negative", negative_enum_sample()),
+         ("negative", via(EnumWithValuesStructure(var_enumwithvalues=EnumWithValues.ENUM_VALUE1),
+                           EnumWithValuesStructure_wire(var_enumwithvalues=-3))),
          ("positive", EnumWithValuesStructure(var_enumwithvalues=EnumWithValues.ENUM_VALUE3))]),
     ("BitMaskStructure", f"{EPROSIMA}/enumerations.idl", "BitMaskStructure", BitMaskStructure, [
         ("some", BitMaskStructure(var_InnerBitMaskHelper=bm(InnerBitMaskHelper, "flag0", "flag6"))),
@@ -159,31 +190,43 @@ ENTRIES = [
     ("NoCommon_Module.My_Structure", f"{EPROSIMA}/sequences.idl", "NoCommon_Module::My_Structure",
      NoCommon_Module_My_Structure, [
          ("basic", NoCommon_Module_My_Structure(list=[["a", "b"], [], ["x"] * 20]))]),
-    ("geometry_msgs.msg.PoseStamped", f"{ROS}/geometry_msgs/msg/PoseStamped.idl", "geometry_msgs::msg::PoseStamped",
-     geometry_msgs_msg_PoseStamped, [
-         ("basic", geometry_msgs_msg_PoseStamped(
-             header=header(1700000000, 123456789, "map"),
-             pose=geometry_msgs_msg_Pose(position=geometry_msgs_msg_Point(x=1.0, y=-2.0, z=3.5),
-                                         orientation=geometry_msgs_msg_Quaternion(
-                                             x=0.0, y=0.0, z=math.sqrt(0.5), w=math.sqrt(0.5)))))]),
-    ("sensor_msgs.msg.Imu", f"{ROS}/sensor_msgs/msg/Imu.idl", "sensor_msgs::msg::Imu", sensor_msgs_msg_Imu, [
-        ("basic", sensor_msgs_msg_Imu(
-            header=header(-1, 999999999, "imu_link"),
-            orientation=geometry_msgs_msg_Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
-            orientation_covariance=[float(i) for i in range(9)],
-            angular_velocity=geometry_msgs_msg_Vector3(x=0.1, y=0.2, z=0.3),
-            angular_velocity_covariance=[-1.0] + [0.0] * 8,
-            linear_acceleration=geometry_msgs_msg_Vector3(x=0.0, y=0.0, z=9.81),
-            linear_acceleration_covariance=[0.5 ** i for i in range(9)]))]),
-    ("diagnostic_msgs.msg.DiagnosticStatus", f"{ROS}/diagnostic_msgs/msg/DiagnosticStatus.idl",
-     "diagnostic_msgs::msg::DiagnosticStatus", diagnostic_msgs_msg_DiagnosticStatus, [
-         ("basic", diagnostic_msgs_msg_DiagnosticStatus(
-             level=2, name="motor", message="overheat", hardware_id="hw-7",
-             values=[diagnostic_msgs_msg_KeyValue(key="temp", value="97"),
-                     diagnostic_msgs_msg_KeyValue(key="limit", value="90")])),
-         ("empty", diagnostic_msgs_msg_DiagnosticStatus(level=0, name="", message="", hardware_id="",
-                                                        values=[]))]),
 ]
+ENTRIES += ros_samples(False)
+
+KEYEXT_FILE = "cyclonedds/src/core/ddsc/tests/CdrStreamKeyExt.idl"
+for _name in ["t1", "t1a", "t2", "t3"] + [f"t{n}{v}" for n in "456" for v in ("", "a", "b")]:
+    _cls = globals()[f"KeyExt_{_name}"]
+    _fields = {"a": 0x11223344}
+    if "b" in _cls.__dataclass_fields__:
+        _fields["b"] = globals()[f"KeyExt_nested{_name[1:]}"](a=-2)
+    ENTRIES.append((f"CdrStreamKeyExt.{_name}", KEYEXT_FILE, f"CdrStreamKeyExt::{_name}", _cls,
+                    [("basic", _cls(**_fields))]))
+
+XTESTS = "cyclonedds/src/tools/idlc/xtests"
+ENTRIES += [
+    # The values of the C test in the same file; then the default member (discriminator -1, no label).
+    ("test_struct_keys", f"{XTESTS}/test_struct_keys.idl", "test_struct_keys", test_struct_keys, [
+        ("xtest", via(test_struct_keys(f1=u(u1=e.E2), f2="a", f3=u(u1=e.E3), f4=["b", "c"]),
+                      test_struct_keys_wire(f1=u_wire(u1=1), f2="a", f3=u_wire(u1=2), f4=["b", "c"]))),
+        ("default", via(test_struct_keys(f1=u(discriminator=-1, value=-5), f2="z", f3=u(u1=e.E1), f4=["\0", "y"]),
+                        test_struct_keys_wire(f1=u_wire(discriminator=-1, value=-5), f2="z", f3=u_wire(u1=0),
+                                              f4=["\0", "y"])))]),
+    ("test_struct_inherit_mutable_keys", f"{XTESTS}/test_struct_inherit_mutable_keys.idl",
+     "test_struct_inherit_mutable_keys", test_struct_inherit_mutable_keys, [
+         ("xtest", test_struct_inherit_mutable_keys(bb1=3, b1=2, f1=1))]),
+    # Negative labels only on the 32-bit discriminator: libddsc 11.0.1 reads an int8/int16 discriminator
+    # zero-extended, matches no negative label (-1 is read as 255/65535), selects no member and loses its place in
+    # the stream, so it has no vectors for cases -128/-1 of t1 and -32768/-1 of t2 (README.md).
+    ("CdrStreamSignedUnion.t4", "cyclonedds/src/core/ddsc/tests/CdrStreamSignedUnion.idl", "CdrStreamSignedUnion::t4",
+     SignedUnion_t4, [
+         ("positive", SignedUnion_t4(f1=SignedUnion_t1(f3=5), f2=SignedUnion_t2(f4=1.5), f3=SignedUnion_t3(f4=2.5))),
+         ("max", SignedUnion_t4(f1=SignedUnion_t1(f4=0.25), f2=SignedUnion_t2(f3=-7), f3=SignedUnion_t3(f3=7))),
+         ("minus_one_32", SignedUnion_t4(f1=SignedUnion_t1(f3=1), f2=SignedUnion_t2(f3=2), f3=SignedUnion_t3(f2=-3))),
+         ("min_32", SignedUnion_t4(f1=SignedUnion_t1(f4=-0.5), f2=SignedUnion_t2(f4=0.5), f3=SignedUnion_t3(f1="c")))]),
+]
+
+# Cyclone's idlc reads unannotated types as @final: the ROS types again, as a Cyclone (rmw_cyclonedds) peer has them.
+ENTRIES += ros_samples(True)
 
 
 def declared(file, scoped):

@@ -13,9 +13,9 @@ from dataclasses import dataclass
 from typing import Optional
 
 from cyclonedds.idl import IdlStruct, IdlUnion, IdlEnum, IdlBitmask
-from cyclonedds.idl.annotations import (key, member_id, member_hash_id, final, appendable, mutable, nested,
-                                        bit_bound, position)
-from cyclonedds.idl.types import (int16, int32, int64, uint8, uint16, uint32, uint64, byte, char, float32,
+from cyclonedds.idl.annotations import (key, member_id, member_hash_id, external, final, appendable, mutable,
+                                        nested, bit_bound, position)
+from cyclonedds.idl.types import (int8, int16, int32, int64, uint8, uint16, uint32, uint64, byte, char, float32,
                                   float64, sequence, array, bounded_str, case, default, typedef)
 
 EPROSIMA = "eprosima-dds-types-test/IDL"
@@ -497,3 +497,367 @@ class diagnostic_msgs_msg_DiagnosticStatus(IdlStruct, typename="diagnostic_msgs:
     message: str
     hardware_id: str
     values: sequence[diagnostic_msgs_msg_KeyValue]
+
+
+# ---------------------------------------------------------------- cyclonedds/src/core/ddsc/tests/CdrStreamKeyExt.idl
+# Keys through nested structs of every extensibility (module CdrStreamKeyExt).
+
+@dataclass
+@final
+class KeyExt_t1(IdlStruct, typename="CdrStreamKeyExt::t1"):
+    a: int32
+    key("a")
+
+
+@dataclass
+@final
+class KeyExt_t1a(IdlStruct, typename="CdrStreamKeyExt::t1a"):
+    a: int32
+    external("a")
+    key("a")
+
+
+@dataclass
+@appendable
+class KeyExt_t2(IdlStruct, typename="CdrStreamKeyExt::t2"):
+    a: int32
+    key("a")
+
+
+@dataclass
+@mutable
+class KeyExt_t3(IdlStruct, typename="CdrStreamKeyExt::t3"):
+    a: int32
+    key("a")
+
+
+@dataclass
+@appendable
+class KeyExt_nested4(IdlStruct, typename="CdrStreamKeyExt::nested4"):
+    a: int32
+    key("a")
+
+
+@dataclass
+@final
+class KeyExt_t4(IdlStruct, typename="CdrStreamKeyExt::t4"):
+    a: int32
+    key("a")
+    b: KeyExt_nested4
+
+
+@dataclass
+@appendable
+class KeyExt_nested4a(IdlStruct, typename="CdrStreamKeyExt::nested4a"):
+    a: int32
+    key("a")
+
+
+@dataclass
+@final
+class KeyExt_t4a(IdlStruct, typename="CdrStreamKeyExt::t4a"):
+    a: int32
+    key("a")
+    b: KeyExt_nested4a
+    key("b")
+
+
+@dataclass
+@appendable
+class KeyExt_nested4b(IdlStruct, typename="CdrStreamKeyExt::nested4b"):
+    a: int32
+
+
+@dataclass
+@final
+class KeyExt_t4b(IdlStruct, typename="CdrStreamKeyExt::t4b"):
+    a: int32
+    key("a")
+    b: KeyExt_nested4b
+    key("b")
+
+
+@dataclass
+@mutable
+class KeyExt_nested5(IdlStruct, typename="CdrStreamKeyExt::nested5"):
+    a: int32
+    key("a")
+
+
+@dataclass
+@final
+class KeyExt_t5(IdlStruct, typename="CdrStreamKeyExt::t5"):
+    a: int32
+    key("a")
+    b: KeyExt_nested5
+
+
+@dataclass
+@mutable
+class KeyExt_nested5a(IdlStruct, typename="CdrStreamKeyExt::nested5a"):
+    a: int32
+    key("a")
+
+
+@dataclass
+@final
+class KeyExt_t5a(IdlStruct, typename="CdrStreamKeyExt::t5a"):
+    a: int32
+    key("a")
+    b: KeyExt_nested5a
+    key("b")
+
+
+@dataclass
+@mutable
+class KeyExt_nested5b(IdlStruct, typename="CdrStreamKeyExt::nested5b"):
+    a: int32
+
+
+@dataclass
+@final
+class KeyExt_t5b(IdlStruct, typename="CdrStreamKeyExt::t5b"):
+    a: int32
+    key("a")
+    b: KeyExt_nested5b
+    key("b")
+
+
+@dataclass
+@mutable
+class KeyExt_nested6(IdlStruct, typename="CdrStreamKeyExt::nested6"):
+    a: int32
+    key("a")
+
+
+@dataclass
+@appendable
+class KeyExt_t6(IdlStruct, typename="CdrStreamKeyExt::t6"):
+    a: int32
+    key("a")
+    b: KeyExt_nested6
+
+
+@dataclass
+@mutable
+class KeyExt_nested6a(IdlStruct, typename="CdrStreamKeyExt::nested6a"):
+    a: int32
+    key("a")
+
+
+@dataclass
+@appendable
+class KeyExt_t6a(IdlStruct, typename="CdrStreamKeyExt::t6a"):
+    a: int32
+    key("a")
+    b: KeyExt_nested6a
+    key("b")
+
+
+@dataclass
+@mutable
+class KeyExt_nested6b(IdlStruct, typename="CdrStreamKeyExt::nested6b"):
+    a: int32
+
+
+@dataclass
+@appendable
+class KeyExt_t6b(IdlStruct, typename="CdrStreamKeyExt::t6b"):
+    a: int32
+    key("a")
+    b: KeyExt_nested6b
+    key("b")
+
+
+# ---------------------------------------------------------------- cyclonedds/src/tools/idlc/xtests
+
+@bit_bound(10)
+class e(IdlEnum, typename="e"):
+    E1 = 0
+    E2 = 1
+    E3 = 2
+
+
+@final
+@nested
+class u(IdlUnion, discriminator=int16, typename="u"):
+    u1: case[1, e]
+    ud: default[int32]
+
+
+@dataclass
+@final
+class test_struct_keys(IdlStruct, typename="test_struct_keys"):
+    f1: u
+    f2: char
+    key("f2")
+    f3: u
+    f4: array[char, 2]
+    key("f4")
+
+
+@dataclass
+@mutable
+@nested
+class t_base_base(IdlStruct, typename="t_base_base"):
+    bb1: int32
+    key("bb1")
+
+
+@dataclass
+@mutable
+@nested
+class t_base(t_base_base, typename="t_base"):
+    b1: int32
+
+
+@dataclass
+@mutable
+class test_struct_inherit_mutable_keys(t_base, typename="test_struct_inherit_mutable_keys"):
+    f1: int32
+
+
+# ---------------------------------------------------------------- cyclonedds/src/core/ddsc/tests/CdrStreamSignedUnion.idl
+
+@final
+class SignedUnion_t1(IdlUnion, discriminator=int8, typename="CdrStreamSignedUnion::t1"):
+    f1: case[-128, char]
+    f2: case[-1, int16]
+    f3: case[1, int32]
+    f4: case[127, float32]
+
+
+@final
+class SignedUnion_t2(IdlUnion, discriminator=int16, typename="CdrStreamSignedUnion::t2"):
+    f1: case[-32768, char]
+    f2: case[-1, int16]
+    f3: case[1, int32]
+    f4: case[32767, float32]
+
+
+@final
+class SignedUnion_t3(IdlUnion, discriminator=int32, typename="CdrStreamSignedUnion::t3"):
+    f1: case[-2147483648, char]
+    f2: case[-1, int16]
+    f3: case[1, int32]
+    f4: case[2147483647, float32]
+
+
+@dataclass
+@final
+class SignedUnion_t4(IdlStruct, typename="CdrStreamSignedUnion::t4"):
+    f1: SignedUnion_t1
+    f2: SignedUnion_t2
+    f3: SignedUnion_t3
+
+
+# ---------------------------------------------------------------- stand-ins: same wire form, other Python types
+# Input for libddsc where the binding cannot encode the real value (see corpus_idl.via). Never topics themselves.
+
+@dataclass
+@appendable
+class EnumWithValuesStructure_wire(IdlStruct, typename="EnumWithValuesStructure_wire"):
+    var_enumwithvalues: int32  # a 4-byte enum holding -3
+
+
+@final
+@nested
+class u_wire(IdlUnion, discriminator=int16, typename="u_wire"):
+    u1: case[1, uint16]  # `e` has @bit_bound(10): 2 bytes in XCDR1 and XCDR2
+    ud: default[int32]
+
+
+@dataclass
+@final
+class test_struct_keys_wire(IdlStruct, typename="test_struct_keys_wire"):
+    f1: u_wire
+    f2: char
+    f3: u_wire
+    f4: array[char, 2]
+
+
+# ---------------------------------------------------------------- rti-ros-data-types, compiled with final default
+# The same ROS types as Cyclone's own idlc (and so rmw_cyclonedds) reads them: unannotated means @final there.
+# The Rust side compiles these files a second time with `default_extensibility(Final)`.
+
+@dataclass
+@final
+@nested
+class std_msgs_msg_Time_F(IdlStruct, typename="std_msgs::msg::Time"):
+    sec: int32
+    nanosec: uint32
+
+
+@dataclass
+@final
+class std_msgs_msg_Header_F(IdlStruct, typename="std_msgs::msg::Header"):
+    stamp: std_msgs_msg_Time_F
+    frame_id: str
+
+
+@dataclass
+@final
+class geometry_msgs_msg_Point_F(IdlStruct, typename="geometry_msgs::msg::Point"):
+    x: float64
+    y: float64
+    z: float64
+
+
+@dataclass
+@final
+class geometry_msgs_msg_Quaternion_F(IdlStruct, typename="geometry_msgs::msg::Quaternion"):
+    x: float64
+    y: float64
+    z: float64
+    w: float64
+
+
+@dataclass
+@final
+class geometry_msgs_msg_Vector3_F(IdlStruct, typename="geometry_msgs::msg::Vector3"):
+    x: float64
+    y: float64
+    z: float64
+
+
+@dataclass
+@final
+class geometry_msgs_msg_Pose_F(IdlStruct, typename="geometry_msgs::msg::Pose"):
+    position: geometry_msgs_msg_Point_F
+    orientation: geometry_msgs_msg_Quaternion_F
+
+
+@dataclass
+@final
+class geometry_msgs_msg_PoseStamped_F(IdlStruct, typename="geometry_msgs::msg::PoseStamped"):
+    header: std_msgs_msg_Header_F
+    pose: geometry_msgs_msg_Pose_F
+
+
+@dataclass
+@final
+class sensor_msgs_msg_Imu_F(IdlStruct, typename="sensor_msgs::msg::Imu"):
+    header: std_msgs_msg_Header_F
+    orientation: geometry_msgs_msg_Quaternion_F
+    orientation_covariance: sensor_msgs_Imu_double_array_9
+    angular_velocity: geometry_msgs_msg_Vector3_F
+    angular_velocity_covariance: sensor_msgs_Imu_double_array_9
+    linear_acceleration: geometry_msgs_msg_Vector3_F
+    linear_acceleration_covariance: sensor_msgs_Imu_double_array_9
+
+
+@dataclass
+@final
+class diagnostic_msgs_msg_KeyValue_F(IdlStruct, typename="diagnostic_msgs::msg::KeyValue"):
+    key: str
+    value: str
+
+
+@dataclass
+@final
+class diagnostic_msgs_msg_DiagnosticStatus_F(IdlStruct, typename="diagnostic_msgs::msg::DiagnosticStatus"):
+    level: byte
+    name: str
+    message: str
+    hardware_id: str
+    values: sequence[diagnostic_msgs_msg_KeyValue_F]

@@ -41,9 +41,17 @@ idl!(member_id, "member_id");
 idl!(optional, "optional");
 idl!(arrays, "arrays");
 idl!(sequences, "sequences");
+idl!(key_ext, "CdrStreamKeyExt");
+idl!(signed_union, "CdrStreamSignedUnion");
+idl!(struct_keys, "test_struct_keys");
+idl!(inherit_mutable_keys, "test_struct_inherit_mutable_keys");
 idl!(pose_stamped, "PoseStamped");
 idl!(imu, "Imu");
 idl!(diagnostic_status, "DiagnosticStatus");
+// The same ROS files with unannotated types @final, as Cyclone's idlc (and rmw_cyclonedds) reads them.
+idl!(pose_stamped_final, "final/PoseStamped");
+idl!(imu_final, "final/Imu");
+idl!(diagnostic_status_final, "final/DiagnosticStatus");
 
 /// One test per fixture: `golden!(test_name, "idl file stem", "fixture", Type, [("sample", value), ...])`.
 macro_rules! golden {
@@ -841,16 +849,261 @@ golden!(
     )]
 );
 
-// ---------------------------------------------------------------- rti-ros-data-types
+// ---------------------------------------------------------------- cyclonedds/src/core/ddsc/tests/CdrStreamKeyExt.idl
+// @key long a (0x11223344), and a member b of a nested struct (b.a = -2), keyed or not, key or not.
+
+#[cfg(idlc_ok = "CdrStreamKeyExt")]
+use key_ext::cdr_stream_key_ext as ke;
 
 golden!(
-    ros_pose_stamped,
-    "PoseStamped",
-    "geometry_msgs.msg.PoseStamped",
-    pose_stamped::geometry_msgs::msg::PoseStamped,
-    [("basic", {
-        use pose_stamped::geometry_msgs::msg::{Point, Pose, PoseStamped, Quaternion};
-        use pose_stamped::std_msgs::msg::{Header, Time};
+    keyext_t1,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t1",
+    ke::T1,
+    [("basic", ke::T1 { a: 0x1122_3344 })]
+);
+golden!(
+    keyext_t1a,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t1a",
+    ke::T1a,
+    [(
+        "basic",
+        ke::T1a {
+            a: Box::new(0x1122_3344)
+        }
+    ),]
+);
+golden!(
+    keyext_t2,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t2",
+    ke::T2,
+    [("basic", ke::T2 { a: 0x1122_3344 })]
+);
+golden!(
+    keyext_t3,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t3",
+    ke::T3,
+    [("basic", ke::T3 { a: 0x1122_3344 })]
+);
+golden!(
+    keyext_t4,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t4",
+    ke::T4,
+    [(
+        "basic",
+        ke::T4 {
+            a: 0x1122_3344,
+            b: ke::Nested4 { a: -2 }
+        }
+    ),]
+);
+golden!(
+    keyext_t4a,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t4a",
+    ke::T4a,
+    [(
+        "basic",
+        ke::T4a {
+            a: 0x1122_3344,
+            b: ke::Nested4a { a: -2 }
+        }
+    ),]
+);
+golden!(
+    keyext_t4b,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t4b",
+    ke::T4b,
+    [(
+        "basic",
+        ke::T4b {
+            a: 0x1122_3344,
+            b: ke::Nested4b { a: -2 }
+        }
+    ),]
+);
+golden!(
+    keyext_t5,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t5",
+    ke::T5,
+    [(
+        "basic",
+        ke::T5 {
+            a: 0x1122_3344,
+            b: ke::Nested5 { a: -2 }
+        }
+    ),]
+);
+golden!(
+    keyext_t5a,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t5a",
+    ke::T5a,
+    [(
+        "basic",
+        ke::T5a {
+            a: 0x1122_3344,
+            b: ke::Nested5a { a: -2 }
+        }
+    ),]
+);
+golden!(
+    keyext_t5b,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t5b",
+    ke::T5b,
+    [(
+        "basic",
+        ke::T5b {
+            a: 0x1122_3344,
+            b: ke::Nested5b { a: -2 }
+        }
+    ),]
+);
+golden!(
+    keyext_t6,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t6",
+    ke::T6,
+    [(
+        "basic",
+        ke::T6 {
+            a: 0x1122_3344,
+            b: ke::Nested6 { a: -2 }
+        }
+    ),]
+);
+golden!(
+    keyext_t6a,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t6a",
+    ke::T6a,
+    [(
+        "basic",
+        ke::T6a {
+            a: 0x1122_3344,
+            b: ke::Nested6a { a: -2 }
+        }
+    ),]
+);
+golden!(
+    keyext_t6b,
+    "CdrStreamKeyExt",
+    "CdrStreamKeyExt.t6b",
+    ke::T6b,
+    [(
+        "basic",
+        ke::T6b {
+            a: 0x1122_3344,
+            b: ke::Nested6b { a: -2 }
+        }
+    ),]
+);
+
+// ---------------------------------------------------------------- cyclonedds/src/core/ddsc/tests/CdrStreamSignedUnion.idl
+// Negative labels only on the 32-bit discriminator (libddsc 11.0.1 has no vectors for the others; FINDINGS.md).
+
+golden!(
+    cdrstream_signed_union_t4,
+    "CdrStreamSignedUnion",
+    "CdrStreamSignedUnion.t4",
+    signed_union::cdr_stream_signed_union::T4,
+    [
+        ("positive", {
+            use signed_union::cdr_stream_signed_union::{T1, T2, T3, T4};
+            T4 {
+                f1: T1::F3(5),
+                f2: T2::F4(1.5),
+                f3: T3::F4(2.5),
+            }
+        }),
+        ("max", {
+            use signed_union::cdr_stream_signed_union::{T1, T2, T3, T4};
+            T4 {
+                f1: T1::F4(0.25),
+                f2: T2::F3(-7),
+                f3: T3::F3(7),
+            }
+        }),
+        ("minus_one_32", {
+            use signed_union::cdr_stream_signed_union::{T1, T2, T3, T4};
+            T4 {
+                f1: T1::F3(1),
+                f2: T2::F3(2),
+                f3: T3::F2(-3),
+            }
+        }),
+        ("min_32", {
+            use signed_union::cdr_stream_signed_union::{T1, T2, T3, T4};
+            T4 {
+                f1: T1::F4(-0.5),
+                f2: T2::F4(0.5),
+                f3: T3::F1('c'),
+            }
+        }),
+    ]
+);
+
+// ---------------------------------------------------------------- cyclonedds/src/tools/idlc/xtests
+
+golden!(
+    xtest_struct_keys,
+    "test_struct_keys",
+    "test_struct_keys",
+    struct_keys::TestStructKeys,
+    [
+        // the values of the C part of the same file
+        (
+            "xtest",
+            struct_keys::TestStructKeys {
+                f1: struct_keys::U::U1(struct_keys::E::E2),
+                f2: 'a',
+                f3: struct_keys::U::U1(struct_keys::E::E3),
+                f4: ['b', 'c'],
+            }
+        ),
+        (
+            "default",
+            struct_keys::TestStructKeys {
+                f1: struct_keys::U::Ud(-5),
+                f2: 'z',
+                f3: struct_keys::U::U1(struct_keys::E::E1),
+                f4: ['\0', 'y'],
+            }
+        ),
+    ]
+);
+
+golden!(
+    xtest_struct_inherit_mutable_keys,
+    "test_struct_inherit_mutable_keys",
+    "test_struct_inherit_mutable_keys",
+    inherit_mutable_keys::TestStructInheritMutableKeys,
+    [(
+        "xtest",
+        inherit_mutable_keys::TestStructInheritMutableKeys {
+            base: inherit_mutable_keys::TBase {
+                base: inherit_mutable_keys::TBaseBase { bb1: 3 },
+                b1: 2
+            },
+            f1: 1,
+        }
+    )]
+);
+
+// ---------------------------------------------------------------- rti-ros-data-types
+// Each file twice: with our idlc's default (@appendable) and with Cyclone idlc's (@final); same samples.
+
+macro_rules! pose_stamped_basic {
+    ($m:ident) => {{
+        use $m::geometry_msgs::msg::{Point, Pose, PoseStamped, Quaternion};
+        use $m::std_msgs::msg::{Header, Time};
         PoseStamped {
             header: Header {
                 stamp: Time {
@@ -873,20 +1126,16 @@ golden!(
                 },
             },
         }
-    })]
-);
+    }};
+}
 
-golden!(
-    ros_imu,
-    "Imu",
-    "sensor_msgs.msg.Imu",
-    imu::sensor_msgs::msg::Imu,
-    [("basic", {
-        use imu::geometry_msgs::msg::{Quaternion, Vector3};
-        use imu::std_msgs::msg::{Header, Time};
+macro_rules! imu_basic {
+    ($m:ident) => {{
+        use $m::geometry_msgs::msg::{Quaternion, Vector3};
+        use $m::std_msgs::msg::{Header, Time};
         let mut angular = [0.0; 9];
         angular[0] = -1.0;
-        imu::sensor_msgs::msg::Imu {
+        $m::sensor_msgs::msg::Imu {
             header: Header {
                 stamp: Time {
                     sec: -1,
@@ -914,7 +1163,45 @@ golden!(
             },
             linear_acceleration_covariance: std::array::from_fn(|i| 0.5f64.powi(i as i32)),
         }
-    }),]
+    }};
+}
+
+macro_rules! diagnostic_status_basic {
+    ($m:ident) => {{
+        use $m::diagnostic_msgs::msg::{DiagnosticStatus, KeyValue};
+        DiagnosticStatus {
+            level: 2,
+            name: "motor".into(),
+            message: "overheat".into(),
+            hardware_id: "hw-7".into(),
+            values: vec![
+                KeyValue {
+                    key: "temp".into(),
+                    value: "97".into(),
+                },
+                KeyValue {
+                    key: "limit".into(),
+                    value: "90".into(),
+                },
+            ],
+        }
+    }};
+}
+
+golden!(
+    ros_pose_stamped,
+    "PoseStamped",
+    "geometry_msgs.msg.PoseStamped",
+    pose_stamped::geometry_msgs::msg::PoseStamped,
+    [("basic", pose_stamped_basic!(pose_stamped))]
+);
+
+golden!(
+    ros_imu,
+    "Imu",
+    "sensor_msgs.msg.Imu",
+    imu::sensor_msgs::msg::Imu,
+    [("basic", imu_basic!(imu))]
 );
 
 golden!(
@@ -923,28 +1210,34 @@ golden!(
     "diagnostic_msgs.msg.DiagnosticStatus",
     diagnostic_status::diagnostic_msgs::msg::DiagnosticStatus,
     [
-        ("basic", {
-            use diagnostic_status::diagnostic_msgs::msg::{DiagnosticStatus, KeyValue};
-            DiagnosticStatus {
-                level: 2,
-                name: "motor".into(),
-                message: "overheat".into(),
-                hardware_id: "hw-7".into(),
-                values: vec![
-                    KeyValue {
-                        key: "temp".into(),
-                        value: "97".into(),
-                    },
-                    KeyValue {
-                        key: "limit".into(),
-                        value: "90".into(),
-                    },
-                ],
-            }
-        }),
-        (
-            "empty",
-            diagnostic_status::diagnostic_msgs::msg::DiagnosticStatus::default()
-        ),
+        ("basic", diagnostic_status_basic!(diagnostic_status)),
+        ("empty", Default::default()),
+    ]
+);
+
+golden!(
+    ros_pose_stamped_final,
+    "final/PoseStamped",
+    "geometry_msgs.msg.PoseStamped.final",
+    pose_stamped_final::geometry_msgs::msg::PoseStamped,
+    [("basic", pose_stamped_basic!(pose_stamped_final))]
+);
+
+golden!(
+    ros_imu_final,
+    "final/Imu",
+    "sensor_msgs.msg.Imu.final",
+    imu_final::sensor_msgs::msg::Imu,
+    [("basic", imu_basic!(imu_final)),]
+);
+
+golden!(
+    ros_diagnostic_status_final,
+    "final/DiagnosticStatus",
+    "diagnostic_msgs.msg.DiagnosticStatus.final",
+    diagnostic_status_final::diagnostic_msgs::msg::DiagnosticStatus,
+    [
+        ("basic", diagnostic_status_basic!(diagnostic_status_final)),
+        ("empty", Default::default()),
     ]
 );

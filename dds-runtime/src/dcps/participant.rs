@@ -15,7 +15,7 @@ use crate::rtps::{
     EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig, ReceivedSample,
     Transmit,
 };
-use crate::transport::{Channel, UdpTransport};
+use crate::transport::{Channel, Datagram, UdpTransport};
 
 use super::condition::{StatusCondition, StatusCore};
 use super::error::{DdsError, DdsResult};
@@ -691,10 +691,14 @@ impl DomainParticipantBuilder {
             status: Arc::new(StatusCore::default()),
         });
         let weak: Weak<Shared> = Arc::downgrade(&shared);
-        let rx = Arc::new(move |_ch: Channel, data: &[u8], _from: SocketAddr| {
+        let rx = Arc::new(move |_ch: Channel, batch: &[Datagram<'_>]| {
             if let Some(s) = weak.upgrade() {
                 if !s.stopped.load(Ordering::Acquire) {
-                    s.with_core(|c, now| c.handle_datagram(now, data));
+                    s.with_core(|c, now| {
+                        for d in batch {
+                            c.handle_datagram(now, d.data);
+                        }
+                    });
                 }
             }
         });

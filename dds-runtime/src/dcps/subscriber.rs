@@ -17,7 +17,7 @@ use super::cache::{ChangeKindLocal, Incoming, Outcome, ReaderCache, Selection};
 use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition, StatusCore};
 use super::error::{DdsError, DdsResult};
 use super::listener::DataReaderListener;
-use super::participant::{DomainParticipant, Pending, ReaderSink, Shared};
+use super::participant::{DomainParticipant, Pending, ReaderSink, RemoteWriterInfo, Shared};
 use super::sample::{
     InstanceHandle, InstanceStateMask, Sample, SampleInfo, SampleStateMask, ViewStateMask,
 };
@@ -633,88 +633,14 @@ impl<T: DdsType> ReaderInner<T> {
         })
     }
 
-    /// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped.
     fn decode(
         &self,
         s: ReceivedSample,
         by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
         now: Instant,
     ) -> Option<Incoming<T>> {
-        let rx_time = SystemTime::now();
-        let source_timestamp = system_time(s.source_timestamp);
         let info = self.shared.remote_writer(&s.writer);
-        let kind = match s.kind {
-            ChangeKind::Alive => ChangeKindLocal::Alive,
-            ChangeKind::Dispose => ChangeKindLocal::Dispose,
-            ChangeKind::Unregister => ChangeKindLocal::Unregister,
-            ChangeKind::DisposeUnregister => ChangeKindLocal::DisposeUnregister,
-        };
-        let mut key = Vec::new();
-        let mut data = None;
-        let mut key_holder = None;
-        if kind == ChangeKindLocal::Alive {
-            let d = match cdr::deserialize::<T>(&s.payload) {
-                Ok(d) => d,
-                Err(e) => {
-                    tracing::warn!(writer = ?s.writer, seq = s.sequence.0, error = %e, "dropping undecodable sample");
-                    return None;
-                }
-            };
-            if T::IS_KEYED {
-                if let Err(e) = cdr::instance_key(&d, &mut key) {
-                    tracing::warn!(error = %e, "cannot compute the instance key");
-                    return None;
-                }
-                if let Some(kh) = s.key_hash {
-                    if by_hash.len() >= MAX_REMEMBERED_HASHES {
-                        by_hash.clear();
-                    }
-                    by_hash.entry(kh).or_insert_with(|| key.clone());
-                }
-            }
-            data = Some(d);
-        } else if T::IS_KEYED {
-            if !s.payload.is_empty() {
-                match cdr::deserialize_key::<T>(&s.payload) {
-                    Ok(k) => {
-                        if let Err(e) = cdr::instance_key(&k, &mut key) {
-                            tracing::warn!(error = %e, "cannot compute the instance key");
-                            return None;
-                        }
-                        key_holder = Some(k);
-                    }
-                    Err(e) => {
-                        tracing::debug!(error = %e, "undecodable key payload; trying the key hash")
-                    }
-                }
-            }
-            if key_holder.is_none() {
-                match s.key_hash.and_then(|kh| by_hash.get(&kh).cloned()) {
-                    Some(k) => key = k,
-                    None => {
-                        tracing::debug!(writer = ?s.writer, kind = ?s.kind, "key-only change for an unknown instance");
-                        return None;
-                    }
-                }
-            }
-        }
-        Some(Incoming {
-            writer: s.writer.to_bytes(),
-            kind,
-            data,
-            key,
-            key_holder,
-            source_timestamp: source_timestamp.unwrap_or(rx_time),
-            reception_timestamp: rx_time,
-            strength: info.strength,
-            expires: info.lifespan.and_then(|l| {
-                // Lifespan counts from the source timestamp; its age so far is spent already.
-                let age = source_timestamp
-                    .and_then(|t| rx_time.duration_since(t).ok())
-                    .unwrap_or_default();
-                now.checked_add(l.saturating_sub(age))
-            }),
-        })
+        decode_change::<T>(s, info, by_hash, now)
     }
 
     fn notify_data(self: &Arc<Self>) {
@@ -730,6 +656,91 @@ impl<T: DdsType> ReaderInner<T> {
             l.on_data_available(&r);
         }
     }
+}
+
+/// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped to an
+/// instance. Instances are identified by `cdr::instance_key`; a key-only change without a decodable key
+/// payload is mapped through its key hash to an instance seen before with the same hash.
+fn decode_change<T: DdsType>(
+    s: ReceivedSample,
+    info: RemoteWriterInfo,
+    by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
+    now: Instant,
+) -> Option<Incoming<T>> {
+    let rx_time = SystemTime::now();
+    let source_timestamp = system_time(s.source_timestamp);
+    let kind = match s.kind {
+        ChangeKind::Alive => ChangeKindLocal::Alive,
+        ChangeKind::Dispose => ChangeKindLocal::Dispose,
+        ChangeKind::Unregister => ChangeKindLocal::Unregister,
+        ChangeKind::DisposeUnregister => ChangeKindLocal::DisposeUnregister,
+    };
+    let mut key = Vec::new();
+    let mut data = None;
+    let mut key_holder = None;
+    if kind == ChangeKindLocal::Alive {
+        let d = match cdr::deserialize::<T>(&s.payload) {
+            Ok(d) => d,
+            Err(e) => {
+                tracing::warn!(writer = ?s.writer, seq = s.sequence.0, error = %e, "dropping undecodable sample");
+                return None;
+            }
+        };
+        if T::IS_KEYED {
+            if let Err(e) = cdr::instance_key(&d, &mut key) {
+                tracing::warn!(error = %e, "cannot compute the instance key");
+                return None;
+            }
+            if let Some(kh) = s.key_hash {
+                if by_hash.len() >= MAX_REMEMBERED_HASHES {
+                    by_hash.clear();
+                }
+                by_hash.entry(kh).or_insert_with(|| key.clone());
+            }
+        }
+        data = Some(d);
+    } else if T::IS_KEYED {
+        if !s.payload.is_empty() {
+            match cdr::deserialize_key::<T>(&s.payload) {
+                Ok(k) => {
+                    if let Err(e) = cdr::instance_key(&k, &mut key) {
+                        tracing::warn!(error = %e, "cannot compute the instance key");
+                        return None;
+                    }
+                    key_holder = Some(k);
+                }
+                Err(e) => {
+                    tracing::debug!(error = %e, "undecodable key payload; trying the key hash")
+                }
+            }
+        }
+        if key_holder.is_none() {
+            match s.key_hash.and_then(|kh| by_hash.get(&kh).cloned()) {
+                Some(k) => key = k,
+                None => {
+                    tracing::debug!(writer = ?s.writer, kind = ?s.kind, "key-only change for an unknown instance");
+                    return None;
+                }
+            }
+        }
+    }
+    Some(Incoming {
+        writer: s.writer.to_bytes(),
+        kind,
+        data,
+        key,
+        key_holder,
+        source_timestamp: source_timestamp.unwrap_or(rx_time),
+        reception_timestamp: rx_time,
+        strength: info.strength,
+        expires: info.lifespan.and_then(|l| {
+            // Lifespan counts from the source timestamp; its age so far is spent already.
+            let age = source_timestamp
+                .and_then(|t| rx_time.duration_since(t).ok())
+                .unwrap_or_default();
+            now.checked_add(l.saturating_sub(age))
+        }),
+    })
 }
 
 impl<T: DdsType> ReaderSink for ReaderInner<T> {
@@ -960,5 +971,82 @@ impl<T: DdsType> futures_core::Stream for SampleStream<T> {
             Some(s) => Poll::Ready(Some(s)),
             None => Poll::Pending,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cdr::{ByteOrder, XcdrVersion};
+    use crate::rtps::{GuidPrefix, Payload, SequenceNumber};
+
+    #[derive(dds_macros::DdsType, Debug, Clone, PartialEq, Default)]
+    #[dds(name = "test::K", appendable)]
+    struct K {
+        #[dds(key)]
+        id: String,
+        v: i32,
+    }
+
+    fn rs(kind: ChangeKind, payload: Vec<u8>, key_hash: Option<[u8; 16]>) -> ReceivedSample {
+        ReceivedSample {
+            reader: EntityId([0, 0, 1, 7]),
+            writer: Guid::new(GuidPrefix([1; 12]), EntityId([0, 0, 1, 2])),
+            sequence: SequenceNumber(1),
+            kind,
+            payload: Payload::from(payload),
+            key_hash,
+            source_timestamp: None,
+        }
+    }
+
+    #[test]
+    fn key_only_changes_map_by_key_payload_or_known_hash() {
+        let mut by_hash = HashMap::new();
+        let now = Instant::now();
+        let info = RemoteWriterInfo::default();
+        let s = K {
+            id: "a".into(),
+            v: 1,
+        };
+        let mut buf = Vec::new();
+        cdr::serialize(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut buf).unwrap();
+        let kh = cdr::key_hash(&s, XcdrVersion::Xcdr2).unwrap();
+        let alive = decode_change::<K>(
+            rs(ChangeKind::Alive, buf, Some(kh)),
+            info,
+            &mut by_hash,
+            now,
+        )
+        .unwrap();
+        assert_eq!(alive.data.as_ref(), Some(&s));
+        let mut expected = Vec::new();
+        cdr::instance_key(&s, &mut expected).unwrap();
+        assert_eq!(alive.key, expected);
+
+        let mut kp = Vec::new();
+        cdr::serialize_key(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut kp).unwrap();
+        let d =
+            decode_change::<K>(rs(ChangeKind::Dispose, kp, None), info, &mut by_hash, now).unwrap();
+        assert_eq!(d.key, expected, "by key payload");
+        assert_eq!(d.kind, ChangeKindLocal::Dispose);
+
+        let u = decode_change::<K>(
+            rs(ChangeKind::Unregister, Vec::new(), Some(kh)),
+            info,
+            &mut by_hash,
+            now,
+        )
+        .unwrap();
+        assert_eq!(u.key, expected, "by a key hash seen before");
+
+        let unknown = rs(ChangeKind::Dispose, Vec::new(), Some([9; 16]));
+        assert!(decode_change::<K>(unknown, info, &mut by_hash, now).is_none());
+        let garbage = rs(
+            ChangeKind::Alive,
+            vec![0, 7, 0, 0, 0xff, 0xff, 0xff, 0x7f],
+            None,
+        );
+        assert!(decode_change::<K>(garbage, info, &mut by_hash, now).is_none());
     }
 }

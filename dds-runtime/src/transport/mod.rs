@@ -13,11 +13,12 @@
 //! - when multicast is on, the SPDP multicast socket: `SO_REUSEADDR` + `SO_REUSEPORT` on the domain's
 //!   discovery port, joined to 239.255.0.1 on the selected interface only (`IP_MULTICAST_ALL` off).
 //!
-//! Batched sends (`sendmmsg`) and receives (`recvmmsg`) are not used yet.
+//! Receive threads read with `recvmmsg` (up to 8 datagrams per call) and hand the whole batch to the
+//! receiver, so the core's lock is taken once per batch. Sends are one `sendto` per datagram.
 
 pub mod iface;
 pub mod ports;
 mod udp;
 
 pub use iface::Interface;
-pub use udp::{Channel, Receiver, TransportStats, UdpTransport};
+pub use udp::{Channel, Datagram, Receiver, TransportStats, UdpTransport};

@@ -24,8 +24,20 @@ pub enum Channel {
     UserUnicast,
 }
 
-/// Called by the receive threads for every datagram.
-pub type Receiver = Arc<dyn Fn(Channel, &[u8], SocketAddr) + Send + Sync>;
+/// One received datagram.
+#[derive(Debug, Clone, Copy)]
+pub struct Datagram<'a> {
+    /// The payload.
+    pub data: &'a [u8],
+    /// The sender.
+    pub from: SocketAddr,
+}
+
+/// Called by the receive threads with each batch of datagrams (one `recvmmsg`, at least one datagram).
+pub type Receiver = Arc<dyn Fn(Channel, &[Datagram<'_>]) + Send + Sync>;
+
+/// Datagrams received per `recvmmsg` call.
+const RECV_BATCH: usize = 8;
 
 /// Largest UDP payload we can receive.
 const RECV_BUFFER: usize = 65536;
@@ -368,6 +380,98 @@ impl Drop for UdpTransport {
     }
 }
 
+/// Buffers for one `recvmmsg` call. The pointers inside `hdrs` point into the other vectors' heap storage,
+/// which never reallocates after construction.
+struct RecvBatch {
+    bufs: Vec<Vec<u8>>,
+    addrs: Vec<libc::sockaddr_storage>,
+    iovs: Vec<libc::iovec>,
+    hdrs: Vec<libc::mmsghdr>,
+}
+
+// SAFETY: the raw pointers only reference the batch's own heap buffers; the batch is used by one thread.
+unsafe impl Send for RecvBatch {}
+
+impl RecvBatch {
+    fn new() -> Self {
+        let mut bufs: Vec<Vec<u8>> = (0..RECV_BATCH).map(|_| vec![0u8; RECV_BUFFER]).collect();
+        // SAFETY: sockaddr_storage and mmsghdr are plain C structs for which all-zero is valid.
+        let mut addrs: Vec<libc::sockaddr_storage> = (0..RECV_BATCH)
+            .map(|_| unsafe { std::mem::zeroed() })
+            .collect();
+        let mut iovs: Vec<libc::iovec> = bufs
+            .iter_mut()
+            .map(|b| libc::iovec {
+                iov_base: b.as_mut_ptr().cast(),
+                iov_len: b.len(),
+            })
+            .collect();
+        let hdrs: Vec<libc::mmsghdr> = (0..RECV_BATCH)
+            .map(|i| {
+                // SAFETY: see above.
+                let mut h: libc::mmsghdr = unsafe { std::mem::zeroed() };
+                h.msg_hdr.msg_name = (&mut addrs[i] as *mut libc::sockaddr_storage).cast();
+                h.msg_hdr.msg_iov = &mut iovs[i];
+                h.msg_hdr.msg_iovlen = 1;
+                h
+            })
+            .collect();
+        RecvBatch {
+            bufs,
+            addrs,
+            iovs,
+            hdrs,
+        }
+    }
+
+    /// Blocks for the first datagram, then takes what else is queued; returns how many arrived.
+    fn recv(&mut self, sock: &UdpSocket) -> io::Result<usize> {
+        use std::os::fd::AsRawFd;
+        for h in &mut self.hdrs {
+            h.msg_hdr.msg_namelen =
+                std::mem::size_of::<libc::sockaddr_storage>() as libc::socklen_t;
+            h.msg_len = 0;
+        }
+        // SAFETY: every header points at a live buffer of the stated length and a sockaddr_storage.
+        let n = unsafe {
+            libc::recvmmsg(
+                sock.as_raw_fd(),
+                self.hdrs.as_mut_ptr(),
+                RECV_BATCH as libc::c_uint,
+                libc::MSG_WAITFORONE,
+                std::ptr::null_mut(),
+            )
+        };
+        if n < 0 {
+            Err(io::Error::last_os_error())
+        } else {
+            Ok(n as usize)
+        }
+    }
+
+    fn datagram(&self, i: usize) -> Option<Datagram<'_>> {
+        let len = (self.hdrs[i].msg_len as usize).min(self.bufs[i].len());
+        let from = sockaddr_v4(&self.addrs[i])?;
+        let _ = &self.iovs;
+        Some(Datagram {
+            data: &self.bufs[i][..len],
+            from,
+        })
+    }
+}
+
+fn sockaddr_v4(a: &libc::sockaddr_storage) -> Option<SocketAddr> {
+    if i32::from(a.ss_family) != libc::AF_INET {
+        return None;
+    }
+    // SAFETY: the family says this storage holds a sockaddr_in.
+    let sin = unsafe { &*(a as *const libc::sockaddr_storage).cast::<libc::sockaddr_in>() };
+    Some(SocketAddr::V4(SocketAddrV4::new(
+        Ipv4Addr::from(u32::from_be(sin.sin_addr.s_addr)),
+        u16::from_be(sin.sin_port),
+    )))
+}
+
 fn recv_loop(
     ch: Channel,
     sock: &UdpSocket,
@@ -375,19 +479,30 @@ fn recv_loop(
     rx: &Receiver,
     stats: &TransportStats,
 ) {
-    let mut buf = vec![0u8; RECV_BUFFER];
+    let mut batch = RecvBatch::new();
+    let mut grams: Vec<Datagram<'_>> = Vec::with_capacity(RECV_BATCH);
     while !stop.load(Ordering::Relaxed) {
-        match sock.recv_from(&mut buf) {
-            Ok((n, from)) => {
+        match batch.recv(sock) {
+            Ok(n) => {
                 if stop.load(Ordering::Relaxed) {
                     break;
                 }
-                if n == 0 {
+                grams.clear();
+                grams.extend(
+                    (0..n)
+                        .filter_map(|i| batch.datagram(i))
+                        .filter(|d| !d.data.is_empty()),
+                );
+                if grams.is_empty() {
                     continue;
                 }
-                stats.received.fetch_add(1, Ordering::Relaxed);
-                tracing::trace!(channel = ?ch, %from, len = n, "received");
-                rx(ch, &buf[..n], from);
+                stats
+                    .received
+                    .fetch_add(grams.len() as u64, Ordering::Relaxed);
+                for d in &grams {
+                    tracing::trace!(channel = ?ch, from = %d.from, len = d.data.len(), "received");
+                }
+                rx(ch, &grams);
             }
             Err(e)
                 if matches!(

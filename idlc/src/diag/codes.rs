@@ -61,6 +61,7 @@ codes! {
     AnnotationPlace = "E0412": "annotation not allowed here",
     DuplicateMember = "E0413": "two members have the same name",
     BadMemberType = "E0414": "type not allowed for this member",
+    UnreachableDefault = "E0415": "union default label can never be selected",
     // Warnings
     PragmaIgnored = "W0001": "unknown #pragma ignored",
     WarningDirective = "W0002": "#warning directive",

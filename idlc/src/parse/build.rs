@@ -499,7 +499,16 @@ impl<'a> Builder<'a> {
     pub fn const_expr(&mut self, p: P) -> ConstExpr {
         let loc = self.loc(&p);
         match p.as_rule() {
-            Rule::const_expr | Rule::xor_expr | Rule::and_expr | Rule::shift_expr | Rule::add_expr | Rule::mult_expr => {
+            Rule::const_expr
+            | Rule::xor_expr
+            | Rule::and_expr
+            | Rule::shift_expr
+            | Rule::add_expr
+            | Rule::mult_expr
+            | Rule::tmpl_expr
+            | Rule::tmpl_xor
+            | Rule::tmpl_and
+            | Rule::tmpl_shift => {
                 let mut it = p.into_inner();
                 let mut lhs = self.const_expr(it.next().expect("operand"));
                 while let Some(op) = it.next() {

@@ -83,7 +83,7 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         identifier => "identifier",
         scoped_name => "name",
         type_spec | base_type | template_type | integer_type | floating_type | switch_type | const_type => "type",
-        const_expr | primary_expr | unary_expr | literal | int_lit | float_lit => "expression",
+        const_expr | tmpl_expr | primary_expr | unary_expr | literal | int_lit | float_lit => "expression",
         annotation_appl => "annotation",
         definition => "definition",
         member => "member",
@@ -101,7 +101,7 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         K_ENUM => "`enum`",
         K_TYPEDEF => "`typedef`",
         K_CONST => "`const`",
-        or_op | xor_op | and_op | shift_op | add_op | mult_op => "operator",
+        or_op | xor_op | and_op | shift_op | shl_op | add_op | mult_op => "operator",
         named_param => "parameter",
         _ => return None,
     })

@@ -296,10 +296,8 @@ impl<'a> Resolver<'a> {
                 Type::Map { key: Box::new(k), value, bound }
             }
             TypeSpec::Fixed { digits, scale, loc } => {
-                let (Some(d), Some(s)) = (digits, scale) else {
-                    self.diags.push(Diagnostic::error(Code::BadMemberType, "`fixed` needs digits and scale here").at(*loc, "here"));
-                    return Type::Error;
-                };
+                // Bare `fixed` only occurs as a constant type; the value carries its own digits.
+                let (Some(d), Some(s)) = (digits, scale) else { return Type::Fixed { digits: 0, scale: 0 } };
                 let dv = self.eval_u64(d, "fixed digits", 1).unwrap_or(1);
                 let sv = self.eval_u64(s, "fixed scale", 0).unwrap_or(0);
                 if dv > 31 || sv > dv {

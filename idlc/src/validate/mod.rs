@@ -136,6 +136,31 @@ fn check_union(model: &Model, u: &Union, diags: &mut Diagnostics) {
             }
         }
     }
+    if let Some(d) = default {
+        check_unreachable_default(model, u, d, diags);
+    }
+}
+
+/// A `default:` is only meaningful when some discriminator value has no label (enums and booleans are finite).
+fn check_unreachable_default(model: &Model, u: &Union, default: crate::source::Loc, diags: &mut Diagnostics) {
+    let total = match model.resolve_alias(&u.discriminator) {
+        Type::Named { decl, .. } => match &model.decls[*decl].kind {
+            DeclKind::Enum(e) => e.enumerators.len(),
+            _ => return,
+        },
+        Type::Prim { prim: crate::ast::Prim::Bool } => 2,
+        _ => return,
+    };
+    let mut labels: Vec<&Value> = u.cases.iter().flat_map(|c| c.labels.iter()).collect();
+    labels.dedup();
+    let distinct = labels.iter().enumerate().filter(|(i, v)| !labels[..*i].contains(v)).count();
+    if distinct >= total {
+        diags.push(
+            Diagnostic::error(Code::UnreachableDefault, "the `default` member can never be selected")
+                .at(default, "unreachable default")
+                .help("every value of the discriminator already has a case label; remove `default` or a label"),
+        );
+    }
 }
 
 fn show(model: &Model, v: &Value) -> String {

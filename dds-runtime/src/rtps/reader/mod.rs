@@ -295,15 +295,14 @@ impl Reader {
         p.synced = true;
         let base = g.gap_list.base;
         if g.gap_start <= p.next_expected && base > p.next_expected {
-            // Everything up to base is irrelevant or was buffered: buffered data in the range is delivered.
+            // Nothing below base will come any more. What we already hold of it was published and is delivered
+            // in order; the rest is irrelevant (not lost).
             while let Some(e) = p.reorder.first_entry() {
                 if *e.key() >= base {
                     break;
                 }
                 let (sn, slot) = e.remove_entry();
-                if matches!(slot, Slot::Change(_)) && sn >= p.next_expected {
-                    // The writer says sn is irrelevant; honour the GAP.
-                }
+                Self::deliver(rid, p, sn, slot, out);
             }
             p.next_expected = base;
         } else if g.gap_start > p.next_expected && base.0 - g.gap_start.0 <= 256 {

@@ -46,7 +46,8 @@ pub fn snake(s: &str) -> String {
 
 pub fn upper_camel(s: &str) -> String {
     // Already acceptable camel case (acronyms allowed): keep the author's spelling.
-    if s.starts_with(|c: char| c.is_ascii_uppercase()) && !s.contains('_') {
+    let has_lower = s.chars().any(|c| c.is_lowercase());
+    if s.starts_with(|c: char| c.is_ascii_uppercase()) && !s.contains('_') && (has_lower || s.len() == 1) {
         return s.to_string();
     }
     let mut r = String::new();
@@ -103,6 +104,9 @@ mod tests {
         assert_eq!(upper_camel("RED"), "Red");
         assert_eq!(upper_camel("COLOR_RED"), "ColorRed");
         assert_eq!(upper_camel("HTTPServer"), "HTTPServer");
+        assert_eq!(upper_camel("ID"), "Id");
+        assert_eq!(upper_camel("X"), "X");
+        assert_eq!(upper_camel("point3D"), "Point3D");
         assert_eq!(screaming("maxLen"), "MAX_LEN");
         assert_eq!(ident("type"), "r#type");
         assert_eq!(ident("self"), "self_");
