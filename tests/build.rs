@@ -19,6 +19,7 @@ const FILES: &[(&str, &str)] = &[
     ("eprosima-dds-types-test/IDL", "unions.idl"),
     ("eprosima-dds-types-test/IDL", "key.idl"),
     ("eprosima-dds-types-test/IDL", "mutable.idl"),
+    ("eprosima-dds-types-test/IDL", "final.idl"),
     ("eprosima-dds-types-test/IDL", "member_id.idl"),
     ("eprosima-dds-types-test/IDL", "optional.idl"),
     ("eprosima-dds-types-test/IDL", "arrays.idl"),

@@ -67,15 +67,25 @@ where
     let versions = [(XcdrVersion::Xcdr1, "xcdr1"), (XcdrVersion::Xcdr2, "xcdr2")];
     let dust_type = T::get_type();
 
-    // Each library must decode its own output back to the value, or the numbers mean nothing.
+    // Each library must decode its own output back to the value, or the numbers mean nothing. Dust DDS 0.15
+    // cannot decode some of its own encodings (its XCDR1 parameter lists of mutable types): those decode
+    // entries are left out and reported.
     let mut payloads = Vec::new();
     for (ver, tag) in versions {
         let ours = ours_encode(v, ver);
         assert_eq!(&cdr::deserialize::<T>(&ours).expect("ours decodes"), v, "ours {tag}");
         let dust = dust_encode(v, ver);
-        let back = T::create_sample(CdrDeserializer::deserialize(dust_type.clone(), &dust).expect("dust decodes"));
-        assert_eq!(&back, v, "dust {tag}");
-        payloads.push((ver, tag, ours, dust));
+        let dust_ok = match CdrDeserializer::deserialize(dust_type.clone(), &dust) {
+            Ok(d) => {
+                assert_eq!(&T::create_sample(d), v, "dust {tag}");
+                true
+            }
+            Err(e) => {
+                eprintln!("note: {name}: dust_dds cannot decode its own {tag} encoding ({e:?}); not measured");
+                false
+            }
+        };
+        payloads.push((ver, tag, ours, dust, dust_ok));
     }
     let mut serde_bytes = Vec::new();
     serde_encode(v, &mut serde_bytes);
@@ -83,7 +93,7 @@ where
 
     let mut g = c.benchmark_group(format!("{name}_encode"));
     g.throughput(Throughput::Bytes(payloads[0].2.len() as u64));
-    for (ver, tag, ours, _) in &payloads {
+    for (ver, tag, ours, _, _) in &payloads {
         let mut buf = Vec::with_capacity(ours.len());
         g.bench_function(format!("ours_{tag}"), |b| {
             b.iter(|| {
@@ -93,7 +103,7 @@ where
             })
         });
     }
-    for (ver, tag, _, _) in &payloads {
+    for (ver, tag, _, _, _) in &payloads {
         g.bench_function(format!("dust_{tag}"), |b| {
             b.iter_batched(
                 || v.clone(),
@@ -120,10 +130,10 @@ where
 
     let mut g = c.benchmark_group(format!("{name}_decode"));
     g.throughput(Throughput::Bytes(payloads[0].2.len() as u64));
-    for (_, tag, ours, _) in &payloads {
+    for (_, tag, ours, _, _) in &payloads {
         g.bench_function(format!("ours_{tag}"), |b| b.iter(|| cdr::deserialize::<T>(black_box(ours)).unwrap()));
     }
-    for (_, tag, _, dust) in &payloads {
+    for (_, tag, _, dust, _) in payloads.iter().filter(|p| p.4) {
         g.bench_function(format!("dust_{tag}"), |b| {
             b.iter(|| T::create_sample(CdrDeserializer::deserialize(dust_type.clone(), black_box(dust)).unwrap()))
         });

@@ -576,3 +576,62 @@ fn keep_last_writer_under_loss_converges_to_the_latest() {
         );
     }
 }
+
+/// Core-only throughput (no sockets, no serialization): `cargo test --release -p dds-runtime --test
+/// rtps_reliability -- --ignored --nocapture core_throughput`.
+#[test]
+#[ignore = "measurement; run in release"]
+fn core_throughput() {
+    let mut s = setup(
+        1,
+        Faults::NONE,
+        DataWriterQos::builder().history(History::KeepAll).build(),
+        DataReaderQos::builder()
+            .reliability(Reliability::RELIABLE)
+            .history(History::KeepAll)
+            .build(),
+    );
+    let (w, r) = (s.w, s.r);
+    let payload = Payload::from(sample(0, 1024));
+    let n = 1_000_000u64;
+    let start = std::time::Instant::now();
+    let (mut written, mut received) = (0u64, 0u64);
+    let mut now = s.sim.now;
+    while received < n {
+        let [a, b] = &mut s.sim.nodes[..] else {
+            unreachable!()
+        };
+        while written < n {
+            match a.p.write(now, w, WriteChange::alive(payload.clone())) {
+                Ok(_) => written += 1,
+                Err(WriteError::WouldBlock) => break,
+                Err(e) => panic!("{e}"),
+            }
+            if written % 64 == 0 {
+                break;
+            }
+        }
+        while let Some(t) = a.p.poll_transmit(now) {
+            b.p.handle_datagram(now, &t.payload);
+            a.p.recycle(t.payload);
+        }
+        while let Some(t) = b.p.poll_transmit(now) {
+            a.p.handle_datagram(now, &t.payload);
+        }
+        while let Some(e) = b.p.poll_event() {
+            if let Event::Sample(x) = e {
+                assert_eq!(x.reader, r);
+                received += 1;
+            }
+        }
+        while a.p.poll_event().is_some() {}
+        now += Duration::from_micros(10);
+        a.p.handle_timeout(now);
+        b.p.handle_timeout(now);
+    }
+    let dt = start.elapsed();
+    eprintln!(
+        "{n} × 1 KiB reliable through the core: {:.0} samples/s",
+        n as f64 / dt.as_secs_f64()
+    );
+}

@@ -232,7 +232,9 @@ fn parse_rate(s: &str) -> Option<f64> {
 fn split_number(s: &str) -> (&str, &str) {
     let end = s
         .char_indices()
-        .take_while(|(i, c)| c.is_ascii_digit() || *c == '.' || (*i == 0 && (*c == '-' || *c == '+')))
+        .take_while(|(i, c)| {
+            c.is_ascii_digit() || *c == '.' || (*i == 0 && (*c == '-' || *c == '+'))
+        })
         .map(|(i, c)| i + c.len_utf8())
         .last()
         .unwrap_or(0);
@@ -299,13 +301,23 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
                 'd' => return err(format!("-d {val}: network load reporting not supported")),
                 'D' => o.duration = parse_seconds(&val),
                 'i' => {
-                    o.domain_id = Some(val.parse().map_err(|_| ArgError(format!("-i {val}: invalid domain id")))?)
+                    o.domain_id = Some(
+                        val.parse()
+                            .map_err(|_| ArgError(format!("-i {val}: invalid domain id")))?,
+                    )
                 }
                 'n' => o.nkeyvals = val.parse().unwrap_or(0),
                 'k' => {
-                    o.history_depth = if val == "all" { 0 } else { val.parse::<i64>().unwrap_or(0).clamp(0, 1 << 30) as u32 }
+                    o.history_depth = if val == "all" {
+                        0
+                    } else {
+                        val.parse::<i64>().unwrap_or(0).clamp(0, 1 << 30) as u32
+                    }
                 }
-                'T' => o.topic = TopicSel::parse(&val).ok_or_else(|| ArgError(format!("-T {val}: unknown topic")))?,
+                'T' => {
+                    o.topic = TopicSel::parse(&val)
+                        .ok_or_else(|| ArgError(format!("-T {val}: unknown topic")))?
+                }
                 'Q' => parse_criterion(&mut o, &val)?,
                 'R' | 'K' | 'W' => {}
                 _ => return err(format!("invalid option -- '{c}'")),
@@ -328,10 +340,16 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
         return err(format!("-n {} invalid: topic OU has no key", o.nkeyvals));
     }
     if o.topic != TopicSel::Ks && o.baggage != 0 {
-        return err(format!("size {} invalid: only topic KS has a sequence", o.baggage));
+        return err(format!(
+            "size {} invalid: only topic KS has a sequence",
+            o.baggage
+        ));
     }
     if o.baggage != 0 && o.baggage < 12 {
-        return err(format!("size {} invalid: too small to allow for overhead", o.baggage));
+        return err(format!(
+            "size {} invalid: too small to allow for overhead",
+            o.baggage
+        ));
     } else if o.baggage > 0 {
         o.baggage -= 12;
     }
@@ -364,8 +382,11 @@ fn parse_modes(o: &mut PerfOptions, a: &[String]) -> Result<(), ArgError> {
                 while i < a.len() && !is_mode(&a[i]) {
                     let t = a[i].as_str();
                     if t == "size" {
-                        let v = a.get(i + 1).ok_or_else(|| ArgError("argument missing in size specification".into()))?;
-                        o.baggage = parse_size(v).ok_or_else(|| ArgError(format!("{v}: invalid size specification")))?;
+                        let v = a.get(i + 1).ok_or_else(|| {
+                            ArgError("argument missing in size specification".into())
+                        })?;
+                        o.baggage = parse_size(v)
+                            .ok_or_else(|| ArgError(format!("{v}: invalid size specification")))?;
                         i += 1;
                     } else if t == "waitset" || t == "listener" {
                     } else if let Some(r) = parse_rate(t) {
@@ -412,9 +433,16 @@ fn parse_modes(o: &mut PerfOptions, a: &[String]) -> Result<(), ArgError> {
                 while i < a.len() && !is_mode(&a[i]) {
                     let t = a[i].as_str();
                     if t == "burst" || t == "size" {
-                        let v = a.get(i + 1).ok_or_else(|| ArgError(format!("argument missing in {t} specification")))?;
-                        let n = if t == "burst" { v.parse().ok() } else { parse_size(v) };
-                        let n = n.ok_or_else(|| ArgError(format!("{v}: invalid {t} specification")))?;
+                        let v = a.get(i + 1).ok_or_else(|| {
+                            ArgError(format!("argument missing in {t} specification"))
+                        })?;
+                        let n = if t == "burst" {
+                            v.parse().ok()
+                        } else {
+                            parse_size(v)
+                        };
+                        let n =
+                            n.ok_or_else(|| ArgError(format!("{v}: invalid {t} specification")))?;
                         if t == "burst" {
                             o.burst = n.max(1);
                         } else {
@@ -491,7 +519,10 @@ mod tests {
         assert_eq!(o.sub, Some(TriggerMode::Listener));
         assert!(o.pong);
         assert_eq!(run("ping").ping_interval, Some(Duration::ZERO));
-        assert_eq!(run("ping 10Hz size 100").ping_interval, Some(Duration::from_millis(100)));
+        assert_eq!(
+            run("ping 10Hz size 100").ping_interval,
+            Some(Duration::from_millis(100))
+        );
         assert_eq!(run("ping 10Hz size 100").baggage, 88);
         assert_eq!(run("sanity").ping_interval, Some(Duration::from_secs(1)));
         assert_eq!(run("-k all sub polling").sub, Some(TriggerMode::Polling));

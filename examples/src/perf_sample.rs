@@ -3,7 +3,9 @@
 use dds_runtime::cdr::DdsType;
 
 use crate::perf_args::TopicSel;
-use crate::topic_types::{Keyed256, Keyed32, KeyedSeq, OneULong, Struct16, Struct256, Struct32k, Struct4k};
+use crate::topic_types::{
+    Keyed256, Keyed32, KeyedSeq, OneULong, Struct16, Struct256, Struct32k, Struct4k,
+};
 
 /// A ddsperf sample type.
 pub trait PerfSample: DdsType + Clone + Send + Sync + 'static {
@@ -27,7 +29,11 @@ impl PerfSample for KeyedSeq {
     const TOPIC: TopicSel = TopicSel::Ks;
     fn make(seq: u32, baggage: u32) -> Self {
         // ddsperf fills the baggage with 0xee.
-        KeyedSeq { seq, keyval: 0, baggage: vec![0xee; baggage as usize] }
+        KeyedSeq {
+            seq,
+            keyval: 0,
+            baggage: vec![0xee; baggage as usize],
+        }
     }
     fn seq(&self) -> u32 {
         self.seq
@@ -105,7 +111,13 @@ mod tests {
         // XCDR1 body size (without the 4-byte header) equals ddsperf's reported size for fixed types.
         fn body<T: PerfSample>() -> usize {
             let mut v = Vec::new();
-            serialize(&T::make(1, 0), XcdrVersion::Xcdr1, ByteOrder::LittleEndian, &mut v).expect("encodes");
+            serialize(
+                &T::make(1, 0),
+                XcdrVersion::Xcdr1,
+                ByteOrder::LittleEndian,
+                &mut v,
+            )
+            .expect("encodes");
             v.len() - 4
         }
         assert_eq!(body::<Keyed32>(), 32);

@@ -30,7 +30,11 @@ pub struct LatencyStat {
 
 impl LatencyStat {
     pub fn new() -> Self {
-        LatencyStat { min: i64::MAX, max: i64::MIN, ..Default::default() }
+        LatencyStat {
+            min: i64::MAX,
+            max: i64::MIN,
+            ..Default::default()
+        }
     }
 
     pub fn record(&mut self, ns: i64) {
@@ -68,7 +72,11 @@ impl LatencyStat {
         };
         let total = self.total;
         self.raw.clear();
-        *self = LatencyStat { total, raw: std::mem::take(&mut self.raw), ..LatencyStat::new() };
+        *self = LatencyStat {
+            total,
+            raw: std::mem::take(&mut self.raw),
+            ..LatencyStat::new()
+        };
         Some(s)
     }
 }
@@ -86,7 +94,13 @@ pub struct LatencySummary {
 }
 
 /// `{prefix}{sub} {peer} size {size} mean ..us min ..us 50% ..us 90% ..us 99% ..us max ..us cnt N`.
-pub fn latency_line(prefix: &str, subprefix: &str, peer: &str, size: u32, s: &LatencySummary) -> String {
+pub fn latency_line(
+    prefix: &str,
+    subprefix: &str,
+    peer: &str,
+    size: u32,
+    s: &LatencySummary,
+) -> String {
     format!(
         "{prefix}{subprefix} {peer} size {size} mean {:.3}us min {:.3}us 50% {:.3}us 90% {:.3}us 99% {:.3}us max {:.3}us cnt {}",
         s.mean_us, s.min_us, s.p50_us, s.p90_us, s.p99_us, s.max_us, s.count
@@ -131,7 +145,10 @@ pub enum SeqCheck {
 
 impl SubStats {
     pub fn new(nkeys: u32) -> Self {
-        SubStats { nkeys: nkeys.max(1), pubs: HashMap::new() }
+        SubStats {
+            nkeys: nkeys.max(1),
+            pubs: HashMap::new(),
+        }
     }
 
     /// Accounts one sample from writer `writer`.
@@ -148,15 +165,35 @@ impl SubStats {
             let lost = seq.wrapping_sub(e);
             p.now.nlost += u64::from(lost);
             p.last_size = size;
-            return if lost == 0 { SeqCheck::InOrder } else { SeqCheck::Gap { lost } };
+            return if lost == 0 {
+                SeqCheck::InOrder
+            } else {
+                SeqCheck::Gap { lost }
+            };
         }
         // First sample from this writer: the writer cycles through the keys, so the next expected
         // sequence number for key i is seq + (i - keyval), one round later for keys at or before keyval.
         let expected = (0..nkeys)
-            .map(|i| seq.wrapping_add(i.wrapping_sub(keyval)).wrapping_add(if i <= keyval { nkeys } else { 0 }))
+            .map(|i| {
+                seq.wrapping_add(i.wrapping_sub(keyval))
+                    .wrapping_add(if i <= keyval { nkeys } else { 0 })
+            })
             .collect();
-        let now = Counts { nrecv: 1, nlost: 0, bytes: u64::from(size) };
-        self.pubs.insert(writer, PubStat { expected, now, last_size: size, refs: [Counts::default(); 10], refidx: 0 });
+        let now = Counts {
+            nrecv: 1,
+            nlost: 0,
+            bytes: u64::from(size),
+        };
+        self.pubs.insert(
+            writer,
+            PubStat {
+                expected,
+                now,
+                last_size: size,
+                refs: [Counts::default(); 10],
+                refidx: 0,
+            },
+        );
         SeqCheck::InOrder
     }
 
@@ -178,7 +215,8 @@ impl SubStats {
     /// The per-second line (`None` when nothing arrived and `every_second` is off), advancing the
     /// snapshot ring. `dt_ns` is the time since the previous call.
     pub fn second_line(&mut self, prefix: &str, dt_ns: f64, every_second: bool) -> Option<String> {
-        let (mut tot_recv, mut tot_lost, mut nrecv, mut nlost, mut bytes, mut nrecv10, mut bytes10) = (0, 0, 0, 0, 0, 0, 0);
+        let (mut tot_recv, mut tot_lost, mut nrecv, mut nlost, mut bytes, mut nrecv10, mut bytes10) =
+            (0, 0, 0, 0, 0, 0, 0);
         let mut last_size = 0;
         for p in self.pubs.values_mut() {
             let r1 = p.refs[(p.refidx + 9) % 10];
@@ -219,7 +257,12 @@ pub struct WriteHist {
 
 impl Default for WriteHist {
     fn default() -> Self {
-        WriteHist { bins: [0; 30], over: 0, min: u64::MAX, max: 0 }
+        WriteHist {
+            bins: [0; 30],
+            over: 0,
+            min: u64::MAX,
+            max: 0,
+        }
     }
 }
 
@@ -291,9 +334,16 @@ impl WriteHist {
         } else {
             format!("{:>4}M", fmt_g3(avg / 1e6))
         };
-        let min = if self.min == u64::MAX { " inf".to_string() } else { fmt_ns(self.min) };
-        let pct = if cnt == 0 { 0 } else { 100 * ((self.over + cnt / 2) / cnt) };
-        let line = format!("{prefix}{rate}/s {min} |{hist}| {pct:3}% {}", fmt_ns(self.max));
+        let min = if self.min == u64::MAX {
+            " inf".to_string()
+        } else {
+            fmt_ns(self.min)
+        };
+        let pct = 100 * (self.over + cnt / 2).checked_div(cnt).unwrap_or(0);
+        let line = format!(
+            "{prefix}{rate}/s {min} |{hist}| {pct:3}% {}",
+            fmt_ns(self.max)
+        );
         *self = WriteHist::default();
         line
     }
@@ -331,7 +381,10 @@ mod tests {
             "[42] 1.000  size 1024 total 1000 lost 0 delta 1000 lost 0 rate 1.00 kS/s 8.19 Mb/s (0.10 kS/s 0.82 Mb/s)"
         );
         assert_eq!(s.second_line(&prefix(42, 2.0), 1e9, false), None);
-        assert!(s.second_line(&prefix(42, 3.0), 1e9, true).expect("forced").contains("delta 0 lost 0"));
+        assert!(s
+            .second_line(&prefix(42, 3.0), 1e9, true)
+            .expect("forced")
+            .contains("delta 0 lost 0"));
     }
 
     #[test]
@@ -350,7 +403,10 @@ mod tests {
         assert!(l.take_summary().is_none());
         assert_eq!(l.total, 100);
         let line = latency_line(&prefix(7, 1.0), "", "host:7", 12, &s);
-        assert!(line.starts_with("[7] 1.000  host:7 size 12 mean 50.500us min 1.000us 50% 51.000us"), "{line}");
+        assert!(
+            line.starts_with("[7] 1.000  host:7 size 12 mean 50.500us min 1.000us 50% 51.000us"),
+            "{line}"
+        );
         assert!(line.ends_with("cnt 100"));
     }
 

@@ -126,7 +126,10 @@ impl Default for ShapeOptions {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Parsed {
     /// Run with these options; `warnings` are printed first (shape_main prints them as errors but runs).
-    Run { options: ShapeOptions, warnings: Vec<String> },
+    Run {
+        options: Box<ShapeOptions>,
+        warnings: Vec<String>,
+    },
     /// `-h`/`--help`.
     Help,
 }
@@ -236,7 +239,10 @@ fn tokenize(args: &[String]) -> Result<Vec<(String, Option<String>)>, String> {
                 let v = match inline {
                     Some(v) => v,
                     None => {
-                        let v = args.get(i).cloned().ok_or_else(|| format!("option '--{full}' requires an argument"))?;
+                        let v = args
+                            .get(i)
+                            .cloned()
+                            .ok_or_else(|| format!("option '--{full}' requires an argument"))?;
                         i += 1;
                         v
                     }
@@ -259,7 +265,10 @@ fn tokenize(args: &[String]) -> Result<Vec<(String, Option<String>)>, String> {
                     let v = if !rest.is_empty() {
                         rest
                     } else {
-                        let v = args.get(i).cloned().ok_or_else(|| format!("option requires an argument -- '{c}'"))?;
+                        let v = args
+                            .get(i)
+                            .cloned()
+                            .ok_or_else(|| format!("option requires an argument -- '{c}'"))?;
                         i += 1;
                         v
                     };
@@ -383,14 +392,20 @@ pub fn parse(args: &[String]) -> Result<Parsed, ParseError> {
             "--write-period" => o.write_period = ms(&mut errors, "write-period"),
             "--read-period" => o.read_period = ms(&mut errors, "read-period"),
             "--lifespan" => o.lifespan = ms(&mut errors, "lifespan"),
-            "--periodic-announcement" => o.periodic_announcement = ms(&mut errors, "periodic-announcement"),
+            "--periodic-announcement" => {
+                o.periodic_announcement = ms(&mut errors, "periodic-announcement")
+            }
             "--num-iterations" => o.num_iterations = positive(&mut errors, "num-iterations"),
             "--num-instances" => o.num_instances = positive(&mut errors, "num-instances"),
             "--num-topics" => o.num_topics = positive(&mut errors, "num-topics"),
-            "--additional-payload-size" => o.additional_payload_size = positive(&mut errors, "additional-payload-size"),
+            "--additional-payload-size" => {
+                o.additional_payload_size = positive(&mut errors, "additional-payload-size")
+            }
             "--coherent-sample-count" => match num {
                 Some(n) if n >= 2 => o.coherent_sample_count = n.min(i64::from(u32::MAX)) as u32,
-                Some(n) => errors.push(format!("incorrect value for coherent-sample-count, it must be >=2 {n}")),
+                Some(n) => errors.push(format!(
+                    "incorrect value for coherent-sample-count, it must be >=2 {n}"
+                )),
                 None => errors.push(format!("unrecognized value for coherent-sample-count {c0}")),
             },
             "--final-instance-state" => {
@@ -404,7 +419,10 @@ pub fn parse(args: &[String]) -> Result<Parsed, ParseError> {
                 };
                 if let (Some(old), Some(new)) = (o.final_instance_state, new) {
                     if old != new {
-                        errors.push("error, cannot configure unregister and dispose at the same time".into());
+                        errors.push(
+                            "error, cannot configure unregister and dispose at the same time"
+                                .into(),
+                        );
                     }
                 }
                 o.final_instance_state = new.or(o.final_instance_state);
@@ -426,7 +444,9 @@ pub fn parse(args: &[String]) -> Result<Parsed, ParseError> {
             "--take-read" => o.take_read_next_instance = false,
             "--datafrag-size" => match num {
                 Some(n) if (0..=65535).contains(&n) => o.datafrag_size = n as u32,
-                Some(n) => errors.push(format!("incorrect value for datafrag-size, it must be <= 65535 bytes{n}")),
+                Some(n) => errors.push(format!(
+                    "incorrect value for datafrag-size, it must be <= 65535 bytes{n}"
+                )),
                 None => errors.push(format!("unrecognized value for datafrag-size {c0}")),
             },
             "--cft" => o.cft_expression = Some(v),
@@ -442,26 +462,39 @@ pub fn parse(args: &[String]) -> Result<Parsed, ParseError> {
     }
     let mut warnings = Vec::new();
     validate(&mut o, access_scope_set, &mut warnings)?;
-    Ok(Parsed::Run { options: o, warnings })
+    Ok(Parsed::Run {
+        options: Box::new(o),
+        warnings,
+    })
 }
 
 /// shape_main's `validate()`: fatal combinations are errors, the rest warnings.
-fn validate(o: &mut ShapeOptions, access_scope_set: bool, w: &mut Vec<String>) -> Result<(), ParseError> {
+fn validate(
+    o: &mut ShapeOptions,
+    access_scope_set: bool,
+    w: &mut Vec<String>,
+) -> Result<(), ParseError> {
     if o.topic.is_none() {
         return Err(ParseError(vec!["please specify topic name [-t]".into()]));
     }
     if !o.publish && !o.subscribe {
-        return Err(ParseError(vec!["please specify publish [-P] or subscribe [-S]".into()]));
+        return Err(ParseError(vec![
+            "please specify publish [-P] or subscribe [-S]".into(),
+        ]));
     }
     if o.publish && o.subscribe {
-        return Err(ParseError(vec!["please specify only one of: publish [-P] or subscribe [-S]".into()]));
+        return Err(ParseError(vec![
+            "please specify only one of: publish [-P] or subscribe [-S]".into(),
+        ]));
     }
     if o.publish && o.color.is_none() {
         o.color = Some("BLUE".into());
         w.push("warning: color was not specified, defaulting to \"BLUE\"".into());
     }
     if o.publish && !o.time_filter.is_zero() {
-        w.push("warning: time base filter [--time-filter] ignored on publisher applications".into());
+        w.push(
+            "warning: time base filter [--time-filter] ignored on publisher applications".into(),
+        );
     }
     if o.publish && o.use_read {
         w.push("warning: use read [-R] ignored on publisher applications".into());
@@ -500,7 +533,9 @@ fn validate(o: &mut ShapeOptions, access_scope_set: bool, w: &mut Vec<String>) -
         w.push("warning: --size-modulo has no effect unless shapesize (-z) is set to 0".into());
     }
     if o.subscribe && o.color.is_some() && o.cft_expression.is_some() {
-        return Err(ParseError(vec!["error: cannot specify both --cft and -c for subscriber applications".into()]));
+        return Err(ParseError(vec![
+            "error: cannot specify both --cft and -c for subscriber applications".into(),
+        ]));
     }
     Ok(())
 }
@@ -515,7 +550,7 @@ mod tests {
 
     fn run(s: &str) -> (ShapeOptions, Vec<String>) {
         match parse(&args(s)).expect("parses") {
-            Parsed::Run { options, warnings } => (options, warnings),
+            Parsed::Run { options, warnings } => (*options, warnings),
             Parsed::Help => panic!("help"),
         }
     }
@@ -524,7 +559,10 @@ mod tests {
     fn defaults_match_shape_main() {
         let (o, w) = run("-P -t Square");
         assert_eq!(o.color.as_deref(), Some("BLUE"));
-        assert_eq!(w, vec!["warning: color was not specified, defaulting to \"BLUE\"".to_string()]);
+        assert_eq!(
+            w,
+            vec!["warning: color was not specified, defaulting to \"BLUE\"".to_string()]
+        );
         assert!(o.reliable);
         assert_eq!(o.xcdr, 1);
         assert_eq!(o.durability, DurabilityArg::Volatile);
@@ -568,7 +606,10 @@ mod tests {
         assert!(parse(&args("-P -t Square -d -1")).is_err());
         assert!(parse(&args("-P -t Square --num-iterations 0")).is_err());
         assert!(parse(&args("-P -t Square --bogus")).is_err());
-        assert!(parse(&args("-P -t Square --final-instance-state u --final-instance-state d")).is_err());
+        assert!(parse(&args(
+            "-P -t Square --final-instance-state u --final-instance-state d"
+        ))
+        .is_err());
         assert!(parse(&args("-S -t Square -c RED --cft x")).is_err());
         assert_eq!(parse(&args("-h")), Ok(Parsed::Help));
     }

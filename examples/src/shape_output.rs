@@ -74,7 +74,12 @@ pub fn publication_matched_line(topic: &str, type_name: &str, current: u32, chan
     format!("on_publication_matched() topic: '{topic}'  type: '{type_name}' : matched readers {current} (change = {change})")
 }
 
-pub fn subscription_matched_line(topic: &str, type_name: &str, current: u32, change: i32) -> String {
+pub fn subscription_matched_line(
+    topic: &str,
+    type_name: &str,
+    current: u32,
+    change: i32,
+) -> String {
     format!("on_subscription_matched() topic: '{topic}'  type: '{type_name}' : matched writers {current} (change = {change})")
 }
 
@@ -90,7 +95,11 @@ pub fn offered_incompatible_line(topic: &str, type_name: &str, id: Option<QosPol
     )
 }
 
-pub fn requested_incompatible_line(topic: &str, type_name: &str, id: Option<QosPolicyId>) -> String {
+pub fn requested_incompatible_line(
+    topic: &str,
+    type_name: &str,
+    id: Option<QosPolicyId>,
+) -> String {
     format!(
         "on_requested_incompatible_qos() topic: '{topic}'  type: '{type_name}' : {} ({})",
         policy_number(id),
@@ -104,12 +113,18 @@ mod tests {
 
     #[test]
     fn sample_lines_match_printf() {
-        assert_eq!(sample_line("Square", "BLUE", 5, 123, 20, &[]), "Square     BLUE       005 123 [20]");
+        assert_eq!(
+            sample_line("Square", "BLUE", 5, 123, 20, &[]),
+            "Square     BLUE       005 123 [20]"
+        );
         assert_eq!(
             sample_line("Circle", "RED", 240, 7, 30, &[255, 255]),
             "Circle     RED        240 007 [30] {255}"
         );
-        assert_eq!(sample_line("LongTopicName", "C", -3, 0, 1, &[]), "LongTopicName C          -03 000 [1]");
+        assert_eq!(
+            sample_line("LongTopicName", "C", -3, 0, 1, &[]),
+            "LongTopicName C          -03 000 [1]"
+        );
     }
 
     #[test]

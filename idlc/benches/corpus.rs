@@ -46,7 +46,10 @@ fn main() {
         return;
     };
     let files = files(&root);
-    let rounds: usize = std::env::var("ROUNDS").ok().and_then(|r| r.parse().ok()).unwrap_or(5);
+    let rounds: usize = std::env::var("ROUNDS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(5);
     // Warm the page cache and the allocator.
     for (f, o) in &files {
         let _ = compile_file(f, o).rust();
@@ -71,8 +74,15 @@ fn main() {
         best_full = best_full.min(t.elapsed());
     }
     let n = files.len() as f64;
-    println!("idlc (this crate), {} files, best of {rounds} rounds, one thread:", files.len());
-    println!("  front end only        {:>8.1} ms  {:>8.0} files/s", best_front.as_secs_f64() * 1e3, n / best_front.as_secs_f64());
+    println!(
+        "idlc (this crate), {} files, best of {rounds} rounds, one thread:",
+        files.len()
+    );
+    println!(
+        "  front end only        {:>8.1} ms  {:>8.0} files/s",
+        best_front.as_secs_f64() * 1e3,
+        n / best_front.as_secs_f64()
+    );
     println!(
         "  front end + Rust emit {:>8.1} ms  {:>8.0} files/s  ({accepted} files produce Rust)",
         best_full.as_secs_f64() * 1e3,
@@ -90,9 +100,21 @@ fn main() {
     let mut ok = 0;
     for (f, o) in &files {
         // Cyclone's idlc exhausts memory on one corpus file: bound it.
-        let inc = o.include_dirs.first().map(|d| format!("-I '{}'", d.display())).unwrap_or_default();
-        let cmd = format!("ulimit -v 2097152; exec timeout 20 '{cyclone}' -o '{}' {inc} '{}'", out.display(), f.display());
-        let st = Command::new("sh").arg("-c").arg(&cmd).current_dir(&out).output();
+        let inc = o
+            .include_dirs
+            .first()
+            .map(|d| format!("-I '{}'", d.display()))
+            .unwrap_or_default();
+        let cmd = format!(
+            "ulimit -v 2097152; exec timeout 20 '{cyclone}' -o '{}' {inc} '{}'",
+            out.display(),
+            f.display()
+        );
+        let st = Command::new("sh")
+            .arg("-c")
+            .arg(&cmd)
+            .current_dir(&out)
+            .output();
         if st.is_ok_and(|s| s.status.success()) {
             ok += 1;
         }

@@ -17,7 +17,12 @@ pub struct ScopedName {
 
 impl ScopedName {
     pub fn text(&self) -> String {
-        let s = self.parts.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join("::");
+        let s = self
+            .parts
+            .iter()
+            .map(|p| p.name.as_str())
+            .collect::<Vec<_>>()
+            .join("::");
         if self.absolute {
             format!("::{s}")
         } else {
@@ -151,7 +156,17 @@ impl Prim {
         }
     }
     pub fn is_integer(self) -> bool {
-        matches!(self, Prim::I8 | Prim::U8 | Prim::I16 | Prim::U16 | Prim::I32 | Prim::U32 | Prim::I64 | Prim::U64)
+        matches!(
+            self,
+            Prim::I8
+                | Prim::U8
+                | Prim::I16
+                | Prim::U16
+                | Prim::I32
+                | Prim::U32
+                | Prim::I64
+                | Prim::U64
+        )
     }
     /// Inclusive range of an integer type.
     pub fn int_range(self) -> Option<(i128, i128)> {
@@ -172,10 +187,27 @@ impl Prim {
 #[derive(Clone, Debug)]
 pub enum TypeSpec {
     Prim(Prim, Loc),
-    String { wide: bool, bound: Option<ConstExpr>, loc: Loc },
-    Sequence { elem: Box<TypeSpec>, bound: Option<ConstExpr>, loc: Loc },
-    Map { key: Box<TypeSpec>, value: Box<TypeSpec>, bound: Option<ConstExpr>, loc: Loc },
-    Fixed { digits: Option<ConstExpr>, scale: Option<ConstExpr>, loc: Loc },
+    String {
+        wide: bool,
+        bound: Option<ConstExpr>,
+        loc: Loc,
+    },
+    Sequence {
+        elem: Box<TypeSpec>,
+        bound: Option<ConstExpr>,
+        loc: Loc,
+    },
+    Map {
+        key: Box<TypeSpec>,
+        value: Box<TypeSpec>,
+        bound: Option<ConstExpr>,
+        loc: Loc,
+    },
+    Fixed {
+        digits: Option<ConstExpr>,
+        scale: Option<ConstExpr>,
+        loc: Loc,
+    },
     Named(ScopedName),
 }
 
@@ -316,7 +348,10 @@ pub enum ForwardKind {
 
 #[derive(Clone, Debug)]
 pub enum DefKind {
-    Module { name: Ident, defs: Vec<Definition> },
+    Module {
+        name: Ident,
+        defs: Vec<Definition>,
+    },
     Struct(StructDef),
     Union(UnionDef),
     Forward(ForwardKind, Ident),
@@ -327,9 +362,15 @@ pub enum DefKind {
     Const(ConstDef),
     Annotation(AnnotationDef),
     /// Interfaces, exceptions, native and value types: parsed, no Rust emitted.
-    Unsupported { what: &'static str, name: Ident },
+    Unsupported {
+        what: &'static str,
+        name: Ident,
+    },
     /// `#pragma keylist Type member...`
-    Keylist { ty: ScopedName, keys: Vec<Vec<Ident>> },
+    Keylist {
+        ty: ScopedName,
+        keys: Vec<Vec<Ident>>,
+    },
 }
 
 #[derive(Clone, Debug)]

@@ -16,10 +16,19 @@ use std::path::{Path, PathBuf};
 pub enum Error {
     /// The IDL has errors; `rendered` holds the full diagnostics.
     #[error("{rendered}\nidlc: {count} error(s) in {file}")]
-    Idl { file: String, count: usize, rendered: String },
+    Idl {
+        file: String,
+        count: usize,
+        rendered: String,
+    },
     #[error("idlc: cannot write {path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
-    #[error("idlc: OUT_DIR is not set and no out_dir was given (are we running outside build.rs?)")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "idlc: OUT_DIR is not set and no out_dir was given (are we running outside build.rs?)"
+    )]
     NoOutDir,
 }
 
@@ -83,7 +92,9 @@ impl Builder {
     pub fn compile(&self, files: &[impl AsRef<Path>]) -> Result<(), Error> {
         let out_dir = match &self.out_dir {
             Some(d) => d.clone(),
-            None => std::env::var_os("OUT_DIR").map(PathBuf::from).ok_or(Error::NoOutDir)?,
+            None => std::env::var_os("OUT_DIR")
+                .map(PathBuf::from)
+                .ok_or(Error::NoOutDir)?,
         };
         let mut first_err = None;
         for file in files {
@@ -106,16 +117,29 @@ impl Builder {
         let code = c.rust();
         if !self.quiet {
             for d in c.diags.iter().filter(|d| d.severity == Severity::Warning) {
-                let at = d.primary_loc().map(|l| format!("{}: ", c.db.describe(l))).unwrap_or_default();
+                let at = d
+                    .primary_loc()
+                    .map(|l| format!("{}: ", c.db.describe(l)))
+                    .unwrap_or_default();
                 println!("cargo:warning={at}{} [{}]", d.message, d.code.as_str());
             }
         }
         let Some(code) = code else {
             let count = c.diags.error_count();
-            let rendered = c.render_diagnostics(RenderOptions { color: false, width: 100 });
-            return Err(Error::Idl { file: file.display().to_string(), count, rendered });
+            let rendered = c.render_diagnostics(RenderOptions {
+                color: false,
+                width: 100,
+            });
+            return Err(Error::Idl {
+                file: file.display().to_string(),
+                count,
+                rendered,
+            });
         };
-        let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "idl".into());
+        let stem = file
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "idl".into());
         let path = out_dir.join(format!("{stem}.rs"));
         std::fs::write(&path, code).map_err(|source| Error::Io { path, source })
     }

@@ -54,7 +54,11 @@ fn with_stack<T: Send>(f: impl FnOnce() -> T + Send) -> T {
 }
 
 pub fn compile_file(path: &Path, opts: &Options) -> Compilation {
-    with_stack(|| run(path, opts, &FsVfs, |db, vfs, pp, diags| preprocess::preprocess(db, vfs, pp, path, diags)))
+    with_stack(|| {
+        run(path, opts, &FsVfs, |db, vfs, pp, diags| {
+            preprocess::preprocess(db, vfs, pp, path, diags)
+        })
+    })
 }
 
 /// Compiles text held in memory; `#include` looks in `files` (by path).
@@ -72,23 +76,41 @@ fn run(
     _path: &Path,
     opts: &Options,
     vfs: &(dyn Vfs + Sync),
-    pre: impl FnOnce(&mut SourceDb, &dyn Vfs, &preprocess::Options, &mut Diagnostics) -> preprocess::Output,
+    pre: impl FnOnce(
+        &mut SourceDb,
+        &dyn Vfs,
+        &preprocess::Options,
+        &mut Diagnostics,
+    ) -> preprocess::Output,
 ) -> Compilation {
     let mut db = SourceDb::new();
     let mut diags = Diagnostics::new();
-    let ppo = preprocess::Options { include_dirs: opts.include_dirs.clone(), defines: opts.defines.clone(), undefines: opts.undefines.clone() };
+    let ppo = preprocess::Options {
+        include_dirs: opts.include_dirs.clone(),
+        defines: opts.defines.clone(),
+        undefines: opts.undefines.clone(),
+    };
     let pp = pre(&mut db, vfs, &ppo, &mut diags);
     let files = pp.files.iter().map(|f| db.get(*f).path.clone()).collect();
     let mut model = Model::default();
     if !diags.has_errors() {
         let spec = crate::parse::parse(&pp, &mut diags);
-        let ropts = crate::resolve::Options { default_extensibility: opts.default_extensibility };
+        let ropts = crate::resolve::Options {
+            default_extensibility: opts.default_extensibility,
+        };
         model = crate::resolve::resolve(std::slice::from_ref(&spec), &ropts, &mut diags);
         if !diags.has_errors() {
             crate::validate::validate(&model, &mut diags);
         }
     }
-    Compilation { db, model, diags, preprocessed: pp, files, opts: opts.clone() }
+    Compilation {
+        db,
+        model,
+        diags,
+        preprocessed: pp,
+        files,
+        opts: opts.clone(),
+    }
 }
 
 impl Compilation {
@@ -103,7 +125,11 @@ impl Compilation {
         }
         let mut ro = self.opts.rust.clone();
         if ro.source_name.is_none() {
-            ro.source_name = self.files.first().and_then(|p| p.file_name()).map(|n| n.to_string_lossy().into_owned());
+            ro.source_name = self
+                .files
+                .first()
+                .and_then(|p| p.file_name())
+                .map(|n| n.to_string_lossy().into_owned());
         }
         let code = crate::emit::rust::emit(&self.model, &ro, &mut self.diags);
         (!self.has_errors()).then_some(code)

@@ -2,15 +2,15 @@
 //!
 //! Each stage is its own module and reports into one [`diag::Diagnostics`] sink, so a run shows every error.
 pub mod ast;
+pub mod builder;
 pub mod diag;
+pub mod driver;
+pub mod emit;
+pub mod model;
 pub mod parse;
 pub mod preprocess;
-pub mod source;
-pub mod model;
 pub mod resolve;
+pub mod source;
 pub mod validate;
-pub mod emit;
-pub mod driver;
-pub mod builder;
 
 pub use builder::{Builder, Error};

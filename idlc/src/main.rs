@@ -105,7 +105,10 @@ fn main() -> ExitCode {
     for file in &cli.files {
         let mut c = compile_file(file, &opts);
         let ext = if cli.emit == Emit::Json { "json" } else { "rs" };
-        let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+        let stem = file
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "out".into());
         let out_path = out_dir.join(format!("{stem}.{ext}"));
         let output = if cli.preprocess_only {
             (!c.has_errors()).then(|| c.preprocessed.with_line_markers(&c.db))
@@ -129,7 +132,9 @@ fn main() -> ExitCode {
         if cli.preprocess_only {
             let _ = stdout.lock().write_all(output.as_bytes());
         } else if !cli.check {
-            if let Err(e) = std::fs::create_dir_all(&out_dir).and_then(|_| std::fs::write(&out_path, output)) {
+            if let Err(e) =
+                std::fs::create_dir_all(&out_dir).and_then(|_| std::fs::write(&out_path, output))
+            {
                 eprintln!("error: cannot write {}: {e}", out_path.display());
                 failed = true;
             }

@@ -35,13 +35,34 @@ pub enum AutoId {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Type {
-    Prim { prim: Prim },
-    String { wide: bool, bound: Option<u64> },
-    Sequence { elem: Box<Type>, bound: Option<u64> },
-    Map { key: Box<Type>, value: Box<Type>, bound: Option<u64> },
-    Array { elem: Box<Type>, dims: Vec<u64> },
-    Fixed { digits: u32, scale: u32 },
-    Named { decl: DeclId, name: String },
+    Prim {
+        prim: Prim,
+    },
+    String {
+        wide: bool,
+        bound: Option<u64>,
+    },
+    Sequence {
+        elem: Box<Type>,
+        bound: Option<u64>,
+    },
+    Map {
+        key: Box<Type>,
+        value: Box<Type>,
+        bound: Option<u64>,
+    },
+    Array {
+        elem: Box<Type>,
+        dims: Vec<u64>,
+    },
+    Fixed {
+        digits: u32,
+        scale: u32,
+    },
+    Named {
+        decl: DeclId,
+        name: String,
+    },
     /// A reference that failed to resolve (an error was reported).
     Error,
 }
@@ -183,10 +204,14 @@ pub enum DeclKind {
     Enum(Enum),
     Bitmask(Bitmask),
     Bitset(Bitset),
-    Alias { ty: Type },
+    Alias {
+        ty: Type,
+    },
     Const(Const),
     /// Declared forward and (so far) not defined.
-    Forward { union: bool },
+    Forward {
+        union: bool,
+    },
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -233,7 +258,10 @@ impl Module {
             let i = match m.modules.iter().position(|x| &x.name == p) {
                 Some(i) => i,
                 None => {
-                    m.modules.push(Module { name: p.clone(), ..Default::default() });
+                    m.modules.push(Module {
+                        name: p.clone(),
+                        ..Default::default()
+                    });
                     m.modules.len() - 1
                 }
             };

@@ -33,7 +33,10 @@ fn shapes_snapshot() {
 #[test]
 fn ddsperf_snapshot() {
     let root = common::workspace_root().join("idl");
-    insta::assert_snapshot!("ddsperf_types", generate(&root.join("ddsperf_types.idl"), &root));
+    insta::assert_snapshot!(
+        "ddsperf_types",
+        generate(&root.join("ddsperf_types.idl"), &root)
+    );
 }
 
 #[test]
@@ -44,15 +47,28 @@ fn corpus_samples_snapshot() {
     };
     for (name, rel) in [
         ("eprosima_unions", "eprosima-dds-types-test/IDL/unions.idl"),
-        ("eprosima_bitsets", "eprosima-dds-types-test/IDL/bitsets.idl"),
-        ("ros2_idl_only_types", "ros2-test-interface-files/idl/IdlOnlyTypes.idl"),
-        ("rti_ros_header", "rti-ros-data-types/std_msgs/msg/Header.idl"),
+        (
+            "eprosima_bitsets",
+            "eprosima-dds-types-test/IDL/bitsets.idl",
+        ),
+        (
+            "ros2_idl_only_types",
+            "ros2-test-interface-files/idl/IdlOnlyTypes.idl",
+        ),
+        (
+            "rti_ros_header",
+            "rti-ros-data-types/std_msgs/msg/Header.idl",
+        ),
     ] {
         let path = corpus.join(rel);
         if !path.exists() {
             continue;
         }
-        let include = if rel.starts_with("rti") { corpus.join("rti-ros-data-types") } else { path.parent().unwrap().to_path_buf() };
+        let include = if rel.starts_with("rti") {
+            corpus.join("rti-ros-data-types")
+        } else {
+            path.parent().unwrap().to_path_buf()
+        };
         insta::assert_snapshot!(name, generate(&path, &include));
     }
 }

@@ -3,7 +3,10 @@
 use std::path::{Path, PathBuf};
 
 pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("idlc lives in the workspace").to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("idlc lives in the workspace")
+        .to_path_buf()
 }
 
 /// The shared IDL corpus: `$IDL_CORPUS`, else `../shared/idl-corpus` next to the workspace.
@@ -17,7 +20,9 @@ pub fn corpus_dir() -> Option<PathBuf> {
 }
 
 pub fn target_dir() -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| workspace_root().join("target"))
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace_root().join("target"))
 }
 
 /// A scratch crate depending on dds-runtime, holding generated modules; built with the workspace's target dir.
@@ -33,11 +38,17 @@ impl ScratchCrate {
         let dir = target_dir().join("idlc-scratch").join(name);
         let _ = std::fs::remove_dir_all(dir.join("src"));
         std::fs::create_dir_all(dir.join("src/gen")).expect("create scratch dir");
-        ScratchCrate { dir, modules: vec![], extra_lib: String::new(), dev: false }
+        ScratchCrate {
+            dir,
+            modules: vec![],
+            extra_lib: String::new(),
+            dev: false,
+        }
     }
 
     pub fn add_module(&mut self, name: &str, code: &str) {
-        std::fs::write(self.dir.join("src/gen").join(format!("{name}.rs")), code).expect("write module");
+        std::fs::write(self.dir.join("src/gen").join(format!("{name}.rs")), code)
+            .expect("write module");
         self.modules.push((name.to_string(), name.to_string()));
     }
 
@@ -47,7 +58,12 @@ impl ScratchCrate {
 
     /// Builds (`cargo build`, or `cargo test` with `test`); returns (success, combined output).
     pub fn build(&self, test: bool) -> (bool, String) {
-        let name = self.dir.file_name().expect("name").to_string_lossy().replace('_', "-");
+        let name = self
+            .dir
+            .file_name()
+            .expect("name")
+            .to_string_lossy()
+            .replace('_', "-");
         let runtime = workspace_root().join("dds-runtime");
         let manifest = format!(
             "[package]\nname = \"idlc-scratch-{name}\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
@@ -56,7 +72,10 @@ impl ScratchCrate {
         );
         std::fs::write(self.dir.join("Cargo.toml"), manifest).expect("write manifest");
         // Same versions as the workspace: nothing new to resolve or build.
-        let _ = std::fs::copy(workspace_root().join("Cargo.lock"), self.dir.join("Cargo.lock"));
+        let _ = std::fs::copy(
+            workspace_root().join("Cargo.lock"),
+            self.dir.join("Cargo.lock"),
+        );
         let mut lib = String::from("#![deny(warnings)]\n#![allow(clippy::all)]\n");
         for (m, file) in &self.modules {
             lib.push_str(&format!("#[path = \"gen/{file}.rs\"]\npub mod {m};\n"));
@@ -64,18 +83,23 @@ impl ScratchCrate {
         lib.push_str(&self.extra_lib);
         std::fs::write(self.dir.join("src/lib.rs"), lib).expect("write lib.rs");
         let _ = self.dev;
-        let out = std::process::Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-            .arg(if test { "test" } else { "build" })
-            .arg("--offline")
-            .arg("--quiet")
-            .arg("--manifest-path")
-            .arg(self.dir.join("Cargo.toml"))
-            .arg("--target-dir")
-            .arg(target_dir())
-            .env_remove("RUSTFLAGS")
-            .output()
-            .expect("run cargo");
-        let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        let out =
+            std::process::Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+                .arg(if test { "test" } else { "build" })
+                .arg("--offline")
+                .arg("--quiet")
+                .arg("--manifest-path")
+                .arg(self.dir.join("Cargo.toml"))
+                .arg("--target-dir")
+                .arg(target_dir())
+                .env_remove("RUSTFLAGS")
+                .output()
+                .expect("run cargo");
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
         (out.status.success(), text)
     }
 }

@@ -10,13 +10,21 @@ use idlc::driver::{compile_file, Options};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-const FOLDERS: &[&str] = &["cyclonedds", "eprosima-dds-types-test", "omg-dds-rtps", "ros2-test-interface-files", "rti-ros-data-types"];
+const FOLDERS: &[&str] = &[
+    "cyclonedds",
+    "eprosima-dds-types-test",
+    "omg-dds-rtps",
+    "ros2-test-interface-files",
+    "rti-ros-data-types",
+];
 
 fn idl_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
-        let Ok(rd) = std::fs::read_dir(&d) else { continue };
+        let Ok(rd) = std::fs::read_dir(&d) else {
+            continue;
+        };
         for e in rd.flatten() {
             let p = e.path();
             if p.is_dir() {
@@ -37,13 +45,26 @@ fn expected_failures() -> BTreeMap<String, (String, String)> {
         .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
         .filter_map(|l| {
             let mut it = l.splitn(3, '\t');
-            Some((it.next()?.to_string(), (it.next()?.to_string(), it.next().unwrap_or("").to_string())))
+            Some((
+                it.next()?.to_string(),
+                (it.next()?.to_string(), it.next().unwrap_or("").to_string()),
+            ))
         })
         .collect()
 }
 
 pub fn module_name(rel: &str) -> String {
-    let s: String = rel.trim_end_matches(".idl").chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '_' }).collect();
+    let s: String = rel
+        .trim_end_matches(".idl")
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
     format!("m_{s}")
 }
 
@@ -57,7 +78,9 @@ fn corpus() {
     let only: Option<String> = std::env::var("IDLC_CORPUS_FOLDER").ok();
     let no_build = std::env::var_os("IDLC_CORPUS_NO_BUILD").is_some();
     let mut problems: Vec<String> = Vec::new();
-    let mut table = String::from("| folder | files | accepted (Rust builds) | expected failures |\n|---|---:|---:|---:|\n");
+    let mut table = String::from(
+        "| folder | files | accepted (Rust builds) | expected failures |\n|---|---:|---:|---:|\n",
+    );
     let mut seen_expected = 0;
     for folder in FOLDERS {
         if only.as_deref().is_some_and(|o| o != *folder) {
@@ -80,10 +103,17 @@ fn corpus() {
                     krate.add_module(&module_name(&rel), &code);
                     accepted += 1;
                 }
-                (Some(_), Some(_)) => problems.push(format!("{rel}: listed as an expected failure but now compiles")),
+                (Some(_), Some(_)) => problems.push(format!(
+                    "{rel}: listed as an expected failure but now compiles"
+                )),
                 (None, Some((want, _))) => {
                     seen_expected += 1;
-                    let first = c.diags.iter().find(|d| d.is_error()).map(|d| d.code.as_str()).unwrap_or("");
+                    let first = c
+                        .diags
+                        .iter()
+                        .find(|d| d.is_error())
+                        .map(|d| d.code.as_str())
+                        .unwrap_or("");
                     if first != want {
                         problems.push(format!("{rel}: expected {want}, first error is {first}"));
                     } else {
@@ -103,12 +133,26 @@ fn corpus() {
                 problems.push(format!("{folder}: generated Rust does not build:\n{head}"));
             }
         }
-        table.push_str(&format!("| {folder} | {} | {accepted} | {failed_as_expected} |\n", files.len()));
+        table.push_str(&format!(
+            "| {folder} | {} | {accepted} | {failed_as_expected} |\n",
+            files.len()
+        ));
     }
     println!("{table}");
-    let _ = std::fs::write(common::target_dir().join("idlc-scratch/corpus-table.md"), &table);
+    let _ = std::fs::write(
+        common::target_dir().join("idlc-scratch/corpus-table.md"),
+        &table,
+    );
     if only.is_none() && seen_expected != expected.len() {
-        problems.push(format!("{} expected-failure entries name files that were not seen", expected.len() - seen_expected));
+        problems.push(format!(
+            "{} expected-failure entries name files that were not seen",
+            expected.len() - seen_expected
+        ));
     }
-    assert!(problems.is_empty(), "{} corpus problem(s):\n{}", problems.len(), problems.join("\n\n"));
+    assert!(
+        problems.is_empty(),
+        "{} corpus problem(s):\n{}",
+        problems.len(),
+        problems.join("\n\n")
+    );
 }

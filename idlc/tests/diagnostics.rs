@@ -6,7 +6,10 @@ use idlc::preprocess::MemVfs;
 fn render_with(files: MemVfs, text: &str) -> String {
     let mut c = compile_str("main.idl", text, &Options::default(), &files);
     let _ = c.rust();
-    let out = c.render_diagnostics(RenderOptions { color: false, width: 100 });
+    let out = c.render_diagnostics(RenderOptions {
+        color: false,
+        width: 100,
+    });
     assert!(!out.is_empty(), "expected at least one diagnostic");
     out
 }
@@ -27,66 +30,238 @@ macro_rules! diag_test {
 }
 
 // ---- syntax ----
-diag_test!(syntax_missing_semicolon, "E0101", "struct A {\n  long x\n};\n");
-diag_test!(syntax_missing_closing_semicolon, "E0101", "module M {\n  struct A { long x; }\n};\n");
-diag_test!(syntax_keyword_as_member_name, "E0101", "struct A {\n  long map;\n};\n");
-diag_test!(keyword_case_collision, "E0103", "struct String {\n  long x;\n};\n");
+diag_test!(
+    syntax_missing_semicolon,
+    "E0101",
+    "struct A {\n  long x\n};\n"
+);
+diag_test!(
+    syntax_missing_closing_semicolon,
+    "E0101",
+    "module M {\n  struct A { long x; }\n};\n"
+);
+diag_test!(
+    syntax_keyword_as_member_name,
+    "E0101",
+    "struct A {\n  long map;\n};\n"
+);
+diag_test!(
+    keyword_case_collision,
+    "E0103",
+    "struct String {\n  long x;\n};\n"
+);
 diag_test!(bad_octal_literal, "E0102", "const long X = 08;\n");
-diag_test!(huge_integer_literal, "E0102", "const unsigned long long X = 123456789012345678901234567890;\n");
+diag_test!(
+    huge_integer_literal,
+    "E0102",
+    "const unsigned long long X = 123456789012345678901234567890;\n"
+);
 // ---- names ----
-diag_test!(unresolved_type_suggestion, "E0201", "struct Point { long x; };\nstruct B {\n  Piont p;\n};\n");
-diag_test!(unresolved_scoped_name, "E0201", "module M { struct Alpha { long x; }; };\nstruct B { M::Alpah a; };\n");
-diag_test!(unresolved_constant, "E0201", "const long SIZE = 4;\nstruct B { long a[SIZ]; };\n");
+diag_test!(
+    unresolved_type_suggestion,
+    "E0201",
+    "struct Point { long x; };\nstruct B {\n  Piont p;\n};\n"
+);
+diag_test!(
+    unresolved_scoped_name,
+    "E0201",
+    "module M { struct Alpha { long x; }; };\nstruct B { M::Alpah a; };\n"
+);
+diag_test!(
+    unresolved_constant,
+    "E0201",
+    "const long SIZE = 4;\nstruct B { long a[SIZ]; };\n"
+);
 diag_test!(ambiguous_shadowed_module, "E0202", "module A { struct X { long a; }; };\nmodule B {\n  module A { struct Other { long b; }; };\n  struct Y { A::X x; };\n};\n");
-diag_test!(duplicate_declaration, "E0203", "struct A { long x; };\nstruct A { long y; };\n");
-diag_test!(case_collision_declaration, "E0204", "struct Foo { long x; };\nstruct foo { long y; };\n");
-diag_test!(case_mismatch_reference, "E0204", "struct Foo { long x; };\nstruct B { foo f; };\n");
-diag_test!(constant_used_as_type, "E0205", "const long N = 3;\nstruct B { N x; };\n");
-diag_test!(incomplete_forward, "E0206", "struct Fwd;\nstruct B { sequence<Fwd> s; };\n");
-diag_test!(infinite_struct, "E0207", "struct Node {\n  long value;\n  Node next;\n};\n");
+diag_test!(
+    duplicate_declaration,
+    "E0203",
+    "struct A { long x; };\nstruct A { long y; };\n"
+);
+diag_test!(
+    case_collision_declaration,
+    "E0204",
+    "struct Foo { long x; };\nstruct foo { long y; };\n"
+);
+diag_test!(
+    case_mismatch_reference,
+    "E0204",
+    "struct Foo { long x; };\nstruct B { foo f; };\n"
+);
+diag_test!(
+    constant_used_as_type,
+    "E0205",
+    "const long N = 3;\nstruct B { N x; };\n"
+);
+diag_test!(
+    incomplete_forward,
+    "E0206",
+    "struct Fwd;\nstruct B { sequence<Fwd> s; };\n"
+);
+diag_test!(
+    infinite_struct,
+    "E0207",
+    "struct Node {\n  long value;\n  Node next;\n};\n"
+);
 // ---- constants ----
 diag_test!(octet_overflow, "E0301", "const octet O = 256;\n");
-diag_test!(expression_overflow, "E0301", "const unsigned long long X = 18446744073709551615 * 2;\n");
-diag_test!(short_overflow_via_shift, "E0301", "const short S = 1 << 15;\n");
+diag_test!(
+    expression_overflow,
+    "E0301",
+    "const unsigned long long X = 18446744073709551615 * 2;\n"
+);
+diag_test!(
+    short_overflow_via_shift,
+    "E0301",
+    "const short S = 1 << 15;\n"
+);
 diag_test!(const_type_mismatch, "E0302", "const long L = \"text\";\n");
 diag_test!(bitwise_on_float, "E0302", "const double D = 1.5 | 2;\n");
 diag_test!(division_by_zero, "E0303", "const long D = 10 / (5 - 5);\n");
 diag_test!(zero_string_bound, "E0304", "struct A { string<0> s; };\n");
 // ---- types ----
-diag_test!(duplicate_union_label, "E0401", "union U switch (long) {\n  case 1: long a;\n  case 2: case 1: short b;\n};\n");
-diag_test!(several_default_labels, "E0402", "union U switch (long) {\n  default: long a;\n  case 1: default: short b;\n};\n");
+diag_test!(
+    duplicate_union_label,
+    "E0401",
+    "union U switch (long) {\n  case 1: long a;\n  case 2: case 1: short b;\n};\n"
+);
+diag_test!(
+    several_default_labels,
+    "E0402",
+    "union U switch (long) {\n  default: long a;\n  case 1: default: short b;\n};\n"
+);
 diag_test!(unreachable_default, "E0415", "enum Bit { ZERO, ONE };\nunion U switch (Bit) {\n  case ZERO: long a;\n  case ONE: short b;\n  default: octet c;\n};\n");
 diag_test!(label_of_wrong_enum, "E0403", "enum Color { RED, GREEN };\nenum Shape { SQUARE, CIRCLE };\nunion U switch (Color) {\n  case SQUARE: long a;\n};\n");
-diag_test!(label_out_of_range, "E0403", "union U switch (octet) {\n  case 300: long a;\n};\n");
-diag_test!(float_discriminator, "E0404", "union U switch (float) {\n  case 1: long a;\n};\n");
-diag_test!(key_on_optional, "E0405", "struct A {\n  @key @optional long id;\n};\n");
-diag_test!(derived_struct_adds_key, "E0406", "struct Base { @key long id; };\nstruct Derived : Base {\n  @key long id2;\n};\n");
-diag_test!(duplicate_member_id, "E0407", "@mutable struct A {\n  @id(1) long a;\n  @id(1) long b;\n};\n");
-diag_test!(bad_extensibility_param, "E0408", "@extensibility(SOMETIMES) struct A { long x; };\n");
-diag_test!(base_not_a_struct, "E0409", "enum E { ONE };\nstruct D : E { long x; };\n");
-diag_test!(bitmask_position_out_of_bound, "E0410", "@bit_bound(8) bitmask M {\n  A,\n  @position(9) B\n};\n");
-diag_test!(bitset_too_wide, "E0410", "bitset B {\n  bitfield<40> a;\n  bitfield<30> b;\n};\n");
-diag_test!(duplicate_enum_value, "E0411", "enum E {\n  @value(1) A,\n  @value(1) B\n};\n");
-diag_test!(duplicate_member, "E0413", "struct A {\n  long x;\n  short x;\n};\n");
-diag_test!(float_map_key, "E0414", "struct A { map<double, long> m; };\n");
-diag_test!(fixed_has_no_rust_mapping, "E0414", "struct A { fixed<5,2> price; };\n");
+diag_test!(
+    label_out_of_range,
+    "E0403",
+    "union U switch (octet) {\n  case 300: long a;\n};\n"
+);
+diag_test!(
+    float_discriminator,
+    "E0404",
+    "union U switch (float) {\n  case 1: long a;\n};\n"
+);
+diag_test!(
+    key_on_optional,
+    "E0405",
+    "struct A {\n  @key @optional long id;\n};\n"
+);
+diag_test!(
+    derived_struct_adds_key,
+    "E0406",
+    "struct Base { @key long id; };\nstruct Derived : Base {\n  @key long id2;\n};\n"
+);
+diag_test!(
+    duplicate_member_id,
+    "E0407",
+    "@mutable struct A {\n  @id(1) long a;\n  @id(1) long b;\n};\n"
+);
+diag_test!(
+    bad_extensibility_param,
+    "E0408",
+    "@extensibility(SOMETIMES) struct A { long x; };\n"
+);
+diag_test!(
+    base_not_a_struct,
+    "E0409",
+    "enum E { ONE };\nstruct D : E { long x; };\n"
+);
+diag_test!(
+    bitmask_position_out_of_bound,
+    "E0410",
+    "@bit_bound(8) bitmask M {\n  A,\n  @position(9) B\n};\n"
+);
+diag_test!(
+    bitset_too_wide,
+    "E0410",
+    "bitset B {\n  bitfield<40> a;\n  bitfield<30> b;\n};\n"
+);
+diag_test!(
+    duplicate_enum_value,
+    "E0411",
+    "enum E {\n  @value(1) A,\n  @value(1) B\n};\n"
+);
+diag_test!(
+    duplicate_member,
+    "E0413",
+    "struct A {\n  long x;\n  short x;\n};\n"
+);
+diag_test!(
+    float_map_key,
+    "E0414",
+    "struct A { map<double, long> m; };\n"
+);
+diag_test!(
+    fixed_has_no_rust_mapping,
+    "E0414",
+    "struct A { fixed<5,2> price; };\n"
+);
 diag_test!(any_is_not_data, "E0414", "struct A { any value; };\n");
 // ---- preprocessor ----
-diag_test!(include_not_found, "E0002", "#include \"missing.idl\"\nstruct A { long x; };\n");
-diag_test!(error_directive, "E0004", "#ifndef FEATURE\n#error \"FEATURE must be defined\"\n#endif\n");
-diag_test!(unknown_directive, "E0005", "#frobnicate\nstruct A { long x; };\n");
-diag_test!(unterminated_if, "E0006", "#ifdef X\nstruct A { long x; };\n");
+diag_test!(
+    include_not_found,
+    "E0002",
+    "#include \"missing.idl\"\nstruct A { long x; };\n"
+);
+diag_test!(
+    error_directive,
+    "E0004",
+    "#ifndef FEATURE\n#error \"FEATURE must be defined\"\n#endif\n"
+);
+diag_test!(
+    unknown_directive,
+    "E0005",
+    "#frobnicate\nstruct A { long x; };\n"
+);
+diag_test!(
+    unterminated_if,
+    "E0006",
+    "#ifdef X\nstruct A { long x; };\n"
+);
 diag_test!(else_without_if, "E0006", "struct A { long x; };\n#else\n");
 diag_test!(bad_if_expression, "E0007", "#if 1 +\n#endif\n");
-diag_test!(macro_argument_count, "E0008", "#define PAIR(a, b) a b\nconst long X = PAIR(1);\n");
-diag_test!(unterminated_comment, "E0009", "struct A { long x; };\n/* never closed\n");
+diag_test!(
+    macro_argument_count,
+    "E0008",
+    "#define PAIR(a, b) a b\nconst long X = PAIR(1);\n"
+);
+diag_test!(
+    unterminated_comment,
+    "E0009",
+    "struct A { long x; };\n/* never closed\n"
+);
 // ---- warnings ----
-diag_test!(unknown_annotation_suggestion, "W0103", "struct A {\n  @optinal long x;\n};\n");
-diag_test!(interface_not_emitted, "W0101", "interface Calculator {\n  long add(in long a, in long b);\n};\n");
-diag_test!(legacy_key_comment, "W0102", "struct A {\n  long id; //@key\n  long value;\n};\n");
-diag_test!(unknown_pragma, "W0001", "#pragma frobnicate on\nstruct A { long x; };\n");
-diag_test!(warning_directive, "W0002", "#warning \"deprecated file\"\nstruct A { long x; };\n");
-diag_test!(misplaced_annotation, "W0104", "@key struct A { long x; };\n");
+diag_test!(
+    unknown_annotation_suggestion,
+    "W0103",
+    "struct A {\n  @optinal long x;\n};\n"
+);
+diag_test!(
+    interface_not_emitted,
+    "W0101",
+    "interface Calculator {\n  long add(in long a, in long b);\n};\n"
+);
+diag_test!(
+    legacy_key_comment,
+    "W0102",
+    "struct A {\n  long id; //@key\n  long value;\n};\n"
+);
+diag_test!(
+    unknown_pragma,
+    "W0001",
+    "#pragma frobnicate on\nstruct A { long x; };\n"
+);
+diag_test!(
+    warning_directive,
+    "W0002",
+    "#warning \"deprecated file\"\nstruct A { long x; };\n"
+);
+diag_test!(
+    misplaced_annotation,
+    "W0104",
+    "@key struct A { long x; };\n"
+);
 
 #[test]
 fn error_in_included_file_points_into_that_file() {
@@ -98,7 +273,9 @@ fn error_in_included_file_points_into_that_file() {
 
 #[test]
 fn include_cycle_is_reported() {
-    let files = MemVfs::new().with("a.idl", "#include \"b.idl\"\n").with("b.idl", "#include \"a.idl\"\n");
+    let files = MemVfs::new()
+        .with("a.idl", "#include \"b.idl\"\n")
+        .with("b.idl", "#include \"a.idl\"\n");
     let out = render_with(files, "#include \"a.idl\"\n");
     assert!(out.contains("E0003"), "{out}");
     insta::assert_snapshot!("include_cycle", out);
@@ -106,7 +283,8 @@ fn include_cycle_is_reported() {
 
 #[test]
 fn every_error_of_a_run_is_reported() {
-    let out = render("struct A { Missing1 a; };\nstruct B { Missing2 b; };\nconst octet C = 999;\n");
+    let out =
+        render("struct A { Missing1 a; };\nstruct B { Missing2 b; };\nconst octet C = 999;\n");
     assert_eq!(out.matches("idlc::E0201").count(), 2, "{out}");
     assert_eq!(out.matches("idlc::E0301").count(), 1, "{out}");
     insta::assert_snapshot!("several_errors", out);

@@ -15,7 +15,12 @@ fn ok(text: &str) -> Compilation {
 }
 
 fn decl<'a>(c: &'a Compilation, scoped: &str) -> &'a DeclKind {
-    &c.model.decls.iter().find(|d| d.scoped_name() == scoped).unwrap_or_else(|| panic!("no {scoped}")).kind
+    &c.model
+        .decls
+        .iter()
+        .find(|d| d.scoped_name() == scoped)
+        .unwrap_or_else(|| panic!("no {scoped}"))
+        .kind
 }
 
 fn const_value(c: &Compilation, scoped: &str) -> Value {
@@ -32,8 +37,10 @@ fn codes(text: &str) -> Vec<&'static str> {
 
 #[test]
 fn object_and_function_macros() {
-    let c = ok("#define N 4\n#define TWICE(x) ((x) * 2)\n#define CAT(a, b) a##b\n#define STR(s) #s\n\
-                const long A = TWICE(N) + 1;\nconst long CAT(B, 2) = 3;\nconst string S = STR(hello);\n");
+    let c = ok(
+        "#define N 4\n#define TWICE(x) ((x) * 2)\n#define CAT(a, b) a##b\n#define STR(s) #s\n\
+                const long A = TWICE(N) + 1;\nconst long CAT(B, 2) = 3;\nconst string S = STR(hello);\n",
+    );
     assert_eq!(const_value(&c, "A"), Value::Int(9));
     assert_eq!(const_value(&c, "B2"), Value::Int(3));
     assert_eq!(const_value(&c, "S"), Value::Str("hello".into()));
@@ -51,10 +58,16 @@ fn conditionals_with_expressions() {
 
 #[test]
 fn command_line_defines_and_undefines() {
-    let mut opts = Options::default();
-    opts.defines = vec!["SIZE=8".into(), "FLAG".into(), "GONE".into()];
-    opts.undefines = vec!["GONE".into()];
-    let c = ok_with(MemVfs::new(), &opts, "const long S = SIZE;\n#ifdef FLAG\nconst long F = FLAG;\n#endif\n#ifdef GONE\n#error gone\n#endif\n");
+    let opts = Options {
+        defines: vec!["SIZE=8".into(), "FLAG".into(), "GONE".into()],
+        undefines: vec!["GONE".into()],
+        ..Default::default()
+    };
+    let c = ok_with(
+        MemVfs::new(),
+        &opts,
+        "const long S = SIZE;\n#ifdef FLAG\nconst long F = FLAG;\n#endif\n#ifdef GONE\n#error gone\n#endif\n",
+    );
     assert_eq!(const_value(&c, "S"), Value::Int(8));
     assert_eq!(const_value(&c, "F"), Value::Int(1));
 }
@@ -68,8 +81,14 @@ fn undef_line_and_null_directives() {
 #[test]
 fn includes_quoted_and_angled_with_search_path() {
     let files = MemVfs::new()
-        .with("inc/common.idl", "#ifndef COMMON\n#define COMMON\nmodule m { struct Common { long x; }; };\n#endif\n")
-        .with("inc/other.idl", "#pragma once\n#include <common.idl>\nmodule m { struct Other { Common c; }; };\n");
+        .with(
+            "inc/common.idl",
+            "#ifndef COMMON\n#define COMMON\nmodule m { struct Common { long x; }; };\n#endif\n",
+        )
+        .with(
+            "inc/other.idl",
+            "#pragma once\n#include <common.idl>\nmodule m { struct Other { Common c; }; };\n",
+        );
     let mut opts = Options::default();
     opts.include_dirs.push("inc".into());
     let c = ok_with(files, &opts, "#include <other.idl>\n#include \"inc/common.idl\"\n#include <other.idl>\nmodule m { struct Top { Other o; }; };\n");
@@ -80,14 +99,25 @@ fn includes_quoted_and_angled_with_search_path() {
 #[test]
 fn pragma_keylist_sets_keys() {
     let c = ok("module M { struct S { long a; long b; string c; };\n#pragma keylist S a c\n};\n");
-    let DeclKind::Struct(s) = decl(&c, "M::S") else { panic!() };
-    assert_eq!(s.fields.iter().filter(|f| f.key).map(|f| f.name.as_str()).collect::<Vec<_>>(), ["a", "c"]);
+    let DeclKind::Struct(s) = decl(&c, "M::S") else {
+        panic!()
+    };
+    assert_eq!(
+        s.fields
+            .iter()
+            .filter(|f| f.key)
+            .map(|f| f.name.as_str())
+            .collect::<Vec<_>>(),
+        ["a", "c"]
+    );
 }
 
 #[test]
 fn legacy_key_comment_sets_key() {
     let c = ok("struct S {\n  long id; //@Key\n  long v; // not a key\n};\n");
-    let DeclKind::Struct(s) = decl(&c, "S") else { panic!() };
+    let DeclKind::Struct(s) = decl(&c, "S") else {
+        panic!()
+    };
     assert!(s.fields[0].key && !s.fields[1].key);
 }
 
@@ -127,9 +157,14 @@ fn constant_expressions_full_operator_set() {
 
 #[test]
 fn nested_templates_close_with_shift_token() {
-    let c = ok("struct S { sequence<sequence<long, 3>> a; map<string, sequence<octet>> m; sequence<sequence<long>>b; };\n");
-    let DeclKind::Struct(s) = decl(&c, "S") else { panic!() };
-    assert!(matches!(&s.fields[0].ty, Type::Sequence { bound: None, elem } if matches!(**elem, Type::Sequence { bound: Some(3), .. })));
+    let c =
+        ok("struct S { sequence<sequence<long, 3>> a; map<string, sequence<octet>> m; sequence<sequence<long>>b; };\n");
+    let DeclKind::Struct(s) = decl(&c, "S") else {
+        panic!()
+    };
+    assert!(
+        matches!(&s.fields[0].ty, Type::Sequence { bound: None, elem } if matches!(**elem, Type::Sequence { bound: Some(3), .. }))
+    );
 }
 
 #[test]
@@ -158,20 +193,40 @@ fn every_discriminator_kind() {
 fn bitmask_bitset_enum_annotations() {
     let c = ok("@bit_bound(8) enum E { @value(3) A, B, @default_literal C };\n@bit_bound(16) bitmask M { X, @position(9) Y, Z };\n\
                 bitset Base { bitfield<3> a; };\nbitset S : Base { bitfield<2> b; bitfield<5>; bitfield<4, short> c; };\n");
-    let DeclKind::Enum(e) = decl(&c, "E") else { panic!() };
-    assert_eq!(e.enumerators.iter().map(|x| x.value).collect::<Vec<_>>(), [3, 4, 5]);
+    let DeclKind::Enum(e) = decl(&c, "E") else {
+        panic!()
+    };
+    assert_eq!(
+        e.enumerators.iter().map(|x| x.value).collect::<Vec<_>>(),
+        [3, 4, 5]
+    );
     assert_eq!(e.default_index, 2);
-    let DeclKind::Bitmask(m) = decl(&c, "M") else { panic!() };
-    assert_eq!(m.flags.iter().map(|f| f.position).collect::<Vec<_>>(), [0, 9, 10]);
-    let DeclKind::Bitset(s) = decl(&c, "S") else { panic!() };
+    let DeclKind::Bitmask(m) = decl(&c, "M") else {
+        panic!()
+    };
+    assert_eq!(
+        m.flags.iter().map(|f| f.position).collect::<Vec<_>>(),
+        [0, 9, 10]
+    );
+    let DeclKind::Bitset(s) = decl(&c, "S") else {
+        panic!()
+    };
     assert_eq!(s.bits, 14);
-    assert_eq!(s.fields.iter().map(|f| (f.offset, f.width)).collect::<Vec<_>>(), [(0, 3), (3, 2), (5, 5), (10, 4)]);
+    assert_eq!(
+        s.fields
+            .iter()
+            .map(|f| (f.offset, f.width))
+            .collect::<Vec<_>>(),
+        [(0, 3), (3, 2), (5, 5), (10, 4)]
+    );
 }
 
 #[test]
 fn struct_annotations() {
     let c = ok("@mutable @autoid(HASH) struct S {\n  @key @must_understand long k;\n  @optional @external string o;\n  @id(7) @default(3) @range(min=0, max=9) @unit(\"m\") long r;\n  @hashid(\"other\") long h;\n  @non_serialized long n;\n};\n@final @nested struct F { long x; };\n@topic struct T { long x; };\n@default_nested(TRUE) module N { struct Q { long x; }; };\n");
-    let DeclKind::Struct(s) = decl(&c, "S") else { panic!() };
+    let DeclKind::Struct(s) = decl(&c, "S") else {
+        panic!()
+    };
     assert_eq!(s.extensibility, Extensibility::Mutable);
     assert!(s.fields[0].key && s.fields[0].must_understand);
     assert!(s.fields[1].optional && s.fields[1].external);
@@ -180,20 +235,34 @@ fn struct_annotations() {
     assert_eq!(s.fields[2].max, Some(Value::Int(9)));
     assert_eq!(s.fields[3].hashid.as_deref(), Some("other"));
     assert!(s.fields[4].non_serialized);
-    let DeclKind::Struct(f) = decl(&c, "F") else { panic!() };
+    let DeclKind::Struct(f) = decl(&c, "F") else {
+        panic!()
+    };
     assert!(f.nested && f.extensibility == Extensibility::Final);
-    let DeclKind::Struct(q) = decl(&c, "N::Q") else { panic!() };
+    let DeclKind::Struct(q) = decl(&c, "N::Q") else {
+        panic!()
+    };
     assert!(q.nested);
-    let DeclKind::Struct(t) = decl(&c, "T") else { panic!() };
+    let DeclKind::Struct(t) = decl(&c, "T") else {
+        panic!()
+    };
     assert!(!t.nested);
 }
 
 #[test]
 fn default_extensibility_option() {
-    let mut opts = Options::default();
-    opts.default_extensibility = Extensibility::Final;
-    let c = ok_with(MemVfs::new(), &opts, "struct S { long x; };\n@appendable struct A { long x; };\n");
-    let DeclKind::Struct(s) = decl(&c, "S") else { panic!() };
+    let opts = Options {
+        default_extensibility: Extensibility::Final,
+        ..Default::default()
+    };
+    let c = ok_with(
+        MemVfs::new(),
+        &opts,
+        "struct S { long x; };\n@appendable struct A { long x; };\n",
+    );
+    let DeclKind::Struct(s) = decl(&c, "S") else {
+        panic!()
+    };
     assert_eq!(s.extensibility, Extensibility::Final);
 }
 
@@ -206,7 +275,9 @@ fn unsupported_constructs_warn_once_each() {
 
 #[test]
 fn annotation_declarations_are_accepted() {
-    let c = ok("@annotation MyAnn { long level default 1; string note; };\n@MyAnn(level = 2) struct S { @MyAnn long x; };\n");
+    let c = ok(
+        "@annotation MyAnn { long level default 1; string note; };\n@MyAnn(level = 2) struct S { @MyAnn long x; };\n",
+    );
     assert!(c.diags.iter().next().is_none());
 }
 
@@ -214,13 +285,21 @@ fn annotation_declarations_are_accepted() {
 fn typedefs_of_anonymous_and_array_types() {
     let c = ok("typedef struct Inner { long x; } InnerAlias, InnerArr[2];\ntypedef long Grid[2][3], Row[3];\nstruct S { InnerAlias a; InnerArr b; Grid g; };\n");
     assert!(matches!(decl(&c, "Inner"), DeclKind::Struct(_)));
-    assert!(matches!(decl(&c, "Grid"), DeclKind::Alias { ty: Type::Array { dims, .. } } if dims == &vec![2, 3]));
+    assert!(
+        matches!(decl(&c, "Grid"), DeclKind::Alias { ty: Type::Array { dims, .. } } if dims == &vec![2, 3])
+    );
 }
 
 #[test]
 fn semantic_error_codes() {
-    assert!(codes("struct A { @key long a; };\nstruct B : A { @key long b; };\n").contains(&"idlc::E0406"));
-    assert!(codes("union U switch (long) { case 1: long a; case 1: long b; };\n").contains(&"idlc::E0401"));
+    assert!(
+        codes("struct A { @key long a; };\nstruct B : A { @key long b; };\n")
+            .contains(&"idlc::E0406")
+    );
+    assert!(
+        codes("union U switch (long) { case 1: long a; case 1: long b; };\n")
+            .contains(&"idlc::E0401")
+    );
     assert!(codes("const long X = 2147483648;\n").contains(&"idlc::E0301"));
     assert!(codes("struct S { @key @optional long a; };\n").contains(&"idlc::E0405"));
     assert!(codes("struct S { X x; };\n").contains(&"idlc::E0201"));
@@ -229,7 +308,12 @@ fn semantic_error_codes() {
 #[test]
 fn locations_survive_includes_and_macros() {
     let files = MemVfs::new().with("inc.idl", "\n\nstruct Bad { Nope n; };\n");
-    let c = compile_str("main.idl", "#define T long\nstruct A { T a; };\n#include \"inc.idl\"\n", &Options::default(), &files);
+    let c = compile_str(
+        "main.idl",
+        "#define T long\nstruct A { T a; };\n#include \"inc.idl\"\n",
+        &Options::default(),
+        &files,
+    );
     let d = c.diags.iter().find(|d| d.is_error()).expect("an error");
     let loc = d.primary_loc().unwrap();
     assert_eq!(c.db.describe(loc), "inc.idl:3:14");

@@ -18,7 +18,11 @@ fn compile_with(files: MemVfs, text: &str) -> (bool, Vec<&'static str>, Duration
 #[test]
 fn deeply_nested_modules() {
     let n = 100_000;
-    let text = format!("{}struct A {{ long x; }};{}", "module m { ".repeat(n), "};".repeat(n));
+    let text = format!(
+        "{}struct A {{ long x; }};{}",
+        "module m { ".repeat(n),
+        "};".repeat(n)
+    );
     let (ok, codes, _) = compile(&text);
     assert!(!ok);
     assert!(codes.contains(&"idlc::E0010"), "{codes:?}");
@@ -44,7 +48,11 @@ fn nesting_just_under_the_limit_is_accepted() {
 #[test]
 fn deeply_nested_templates() {
     let n = 50_000;
-    let text = format!("struct A {{ {}long{} x; }};", "sequence<".repeat(n), ">".repeat(n));
+    let text = format!(
+        "struct A {{ {}long{} x; }};",
+        "sequence<".repeat(n),
+        ">".repeat(n)
+    );
     let (ok, codes, _) = compile(&text);
     assert!(!ok);
     assert!(codes.contains(&"idlc::E0010"), "{codes:?}");
@@ -88,8 +96,14 @@ fn include_cycle_without_guards() {
 #[test]
 fn include_cycle_with_pragma_once_is_fine() {
     let files = MemVfs::new()
-        .with("a.idl", "#pragma once\n#include \"b.idl\"\nstruct A { long x; };\n")
-        .with("b.idl", "#pragma once\n#include \"a.idl\"\nstruct B { long y; };\n");
+        .with(
+            "a.idl",
+            "#pragma once\n#include \"b.idl\"\nstruct A { long x; };\n",
+        )
+        .with(
+            "b.idl",
+            "#pragma once\n#include \"a.idl\"\nstruct B { long y; };\n",
+        );
     let (ok, codes, _) = compile_with(files, "#include \"a.idl\"\n#include \"b.idl\"\n");
     assert!(ok, "{codes:?}");
 }
@@ -116,7 +130,9 @@ fn self_referential_macro_terminates() {
 
 #[test]
 fn garbage_bytes() {
-    let text: String = (0..20_000u32).map(|i| char::from_u32((i * 7919) % 0x2FF + 1).unwrap_or('?')).collect();
+    let text: String = (0..20_000u32)
+        .map(|i| char::from_u32((i * 7919) % 0x2FF + 1).unwrap_or('?'))
+        .collect();
     let (ok, _, _) = compile(&text);
     assert!(!ok);
 }

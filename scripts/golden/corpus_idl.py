@@ -166,6 +166,12 @@ ENTRIES = [
     ("MutableInheritanceStruct", f"{EPROSIMA}/mutable.idl", "MutableInheritanceStruct",
      MutableInheritanceStruct, [
          ("basic", MutableInheritanceStruct(var_short=-1, var_str="mutable"))]),
+    ("MutableExtensibilityInheritance", f"{EPROSIMA}/mutable.idl", "MutableExtensibilityInheritance",
+     MutableExtensibilityInheritance, [
+         ("basic", MutableExtensibilityInheritance(var_short=-1, var_long=0x01020304))]),
+    ("FinalExtensibilityInheritance", f"{EPROSIMA}/final.idl", "FinalExtensibilityInheritance",
+     FinalExtensibilityInheritance, [
+         ("basic", FinalExtensibilityInheritance(var_short=-1, var_long=0x01020304))]),
     ("FixId", f"{EPROSIMA}/member_id.idl", "FixId", FixId, [
         ("basic", FixId(o=1, s=-2, l=3, ll=-4))]),
     ("FixHashidDefault", f"{EPROSIMA}/member_id.idl", "FixHashidDefault", FixHashidDefault, [

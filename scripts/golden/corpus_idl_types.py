@@ -340,6 +340,28 @@ class MutableInheritanceStruct(MutableShortStruct, typename="MutableInheritanceS
     var_str: str
 
 
+# An unannotated struct takes its base's extensibility (Cyclone's idlc does so; it rejects a derived struct whose
+# annotation differs from its base's), whatever the default.
+@dataclass
+@mutable
+class MutableExtensibilityInheritance(MutableShortStruct, typename="MutableExtensibilityInheritance"):
+    var_long: int32
+
+
+# ---------------------------------------------------------------- eprosima: final.idl
+
+@dataclass
+@final
+class FinalShortStruct(IdlStruct, typename="FinalShortStruct"):
+    var_short: int16
+
+
+@dataclass
+@final
+class FinalExtensibilityInheritance(FinalShortStruct, typename="FinalExtensibilityInheritance"):
+    var_long: int32  # unannotated: @final like its base, see above
+
+
 # ---------------------------------------------------------------- eprosima: member_id.idl
 
 @dataclass

@@ -59,112 +59,114 @@ pub struct Telemetry {
     pub counters: Vec<i32>,
 }
 
-/// A mutable type with 34 members of mixed kinds (explicit, identical member ids in both derives).
+/// A mutable type with 34 members of mixed kinds (explicit, identical member ids in both derives). The ids start
+/// at 11: Dust DDS 0.15 ends a parameter list at a member with id 1 (it checks for the RTPS PID_SENTINEL, 1, in
+/// XCDR1 and XCDR2 alike) and then cannot decode its own output, which would leave nothing to compare.
 #[derive(Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize)]
 #[dds(mutable, name = "Bench::Wide")]
 #[dust_dds(extensibility = "mutable", name = "Bench::Wide")]
 pub struct Wide {
-    #[dds(key, id = 1)]
-    #[dust_dds(key, id = 1)]
+    #[dds(key, id = 11)]
+    #[dust_dds(key, id = 11)]
     pub id: u32,
-    #[dds(id = 2)]
-    #[dust_dds(id = 2)]
-    pub seq: u64,
-    #[dds(id = 3)]
-    #[dust_dds(id = 3)]
-    pub timestamp: i64,
-    #[dds(id = 4)]
-    #[dust_dds(id = 4)]
-    pub level: i16,
-    #[dds(id = 5)]
-    #[dust_dds(id = 5)]
-    pub flags: u16,
-    #[dds(id = 6)]
-    #[dust_dds(id = 6)]
-    pub min: i32,
-    #[dds(id = 7)]
-    #[dust_dds(id = 7)]
-    pub status: u32,
-    #[dds(id = 8)]
-    #[dust_dds(id = 8)]
-    pub gain: f32,
-    #[dds(id = 9)]
-    #[dust_dds(id = 9)]
-    pub scale: f64,
-    #[dds(id = 10)]
-    #[dust_dds(id = 10)]
-    pub enabled: bool,
-    #[dds(id = 11)]
-    #[dust_dds(id = 11)]
-    pub priority: u8,
     #[dds(id = 12)]
     #[dust_dds(id = 12)]
-    pub offset: i8,
+    pub seq: u64,
     #[dds(id = 13)]
     #[dust_dds(id = 13)]
-    pub name: String,
+    pub timestamp: i64,
     #[dds(id = 14)]
     #[dust_dds(id = 14)]
-    pub description: String,
+    pub level: i16,
     #[dds(id = 15)]
     #[dust_dds(id = 15)]
-    pub unit: String,
+    pub flags: u16,
     #[dds(id = 16)]
     #[dust_dds(id = 16)]
-    pub blob: Vec<u8>,
+    pub min: i32,
     #[dds(id = 17)]
     #[dust_dds(id = 17)]
-    pub histogram: Vec<i32>,
+    pub status: u32,
     #[dds(id = 18)]
     #[dust_dds(id = 18)]
-    pub series: Vec<f64>,
+    pub gain: f32,
     #[dds(id = 19)]
     #[dust_dds(id = 19)]
-    pub tags: Vec<String>,
+    pub scale: f64,
     #[dds(id = 20)]
     #[dust_dds(id = 20)]
-    pub x: f64,
+    pub enabled: bool,
     #[dds(id = 21)]
     #[dust_dds(id = 21)]
-    pub y: f64,
+    pub priority: u8,
     #[dds(id = 22)]
     #[dust_dds(id = 22)]
-    pub z: f64,
+    pub offset: i8,
     #[dds(id = 23)]
     #[dust_dds(id = 23)]
-    pub roll: f32,
+    pub name: String,
     #[dds(id = 24)]
     #[dust_dds(id = 24)]
-    pub pitch: f32,
+    pub description: String,
     #[dds(id = 25)]
     #[dust_dds(id = 25)]
-    pub yaw: f32,
+    pub unit: String,
     #[dds(id = 26)]
     #[dust_dds(id = 26)]
-    pub errors: u32,
+    pub blob: Vec<u8>,
     #[dds(id = 27)]
     #[dust_dds(id = 27)]
-    pub mask: u16,
+    pub histogram: Vec<i32>,
     #[dds(id = 28)]
     #[dust_dds(id = 28)]
-    pub delta: i16,
+    pub series: Vec<f64>,
     #[dds(id = 29)]
     #[dust_dds(id = 29)]
-    pub count: u64,
+    pub tags: Vec<String>,
     #[dds(id = 30)]
     #[dust_dds(id = 30)]
-    pub low: i32,
+    pub x: f64,
     #[dds(id = 31)]
     #[dust_dds(id = 31)]
-    pub high: i32,
+    pub y: f64,
     #[dds(id = 32)]
     #[dust_dds(id = 32)]
-    pub ok: bool,
+    pub z: f64,
     #[dds(id = 33)]
     #[dust_dds(id = 33)]
-    pub note: String,
+    pub roll: f32,
     #[dds(id = 34)]
     #[dust_dds(id = 34)]
+    pub pitch: f32,
+    #[dds(id = 35)]
+    #[dust_dds(id = 35)]
+    pub yaw: f32,
+    #[dds(id = 36)]
+    #[dust_dds(id = 36)]
+    pub errors: u32,
+    #[dds(id = 37)]
+    #[dust_dds(id = 37)]
+    pub mask: u16,
+    #[dds(id = 38)]
+    #[dust_dds(id = 38)]
+    pub delta: i16,
+    #[dds(id = 39)]
+    #[dust_dds(id = 39)]
+    pub count: u64,
+    #[dds(id = 40)]
+    #[dust_dds(id = 40)]
+    pub low: i32,
+    #[dds(id = 41)]
+    #[dust_dds(id = 41)]
+    pub high: i32,
+    #[dds(id = 42)]
+    #[dust_dds(id = 42)]
+    pub ok: bool,
+    #[dds(id = 43)]
+    #[dust_dds(id = 43)]
+    pub note: String,
+    #[dds(id = 44)]
+    #[dust_dds(id = 44)]
     pub extra: Vec<u16>,
 }
 

@@ -306,14 +306,6 @@ pub fn decode_optional<T: CdrType>(
     }
 }
 
-/// Lower bound of the encoded size of a member (for hostile-length checks of sequences of structs).
-pub const fn member_min_size(layout_min: usize, ext: Extensibility, optional: bool) -> usize {
-    match ext {
-        Extensibility::Final if !optional => layout_min,
-        _ => 0,
-    }
-}
-
 /// A union discriminator type: integers, `bool`, `char` and enums deriving `DdsType`.
 pub trait Discriminator: CdrType + Copy {
     /// How the default discriminator value is searched (libddsc's rule).
@@ -324,7 +316,7 @@ pub trait Discriminator: CdrType + Copy {
     fn write_raw(w: &mut CdrWriter<'_>, raw: i64) -> Result<(), EncodeError>;
     /// Reads a label value without requiring it to be a valid `Self`.
     fn read_raw(r: &mut CdrReader<'_>) -> Result<i64, DecodeError>;
-    /// Enumerator values, for enums.
+    /// Enumerator values as written on the wire, in declaration order (enums only).
     fn enumerators() -> &'static [i64] {
         &[]
     }

@@ -126,8 +126,10 @@ pub struct ParticipantConfig {
     /// Per remote writer: samples defragmented at once (default 8) and bytes held in fragments (default 16 MiB).
     pub defrag_max_samples: usize,
     pub defrag_max_bytes: usize,
-    /// Per remote writer: out-of-order samples held for reordering (default 1024).
+    /// Per remote writer: out-of-order samples held for reordering (default 1024) and their bytes (default
+    /// 64 MiB); beyond either, later samples are dropped and requested again once the gap is filled.
     pub reorder_max_samples: usize,
+    pub reorder_max_bytes: usize,
     /// How long a deleted reliable writer lingers waiting for acknowledgements (default 1 s).
     pub writer_linger_duration: Duration,
     /// Upper bound on bytes retransmitted per repair round to one reader (default 256 KiB).
@@ -177,6 +179,7 @@ impl ParticipantConfig {
             defrag_max_samples: 8,
             defrag_max_bytes: 16 * 1024 * 1024,
             reorder_max_samples: 1024,
+            reorder_max_bytes: 64 * 1024 * 1024,
             writer_linger_duration: Duration::from_secs(1),
             max_repair_bytes: 256 * 1024,
         }

@@ -76,6 +76,7 @@ fn reader_params(c: &ParticipantConfig, reliable: bool) -> ReaderParams {
         defrag_max_samples: c.defrag_max_samples.max(1),
         defrag_max_bytes: c.defrag_max_bytes,
         reorder_max_samples: c.reorder_max_samples.max(1),
+        reorder_max_bytes: c.reorder_max_bytes,
     }
 }
 

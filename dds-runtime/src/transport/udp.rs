@@ -385,6 +385,8 @@ impl Drop for UdpTransport {
 struct RecvBatch {
     bufs: Vec<Vec<u8>>,
     addrs: Vec<libc::sockaddr_storage>,
+    /// Never read from Rust: `hdrs` point into it, so it must live as long as the batch.
+    #[allow(dead_code)]
     iovs: Vec<libc::iovec>,
     hdrs: Vec<libc::mmsghdr>,
 }
@@ -452,7 +454,6 @@ impl RecvBatch {
     fn datagram(&self, i: usize) -> Option<Datagram<'_>> {
         let len = (self.hdrs[i].msg_len as usize).min(self.bufs[i].len());
         let from = sockaddr_v4(&self.addrs[i])?;
-        let _ = &self.iovs;
         Some(Datagram {
             data: &self.bufs[i][..len],
             from,
@@ -480,19 +481,16 @@ fn recv_loop(
     stats: &TransportStats,
 ) {
     let mut batch = RecvBatch::new();
-    let mut grams: Vec<Datagram<'_>> = Vec::with_capacity(RECV_BATCH);
     while !stop.load(Ordering::Relaxed) {
         match batch.recv(sock) {
             Ok(n) => {
                 if stop.load(Ordering::Relaxed) {
                     break;
                 }
-                grams.clear();
-                grams.extend(
-                    (0..n)
-                        .filter_map(|i| batch.datagram(i))
-                        .filter(|d| !d.data.is_empty()),
-                );
+                let grams: Vec<Datagram<'_>> = (0..n)
+                    .filter_map(|i| batch.datagram(i))
+                    .filter(|d| !d.data.is_empty())
+                    .collect();
                 if grams.is_empty() {
                     continue;
                 }

@@ -19,7 +19,9 @@ use dds_examples::perf_args::{self, PerfCommand, PerfOptions, TopicSel};
 use dds_examples::perf_sample::PerfSample;
 use dds_examples::perf_stats::{self, LatencyStat, SeqCheck, SubStats, WriteHist};
 use dds_examples::shutdown;
-use dds_examples::topic_types::{Keyed256, Keyed32, KeyedSeq, OneULong, Struct16, Struct256, Struct32k, Struct4k};
+use dds_examples::topic_types::{
+    Keyed256, Keyed32, KeyedSeq, OneULong, Struct16, Struct256, Struct32k, Struct4k,
+};
 use dds_runtime::prelude::*;
 
 fn main() -> ExitCode {
@@ -57,7 +59,10 @@ fn main() -> ExitCode {
 }
 
 fn now_ns() -> i64 {
-    SystemTime::now().duration_since(UNIX_EPOCH).map(|d| d.as_nanos() as i64).unwrap_or(0)
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_nanos() as i64)
+        .unwrap_or(0)
 }
 
 fn ts(ns: i64) -> SystemTime {
@@ -65,7 +70,9 @@ fn ts(ns: i64) -> SystemTime {
 }
 
 fn ns_of(t: SystemTime) -> i64 {
-    t.duration_since(UNIX_EPOCH).map(|d| d.as_nanos() as i64).unwrap_or(0)
+    t.duration_since(UNIX_EPOCH)
+        .map(|d| d.as_nanos() as i64)
+        .unwrap_or(0)
 }
 
 /// ddsperf's partition name for a participant: its GUID as 4 groups of 8 hex digits.
@@ -73,7 +80,10 @@ fn guid_string(prefix: &[u8; 12]) -> String {
     let mut g = [0u8; 16];
     g[..12].copy_from_slice(prefix);
     g[12..].copy_from_slice(&[0, 0, 1, 0xc1]);
-    g.chunks(4).map(|c| c.iter().map(|b| format!("{b:02x}")).collect::<String>()).collect::<Vec<_>>().join("_")
+    g.chunks(4)
+        .map(|c| c.iter().map(|b| format!("{b:02x}")).collect::<String>())
+        .collect::<Vec<_>>()
+        .join("_")
 }
 
 fn hostname() -> String {
@@ -134,16 +144,27 @@ impl<T: PerfSample> Ctx<T> {
     /// Pongs expected per ping: remote participants whose pong reader matched our pong writer for them.
     fn pongs_expected(&self) -> u32 {
         let w = self.pong_writers.read().expect("pong writers");
-        w.values().filter(|w| w.publication_matched_status().current_count > 0).count() as u32
+        w.values()
+            .filter(|w| w.publication_matched_status().current_count > 0)
+            .count() as u32
     }
 
     fn pong_writer_for(&self, guid: &[u8; 16]) -> Option<DataWriter<T>> {
-        self.pong_writers.read().expect("pong writers").get(&prefix_of(guid)).cloned()
+        self.pong_writers
+            .read()
+            .expect("pong writers")
+            .get(&prefix_of(guid))
+            .cloned()
     }
 
     /// Creates pong writers for newly discovered participants (and ourselves with -L).
     fn refresh_pong_writers(&self) -> DdsResult<()> {
-        let mut prefixes: Vec<[u8; 12]> = self.participant.discovered_participants().into_iter().map(|p| p.guid_prefix).collect();
+        let mut prefixes: Vec<[u8; 12]> = self
+            .participant
+            .discovered_participants()
+            .into_iter()
+            .map(|p| p.guid_prefix)
+            .collect();
         if self.o.match_local {
             prefixes.push(self.own_prefix);
         }
@@ -151,14 +172,24 @@ impl<T: PerfSample> Ctx<T> {
             if prefix == self.own_prefix && !self.o.match_local {
                 continue;
             }
-            if self.pong_writers.read().expect("pong writers").contains_key(&prefix) {
+            if self
+                .pong_writers
+                .read()
+                .expect("pong writers")
+                .contains_key(&prefix)
+            {
                 continue;
             }
-            let publ = self
-                .participant
-                .create_publisher(&PublisherQos::builder().partition(Partition::new([guid_string(&prefix)])).build())?;
+            let publ = self.participant.create_publisher(
+                &PublisherQos::builder()
+                    .partition(Partition::new([guid_string(&prefix)]))
+                    .build(),
+            )?;
             let w = publ.create_datawriter(&self.pong_topic, &self.pingpong_qos)?;
-            self.pong_writers.write().expect("pong writers").insert(prefix, w);
+            self.pong_writers
+                .write()
+                .expect("pong writers")
+                .insert(prefix, w);
         }
         Ok(())
     }
@@ -178,8 +209,16 @@ impl<T: PerfSample> Ctx<T> {
 fn data_qos_reader(o: &PerfOptions) -> DataReaderQos {
     let mut q = DataReaderQos::builder()
         .reliability(reliability(o))
-        .history(if o.history_depth == 0 { History::KeepAll } else { History::KeepLast(o.history_depth) })
-        .resource_limits(ResourceLimits { max_samples: Some(10_000), max_instances: None, max_samples_per_instance: None });
+        .history(if o.history_depth == 0 {
+            History::KeepAll
+        } else {
+            History::KeepLast(o.history_depth)
+        })
+        .resource_limits(ResourceLimits {
+            max_samples: Some(10_000),
+            max_instances: None,
+            max_samples_per_instance: None,
+        });
     if !o.reliable {
         q = q.reliability(Reliability::BestEffort);
     }
@@ -189,14 +228,24 @@ fn data_qos_reader(o: &PerfOptions) -> DataReaderQos {
 fn data_qos_writer(o: &PerfOptions) -> DataWriterQos {
     DataWriterQos::builder()
         .reliability(reliability(o))
-        .history(if o.history_depth == 0 { History::KeepAll } else { History::KeepLast(o.history_depth) })
-        .resource_limits(ResourceLimits { max_samples: Some(10_000), max_instances: None, max_samples_per_instance: None })
+        .history(if o.history_depth == 0 {
+            History::KeepAll
+        } else {
+            History::KeepLast(o.history_depth)
+        })
+        .resource_limits(ResourceLimits {
+            max_samples: Some(10_000),
+            max_instances: None,
+            max_samples_per_instance: None,
+        })
         .build()
 }
 
 fn reliability(o: &PerfOptions) -> Reliability {
     if o.reliable {
-        Reliability::Reliable { max_blocking_time: Duration::from_secs(10) }
+        Reliability::Reliable {
+            max_blocking_time: Duration::from_secs(10),
+        }
     } else {
         Reliability::BestEffort
     }
@@ -221,8 +270,14 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
 
     let publ = participant.create_publisher(&PublisherQos::default())?;
     let subs = participant.create_subscriber(&SubscriberQos::default())?;
-    let pingpong_w = DataWriterQos::builder().reliability(reliability(o)).history(History::KeepLast(1)).build();
-    let pingpong_r = DataReaderQos::builder().reliability(reliability(o)).history(History::KeepLast(1)).build();
+    let pingpong_w = DataWriterQos::builder()
+        .reliability(reliability(o))
+        .history(History::KeepLast(1))
+        .build();
+    let pingpong_r = DataReaderQos::builder()
+        .reliability(reliability(o))
+        .history(History::KeepLast(1))
+        .build();
     let ping_reader = subs.create_datareader(&ping_topic, &pingpong_r)?;
     let ping_writer = publ.create_datawriter(&ping_topic, &pingpong_w)?;
     let data_reader = match o.sub {
@@ -231,15 +286,18 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
     };
     let data_writer = publ.create_datawriter(&data_topic, &data_qos_writer(o))?;
     // Pongs for us arrive in our own partition.
-    let pong_sub =
-        participant.create_subscriber(&SubscriberQos::builder().partition(Partition::new([guid_string(&own_prefix)])).build())?;
+    let pong_sub = participant.create_subscriber(
+        &SubscriberQos::builder()
+            .partition(Partition::new([guid_string(&own_prefix)]))
+            .build(),
+    )?;
     let pong_reader = pong_sub.create_datareader(&pong_topic, &pingpong_r)?;
 
     let ctx = Arc::new(Ctx {
         o: o.clone(),
         pid,
         own_prefix,
-            participant: participant.clone(),
+        participant: participant.clone(),
         pong_topic,
         pingpong_qos: pingpong_w,
         pong_writers: RwLock::new(HashMap::new()),
@@ -305,7 +363,11 @@ fn main_loop<T: PerfSample>(ctx: &Ctx<T>) -> u8 {
         if now >= next {
             print_stats(ctx, start, now, last);
             last = now;
-            next = if now > next + Duration::from_millis(500) { now + Duration::from_secs(1) } else { next + Duration::from_secs(1) };
+            next = if now > next + Duration::from_millis(500) {
+                now + Duration::from_secs(1)
+            } else {
+                next + Duration::from_secs(1)
+            };
         }
         if let Some(np) = next_ping {
             if now >= np {
@@ -319,7 +381,10 @@ fn main_loop<T: PerfSample>(ctx: &Ctx<T>) -> u8 {
         if let Some(t) = next_ping {
             wake = wake.min(t);
         }
-        thread::sleep(wake.saturating_duration_since(Instant::now()).min(Duration::from_millis(20)));
+        thread::sleep(
+            wake.saturating_duration_since(Instant::now())
+                .min(Duration::from_millis(20)),
+        );
     }
     ctx.stop.store(true, Ordering::SeqCst);
 
@@ -331,7 +396,10 @@ fn main_loop<T: PerfSample>(ctx: &Ctx<T>) -> u8 {
         ok = false;
     }
     if o.min_samples > 0 && stats.min_received_per_writer() < o.min_samples {
-        println!("[{}] error: too few samples received from some peers", ctx.pid);
+        println!(
+            "[{}] error: too few samples received from some peers",
+            ctx.pid
+        );
         ok = false;
     }
     drop(stats);
@@ -343,7 +411,11 @@ fn main_loop<T: PerfSample>(ctx: &Ctx<T>) -> u8 {
         }
     }
     if o.min_match > 0 && ctx.pongs_expected() < o.min_match {
-        println!("[{}] error: too few matching participants ({})", ctx.pid, ctx.pongs_expected());
+        println!(
+            "[{}] error: too few matching participants ({})",
+            ctx.pid,
+            ctx.pongs_expected()
+        );
         ok = false;
     }
     u8::from(!ok)
@@ -365,7 +437,10 @@ fn ping_timer<T: PerfSample>(ctx: &Ctx<T>, now: Instant) -> Instant {
     if st.sent_at.is_some() && st.seen < expected {
         st.timeouts += 1;
         if st.warn_after.is_none_or(|w| now > w) {
-            println!("[{}] ping timed out (total {} times) ... sending new ping", ctx.pid, st.timeouts);
+            println!(
+                "[{}] ping timed out (total {} times) ... sending new ping",
+                ctx.pid, st.timeouts
+            );
             st.warn_after = Some(now + Duration::from_secs(1));
         }
     }
@@ -387,15 +462,34 @@ fn print_stats<T: PerfSample>(ctx: &Ctx<T>, start: Instant, now: Instant, last: 
     let prefix = perf_stats::prefix(ctx.pid, (now - start).as_secs_f64());
     let dt = (now - last).as_nanos() as f64;
     if o.pub_rate.is_some_and(|r| r > 0.0) {
-        println!("{}", ctx.pub_hist.lock().expect("pub hist").take_line(&prefix, dt));
+        println!(
+            "{}",
+            ctx.pub_hist
+                .lock()
+                .expect("pub hist")
+                .take_line(&prefix, dt)
+        );
     }
     if o.sub.is_some() {
-        if let Some(l) = ctx.sub_stats.lock().expect("sub stats").second_line(&prefix, dt, o.substat_every_second) {
+        if let Some(l) = ctx.sub_stats.lock().expect("sub stats").second_line(
+            &prefix,
+            dt,
+            o.substat_every_second,
+        ) {
             println!("{l}");
         }
         if o.sublatency {
             if let Some(s) = ctx.sub_latency.lock().expect("sub latency").take_summary() {
-                println!("{}", perf_stats::latency_line(&prefix, " sublat", "all", T::TOPIC.payload_size(o.baggage), &s));
+                println!(
+                    "{}",
+                    perf_stats::latency_line(
+                        &prefix,
+                        " sublat",
+                        "all",
+                        T::TOPIC.payload_size(o.baggage),
+                        &s
+                    )
+                );
             }
         }
     }
@@ -403,7 +497,10 @@ fn print_stats<T: PerfSample>(ctx: &Ctx<T>, start: Instant, now: Instant, last: 
     for (guid, stat) in ps.iter_mut() {
         if let Some(s) = stat.take_summary() {
             let peer: String = guid[..12].iter().map(|b| format!("{b:02x}")).collect();
-            println!("{}", perf_stats::latency_line(&prefix, "", &peer, T::TOPIC.payload_size(o.baggage), &s));
+            println!(
+                "{}",
+                perf_stats::latency_line(&prefix, "", &peer, T::TOPIC.payload_size(o.baggage), &s)
+            );
         }
     }
 }
@@ -420,7 +517,10 @@ fn discovery_loop<T: PerfSample>(ctx: &Ctx<T>) {
 /// Answers pings: echo on the pinging participant's pong writer with the timestamp's lsb set.
 fn ping_responder<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
     while !ctx.stopping() {
-        if !reader.wait_for_data(Duration::from_millis(100)).unwrap_or(false) {
+        if !reader
+            .wait_for_data(Duration::from_millis(100))
+            .unwrap_or(false)
+        {
             continue;
         }
         let Ok(samples) = reader.take() else { continue };
@@ -439,7 +539,10 @@ fn ping_responder<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
 /// Receives pongs: half the round trip per answering writer; the next ping once all answered.
 fn pong_receiver<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
     while !ctx.stopping() {
-        if !reader.wait_for_data(Duration::from_millis(100)).unwrap_or(false) {
+        if !reader
+            .wait_for_data(Duration::from_millis(100))
+            .unwrap_or(false)
+        {
             continue;
         }
         let Ok(samples) = reader.take() else { continue };
@@ -491,29 +594,40 @@ fn pong_receiver<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
 /// `sub` mode: sequence checking per writer and key, optional latency, and pongs for pinged data.
 fn data_receiver<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
     while !ctx.stopping() {
-        if !reader.wait_for_data(Duration::from_millis(100)).unwrap_or(false) {
+        if !reader
+            .wait_for_data(Duration::from_millis(100))
+            .unwrap_or(false)
+        {
             continue;
         }
-        let Ok(samples) = reader.select().max_samples(1000).take() else { continue };
+        let Ok(samples) = reader.select().max_samples(1000).take() else {
+            continue;
+        };
         let mut stats = ctx.sub_stats.lock().expect("sub stats");
         for s in &samples {
             let Some(d) = &s.data else { continue };
             if ctx.is_local(&s.info.publication_guid) && !ctx.o.match_local {
                 continue;
             }
-            if stats.record(s.info.publication_guid, d.seq(), d.keyval(), d.size()) == SeqCheck::BadKey {
+            if stats.record(s.info.publication_guid, d.seq(), d.keyval(), d.size())
+                == SeqCheck::BadKey
+            {
                 println!("received key {} >= nkeys {}", d.keyval(), ctx.o.nkeyvals);
                 shutdown::request();
             }
             if ctx.o.sublatency {
-                ctx.sub_latency.lock().expect("sub latency").record(now_ns() - ns_of(s.info.source_timestamp));
+                ctx.sub_latency
+                    .lock()
+                    .expect("sub latency")
+                    .record(now_ns() - ns_of(s.info.source_timestamp));
             }
         }
         drop(stats);
         for s in samples {
             let sent = ns_of(s.info.source_timestamp);
             if sent & 1 == 1 {
-                if let (Some(d), Some(w)) = (s.data, ctx.pong_writer_for(&s.info.publication_guid)) {
+                if let (Some(d), Some(w)) = (s.data, ctx.pong_writer_for(&s.info.publication_guid))
+                {
                     let _ = w.write_w_timestamp(&d, ts(sent - 1));
                 }
             }
@@ -555,7 +669,10 @@ fn publisher<T: PerfSample>(ctx: &Ctx<T>, w: &DataWriter<T>) {
                 return;
             }
         }
-        ctx.pub_hist.lock().expect("pub hist").record(t0.elapsed().as_nanos() as u64);
+        ctx.pub_hist
+            .lock()
+            .expect("pub hist")
+            .record(t0.elapsed().as_nanos() as u64);
         ntot += 1;
         sample.set_seq(sample.seq().wrapping_add(1));
         keyval = (keyval + 1) % nkeys;
@@ -564,7 +681,10 @@ fn publisher<T: PerfSample>(ctx: &Ctx<T>, w: &DataWriter<T>) {
             batch += 1;
             if batch >= o.burst {
                 batch = 0;
-                while !ctx.stopping() && (ntot / u64::from(o.burst)) as f64 / (start.elapsed().as_secs_f64() + 5e-3) > rate {
+                while !ctx.stopping()
+                    && (ntot / u64::from(o.burst)) as f64 / (start.elapsed().as_secs_f64() + 5e-3)
+                        > rate
+                {
                     thread::sleep(Duration::from_millis(1));
                 }
             }

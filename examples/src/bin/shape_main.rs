@@ -6,7 +6,9 @@ use std::collections::HashMap;
 use std::process::ExitCode;
 use std::time::Duration;
 
-use dds_examples::shape_opts::{self, AccessScope, DurabilityArg, FinalInstanceState, Parsed, ShapeOptions};
+use dds_examples::shape_opts::{
+    self, AccessScope, DurabilityArg, FinalInstanceState, Parsed, ShapeOptions,
+};
 use dds_examples::shape_output::{self, NotAlive};
 use dds_examples::shutdown;
 use dds_examples::topic_types::ShapeType;
@@ -18,7 +20,9 @@ const ERROR_RUNNING: u8 = 3;
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let prog = std::env::args().next().unwrap_or_else(|| "shape_main".into());
+    let prog = std::env::args()
+        .next()
+        .unwrap_or_else(|| "shape_main".into());
     let options = match shape_opts::parse(&args) {
         Ok(Parsed::Help) => {
             print!("{}", shape_opts::usage(&prog));
@@ -72,13 +76,19 @@ fn unsupported(o: &ShapeOptions) -> Option<String> {
     if o.ordered {
         return Some("    Presentation Ordered Access = not supported".into());
     }
-    if matches!(o.access_scope, Some(AccessScope::Topic | AccessScope::Group)) {
+    if matches!(
+        o.access_scope,
+        Some(AccessScope::Topic | AccessScope::Group)
+    ) {
         return Some("    Presentation Access Scope = not supported".into());
     }
     if o.cft_expression.is_some() {
         return Some("    ContentFilteredTopic expression (--cft) = not supported".into());
     }
-    if matches!(o.durability, DurabilityArg::Transient | DurabilityArg::Persistent) {
+    if matches!(
+        o.durability,
+        DurabilityArg::Transient | DurabilityArg::Persistent
+    ) {
         return Some("    Durability TRANSIENT/PERSISTENT = not supported".into());
     }
     None
@@ -104,11 +114,23 @@ impl DataWriterListener<ShapeType> for Printer {
     fn on_publication_matched(&self, w: &DataWriter<ShapeType>, st: PublicationMatchedStatus) {
         println!(
             "{}",
-            shape_output::publication_matched_line(&self.topic, w.topic().type_name(), st.current_count, st.current_count_change)
+            shape_output::publication_matched_line(
+                &self.topic,
+                w.topic().type_name(),
+                st.current_count,
+                st.current_count_change
+            )
         );
     }
     fn on_offered_incompatible_qos(&self, w: &DataWriter<ShapeType>, st: IncompatibleQosStatus) {
-        println!("{}", shape_output::offered_incompatible_line(&self.topic, w.topic().type_name(), st.last_policy_id));
+        println!(
+            "{}",
+            shape_output::offered_incompatible_line(
+                &self.topic,
+                w.topic().type_name(),
+                st.last_policy_id
+            )
+        );
     }
 }
 
@@ -116,17 +138,37 @@ impl DataReaderListener<ShapeType> for Printer {
     fn on_subscription_matched(&self, r: &DataReader<ShapeType>, st: SubscriptionMatchedStatus) {
         println!(
             "{}",
-            shape_output::subscription_matched_line(&self.topic, r.topic().type_name(), st.current_count, st.current_count_change)
+            shape_output::subscription_matched_line(
+                &self.topic,
+                r.topic().type_name(),
+                st.current_count,
+                st.current_count_change
+            )
         );
     }
     fn on_requested_incompatible_qos(&self, r: &DataReader<ShapeType>, st: IncompatibleQosStatus) {
-        println!("{}", shape_output::requested_incompatible_line(&self.topic, r.topic().type_name(), st.last_policy_id));
+        println!(
+            "{}",
+            shape_output::requested_incompatible_line(
+                &self.topic,
+                r.topic().type_name(),
+                st.last_policy_id
+            )
+        );
     }
 }
 
 fn topic_names(o: &ShapeOptions) -> Vec<String> {
     let base = o.topic.clone().unwrap_or_default();
-    (0..o.num_topics).map(|i| if i == 0 { base.clone() } else { format!("{base}{i}") }).collect()
+    (0..o.num_topics)
+        .map(|i| {
+            if i == 0 {
+                base.clone()
+            } else {
+                format!("{base}{i}")
+            }
+        })
+        .collect()
 }
 
 fn reliability(o: &ShapeOptions) -> Reliability {
@@ -186,7 +228,11 @@ impl App {
             topics.push(participant.create_topic::<ShapeType>(&name, &TopicQos::default())?);
         }
         let role = if o.publish {
-            let publisher = participant.create_publisher(&PublisherQos::builder().partition(partition(&o.partition)).build())?;
+            let publisher = participant.create_publisher(
+                &PublisherQos::builder()
+                    .partition(partition(&o.partition))
+                    .build(),
+            )?;
             let mut qos = DataWriterQos::builder()
                 .reliability(reliability(o))
                 .durability(durability(o))
@@ -195,7 +241,9 @@ impl App {
                 qos = qos.history(h);
             }
             if let Some(s) = o.ownership_strength {
-                qos = qos.ownership(Ownership::Exclusive).ownership_strength(OwnershipStrength(s));
+                qos = qos
+                    .ownership(Ownership::Exclusive)
+                    .ownership_strength(OwnershipStrength(s));
             }
             if !o.deadline.is_zero() {
                 qos = qos.deadline(Deadline(o.deadline));
@@ -204,20 +252,31 @@ impl App {
                 qos = qos.lifespan(Lifespan(o.lifespan));
             }
             if o.final_instance_state == Some(FinalInstanceState::Unregister) {
-                qos = qos.writer_data_lifecycle(WriterDataLifecycle { autodispose_unregistered_instances: false });
+                qos = qos.writer_data_lifecycle(WriterDataLifecycle {
+                    autodispose_unregistered_instances: false,
+                });
             }
             let qos = qos.build();
             let mut writers = Vec::new();
             for t in &topics {
-                println!("Create writer for topic: {} color: {}", t.name(), o.color.as_deref().unwrap_or("BLUE"));
+                println!(
+                    "Create writer for topic: {} color: {}",
+                    t.name(),
+                    o.color.as_deref().unwrap_or("BLUE")
+                );
                 let w = publisher.create_datawriter(t, &qos)?;
-                w.set_listener(Box::new(Printer { topic: t.name().to_string() }));
+                w.set_listener(Box::new(Printer {
+                    topic: t.name().to_string(),
+                }));
                 writers.push(w);
             }
             Role::Publisher(writers)
         } else {
-            let subscriber =
-                participant.create_subscriber(&SubscriberQos::builder().partition(partition(&o.partition)).build())?;
+            let subscriber = participant.create_subscriber(
+                &SubscriberQos::builder()
+                    .partition(partition(&o.partition))
+                    .build(),
+            )?;
             let mut qos = DataReaderQos::builder()
                 .reliability(reliability(o))
                 .durability(durability(o))
@@ -232,22 +291,33 @@ impl App {
                 qos = qos.deadline(Deadline(o.deadline));
             }
             if !o.time_filter.is_zero() {
-                qos = qos.time_based_filter(TimeBasedFilter { minimum_separation: o.time_filter });
+                qos = qos.time_based_filter(TimeBasedFilter {
+                    minimum_separation: o.time_filter,
+                });
             }
             let qos = qos.build();
             let mut readers = Vec::new();
             for t in &topics {
                 // shape_main reads a content-filtered topic "<topic>_filtered" on `color` when -c is
                 // given; the filter is applied when printing (same output).
-                let shown = if o.color.is_some() { format!("{}_filtered", t.name()) } else { t.name().to_string() };
+                let shown = if o.color.is_some() {
+                    format!("{}_filtered", t.name())
+                } else {
+                    t.name().to_string()
+                };
                 println!("Create reader for topic: {shown}");
                 let r = subscriber.create_datareader(t, &qos)?;
-                r.set_listener(Box::new(Printer { topic: t.name().to_string() }));
+                r.set_listener(Box::new(Printer {
+                    topic: t.name().to_string(),
+                }));
                 readers.push(r);
             }
             Role::Subscriber(readers)
         };
-        Ok(App { _participant: participant, role })
+        Ok(App {
+            _participant: participant,
+            role,
+        })
     }
 }
 
@@ -285,7 +355,10 @@ impl Mover {
 
 /// A small xorshift generator seeded from the clock and pid: positions only need to differ per run.
 fn seed_rng() -> impl FnMut() -> u32 {
-    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(1);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_nanos())
+        .unwrap_or(1);
     let mut state = (nanos as u64) ^ (u64::from(std::process::id()) << 32) | 1;
     move || {
         state ^= state << 13;
@@ -297,7 +370,15 @@ fn seed_rng() -> impl FnMut() -> u32 {
 
 fn instance_colors(o: &ShapeOptions) -> Vec<String> {
     let base = o.color.clone().unwrap_or_else(|| "BLUE".into());
-    (0..o.num_instances).map(|j| if j == 0 { base.clone() } else { format!("{base}{j}") }).collect()
+    (0..o.num_instances)
+        .map(|j| {
+            if j == 0 {
+                base.clone()
+            } else {
+                format!("{base}{j}")
+            }
+        })
+        .collect()
 }
 
 fn run_publisher(o: &ShapeOptions, writers: &[DataWriter<ShapeType>]) -> DdsResult<()> {
@@ -311,13 +392,20 @@ fn run_publisher(o: &ShapeOptions, writers: &[DataWriter<ShapeType>]) -> DdsResu
     };
     // Velocities 1..=5 in either direction, like shape_main.
     let mut velocity = || (1 + (rng() % 5) as i32) * if rng() % 2 == 1 { -1 } else { 1 };
-    let mut mover = Mover { xvel: velocity(), yvel: velocity() };
+    let mut mover = Mover {
+        xvel: velocity(),
+        yvel: velocity(),
+    };
     let colors = instance_colors(o);
     let mut n = 0u32;
     while !shutdown::requested() {
         mover.step(&mut shape);
         if o.shapesize == 0 {
-            shape.shapesize = if o.size_modulo > 0 { shape.shapesize % o.size_modulo + 1 } else { shape.shapesize + 1 };
+            shape.shapesize = if o.size_modulo > 0 {
+                shape.shapesize % o.size_modulo + 1
+            } else {
+                shape.shapesize + 1
+            };
         }
         for w in writers {
             for c in &colors {
@@ -388,7 +476,14 @@ fn run_subscriber(o: &ShapeOptions, readers: &[DataReader<ShapeType>]) -> DdsRes
                         if o.color.as_ref().is_none_or(|c| *c == d.color) {
                             println!(
                                 "{}",
-                                shape_output::sample_line(&topic, &d.color, d.x, d.y, d.shapesize, &d.additional_payload_size)
+                                shape_output::sample_line(
+                                    &topic,
+                                    &d.color,
+                                    d.x,
+                                    d.y,
+                                    d.shapesize,
+                                    &d.additional_payload_size
+                                )
                             );
                         }
                     }
@@ -399,7 +494,10 @@ fn run_subscriber(o: &ShapeOptions, readers: &[DataReader<ShapeType>]) -> DdsRes
                     };
                     let color = colors.get(&(i, handle)).cloned().unwrap_or_default();
                     if o.color.as_ref().is_none_or(|c| *c == color) {
-                        println!("{}", shape_output::instance_state_line(&topic, &color, state));
+                        println!(
+                            "{}",
+                            shape_output::instance_state_line(&topic, &color, state)
+                        );
                     }
                 }
                 if !o.take_read_next_instance {

@@ -28,7 +28,8 @@ struct Args {
     quiet: bool,
 }
 
-const USAGE: &str = "usage: shapes [--pub-only | --sub-only] [-t|--topic NAME] [-c|--color COLOR]...
+const USAGE: &str =
+    "usage: shapes [--pub-only | --sub-only] [-t|--topic NAME] [-c|--color COLOR]...
               [-d|--domain ID] [--duration SECS] [--count N] [--rate HZ] [-q|--quiet]
 
   Runs a publisher of bouncing shapes and a subscriber in one process (two participants, real RTPS)
@@ -55,7 +56,10 @@ fn parse_args(argv: &[String]) -> Result<Option<Args>, String> {
             _ => (arg.as_str(), None),
         };
         let mut value = |what: &str| -> Result<String, String> {
-            inline.clone().or_else(|| it.next().cloned()).ok_or_else(|| format!("{what} needs a value"))
+            inline
+                .clone()
+                .or_else(|| it.next().cloned())
+                .ok_or_else(|| format!("{what} needs a value"))
         };
         match name {
             "-h" | "--help" => return Ok(None),
@@ -64,17 +68,31 @@ fn parse_args(argv: &[String]) -> Result<Option<Args>, String> {
             "-q" | "--quiet" => a.quiet = true,
             "-t" | "--topic" => a.topic = value("--topic")?,
             "-c" | "--color" => a.colors.push(value("--color")?),
-            "-d" | "--domain" => a.domain = value("--domain")?.parse().map_err(|_| "bad --domain".to_string())?,
+            "-d" | "--domain" => {
+                a.domain = value("--domain")?
+                    .parse()
+                    .map_err(|_| "bad --domain".to_string())?
+            }
             "--duration" => {
-                let s: f64 = value("--duration")?.parse().map_err(|_| "bad --duration".to_string())?;
+                let s: f64 = value("--duration")?
+                    .parse()
+                    .map_err(|_| "bad --duration".to_string())?;
                 if !(s > 0.0 && s.is_finite()) {
                     return Err("--duration must be > 0".into());
                 }
                 a.duration = Duration::from_secs_f64(s);
             }
-            "--count" => a.count = Some(value("--count")?.parse().map_err(|_| "bad --count".to_string())?),
+            "--count" => {
+                a.count = Some(
+                    value("--count")?
+                        .parse()
+                        .map_err(|_| "bad --count".to_string())?,
+                )
+            }
             "--rate" => {
-                a.rate_hz = value("--rate")?.parse().map_err(|_| "bad --rate".to_string())?;
+                a.rate_hz = value("--rate")?
+                    .parse()
+                    .map_err(|_| "bad --rate".to_string())?;
                 if !(a.rate_hz > 0.0 && a.rate_hz <= 10_000.0) {
                     return Err("--rate must be in (0, 10000]".into());
                 }
@@ -86,7 +104,11 @@ fn parse_args(argv: &[String]) -> Result<Option<Args>, String> {
         return Err("--pub-only and --sub-only exclude each other".into());
     }
     if a.colors.is_empty() {
-        a.colors = if a.publish { vec!["BLUE".into(), "RED".into()] } else { Vec::new() };
+        a.colors = if a.publish {
+            vec!["BLUE".into(), "RED".into()]
+        } else {
+            Vec::new()
+        };
     }
     Ok(Some(a))
 }
@@ -125,7 +147,13 @@ impl Bouncer {
     fn new(color: &str, i: usize) -> Self {
         let i = i as i32;
         Bouncer {
-            shape: ShapeType { color: color.into(), x: 20 + 37 * i % 200, y: 30 + 53 * i % 230, shapesize: 30, ..Default::default() },
+            shape: ShapeType {
+                color: color.into(),
+                x: 20 + 37 * i % 200,
+                y: 30 + 53 * i % 230,
+                shapesize: 30,
+                ..Default::default()
+            },
             dx: 3 + i % 3,
             dy: 2 + (i + 1) % 4,
         }
@@ -155,14 +183,22 @@ struct Received {
 }
 
 fn run(a: &Args) -> DdsResult<u8> {
-    let reliable = DataWriterQos::builder().reliability(Reliability::RELIABLE).history(History::KeepLast(1)).build();
-    let reader_qos = DataReaderQos::builder().reliability(Reliability::RELIABLE).history(History::KeepLast(8)).build();
+    let reliable = DataWriterQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .history(History::KeepLast(1))
+        .build();
+    let reader_qos = DataReaderQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .history(History::KeepLast(8))
+        .build();
 
     // Separate participants: what the subscriber prints has gone through the stack's sockets.
     let sub_side = if a.subscribe {
         let p = DomainParticipant::builder().domain_id(a.domain).build()?;
         let topic = p.create_topic::<ShapeType>(&a.topic, &TopicQos::default())?;
-        let reader = p.create_subscriber(&SubscriberQos::default())?.create_datareader(&topic, &reader_qos)?;
+        let reader = p
+            .create_subscriber(&SubscriberQos::default())?
+            .create_datareader(&topic, &reader_qos)?;
         Some((p, reader))
     } else {
         None
@@ -170,7 +206,9 @@ fn run(a: &Args) -> DdsResult<u8> {
     let pub_side = if a.publish {
         let p = DomainParticipant::builder().domain_id(a.domain).build()?;
         let topic = p.create_topic::<ShapeType>(&a.topic, &TopicQos::default())?;
-        let writer = p.create_publisher(&PublisherQos::default())?.create_datawriter(&topic, &reliable)?;
+        let writer = p
+            .create_publisher(&PublisherQos::default())?
+            .create_datawriter(&topic, &reliable)?;
         Some((p, writer))
     } else {
         None
@@ -185,16 +223,28 @@ fn run(a: &Args) -> DdsResult<u8> {
         a.topic,
         a.domain,
         a.duration.as_secs_f64(),
-        if a.publish { format!(", colors {}", a.colors.join(" ")) } else { String::new() }
+        if a.publish {
+            format!(", colors {}", a.colors.join(" "))
+        } else {
+            String::new()
+        }
     );
 
-    let mut bouncers: Vec<Bouncer> = a.colors.iter().enumerate().map(|(i, c)| Bouncer::new(c, i)).collect();
+    let mut bouncers: Vec<Bouncer> = a
+        .colors
+        .iter()
+        .enumerate()
+        .map(|(i, c)| Bouncer::new(c, i))
+        .collect();
     let period = Duration::from_secs_f64(1.0 / a.rate_hz);
     let start = Instant::now();
     let mut next_write = start;
     let mut written = 0u64;
     let mut got = Received::default();
-    while !shutdown::requested() && start.elapsed() < a.duration && a.count.is_none_or(|n| got.samples < n) {
+    while !shutdown::requested()
+        && start.elapsed() < a.duration
+        && a.count.is_none_or(|n| got.samples < n)
+    {
         if let Some((_, w)) = &pub_side {
             if Instant::now() >= next_write {
                 for b in &mut bouncers {
@@ -205,18 +255,25 @@ fn run(a: &Args) -> DdsResult<u8> {
                         Err(e) => return Err(e),
                     }
                     if !a.subscribe && !a.quiet {
-                        println!("sent     {:<10} {:<8} x={:3} y={:3}", a.topic, b.shape.color, b.shape.x, b.shape.y);
+                        println!(
+                            "sent     {:<10} {:<8} x={:3} y={:3}",
+                            a.topic, b.shape.color, b.shape.x, b.shape.y
+                        );
                     }
                 }
                 next_write += period;
             }
         }
-        let wait = next_write.saturating_duration_since(Instant::now()).min(Duration::from_millis(50));
+        let wait = next_write
+            .saturating_duration_since(Instant::now())
+            .min(Duration::from_millis(50));
         if let Some((_, r)) = &sub_side {
             if r.wait_for_data(wait)? {
                 for s in r.take()? {
                     let Some(d) = s.data else { continue };
-                    let latency = SystemTime::now().duration_since(s.info.source_timestamp).unwrap_or_default();
+                    let latency = SystemTime::now()
+                        .duration_since(s.info.source_timestamp)
+                        .unwrap_or_default();
                     got.samples += 1;
                     *got.per_color.entry(d.color.clone()).or_default() += 1;
                     got.latency_sum += latency;
@@ -246,13 +303,32 @@ fn run(a: &Args) -> DdsResult<u8> {
     let elapsed = start.elapsed().as_secs_f64();
     println!("---- summary after {elapsed:.1} s ----");
     if a.publish {
-        println!("wrote    {written} samples ({} colors at {} Hz)", a.colors.len(), a.rate_hz);
+        println!(
+            "wrote    {written} samples ({} colors at {} Hz)",
+            a.colors.len(),
+            a.rate_hz
+        );
     }
     if a.subscribe {
-        let mean = if got.samples > 0 { got.latency_sum.as_secs_f64() * 1e6 / got.samples as f64 } else { 0.0 };
-        let colors: Vec<String> = got.per_color.iter().map(|(c, n)| format!("{c}: {n}")).collect();
+        let mean = if got.samples > 0 {
+            got.latency_sum.as_secs_f64() * 1e6 / got.samples as f64
+        } else {
+            0.0
+        };
+        let colors: Vec<String> = got
+            .per_color
+            .iter()
+            .map(|(c, n)| format!("{c}: {n}"))
+            .collect();
         println!("received {} samples [{}]", got.samples, colors.join(", "));
-        println!("latency  mean {mean:.0} us, max {:.0} us", got.latency_max.as_secs_f64() * 1e6);
+        println!(
+            "latency  mean {mean:.0} us, max {:.0} us",
+            got.latency_max.as_secs_f64() * 1e6
+        );
     }
-    Ok(if a.subscribe && got.samples == 0 { 1 } else { 0 })
+    Ok(if a.subscribe && got.samples == 0 {
+        1
+    } else {
+        0
+    })
 }

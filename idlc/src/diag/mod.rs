@@ -33,19 +33,37 @@ pub struct Diagnostic {
 
 impl Diagnostic {
     pub fn error(code: Code, message: impl Into<String>) -> Self {
-        Diagnostic { severity: Severity::Error, code, message: message.into(), labels: vec![], help: None, notes: vec![] }
+        Diagnostic {
+            severity: Severity::Error,
+            code,
+            message: message.into(),
+            labels: vec![],
+            help: None,
+            notes: vec![],
+        }
     }
     pub fn warning(code: Code, message: impl Into<String>) -> Self {
-        Diagnostic { severity: Severity::Warning, ..Self::error(code, message) }
+        Diagnostic {
+            severity: Severity::Warning,
+            ..Self::error(code, message)
+        }
     }
     /// The primary location, with a label text.
     pub fn at(mut self, loc: Loc, label: impl Into<String>) -> Self {
-        self.labels.push(Label { loc, message: Some(label.into()), primary: true });
+        self.labels.push(Label {
+            loc,
+            message: Some(label.into()),
+            primary: true,
+        });
         self
     }
     /// A secondary location.
     pub fn also(mut self, loc: Loc, label: impl Into<String>) -> Self {
-        self.labels.push(Label { loc, message: Some(label.into()), primary: false });
+        self.labels.push(Label {
+            loc,
+            message: Some(label.into()),
+            primary: false,
+        });
         self
     }
     pub fn help(mut self, help: impl Into<String>) -> Self {
@@ -57,7 +75,11 @@ impl Diagnostic {
         self
     }
     pub fn primary_loc(&self) -> Option<Loc> {
-        self.labels.iter().find(|l| l.primary).or(self.labels.first()).map(|l| l.loc)
+        self.labels
+            .iter()
+            .find(|l| l.primary)
+            .or(self.labels.first())
+            .map(|l| l.loc)
     }
     pub fn is_error(&self) -> bool {
         self.severity == Severity::Error
@@ -99,7 +121,11 @@ impl Diagnostics {
     }
     /// Sorted by file and position, errors of one place before warnings; stable output for tests.
     pub fn sort(&mut self) {
-        self.list.sort_by_key(|d| d.primary_loc().map(|l| (l.file, l.start)).unwrap_or_default());
+        self.list.sort_by_key(|d| {
+            d.primary_loc()
+                .map(|l| (l.file, l.start))
+                .unwrap_or_default()
+        });
     }
 }
 
@@ -110,12 +136,15 @@ pub fn suggest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) ->
         if c == name {
             continue;
         }
-        let score = if c.eq_ignore_ascii_case(name) { 1.0 } else { strsim::jaro_winkler(name, c) };
+        let score = if c.eq_ignore_ascii_case(name) {
+            1.0
+        } else {
+            strsim::jaro_winkler(name, c)
+        };
         let lev = strsim::levenshtein(&name.to_ascii_lowercase(), &c.to_ascii_lowercase());
-        if score >= 0.85 || lev <= (name.len().max(3) / 3) {
-            if best.map(|(_, s)| score > s).unwrap_or(true) {
-                best = Some((c, score));
-            }
+        if (score >= 0.85 || lev <= (name.len().max(3) / 3)) && best.is_none_or(|(_, s)| score > s)
+        {
+            best = Some((c, score));
         }
     }
     best.map(|(c, _)| c)

@@ -12,7 +12,10 @@ pub struct RenderOptions {
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { color: false, width: 100 }
+        RenderOptions {
+            color: false,
+            width: 100,
+        }
     }
 }
 
@@ -46,21 +49,29 @@ impl miette::Diagnostic for Report<'_> {
         })
     }
     fn help<'b>(&'b self) -> Option<Box<dyn fmt::Display + 'b>> {
-        self.help.as_ref().map(|h| Box::new(h) as Box<dyn fmt::Display>)
+        self.help
+            .as_ref()
+            .map(|h| Box::new(h) as Box<dyn fmt::Display>)
     }
     fn source_code(&self) -> Option<&dyn miette::SourceCode> {
         self.source.as_ref().map(|s| s as &dyn miette::SourceCode)
     }
     fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
         let file = self.file?;
-        Some(Box::new(self.diag.labels.iter().filter(move |l| l.loc.file == file).map(|l| {
-            let span = (l.loc.start as usize, l.loc.len());
-            if l.primary {
-                LabeledSpan::new_primary_with_span(l.message.clone(), span)
-            } else {
-                LabeledSpan::new_with_span(l.message.clone(), span)
-            }
-        })))
+        Some(Box::new(
+            self.diag
+                .labels
+                .iter()
+                .filter(move |l| l.loc.file == file)
+                .map(|l| {
+                    let span = (l.loc.start as usize, l.loc.len());
+                    if l.primary {
+                        LabeledSpan::new_primary_with_span(l.message.clone(), span)
+                    } else {
+                        LabeledSpan::new_with_span(l.message.clone(), span)
+                    }
+                }),
+        ))
     }
 }
 
@@ -76,7 +87,13 @@ pub fn render(db: &SourceDb, diag: &Diagnostic, opts: RenderOptions) -> String {
         .labels
         .iter()
         .filter(|l| Some(l.loc.file) != file)
-        .map(|l| format!("note: {} at {}", l.message.as_deref().unwrap_or("see"), db.describe(l.loc)))
+        .map(|l| {
+            format!(
+                "note: {} at {}",
+                l.message.as_deref().unwrap_or("see"),
+                db.describe(l.loc)
+            )
+        })
         .collect();
     extra.extend(diag.notes.iter().map(|n| format!("note: {n}")));
     let help = match (&diag.help, extra.is_empty()) {
@@ -85,9 +102,20 @@ pub fn render(db: &SourceDb, diag: &Diagnostic, opts: RenderOptions) -> String {
         (None, false) => Some(extra.join("\n")),
         (None, true) => None,
     };
-    let report = Report { diag, source, file, help };
-    let theme = if opts.color { GraphicalTheme::unicode() } else { GraphicalTheme::unicode_nocolor() };
-    let handler = GraphicalReportHandler::new_themed(theme).with_width(opts.width).with_links(false);
+    let report = Report {
+        diag,
+        source,
+        file,
+        help,
+    };
+    let theme = if opts.color {
+        GraphicalTheme::unicode()
+    } else {
+        GraphicalTheme::unicode_nocolor()
+    };
+    let handler = GraphicalReportHandler::new_themed(theme)
+        .with_width(opts.width)
+        .with_links(false);
     let mut out = String::new();
     if handler.render_report(&mut out, &report).is_err() {
         out = format!("{}: {}", diag.code.as_str(), diag.message);
@@ -96,6 +124,14 @@ pub fn render(db: &SourceDb, diag: &Diagnostic, opts: RenderOptions) -> String {
 }
 
 /// Renders several diagnostics, separated by blank lines.
-pub fn render_all<'a>(db: &SourceDb, diags: impl IntoIterator<Item = &'a Diagnostic>, opts: RenderOptions) -> String {
-    diags.into_iter().map(|d| render(db, d, opts)).collect::<Vec<_>>().join("\n")
+pub fn render_all<'a>(
+    db: &SourceDb,
+    diags: impl IntoIterator<Item = &'a Diagnostic>,
+    opts: RenderOptions,
+) -> String {
+    diags
+        .into_iter()
+        .map(|d| render(db, d, opts))
+        .collect::<Vec<_>>()
+        .join("\n")
 }

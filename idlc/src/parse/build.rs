@@ -29,7 +29,11 @@ impl<'a> Builder<'a> {
     }
 
     pub fn specification(&mut self, p: P) -> Spec {
-        let defs = p.into_inner().filter(|p| p.as_rule() == Rule::definition).map(|d| self.definition(d)).collect();
+        let defs = p
+            .into_inner()
+            .filter(|p| p.as_rule() == Rule::definition)
+            .map(|d| self.definition(d))
+            .collect();
         Spec { defs }
     }
 
@@ -50,8 +54,10 @@ impl<'a> Builder<'a> {
                 if b.starts_with('*') || b.is_empty() {
                     break;
                 }
-                let lines: Vec<String> =
-                    b.lines().map(|l| l.trim().trim_start_matches('*').trim_start().to_string()).collect();
+                let lines: Vec<String> = b
+                    .lines()
+                    .map(|l| l.trim().trim_start_matches('*').trim_start().to_string())
+                    .collect();
                 let lines = trim_blank(lines);
                 docs.splice(0..0, lines);
             } else if let Some(b) = body.strip_prefix("///") {
@@ -80,12 +86,27 @@ impl<'a> Builder<'a> {
         }
         let loc = self.pp.map.loc(c.start, c.end);
         self.diags.push(
-            Diagnostic::warning(Code::LegacyAnnotation, "legacy comment annotation `//@key` treated as `@key`")
-                .at(loc, "comment annotation")
-                .help("write `@key` before the member instead"),
+            Diagnostic::warning(
+                Code::LegacyAnnotation,
+                "legacy comment annotation `//@key` treated as `@key`",
+            )
+            .at(loc, "comment annotation")
+            .help("write `@key` before the member instead"),
         );
-        let name = Ident { name: "key".into(), loc };
-        Some(Annotation { name: ScopedName { absolute: false, parts: vec![name], loc }, params: AnnotationParams::None, loc, legacy: true })
+        let name = Ident {
+            name: "key".into(),
+            loc,
+        };
+        Some(Annotation {
+            name: ScopedName {
+                absolute: false,
+                parts: vec![name],
+                loc,
+            },
+            params: AnnotationParams::None,
+            loc,
+            legacy: true,
+        })
     }
 
     fn definition(&mut self, p: P) -> Definition {
@@ -101,7 +122,12 @@ impl<'a> Builder<'a> {
             }
         }
         let kind = kind.expect("grammar guarantees a definition body");
-        Definition { annotations, kind, doc, loc }
+        Definition {
+            annotations,
+            kind,
+            doc,
+            loc,
+        }
     }
 
     fn def_kind(&mut self, c: P) -> DefKind {
@@ -109,33 +135,52 @@ impl<'a> Builder<'a> {
             Rule::module_dcl => {
                 let mut it = c.into_inner().skip(1);
                 let name = self.ident(it.next().expect("module name"));
-                let defs = it.filter(|d| d.as_rule() == Rule::definition).map(|d| self.definition(d)).collect();
+                let defs = it
+                    .filter(|d| d.as_rule() == Rule::definition)
+                    .map(|d| self.definition(d))
+                    .collect();
                 DefKind::Module { name, defs }
             }
             Rule::struct_def => DefKind::Struct(self.struct_def(c)),
-            Rule::struct_forward => DefKind::Forward(ForwardKind::Struct, self.ident(c.into_inner().nth(1).expect("name"))),
+            Rule::struct_forward => DefKind::Forward(
+                ForwardKind::Struct,
+                self.ident(c.into_inner().nth(1).expect("name")),
+            ),
             Rule::union_def => DefKind::Union(self.union_def(c)),
-            Rule::union_forward => DefKind::Forward(ForwardKind::Union, self.ident(c.into_inner().nth(1).expect("name"))),
+            Rule::union_forward => DefKind::Forward(
+                ForwardKind::Union,
+                self.ident(c.into_inner().nth(1).expect("name")),
+            ),
             Rule::enum_dcl => DefKind::Enum(self.enum_def(c)),
             Rule::bitmask_dcl => {
                 let e = self.enum_def(c);
-                DefKind::Bitmask(BitmaskDef { name: e.name, values: e.enumerators })
+                DefKind::Bitmask(BitmaskDef {
+                    name: e.name,
+                    values: e.enumerators,
+                })
             }
             Rule::bitset_dcl => DefKind::Bitset(self.bitset(c)),
             Rule::typedef_dcl => DefKind::Typedef(self.typedef(c)),
             Rule::const_dcl => DefKind::Const(self.const_dcl(c)),
             Rule::annotation_dcl => DefKind::Annotation(self.annotation_dcl(c)),
-            Rule::native_dcl => {
-                DefKind::Unsupported { what: "native", name: self.ident(c.into_inner().nth(1).expect("name")) }
-            }
+            Rule::native_dcl => DefKind::Unsupported {
+                what: "native",
+                name: self.ident(c.into_inner().nth(1).expect("name")),
+            },
             Rule::interface_dcl | Rule::except_dcl | Rule::value_dcl => {
                 let what = match c.as_rule() {
                     Rule::interface_dcl => "interface",
                     Rule::except_dcl => "exception",
                     _ => "valuetype",
                 };
-                let name = c.into_inner().find(|p| p.as_rule() == Rule::identifier).expect("name");
-                DefKind::Unsupported { what, name: self.ident(name) }
+                let name = c
+                    .into_inner()
+                    .find(|p| p.as_rule() == Rule::identifier)
+                    .expect("name");
+                DefKind::Unsupported {
+                    what,
+                    name: self.ident(name),
+                }
             }
             r => unreachable!("unexpected rule {r:?} in definition"),
         }
@@ -144,7 +189,9 @@ impl<'a> Builder<'a> {
     fn keylist(&mut self, p: P) -> DefKind {
         let mut it = p.into_inner();
         let ty = self.scoped_name(it.next().expect("type"));
-        let keys = it.map(|k| k.into_inner().map(|i| self.ident(i)).collect()).collect();
+        let keys = it
+            .map(|k| k.into_inner().map(|i| self.ident(i)).collect())
+            .collect();
         DefKind::Keylist { ty, keys }
     }
 
@@ -152,16 +199,27 @@ impl<'a> Builder<'a> {
         let loc = self.loc(&p);
         let text = p.as_str();
         if let Some(esc) = text.strip_prefix('_') {
-            return Ident { name: esc.to_string(), loc };
+            return Ident {
+                name: esc.to_string(),
+                loc,
+            };
         }
         if let Some(kw) = KEYWORDS.iter().find(|k| k.eq_ignore_ascii_case(text)) {
             self.diags.push(
-                Diagnostic::error(Code::KeywordIdent, format!("identifier `{text}` collides with the keyword `{kw}`"))
-                    .at(loc, "differs from a keyword only in case")
-                    .help(format!("IDL compares identifiers with keywords ignoring case; escape it as `_{text}`")),
+                Diagnostic::error(
+                    Code::KeywordIdent,
+                    format!("identifier `{text}` collides with the keyword `{kw}`"),
+                )
+                .at(loc, "differs from a keyword only in case")
+                .help(format!(
+                    "IDL compares identifiers with keywords ignoring case; escape it as `_{text}`"
+                )),
             );
         }
-        Ident { name: text.to_string(), loc }
+        Ident {
+            name: text.to_string(),
+            loc,
+        }
     }
 
     fn scoped_name(&mut self, p: P) -> ScopedName {
@@ -174,7 +232,11 @@ impl<'a> Builder<'a> {
                 _ => parts.push(self.ident(c)),
             }
         }
-        ScopedName { absolute, parts, loc }
+        ScopedName {
+            absolute,
+            parts,
+            loc,
+        }
     }
 
     fn annotation(&mut self, p: P) -> Annotation {
@@ -187,14 +249,26 @@ impl<'a> Builder<'a> {
             Some(b) => (true, b),
             None => (false, text),
         };
-        let parts = body.split("::").map(|s| Ident { name: s.to_string(), loc: nloc }).collect();
-        let name = ScopedName { absolute, parts, loc: nloc };
+        let parts = body
+            .split("::")
+            .map(|s| Ident {
+                name: s.to_string(),
+                loc: nloc,
+            })
+            .collect();
+        let name = ScopedName {
+            absolute,
+            parts,
+            loc: nloc,
+        };
         let params = match it.next() {
             None => AnnotationParams::None,
             Some(ps) => {
                 let inner: Vec<P> = ps.into_inner().collect();
                 if inner.len() == 1 && inner[0].as_rule() == Rule::const_expr {
-                    AnnotationParams::Single(self.const_expr(inner.into_iter().next().expect("one")))
+                    AnnotationParams::Single(
+                        self.const_expr(inner.into_iter().next().expect("one")),
+                    )
                 } else {
                     let mut named = Vec::new();
                     for np in inner {
@@ -207,7 +281,12 @@ impl<'a> Builder<'a> {
                 }
             }
         };
-        Annotation { name, params, loc, legacy: false }
+        Annotation {
+            name,
+            params,
+            loc,
+            legacy: false,
+        }
     }
 
     fn struct_def(&mut self, p: P) -> StructDef {
@@ -222,7 +301,11 @@ impl<'a> Builder<'a> {
                 _ => {}
             }
         }
-        StructDef { name, base, members }
+        StructDef {
+            name,
+            base,
+            members,
+        }
     }
 
     fn member(&mut self, p: P) -> Member {
@@ -236,20 +319,30 @@ impl<'a> Builder<'a> {
             match c.as_rule() {
                 Rule::annotation_appl => annotations.push(self.annotation(c)),
                 Rule::type_spec => ty = Some(self.type_spec(c)),
-                Rule::declarators => declarators = c.into_inner().map(|d| self.declarator(d)).collect(),
+                Rule::declarators => {
+                    declarators = c.into_inner().map(|d| self.declarator(d)).collect()
+                }
                 _ => {}
             }
         }
         if let Some(a) = self.legacy_key_after(span.end()) {
             annotations.push(a);
         }
-        Member { annotations, ty: ty.expect("member type"), declarators, doc, loc }
+        Member {
+            annotations,
+            ty: ty.expect("member type"),
+            declarators,
+            doc,
+            loc,
+        }
     }
 
     fn declarator(&mut self, p: P) -> Declarator {
         let mut it = p.into_inner();
         let name = self.ident(it.next().expect("declarator name"));
-        let dims = it.map(|a| self.const_expr(a.into_inner().next().expect("size"))).collect();
+        let dims = it
+            .map(|a| self.const_expr(a.into_inner().next().expect("size")))
+            .collect();
         Declarator { name, dims }
     }
 
@@ -270,7 +363,12 @@ impl<'a> Builder<'a> {
                 _ => {}
             }
         }
-        UnionDef { name, switch_annotations, switch: switch.expect("switch"), cases }
+        UnionDef {
+            name,
+            switch_annotations,
+            switch: switch.expect("switch"),
+            cases,
+        }
     }
 
     fn case(&mut self, p: P) -> Case {
@@ -285,7 +383,10 @@ impl<'a> Builder<'a> {
             match c.as_rule() {
                 Rule::annotation_appl => annotations.push(self.annotation(c)),
                 Rule::case_label => {
-                    let l = c.into_inner().find(|x| x.as_rule() != Rule::K_CASE).expect("label");
+                    let l = c
+                        .into_inner()
+                        .find(|x| x.as_rule() != Rule::K_CASE)
+                        .expect("label");
                     if l.as_rule() == Rule::default_label {
                         labels.push(CaseLabel::Default(self.loc(&l)));
                     } else {
@@ -300,7 +401,14 @@ impl<'a> Builder<'a> {
         if let Some(a) = self.legacy_key_after(span.end()) {
             annotations.push(a);
         }
-        Case { labels, annotations, ty: ty.expect("case type"), declarator: declarator.expect("case declarator"), doc, loc }
+        Case {
+            labels,
+            annotations,
+            ty: ty.expect("case type"),
+            declarator: declarator.expect("case declarator"),
+            doc,
+            loc,
+        }
     }
 
     fn enum_def(&mut self, p: P) -> EnumDef {
@@ -317,7 +425,11 @@ impl<'a> Builder<'a> {
                         _ => name = Some(self.ident(c)),
                     }
                 }
-                Enumerator { annotations, name: name.expect("enumerator name"), doc }
+                Enumerator {
+                    annotations,
+                    name: name.expect("enumerator name"),
+                    doc,
+                }
             })
             .collect();
         EnumDef { name, enumerators }
@@ -345,7 +457,9 @@ impl<'a> Builder<'a> {
                                     match s.as_rule() {
                                         Rule::const_expr => width = Some(self.const_expr(s)),
                                         Rule::bitfield_type => {
-                                            if let TypeSpec::Prim(p, _) = self.type_of(s.into_inner().next().expect("type")) {
+                                            if let TypeSpec::Prim(p, _) =
+                                                self.type_of(s.into_inner().next().expect("type"))
+                                            {
                                                 dest = Some(p);
                                             }
                                         }
@@ -357,7 +471,13 @@ impl<'a> Builder<'a> {
                             _ => {}
                         }
                     }
-                    fields.push(Bitfield { annotations, width: width.expect("bitfield width"), dest, names, loc });
+                    fields.push(Bitfield {
+                        annotations,
+                        width: width.expect("bitfield width"),
+                        dest,
+                        names,
+                        loc,
+                    });
                 }
                 _ => {}
             }
@@ -378,14 +498,24 @@ impl<'a> Builder<'a> {
                     let loc = self.loc(&inner);
                     let doc = self.doc_before(inner.as_span().start());
                     let kind = self.def_kind(inner);
-                    let def = Definition { annotations: std::mem::take(&mut annotations), kind, doc, loc };
+                    let def = Definition {
+                        annotations: std::mem::take(&mut annotations),
+                        kind,
+                        doc,
+                        loc,
+                    };
                     target = Some(TypedefTarget::Constructed(Box::new(def)));
                 }
-                Rule::declarators => declarators = c.into_inner().map(|d| self.declarator(d)).collect(),
+                Rule::declarators => {
+                    declarators = c.into_inner().map(|d| self.declarator(d)).collect()
+                }
                 _ => {}
             }
         }
-        Typedef { target: target.expect("typedef target"), declarators }
+        Typedef {
+            target: target.expect("typedef target"),
+            declarators,
+        }
     }
 
     fn const_dcl(&mut self, p: P) -> ConstDef {
@@ -401,7 +531,11 @@ impl<'a> Builder<'a> {
         let loc = self.loc(&p);
         let inner = p.into_inner().next().expect("const type");
         match inner.as_rule() {
-            Rule::fixed_pt_const_type => TypeSpec::Fixed { digits: None, scale: None, loc },
+            Rule::fixed_pt_const_type => TypeSpec::Fixed {
+                digits: None,
+                scale: None,
+                loc,
+            },
             _ => self.type_of(inner),
         }
     }
@@ -419,16 +553,27 @@ impl<'a> Builder<'a> {
                     let mut m = c.into_inner();
                     let ty = self.const_type(m.next().expect("type"));
                     let name = self.ident(m.next().expect("name"));
-                    let default = m.find(|x| x.as_rule() == Rule::const_expr).map(|e| self.const_expr(e));
+                    let default = m
+                        .find(|x| x.as_rule() == Rule::const_expr)
+                        .map(|e| self.const_expr(e));
                     members.push(AnnotationMember { ty, name, default });
                 }
                 _ => {
                     let kind = self.def_kind(c);
-                    inner.push(Definition { annotations: vec![], kind, doc: vec![], loc });
+                    inner.push(Definition {
+                        annotations: vec![],
+                        kind,
+                        doc: vec![],
+                        loc,
+                    });
                 }
             }
         }
-        AnnotationDef { name, members, inner }
+        AnnotationDef {
+            name,
+            members,
+            inner,
+        }
     }
 
     fn type_spec(&mut self, p: P) -> TypeSpec {
@@ -447,7 +592,10 @@ impl<'a> Builder<'a> {
             }
             Rule::scoped_name => TypeSpec::Named(self.scoped_name(p)),
             Rule::sequence_type => {
-                let mut it = p.into_inner().skip(1).filter(|x| x.as_rule() != Rule::annotation_appl);
+                let mut it = p
+                    .into_inner()
+                    .skip(1)
+                    .filter(|x| x.as_rule() != Rule::annotation_appl);
                 let elem = Box::new(self.type_spec(it.next().expect("element type")));
                 let bound = it.next().map(|b| self.const_expr(b));
                 TypeSpec::Sequence { elem, bound, loc }
@@ -458,11 +606,19 @@ impl<'a> Builder<'a> {
                 TypeSpec::String { wide, bound, loc }
             }
             Rule::map_type => {
-                let mut it = p.into_inner().skip(1).filter(|x| x.as_rule() != Rule::annotation_appl);
+                let mut it = p
+                    .into_inner()
+                    .skip(1)
+                    .filter(|x| x.as_rule() != Rule::annotation_appl);
                 let key = Box::new(self.type_spec(it.next().expect("key type")));
                 let value = Box::new(self.type_spec(it.next().expect("value type")));
                 let bound = it.next().map(|b| self.const_expr(b));
-                TypeSpec::Map { key, value, bound, loc }
+                TypeSpec::Map {
+                    key,
+                    value,
+                    bound,
+                    loc,
+                }
             }
             Rule::fixed_pt_type => {
                 let mut it = p.into_inner().skip(1);
@@ -525,8 +681,19 @@ impl<'a> Builder<'a> {
                         "/" => BinOp::Div,
                         _ => BinOp::Mod,
                     };
-                    let l = Loc { file: lhs.loc.file, start: lhs.loc.start, end: if rhs.loc.file == lhs.loc.file { rhs.loc.end } else { lhs.loc.end } };
-                    lhs = ConstExpr { kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)), loc: l };
+                    let l = Loc {
+                        file: lhs.loc.file,
+                        start: lhs.loc.start,
+                        end: if rhs.loc.file == lhs.loc.file {
+                            rhs.loc.end
+                        } else {
+                            lhs.loc.end
+                        },
+                    };
+                    lhs = ConstExpr {
+                        kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+                        loc: l,
+                    };
                 }
                 lhs
             }
@@ -540,7 +707,10 @@ impl<'a> Builder<'a> {
                         _ => UnaryOp::Not,
                     };
                     let e = self.const_expr(it.next().expect("operand"));
-                    ConstExpr { kind: ExprKind::Unary(op, Box::new(e)), loc }
+                    ConstExpr {
+                        kind: ExprKind::Unary(op, Box::new(e)),
+                        loc,
+                    }
                 } else {
                     self.const_expr(first)
                 }
@@ -549,7 +719,10 @@ impl<'a> Builder<'a> {
                 let inner = p.into_inner().next().expect("primary");
                 self.const_expr(inner)
             }
-            Rule::scoped_name => ConstExpr { kind: ExprKind::Name(self.scoped_name(p)), loc },
+            Rule::scoped_name => ConstExpr {
+                kind: ExprKind::Name(self.scoped_name(p)),
+                loc,
+            },
             Rule::literal => {
                 let inner = p.into_inner().next().expect("literal");
                 self.literal(inner)
@@ -578,7 +751,12 @@ impl<'a> Builder<'a> {
                 let c = match unescape(body) {
                     Ok(u) if u.chars().count() == 1 => u.chars().next().unwrap_or('\0'),
                     Ok(_) => {
-                        self.err(Code::BadLiteral, loc, "character literal must hold exactly one character", "here");
+                        self.err(
+                            Code::BadLiteral,
+                            loc,
+                            "character literal must hold exactly one character",
+                            "here",
+                        );
                         '\0'
                     }
                     Err(e) => {
@@ -590,7 +768,12 @@ impl<'a> Builder<'a> {
                     Literal::WChar(c)
                 } else {
                     if c as u32 > 0xFF {
-                        self.err(Code::BadLiteral, loc, "`char` literal out of range (max \\xFF); use a wide literal `L'…'`", "here");
+                        self.err(
+                            Code::BadLiteral,
+                            loc,
+                            "`char` literal out of range (max \\xFF); use a wide literal `L'…'`",
+                            "here",
+                        );
                     }
                     Literal::Char(c)
                 }
@@ -610,7 +793,12 @@ impl<'a> Builder<'a> {
                     }
                 }
                 if !wide && out.contains('\0') {
-                    self.err(Code::BadLiteral, loc, "string literal contains a NUL character", "here");
+                    self.err(
+                        Code::BadLiteral,
+                        loc,
+                        "string literal contains a NUL character",
+                        "here",
+                    );
                 }
                 if wide {
                     Literal::WStr(out)
@@ -620,7 +808,10 @@ impl<'a> Builder<'a> {
             }
             r => unreachable!("unexpected literal rule {r:?}"),
         };
-        ConstExpr { kind: ExprKind::Literal(lit), loc }
+        ConstExpr {
+            kind: ExprKind::Literal(lit),
+            loc,
+        }
     }
 }
 

@@ -10,7 +10,9 @@ pub fn parse_int(s: &str) -> Result<u128, String> {
         (s, 10)
     };
     if radix == 8 && digits.bytes().any(|b| b > b'7') {
-        return Err(format!("`{s}` is not a valid octal literal (a leading 0 means octal)"));
+        return Err(format!(
+            "`{s}` is not a valid octal literal (a leading 0 means octal)"
+        ));
     }
     if digits.len() > 64 {
         return Err("integer literal is too large for any IDL integer type".into());
@@ -18,7 +20,9 @@ pub fn parse_int(s: &str) -> Result<u128, String> {
     u128::from_str_radix(digits, radix)
         .ok()
         .filter(|v| *v <= u64::MAX as u128)
-        .ok_or_else(|| "integer literal is too large for any IDL integer type (max 2^64-1)".to_string())
+        .ok_or_else(|| {
+            "integer literal is too large for any IDL integer type (max 2^64-1)".to_string()
+        })
 }
 
 /// Resolves the escapes of a char or string literal body.

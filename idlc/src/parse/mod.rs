@@ -19,14 +19,19 @@ pub const MAX_NESTING: usize = 100;
 pub fn parse(pp: &Output, diags: &mut Diagnostics) -> Spec {
     if let Some(off) = too_deep(&pp.text) {
         diags.push(
-            Diagnostic::error(Code::Limit, format!("brackets nested more than {MAX_NESTING} deep"))
-                .at(pp.map.loc(off, off + 1), "nesting limit reached here"),
+            Diagnostic::error(
+                Code::Limit,
+                format!("brackets nested more than {MAX_NESTING} deep"),
+            )
+            .at(pp.map.loc(off, off + 1), "nesting limit reached here"),
         );
         return Spec::default();
     }
     match IdlParser::parse(Rule::specification, &pp.text) {
         Ok(mut pairs) => {
-            let spec = pairs.next().expect("specification rule always produces a pair");
+            let spec = pairs
+                .next()
+                .expect("specification rule always produces a pair");
             build::Builder::new(pp, diags).specification(spec)
         }
         Err(_) => {
@@ -50,7 +55,10 @@ fn too_deep(text: &str) -> Option<usize> {
     while i < b.len() {
         match b[i] {
             b'/' if b.get(i + 1) == Some(&b'/') => {
-                i = b[i..].iter().position(|&c| c == b'\n').map_or(b.len(), |p| i + p);
+                i = b[i..]
+                    .iter()
+                    .position(|&c| c == b'\n')
+                    .map_or(b.len(), |p| i + p);
             }
             b'/' if b.get(i + 1) == Some(&b'*') => {
                 i = text[i + 2..].find("*/").map_or(b.len(), |p| i + 2 + p + 2);
@@ -82,8 +90,11 @@ fn rule_name(r: Rule) -> Option<&'static str> {
     Some(match r {
         identifier => "identifier",
         scoped_name => "name",
-        type_spec | base_type | template_type | integer_type | floating_type | switch_type | const_type => "type",
-        const_expr | tmpl_expr | primary_expr | unary_expr | literal | int_lit | float_lit => "expression",
+        type_spec | base_type | template_type | integer_type | floating_type | switch_type
+        | const_type => "type",
+        const_expr | tmpl_expr | primary_expr | unary_expr | literal | int_lit | float_lit => {
+            "expression"
+        }
         annotation_appl => "annotation",
         definition => "definition",
         member => "member",
@@ -157,40 +168,93 @@ fn syntax_error(pp: &Output, e: &pest::error::Error<Rule>) -> Diagnostic {
         _ => {
             let last = expected.pop().unwrap_or_default();
             last_is_ident = last == "identifier";
-            format!("expected one of {} or {last}, found {found}", expected.join(", "))
+            format!(
+                "expected one of {} or {last}, found {found}",
+                expected.join(", ")
+            )
         }
     };
     let len = found_len(&pp.text, pos).max(1);
     let loc = pp.map.loc(pos, (pos + len).min(pp.text.len().max(pos + 1)));
     let mut d = Diagnostic::error(Code::Syntax, msg).at(loc, "unexpected here");
     let word = &pp.text[pos..pos + found_len(&pp.text, pos)];
-    let wants_name = expected.iter().any(|e| e == "identifier" || e == "declarator") || last_is_ident;
+    let wants_name = expected
+        .iter()
+        .any(|e| e == "identifier" || e == "declarator")
+        || last_is_ident;
     if !wants_name {
         return d;
     }
     if KEYWORDS.contains(&word) {
-        d = d.help(format!("`{word}` is a keyword; to use it as a name write `_{word}`"));
-    } else if let Some(kw) = KEYWORDS.iter().find(|k| !word.is_empty() && k.eq_ignore_ascii_case(word)) {
-        d = d.help(format!("`{word}` differs only in case from the keyword `{kw}`; escape it as `_{word}`"));
+        d = d.help(format!(
+            "`{word}` is a keyword; to use it as a name write `_{word}`"
+        ));
+    } else if let Some(kw) = KEYWORDS
+        .iter()
+        .find(|k| !word.is_empty() && k.eq_ignore_ascii_case(word))
+    {
+        d = d.help(format!(
+            "`{word}` differs only in case from the keyword `{kw}`; escape it as `_{word}`"
+        ));
     }
     d
 }
 
 /// Keywords that can never be identifiers (IDL 4.2 §7.2.4, the subset this grammar reserves).
 pub const KEYWORDS: &[&str] = &[
-    "any", "bitfield", "bitmask", "bitset", "boolean", "case", "char", "const", "default", "double", "enum",
-    "exception", "FALSE", "fixed", "float", "int8", "int16", "int32", "int64", "interface", "long", "map", "module",
-    "native", "Object", "octet", "sequence", "short", "string", "struct", "switch", "TRUE", "typedef", "uint8",
-    "uint16", "uint32", "uint64", "union", "unsigned", "valuetype", "wchar", "wstring",
+    "any",
+    "bitfield",
+    "bitmask",
+    "bitset",
+    "boolean",
+    "case",
+    "char",
+    "const",
+    "default",
+    "double",
+    "enum",
+    "exception",
+    "FALSE",
+    "fixed",
+    "float",
+    "int8",
+    "int16",
+    "int32",
+    "int64",
+    "interface",
+    "long",
+    "map",
+    "module",
+    "native",
+    "Object",
+    "octet",
+    "sequence",
+    "short",
+    "string",
+    "struct",
+    "switch",
+    "TRUE",
+    "typedef",
+    "uint8",
+    "uint16",
+    "uint32",
+    "uint64",
+    "union",
+    "unsigned",
+    "valuetype",
+    "wchar",
+    "wstring",
 ];
 
 fn found_len(text: &str, pos: usize) -> usize {
     let b = &text.as_bytes()[pos.min(text.len())..];
     match b.first() {
         None => 0,
-        Some(c) if c.is_ascii_alphanumeric() || *c == b'_' => {
-            b.iter().take_while(|c| c.is_ascii_alphanumeric() || **c == b'_').count().min(64)
-        }
+        Some(c) if c.is_ascii_alphanumeric() || *c == b'_' => b
+            .iter()
+            .take_while(|c| c.is_ascii_alphanumeric() || **c == b'_')
+            .count()
+            .min(64),
         Some(_) => text[pos..].chars().next().map_or(1, char::len_utf8),
     }
 }

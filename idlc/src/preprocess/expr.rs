@@ -4,7 +4,11 @@ use super::lex::{Kind, Tok};
 
 pub fn eval(toks: &[Tok]) -> Result<i64, String> {
     let toks: Vec<&Tok> = toks.iter().filter(|t| t.kind != Kind::Ws).collect();
-    let mut p = Parser { toks, pos: 0, depth: 0 };
+    let mut p = Parser {
+        toks,
+        pos: 0,
+        depth: 0,
+    };
     let v = p.ternary()?;
     match p.toks.get(p.pos) {
         None => Ok(v),
@@ -18,8 +22,18 @@ struct Parser<'a> {
     depth: usize,
 }
 
-const BINARY: &[&[&str]] =
-    &[&["||"], &["&&"], &["|"], &["^"], &["&"], &["==", "!="], &["<", ">", "<=", ">="], &["<<", ">>"], &["+", "-"], &["*", "/", "%"]];
+const BINARY: &[&[&str]] = &[
+    &["||"],
+    &["&&"],
+    &["|"],
+    &["^"],
+    &["&"],
+    &["==", "!="],
+    &["<", ">", "<=", ">="],
+    &["<<", ">>"],
+    &["+", "-"],
+    &["*", "/", "%"],
+];
 
 impl Parser<'_> {
     fn peek(&self) -> Option<&str> {
@@ -50,7 +64,11 @@ impl Parser<'_> {
             return self.unary();
         }
         let mut l = self.binary(level + 1)?;
-        while let Some(op) = self.peek().filter(|p| BINARY[level].contains(p)).map(str::to_owned) {
+        while let Some(op) = self
+            .peek()
+            .filter(|p| BINARY[level].contains(p))
+            .map(str::to_owned)
+        {
             self.pos += 1;
             let r = self.binary(level + 1)?;
             l = match op.as_str() {
@@ -123,7 +141,8 @@ fn parse_int(s: &str) -> Result<i64, String> {
     } else {
         t.parse::<u64>()
     };
-    r.map(|v| v as i64).map_err(|_| format!("invalid integer `{s}` in #if expression"))
+    r.map(|v| v as i64)
+        .map_err(|_| format!("invalid integer `{s}` in #if expression"))
 }
 
 fn parse_char(s: &str) -> Result<i64, String> {

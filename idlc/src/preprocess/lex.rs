@@ -18,7 +18,10 @@ pub struct Tok {
 
 impl Tok {
     pub fn new(kind: Kind, text: impl Into<String>) -> Self {
-        Tok { kind, text: text.into() }
+        Tok {
+            kind,
+            text: text.into(),
+        }
     }
     pub fn is(&self, s: &str) -> bool {
         self.kind != Kind::Ws && self.text == s
@@ -52,9 +55,10 @@ pub fn number_len(s: &[u8]) -> usize {
     let mut i = 1;
     while i < s.len() {
         let c = s[i];
-        if (c == b'+' || c == b'-') && matches!(s[i - 1], b'e' | b'E') && !s[..i].starts_with(b"0x") {
-            i += 1;
-        } else if is_ident_char(c) || c == b'.' {
+        let exponent_sign = (c == b'+' || c == b'-')
+            && matches!(s[i - 1], b'e' | b'E')
+            && !s[..i].starts_with(b"0x");
+        if exponent_sign || is_ident_char(c) || c == b'.' {
             i += 1;
         } else {
             break;
@@ -82,7 +86,9 @@ pub fn lex(text: &str) -> Vec<Tok> {
                 j += 1;
             }
             (Kind::Ident, j - i)
-        } else if c.is_ascii_digit() || (c == b'.' && b.get(i + 1).is_some_and(|d| d.is_ascii_digit())) {
+        } else if c.is_ascii_digit()
+            || (c == b'.' && b.get(i + 1).is_some_and(|d| d.is_ascii_digit()))
+        {
             (Kind::Number, number_len(&b[i..]))
         } else if c == b'"' || c == b'\'' {
             match literal_len(&b[i..]) {
@@ -91,7 +97,14 @@ pub fn lex(text: &str) -> Vec<Tok> {
             }
         } else {
             let two = &b[i..(i + 2).min(b.len())];
-            let n = if matches!(two, b"##" | b"&&" | b"||" | b"==" | b"!=" | b"<=" | b">=" | b"<<" | b">>") { 2 } else { 1 };
+            let n = if matches!(
+                two,
+                b"##" | b"&&" | b"||" | b"==" | b"!=" | b"<=" | b">=" | b"<<" | b">>"
+            ) {
+                2
+            } else {
+                1
+            };
             // keep UTF-8 sequences whole
             let mut n = n;
             while i + n < b.len() && !text.is_char_boundary(i + n) {

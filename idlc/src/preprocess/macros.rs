@@ -27,17 +27,26 @@ impl MacroTable {
     /// Parses the text after `#define`.
     pub fn define(&mut self, text: &str) -> Result<(), String> {
         let text = text.trim_start();
-        let name_len = text.bytes().take_while(|b| super::lex::is_ident_char(*b)).count();
+        let name_len = text
+            .bytes()
+            .take_while(|b| super::lex::is_ident_char(*b))
+            .count();
         if name_len == 0 || !super::lex::is_ident_start(text.as_bytes()[0]) {
             return Err("#define needs a macro name".into());
         }
         let name = &text[..name_len];
         let rest = &text[name_len..];
         let (params, variadic, body) = if let Some(after) = rest.strip_prefix('(') {
-            let close = after.find(')').ok_or("missing `)` in macro parameter list")?;
+            let close = after
+                .find(')')
+                .ok_or("missing `)` in macro parameter list")?;
             let mut params = Vec::new();
             let mut variadic = false;
-            for p in after[..close].split(',').map(str::trim).filter(|p| !p.is_empty()) {
+            for p in after[..close]
+                .split(',')
+                .map(str::trim)
+                .filter(|p| !p.is_empty())
+            {
                 if p == "..." {
                     variadic = true;
                 } else if p.bytes().all(super::lex::is_ident_char) {
@@ -51,7 +60,14 @@ impl MacroTable {
             (None, false, rest)
         };
         let body = lex(body.trim());
-        self.defs.insert(name.to_string(), Macro { params, variadic, body });
+        self.defs.insert(
+            name.to_string(),
+            Macro {
+                params,
+                variadic,
+                body,
+            },
+        );
         Ok(())
     }
 
@@ -62,7 +78,12 @@ impl MacroTable {
         self.expand_in(toks, &mut hide, &mut budget)
     }
 
-    fn expand_in(&self, toks: &[Tok], hide: &mut Vec<String>, budget: &mut usize) -> Result<Vec<Tok>, String> {
+    fn expand_in(
+        &self,
+        toks: &[Tok],
+        hide: &mut Vec<String>,
+        budget: &mut usize,
+    ) -> Result<Vec<Tok>, String> {
         if hide.len() > MAX_DEPTH {
             return Err("macro expansion nested too deeply".into());
         }
@@ -91,7 +112,10 @@ impl MacroTable {
                     }
                     let (args, end) = collect_args(toks, j)?;
                     i = end;
-                    let args = if args.len() == 1 && args[0].iter().all(|t| t.kind == Kind::Ws) && params.is_empty() {
+                    let args = if args.len() == 1
+                        && args[0].iter().all(|t| t.kind == Kind::Ws)
+                        && params.is_empty()
+                    {
                         vec![]
                     } else {
                         args
@@ -110,7 +134,9 @@ impl MacroTable {
             hide.push(t.text.clone());
             let expanded = self.expand_in(&replaced, hide, budget)?;
             hide.pop();
-            *budget = budget.checked_sub(expanded.len()).ok_or("macro expansion too large")?;
+            *budget = budget
+                .checked_sub(expanded.len())
+                .ok_or("macro expansion too large")?;
             out.extend(expanded);
         }
         Ok(out)
@@ -165,7 +191,12 @@ impl MacroTable {
                 let left = out.pop().map(|t| t.text).unwrap_or_default();
                 let Some(n) = next_sig(k + 1) else { break };
                 let right: String = match arg_of(&body[n].text) {
-                    Some(a) => a.iter().map(|t| t.text.as_str()).collect::<String>().trim().to_string(),
+                    Some(a) => a
+                        .iter()
+                        .map(|t| t.text.as_str())
+                        .collect::<String>()
+                        .trim()
+                        .to_string(),
                     None => body[n].text.clone(),
                 };
                 out.extend(lex(&format!("{left}{right}")));

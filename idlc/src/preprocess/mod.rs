@@ -70,11 +70,25 @@ impl SourceMap {
 
     /// The source location of an output range.
     pub fn loc(&self, start: usize, end: usize) -> Loc {
-        let Some((f, a, a_end)) = self.point(start) else { return Loc::default() };
-        let end_pt = if end > start { self.point(end - 1) } else { None };
+        let Some((f, a, a_end)) = self.point(start) else {
+            return Loc::default();
+        };
+        let end_pt = if end > start {
+            self.point(end - 1)
+        } else {
+            None
+        };
         match end_pt {
-            Some((g, b, b_end)) if g == f && b >= a => Loc { file: f, start: a, end: b_end.max(b + 1) },
-            _ => Loc { file: f, start: a, end: a_end.max(a + 1) },
+            Some((g, b, b_end)) if g == f && b >= a => Loc {
+                file: f,
+                start: a,
+                end: b_end.max(b + 1),
+            },
+            _ => Loc {
+                file: f,
+                start: a,
+                end: a_end.max(a + 1),
+            },
         }
     }
 
@@ -84,7 +98,11 @@ impl SourceMap {
                 *last = seg;
                 return;
             }
-            if last.linear && seg.linear && last.file == seg.file && last.src + (seg.out - last.out) == seg.src {
+            if last.linear
+                && seg.linear
+                && last.file == seg.file
+                && last.src + (seg.out - last.out) == seg.src
+            {
                 last.src_end = seg.src_end;
                 return;
             }
@@ -154,27 +172,47 @@ pub struct Preprocessor<'a> {
 }
 
 /// Preprocesses `path` (read through `vfs`).
-pub fn preprocess(db: &mut SourceDb, vfs: &dyn Vfs, opts: &Options, path: &Path, diags: &mut Diagnostics) -> Output {
+pub fn preprocess(
+    db: &mut SourceDb,
+    vfs: &dyn Vfs,
+    opts: &Options,
+    path: &Path,
+    diags: &mut Diagnostics,
+) -> Output {
     let mut pp = Preprocessor::new(db, vfs, opts, diags);
     match vfs.read(path) {
         Ok(text) => {
             let id = pp.db.add(path.display().to_string(), path, text);
             pp.run(id);
         }
-        Err(e) => pp.diags.push(Diagnostic::error(Code::Io, format!("cannot read `{}`: {e}", path.display()))),
+        Err(e) => pp.diags.push(Diagnostic::error(
+            Code::Io,
+            format!("cannot read `{}`: {e}", path.display()),
+        )),
     }
     pp.out
 }
 
 /// Preprocesses a file already in `db` (used for in-memory sources).
-pub fn preprocess_file(db: &mut SourceDb, vfs: &dyn Vfs, opts: &Options, file: FileId, diags: &mut Diagnostics) -> Output {
+pub fn preprocess_file(
+    db: &mut SourceDb,
+    vfs: &dyn Vfs,
+    opts: &Options,
+    file: FileId,
+    diags: &mut Diagnostics,
+) -> Output {
     let mut pp = Preprocessor::new(db, vfs, opts, diags);
     pp.run(file);
     pp.out
 }
 
 impl<'a> Preprocessor<'a> {
-    fn new(db: &'a mut SourceDb, vfs: &'a dyn Vfs, opts: &'a Options, diags: &'a mut Diagnostics) -> Self {
+    fn new(
+        db: &'a mut SourceDb,
+        vfs: &'a dyn Vfs,
+        opts: &'a Options,
+        diags: &'a mut Diagnostics,
+    ) -> Self {
         let mut macros = MacroTable::default();
         // Cyclone's idlc defines __IDLC__ and IDL in the wild relies on it to hide C code from the compiler.
         for pre in ["__IDLC__ 1", "__IDLC_RS__ 1"] {
@@ -186,13 +224,26 @@ impl<'a> Preprocessor<'a> {
                 None => format!("{d} 1"),
             };
             if let Err(e) = macros.define(&text) {
-                diags.push(Diagnostic::error(Code::Macro, format!("invalid -D `{d}`: {e}")));
+                diags.push(Diagnostic::error(
+                    Code::Macro,
+                    format!("invalid -D `{d}`: {e}"),
+                ));
             }
         }
         for u in &opts.undefines {
             macros.defs.remove(u);
         }
-        Preprocessor { db, vfs, diags, opts, macros, once: HashSet::new(), out: Output::default(), in_comment: None, too_big: false }
+        Preprocessor {
+            db,
+            vfs,
+            diags,
+            opts,
+            macros,
+            once: HashSet::new(),
+            out: Output::default(),
+            in_comment: None,
+            too_big: false,
+        }
     }
 
     fn run(&mut self, file: FileId) {
@@ -209,17 +260,34 @@ impl<'a> Preprocessor<'a> {
         }
         if self.out.text.len() + (to - from) > MAX_OUTPUT {
             self.too_big = true;
-            self.err(Code::Limit, Loc::new(file, from, from + 1), "preprocessed output exceeds 256 MiB", "while copying this");
+            self.err(
+                Code::Limit,
+                Loc::new(file, from, from + 1),
+                "preprocessed output exceeds 256 MiB",
+                "while copying this",
+            );
             return;
         }
         let out = self.out.text.len() as u32;
-        self.out.map.push(Seg { out, file, src: from as u32, src_end: to as u32, linear: true });
+        self.out.map.push(Seg {
+            out,
+            file,
+            src: from as u32,
+            src_end: to as u32,
+            linear: true,
+        });
         self.out.text.push_str(&text[from..to]);
     }
 
     fn emit_expansion(&mut self, loc: Loc, toks: &[Tok]) {
         let out = self.out.text.len() as u32;
-        self.out.map.push(Seg { out, file: loc.file, src: loc.start, src_end: loc.end, linear: false });
+        self.out.map.push(Seg {
+            out,
+            file: loc.file,
+            src: loc.start,
+            src_end: loc.end,
+            linear: false,
+        });
         for t in toks {
             self.out.text.push_str(&t.text);
         }
@@ -243,11 +311,18 @@ impl<'a> Preprocessor<'a> {
             if self.in_comment.is_none() && trimmed.starts_with('#') {
                 // Directive: join continuation lines.
                 let mut end = line_end;
-                while end > pos && text[pos..end].trim_end_matches(['\n', '\r']).ends_with('\\') && end < bytes.len() {
+                while end > pos
+                    && text[pos..end]
+                        .trim_end_matches(['\n', '\r'])
+                        .ends_with('\\')
+                    && end < bytes.len()
+                {
                     end = memchr_nl(bytes, end);
                 }
                 let hash = pos + (text[pos..line_end].len() - trimmed.len());
-                let raw = text[hash + 1..end].replace("\\\r\n", " ").replace("\\\n", " ");
+                let raw = text[hash + 1..end]
+                    .replace("\\\r\n", " ")
+                    .replace("\\\n", " ");
                 let body = lex::strip_comments(&raw);
                 let loc = Loc::new(file, hash, text[..end].trim_end().len().max(hash + 1));
                 self.directive(file, &text, hash, &body, loc, &mut conds, active, depth);
@@ -266,10 +341,20 @@ impl<'a> Preprocessor<'a> {
             let end = self.out.text.len();
             let loc = self.out.map.loc(start, start + 2);
             self.out.comments.push(Comment { start, end });
-            self.err(Code::Unterminated, loc, "unterminated block comment", "comment starts here");
+            self.err(
+                Code::Unterminated,
+                loc,
+                "unterminated block comment",
+                "comment starts here",
+            );
         }
         for c in conds {
-            self.err(Code::Conditional, c.loc, "unterminated conditional directive", "this #if has no #endif");
+            self.err(
+                Code::Conditional,
+                c.loc,
+                "unterminated conditional directive",
+                "this #if has no #endif",
+            );
         }
     }
 
@@ -331,9 +416,20 @@ impl<'a> Preprocessor<'a> {
             }
             let c = b[i];
             if c == b'/' && b.get(i + 1) == Some(&b'/') {
-                let end = if to > from && b[to - 1] == b'\n' { to - 1 } else { to };
-                let end = if end > i && b[end - 1] == b'\r' { end - 1 } else { end };
-                self.out.comments.push(Comment { start: out_at!(i), end: out_at!(end) });
+                let end = if to > from && b[to - 1] == b'\n' {
+                    to - 1
+                } else {
+                    to
+                };
+                let end = if end > i && b[end - 1] == b'\r' {
+                    end - 1
+                } else {
+                    end
+                };
+                self.out.comments.push(Comment {
+                    start: out_at!(i),
+                    end: out_at!(end),
+                });
                 i = to;
             } else if c == b'/' && b.get(i + 1) == Some(&b'*') {
                 self.in_comment = Some(out_at!(i));
@@ -343,8 +439,17 @@ impl<'a> Preprocessor<'a> {
                     Some(n) if n > MAX_TOKEN => return self.token_too_long(file, i, n),
                     Some(n) => i += n,
                     None => {
-                        let what = if c == b'"' { "string literal" } else { "character literal" };
-                        self.err(Code::Unterminated, Loc::new(file, i, i + 1), format!("unterminated {what}"), "starts here");
+                        let what = if c == b'"' {
+                            "string literal"
+                        } else {
+                            "character literal"
+                        };
+                        self.err(
+                            Code::Unterminated,
+                            Loc::new(file, i, i + 1),
+                            format!("unterminated {what}"),
+                            "starts here",
+                        );
                         i = to;
                     }
                 }
@@ -369,12 +474,23 @@ impl<'a> Preprocessor<'a> {
                     let m = &self.macros.defs[name];
                     let mut inv_len = name.len();
                     if m.params.is_some() {
-                        let k = rest.iter().skip(1).position(|t| t.kind != Kind::Ws).map(|p| p + 1);
+                        let k = rest
+                            .iter()
+                            .skip(1)
+                            .position(|t| t.kind != Kind::Ws)
+                            .map(|p| p + 1);
                         match k {
                             Some(k) if rest[k].is("(") => match macros::collect_args(&rest, k) {
-                                Ok((_, end)) => inv_len = rest[..end].iter().map(|t| t.text.len()).sum(),
+                                Ok((_, end)) => {
+                                    inv_len = rest[..end].iter().map(|t| t.text.len()).sum()
+                                }
                                 Err(e) => {
-                                    self.err(Code::Macro, Loc::new(file, i, j), e, "in this invocation");
+                                    self.err(
+                                        Code::Macro,
+                                        Loc::new(file, i, j),
+                                        e,
+                                        "in this invocation",
+                                    );
                                     i = j;
                                     continue;
                                 }
@@ -408,7 +524,12 @@ impl<'a> Preprocessor<'a> {
     }
 
     fn token_too_long(&mut self, file: FileId, at: usize, len: usize) {
-        self.err(Code::Limit, Loc::new(file, at, at + 16), format!("token of {len} bytes exceeds the {MAX_TOKEN}-byte limit"), "this token");
+        self.err(
+            Code::Limit,
+            Loc::new(file, at, at + 16),
+            format!("token of {len} bytes exceeds the {MAX_TOKEN}-byte limit"),
+            "this token",
+        );
         self.too_big = true;
     }
 
@@ -429,7 +550,10 @@ impl<'a> Preprocessor<'a> {
         let name = &b[..name_len];
         let rest = b[name_len..].trim();
         // Location of the directive name, for carets.
-        let name_off = text[hash + 1..].find(name).map(|p| hash + 1 + p).unwrap_or(hash);
+        let name_off = text[hash + 1..]
+            .find(name)
+            .map(|p| hash + 1 + p)
+            .unwrap_or(hash);
         let name_loc = Loc::new(file, name_off, name_off + name.len().max(1));
         match name {
             "if" | "ifdef" | "ifndef" => {
@@ -438,20 +562,45 @@ impl<'a> Preprocessor<'a> {
                 } else if name == "if" {
                     self.eval_cond(rest, loc)
                 } else {
-                    let id: String = rest.bytes().take_while(|c| is_ident_char(*c)).map(char::from).collect();
+                    let id: String = rest
+                        .bytes()
+                        .take_while(|c| is_ident_char(*c))
+                        .map(char::from)
+                        .collect();
                     if id.is_empty() {
-                        self.err(Code::BadDirective, loc, format!("#{name} needs a macro name"), "here");
+                        self.err(
+                            Code::BadDirective,
+                            loc,
+                            format!("#{name} needs a macro name"),
+                            "here",
+                        );
                     }
                     self.macros.is_defined(&id) == (name == "ifdef")
                 };
-                conds.push(Cond { active: active && value, taken: value, seen_else: false, parent_active: active, loc });
+                conds.push(Cond {
+                    active: active && value,
+                    taken: value,
+                    seen_else: false,
+                    parent_active: active,
+                    loc,
+                });
             }
             "elif" | "else" => {
                 let Some(c) = conds.last_mut() else {
-                    return self.err(Code::Conditional, name_loc, format!("#{name} without #if"), "no matching #if");
+                    return self.err(
+                        Code::Conditional,
+                        name_loc,
+                        format!("#{name} without #if"),
+                        "no matching #if",
+                    );
                 };
                 if c.seen_else {
-                    return self.err(Code::Conditional, name_loc, format!("#{name} after #else"), "unexpected here");
+                    return self.err(
+                        Code::Conditional,
+                        name_loc,
+                        format!("#{name} after #else"),
+                        "unexpected here",
+                    );
                 }
                 let parent = c.parent_active;
                 let taken = c.taken;
@@ -469,7 +618,12 @@ impl<'a> Preprocessor<'a> {
             }
             "endif" => {
                 if conds.pop().is_none() {
-                    self.err(Code::Conditional, name_loc, "#endif without #if", "no matching #if");
+                    self.err(
+                        Code::Conditional,
+                        name_loc,
+                        "#endif without #if",
+                        "no matching #if",
+                    );
                 }
             }
             _ if !active => {}
@@ -480,19 +634,37 @@ impl<'a> Preprocessor<'a> {
                 }
             }
             "undef" => {
-                self.macros.defs.remove(rest.split_whitespace().next().unwrap_or(""));
+                self.macros
+                    .defs
+                    .remove(rest.split_whitespace().next().unwrap_or(""));
             }
             "include" => self.include(file, rest, loc, depth),
-            "error" => self.err(Code::ErrorDirective, loc, format!("#error {rest}"), "reached here"),
-            "warning" => self.diags.push(Diagnostic::warning(Code::WarningDirective, format!("#warning {rest}")).at(loc, "here")),
+            "error" => self.err(
+                Code::ErrorDirective,
+                loc,
+                format!("#error {rest}"),
+                "reached here",
+            ),
+            "warning" => self.diags.push(
+                Diagnostic::warning(Code::WarningDirective, format!("#warning {rest}"))
+                    .at(loc, "here"),
+            ),
             "line" => {
-                let ok = rest.split_whitespace().next().is_some_and(|n| n.bytes().all(|c| c.is_ascii_digit()));
+                let ok = rest
+                    .split_whitespace()
+                    .next()
+                    .is_some_and(|n| n.bytes().all(|c| c.is_ascii_digit()));
                 if !ok {
                     self.err(Code::BadDirective, loc, "#line needs a line number", "here");
                 }
             }
             "pragma" => self.pragma(file, text, hash, rest, loc),
-            _ => self.err(Code::BadDirective, name_loc, format!("unknown preprocessor directive `#{name}`"), "not a directive"),
+            _ => self.err(
+                Code::BadDirective,
+                name_loc,
+                format!("unknown preprocessor directive `#{name}`"),
+                "not a directive",
+            ),
         }
     }
 
@@ -509,9 +681,12 @@ impl<'a> Preprocessor<'a> {
                 self.emit_copy(file, text, hash, end);
             }
             _ => self.diags.push(
-                Diagnostic::warning(Code::PragmaIgnored, format!("unknown pragma `{word}` ignored"))
-                    .at(loc, "ignored")
-                    .help("idlc understands `#pragma once` and `#pragma keylist <type> <member>...`"),
+                Diagnostic::warning(
+                    Code::PragmaIgnored,
+                    format!("unknown pragma `{word}` ignored"),
+                )
+                .at(loc, "ignored")
+                .help("idlc understands `#pragma once` and `#pragma keylist <type> <member>...`"),
             ),
         }
     }
@@ -523,16 +698,30 @@ impl<'a> Preprocessor<'a> {
         let mut i = 0;
         while i < toks.len() {
             if toks[i].kind == Kind::Ident && toks[i].text == "defined" {
-                let sig: Vec<usize> = (i + 1..toks.len()).filter(|&k| toks[k].kind != Kind::Ws).take(3).collect();
+                let sig: Vec<usize> = (i + 1..toks.len())
+                    .filter(|&k| toks[k].kind != Kind::Ws)
+                    .take(3)
+                    .collect();
                 let (name, next) = match sig.as_slice() {
-                    [a, b, c, ..] if toks[*a].is("(") && toks[*c].is(")") => (toks[*b].text.clone(), c + 1),
+                    [a, b, c, ..] if toks[*a].is("(") && toks[*c].is(")") => {
+                        (toks[*b].text.clone(), c + 1)
+                    }
                     [a, ..] if toks[*a].kind == Kind::Ident => (toks[*a].text.clone(), a + 1),
                     _ => {
-                        self.err(Code::PpExpr, loc, "`defined` needs a macro name", "in this condition");
+                        self.err(
+                            Code::PpExpr,
+                            loc,
+                            "`defined` needs a macro name",
+                            "in this condition",
+                        );
                         return false;
                     }
                 };
-                let v = if self.macros.is_defined(&name) { "1" } else { "0" };
+                let v = if self.macros.is_defined(&name) {
+                    "1"
+                } else {
+                    "0"
+                };
                 pre.push(Tok::new(Kind::Number, v));
                 i = next;
             } else {
@@ -560,24 +749,44 @@ impl<'a> Preprocessor<'a> {
         let mut spec = rest.to_string();
         if !(spec.starts_with('"') || spec.starts_with('<')) {
             if let Ok(t) = self.macros.expand(&lex::lex(rest)) {
-                spec = t.iter().map(|t| t.text.as_str()).collect::<String>().trim().to_string();
+                spec = t
+                    .iter()
+                    .map(|t| t.text.as_str())
+                    .collect::<String>()
+                    .trim()
+                    .to_string();
             }
         }
-        let (name, quoted) = if let Some(s) = spec.strip_prefix('"').and_then(|s| s.split('"').next()) {
-            (s.to_string(), true)
-        } else if let Some(s) = spec.strip_prefix('<').and_then(|s| s.split('>').next()) {
-            (s.to_string(), false)
-        } else {
-            return self.err(Code::BadDirective, loc, "#include expects \"FILE\" or <FILE>", "malformed include");
-        };
+        let (name, quoted) =
+            if let Some(s) = spec.strip_prefix('"').and_then(|s| s.split('"').next()) {
+                (s.to_string(), true)
+            } else if let Some(s) = spec.strip_prefix('<').and_then(|s| s.split('>').next()) {
+                (s.to_string(), false)
+            } else {
+                return self.err(
+                    Code::BadDirective,
+                    loc,
+                    "#include expects \"FILE\" or <FILE>",
+                    "malformed include",
+                );
+            };
         if depth >= MAX_INCLUDE_DEPTH {
             return self.diags.push(
-                Diagnostic::error(Code::IncludeDepth, format!("#include nested more than {MAX_INCLUDE_DEPTH} deep"))
-                    .at(loc, "included from here")
-                    .help("this is usually an include cycle: add an include guard or `#pragma once`"),
+                Diagnostic::error(
+                    Code::IncludeDepth,
+                    format!("#include nested more than {MAX_INCLUDE_DEPTH} deep"),
+                )
+                .at(loc, "included from here")
+                .help("this is usually an include cycle: add an include guard or `#pragma once`"),
             );
         }
-        let cur_dir = self.db.get(file).path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let cur_dir = self
+            .db
+            .get(file)
+            .path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
         let mut candidates: Vec<PathBuf> = Vec::new();
         if quoted {
             candidates.push(cur_dir.join(&name));
@@ -587,13 +796,24 @@ impl<'a> Preprocessor<'a> {
             candidates.push(cur_dir.join(&name));
         }
         let Some(found) = candidates.into_iter().find(|p| self.vfs.exists(p)) else {
-            let mut d = Diagnostic::error(Code::IncludeNotFound, format!("cannot find include file `{name}`"))
-                .at(loc, "included here");
+            let mut d = Diagnostic::error(
+                Code::IncludeNotFound,
+                format!("cannot find include file `{name}`"),
+            )
+            .at(loc, "included here");
             d = if self.opts.include_dirs.is_empty() {
                 d.help("add the directory that holds it with `-I <dir>`")
             } else {
-                let dirs: Vec<String> = self.opts.include_dirs.iter().map(|d| d.display().to_string()).collect();
-                d.help(format!("searched the including file's directory and: {}", dirs.join(", ")))
+                let dirs: Vec<String> = self
+                    .opts
+                    .include_dirs
+                    .iter()
+                    .map(|d| d.display().to_string())
+                    .collect();
+                d.help(format!(
+                    "searched the including file's directory and: {}",
+                    dirs.join(", ")
+                ))
             };
             return self.diags.push(d);
         };
@@ -606,7 +826,12 @@ impl<'a> Preprocessor<'a> {
             None => match self.vfs.read(&found) {
                 Ok(text) => self.db.add(found.display().to_string(), &found, text),
                 Err(e) => {
-                    return self.err(Code::Io, loc, format!("cannot read `{}`: {e}", found.display()), "included here");
+                    return self.err(
+                        Code::Io,
+                        loc,
+                        format!("cannot read `{}`: {e}", found.display()),
+                        "included here",
+                    );
                 }
             },
         };
@@ -620,7 +845,11 @@ impl<'a> Preprocessor<'a> {
 }
 
 fn memchr_nl(b: &[u8], from: usize) -> usize {
-    b[from..].iter().position(|&c| c == b'\n').map(|p| from + p + 1).unwrap_or(b.len())
+    b[from..]
+        .iter()
+        .position(|&c| c == b'\n')
+        .map(|p| from + p + 1)
+        .unwrap_or(b.len())
 }
 
 /// Lexical normalisation (no filesystem access): removes `.` and `x/..` components.

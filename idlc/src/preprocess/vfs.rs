@@ -47,7 +47,10 @@ impl MemVfs {
 
 impl Vfs for MemVfs {
     fn read(&self, path: &Path) -> io::Result<String> {
-        self.files.get(path).cloned().ok_or_else(|| io::Error::new(io::ErrorKind::NotFound, "no such file"))
+        self.files
+            .get(path)
+            .cloned()
+            .ok_or_else(|| io::Error::new(io::ErrorKind::NotFound, "no such file"))
     }
     fn exists(&self, path: &Path) -> bool {
         self.files.contains_key(path)

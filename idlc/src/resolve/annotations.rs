@@ -51,9 +51,30 @@ const BUILTIN: &[(&str, &[Place])] = {
         ("nested", &[Struct, Union]),
         ("default_nested", &[Module]),
         ("topic", &[Struct, Union]),
-        ("data_representation", &[Struct, Union, Enum, Bitmask, Bitset, Typedef]),
-        ("try_construct", &[Member, UnionMember, Discriminator, Struct, Union, Typedef]),
-        ("verbatim", &[Module, Struct, Union, Enum, Bitmask, Bitset, Typedef, Const, Member, UnionMember, Other]),
+        (
+            "data_representation",
+            &[Struct, Union, Enum, Bitmask, Bitset, Typedef],
+        ),
+        (
+            "try_construct",
+            &[Member, UnionMember, Discriminator, Struct, Union, Typedef],
+        ),
+        (
+            "verbatim",
+            &[
+                Module,
+                Struct,
+                Union,
+                Enum,
+                Bitmask,
+                Bitset,
+                Typedef,
+                Const,
+                Member,
+                UnionMember,
+                Other,
+            ],
+        ),
         ("non_serialized", &[Member]),
         ("ignore_literal_names", &[Enum, Bitmask]),
         ("oneway", &[Other]),
@@ -93,7 +114,8 @@ pub struct Anns<'a> {
 
 impl Resolver<'_> {
     fn ann_err(&mut self, a: &Annotation, msg: String) {
-        self.diags.push(Diagnostic::error(Code::AnnotationParam, msg).at(a.loc, "in this annotation"));
+        self.diags
+            .push(Diagnostic::error(Code::AnnotationParam, msg).at(a.loc, "in this annotation"));
     }
 
     fn bool_param(&mut self, a: &Annotation) -> bool {
@@ -116,7 +138,9 @@ impl Resolver<'_> {
     fn single<'a>(&mut self, a: &'a Annotation) -> Option<&'a ConstExpr> {
         match &a.params {
             AnnotationParams::Single(e) => Some(e),
-            AnnotationParams::Named(ps) if ps.len() == 1 && ps[0].0.name == "value" => Some(&ps[0].1),
+            AnnotationParams::Named(ps) if ps.len() == 1 && ps[0].0.name == "value" => {
+                Some(&ps[0].1)
+            }
             _ => {
                 self.ann_err(a, format!("`@{}` needs one parameter", a.name.text()));
                 None
@@ -131,7 +155,10 @@ impl Resolver<'_> {
             ExprKind::Name(n) => n.parts.last().map(|p| p.name.to_ascii_uppercase()),
             ExprKind::Literal(Literal::Str(s)) => Some(s.to_ascii_uppercase()),
             _ => {
-                self.ann_err(a, format!("`@{}` expects a name such as FINAL", a.name.text()));
+                self.ann_err(
+                    a,
+                    format!("`@{}` expects a name such as FINAL", a.name.text()),
+                );
                 None
             }
         }
@@ -139,7 +166,10 @@ impl Resolver<'_> {
 
     fn named<'a>(&mut self, a: &'a Annotation, name: &str) -> Option<&'a ConstExpr> {
         match &a.params {
-            AnnotationParams::Named(ps) => ps.iter().find(|(n, _)| n.name.eq_ignore_ascii_case(name)).map(|(_, e)| e),
+            AnnotationParams::Named(ps) => ps
+                .iter()
+                .find(|(n, _)| n.name.eq_ignore_ascii_case(name))
+                .map(|(_, e)| e),
             _ => None,
         }
     }
@@ -154,12 +184,20 @@ impl Resolver<'_> {
     pub fn annotations<'a>(&mut self, list: &'a [Annotation], place: Place) -> Anns<'a> {
         let mut r = Anns::default();
         for a in list {
-            let name = a.name.parts.last().map(|p| p.name.to_ascii_lowercase()).unwrap_or_default();
+            let name = a
+                .name
+                .parts
+                .last()
+                .map(|p| p.name.to_ascii_lowercase())
+                .unwrap_or_default();
             let Some((_, places)) = BUILTIN.iter().find(|(n, _)| *n == name) else {
                 if !self.user_annotations.contains(&name) {
                     let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
-                    let mut d = Diagnostic::warning(Code::UnknownAnnotation, format!("unknown annotation `@{}` ignored", a.name.text()))
-                        .at(a.loc, "not a built-in annotation");
+                    let mut d = Diagnostic::warning(
+                        Code::UnknownAnnotation,
+                        format!("unknown annotation `@{}` ignored", a.name.text()),
+                    )
+                    .at(a.loc, "not a built-in annotation");
                     if let Some(s) = crate::diag::suggest(&name, known) {
                         d = d.help(format!("did you mean `@{s}`?"));
                     }
@@ -169,8 +207,11 @@ impl Resolver<'_> {
             };
             if !places.contains(&place) {
                 self.diags.push(
-                    Diagnostic::warning(Code::IgnoredAnnotation, format!("`@{}` has no effect here", a.name.text()))
-                        .at(a.loc, "ignored"),
+                    Diagnostic::warning(
+                        Code::IgnoredAnnotation,
+                        format!("`@{}` has no effect here", a.name.text()),
+                    )
+                    .at(a.loc, "ignored"),
                 );
                 continue;
             }
@@ -220,7 +261,10 @@ impl Resolver<'_> {
                         Some("APPENDABLE") => Some(Extensibility::Appendable),
                         Some("MUTABLE") => Some(Extensibility::Mutable),
                         _ => {
-                            self.ann_err(a, "`@extensibility` takes FINAL, APPENDABLE or MUTABLE".into());
+                            self.ann_err(
+                                a,
+                                "`@extensibility` takes FINAL, APPENDABLE or MUTABLE".into(),
+                            );
                             None
                         }
                     }
@@ -246,7 +290,10 @@ impl Resolver<'_> {
                 "topic" => r.topic = true,
                 "non_serialized" => r.non_serialized = self.bool_param(a),
                 "verbatim" => {
-                    let lang = self.named(a, "language").and_then(|e| self.string_of(e)).unwrap_or_else(|| "*".into());
+                    let lang = self
+                        .named(a, "language")
+                        .and_then(|e| self.string_of(e))
+                        .unwrap_or_else(|| "*".into());
                     let placement = self
                         .named(a, "placement")
                         .and_then(|e| self.string_of(e))
@@ -257,7 +304,10 @@ impl Resolver<'_> {
                     };
                     if lang == "*" || lang.eq_ignore_ascii_case("rust") {
                         if let Some(text) = text {
-                            r.verbatim.push(Verbatim { placement: placement.to_ascii_uppercase(), text });
+                            r.verbatim.push(Verbatim {
+                                placement: placement.to_ascii_uppercase(),
+                                text,
+                            });
                         }
                     }
                 }
@@ -270,7 +320,10 @@ impl Resolver<'_> {
 
     fn id_range(&mut self, a: &Annotation, v: u64) -> Option<u32> {
         if v > 0x0FFF_FFFF {
-            self.ann_err(a, format!("member id {v} is larger than the maximum 0x0FFFFFFF"));
+            self.ann_err(
+                a,
+                format!("member id {v} is larger than the maximum 0x0FFFFFFF"),
+            );
             return None;
         }
         Some(v as u32)

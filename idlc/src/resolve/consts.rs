@@ -53,20 +53,37 @@ impl Resolver<'_> {
                 }
                 Some(Value::Int(i))
             }
-            (Type::Prim { prim: Prim::F32 | Prim::F64 | Prim::F128 }, Value::Int(i)) => Some(Value::Float(i as f64)),
-            (Type::Prim { prim }, Value::Float(f)) if matches!(prim, Prim::F32 | Prim::F64 | Prim::F128) => {
+            (
+                Type::Prim {
+                    prim: Prim::F32 | Prim::F64 | Prim::F128,
+                },
+                Value::Int(i),
+            ) => Some(Value::Float(i as f64)),
+            (Type::Prim { prim }, Value::Float(f))
+                if matches!(prim, Prim::F32 | Prim::F64 | Prim::F128) =>
+            {
                 if *prim == Prim::F32 && f.is_finite() && f.abs() > f32::MAX as f64 {
-                    return self.cerr(Code::Overflow, loc, format!("value {f} does not fit in `float`"), "out of range");
+                    return self.cerr(
+                        Code::Overflow,
+                        loc,
+                        format!("value {f} does not fit in `float`"),
+                        "out of range",
+                    );
                 }
                 Some(Value::Float(f))
             }
             (Type::Prim { prim: Prim::Bool }, Value::Bool(b)) => Some(Value::Bool(b)),
             (Type::Prim { prim: Prim::Char }, Value::Char(c)) => Some(Value::Char(c)),
-            (Type::Prim { prim: Prim::WChar }, Value::Char(c) | Value::WChar(c)) => Some(Value::WChar(c)),
+            (Type::Prim { prim: Prim::WChar }, Value::Char(c) | Value::WChar(c)) => {
+                Some(Value::WChar(c))
+            }
             (Type::String { wide, bound }, Value::Str(s) | Value::WStr(s)) => {
                 if let Some(b) = bound {
                     if s.chars().count() as u64 > *b {
-                        let msg = format!("string of length {} does not fit in `{tname}`", s.chars().count());
+                        let msg = format!(
+                            "string of length {} does not fit in `{tname}`",
+                            s.chars().count()
+                        );
                         return self.cerr(Code::Overflow, loc, msg, "too long");
                     }
                 }
@@ -107,9 +124,11 @@ impl Resolver<'_> {
                     (UnaryOp::Plus, v @ (Value::Int(_) | Value::Float(_))) => Some(v),
                     (UnaryOp::Neg, Value::Int(i)) => self.check_range(-i, e.loc),
                     (UnaryOp::Neg, Value::Float(f)) => Some(Value::Float(-f)),
-                    (UnaryOp::Neg, Value::Fixed(s)) => {
-                        Some(Value::Fixed(s.strip_prefix('-').map(str::to_string).unwrap_or(format!("-{s}"))))
-                    }
+                    (UnaryOp::Neg, Value::Fixed(s)) => Some(Value::Fixed(
+                        s.strip_prefix('-')
+                            .map(str::to_string)
+                            .unwrap_or(format!("-{s}")),
+                    )),
                     (UnaryOp::Not, Value::Int(i)) => Some(Value::Int(match unsigned_max {
                         Some(m) if i >= 0 => m ^ i,
                         _ => !i,
@@ -135,7 +154,8 @@ impl Resolver<'_> {
 
     fn check_range(&mut self, v: i128, loc: Loc) -> Option<Value> {
         if !(MIN..=MAX).contains(&v) {
-            let msg = format!("constant expression overflows: {v} is outside every IDL integer type");
+            let msg =
+                format!("constant expression overflows: {v} is outside every IDL integer type");
             return self.cerr(Code::Overflow, loc, msg, "overflows here");
         }
         Some(Value::Int(v))
@@ -158,19 +178,38 @@ impl Resolver<'_> {
                     Add => x.checked_add(y),
                     Sub => x.checked_sub(y),
                     Mul => x.checked_mul(y),
-                    Div | Mod if y == 0 => return self.cerr(Code::DivZero, rloc, "division by zero".into(), "this is zero"),
+                    Div | Mod if y == 0 => {
+                        return self.cerr(
+                            Code::DivZero,
+                            rloc,
+                            "division by zero".into(),
+                            "this is zero",
+                        )
+                    }
                     Div => x.checked_div(y),
                     Mod => x.checked_rem(y),
                 };
                 match r {
                     Some(v) => self.check_range(v, loc),
-                    None => self.cerr(Code::Overflow, loc, "constant expression overflows".into(), "overflows here"),
+                    None => self.cerr(
+                        Code::Overflow,
+                        loc,
+                        "constant expression overflows".into(),
+                        "overflows here",
+                    ),
                 }
             }
-            (a @ (Value::Int(_) | Value::Float(_)), b @ (Value::Int(_) | Value::Float(_))) if matches!(op, Add | Sub | Mul | Div) => {
+            (a @ (Value::Int(_) | Value::Float(_)), b @ (Value::Int(_) | Value::Float(_)))
+                if matches!(op, Add | Sub | Mul | Div) =>
+            {
                 let (x, y) = (as_f64(&a), as_f64(&b));
                 if op == Div && y == 0.0 {
-                    return self.cerr(Code::DivZero, rloc, "division by zero".into(), "this is zero");
+                    return self.cerr(
+                        Code::DivZero,
+                        rloc,
+                        "division by zero".into(),
+                        "this is zero",
+                    );
                 }
                 let r = match op {
                     Add => x + y,
@@ -179,12 +218,22 @@ impl Resolver<'_> {
                     _ => x / y,
                 };
                 if !r.is_finite() {
-                    return self.cerr(Code::Overflow, loc, "floating-point constant overflows".into(), "overflows here");
+                    return self.cerr(
+                        Code::Overflow,
+                        loc,
+                        "floating-point constant overflows".into(),
+                        "overflows here",
+                    );
                 }
                 Some(Value::Float(r))
             }
             (a, b) => {
-                let msg = format!("operator `{}` cannot be applied to {} and {}", op.symbol(), describe(&a), describe(&b));
+                let msg = format!(
+                    "operator `{}` cannot be applied to {} and {}",
+                    op.symbol(),
+                    describe(&a),
+                    describe(&b)
+                );
                 self.cerr(Code::ConstType, loc, msg, "invalid operands")
             }
         }

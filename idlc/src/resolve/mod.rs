@@ -19,7 +19,9 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Options { default_extensibility: Extensibility::Appendable }
+        Options {
+            default_extensibility: Extensibility::Appendable,
+        }
     }
 }
 
@@ -58,7 +60,10 @@ pub fn resolve(specs: &[ast::Spec], opts: &Options, diags: &mut Diagnostics) -> 
             r.diags.push(
                 Diagnostic::error(Code::IncompleteForward, msg)
                     .at(loc, "forward declaration")
-                    .help(format!("define `{what} {} {{ ... }};` in the same scope", d.name)),
+                    .help(format!(
+                        "define `{what} {} {{ ... }};` in the same scope",
+                        d.name
+                    )),
             );
         }
     }
@@ -83,18 +88,38 @@ impl<'a> Resolver<'a> {
             Ok(()) => true,
             Err(prev) => {
                 let (code, msg) = if prev.name == name.name {
-                    (Code::Duplicate, format!("`{}` is declared twice in this scope", name.name))
+                    (
+                        Code::Duplicate,
+                        format!("`{}` is declared twice in this scope", name.name),
+                    )
                 } else {
-                    (Code::CaseCollision, format!("`{}` collides with `{}`: IDL names must differ by more than case", name.name, prev.name))
+                    (
+                        Code::CaseCollision,
+                        format!(
+                            "`{}` collides with `{}`: IDL names must differ by more than case",
+                            name.name, prev.name
+                        ),
+                    )
                 };
-                self.diags.push(Diagnostic::error(code, msg).at(name.loc, "redeclared here").also(prev.loc, "first declared here"));
+                self.diags.push(
+                    Diagnostic::error(code, msg)
+                        .at(name.loc, "redeclared here")
+                        .also(prev.loc, "first declared here"),
+                );
                 false
             }
         }
     }
 
     fn new_decl(&mut self, name: &ast::Ident, kind: DeclKind, doc: &[String], loc: Loc) -> DeclId {
-        self.model.decls.push(Decl { scope: self.cur.clone(), name: name.name.clone(), kind, doc: doc.to_vec(), verbatim: vec![], loc });
+        self.model.decls.push(Decl {
+            scope: self.cur.clone(),
+            name: name.name.clone(),
+            kind,
+            doc: doc.to_vec(),
+            verbatim: vec![],
+            loc,
+        });
         let id = self.model.decls.len() - 1;
         let cur = self.cur.clone();
         self.model.root.module_mut(&cur).decls.push(id);
@@ -102,12 +127,21 @@ impl<'a> Resolver<'a> {
     }
 
     /// Declares a new type, or completes a forward declaration of it.
-    fn type_decl(&mut self, name: &ast::Ident, doc: &[String], loc: Loc, forward_kind: Option<ForwardKind>) -> Option<DeclId> {
+    fn type_decl(
+        &mut self,
+        name: &ast::Ident,
+        doc: &[String],
+        loc: Loc,
+        forward_kind: Option<ForwardKind>,
+    ) -> Option<DeclId> {
         let key = self.scope_key();
         if let Some(e) = self.scopes.get(&key, &name.name).cloned() {
             if let Sym::Decl(id) = e.sym {
                 if let DeclKind::Forward { union } = self.model.decls[id].kind {
-                    let kind_ok = matches!((forward_kind, union), (Some(ForwardKind::Union), true) | (Some(ForwardKind::Struct), false));
+                    let kind_ok = matches!(
+                        (forward_kind, union),
+                        (Some(ForwardKind::Union), true) | (Some(ForwardKind::Struct), false)
+                    );
                     if kind_ok && e.name == name.name {
                         self.model.decls[id].doc = doc.to_vec();
                         self.model.decls[id].loc = loc;
@@ -153,7 +187,14 @@ impl<'a> Resolver<'a> {
                         return; // forward declaration after the definition, or repeated: harmless
                     }
                 }
-                let id = self.new_decl(name, DeclKind::Forward { union: *kind == ForwardKind::Union }, &d.doc, d.loc);
+                let id = self.new_decl(
+                    name,
+                    DeclKind::Forward {
+                        union: *kind == ForwardKind::Union,
+                    },
+                    &d.doc,
+                    d.loc,
+                );
                 if self.declare(name, Sym::Decl(id)) {
                     self.forwards.push((id, name.loc));
                 }
@@ -166,7 +207,8 @@ impl<'a> Resolver<'a> {
             DefKind::Typedef(t) => self.typedef(t, d),
             DefKind::Const(c) => self.const_def(c, d),
             DefKind::Annotation(a) => {
-                self.user_annotations.insert(a.name.name.to_ascii_lowercase());
+                self.user_annotations
+                    .insert(a.name.name.to_ascii_lowercase());
                 if BUILTIN_NAMES.contains(&a.name.name.to_ascii_lowercase().as_str()) {
                     return; // re-declaring a built-in (common in vendor IDL) changes nothing
                 }
@@ -175,9 +217,12 @@ impl<'a> Resolver<'a> {
             DefKind::Unsupported { what, name } => {
                 self.declare(name, Sym::Annotation);
                 self.diags.push(
-                    Diagnostic::warning(Code::NotEmitted, format!("{what} `{}` is parsed but no Rust is emitted for it", name.name))
-                        .at(name.loc, format!("{what} skipped"))
-                        .help("idlc generates data types only; DDS-RPC and CORBA constructs have no Rust mapping"),
+                    Diagnostic::warning(
+                        Code::NotEmitted,
+                        format!("{what} `{}` is parsed but no Rust is emitted for it", name.name),
+                    )
+                    .at(name.loc, format!("{what} skipped"))
+                    .help("idlc generates data types only; DDS-RPC and CORBA constructs have no Rust mapping"),
                 );
             }
             DefKind::Keylist { ty, keys } => self.keylist(ty, keys),
@@ -199,34 +244,56 @@ impl<'a> Resolver<'a> {
             Lookup::Found(sym, _) => Some(sym),
             Lookup::CaseMismatch { found, sym, loc } => {
                 self.diags.push(
-                    Diagnostic::error(Code::CaseCollision, format!("`{}` differs only in case from `{found}`", n.text()))
-                        .at(n.loc, "wrong case")
-                        .also(loc, "declared here")
-                        .help(format!("did you mean `{found}`?")),
+                    Diagnostic::error(
+                        Code::CaseCollision,
+                        format!("`{}` differs only in case from `{found}`", n.text()),
+                    )
+                    .at(n.loc, "wrong case")
+                    .also(loc, "declared here")
+                    .help(format!("did you mean `{found}`?")),
                 );
                 Some(sym)
             }
             Lookup::Shadowed { near, far } => {
                 self.diags.push(
-                    Diagnostic::error(Code::Ambiguous, format!("`{}` is ambiguous: `{near}` hides the outer declaration", n.text()))
-                        .at(n.loc, format!("resolves through `{near}`, which has no such member"))
-                        .help(format!("write the absolute name `{far}`")),
+                    Diagnostic::error(
+                        Code::Ambiguous,
+                        format!(
+                            "`{}` is ambiguous: `{near}` hides the outer declaration",
+                            n.text()
+                        ),
+                    )
+                    .at(
+                        n.loc,
+                        format!("resolves through `{near}`, which has no such member"),
+                    )
+                    .help(format!("write the absolute name `{far}`")),
                 );
                 None
             }
             Lookup::NotFound { missing, scope } => {
-                let candidates: Vec<String> = if n.parts.len() == 1 || scope.is_empty() && n.absolute {
-                    self.scopes.visible_names(&self.cur)
+                let candidates: Vec<String> =
+                    if n.parts.len() == 1 || scope.is_empty() && n.absolute {
+                        self.scopes.visible_names(&self.cur)
+                    } else {
+                        self.scopes.names_in(&scope)
+                    };
+                let where_ = if scope.is_empty() || n.parts.len() == 1 {
+                    String::new()
                 } else {
-                    self.scopes.names_in(&scope)
+                    format!(" in `{scope}`")
                 };
-                let where_ = if scope.is_empty() || n.parts.len() == 1 { String::new() } else { format!(" in `{scope}`") };
-                let mut diag = Diagnostic::error(Code::Unresolved, format!("cannot find {what} `{missing}`{where_}"))
-                    .at(n.loc, "not found");
+                let mut diag = Diagnostic::error(
+                    Code::Unresolved,
+                    format!("cannot find {what} `{missing}`{where_}"),
+                )
+                .at(n.loc, "not found");
                 if let Some(s) = suggest(&missing, candidates.iter().map(String::as_str)) {
                     diag = diag.help(format!("did you mean `{s}`?"));
                 } else if let Some(later) = self.find_anywhere(&missing) {
-                    diag = diag.help(format!("a declaration `{later}` exists elsewhere; qualify the name or check the include"));
+                    diag = diag.help(format!(
+                        "a declaration `{later}` exists elsewhere; qualify the name or check the include"
+                    ));
                 }
                 self.diags.push(diag);
                 None
@@ -235,7 +302,11 @@ impl<'a> Resolver<'a> {
     }
 
     fn find_anywhere(&self, name: &str) -> Option<String> {
-        self.model.decls.iter().find(|d| d.name == name).map(|d| d.scoped_name())
+        self.model
+            .decls
+            .iter()
+            .find(|d| d.name == name)
+            .map(|d| d.scoped_name())
     }
 
     pub fn type_name(&self, t: &Type) -> String {
@@ -249,8 +320,14 @@ impl<'a> Resolver<'a> {
                 }
             }
             Type::Sequence { elem, .. } => format!("sequence<{}>", self.type_name(elem)),
-            Type::Map { key, value, .. } => format!("map<{}, {}>", self.type_name(key), self.type_name(value)),
-            Type::Array { elem, dims } => format!("{}{}", self.type_name(elem), dims.iter().map(|d| format!("[{d}]")).collect::<String>()),
+            Type::Map { key, value, .. } => {
+                format!("map<{}, {}>", self.type_name(key), self.type_name(value))
+            }
+            Type::Array { elem, dims } => format!(
+                "{}{}",
+                self.type_name(elem),
+                dims.iter().map(|d| format!("[{d}]")).collect::<String>()
+            ),
             Type::Fixed { digits, scale } => format!("fixed<{digits},{scale}>"),
             Type::Named { name, .. } => name.clone(),
             Type::Error => "{error}".into(),
@@ -264,23 +341,32 @@ impl<'a> Resolver<'a> {
             TypeSpec::Prim(p, loc) => {
                 if matches!(p, Prim::Any | Prim::Object) {
                     self.diags.push(
-                        Diagnostic::error(Code::BadMemberType, format!("type `{}` cannot be used in a DDS data type", p.idl_name()))
-                            .at(*loc, "not a data type"),
+                        Diagnostic::error(
+                            Code::BadMemberType,
+                            format!("type `{}` cannot be used in a DDS data type", p.idl_name()),
+                        )
+                        .at(*loc, "not a data type"),
                     );
                     return Type::Error;
                 }
                 Type::Prim { prim: *p }
             }
             TypeSpec::String { wide, bound, .. } => {
-                let bound = bound.as_ref().and_then(|b| self.eval_u64(b, "string bound", 1));
+                let bound = bound
+                    .as_ref()
+                    .and_then(|b| self.eval_u64(b, "string bound", 1));
                 Type::String { wide: *wide, bound }
             }
             TypeSpec::Sequence { elem, bound, .. } => {
                 let elem = Box::new(self.lower_type(elem));
-                let bound = bound.as_ref().and_then(|b| self.eval_u64(b, "sequence bound", 1));
+                let bound = bound
+                    .as_ref()
+                    .and_then(|b| self.eval_u64(b, "sequence bound", 1));
                 Type::Sequence { elem, bound }
             }
-            TypeSpec::Map { key, value, bound, .. } => {
+            TypeSpec::Map {
+                key, value, bound, ..
+            } => {
                 let k = self.lower_type(key);
                 let kr = self.model.resolve_alias(&k);
                 let key_ok = matches!(kr, Type::Prim { prim } if prim.is_integer() || *prim == Prim::Octet)
@@ -288,32 +374,58 @@ impl<'a> Resolver<'a> {
                 if !key_ok {
                     let msg = format!("map key type `{}` is not allowed", self.type_name(&k));
                     self.diags.push(
-                        Diagnostic::error(Code::BadMemberType, msg).at(key.loc(), "map key").help("map keys must be integers or strings"),
+                        Diagnostic::error(Code::BadMemberType, msg)
+                            .at(key.loc(), "map key")
+                            .help("map keys must be integers or strings"),
                     );
                 }
                 let value = Box::new(self.lower_type(value));
-                let bound = bound.as_ref().and_then(|b| self.eval_u64(b, "map bound", 1));
-                Type::Map { key: Box::new(k), value, bound }
+                let bound = bound
+                    .as_ref()
+                    .and_then(|b| self.eval_u64(b, "map bound", 1));
+                Type::Map {
+                    key: Box::new(k),
+                    value,
+                    bound,
+                }
             }
             TypeSpec::Fixed { digits, scale, loc } => {
                 // Bare `fixed` only occurs as a constant type; the value carries its own digits.
-                let (Some(d), Some(s)) = (digits, scale) else { return Type::Fixed { digits: 0, scale: 0 } };
+                let (Some(d), Some(s)) = (digits, scale) else {
+                    return Type::Fixed {
+                        digits: 0,
+                        scale: 0,
+                    };
+                };
                 let dv = self.eval_u64(d, "fixed digits", 1).unwrap_or(1);
                 let sv = self.eval_u64(s, "fixed scale", 0).unwrap_or(0);
                 if dv > 31 || sv > dv {
-                    let msg = format!("fixed<{dv},{sv}>: digits must be 1..=31 and scale at most digits");
-                    self.diags.push(Diagnostic::error(Code::BadBound, msg).at(*loc, "invalid fixed-point type"));
+                    let msg =
+                        format!("fixed<{dv},{sv}>: digits must be 1..=31 and scale at most digits");
+                    self.diags.push(
+                        Diagnostic::error(Code::BadBound, msg).at(*loc, "invalid fixed-point type"),
+                    );
                 }
-                Type::Fixed { digits: dv as u32, scale: sv as u32 }
+                Type::Fixed {
+                    digits: dv as u32,
+                    scale: sv as u32,
+                }
             }
             TypeSpec::Named(n) => match self.resolve_name(n, "type") {
                 Some(Sym::Decl(id)) => match &self.model.decls[id].kind {
                     DeclKind::Const(_) => {
                         let msg = format!("`{}` is a constant, not a type", n.text());
-                        self.diags.push(Diagnostic::error(Code::NotAType, msg).at(n.loc, "expected a type").also(self.model.decls[id].loc, "declared here"));
+                        self.diags.push(
+                            Diagnostic::error(Code::NotAType, msg)
+                                .at(n.loc, "expected a type")
+                                .also(self.model.decls[id].loc, "declared here"),
+                        );
                         Type::Error
                     }
-                    _ => Type::Named { decl: id, name: self.model.decls[id].scoped_name() },
+                    _ => Type::Named {
+                        decl: id,
+                        name: self.model.decls[id].scoped_name(),
+                    },
                 },
                 Some(sym) => {
                     let what = match sym {
@@ -321,7 +433,13 @@ impl<'a> Resolver<'a> {
                         Sym::Enumerator(..) => "an enumerator",
                         _ => "not a data type",
                     };
-                    self.diags.push(Diagnostic::error(Code::NotAType, format!("`{}` is {what}, not a type", n.text())).at(n.loc, "expected a type"));
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::NotAType,
+                            format!("`{}` is {what}, not a type", n.text()),
+                        )
+                        .at(n.loc, "expected a type"),
+                    );
                     Type::Error
                 }
                 None => Type::Error,
@@ -333,12 +451,23 @@ impl<'a> Resolver<'a> {
         if dims.is_empty() {
             return ty;
         }
-        let dims: Vec<u64> = dims.iter().map(|e| self.eval_u64(e, "array size", 1).unwrap_or(1)).collect();
-        if dims.iter().try_fold(1u64, |a, d| a.checked_mul(*d)).is_none_or(|n| n > 1 << 32) {
+        let dims: Vec<u64> = dims
+            .iter()
+            .map(|e| self.eval_u64(e, "array size", 1).unwrap_or(1))
+            .collect();
+        if dims
+            .iter()
+            .try_fold(1u64, |a, d| a.checked_mul(*d))
+            .is_none_or(|n| n > 1 << 32)
+        {
             let msg = "array has more than 2^32 elements".to_string();
-            self.diags.push(Diagnostic::error(Code::BadBound, msg).at(Loc::default(), "here"));
+            self.diags
+                .push(Diagnostic::error(Code::BadBound, msg).at(Loc::default(), "here"));
         }
-        Type::Array { elem: Box::new(ty), dims }
+        Type::Array {
+            elem: Box::new(ty),
+            dims,
+        }
     }
 
     fn is_struct(&self, t: &Type) -> bool {
@@ -349,7 +478,9 @@ impl<'a> Resolver<'a> {
 
     fn struct_def(&mut self, s: &ast::StructDef, d: &Definition) {
         let anns = self.annotations(&d.annotations, Place::Struct);
-        let Some(id) = self.type_decl(&s.name, &d.doc, d.loc, Some(ForwardKind::Struct)) else { return };
+        let Some(id) = self.type_decl(&s.name, &d.doc, d.loc, Some(ForwardKind::Struct)) else {
+            return;
+        };
         let base = s.base.as_ref().and_then(|b| {
             let t = self.lower_type(&TypeSpec::Named(b.clone()));
             if matches!(t, Type::Error) {
@@ -357,10 +488,18 @@ impl<'a> Resolver<'a> {
             }
             let resolved = self.model.resolve_alias(&t).clone();
             match resolved {
-                Type::Named { decl, .. } if matches!(self.model.decls[decl].kind, DeclKind::Struct(_)) && decl != id => Some(decl),
+                Type::Named { decl, .. }
+                    if matches!(self.model.decls[decl].kind, DeclKind::Struct(_)) && decl != id =>
+                {
+                    Some(decl)
+                }
                 _ => {
-                    let msg = format!("`{}` cannot be a base of a struct: it is not a (defined) struct", b.text());
-                    self.diags.push(Diagnostic::error(Code::BadBase, msg).at(b.loc, "not a struct"));
+                    let msg = format!(
+                        "`{}` cannot be a base of a struct: it is not a (defined) struct",
+                        b.text()
+                    );
+                    self.diags
+                        .push(Diagnostic::error(Code::BadBase, msg).at(b.loc, "not a struct"));
                     None
                 }
             }
@@ -373,7 +512,9 @@ impl<'a> Resolver<'a> {
         let st = Struct {
             base,
             fields,
-            extensibility: anns.extensibility.unwrap_or(self.opts.default_extensibility),
+            extensibility: anns
+                .extensibility
+                .unwrap_or(self.opts.default_extensibility),
             autoid: anns.autoid.unwrap_or_default(),
             nested,
         };
@@ -391,12 +532,16 @@ impl<'a> Resolver<'a> {
             let min = anns.min.and_then(|e| self.eval_as(e, &ty));
             let max = anns.max.and_then(|e| self.eval_as(e, &ty));
             if anns.key && anns.optional {
-                let mut diag = Diagnostic::error(Code::KeyOptional, format!("key member `{}` cannot be optional", dcl.name.name))
-                    .at(dcl.name.loc, "declared here");
+                let mut diag = Diagnostic::error(
+                    Code::KeyOptional,
+                    format!("key member `{}` cannot be optional", dcl.name.name),
+                )
+                .at(dcl.name.loc, "declared here");
                 if let Some(l) = anns.optional_loc {
                     diag = diag.also(l, "made optional here");
                 }
-                self.diags.push(diag.help("a key must always be present: remove `@optional` or `@key`"));
+                self.diags
+                    .push(diag.help("a key must always be present: remove `@optional` or `@key`"));
             }
             out.push(Field {
                 name: dcl.name.name.clone(),
@@ -406,7 +551,9 @@ impl<'a> Resolver<'a> {
                 external: anns.external,
                 must_understand: anns.must_understand,
                 non_serialized: anns.non_serialized,
-                id: anns.id.filter(|_| m.declarators.len() == 1 || out.is_empty()),
+                id: anns
+                    .id
+                    .filter(|_| m.declarators.len() == 1 || out.is_empty()),
                 hashid: anns.hashid.clone(),
                 default,
                 min,
@@ -425,20 +572,28 @@ impl<'a> Resolver<'a> {
         let disc = self.lower_type(&u.switch);
         let resolved = self.model.resolve_alias(&disc).clone();
         let disc_ok = match &resolved {
-            Type::Prim { prim } => prim.is_integer() || matches!(prim, Prim::Char | Prim::WChar | Prim::Bool | Prim::Octet),
+            Type::Prim { prim } => {
+                prim.is_integer()
+                    || matches!(prim, Prim::Char | Prim::WChar | Prim::Bool | Prim::Octet)
+            }
             Type::Named { decl, .. } => matches!(self.model.decls[*decl].kind, DeclKind::Enum(_)),
             Type::Error => true,
             _ => false,
         };
         if !disc_ok {
-            let msg = format!("`{}` cannot be a union discriminator", self.type_name(&disc));
+            let msg = format!(
+                "`{}` cannot be a union discriminator",
+                self.type_name(&disc)
+            );
             self.diags.push(
                 Diagnostic::error(Code::BadDiscriminator, msg)
                     .at(u.switch.loc(), "invalid discriminator type")
                     .help("use an integer type, char, wchar, boolean, octet or an enum"),
             );
         }
-        let Some(id) = self.type_decl(&u.name, &d.doc, d.loc, Some(ForwardKind::Union)) else { return };
+        let Some(id) = self.type_decl(&u.name, &d.doc, d.loc, Some(ForwardKind::Union)) else {
+            return;
+        };
         let mut cases = Vec::new();
         for c in &u.cases {
             let canns = self.annotations(&c.annotations, Place::UnionMember);
@@ -453,7 +608,11 @@ impl<'a> Resolver<'a> {
                     ast::CaseLabel::Default(loc) => {
                         if is_default {
                             self.diags.push(
-                                Diagnostic::error(Code::SeveralDefaults, "union has more than one `default` label").at(*loc, "second default"),
+                                Diagnostic::error(
+                                    Code::SeveralDefaults,
+                                    "union has more than one `default` label",
+                                )
+                                .at(*loc, "second default"),
                             );
                         }
                         is_default = true;
@@ -487,7 +646,9 @@ impl<'a> Resolver<'a> {
             discriminator: if disc_ok { disc } else { Type::Error },
             disc_key: sanns.key,
             cases,
-            extensibility: anns.extensibility.unwrap_or(self.opts.default_extensibility),
+            extensibility: anns
+                .extensibility
+                .unwrap_or(self.opts.default_extensibility),
             nested: anns.nested.unwrap_or(!anns.topic && self.nested_default()),
         };
         self.model.decls[id].kind = DeclKind::Union(un);
@@ -506,8 +667,11 @@ impl<'a> Resolver<'a> {
                         _ => String::new(),
                     };
                     let want = self.model.decls[*decl].scoped_name();
-                    let mut diag = Diagnostic::error(Code::LabelType, format!("case label `{en}` is an enumerator of `{other}`, but the discriminator is `{want}`"))
-                        .at(e.loc, format!("expected an enumerator of `{want}`"));
+                    let mut diag = Diagnostic::error(
+                        Code::LabelType,
+                        format!("case label `{en}` is an enumerator of `{other}`, but the discriminator is `{want}`"),
+                    )
+                    .at(e.loc, format!("expected an enumerator of `{want}`"));
                     let names: Vec<String> = match &self.model.decls[*decl].kind {
                         DeclKind::Enum(x) => x.enumerators.iter().map(|e| e.name.clone()).collect(),
                         _ => vec![],
@@ -520,8 +684,13 @@ impl<'a> Resolver<'a> {
                 }
                 other => {
                     let want = self.model.decls[*decl].scoped_name();
-                    let msg = format!("case label must be an enumerator of `{want}`, found {}", consts::describe(&other));
-                    self.diags.push(Diagnostic::error(Code::LabelType, msg).at(e.loc, "wrong label type"));
+                    let msg = format!(
+                        "case label must be an enumerator of `{want}`, found {}",
+                        consts::describe(&other)
+                    );
+                    self.diags.push(
+                        Diagnostic::error(Code::LabelType, msg).at(e.loc, "wrong label type"),
+                    );
                     None
                 }
             };
@@ -534,8 +703,13 @@ impl<'a> Resolver<'a> {
             (Type::Prim { prim }, Value::Int(i)) => match prim.int_range() {
                 Some((lo, hi)) => {
                     if *i < lo || *i > hi {
-                        let msg = format!("case label {i} is out of range for discriminator type `{}`", self.type_name(disc));
-                        self.diags.push(Diagnostic::error(Code::LabelType, msg).at(e.loc, "out of range"));
+                        let msg = format!(
+                            "case label {i} is out of range for discriminator type `{}`",
+                            self.type_name(disc)
+                        );
+                        self.diags.push(
+                            Diagnostic::error(Code::LabelType, msg).at(e.loc, "out of range"),
+                        );
                         return None;
                     }
                     true
@@ -545,8 +719,13 @@ impl<'a> Resolver<'a> {
             _ => false,
         };
         if !ok {
-            let msg = format!("case label {} does not match discriminator type `{}`", consts::describe(&v), self.type_name(disc));
-            self.diags.push(Diagnostic::error(Code::LabelType, msg).at(e.loc, "wrong label type"));
+            let msg = format!(
+                "case label {} does not match discriminator type `{}`",
+                consts::describe(&v),
+                self.type_name(disc)
+            );
+            self.diags
+                .push(Diagnostic::error(Code::LabelType, msg).at(e.loc, "wrong label type"));
             return None;
         }
         Some(match (resolved, v) {
@@ -557,18 +736,29 @@ impl<'a> Resolver<'a> {
 
     fn enum_def(&mut self, e: &ast::EnumDef, d: &Definition) {
         let anns = self.annotations(&d.annotations, Place::Enum);
-        let Some(id) = self.type_decl(&e.name, &d.doc, d.loc, None) else { return };
-        let bit_bound = anns.bit_bound.and_then(|b| self.eval_u64(b, "@bit_bound", 1)).map(|b| b as u32);
+        let Some(id) = self.type_decl(&e.name, &d.doc, d.loc, None) else {
+            return;
+        };
+        let bit_bound = anns
+            .bit_bound
+            .and_then(|b| self.eval_u64(b, "@bit_bound", 1))
+            .map(|b| b as u32);
         if let Some(b) = bit_bound {
             if b > 32 {
                 let msg = format!("@bit_bound({b}) on an enum must be 1..=32");
-                self.diags.push(Diagnostic::error(Code::BitBound, msg).at(d.loc, "in this enum"));
+                self.diags
+                    .push(Diagnostic::error(Code::BitBound, msg).at(d.loc, "in this enum"));
             }
         }
         let mut enumerators: Vec<Enumerator> = Vec::new();
         let mut next: i64 = 0;
         let mut default_index = 0;
-        self.model.decls[id].kind = DeclKind::Enum(Enum { enumerators: vec![], bit_bound, default_index: 0, extensibility: anns.extensibility.unwrap_or(Extensibility::Final) });
+        self.model.decls[id].kind = DeclKind::Enum(Enum {
+            enumerators: vec![],
+            bit_bound,
+            default_index: 0,
+            extensibility: anns.extensibility.unwrap_or(Extensibility::Final),
+        });
         let int32 = Type::Prim { prim: Prim::I32 };
         for (i, en) in e.enumerators.iter().enumerate() {
             let ea = self.annotations(&en.annotations, Place::Enumerator);
@@ -580,14 +770,20 @@ impl<'a> Resolver<'a> {
             if let Some(b) = bit_bound.filter(|b| (1..32).contains(b)) {
                 if value < -(1i64 << (b - 1)) || value >= 1i64 << (b - 1) {
                     let msg = format!("enumerator value {value} does not fit in @bit_bound({b})");
-                    self.diags.push(Diagnostic::error(Code::BitBound, msg).at(en.name.loc, "too large"));
+                    self.diags
+                        .push(Diagnostic::error(Code::BitBound, msg).at(en.name.loc, "too large"));
                 }
             }
             if ea.default_literal {
                 default_index = i;
             }
             next = value.wrapping_add(1);
-            enumerators.push(Enumerator { name: en.name.name.clone(), value, doc: en.doc.clone(), loc: en.name.loc });
+            enumerators.push(Enumerator {
+                name: en.name.name.clone(),
+                value,
+                doc: en.doc.clone(),
+                loc: en.name.loc,
+            });
             // Enumerators live in the enum's enclosing scope (IDL 4.2 §7.4.1.4.4.4.3).
             if let DeclKind::Enum(x) = &mut self.model.decls[id].kind {
                 x.enumerators = enumerators.clone();
@@ -602,23 +798,42 @@ impl<'a> Resolver<'a> {
 
     fn bitmask_def(&mut self, b: &ast::BitmaskDef, d: &Definition) {
         let anns = self.annotations(&d.annotations, Place::Bitmask);
-        let Some(id) = self.type_decl(&b.name, &d.doc, d.loc, None) else { return };
-        let bit_bound = anns.bit_bound.and_then(|e| self.eval_u64(e, "@bit_bound", 1)).unwrap_or(32) as u32;
+        let Some(id) = self.type_decl(&b.name, &d.doc, d.loc, None) else {
+            return;
+        };
+        let bit_bound = anns
+            .bit_bound
+            .and_then(|e| self.eval_u64(e, "@bit_bound", 1))
+            .unwrap_or(32) as u32;
         if !(1..=64).contains(&bit_bound) {
             let msg = format!("@bit_bound({bit_bound}) on a bitmask must be 1..=64");
-            self.diags.push(Diagnostic::error(Code::BitBound, msg).at(d.loc, "in this bitmask"));
+            self.diags
+                .push(Diagnostic::error(Code::BitBound, msg).at(d.loc, "in this bitmask"));
         }
         let mut flags = Vec::new();
         let mut next = 0u64;
         for v in &b.values {
             let va = self.annotations(&v.annotations, Place::BitFlag);
-            let pos = va.position.and_then(|e| self.eval_u64(e, "@position", 0)).unwrap_or(next);
+            let pos = va
+                .position
+                .and_then(|e| self.eval_u64(e, "@position", 0))
+                .unwrap_or(next);
             if pos >= bit_bound as u64 {
-                let msg = format!("bit position {pos} of `{}` is outside @bit_bound({bit_bound})", v.name.name);
-                self.diags.push(Diagnostic::error(Code::BitBound, msg).at(v.name.loc, "position too large"));
+                let msg = format!(
+                    "bit position {pos} of `{}` is outside @bit_bound({bit_bound})",
+                    v.name.name
+                );
+                self.diags.push(
+                    Diagnostic::error(Code::BitBound, msg).at(v.name.loc, "position too large"),
+                );
             }
             next = pos + 1;
-            flags.push(Flag { name: v.name.name.clone(), position: pos.min(63) as u32, doc: v.doc.clone(), loc: v.name.loc });
+            flags.push(Flag {
+                name: v.name.name.clone(),
+                position: pos.min(63) as u32,
+                doc: v.doc.clone(),
+                loc: v.name.loc,
+            });
         }
         self.model.decls[id].kind = DeclKind::Bitmask(Bitmask { flags, bit_bound });
         self.model.decls[id].verbatim = anns.verbatim;
@@ -626,7 +841,9 @@ impl<'a> Resolver<'a> {
 
     fn bitset_def(&mut self, b: &ast::BitsetDef, d: &Definition) {
         let anns = self.annotations(&d.annotations, Place::Bitset);
-        let Some(id) = self.type_decl(&b.name, &d.doc, d.loc, None) else { return };
+        let Some(id) = self.type_decl(&b.name, &d.doc, d.loc, None) else {
+            return;
+        };
         let mut fields = Vec::new();
         let mut offset = 0u32;
         let mut base_id = None;
@@ -641,13 +858,15 @@ impl<'a> Resolver<'a> {
                     }
                     _ => {
                         let msg = format!("`{}` is not a bitset", bn.text());
-                        self.diags.push(Diagnostic::error(Code::BadBase, msg).at(bn.loc, "not a bitset"));
+                        self.diags
+                            .push(Diagnostic::error(Code::BadBase, msg).at(bn.loc, "not a bitset"));
                     }
                 },
                 Type::Error => {}
                 _ => {
                     let msg = format!("`{}` is not a bitset", bn.text());
-                    self.diags.push(Diagnostic::error(Code::BadBase, msg).at(bn.loc, "not a bitset"));
+                    self.diags
+                        .push(Diagnostic::error(Code::BadBase, msg).at(bn.loc, "not a bitset"));
                 }
             }
         }
@@ -655,7 +874,10 @@ impl<'a> Resolver<'a> {
             let _ = self.annotations(&f.annotations, Place::Bitfield);
             let width = self.eval_u64(&f.width, "bitfield width", 1).unwrap_or(1);
             if width > 64 {
-                self.diags.push(Diagnostic::error(Code::BitBound, format!("bitfield width {width} exceeds 64")).at(f.width.loc, "too wide"));
+                self.diags.push(
+                    Diagnostic::error(Code::BitBound, format!("bitfield width {width} exceeds 64"))
+                        .at(f.width.loc, "too wide"),
+                );
                 continue;
             }
             let width = width as u32;
@@ -674,20 +896,43 @@ impl<'a> Resolver<'a> {
                 _ => 64,
             };
             if width > cap {
-                let msg = format!("bitfield<{width}> does not fit in its type `{}`", dest.idl_name());
-                self.diags.push(Diagnostic::error(Code::BitBound, msg).at(f.loc, "too wide for the type"));
+                let msg = format!(
+                    "bitfield<{width}> does not fit in its type `{}`",
+                    dest.idl_name()
+                );
+                self.diags.push(
+                    Diagnostic::error(Code::BitBound, msg).at(f.loc, "too wide for the type"),
+                );
             }
-            let names: Vec<Option<String>> = if f.names.is_empty() { vec![None] } else { f.names.iter().map(|n| Some(n.name.clone())).collect() };
+            let names: Vec<Option<String>> = if f.names.is_empty() {
+                vec![None]
+            } else {
+                f.names.iter().map(|n| Some(n.name.clone())).collect()
+            };
             for name in names {
-                fields.push(BitField { name, offset, width, dest, loc: f.loc });
+                fields.push(BitField {
+                    name,
+                    offset,
+                    width,
+                    dest,
+                    loc: f.loc,
+                });
                 offset += width;
             }
         }
         if offset > 64 {
-            let msg = format!("bitset `{}` holds {offset} bits; at most 64 are allowed", b.name.name);
-            self.diags.push(Diagnostic::error(Code::BitBound, msg).at(b.name.loc, "too many bits"));
+            let msg = format!(
+                "bitset `{}` holds {offset} bits; at most 64 are allowed",
+                b.name.name
+            );
+            self.diags
+                .push(Diagnostic::error(Code::BitBound, msg).at(b.name.loc, "too many bits"));
         }
-        self.model.decls[id].kind = DeclKind::Bitset(Bitset { base: base_id, fields, bits: offset });
+        self.model.decls[id].kind = DeclKind::Bitset(Bitset {
+            base: base_id,
+            fields,
+            bits: offset,
+        });
         self.model.decls[id].verbatim = anns.verbatim;
     }
 
@@ -699,7 +944,10 @@ impl<'a> Resolver<'a> {
                 let before = self.model.decls.len();
                 self.definition(inner);
                 match self.model.decls.get(before) {
-                    Some(_) => Type::Named { decl: before, name: self.model.decls[before].scoped_name() },
+                    Some(_) => Type::Named {
+                        decl: before,
+                        name: self.model.decls[before].scoped_name(),
+                    },
                     None => Type::Error,
                 }
             }
@@ -707,7 +955,9 @@ impl<'a> Resolver<'a> {
         let _ = anns;
         for dcl in &t.declarators {
             let ty = self.with_dims(base.clone(), &dcl.dims);
-            let Some(id) = self.type_decl(&dcl.name, &d.doc, d.loc, None) else { continue };
+            let Some(id) = self.type_decl(&dcl.name, &d.doc, d.loc, None) else {
+                continue;
+            };
             self.model.decls[id].kind = DeclKind::Alias { ty };
         }
     }
@@ -716,14 +966,27 @@ impl<'a> Resolver<'a> {
         let _ = self.annotations(&d.annotations, Place::Const);
         let ty = self.lower_type(&c.ty);
         let resolved = self.model.resolve_alias(&ty).clone();
-        let ok = matches!(resolved, Type::Prim { .. } | Type::String { .. } | Type::Fixed { .. } | Type::Error)
-            || matches!(&resolved, Type::Named { decl, .. } if matches!(self.model.decls[*decl].kind, DeclKind::Enum(_)));
+        let ok = matches!(
+            resolved,
+            Type::Prim { .. } | Type::String { .. } | Type::Fixed { .. } | Type::Error
+        ) || matches!(&resolved, Type::Named { decl, .. } if matches!(self.model.decls[*decl].kind, DeclKind::Enum(_)));
         if !ok {
-            let msg = format!("constants of type `{}` are not allowed", self.type_name(&ty));
-            self.diags.push(Diagnostic::error(Code::ConstType, msg).at(c.ty.loc(), "invalid constant type"));
+            let msg = format!(
+                "constants of type `{}` are not allowed",
+                self.type_name(&ty)
+            );
+            self.diags.push(
+                Diagnostic::error(Code::ConstType, msg).at(c.ty.loc(), "invalid constant type"),
+            );
         }
-        let value = if ok { self.eval_as(&c.value, &ty) } else { None };
-        let Some(id) = self.type_decl(&c.name, &d.doc, d.loc, None) else { return };
+        let value = if ok {
+            self.eval_as(&c.value, &ty)
+        } else {
+            None
+        };
+        let Some(id) = self.type_decl(&c.name, &d.doc, d.loc, None) else {
+            return;
+        };
         match value {
             Some(value) => self.model.decls[id].kind = DeclKind::Const(Const { ty, value }),
             None => {
@@ -731,20 +994,31 @@ impl<'a> Resolver<'a> {
                 let zero = match resolved {
                     Type::String { .. } => Value::Str(String::new()),
                     Type::Prim { prim: Prim::Bool } => Value::Bool(false),
-                    Type::Prim { prim: Prim::F32 | Prim::F64 | Prim::F128 } => Value::Float(0.0),
+                    Type::Prim {
+                        prim: Prim::F32 | Prim::F64 | Prim::F128,
+                    } => Value::Float(0.0),
                     _ => Value::Int(0),
                 };
-                self.model.decls[id].kind = DeclKind::Const(Const { ty: Type::Error, value: zero });
+                self.model.decls[id].kind = DeclKind::Const(Const {
+                    ty: Type::Error,
+                    value: zero,
+                });
             }
         }
     }
 
     fn keylist(&mut self, ty: &ScopedName, keys: &[Vec<ast::Ident>]) {
-        let Some(sym) = self.resolve_name(ty, "type") else { return };
+        let Some(sym) = self.resolve_name(ty, "type") else {
+            return;
+        };
         let Sym::Decl(id) = sym else { return };
         let DeclKind::Struct(st) = &mut self.model.decls[id].kind else {
-            let msg = format!("`#pragma keylist` names `{}`, which is not a struct", ty.text());
-            self.diags.push(Diagnostic::error(Code::NotAType, msg).at(ty.loc, "not a struct"));
+            let msg = format!(
+                "`#pragma keylist` names `{}`, which is not a struct",
+                ty.text()
+            );
+            self.diags
+                .push(Diagnostic::error(Code::NotAType, msg).at(ty.loc, "not a struct"));
             return;
         };
         let mut missing = Vec::new();
@@ -757,7 +1031,15 @@ impl<'a> Resolver<'a> {
         }
         let names: Vec<String> = st.fields.iter().map(|f| f.name.clone()).collect();
         for m in missing {
-            let mut diag = Diagnostic::error(Code::Unresolved, format!("`#pragma keylist`: `{}` has no member `{}`", ty.text(), m.name)).at(m.loc, "no such member");
+            let mut diag = Diagnostic::error(
+                Code::Unresolved,
+                format!(
+                    "`#pragma keylist`: `{}` has no member `{}`",
+                    ty.text(),
+                    m.name
+                ),
+            )
+            .at(m.loc, "no such member");
             if let Some(s) = suggest(&m.name, names.iter().map(String::as_str)) {
                 diag = diag.help(format!("did you mean `{s}`?"));
             }
@@ -767,9 +1049,33 @@ impl<'a> Resolver<'a> {
 }
 
 const BUILTIN_NAMES: &[&str] = &[
-    "id", "autoid", "hashid", "key", "optional", "external", "must_understand", "extensibility", "final", "appendable",
-    "mutable", "value", "position", "bit_bound", "default", "default_literal", "range", "min", "max", "unit", "nested",
-    "default_nested", "topic", "data_representation", "try_construct", "verbatim", "non_serialized",
+    "id",
+    "autoid",
+    "hashid",
+    "key",
+    "optional",
+    "external",
+    "must_understand",
+    "extensibility",
+    "final",
+    "appendable",
+    "mutable",
+    "value",
+    "position",
+    "bit_bound",
+    "default",
+    "default_literal",
+    "range",
+    "min",
+    "max",
+    "unit",
+    "nested",
+    "default_nested",
+    "topic",
+    "data_representation",
+    "try_construct",
+    "verbatim",
+    "non_serialized",
 ];
 
 impl Resolver<'_> {

@@ -28,11 +28,21 @@ pub struct Scopes {
 pub enum Lookup {
     Found(Sym, Loc),
     /// Found, but spelled with different case.
-    CaseMismatch { found: String, sym: Sym, loc: Loc },
+    CaseMismatch {
+        found: String,
+        sym: Sym,
+        loc: Loc,
+    },
     /// Stopped at `stop` (a scope that exists) where `missing` was not found.
-    NotFound { missing: String, scope: String },
+    NotFound {
+        missing: String,
+        scope: String,
+    },
     /// The first component resolved in a nearer scope that lacks the rest, while an outer scope has it all.
-    Shadowed { near: String, far: String },
+    Shadowed {
+        near: String,
+        far: String,
+    },
 }
 
 pub fn key(path: &[String]) -> String {
@@ -51,13 +61,27 @@ impl Scopes {
         if let Some(e) = s.get(&k) {
             return Err(e.clone());
         }
-        s.insert(k, Entry { name: name.to_string(), sym, loc });
+        s.insert(
+            k,
+            Entry {
+                name: name.to_string(),
+                sym,
+                loc,
+            },
+        );
         Ok(())
     }
 
     pub fn replace(&mut self, scope: &str, name: &str, sym: Sym, loc: Loc) {
         let s = self.scopes.entry(scope.to_string()).or_default();
-        s.insert(name.to_ascii_lowercase(), Entry { name: name.to_string(), sym, loc });
+        s.insert(
+            name.to_ascii_lowercase(),
+            Entry {
+                name: name.to_string(),
+                sym,
+                loc,
+            },
+        );
     }
 
     /// Names visible from `from` (for suggestions).
@@ -73,12 +97,25 @@ impl Scopes {
 
     /// Names declared directly in a scope.
     pub fn names_in(&self, scope: &str) -> Vec<String> {
-        self.scopes.get(scope).map(|s| s.values().map(|e| e.name.clone()).collect()).unwrap_or_default()
+        self.scopes
+            .get(scope)
+            .map(|s| s.values().map(|e| e.name.clone()).collect())
+            .unwrap_or_default()
     }
 
-    fn resolve_rest(&self, start_scope: &str, first: &Entry, rest: &[String], enum_members: &dyn Fn(DeclId, &str) -> Option<usize>) -> Result<(Sym, Loc, bool), (String, String)> {
+    fn resolve_rest(
+        &self,
+        start_scope: &str,
+        first: &Entry,
+        rest: &[String],
+        enum_members: &dyn Fn(DeclId, &str) -> Option<usize>,
+    ) -> Result<(Sym, Loc, bool), (String, String)> {
         let mut cur = first.clone();
-        let mut scope = if start_scope.is_empty() { first.name.clone() } else { format!("{start_scope}::{}", first.name) };
+        let mut scope = if start_scope.is_empty() {
+            first.name.clone()
+        } else {
+            format!("{start_scope}::{}", first.name)
+        };
         let mut case_ok = true;
         for part in rest {
             match cur.sym {
@@ -101,29 +138,49 @@ impl Scopes {
         Ok((cur.sym, cur.loc, case_ok))
     }
 
-    pub fn lookup(&self, name: &ScopedName, from: &[String], enum_members: &dyn Fn(DeclId, &str) -> Option<usize>) -> Lookup {
+    pub fn lookup(
+        &self,
+        name: &ScopedName,
+        from: &[String],
+        enum_members: &dyn Fn(DeclId, &str) -> Option<usize>,
+    ) -> Lookup {
         let parts: Vec<String> = name.parts.iter().map(|p| p.name.clone()).collect();
-        let starts: Vec<usize> = if name.absolute { vec![0] } else { (0..=from.len()).rev().collect() };
+        let starts: Vec<usize> = if name.absolute {
+            vec![0]
+        } else {
+            (0..=from.len()).rev().collect()
+        };
         let mut first_failure: Option<(String, String, String)> = None;
         for i in starts {
             let scope = key(&from[..i]);
-            let Some(first) = self.get(&scope, &parts[0]) else { continue };
+            let Some(first) = self.get(&scope, &parts[0]) else {
+                continue;
+            };
             match self.resolve_rest(&scope, first, &parts[1..], enum_members) {
                 Ok((sym, loc, case_ok)) => {
                     if let Some((_, _, near)) = first_failure {
-                        let far = if scope.is_empty() { format!("::{}", parts.join("::")) } else { format!("::{scope}::{}", parts.join("::")) };
+                        let far = if scope.is_empty() {
+                            format!("::{}", parts.join("::"))
+                        } else {
+                            format!("::{scope}::{}", parts.join("::"))
+                        };
                         return Lookup::Shadowed { near, far };
                     }
                     if !case_ok || first.name != parts[0] {
-                        let found = if scope.is_empty() { parts.join("::") } else { parts.join("::") };
-                        let found = self.spelled(&scope, &parts).unwrap_or(found);
+                        let found = self
+                            .spelled(&scope, &parts)
+                            .unwrap_or_else(|| parts.join("::"));
                         return Lookup::CaseMismatch { found, sym, loc };
                     }
                     return Lookup::Found(sym, loc);
                 }
                 Err((missing, sc)) => {
                     if first_failure.is_none() {
-                        let near = if scope.is_empty() { first.name.clone() } else { format!("{scope}::{}", first.name) };
+                        let near = if scope.is_empty() {
+                            first.name.clone()
+                        } else {
+                            format!("{scope}::{}", first.name)
+                        };
                         first_failure = Some((missing, sc, near));
                     }
                 }
@@ -131,7 +188,10 @@ impl Scopes {
         }
         match first_failure {
             Some((missing, scope, _)) => Lookup::NotFound { missing, scope },
-            None => Lookup::NotFound { missing: parts[0].clone(), scope: String::new() },
+            None => Lookup::NotFound {
+                missing: parts[0].clone(),
+                scope: String::new(),
+            },
         }
     }
 
@@ -142,7 +202,11 @@ impl Scopes {
         for p in parts {
             let e = self.get(&sc, p)?;
             out.push(e.name.clone());
-            sc = if sc.is_empty() { e.name.clone() } else { format!("{sc}::{}", e.name) };
+            sc = if sc.is_empty() {
+                e.name.clone()
+            } else {
+                format!("{sc}::{}", e.name)
+            };
             if !matches!(e.sym, Sym::Module) {
                 break;
             }

@@ -67,11 +67,24 @@ fn check_struct(model: &Model, _id: DeclId, s: &Struct, diags: &mut Diagnostics)
     for f in &fields {
         if let Some(prev) = seen.get(&f.name.to_ascii_lowercase()) {
             let (code, msg) = if prev.name == f.name {
-                (Code::DuplicateMember, format!("member `{}` is declared twice", f.name))
+                (
+                    Code::DuplicateMember,
+                    format!("member `{}` is declared twice", f.name),
+                )
             } else {
-                (Code::CaseCollision, format!("member `{}` collides with `{}`: names must differ by more than case", f.name, prev.name))
+                (
+                    Code::CaseCollision,
+                    format!(
+                        "member `{}` collides with `{}`: names must differ by more than case",
+                        f.name, prev.name
+                    ),
+                )
             };
-            diags.push(Diagnostic::error(code, msg).at(f.loc, "redeclared here").also(prev.loc, "first declared here"));
+            diags.push(
+                Diagnostic::error(code, msg)
+                    .at(f.loc, "redeclared here")
+                    .also(prev.loc, "first declared here"),
+            );
         } else {
             seen.insert(f.name.to_ascii_lowercase(), f);
         }
@@ -81,7 +94,10 @@ fn check_struct(model: &Model, _id: DeclId, s: &Struct, diags: &mut Diagnostics)
     let mut by_id: HashMap<u32, &Field> = HashMap::new();
     for (f, id) in fields.iter().zip(ids) {
         if let Some(prev) = by_id.insert(id, f) {
-            let msg = format!("members `{}` and `{}` both have member id {id}", prev.name, f.name);
+            let msg = format!(
+                "members `{}` and `{}` both have member id {id}",
+                prev.name, f.name
+            );
             diags.push(
                 Diagnostic::error(Code::DuplicateId, msg)
                     .at(f.loc, format!("id {id}"))
@@ -92,7 +108,10 @@ fn check_struct(model: &Model, _id: DeclId, s: &Struct, diags: &mut Diagnostics)
     }
     // A derived struct may not add keys to a keyed base (XTypes 1.3 §7.2.2.4.4.4.3).
     if s.base.is_some() {
-        let base_keyed = fields.len() > s.fields.len() && fields[..fields.len() - s.fields.len()].iter().any(|f| f.key);
+        let base_keyed = fields.len() > s.fields.len()
+            && fields[..fields.len() - s.fields.len()]
+                .iter()
+                .any(|f| f.key);
         if base_keyed {
             for f in s.fields.iter().filter(|f| f.key) {
                 let msg = format!("derived struct adds key member `{}`", f.name);
@@ -113,16 +132,23 @@ fn check_union(model: &Model, u: &Union, diags: &mut Diagnostics) {
     for c in &u.cases {
         if let Some(prev) = names.get(&c.name.to_ascii_lowercase()) {
             let msg = format!("union member `{}` is declared twice", c.name);
-            diags.push(Diagnostic::error(Code::DuplicateMember, msg).at(c.loc, "redeclared here").also(prev.loc, "first declared here"));
+            diags.push(
+                Diagnostic::error(Code::DuplicateMember, msg)
+                    .at(c.loc, "redeclared here")
+                    .also(prev.loc, "first declared here"),
+            );
         } else {
             names.insert(c.name.to_ascii_lowercase(), c);
         }
         if let Some(loc) = c.default_loc {
             if let Some(prev) = default {
                 diags.push(
-                    Diagnostic::error(Code::SeveralDefaults, "union has more than one `default` label")
-                        .at(loc, "second default")
-                        .also(prev, "first default"),
+                    Diagnostic::error(
+                        Code::SeveralDefaults,
+                        "union has more than one `default` label",
+                    )
+                    .at(loc, "second default")
+                    .also(prev, "first default"),
                 );
             }
             default = Some(loc);
@@ -130,7 +156,11 @@ fn check_union(model: &Model, u: &Union, diags: &mut Diagnostics) {
         for (v, loc) in c.labels.iter().zip(&c.label_locs) {
             if let Some((_, prev)) = seen.iter().find(|(p, _)| *p == v) {
                 let msg = format!("duplicate case label {}", show(model, v));
-                diags.push(Diagnostic::error(Code::DuplicateLabel, msg).at(*loc, "repeated here").also(*prev, "first used here"));
+                diags.push(
+                    Diagnostic::error(Code::DuplicateLabel, msg)
+                        .at(*loc, "repeated here")
+                        .also(*prev, "first used here"),
+                );
             } else {
                 seen.push((v, *loc));
             }
@@ -142,18 +172,29 @@ fn check_union(model: &Model, u: &Union, diags: &mut Diagnostics) {
 }
 
 /// A `default:` is only meaningful when some discriminator value has no label (enums and booleans are finite).
-fn check_unreachable_default(model: &Model, u: &Union, default: crate::source::Loc, diags: &mut Diagnostics) {
+fn check_unreachable_default(
+    model: &Model,
+    u: &Union,
+    default: crate::source::Loc,
+    diags: &mut Diagnostics,
+) {
     let total = match model.resolve_alias(&u.discriminator) {
         Type::Named { decl, .. } => match &model.decls[*decl].kind {
             DeclKind::Enum(e) => e.enumerators.len(),
             _ => return,
         },
-        Type::Prim { prim: crate::ast::Prim::Bool } => 2,
+        Type::Prim {
+            prim: crate::ast::Prim::Bool,
+        } => 2,
         _ => return,
     };
     let mut labels: Vec<&Value> = u.cases.iter().flat_map(|c| c.labels.iter()).collect();
     labels.dedup();
-    let distinct = labels.iter().enumerate().filter(|(i, v)| !labels[..*i].contains(v)).count();
+    let distinct = labels
+        .iter()
+        .enumerate()
+        .filter(|(i, v)| !labels[..*i].contains(v))
+        .count();
     if distinct >= total {
         diags.push(
             Diagnostic::error(Code::UnreachableDefault, "the `default` member can never be selected")
@@ -180,8 +221,15 @@ fn check_enum(e: &Enum, diags: &mut Diagnostics) {
     let mut seen: HashMap<i64, &Enumerator> = HashMap::new();
     for en in &e.enumerators {
         if let Some(prev) = seen.insert(en.value, en) {
-            let msg = format!("enumerators `{}` and `{}` have the same value {}", prev.name, en.name, en.value);
-            diags.push(Diagnostic::error(Code::DuplicateValue, msg).at(en.loc, "same value").also(prev.loc, "first here"));
+            let msg = format!(
+                "enumerators `{}` and `{}` have the same value {}",
+                prev.name, en.name, en.value
+            );
+            diags.push(
+                Diagnostic::error(Code::DuplicateValue, msg)
+                    .at(en.loc, "same value")
+                    .also(prev.loc, "first here"),
+            );
         }
     }
 }
@@ -190,8 +238,15 @@ fn check_bitmask(b: &Bitmask, diags: &mut Diagnostics) {
     let mut seen: HashMap<u32, &Flag> = HashMap::new();
     for f in &b.flags {
         if let Some(prev) = seen.insert(f.position, f) {
-            let msg = format!("flags `{}` and `{}` have the same position {}", prev.name, f.name, f.position);
-            diags.push(Diagnostic::error(Code::DuplicateValue, msg).at(f.loc, "same position").also(prev.loc, "first here"));
+            let msg = format!(
+                "flags `{}` and `{}` have the same position {}",
+                prev.name, f.name, f.position
+            );
+            diags.push(
+                Diagnostic::error(Code::DuplicateValue, msg)
+                    .at(f.loc, "same position")
+                    .also(prev.loc, "first here"),
+            );
         }
     }
 }
@@ -224,7 +279,14 @@ fn check_infinite(model: &Model, diags: &mut Diagnostics) {
         match &d.kind {
             DeclKind::Struct(s) => {
                 if let Some(b) = s.base {
-                    push(&Type::Named { decl: b, name: String::new() }, false, d.loc);
+                    push(
+                        &Type::Named {
+                            decl: b,
+                            name: String::new(),
+                        },
+                        false,
+                        d.loc,
+                    );
                 }
                 for f in &s.fields {
                     push(&f.ty, f.external, f.loc);
@@ -251,7 +313,10 @@ fn check_infinite(model: &Model, diags: &mut Diagnostics) {
                 stack.push((node, i + 1));
                 let (next, loc) = edges[node][i];
                 if colour[next] == 1 {
-                    let msg = format!("`{}` contains itself by value and would have infinite size", model.decls[next].scoped_name());
+                    let msg = format!(
+                        "`{}` contains itself by value and would have infinite size",
+                        model.decls[next].scoped_name()
+                    );
                     diags.push(
                         Diagnostic::error(Code::InfiniteType, msg)
                             .at(loc, "recursive without indirection")

@@ -365,6 +365,12 @@ int run_subscriber(const Options& o, DomainParticipant* dp, Topic* topic) {
             if (rc != ReturnCode_t::RETCODE_OK) break;
             for (LoanableCollection::size_type i = 0; i < samples.length(); ++i) {
                 const SampleInfo& info = infos[i];
+                if (std::getenv("SHAPE_DEBUG") != nullptr) {
+                    std::fprintf(stderr, "sample valid=%d state=%d handle=", info.valid_data ? 1 : 0,
+                                 static_cast<int>(info.instance_state));
+                    for (int b = 0; b < 16; ++b) std::fprintf(stderr, "%02x", info.instance_handle.value[b]);
+                    std::fprintf(stderr, "\n");
+                }
                 if (info.valid_data) {
                     instance_color[info.instance_handle] = samples[i].color;
                     if (o.color.empty() || samples[i].color == o.color) print_shape(o.topic, samples[i]);

@@ -21,7 +21,12 @@ fn ours(label: &str, args: &str) -> Result<Proc, Skip> {
 /// Parses `... total N lost L delta ...` from a sub line.
 fn sub_totals(line: &str) -> Option<(u64, u64)> {
     let w: Vec<&str> = line.split_whitespace().collect();
-    let at = |k: &str| w.iter().position(|x| *x == k).and_then(|i| w.get(i + 1)).and_then(|v| v.parse().ok());
+    let at = |k: &str| {
+        w.iter()
+            .position(|x| *x == k)
+            .and_then(|i| w.get(i + 1))
+            .and_then(|v| v.parse().ok())
+    };
     Some((at("total")?, at("lost")?))
 }
 
@@ -34,7 +39,8 @@ fn latency_count(l: &str) -> Option<u64> {
     if !l.contains(" mean ") || !l.contains("us min ") {
         return None;
     }
-    l.rsplit_once(" cnt ").and_then(|(_, n)| n.trim().parse().ok())
+    l.rsplit_once(" cnt ")
+        .and_then(|(_, n)| n.trim().parse().ok())
 }
 
 /// A subscriber's run: at least `min_total` received, no loss reported anywhere, clean exit.
@@ -43,14 +49,37 @@ fn check_sub(sub: &mut Proc, publ: &mut Proc, min_total: u64) {
     let ss = sub.wait_exit(Duration::from_secs(30));
     let last = sub.grep(is_sub_line).pop();
     let totals = last.as_deref().and_then(sub_totals);
-    check!(totals.is_some_and(|(t, _)| t >= min_total), &[&*publ, &*sub], "too few samples: {totals:?}");
+    check!(
+        totals.is_some_and(|(t, _)| t >= min_total),
+        &[&*publ, &*sub],
+        "too few samples: {totals:?}"
+    );
     for l in sub.grep(is_sub_line) {
-        check!(sub_totals(&l).is_some_and(|(_, lost)| lost == 0), &[&*publ, &*sub], "loss reported: {l}");
+        check!(
+            sub_totals(&l).is_some_and(|(_, lost)| lost == 0),
+            &[&*publ, &*sub],
+            "loss reported: {l}"
+        );
     }
-    let errors = [&*publ, &*sub].iter().flat_map(|p| p.grep(|l| l.contains("error") || l.contains("failed to match"))).collect::<Vec<_>>();
-    check!(errors.is_empty(), &[&*publ, &*sub], "errors reported: {errors:?}");
-    check!(ps.is_some_and(|s| s.success()), &[&*publ], "publisher exit {ps:?}");
-    check!(ss.is_some_and(|s| s.success()), &[&*sub], "subscriber exit {ss:?}");
+    let errors = [&*publ, &*sub]
+        .iter()
+        .flat_map(|p| p.grep(|l| l.contains("error") || l.contains("failed to match")))
+        .collect::<Vec<_>>();
+    check!(
+        errors.is_empty(),
+        &[&*publ, &*sub],
+        "errors reported: {errors:?}"
+    );
+    check!(
+        ps.is_some_and(|s| s.success()),
+        &[&*publ],
+        "publisher exit {ps:?}"
+    );
+    check!(
+        ss.is_some_and(|s| s.success()),
+        &[&*sub],
+        "subscriber exit {ss:?}"
+    );
 }
 
 #[test]
@@ -109,12 +138,35 @@ fn keyed_k256_ours_to_ddsperf() -> Result<(), Skip> {
 fn check_pingpong(ping: &mut Proc, pong: &mut Proc) {
     let pi = ping.wait_exit(Duration::from_secs(30));
     let po = pong.wait_exit(Duration::from_secs(30));
-    let counts: Vec<u64> = ping.lines().iter().filter_map(|l| latency_count(l)).collect();
-    check!(counts.len() >= 2 && counts.iter().sum::<u64>() >= 1000, &[&*ping, &*pong], "too few round trips: {counts:?}");
-    let errors = [&*ping, &*pong].iter().flat_map(|p| p.grep(|l| l.contains("error") || l.contains("failed to match"))).collect::<Vec<_>>();
-    check!(errors.is_empty(), &[&*ping, &*pong], "errors reported: {errors:?}");
-    check!(pi.is_some_and(|s| s.success()), &[&*ping], "ping exit {pi:?}");
-    check!(po.is_some_and(|s| s.success()), &[&*pong], "pong exit {po:?}");
+    let counts: Vec<u64> = ping
+        .lines()
+        .iter()
+        .filter_map(|l| latency_count(l))
+        .collect();
+    check!(
+        counts.len() >= 2 && counts.iter().sum::<u64>() >= 1000,
+        &[&*ping, &*pong],
+        "too few round trips: {counts:?}"
+    );
+    let errors = [&*ping, &*pong]
+        .iter()
+        .flat_map(|p| p.grep(|l| l.contains("error") || l.contains("failed to match")))
+        .collect::<Vec<_>>();
+    check!(
+        errors.is_empty(),
+        &[&*ping, &*pong],
+        "errors reported: {errors:?}"
+    );
+    check!(
+        pi.is_some_and(|s| s.success()),
+        &[&*ping],
+        "ping exit {pi:?}"
+    );
+    check!(
+        po.is_some_and(|s| s.success()),
+        &[&*pong],
+        "pong exit {po:?}"
+    );
 }
 
 #[test]

@@ -13,7 +13,10 @@ use std::time::{Duration, Instant};
 
 /// The workspace root (`tests/..`).
 pub fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("workspace root").to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("workspace root")
+        .to_path_buf()
 }
 
 fn in_ci() -> bool {
@@ -47,9 +50,14 @@ pub fn require_netns() -> Result<(), Skip> {
 /// One of our release binaries (`cargo build --release` first); `INTEROP_BIN_DIR` points elsewhere
 /// (e.g. target/debug) when iterating.
 pub fn our_bin(name: &str) -> Result<PathBuf, Skip> {
-    let dir = std::env::var_os("INTEROP_BIN_DIR").map(PathBuf::from).unwrap_or_else(|| root().join("target/release"));
+    let dir = std::env::var_os("INTEROP_BIN_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target/release"));
     let p = dir.join(name);
-    require(p.is_file(), &format!("{} not built (cargo build --release --bins)", p.display()))?;
+    require(
+        p.is_file(),
+        &format!("{} not built (cargo build --release --bins)", p.display()),
+    )?;
     Ok(p)
 }
 
@@ -66,7 +74,10 @@ fn probe(cmd: &str, args: &[&str]) -> bool {
 pub fn cyclone_peer() -> Result<PathBuf, Skip> {
     static OK: OnceLock<bool> = OnceLock::new();
     let ok = *OK.get_or_init(|| probe("python3", &["-c", "import cyclonedds.domain"]));
-    require(ok, "python3 with cyclonedds==11.0.1 (pip install cyclonedds==11.0.1)")?;
+    require(
+        ok,
+        "python3 with cyclonedds==11.0.1 (pip install cyclonedds==11.0.1)",
+    )?;
     Ok(root().join("tests/peers/cyclone_shape.py"))
 }
 
@@ -80,15 +91,25 @@ pub fn fastdds_peer() -> Result<PathBuf, Skip> {
             .is_ok_and(|s| s.success())
     });
     let p = root().join("target/peers/fastdds_shape_main");
-    require(ok && p.is_file(), "Fast DDS peer (apt-get install libfastrtps-dev g++; scripts/build-fastdds-peer.sh)")?;
+    require(
+        ok && p.is_file(),
+        "Fast DDS peer (apt-get install libfastrtps-dev g++; scripts/build-fastdds-peer.sh)",
+    )?;
     Ok(p)
 }
 
 /// Cyclone's `ddsperf` (Debian cyclonedds-tools).
 pub fn ddsperf() -> Result<PathBuf, Skip> {
     let p = PathBuf::from("/usr/bin/ddsperf");
-    let found = if p.is_file() { Some(p) } else { which("ddsperf") };
-    require(found.is_some(), "ddsperf (apt-get install cyclonedds-tools)")?;
+    let found = if p.is_file() {
+        Some(p)
+    } else {
+        which("ddsperf")
+    };
+    require(
+        found.is_some(),
+        "ddsperf (apt-get install cyclonedds-tools)",
+    )?;
     Ok(found.expect("checked"))
 }
 
@@ -124,8 +145,12 @@ pub struct Proc {
 impl Proc {
     /// Spawns `cmd` with piped output. `name` labels the dump on failure.
     pub fn spawn(name: &str, mut cmd: Command) -> Proc {
-        cmd.stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped());
-        let mut child = cmd.spawn().unwrap_or_else(|e| panic!("spawning {name} ({cmd:?}): {e}"));
+        cmd.stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        let mut child = cmd
+            .spawn()
+            .unwrap_or_else(|e| panic!("spawning {name} ({cmd:?}): {e}"));
         let out = Arc::new((Mutex::new(Output::default()), Condvar::new()));
         let stdout = child.stdout.take().expect("piped stdout");
         let stderr = child.stderr.take().expect("piped stderr");
@@ -133,7 +158,12 @@ impl Proc {
         thread::spawn(move || pump(stdout, o1, ""));
         let o2 = out.clone();
         thread::spawn(move || pump(stderr, o2, "stderr: "));
-        Proc { name: name.to_string(), child, out, status: None }
+        Proc {
+            name: name.to_string(),
+            child,
+            out,
+            status: None,
+        }
     }
 
     /// Waits until a line satisfies `pred`; returns it, or `None` at the deadline or when the output ends.
@@ -142,7 +172,12 @@ impl Proc {
     }
 
     /// Waits until `n` lines satisfy `pred`; returns them.
-    pub fn wait_lines(&self, timeout: Duration, n: usize, pred: impl Fn(&str) -> bool) -> Option<Vec<String>> {
+    pub fn wait_lines(
+        &self,
+        timeout: Duration,
+        n: usize,
+        pred: impl Fn(&str) -> bool,
+    ) -> Option<Vec<String>> {
         let deadline = Instant::now() + timeout;
         let (lock, cv) = &*self.out;
         let mut g = lock.lock().expect("output lock");
@@ -206,7 +241,10 @@ impl Proc {
     /// SIGINT (the programs' clean stop), then waits up to `timeout` for the exit.
     pub fn interrupt(&mut self, timeout: Duration) -> Option<ExitStatus> {
         if self.status.is_none() {
-            let _ = Command::new("kill").arg("-INT").arg(self.child.id().to_string()).status();
+            let _ = Command::new("kill")
+                .arg("-INT")
+                .arg(self.child.id().to_string())
+                .status();
         }
         self.wait_exit(timeout)
     }
@@ -241,9 +279,14 @@ fn pump(r: impl std::io::Read, out: Arc<(Mutex<Output>, Condvar)>, tag: &str) {
         match reader.read_until(b'\n', &mut buf) {
             Ok(0) | Err(_) => break,
             Ok(_) => {
-                let line = String::from_utf8_lossy(&buf).trim_end_matches(['\n', '\r']).to_string();
+                let line = String::from_utf8_lossy(&buf)
+                    .trim_end_matches(['\n', '\r'])
+                    .to_string();
                 let (lock, cv) = &*out;
-                lock.lock().expect("output lock").lines.push(format!("{tag}{line}"));
+                lock.lock()
+                    .expect("output lock")
+                    .lines
+                    .push(format!("{tag}{line}"));
                 cv.notify_all();
             }
         }

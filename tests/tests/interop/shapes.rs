@@ -42,7 +42,9 @@ const EXIT: Duration = Duration::from_secs(15);
 
 /// A sample line `%-10s %-10s %03d %03d [%d]` for `topic` and `color`.
 fn is_sample(line: &str, topic: &str, color: &str) -> bool {
-    line.starts_with(&format!("{topic:<10} {color:<10} ")) && line.contains(" [") && !line.contains("NOT_ALIVE")
+    line.starts_with(&format!("{topic:<10} {color:<10} "))
+        && line.contains(" [")
+        && !line.contains("NOT_ALIVE")
 }
 
 fn stop(p: &mut Proc) {
@@ -50,18 +52,44 @@ fn stop(p: &mut Proc) {
 }
 
 /// Publisher and subscriber match and the subscriber prints at least `n` samples.
-pub fn exchange(publ: Prog, sub: Prog, domain: u32, pub_extra: &str, sub_extra: &str, n: usize) -> Result<(), Skip> {
+pub fn exchange(
+    publ: Prog,
+    sub: Prog,
+    domain: u32,
+    pub_extra: &str,
+    sub_extra: &str,
+    n: usize,
+) -> Result<(), Skip> {
     require_netns()?;
     let mut s = sub.spawn("sub", &format!("-S -t Square -d {domain} {sub_extra}"))?;
-    let mut p = publ.spawn("pub", &format!("-P -t Square -d {domain} -c BLUE {pub_extra}"))?;
+    let mut p = publ.spawn(
+        "pub",
+        &format!("-P -t Square -d {domain} -c BLUE {pub_extra}"),
+    )?;
     let got = s.wait_lines(WAIT, n, |l| is_sample(l, "Square", "BLUE"));
-    check!(got.is_some(), &[&p, &s], "subscriber did not print {n} BLUE samples");
-    let pm = p.wait_line(Duration::from_secs(5), |l| l.starts_with("on_publication_matched()") && l.contains("matched readers 1"));
-    let sm = s.wait_line(Duration::from_secs(5), |l| l.starts_with("on_subscription_matched()") && l.contains("matched writers 1"));
-    check!(pm.is_some() && sm.is_some(), &[&p, &s], "matched lines missing");
+    check!(
+        got.is_some(),
+        &[&p, &s],
+        "subscriber did not print {n} BLUE samples"
+    );
+    let pm = p.wait_line(Duration::from_secs(5), |l| {
+        l.starts_with("on_publication_matched()") && l.contains("matched readers 1")
+    });
+    let sm = s.wait_line(Duration::from_secs(5), |l| {
+        l.starts_with("on_subscription_matched()") && l.contains("matched writers 1")
+    });
+    check!(
+        pm.is_some() && sm.is_some(),
+        &[&p, &s],
+        "matched lines missing"
+    );
     stop(&mut p);
     stop(&mut s);
-    check!(p.grep(|l| l == "Done.").len() == 1, &[&p], "publisher did not finish cleanly");
+    check!(
+        p.grep(|l| l == "Done.").len() == 1,
+        &[&p],
+        "publisher did not finish cleanly"
+    );
     Ok(())
 }
 
@@ -79,13 +107,29 @@ pub fn final_state(publ: Prog, sub: Prog, domain: u32, which: char, xcdr: u8) ->
         _ => "NOT_ALIVE_NO_WRITERS_INSTANCE_STATE",
     };
     let seen = s.wait_lines(WAIT, 3, |l| is_sample(l, "Circle", "RED"));
-    check!(seen.is_some(), &[&p, &s], "no RED samples before the final state");
+    check!(
+        seen.is_some(),
+        &[&p, &s],
+        "no RED samples before the final state"
+    );
     let line = s.wait_line(WAIT, |l| l.contains(expect));
-    check!(line.is_some(), &[&p, &s], "subscriber did not report {expect}");
+    check!(
+        line.is_some(),
+        &[&p, &s],
+        "subscriber did not report {expect}"
+    );
     let line = line.expect("checked");
-    check!(line == format!("{:<10} {:<10} {expect}", "Circle", "RED"), &[&p, &s], "state line names the instance: {line:?}");
+    check!(
+        line == format!("{:<10} {:<10} {expect}", "Circle", "RED"),
+        &[&p, &s],
+        "state line names the instance: {line:?}"
+    );
     let st = p.wait_exit(EXIT);
-    check!(st.is_some_and(|s| s.success()), &[&p], "publisher exit {st:?}");
+    check!(
+        st.is_some_and(|s| s.success()),
+        &[&p],
+        "publisher exit {st:?}"
+    );
     stop(&mut s);
     Ok(())
 }
@@ -103,7 +147,11 @@ pub fn late_joiner(publ: Prog, sub: Prog, domain: u32) -> Result<(), Skip> {
     let first = first.expect("checked");
     let mut s = sub.spawn("sub", &format!("-S -t Triangle -d {domain} -D l -k 1"))?;
     let got = s.wait_line(Duration::from_secs(5), |l| l == first);
-    check!(got.is_some(), &[&p, &s], "late joiner did not receive the historical sample {first:?}");
+    check!(
+        got.is_some(),
+        &[&p, &s],
+        "late joiner did not receive the historical sample {first:?}"
+    );
     stop(&mut p);
     stop(&mut s);
     Ok(())
@@ -117,7 +165,9 @@ pub fn large(publ: Prog, sub: Prog, domain: u32, xcdr: u8) -> Result<(), Skip> {
         "pub",
         &format!("-P -t Square -d {domain} -c ORANGE -x {xcdr} --write-period 100 --additional-payload-size 100000"),
     )?;
-    let got = s.wait_lines(WAIT, 3, |l| is_sample(l, "Square", "ORANGE") && l.ends_with(" {255}"));
+    let got = s.wait_lines(WAIT, 3, |l| {
+        is_sample(l, "Square", "ORANGE") && l.ends_with(" {255}")
+    });
     check!(got.is_some(), &[&p, &s], "no complete 100 kB samples");
     stop(&mut p);
     stop(&mut s);
@@ -131,11 +181,19 @@ pub fn partitions(publ: Prog, sub: Prog, domain: u32) -> Result<(), Skip> {
     let mut sb = sub.spawn("subB", &format!("-S -t Square -d {domain} -p B"))?;
     let mut p = publ.spawn("pub", &format!("-P -t Square -d {domain} -c PURPLE -p A"))?;
     let got = sa.wait_lines(WAIT, 5, |l| is_sample(l, "Square", "PURPLE"));
-    check!(got.is_some(), &[&p, &sa], "same-partition subscriber got nothing");
+    check!(
+        got.is_some(),
+        &[&p, &sa],
+        "same-partition subscriber got nothing"
+    );
     // Give the other partition time to (wrongly) match.
     std::thread::sleep(Duration::from_secs(2));
     let wrong = sb.grep(|l| is_sample(l, "Square", "PURPLE") || l.contains("matched writers 1"));
-    check!(wrong.is_empty(), &[&p, &sb], "partition B matched or received: {wrong:?}");
+    check!(
+        wrong.is_empty(),
+        &[&p, &sb],
+        "partition B matched or received: {wrong:?}"
+    );
     stop(&mut p);
     stop(&mut sa);
     stop(&mut sb);
@@ -150,11 +208,23 @@ pub fn incompatible(publ: Prog, sub: Prog, domain: u32) -> Result<(), Skip> {
     let mut p = publ.spawn("pub", &format!("-P -t Square -d {domain} -c YELLOW -b"))?;
     let sl = s.wait_line(WAIT, |l| l.starts_with("on_requested_incompatible_qos()"));
     let pl = p.wait_line(WAIT, |l| l.starts_with("on_offered_incompatible_qos()"));
-    check!(sl.as_deref().is_some_and(|l| l.ends_with("(RELIABILITY)")), &[&p, &s], "reader incompatible line");
-    check!(pl.as_deref().is_some_and(|l| l.ends_with("(RELIABILITY)")), &[&p, &s], "writer incompatible line");
+    check!(
+        sl.as_deref().is_some_and(|l| l.ends_with("(RELIABILITY)")),
+        &[&p, &s],
+        "reader incompatible line"
+    );
+    check!(
+        pl.as_deref().is_some_and(|l| l.ends_with("(RELIABILITY)")),
+        &[&p, &s],
+        "writer incompatible line"
+    );
     std::thread::sleep(Duration::from_secs(1));
     let data = s.grep(|l| is_sample(l, "Square", "YELLOW"));
-    check!(data.is_empty(), &[&p, &s], "incompatible pair exchanged data");
+    check!(
+        data.is_empty(),
+        &[&p, &s],
+        "incompatible pair exchanged data"
+    );
     stop(&mut p);
     stop(&mut s);
     Ok(())
@@ -167,9 +237,18 @@ pub fn representation_mismatch(publ: Prog, sub: Prog, domain: u32) -> Result<(),
     let mut s = sub.spawn("sub", &format!("-S -t Square -d {domain} -x 1"))?;
     let mut p = publ.spawn("pub", &format!("-P -t Square -d {domain} -c CYAN -x 2"))?;
     let pl = p.wait_line(WAIT, |l| l.starts_with("on_offered_incompatible_qos()"));
-    check!(pl.as_deref().is_some_and(|l| l.ends_with("(DATAREPRESENTATION)")), &[&p, &s], "writer incompatible line");
+    check!(
+        pl.as_deref()
+            .is_some_and(|l| l.ends_with("(DATAREPRESENTATION)")),
+        &[&p, &s],
+        "writer incompatible line"
+    );
     let data = s.grep(|l| is_sample(l, "Square", "CYAN"));
-    check!(data.is_empty(), &[&p, &s], "mismatched representations exchanged data");
+    check!(
+        data.is_empty(),
+        &[&p, &s],
+        "mismatched representations exchanged data"
+    );
     stop(&mut p);
     stop(&mut s);
     Ok(())

@@ -25,7 +25,16 @@ fn tshark_fields(cap: &str, filter: &str, fields: &[&str]) -> Vec<String> {
         c.args(["-e", f]);
     }
     let out = c.output().expect("running tshark -r");
-    String::from_utf8_lossy(&out.stdout).lines().map(String::from).collect()
+    // A rejected filter would otherwise read as "nothing found".
+    assert!(
+        out.status.success(),
+        "tshark -r -Y {filter:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(String::from)
+        .collect()
 }
 
 #[test]
@@ -54,11 +63,21 @@ fn run() -> Result<(), Skip> {
         &format!("-P -t Square -d {d} -c BLUE -D l -r --additional-payload-size 100000 --num-iterations 60 --final-instance-state d"),
     )?;
     let mut be_sub = spawn("be-sub", "shape_main", &format!("-S -t Circle -d {d} -b"))?;
-    let mut be_pub = spawn("be-pub", "shape_main", &format!("-P -t Circle -d {d} -c RED -b --num-iterations 60"))?;
+    let mut be_pub = spawn(
+        "be-pub",
+        "shape_main",
+        &format!("-P -t Circle -d {d} -c RED -b --num-iterations 60"),
+    )?;
     let mut pong = spawn("pong", "dds-perf", &format!("-i {d} -D 4 pong"))?;
     let mut ping = spawn("ping", "dds-perf", &format!("-i {d} -D 3 ping"))?;
-    let disposed = sub.wait_line(Duration::from_secs(30), |l| l.contains("NOT_ALIVE_DISPOSED_INSTANCE_STATE"));
-    check!(disposed.is_some(), &[&publ, &sub], "shape exchange did not complete");
+    let disposed = sub.wait_line(Duration::from_secs(30), |l| {
+        l.contains("NOT_ALIVE_DISPOSED_INSTANCE_STATE")
+    });
+    check!(
+        disposed.is_some(),
+        &[&publ, &sub],
+        "shape exchange did not complete"
+    );
     let _ = publ.wait_exit(Duration::from_secs(15));
     let _ = be_pub.wait_exit(Duration::from_secs(15));
     let _ = ping.wait_exit(Duration::from_secs(15));
@@ -71,7 +90,11 @@ fn run() -> Result<(), Skip> {
     let ours = format!("rtps.vendorId == {OUR_VENDOR}");
     let kinds: BTreeSet<String> = tshark_fields(&cap_s, &ours, &["rtps.sm.id"])
         .iter()
-        .flat_map(|l| l.split(',').map(|s| s.trim().to_string()).collect::<Vec<_>>())
+        .flat_map(|l| {
+            l.split(',')
+                .map(|s| s.trim().to_string())
+                .collect::<Vec<_>>()
+        })
         .filter(|s| !s.is_empty())
         .collect();
     let bad = tshark_fields(
@@ -79,10 +102,27 @@ fn run() -> Result<(), Skip> {
         &format!("{ours} && (_ws.malformed || _ws.expert.severity >= \"Warning\")"),
         &["frame.number", "_ws.col.Info", "_ws.expert.message"],
     );
-    check!(bad.is_empty(), &[&t], "tshark flags our packets ({} of them): {:?}", bad.len(), &bad[..bad.len().min(10)]);
+    check!(
+        bad.is_empty(),
+        &[&t],
+        "tshark flags our packets ({} of them): {:?}",
+        bad.len(),
+        &bad[..bad.len().min(10)]
+    );
     // DATA, DATA_FRAG, HEARTBEAT, ACKNACK, INFO_TS, INFO_DST must all have been sent (and decoded).
-    for (id, name) in [("0x15", "DATA"), ("0x16", "DATA_FRAG"), ("0x07", "HEARTBEAT"), ("0x06", "ACKNACK"), ("0x09", "INFO_TS"), ("0x0e", "INFO_DST")] {
-        check!(kinds.contains(id), &[&t], "no {name} ({id}) from us in the capture; kinds seen: {kinds:?}");
+    for (id, name) in [
+        ("0x15", "DATA"),
+        ("0x16", "DATA_FRAG"),
+        ("0x07", "HEARTBEAT"),
+        ("0x06", "ACKNACK"),
+        ("0x09", "INFO_TS"),
+        ("0x0e", "INFO_DST"),
+    ] {
+        check!(
+            kinds.contains(id),
+            &[&t],
+            "no {name} ({id}) from us in the capture; kinds seen: {kinds:?}"
+        );
     }
     eprintln!("submessage kinds we sent, all decoded cleanly: {kinds:?}");
     let _ = std::fs::remove_file(&cap);

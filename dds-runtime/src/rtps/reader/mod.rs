@@ -17,6 +17,13 @@ use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
 use defrag::Defrag;
 
+fn slot_size(s: &Slot) -> usize {
+    match s {
+        Slot::Change(c) => c.payload.len(),
+        Slot::Irrelevant => 0,
+    }
+}
+
 /// Whether every must-understand inline QoS parameter is one we know.
 fn inline_qos_understood(q: Option<&crate::rtps::messages::ParameterList<'_>>) -> bool {
     use crate::rtps::messages::parameter::pid;
@@ -40,6 +47,7 @@ pub struct ReaderParams {
     pub defrag_max_samples: usize,
     pub defrag_max_bytes: usize,
     pub reorder_max_samples: usize,
+    pub reorder_max_bytes: usize,
 }
 
 /// A local reader's protocol state.
@@ -111,6 +119,7 @@ impl Reader {
                 break;
             }
             let (sn, slot) = e.remove_entry();
+            p.reorder_bytes -= slot_size(&slot);
             if sn == p.next_expected {
                 Self::deliver(reader, p, sn, slot, out);
                 p.next_expected = sn.next();
@@ -130,8 +139,14 @@ impl Reader {
                 Self::deliver(rid, p, sn, slot, out);
                 p.next_expected = sn.next();
                 Self::drain(rid, p, out);
-            } else if p.reorder.len() < self.params.reorder_max_samples {
-                p.reorder.insert(sn, slot);
+            } else {
+                let size = slot_size(&slot);
+                if p.reorder.len() < self.params.reorder_max_samples
+                    && p.reorder_bytes + size <= self.params.reorder_max_bytes
+                {
+                    p.reorder_bytes += size;
+                    p.reorder.insert(sn, slot);
+                }
             }
         } else {
             if sn < p.next_expected {
@@ -302,6 +317,7 @@ impl Reader {
                     break;
                 }
                 let (sn, slot) = e.remove_entry();
+                p.reorder_bytes -= slot_size(&slot);
                 Self::deliver(rid, p, sn, slot, out);
             }
             p.next_expected = base;
@@ -352,6 +368,7 @@ impl Reader {
                     break;
                 }
                 let (k, slot) = e.remove_entry();
+                p.reorder_bytes -= slot_size(&slot);
                 if matches!(slot, Slot::Change(_)) {
                     lost += (k.0 - sn.0) as u64;
                     Self::deliver(rid, p, k, slot, out);

@@ -33,6 +33,8 @@ pub struct WriterProxy {
     /// Something (data, gap or heartbeat) was received from this writer.
     pub synced: bool,
     pub reorder: BTreeMap<SequenceNumber, Slot>,
+    /// Payload bytes held in `reorder`.
+    pub reorder_bytes: usize,
     pub hb_last: SequenceNumber,
     pub last_hb_count: Option<i32>,
     pub last_hbfrag_count: Option<i32>,
@@ -52,6 +54,7 @@ impl WriterProxy {
             next_expected: SequenceNumber(1),
             synced: false,
             reorder: BTreeMap::new(),
+            reorder_bytes: 0,
             hb_last: SequenceNumber(0),
             last_hb_count: None,
             last_hbfrag_count: None,

@@ -2,10 +2,11 @@
 //! SCREAMING_SNAKE_CASE; Rust keywords become raw identifiers.
 
 const KEYWORDS: &[&str] = &[
-    "as", "break", "const", "continue", "crate", "else", "enum", "extern", "false", "fn", "for", "if", "impl", "in",
-    "let", "loop", "match", "mod", "move", "mut", "pub", "ref", "return", "self", "Self", "static", "struct", "super",
-    "trait", "true", "type", "unsafe", "use", "where", "while", "async", "await", "dyn", "abstract", "become", "box",
-    "do", "final", "macro", "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
+    "as", "break", "const", "continue", "crate", "else", "enum", "extern", "false", "fn", "for",
+    "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub", "ref", "return",
+    "self", "Self", "static", "struct", "super", "trait", "true", "type", "unsafe", "use", "where",
+    "while", "async", "await", "dyn", "abstract", "become", "box", "do", "final", "macro",
+    "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
 ];
 
 /// Words into parts at underscores and case changes: `HTTPServer_id2` → [HTTP, Server, id2].
@@ -19,7 +20,10 @@ fn words(s: &str) -> Vec<String> {
             if i > 0 && c.is_uppercase() {
                 let prev = cs[i - 1];
                 let next_lower = cs.get(i + 1).is_some_and(|n| n.is_lowercase());
-                if prev.is_lowercase() || prev.is_ascii_digit() || (prev.is_uppercase() && next_lower) {
+                if prev.is_lowercase()
+                    || prev.is_ascii_digit()
+                    || (prev.is_uppercase() && next_lower)
+                {
                     out.push(std::mem::take(&mut cur));
                 }
             }
@@ -37,7 +41,11 @@ pub fn snake(s: &str) -> String {
     if w.is_empty() {
         return "_".into();
     }
-    let mut r = w.iter().map(|w| w.to_lowercase()).collect::<Vec<_>>().join("_");
+    let mut r = w
+        .iter()
+        .map(|w| w.to_lowercase())
+        .collect::<Vec<_>>()
+        .join("_");
     if r.starts_with(|c: char| c.is_ascii_digit()) {
         r.insert(0, '_');
     }
@@ -47,7 +55,10 @@ pub fn snake(s: &str) -> String {
 pub fn upper_camel(s: &str) -> String {
     // Already acceptable camel case (acronyms allowed): keep the author's spelling.
     let has_lower = s.chars().any(|c| c.is_lowercase());
-    if s.starts_with(|c: char| c.is_ascii_uppercase()) && !s.contains('_') && (has_lower || s.len() == 1) {
+    if s.starts_with(|c: char| c.is_ascii_uppercase())
+        && !s.contains('_')
+        && (has_lower || s.len() == 1)
+    {
         return s.to_string();
     }
     let mut r = String::new();

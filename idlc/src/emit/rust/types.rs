@@ -54,7 +54,10 @@ impl Emitter<'_> {
         match t {
             Type::Prim { prim } => self.prim(*prim),
             Type::String { wide: true, .. } => format!("{rt}::cdr::WString"),
-            Type::String { wide: false, bound: Some(b) } if pos == Pos::Nested => format!("{rt}::cdr::BoundedString<{b}>"),
+            Type::String {
+                wide: false,
+                bound: Some(b),
+            } if pos == Pos::Nested => format!("{rt}::cdr::BoundedString<{b}>"),
             Type::String { wide: false, .. } => self.std("String"),
             Type::Sequence { elem, bound } => {
                 let e = self.rust_type(elem, Pos::Nested);
@@ -64,7 +67,11 @@ impl Emitter<'_> {
                 }
             }
             Type::Map { key, value, .. } => {
-                format!("::std::collections::BTreeMap<{}, {}>", self.rust_type(key, Pos::Nested), self.rust_type(value, Pos::Nested))
+                format!(
+                    "::std::collections::BTreeMap<{}, {}>",
+                    self.rust_type(key, Pos::Nested),
+                    self.rust_type(value, Pos::Nested)
+                )
             }
             Type::Array { elem, dims } => {
                 let mut s = self.rust_type(elem, Pos::Nested);
@@ -78,7 +85,13 @@ impl Emitter<'_> {
                 // An alias that hides a bound cannot carry it into a nested position: spell the bounded type.
                 if pos == Pos::Nested {
                     let r = self.model.resolve_alias(t);
-                    if matches!(r, Type::String { wide: false, bound: Some(_) } | Type::Sequence { bound: Some(_), .. }) {
+                    if matches!(
+                        r,
+                        Type::String {
+                            wide: false,
+                            bound: Some(_)
+                        } | Type::Sequence { bound: Some(_), .. }
+                    ) {
                         return self.rust_type(r, Pos::Nested);
                     }
                 }
@@ -90,7 +103,9 @@ impl Emitter<'_> {
     /// The bound to put on a field of this type (through aliases).
     pub fn field_bound(&self, t: &Type) -> Option<u64> {
         match self.model.resolve_alias(t) {
-            Type::String { bound, .. } | Type::Sequence { bound, .. } | Type::Map { bound, .. } => *bound,
+            Type::String { bound, .. } | Type::Sequence { bound, .. } | Type::Map { bound, .. } => {
+                *bound
+            }
             _ => None,
         }
     }
@@ -106,8 +121,12 @@ impl Emitter<'_> {
             // LongDouble is a byte carrier with Eq and Hash.
             Type::Prim { prim } => !matches!(prim, Prim::F32 | Prim::F64),
             Type::String { .. } | Type::Fixed { .. } | Type::Error => true,
-            Type::Sequence { elem, .. } | Type::Array { elem, .. } => self.eq_hash_in(elem, visiting),
-            Type::Map { key, value, .. } => self.eq_hash_in(key, visiting) && self.eq_hash_in(value, visiting),
+            Type::Sequence { elem, .. } | Type::Array { elem, .. } => {
+                self.eq_hash_in(elem, visiting)
+            }
+            Type::Map { key, value, .. } => {
+                self.eq_hash_in(key, visiting) && self.eq_hash_in(value, visiting)
+            }
             Type::Named { decl, .. } => self.decl_eq_hash(*decl, visiting),
         }
     }
@@ -122,9 +141,13 @@ impl Emitter<'_> {
         visiting.push(id);
         let r = match &self.model.decls[id].kind {
             DeclKind::Struct(s) => {
-                s.base.is_none_or(|b| self.decl_eq_hash(b, visiting)) && s.fields.iter().all(|f| self.eq_hash_in(&f.ty, visiting))
+                s.base.is_none_or(|b| self.decl_eq_hash(b, visiting))
+                    && s.fields.iter().all(|f| self.eq_hash_in(&f.ty, visiting))
             }
-            DeclKind::Union(u) => self.eq_hash_in(&u.discriminator, visiting) && u.cases.iter().all(|c| self.eq_hash_in(&c.ty, visiting)),
+            DeclKind::Union(u) => {
+                self.eq_hash_in(&u.discriminator, visiting)
+                    && u.cases.iter().all(|c| self.eq_hash_in(&c.ty, visiting))
+            }
             DeclKind::Alias { ty } => self.eq_hash_in(ty, visiting),
             _ => true,
         };
@@ -156,7 +179,10 @@ impl Emitter<'_> {
         match t {
             Type::Array { elem, dims } if !self.has_default(t) => {
                 let inner = if dims.len() > 1 {
-                    self.default_expr(&Type::Array { elem: elem.clone(), dims: dims[1..].to_vec() })
+                    self.default_expr(&Type::Array {
+                        elem: elem.clone(),
+                        dims: dims[1..].to_vec(),
+                    })
                 } else {
                     self.default_expr(elem)
                 };

@@ -1,0 +1,60 @@
+//! Runs one codec operation in a loop, for profilers:
+//! `cdr_loop TYPE OP LIB [ITERATIONS]` with TYPE shape|octets1k|nested|wide, OP encode|decode,
+//! LIB ours1|ours2|serde (cdr-encoding, XCDR1). Example, instructions per operation with callgrind:
+//! `valgrind --tool=callgrind --callgrind-out-file=cg.out target/bench-cdr/release/examples/cdr_loop shape decode ours1 10000`
+
+mod common;
+
+use std::hint::black_box;
+
+use byteorder::LittleEndian;
+use common::*;
+use dds_runtime::cdr::{self, ByteOrder, DdsType, XcdrVersion};
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+fn run<T: DdsType + Serialize + DeserializeOwned>(v: T, op: &str, lib: &str, n: usize) {
+    let version = if lib == "ours2" { XcdrVersion::Xcdr2 } else { XcdrVersion::Xcdr1 };
+    let mut buf = Vec::new();
+    if lib == "serde" {
+        buf.extend_from_slice(&[0, 1, 0, 0]);
+        cdr_encoding::to_writer::<T, LittleEndian, _>(&mut buf, &v).unwrap();
+    } else {
+        cdr::serialize(&v, version, ByteOrder::LittleEndian, &mut buf).unwrap();
+    }
+    let bytes = buf.clone();
+    for _ in 0..n {
+        match (op, lib) {
+            ("encode", "serde") => {
+                buf.clear();
+                buf.extend_from_slice(&[0, 1, 0, 0]);
+                cdr_encoding::to_writer::<T, LittleEndian, _>(&mut buf, black_box(&v)).unwrap();
+            }
+            ("encode", _) => {
+                buf.clear();
+                cdr::serialize(black_box(&v), version, ByteOrder::LittleEndian, &mut buf).unwrap();
+            }
+            ("decode", "serde") => {
+                black_box(cdr_encoding::from_bytes::<T, LittleEndian>(black_box(&bytes[4..])).unwrap());
+            }
+            ("decode", _) => {
+                black_box(cdr::deserialize::<T>(black_box(&bytes)).unwrap());
+            }
+            _ => panic!("OP is encode or decode"),
+        }
+        black_box(&buf);
+    }
+}
+
+fn main() {
+    let a: Vec<String> = std::env::args().skip(1).collect();
+    let [ty, op, lib] = [&a[0], &a[1], &a[2]].map(String::as_str);
+    let n = a.get(3).map_or(1_000_000, |s| s.parse().unwrap());
+    match ty {
+        "shape" => run(shape(), op, lib, n),
+        "octets1k" => run(keyed_seq_1k(), op, lib, n),
+        "nested" => run(telemetry(), op, lib, n),
+        "wide" => run(wide(), op, lib, n),
+        t => panic!("unknown type {t}"),
+    }
+}

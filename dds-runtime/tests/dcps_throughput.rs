@@ -1,0 +1,87 @@
+//! Rough throughput of the whole stack in one process (two participants over loopback). Ignored by default;
+//! meaningful only in release: `scripts/isolated cargo test --release -p dds-runtime --test dcps_throughput
+//! -- --ignored --nocapture`.
+mod dcps_util;
+
+use std::time::{Duration, Instant};
+
+use dcps_util::*;
+use dds_runtime::prelude::*;
+
+#[derive(DdsType, Debug, Clone, PartialEq, Default)]
+#[dds(name = "test::Payload", final)]
+struct Payload {
+    seq: u64,
+    data: Vec<u8>,
+}
+
+#[test]
+#[ignore = "measurement; run in release"]
+fn reliable_keep_all_1k_throughput() {
+    let p1 = participant(81);
+    let p2 = participant(81);
+    let t1 = p1
+        .create_topic::<Payload>("Throughput", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<Payload>("Throughput", &TopicQos::default())
+        .unwrap();
+    let q = DataWriterQos::builder()
+        .reliability(Reliability::Reliable {
+            max_blocking_time: Duration::from_secs(10),
+        })
+        .history(History::KeepAll)
+        .build();
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(&t1, &q)
+        .unwrap();
+    let rq = DataReaderQos::builder()
+        .reliability(reliable())
+        .history(History::KeepAll)
+        .build();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&t2, &rq)
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    let run = Duration::from_secs(3);
+    let reader = std::thread::spawn(move || {
+        let mut n = 0u64;
+        let mut expect = 0u64;
+        while r.wait_for_data(Duration::from_secs(2)).unwrap() {
+            for s in r.take().unwrap() {
+                assert_eq!(s.data.unwrap().seq, expect);
+                expect += 1;
+                n += 1;
+            }
+        }
+        n
+    });
+    let sample = |seq| Payload {
+        seq,
+        data: vec![0x5a; 1024],
+    };
+    let start = Instant::now();
+    let mut sent = 0u64;
+    while start.elapsed() < run {
+        for _ in 0..100 {
+            w.write(&sample(sent)).unwrap();
+            sent += 1;
+        }
+    }
+    w.wait_for_acknowledgments(Duration::from_secs(20)).unwrap();
+    let secs = start.elapsed().as_secs_f64();
+    let got = reader.join().unwrap();
+    assert_eq!(got, sent);
+    eprintln!(
+        "1 KiB reliable keep-all: {sent} samples in {secs:.2} s = {:.0} samples/s, {:.2} Gb/s",
+        sent as f64 / secs,
+        sent as f64 * 1024.0 * 8.0 / secs / 1e9
+    );
+}
