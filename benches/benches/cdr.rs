@@ -57,7 +57,9 @@ fn serde_encode<T: Serialize>(v: &T, out: &mut Vec<u8>) {
 }
 
 fn serde_decode<T: DeserializeOwned>(bytes: &[u8]) -> T {
-    cdr_encoding::from_bytes::<T, LittleEndian>(&bytes[4..]).expect("cdr-encoding decodes").0
+    cdr_encoding::from_bytes::<T, LittleEndian>(&bytes[4..])
+        .expect("cdr-encoding decodes")
+        .0
 }
 
 fn bench_type<T>(c: &mut Criterion, name: &str, v: &T)
@@ -73,7 +75,11 @@ where
     let mut payloads = Vec::new();
     for (ver, tag) in versions {
         let ours = ours_encode(v, ver);
-        assert_eq!(&cdr::deserialize::<T>(&ours).expect("ours decodes"), v, "ours {tag}");
+        assert_eq!(
+            &cdr::deserialize::<T>(&ours).expect("ours decodes"),
+            v,
+            "ours {tag}"
+        );
         let dust = dust_encode(v, ver);
         let dust_ok = match CdrDeserializer::deserialize(dust_type.clone(), &dust) {
             Ok(d) => {
@@ -90,6 +96,15 @@ where
     let mut serde_bytes = Vec::new();
     serde_encode(v, &mut serde_bytes);
     assert_eq!(&serde_decode::<T>(&serde_bytes), v, "cdr-encoding");
+
+    eprintln!(
+        "payload bytes {name}: ours x1 {} x2 {}, dust x1 {} x2 {}, cdr-encoding {}",
+        payloads[0].2.len(),
+        payloads[1].2.len(),
+        payloads[0].3.len(),
+        payloads[1].3.len(),
+        serde_bytes.len()
+    );
 
     let mut g = c.benchmark_group(format!("{name}_encode"));
     g.throughput(Throughput::Bytes(payloads[0].2.len() as u64));
@@ -131,14 +146,22 @@ where
     let mut g = c.benchmark_group(format!("{name}_decode"));
     g.throughput(Throughput::Bytes(payloads[0].2.len() as u64));
     for (_, tag, ours, _, _) in &payloads {
-        g.bench_function(format!("ours_{tag}"), |b| b.iter(|| cdr::deserialize::<T>(black_box(ours)).unwrap()));
+        g.bench_function(format!("ours_{tag}"), |b| {
+            b.iter(|| cdr::deserialize::<T>(black_box(ours)).unwrap())
+        });
     }
     for (_, tag, _, dust, _) in payloads.iter().filter(|p| p.4) {
         g.bench_function(format!("dust_{tag}"), |b| {
-            b.iter(|| T::create_sample(CdrDeserializer::deserialize(dust_type.clone(), black_box(dust)).unwrap()))
+            b.iter(|| {
+                T::create_sample(
+                    CdrDeserializer::deserialize(dust_type.clone(), black_box(dust)).unwrap(),
+                )
+            })
         });
     }
-    g.bench_function("cdr_encoding_xcdr1", |b| b.iter(|| serde_decode::<T>(black_box(&serde_bytes))));
+    g.bench_function("cdr_encoding_xcdr1", |b| {
+        b.iter(|| serde_decode::<T>(black_box(&serde_bytes)))
+    });
     g.finish();
 }
 

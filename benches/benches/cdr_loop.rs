@@ -1,6 +1,6 @@
 //! Runs one codec operation in a loop, for profilers:
 //! `cdr_loop TYPE OP LIB [ITERATIONS]` with TYPE shape|octets1k|nested|wide, OP encode|decode,
-//! LIB ours1|ours2|serde (cdr-encoding, XCDR1). Example, instructions per operation with callgrind:
+//! LIB ours1|ours2|serde (cdr-encoding, XCDR1)|dust1|dust2 (the same calls as `cdr.rs` makes). Example, instructions per operation with callgrind:
 //! `valgrind --tool=callgrind --callgrind-out-file=cg.out target/bench-cdr/release/examples/cdr_loop shape decode ours1 10000`
 
 mod common;
@@ -10,12 +10,49 @@ use std::hint::black_box;
 use byteorder::LittleEndian;
 use common::*;
 use dds_runtime::cdr::{self, ByteOrder, DdsType, XcdrVersion};
+use dust_dds::infrastructure::type_support::TypeSupport;
+use dust_dds::xtypes::deserializer::CdrDeserializer;
+use dust_dds::xtypes::serializer::{Cdr1LeSerializer, Cdr2LeSerializer};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
-fn run<T: DdsType + Serialize + DeserializeOwned>(v: T, op: &str, lib: &str, n: usize) {
-    let version = if lib == "ours2" { XcdrVersion::Xcdr2 } else { XcdrVersion::Xcdr1 };
+fn dust_encode<T: TypeSupport>(v: T, lib: &str) -> Vec<u8> {
+    let d = v.create_dynamic_sample();
+    if lib == "dust2" {
+        Cdr2LeSerializer::serialize(&d)
+    } else {
+        Cdr1LeSerializer::serialize(&d)
+    }
+    .unwrap()
+}
+
+fn run<T: DdsType + TypeSupport + Clone + Serialize + DeserializeOwned>(
+    v: T,
+    op: &str,
+    lib: &str,
+    n: usize,
+) {
+    let version = if lib == "ours2" {
+        XcdrVersion::Xcdr2
+    } else {
+        XcdrVersion::Xcdr1
+    };
     let mut buf = Vec::new();
+    if lib.starts_with("dust") {
+        let ty = T::get_type();
+        let bytes = dust_encode(v.clone(), lib);
+        for _ in 0..n {
+            if op == "encode" {
+                // The clone is part of the measured loop here (cdr.rs keeps it out with iter_batched).
+                black_box(dust_encode(black_box(&v).clone(), lib));
+            } else {
+                black_box(T::create_sample(
+                    CdrDeserializer::deserialize(ty.clone(), black_box(&bytes)).unwrap(),
+                ));
+            }
+        }
+        return;
+    }
     if lib == "serde" {
         buf.extend_from_slice(&[0, 1, 0, 0]);
         cdr_encoding::to_writer::<T, LittleEndian, _>(&mut buf, &v).unwrap();
@@ -35,7 +72,9 @@ fn run<T: DdsType + Serialize + DeserializeOwned>(v: T, op: &str, lib: &str, n: 
                 cdr::serialize(black_box(&v), version, ByteOrder::LittleEndian, &mut buf).unwrap();
             }
             ("decode", "serde") => {
-                black_box(cdr_encoding::from_bytes::<T, LittleEndian>(black_box(&bytes[4..])).unwrap());
+                black_box(
+                    cdr_encoding::from_bytes::<T, LittleEndian>(black_box(&bytes[4..])).unwrap(),
+                );
             }
             ("decode", _) => {
                 black_box(cdr::deserialize::<T>(black_box(&bytes)).unwrap());

@@ -63,7 +63,10 @@ fn check<T: DdsType>(name: &str, v: &T) {
     for version in [XcdrVersion::Xcdr1, XcdrVersion::Xcdr2] {
         for order in [ByteOrder::LittleEndian, ByteOrder::BigEndian] {
             let n = steady_state_allocs(v, version, order);
-            assert_eq!(n, 0, "{name} {version:?} {order:?}: {n} allocations in 100 encodes into a reused buffer");
+            assert_eq!(
+                n, 0,
+                "{name} {version:?} {order:?}: {n} allocations in 100 encodes into a reused buffer"
+            );
         }
     }
 }

@@ -36,11 +36,18 @@ fn same_as_cdr_encoding<T: DdsType + Serialize>(v: &T) {
     let s = cdr_encoding::to_vec::<T, LittleEndian>(v).unwrap();
     assert_eq!(&o[..2], &[0x00, 0x01], "CDR_LE");
     assert_eq!(&o[4..4 + s.len()], &s[..], "body differs from cdr-encoding");
-    assert!(o[4 + s.len()..].iter().all(|&b| b == 0) && o.len() - 4 - s.len() < 4, "only padding may follow");
+    assert!(
+        o[4 + s.len()..].iter().all(|&b| b == 0) && o.len() - 4 - s.len() < 4,
+        "only padding may follow"
+    );
 }
 
 fn same_as_dust<T: DdsType + TypeSupport + Clone>(v: &T, version: XcdrVersion) {
-    assert_eq!(ours(v, version), dust(v, version), "{version:?} differs from Dust DDS");
+    assert_eq!(
+        ours(v, version),
+        dust(v, version),
+        "{version:?} differs from Dust DDS"
+    );
 }
 
 #[test]
@@ -77,7 +84,11 @@ fn nested_xcdr2_dust_omits_the_sequence_dheaders() {
     let mut stripped = o.clone();
     // `readings` DHEADER sits after id (8) and source (4 + 15 + 1 pad) = offset 4 + 28.
     let readings_dheader = 4 + 28;
-    let len = u32::from_le_bytes(o[readings_dheader..readings_dheader + 4].try_into().unwrap()) as usize;
+    let len = u32::from_le_bytes(
+        o[readings_dheader..readings_dheader + 4]
+            .try_into()
+            .unwrap(),
+    ) as usize;
     let labels_dheader = readings_dheader + 4 + len;
     stripped.drain(labels_dheader..labels_dheader + 4);
     stripped.drain(readings_dheader..readings_dheader + 4);
@@ -94,9 +105,21 @@ fn wide_mutable_xcdr2_dust_writes_xcdr1_style_parameters() {
     assert_eq!(&o[..2], &[0x00, 0x0b], "ours: PL_CDR2_LE");
     assert_eq!(&d[..2], &[0x00, 0x0b], "dust: PL_CDR2_LE too");
     let dheader = u32::from_le_bytes(o[4..8].try_into().unwrap()) as usize;
-    assert_eq!(dheader, o.len() - 8 - usize::from(o[3] & 3), "ours: DHEADER covers the members");
-    assert_eq!(&o[8..12], &[11, 0, 0, 0x20], "ours: EMHEADER id 11, LC 2 (4 bytes)");
-    assert_eq!(&d[4..8], &[11, 0, 4, 0], "dust: short PID 11, length 4, no DHEADER");
+    assert_eq!(
+        dheader,
+        o.len() - 8 - usize::from(o[3] & 3),
+        "ours: DHEADER covers the members"
+    );
+    assert_eq!(
+        &o[8..12],
+        &[11, 0, 0, 0x20],
+        "ours: EMHEADER id 11, LC 2 (4 bytes)"
+    );
+    assert_eq!(
+        &d[4..8],
+        &[11, 0, 4, 0],
+        "dust: short PID 11, length 4, no DHEADER"
+    );
 }
 
 #[test]
@@ -107,10 +130,22 @@ fn wide_mutable_xcdr1_parameter_lists_differ_from_dust() {
     let v = wide();
     let (o, d) = (ours(&v, XcdrVersion::Xcdr1), dust(&v, XcdrVersion::Xcdr1));
     assert_eq!(&o[..2], &d[..2], "both PL_CDR_LE");
-    assert_eq!(&o[4..8], &[0x01, 0x7f, 8, 0], "ours: PID_EXTENDED | must-understand, length 8");
+    assert_eq!(
+        &o[4..8],
+        &[0x01, 0x7f, 8, 0],
+        "ours: PID_EXTENDED | must-understand, length 8"
+    );
     assert_eq!(&d[4..8], &[11, 0, 4, 0], "dust: short PID 11, length 4");
     let pad = usize::from(o[3] & 3);
-    assert_eq!(&o[o.len() - pad - 4..o.len() - pad], &[0x02, 0x7f, 0, 0], "ours ends with PID_LIST_END");
+    assert_eq!(
+        &o[o.len() - pad - 4..o.len() - pad],
+        &[0x02, 0x7f, 0, 0],
+        "ours ends with PID_LIST_END"
+    );
     let pad = usize::from(d[3] & 3);
-    assert_eq!(&d[d.len() - pad - 4..d.len() - pad], &[0x01, 0, 0, 0], "dust ends with PID_SENTINEL");
+    assert_eq!(
+        &d[d.len() - pad - 4..d.len() - pad],
+        &[0x01, 0, 0, 0],
+        "dust ends with PID_SENTINEL"
+    );
 }

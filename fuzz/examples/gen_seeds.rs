@@ -35,9 +35,18 @@ fn main() {
     let cdr = root.join("cdr_decode");
     fs::create_dir_all(&cdr).unwrap();
 
-    let shape = ShapeType { color: "BLUE".into(), x: 10, y: -20, shapesize: 30, additional_payload_size: vec![1, 2, 3] };
+    let shape = ShapeType {
+        color: "BLUE".into(),
+        x: 10,
+        y: -20,
+        shapesize: 30,
+        additional_payload_size: vec![1, 2, 3],
+    };
     cdr_seeds(&cdr, 0, "shape", &shape);
-    let inner = Inner { n: 7, tags: vec!["a".into(), "bc".into()] };
+    let inner = Inner {
+        n: 7,
+        tags: vec!["a".into(), "bc".into()],
+    };
     let mo = MutOpt {
         id: 42,
         a: Some(-3),
@@ -56,13 +65,23 @@ fn main() {
         m: BTreeMap::from([("k".to_string(), vec![1, 2]), ("l".to_string(), vec![])]),
         mi: BTreeMap::from([(-1, inner.clone())]),
         bounded: vec![Inner::default(), inner.clone()],
-        u: vec![SmallUnion::Neg(5), SmallUnion::Nothing, SmallUnion::Other(true)],
+        u: vec![
+            SmallUnion::Neg(5),
+            SmallUnion::Nothing,
+            SmallUnion::Other(true),
+        ],
         arr: [[1, -1], [2, -2]],
         ch: 'é',
         flag: true,
     };
     cdr_seeds(&cdr, 2, "nest", &nest);
-    let outer = Outer { shape, nest, m: Some(mo), u: Either::Bytes(vec![9; 5]), f: 1.5 };
+    let outer = Outer {
+        shape,
+        nest,
+        m: Some(mo),
+        u: Either::Bytes(vec![9; 5]),
+        f: 1.5,
+    };
     cdr_seeds(&cdr, 3, "outer", &outer);
     cdr_seeds(&cdr, 4, "either-num", &Either::Num(-1));
     cdr_seeds(&cdr, 4, "either-text", &Either::Text("abc".into()));
@@ -92,8 +111,13 @@ fn rtps_seeds(dir: &Path) {
     // Inline QoS: a key hash (PID 0x0070) and the sentinel, little-endian.
     let mut qos = vec![0x70, 0x00, 16, 0];
     qos.extend_from_slice(&[0xab; 16]);
-    let qlist = ParameterList { data: &qos, little_endian: true };
-    let payload = [0x00, 0x01, 0x00, 0x00, 4, 0, 0, 0, b'B', b'L', b'U', 0, 1, 0, 0, 0];
+    let qlist = ParameterList {
+        data: &qos,
+        little_endian: true,
+    };
+    let payload = [
+        0x00, 0x01, 0x00, 0x00, 4, 0, 0, 0, b'B', b'L', b'U', 0, 1, 0, 0, 0,
+    ];
     let data = Submessage::Data(Data {
         reader_id: EntityId([0, 0, 0, 0]),
         writer_id: EntityId([0, 0, 1, 2]),
@@ -112,7 +136,11 @@ fn rtps_seeds(dir: &Path) {
         final_flag: false,
         liveliness_flag: false,
     });
-    for (name, subs) in [("data", vec![data]), ("heartbeat", vec![hb]), ("data-heartbeat", vec![data, hb])] {
+    for (name, subs) in [
+        ("data", vec![data]),
+        ("heartbeat", vec![hb]),
+        ("data-heartbeat", vec![data, hb]),
+    ] {
         let mut b = MessageBuilder::new(&header);
         for s in &subs {
             b.push(s);

@@ -113,20 +113,33 @@ pub struct Outer {
 /// version, and checks that each re-encoding decodes back to the same value and re-encodes to the same bytes.
 /// `eq` compares values (so types holding floats can compare bits instead of `==`).
 pub fn round_trip<T: DdsType + std::fmt::Debug>(payload: &[u8], eq: impl Fn(&T, &T) -> bool) {
-    let Ok(v) = cdr::deserialize::<T>(payload) else { return };
+    let Ok(v) = cdr::deserialize::<T>(payload) else {
+        return;
+    };
     let h = EncapsulationHeader::parse(payload).expect("decode succeeded, so the header parsed");
-    let version = h.version().expect("decode succeeded, so the version is known");
+    let version = h
+        .version()
+        .expect("decode succeeded, so the version is known");
     let other = match version {
         XcdrVersion::Xcdr1 => XcdrVersion::Xcdr2,
         XcdrVersion::Xcdr2 => XcdrVersion::Xcdr1,
     };
-    for (ver, order) in [(version, h.byte_order()), (other, ByteOrder::LittleEndian), (other, ByteOrder::BigEndian)] {
+    for (ver, order) in [
+        (version, h.byte_order()),
+        (other, ByteOrder::LittleEndian),
+        (other, ByteOrder::BigEndian),
+    ] {
         let mut out = Vec::new();
-        cdr::serialize(&v, ver, order, &mut out)
-            .unwrap_or_else(|e| panic!("re-encode of a decoded value failed ({ver:?} {order:?}): {e}\n{v:?}"));
-        let back = cdr::deserialize::<T>(&out)
-            .unwrap_or_else(|e| panic!("decode of our own encoding failed ({ver:?} {order:?}): {e}\n{v:?}\n{out:02x?}"));
-        assert!(eq(&v, &back), "value changed through {ver:?} {order:?}:\n{v:?}\n{back:?}");
+        cdr::serialize(&v, ver, order, &mut out).unwrap_or_else(|e| {
+            panic!("re-encode of a decoded value failed ({ver:?} {order:?}): {e}\n{v:?}")
+        });
+        let back = cdr::deserialize::<T>(&out).unwrap_or_else(|e| {
+            panic!("decode of our own encoding failed ({ver:?} {order:?}): {e}\n{v:?}\n{out:02x?}")
+        });
+        assert!(
+            eq(&v, &back),
+            "value changed through {ver:?} {order:?}:\n{v:?}\n{back:?}"
+        );
         let mut again = Vec::new();
         cdr::serialize(&back, ver, order, &mut again).expect("second re-encode");
         assert_eq!(out, again, "encoding not stable through {ver:?} {order:?}");
@@ -143,7 +156,11 @@ pub fn round_trip<T: DdsType + std::fmt::Debug>(payload: &[u8], eq: impl Fn(&T, 
 
 /// Compares two `Outer`s, floats by bit pattern (NaN payloads survive a round trip).
 pub fn outer_eq(a: &Outer, b: &Outer) -> bool {
-    a.f.to_bits() == b.f.to_bits() && a.shape == b.shape && a.nest == b.nest && a.m == b.m && a.u == b.u
+    a.f.to_bits() == b.f.to_bits()
+        && a.shape == b.shape
+        && a.nest == b.nest
+        && a.m == b.m
+        && a.u == b.u
 }
 
 /// The types `cdr_decode` exercises, selected by the first input byte (modulo the count).
@@ -151,7 +168,9 @@ pub const TYPE_COUNT: u8 = 6;
 
 /// Runs one fuzz input: first byte selects the type, the rest is the payload (encapsulation header first).
 pub fn cdr_one(data: &[u8]) {
-    let Some((&sel, payload)) = data.split_first() else { return };
+    let Some((&sel, payload)) = data.split_first() else {
+        return;
+    };
     match sel % TYPE_COUNT {
         0 => round_trip::<ShapeType>(payload, PartialEq::eq),
         1 => round_trip::<MutOpt>(payload, PartialEq::eq),

@@ -6,7 +6,9 @@ use idlc::preprocess::MemVfs;
 
 /// Runs one input (ignored unless it is UTF-8).
 pub fn idl_one(data: &[u8]) {
-    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
     let mut c = compile_str("fuzz.idl", text, &Options::default(), &MemVfs::new());
     if c.has_errors() {
         let _ = c.render_diagnostics(RenderOptions::default());

@@ -40,10 +40,20 @@ pub fn rtps_one(data: &[u8]) {
                 let mut again = MessageIter::new(&out);
                 let back = again
                     .next()
-                    .unwrap_or_else(|| panic!("re-encoded submessage vanished: {sub:?}\n{out:02x?}"))
-                    .unwrap_or_else(|e| panic!("re-encoded submessage does not decode ({e}): {sub:?}\n{out:02x?}"));
-                assert_eq!(sub, back, "submessage changed through re-encode (le={le})\n{out:02x?}");
-                assert!(again.next().is_none(), "re-encoding produced trailing submessages: {out:02x?}");
+                    .unwrap_or_else(|| {
+                        panic!("re-encoded submessage vanished: {sub:?}\n{out:02x?}")
+                    })
+                    .unwrap_or_else(|e| {
+                        panic!("re-encoded submessage does not decode ({e}): {sub:?}\n{out:02x?}")
+                    });
+                assert_eq!(
+                    sub, back,
+                    "submessage changed through re-encode (le={le})\n{out:02x?}"
+                );
+                assert!(
+                    again.next().is_none(),
+                    "re-encoding produced trailing submessages: {out:02x?}"
+                );
             }
         }
     }

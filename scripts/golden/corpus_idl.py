@@ -25,13 +25,11 @@ OUT = ROOT / "tests" / "fixtures" / "idlc-golden"
 CORPUS_DIR = Path(os.environ.get("DDS_IDL_CORPUS", ROOT.parent / "shared" / "idl-corpus"))
 I64_MIN, I64_MAX = -2**63, 2**63 - 1
 
-T = std_msgs_msg_Time
-
 
 def header(sec, nsec, frame, final_=False):
     if final_:
         return std_msgs_msg_Header_F(stamp=std_msgs_msg_Time_F(sec=sec, nanosec=nsec), frame_id=frame)
-    return std_msgs_msg_Header(stamp=T(sec=sec, nanosec=nsec), frame_id=frame)
+    return std_msgs_msg_Header(stamp=std_msgs_msg_Time(sec=sec, nanosec=nsec), frame_id=frame)
 
 
 def ros_samples(final_):
@@ -39,8 +37,10 @@ def ros_samples(final_):
     f = "_F" if final_ else ""
     g = globals()
     Point, Quaternion, Vector3 = (g[f"geometry_msgs_msg_{n}{f}"] for n in ("Point", "Quaternion", "Vector3"))
-    Pose, PoseStamped, Imu = g[f"geometry_msgs_msg_Pose{f}"], g[f"geometry_msgs_msg_PoseStamped{f}"], g[f"sensor_msgs_msg_Imu{f}"]
-    KeyValue, DiagnosticStatus = g[f"diagnostic_msgs_msg_KeyValue{f}"], g[f"diagnostic_msgs_msg_DiagnosticStatus{f}"]
+    Pose, PoseStamped = g[f"geometry_msgs_msg_Pose{f}"], g[f"geometry_msgs_msg_PoseStamped{f}"]
+    Imu = g[f"sensor_msgs_msg_Imu{f}"]
+    KeyValue = g[f"diagnostic_msgs_msg_KeyValue{f}"]
+    DiagnosticStatus = g[f"diagnostic_msgs_msg_DiagnosticStatus{f}"]
     suffix = ".final" if final_ else ""
     return [
         (f"geometry_msgs.msg.PoseStamped{suffix}", f"{ROS}/geometry_msgs/msg/PoseStamped.idl",
@@ -223,15 +223,17 @@ ENTRIES += [
     # Negative labels only on the 32-bit discriminator: libddsc 11.0.1 reads an int8/int16 discriminator
     # zero-extended, matches no negative label (-1 is read as 255/65535), selects no member and loses its place in
     # the stream, so it has no vectors for cases -128/-1 of t1 and -32768/-1 of t2 (README.md).
-    ("CdrStreamSignedUnion.t4", "cyclonedds/src/core/ddsc/tests/CdrStreamSignedUnion.idl", "CdrStreamSignedUnion::t4",
-     SignedUnion_t4, [
+    ("CdrStreamSignedUnion.t4", "cyclonedds/src/core/ddsc/tests/CdrStreamSignedUnion.idl",
+     "CdrStreamSignedUnion::t4", SignedUnion_t4, [
          ("positive", SignedUnion_t4(f1=SignedUnion_t1(f3=5), f2=SignedUnion_t2(f4=1.5), f3=SignedUnion_t3(f4=2.5))),
          ("max", SignedUnion_t4(f1=SignedUnion_t1(f4=0.25), f2=SignedUnion_t2(f3=-7), f3=SignedUnion_t3(f3=7))),
          ("minus_one_32", SignedUnion_t4(f1=SignedUnion_t1(f3=1), f2=SignedUnion_t2(f3=2), f3=SignedUnion_t3(f2=-3))),
-         ("min_32", SignedUnion_t4(f1=SignedUnion_t1(f4=-0.5), f2=SignedUnion_t2(f4=0.5), f3=SignedUnion_t3(f1="c")))]),
+         ("min_32", SignedUnion_t4(f1=SignedUnion_t1(f4=-0.5), f2=SignedUnion_t2(f4=0.5),
+                                   f3=SignedUnion_t3(f1="c")))]),
 ]
 
-# Cyclone's idlc reads unannotated types as @final: the ROS types again, as a Cyclone (rmw_cyclonedds) peer has them.
+# Cyclone's idlc reads unannotated types as @final: the ROS types again, as a Cyclone-based (rmw_cyclonedds) peer
+# has them.
 ENTRIES += ros_samples(True)
 
 

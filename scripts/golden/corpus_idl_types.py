@@ -739,7 +739,7 @@ class test_struct_inherit_mutable_keys(t_base, typename="test_struct_inherit_mut
     f1: int32
 
 
-# ---------------------------------------------------------------- cyclonedds/src/core/ddsc/tests/CdrStreamSignedUnion.idl
+# -------------------------------------------------------- cyclonedds/src/core/ddsc/tests/CdrStreamSignedUnion.idl
 
 @final
 class SignedUnion_t1(IdlUnion, discriminator=int8, typename="CdrStreamSignedUnion::t1"):

@@ -293,10 +293,11 @@ mod check {
         assert!(checked > 0, "{name}: the fixture holds nothing to check");
         assert!(
             bad.is_empty(),
-            "{name} ({}: {}): {} of {checked} checks failed:\n  {}",
+            "{name} ({}: {}): {} of {} checks failed:\n  {}",
             fx["corpus_file"].as_str().unwrap_or_default(),
             fx["corpus_type"].as_str().unwrap_or_default(),
             bad.len(),
+            checked + 4, // and the four constants
             bad.join("\n  ")
         );
     }

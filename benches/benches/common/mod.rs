@@ -10,7 +10,9 @@ use dust_dds::infrastructure::type_support::DdsType as DustType;
 use serde::{Deserialize, Serialize};
 
 /// idl/shapes.idl.
-#[derive(Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize,
+)]
 #[dds(appendable, name = "ShapeType")]
 #[dust_dds(extensibility = "appendable", name = "ShapeType")]
 pub struct ShapeType {
@@ -24,7 +26,9 @@ pub struct ShapeType {
 }
 
 /// ddsperf's `KeyedSeq` (idl/ddsperf_types.idl) carrying 1 KiB of `sequence<octet>`.
-#[derive(Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize,
+)]
 #[dds(final, name = "KeyedSeq")]
 #[dust_dds(extensibility = "final", name = "KeyedSeq")]
 pub struct KeyedSeq {
@@ -36,7 +40,9 @@ pub struct KeyedSeq {
 }
 
 /// One element of [`Telemetry::readings`]: a string and two sequences.
-#[derive(Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize,
+)]
 #[dds(final, nested, name = "Bench::Reading")]
 #[dust_dds(extensibility = "final", nested, name = "Bench::Reading")]
 pub struct Reading {
@@ -46,7 +52,9 @@ pub struct Reading {
 }
 
 /// Strings and nested sequences: a sequence of structs that hold sequences, plus a sequence of strings.
-#[derive(Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize,
+)]
 #[dds(final, name = "Bench::Telemetry")]
 #[dust_dds(extensibility = "final", name = "Bench::Telemetry")]
 pub struct Telemetry {
@@ -62,7 +70,9 @@ pub struct Telemetry {
 /// A mutable type with 34 members of mixed kinds (explicit, identical member ids in both derives). The ids start
 /// at 11: Dust DDS 0.15 ends a parameter list at a member with id 1 (it checks for the RTPS PID_SENTINEL, 1, in
 /// XCDR1 and XCDR2 alike) and then cannot decode its own output, which would leave nothing to compare.
-#[derive(Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, PartialEq, Default, dds_runtime::DdsType, DustType, Serialize, Deserialize,
+)]
 #[dds(mutable, name = "Bench::Wide")]
 #[dust_dds(extensibility = "mutable", name = "Bench::Wide")]
 pub struct Wide {
@@ -171,11 +181,21 @@ pub struct Wide {
 }
 
 pub fn shape() -> ShapeType {
-    ShapeType { color: "BLUE".into(), x: 120, y: 75, shapesize: 30, additional_payload_size: vec![0xa5; 16] }
+    ShapeType {
+        color: "BLUE".into(),
+        x: 120,
+        y: 75,
+        shapesize: 30,
+        additional_payload_size: vec![0xa5; 16],
+    }
 }
 
 pub fn keyed_seq_1k() -> KeyedSeq {
-    KeyedSeq { seq: 12345, keyval: 7, baggage: (0..1024u32).map(|i| i as u8).collect() }
+    KeyedSeq {
+        seq: 12345,
+        keyval: 7,
+        baggage: (0..1024u32).map(|i| i as u8).collect(),
+    }
 }
 
 pub fn telemetry() -> Telemetry {
@@ -189,7 +209,10 @@ pub fn telemetry() -> Telemetry {
                 raw: (0..12).map(|j| (i * 12 + j) as i16 - 40).collect(),
             })
             .collect(),
-        labels: ["alpha", "bravo", "charlie", "delta", "echo"].iter().map(|s| s.to_string()).collect(),
+        labels: ["alpha", "bravo", "charlie", "delta", "echo"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
         counters: (0..32).collect(),
     }
 }
