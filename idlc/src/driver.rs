@@ -45,7 +45,7 @@ pub struct Compilation {
 fn with_stack<T: Send>(f: impl FnOnce() -> T + Send) -> T {
     std::thread::scope(|s| {
         std::thread::Builder::new()
-            .stack_size(256 << 20)
+            .stack_size(64 << 20)
             .spawn_scoped(s, f)
             .map(|h| h.join())
             .unwrap_or_else(|_| Err(Box::new("cannot spawn compiler thread")))

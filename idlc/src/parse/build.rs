@@ -204,6 +204,22 @@ impl<'a> Builder<'a> {
                 loc,
             };
         }
+        if KEYWORDS.contains(&text) {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::Syntax,
+                    format!("expected identifier, found keyword `{text}`"),
+                )
+                .at(loc, "keyword used as a name")
+                .help(format!(
+                    "`{text}` is a keyword; to use it as a name write `_{text}`"
+                )),
+            );
+            return Ident {
+                name: text.to_string(),
+                loc,
+            };
+        }
         if let Some(kw) = KEYWORDS.iter().find(|k| k.eq_ignore_ascii_case(text)) {
             self.diags.push(
                 Diagnostic::error(

@@ -69,16 +69,7 @@ pub fn emit(model: &Model, opts: &RustOptions, diags: &mut Diagnostics) -> Strin
     for d in e.diags.drain(..) {
         diags.push(d);
     }
-    let formatted = match syn::parse_file(&body) {
-        Ok(f) => splice_macros(&space_items(&prettyplease::unparse(&f)), &e.macros),
-        Err(err) => {
-            diags.push(Diagnostic::error(
-                Code::BadMemberType,
-                format!("internal error: generated Rust does not parse: {err}"),
-            ));
-            body
-        }
-    };
+    let formatted = body;
     let src = opts
         .source_name
         .as_deref()
@@ -101,6 +92,54 @@ fn space_items(s: &str) -> String {
         }
         prev_end = t.ends_with('}') || t.ends_with(';');
         out.push_str(line);
+        out.push('\n');
+    }
+    out
+}
+
+/// Formatted items by their unformatted text (and spliced macros). Cleared with [`clear_format_cache`].
+static FORMAT_CACHE: std::sync::Mutex<Option<HashMap<String, String>>> =
+    std::sync::Mutex::new(None);
+
+/// Forgets memoised item formatting (benchmarks call this between rounds).
+pub fn clear_format_cache() {
+    if let Ok(mut c) = FORMAT_CACHE.lock() {
+        *c = None;
+    }
+}
+
+fn format_item(raw: &str, macros: &[String]) -> Result<String, String> {
+    let mut key = raw.to_string();
+    for m in macros {
+        key.push('\0');
+        key.push_str(m);
+    }
+    if let Some(hit) = FORMAT_CACHE
+        .lock()
+        .ok()
+        .and_then(|c| c.as_ref().and_then(|c| c.get(&key).cloned()))
+    {
+        return Ok(hit);
+    }
+    let file = syn::parse_file(raw).map_err(|e| e.to_string())?;
+    let out = splice_macros(&space_items(&prettyplease::unparse(&file)), macros);
+    if let Ok(mut c) = FORMAT_CACHE.lock() {
+        let map = c.get_or_insert_with(HashMap::new);
+        if map.len() > 100_000 {
+            map.clear();
+        }
+        map.insert(key, out.clone());
+    }
+    Ok(out)
+}
+
+fn indent(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + s.len() / 8);
+    for line in s.lines() {
+        if !line.is_empty() {
+            out.push_str("    ");
+            out.push_str(line);
+        }
         out.push('\n');
     }
     out
@@ -388,25 +427,41 @@ impl<'a> Emitter<'a> {
                 self.shadowed.insert(s);
             }
         }
-        let mut out = String::new();
+        // Items are formatted one by one (and memoised: files that include the same IDL emit the same items),
+        // then nested into their modules.
+        let mut parts: Vec<String> = Vec::new();
         for &id in &m.decls {
-            out.push_str(&self.item(id));
-            out.push('\n');
+            let raw = self.item(id);
+            if raw.trim().is_empty() {
+                continue;
+            }
+            let macros = std::mem::take(&mut self.macros);
+            match format_item(&raw, &macros) {
+                Ok(f) => parts.push(f.trim_end().to_string()),
+                Err(err) => {
+                    self.diags.push(Diagnostic::error(
+                        Code::BadMemberType,
+                        format!("internal error: generated Rust does not parse: {err}"),
+                    ));
+                    parts.push(raw);
+                }
+            }
         }
         for sub in &m.modules {
             let name = ident(&snake(&sub.name));
             self.cur.push(name.clone());
-            let body = self.module_body(sub);
+            let body = indent(&self.module_body(sub));
             self.cur.pop();
             let docs = if bare(&name) != sub.name {
-                docs(&[format!("IDL module `{}`.", sub.name)])
+                raw_docs(&[format!("IDL module `{}`.", sub.name)])
             } else {
                 vec![]
             };
-            out.push_str(&render(&ModuleView { docs, name, body }));
-            out.push('\n');
+            parts.push(render(&ModuleView { docs, name, body }).trim().to_string());
         }
         self.shadowed = saved;
+        let mut out = parts.join("\n\n");
+        out.push('\n');
         out
     }
 
@@ -694,7 +749,13 @@ impl<'a> Emitter<'a> {
                 ty,
             });
         }
-        let (default_variant, default_expr) = match u.cases.first() {
+        // The default value must not build the union itself again (`case 1: @external U next;`).
+        let pick = u
+            .cases
+            .iter()
+            .position(|c| !self.default_builds(&c.ty, id, &mut vec![]))
+            .unwrap_or(0);
+        let (default_variant, default_expr) = match u.cases.get(pick) {
             Some(c) => {
                 let mut e = if self.has_default(&c.ty) {
                     format!("{}::default()", self.std("Default"))
@@ -704,7 +765,7 @@ impl<'a> Emitter<'a> {
                 if c.external {
                     e = format!("{}::new({e})", self.std("Box"));
                 }
-                (variants[0].name.clone(), e)
+                (variants[pick].name.clone(), e)
             }
             None => (String::new(), String::new()),
         };
@@ -722,6 +783,46 @@ impl<'a> Emitter<'a> {
             default_expr,
             default_trait: self.std("Default"),
         })
+    }
+
+    /// Whether `Default::default()` of `t` constructs a value of `target` (empty containers and `None` do not).
+    fn default_builds(&self, t: &Type, target: DeclId, seen: &mut Vec<DeclId>) -> bool {
+        match t {
+            Type::Array { elem, .. } => self.default_builds(elem, target, seen),
+            Type::Named { decl, .. } => {
+                if *decl == target {
+                    return true;
+                }
+                if seen.contains(decl) {
+                    return false;
+                }
+                seen.push(*decl);
+                match &self.model.decls[*decl].kind {
+                    DeclKind::Alias { ty } => self.default_builds(ty, target, seen),
+                    DeclKind::Struct(s) => {
+                        s.base.is_some_and(|b| {
+                            self.default_builds(
+                                &Type::Named {
+                                    decl: b,
+                                    name: String::new(),
+                                },
+                                target,
+                                seen,
+                            )
+                        }) || s
+                            .fields
+                            .iter()
+                            .any(|f| !f.optional && self.default_builds(&f.ty, target, seen))
+                    }
+                    DeclKind::Union(u) => u
+                        .cases
+                        .first()
+                        .is_some_and(|c| self.default_builds(&c.ty, target, seen)),
+                    _ => false,
+                }
+            }
+            _ => false,
+        }
     }
 
     fn enum_item(&mut self, id: DeclId, e: &Enum) -> String {
