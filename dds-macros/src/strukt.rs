@@ -572,6 +572,10 @@ pub fn derive(
                 ::core::result::Result::Ok(<Self as #cdr::StructMembers>::finish(p))
             }
 
+            // Only reached for members a sample lacks; kept out of line because inlining it copies the whole
+            // default value of every nested struct into each caller (minutes of LLVM time for large types).
+            #[cold]
+            #[inline(never)]
             fn default_value() -> Self {
                 Self { #default_base #(#default_fields)* }
             }

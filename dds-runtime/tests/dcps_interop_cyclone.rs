@@ -71,7 +71,10 @@ fn rust_writer_to_cyclone_reader() {
         .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
         .collect();
     assert_eq!(xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
-    assert!(lines.iter().any(|l| l.contains("\"disposed\": true")), "no dispose seen by Cyclone: {lines:?}");
+    assert!(
+        lines.iter().any(|l| l.contains("\"disposed\": true")),
+        "no dispose seen by Cyclone: {lines:?}"
+    );
 }
 
 #[test]

@@ -68,91 +68,124 @@ pub fn module_name(rel: &str) -> String {
     format!("m_{s}")
 }
 
-#[test]
-fn corpus() {
+/// One folder: compile every file, build the accepted ones in one scratch crate, compare the failures with
+/// the expected list. Returns the table row.
+fn run_folder(folder: &str) {
     let Some(root) = common::corpus_dir() else {
         println!("SKIP: IDL corpus not found (set IDL_CORPUS or provide ../shared/idl-corpus)");
         return;
     };
     let expected = expected_failures();
-    let only: Option<String> = std::env::var("IDLC_CORPUS_FOLDER").ok();
     let no_build = std::env::var_os("IDLC_CORPUS_NO_BUILD").is_some();
     let mut problems: Vec<String> = Vec::new();
-    let mut table = String::from(
-        "| folder | files | accepted (Rust builds) | expected failures |\n|---|---:|---:|---:|\n",
-    );
-    let mut seen_expected = 0;
-    for folder in FOLDERS {
-        if only.as_deref().is_some_and(|o| o != *folder) {
-            continue;
-        }
-        let dir = root.join(folder);
-        let files = idl_files(&dir);
-        let mut opts = Options::default();
-        if *folder == "rti-ros-data-types" {
-            opts.include_dirs.push(dir.clone());
-        }
-        let mut krate = common::ScratchCrate::new(&folder.replace('-', "_"));
-        let (mut accepted, mut failed_as_expected) = (0, 0);
-        for f in &files {
-            let rel = f.strip_prefix(&root).unwrap_or(f).display().to_string();
-            let mut c = compile_file(f, &opts);
-            let code = c.rust();
-            match (code, expected.get(&rel)) {
-                (Some(code), None) => {
-                    krate.add_module(&module_name(&rel), &code);
-                    accepted += 1;
-                }
-                (Some(_), Some(_)) => problems.push(format!(
-                    "{rel}: listed as an expected failure but now compiles"
-                )),
-                (None, Some((want, _))) => {
-                    seen_expected += 1;
-                    let first = c
-                        .diags
-                        .iter()
-                        .find(|d| d.is_error())
-                        .map(|d| d.code.as_str())
-                        .unwrap_or("");
-                    if first != want {
-                        problems.push(format!("{rel}: expected {want}, first error is {first}"));
-                    } else {
-                        failed_as_expected += 1;
-                    }
-                }
-                (None, None) => {
-                    let text = c.render_diagnostics(Default::default());
-                    problems.push(format!("{rel}: unexpected errors:\n{text}"));
-                }
-            }
-        }
-        if !no_build && accepted > 0 {
-            let (ok, out) = krate.build(false);
-            if !ok {
-                let head: String = out.lines().take(80).collect::<Vec<_>>().join("\n");
-                problems.push(format!("{folder}: generated Rust does not build:\n{head}"));
-            }
-        }
-        table.push_str(&format!(
-            "| {folder} | {} | {accepted} | {failed_as_expected} |\n",
-            files.len()
-        ));
+    let dir = root.join(folder);
+    let files = idl_files(&dir);
+    let mut opts = Options::default();
+    if folder == "rti-ros-data-types" {
+        opts.include_dirs.push(dir.clone());
     }
-    println!("{table}");
-    let _ = std::fs::write(
-        common::target_dir().join("idlc-scratch/corpus-table.md"),
-        &table,
-    );
-    if only.is_none() && seen_expected != expected.len() {
+    let mut krate = common::ScratchCrate::new(&folder.replace('-', "_"));
+    let (mut accepted, mut failed_as_expected, mut seen_expected) = (0, 0, 0);
+    for f in &files {
+        let rel = f.strip_prefix(&root).unwrap_or(f).display().to_string();
+        let mut c = compile_file(f, &opts);
+        let code = c.rust();
+        match (code, expected.get(&rel)) {
+            (Some(code), None) => {
+                krate.add_module(&module_name(&rel), &code);
+                accepted += 1;
+            }
+            (Some(_), Some(_)) => problems.push(format!(
+                "{rel}: listed as an expected failure but now compiles"
+            )),
+            (None, Some((want, _))) => {
+                seen_expected += 1;
+                let first = c
+                    .diags
+                    .iter()
+                    .find(|d| d.is_error())
+                    .map(|d| d.code.as_str())
+                    .unwrap_or("");
+                if first != want {
+                    problems.push(format!("{rel}: expected {want}, first error is {first}"));
+                } else {
+                    failed_as_expected += 1;
+                }
+            }
+            (None, None) => {
+                let text = c.render_diagnostics(Default::default());
+                problems.push(format!("{rel}: unexpected errors:\n{text}"));
+            }
+        }
+    }
+    if !no_build && accepted > 0 {
+        let (ok, out) = krate.build(false);
+        if !ok {
+            let head: String = out.lines().take(80).collect::<Vec<_>>().join("\n");
+            problems.push(format!("{folder}: generated Rust does not build:\n{head}"));
+        }
+    }
+    let listed = expected
+        .keys()
+        .filter(|k| k.starts_with(&format!("{folder}/")))
+        .count();
+    if listed != seen_expected {
         problems.push(format!(
-            "{} expected-failure entries name files that were not seen",
-            expected.len() - seen_expected
+            "{} expected-failure entries of {folder} name files that were not seen",
+            listed - seen_expected
         ));
     }
+    println!("| folder | files | accepted (Rust builds) | expected failures |");
+    println!(
+        "| {folder} | {} | {accepted} | {failed_as_expected} |",
+        files.len()
+    );
     assert!(
         problems.is_empty(),
         "{} corpus problem(s):\n{}",
         problems.len(),
         problems.join("\n\n")
     );
+}
+
+#[test]
+fn corpus_cyclonedds() {
+    run_folder("cyclonedds");
+}
+
+#[test]
+fn corpus_eprosima_dds_types_test() {
+    run_folder("eprosima-dds-types-test");
+}
+
+#[test]
+fn corpus_omg_dds_rtps() {
+    run_folder("omg-dds-rtps");
+}
+
+#[test]
+fn corpus_ros2_test_interface_files() {
+    run_folder("ros2-test-interface-files");
+}
+
+#[test]
+fn corpus_rti_ros_data_types() {
+    run_folder("rti-ros-data-types");
+}
+
+#[test]
+fn corpus_folders_are_all_covered() {
+    let Some(root) = common::corpus_dir() else {
+        println!("SKIP: IDL corpus not found");
+        return;
+    };
+    for e in std::fs::read_dir(&root).expect("corpus dir").flatten() {
+        if e.path().is_dir() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            assert!(
+                FOLDERS.contains(&name.as_str()),
+                "corpus folder {name} has no test"
+            );
+        }
+    }
 }

@@ -86,7 +86,12 @@ pub(crate) struct Shared {
     pub(crate) stopped: AtomicBool,
     timer_thread: Mutex<Option<JoinHandle<()>>>,
     pub(crate) status: Arc<StatusCore>,
+    /// Payload buffers of sent datagrams, handed back to the core at the next `with_core`.
+    spare_buffers: Mutex<Vec<Vec<u8>>>,
 }
+
+/// Most sent buffers kept for recycling.
+const MAX_SPARE_BUFFERS: usize = 32;
 
 #[derive(Default)]
 struct TimerState {
@@ -139,6 +144,10 @@ impl Shared {
         let mut touched: Vec<Arc<dyn ReaderSink>> = Vec::new();
         let (r, next_timeout) = {
             let mut core = lock(&self.core);
+            // Sent datagram buffers go back to the core for reuse (saves an allocation per datagram).
+            for buf in std::mem::take(&mut *lock(&self.spare_buffers)) {
+                core.recycle(buf);
+            }
             let r = f(&mut core, now);
             while let Some(t) = core.poll_transmit(now) {
                 batch.push(t);
@@ -149,6 +158,14 @@ impl Shared {
             (r, core.poll_timeout())
         };
         self.send_batch(&batch);
+        {
+            let mut spare = lock(&self.spare_buffers);
+            for t in batch {
+                if spare.len() < MAX_SPARE_BUFFERS {
+                    spare.push(t.payload);
+                }
+            }
+        }
         self.after_unlock(deferred, touched, next_timeout);
         r
     }
@@ -689,6 +706,7 @@ impl DomainParticipantBuilder {
             stopped: AtomicBool::new(false),
             timer_thread: Mutex::new(None),
             status: Arc::new(StatusCore::default()),
+            spare_buffers: Mutex::new(Vec::new()),
         });
         let weak: Weak<Shared> = Arc::downgrade(&shared);
         let rx = Arc::new(move |_ch: Channel, batch: &[Datagram<'_>]| {
