@@ -120,7 +120,8 @@ impl<'a> CdrWriter<'a> {
         let n = n.min(self.max_align);
         let pad = self.position().wrapping_neg() & (n - 1);
         if pad != 0 {
-            self.buf.resize(self.buf.len() + pad, 0);
+            // A slice copy of at most 7 bytes compiles to plain stores; `resize` calls memset.
+            self.buf.extend_from_slice(&[0u8; 8][..pad]);
         }
     }
 
@@ -233,11 +234,24 @@ impl<'a> CdrWriter<'a> {
         }
         self.align(4);
         // PID_EXTENDED always carries the must-understand bit; the member's own flag rides in the id word.
-        self.write_u16(super::PID_EXTENDED | 0x4000);
-        self.write_u16(8);
-        self.write_u32(id | if must_understand { 0x4000_0000 } else { 0 });
-        let len_at = self.buf.len();
-        self.write_u32(0);
+        // The 16 header bytes are known up front: build them once and append them in one copy.
+        let pid = super::PID_EXTENDED | 0x4000;
+        let word = id | if must_understand { 0x4000_0000 } else { 0 };
+        let mut h = [0u8; 16];
+        match self.order {
+            ByteOrder::BigEndian => {
+                h[0..2].copy_from_slice(&pid.to_be_bytes());
+                h[2..4].copy_from_slice(&8u16.to_be_bytes());
+                h[4..8].copy_from_slice(&word.to_be_bytes());
+            }
+            ByteOrder::LittleEndian => {
+                h[0..2].copy_from_slice(&pid.to_le_bytes());
+                h[2..4].copy_from_slice(&8u16.to_le_bytes());
+                h[4..8].copy_from_slice(&word.to_le_bytes());
+            }
+        }
+        self.buf.extend_from_slice(&h);
+        let len_at = self.buf.len() - 4;
         let body = self.buf.len();
         let saved_origin = std::mem::replace(&mut self.origin, body);
         Ok(ParamSlot {
