@@ -39,6 +39,8 @@ pub struct FieldAttrs {
     pub bound: Option<Expr>,
     pub base: bool,
     pub non_serialized: bool,
+    /// The field's type leads back to this type (mutual recursion): left out of the compile-time constants.
+    pub recursive: bool,
 }
 
 /// Enum variant attributes (enumerators and union cases).
@@ -157,6 +159,8 @@ pub fn parse_field_attrs(attrs: &[Attribute]) -> Result<FieldAttrs> {
                 f.base = true;
             } else if p.is_ident("non_serialized") {
                 f.non_serialized = true;
+            } else if p.is_ident("recursive") {
+                f.recursive = true;
             } else {
                 return Err(m.error("unknown field attribute; see docs/derive.md"));
             }

@@ -298,7 +298,7 @@ pub fn derive_union(
                 {
                     return Err(syn::Error::new_spanned(
                         f,
-                        "a union case accepts only `bound`, `external`, `name` and `must_understand`",
+                        "a union case accepts only `bound`, `external`, `name`, `must_understand` and `recursive`",
                     ));
                 }
                 let ty = &f.ty;
@@ -325,7 +325,7 @@ pub fn derive_union(
                 scan_terms.push(quote!({
                     end = end.max(<#ty as #cdr::CdrType>::key_max_end(p, version, #bo)?);
                 }));
-                if !mentions(ty, name) {
+                if !fa.recursive && !mentions(ty, name) {
                     plain_terms.push(quote!(<#ty as #cdr::CdrType>::XCDR1_PLAIN));
                     mut_terms.push(quote!(<#ty as #cdr::CdrType>::KEY_HAS_MUTABLE));
                     if default_value.is_none() {

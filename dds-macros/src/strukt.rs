@@ -53,6 +53,7 @@ pub fn derive(
     let mut base: Option<(Ident, Type)> = None;
     let mut next_rel: u32 = 0;
     let mut relative = false;
+    let mut absolute_ids: Vec<(u64, String)> = Vec::new();
     for (i, f) in named.named.iter().enumerate() {
         let ident = f.ident.clone().expect("named field");
         let attrs = parse_field_attrs(&f.attrs)?;
@@ -136,6 +137,19 @@ pub fn derive(
                 "member ids are limited to 28 bits",
             ));
         }
+        // Ids relative to a base are only known to the compiler; every other id is checked here, since two
+        // members with one id would silently decode into the wrong field.
+        let is_relative =
+            relative && attrs.id.is_none() && attrs.hashid.is_none() && !ta.autoid_hash;
+        if !is_relative && !attrs.non_serialized {
+            if let Some((_, other)) = absolute_ids.iter().find(|(i, _)| *i == id_order) {
+                return Err(syn::Error::new_spanned(
+                    f,
+                    format!("member id {id_order} is already used by `{other}`"),
+                ));
+            }
+            absolute_ids.push((id_order, ident.to_string()));
+        }
         let (bound, bound_opt) = match &attrs.bound {
             Some(b) => (
                 quote!((#b) as usize),
@@ -143,7 +157,9 @@ pub fn derive(
             ),
             None => (quote!(usize::MAX), quote!(::core::option::Option::None)),
         };
-        let self_ref = mentions(&f.ty, name);
+        // `recursive` marks a field whose type leads back here through another type (A -> Vec<B> -> A): its
+        // constants would depend on this type's own, which rustc rejects as a cycle.
+        let self_ref = attrs.recursive || mentions(&f.ty, name);
         fields.push(Field {
             key: attrs.key.is_some(),
             ident,
@@ -186,6 +202,10 @@ pub fn derive(
         let mu = f.attrs.must_understand;
         if f.optional {
             quote!(#cdr::members::encode_optional::<#inner>(w, ext, #id, #mu, &self.#ident, #bound)?;)
+        } else if ext != Ext::Mutable {
+            // Members of final/appendable structs have no member header (the key-hash stream, which forces
+            // Final, is no different): write the value directly, without `encode_member`'s run-time checks.
+            quote!(<#ty as #cdr::CdrType>::encode_bounded(&self.#ident, w, #bound)?;)
         } else {
             quote!(#cdr::members::encode_member::<#ty>(w, ext, #id, #mu, &self.#ident, #bound)?;)
         }

@@ -3,8 +3,8 @@
 //! take minutes of LLVM time because every nested `default_value` was inlined into its callers.
 
 use dds_runtime::cdr::{
-    deserialize, deserialize_key, key_hash, serialize, serialize_key, ByteOrder, CdrType,
-    DdsType, XcdrVersion,
+    deserialize, deserialize_key, key_hash, serialize, serialize_key, ByteOrder, CdrType, DdsType,
+    XcdrVersion,
 };
 use dds_runtime::DdsType;
 

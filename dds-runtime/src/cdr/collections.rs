@@ -38,10 +38,11 @@ fn bound_error(
 /// Encodes a string body (length with NUL, bytes, NUL); shared by `String` and `BoundedString`.
 pub(crate) fn encode_str(s: &str, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
     check_bound("string", s.len(), bound)?;
-    if let Some(i) = s.bytes().position(|b| b == 0) {
+    // `contains` on bytes is memchr (vectorised); the position is only looked for on error.
+    if s.as_bytes().contains(&0) {
         return Err(EncodeError::InvalidValue {
             what: "NUL inside a string",
-            value: i as u64,
+            value: s.bytes().position(|b| b == 0).unwrap_or(0) as u64,
         });
     }
     w.write_len(s.len() + 1, "string length")?;

@@ -59,7 +59,7 @@ pub(crate) fn finish_payload(
         return Err(e);
     }
     let pad = (out.len() - start).wrapping_neg() & 3;
-    out.resize(out.len() + pad, 0);
+    out.extend_from_slice(&[0u8; 3][..pad]);
     out[start + 3] = (out[start + 3] & !3) | pad as u8;
     Ok(())
 }

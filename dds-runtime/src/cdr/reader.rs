@@ -25,12 +25,18 @@ pub struct Limit {
     origin: usize,
 }
 
+/// Aligned read of a primitive: the in-bounds path is a few instructions and inlines; errors are built out of
+/// line (a `DecodeError` is large, and building it inline kept these readers from inlining).
 macro_rules! get {
     ($self:ident, $t:ty, $n:expr, $what:expr) => {{
-        $self.align($n, $what)?;
-        let b = $self.read_bytes($n, $what)?;
+        let pad = ($self.pos - $self.origin).wrapping_neg() & ($n.min($self.max_align) - 1);
+        let start = $self.pos + pad;
+        if start + $n > $self.end {
+            return Err($self.short_read($n, $what));
+        }
         let mut a = [0u8; $n];
-        a.copy_from_slice(b);
+        a.copy_from_slice(&$self.data[start..start + $n]);
+        $self.pos = start + $n;
         Ok(match $self.order {
             ByteOrder::BigEndian => <$t>::from_be_bytes(a),
             ByteOrder::LittleEndian => <$t>::from_le_bytes(a),
@@ -104,6 +110,7 @@ impl<'a> CdrReader<'a> {
     }
 
     #[cold]
+    #[inline(never)]
     fn eof(&self, expected: &'static str, needed: usize) -> DecodeError {
         self.error(
             expected,
@@ -112,6 +119,16 @@ impl<'a> CdrReader<'a> {
                 available: self.remaining(),
             },
         )
+    }
+
+    /// The error of an aligned read of `n` bytes that does not fit (the padding, or the value after it).
+    #[cold]
+    #[inline(never)]
+    fn short_read(&mut self, n: usize, expected: &'static str) -> DecodeError {
+        if let Err(e) = self.align(n, expected) {
+            return e;
+        }
+        self.eof(expected, n)
     }
 
     /// Skips padding to a multiple of `n` (capped at 4 in XCDR2).
@@ -156,7 +173,12 @@ impl<'a> CdrReader<'a> {
     /// Reads an octet.
     #[inline]
     pub fn read_u8(&mut self, expected: &'static str) -> Result<u8, DecodeError> {
-        Ok(self.read_bytes(1, expected)?[0])
+        if self.pos >= self.end {
+            return Err(self.eof(expected, 1));
+        }
+        let b = self.data[self.pos];
+        self.pos += 1;
+        Ok(b)
     }
 
     /// Reads an aligned 16-bit value.

@@ -234,10 +234,10 @@ impl<'a> CdrWriter<'a> {
         }
         self.align(4);
         // PID_EXTENDED always carries the must-understand bit; the member's own flag rides in the id word.
-        // The 16 header bytes are known up front: build them once and append them in one copy.
+        // The 12 header bytes (the length patched later) are known up front: build them once and append them in one copy.
         let pid = super::PID_EXTENDED | 0x4000;
         let word = id | if must_understand { 0x4000_0000 } else { 0 };
-        let mut h = [0u8; 16];
+        let mut h = [0u8; 12];
         match self.order {
             ByteOrder::BigEndian => {
                 h[0..2].copy_from_slice(&pid.to_be_bytes());
