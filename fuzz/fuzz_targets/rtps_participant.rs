@@ -7,7 +7,7 @@ use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use dds_runtime::qos::{DataReaderQos, DataWriterQos, Durability, Reliability};
-use dds_runtime::rtps::discovery::{ParticipantData, WriterData, ReaderData};
+use dds_runtime::rtps::discovery::{ParticipantData, ReaderData, WriterData};
 use dds_runtime::rtps::messages::{Data, Header, MessageBuilder, Submessage};
 use dds_runtime::rtps::*;
 use libfuzzer_sys::fuzz_target;
@@ -18,7 +18,11 @@ const PEER: GuidPrefix = GuidPrefix([0x01, 0x10, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10])
 fn discovery() -> &'static Vec<Vec<u8>> {
     static D: OnceLock<Vec<Vec<u8>>> = OnceLock::new();
     D.get_or_init(|| {
-        let h = Header { version: ProtocolVersion::V2_5, vendor_id: VendorId::CYCLONE, guid_prefix: PEER };
+        let h = Header {
+            version: ProtocolVersion::V2_5,
+            vendor_id: VendorId::CYCLONE,
+            guid_prefix: PEER,
+        };
         let spdp = ParticipantData {
             guid_prefix: PEER,
             vendor_id: VendorId::CYCLONE,
@@ -29,7 +33,9 @@ fn discovery() -> &'static Vec<Vec<u8>> {
             ..Default::default()
         }
         .encode();
-        let rq = DataReaderQos::builder().reliability(Reliability::RELIABLE).build();
+        let rq = DataReaderQos::builder()
+            .reliability(Reliability::RELIABLE)
+            .build();
         let w = WriterData {
             guid: Guid::new(PEER, EntityId([0, 0, 1, 2])),
             topic_name: "F".into(),
@@ -72,14 +78,25 @@ fuzz_target!(|data: &[u8]| {
     let mut c = ParticipantConfig::new(0, 0, GuidPrefix([7; 12]), [127, 0, 0, 1]);
     c.defrag_max_bytes = 1 << 20;
     let mut p = Participant::new(c, now);
-    let wq = DataWriterQos::builder().durability(Durability::TransientLocal).build();
-    let w = p.create_writer(now, WriterSpec::new("F", "T", true, wq)).unwrap();
-    let rq = DataReaderQos::builder().reliability(Reliability::RELIABLE).build();
-    p.create_reader(now, ReaderSpec::new("F", "T", true, rq)).unwrap();
+    let wq = DataWriterQos::builder()
+        .durability(Durability::TransientLocal)
+        .build();
+    let w = p
+        .create_writer(now, WriterSpec::new("F", "T", true, wq))
+        .unwrap();
+    let rq = DataReaderQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .build();
+    p.create_reader(now, ReaderSpec::new("F", "T", true, rq))
+        .unwrap();
     for d in discovery() {
         p.handle_datagram(now, d);
     }
-    let _ = p.write(now, w, WriteChange::alive(vec![0, 1, 0, 0, 1, 2, 3, 4]).with_key_hash([1; 16]));
+    let _ = p.write(
+        now,
+        w,
+        WriteChange::alive(vec![0, 1, 0, 0, 1, 2, 3, 4]).with_key_hash([1; 16]),
+    );
     // The input is several datagrams, split at 0xfe bytes, all claiming to come from PEER.
     for chunk in data.split(|&b| b == 0xfe) {
         let mut msg = b"RTPS\x02\x05\x01\x10".to_vec();

@@ -153,6 +153,16 @@ diag_test!(
     "struct Base { @key long id; };\nstruct Derived : Base {\n  @key long id2;\n};\n"
 );
 diag_test!(
+    derived_extensibility_mismatch,
+    "E0416",
+    "@mutable struct Base { short s; };\n@final\nstruct Derived : Base {\n  long l;\n};\n"
+);
+diag_test!(
+    derived_extensibility_mismatch_via_extensibility,
+    "E0416",
+    "@final struct Base { short s; };\n@extensibility(APPENDABLE) struct Derived : Base { long l; };\n"
+);
+diag_test!(
     duplicate_member_id,
     "E0407",
     "@mutable struct A {\n  @id(1) long a;\n  @id(1) long b;\n};\n"

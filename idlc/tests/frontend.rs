@@ -267,6 +267,36 @@ fn default_extensibility_option() {
 }
 
 #[test]
+fn derived_struct_inherits_base_extensibility() {
+    // The `-x`/default option must not override what the base dictates.
+    let opts = Options {
+        default_extensibility: Extensibility::Appendable,
+        ..Default::default()
+    };
+    let c = ok_with(
+        MemVfs::new(),
+        &opts,
+        "@mutable struct M { short s; };\nstruct DM : M { long l; };\nstruct DDM : DM { long m; };\n\
+         @final struct F { short s; };\ntypedef F FAlias;\nstruct DF : FAlias { long l; };\n\
+         @final struct DF2 : F { long l; };\nstruct P { long x; };\nstruct DP : P { long y; };\n",
+    );
+    let ext = |n: &str| match decl(&c, n) {
+        DeclKind::Struct(s) => s.extensibility,
+        other => panic!("{n} is {other:?}"),
+    };
+    assert_eq!(ext("DM"), Extensibility::Mutable);
+    assert_eq!(ext("DDM"), Extensibility::Mutable);
+    assert_eq!(ext("DF"), Extensibility::Final);
+    assert_eq!(ext("DF2"), Extensibility::Final);
+    assert_eq!(ext("DP"), Extensibility::Appendable);
+    assert!(c.diags.iter().next().is_none());
+    assert_eq!(
+        codes("@mutable struct B { short s; };\n@appendable struct D : B { long l; };\n"),
+        ["idlc::E0416"]
+    );
+}
+
+#[test]
 fn unsupported_constructs_warn_once_each() {
     let c = ok("interface I { void f(); };\nexception Ex { long code; };\nnative N;\nvaluetype V { public long x; };\nstruct S { long x; };\n");
     let w: Vec<_> = c.diags.iter().map(|d| d.code.as_str()).collect();

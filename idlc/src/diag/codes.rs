@@ -62,6 +62,7 @@ codes! {
     DuplicateMember = "E0413": "two members have the same name",
     BadMemberType = "E0414": "type not allowed for this member",
     UnreachableDefault = "E0415": "union default label can never be selected",
+    ExtensibilityMismatch = "E0416": "derived struct's extensibility differs from its base's",
     // Warnings
     PragmaIgnored = "W0001": "unknown #pragma ignored",
     WarningDirective = "W0002": "#warning directive",

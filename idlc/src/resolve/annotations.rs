@@ -110,6 +110,7 @@ pub struct Anns<'a> {
     pub key_loc: Option<Loc>,
     pub optional_loc: Option<Loc>,
     pub id_loc: Option<Loc>,
+    pub extensibility_loc: Option<Loc>,
 }
 
 impl Resolver<'_> {
@@ -252,22 +253,9 @@ impl Resolver<'_> {
                 }
                 "external" => r.external = self.bool_param(a),
                 "must_understand" => r.must_understand = self.bool_param(a),
-                "final" => r.extensibility = Some(Extensibility::Final),
-                "appendable" => r.extensibility = Some(Extensibility::Appendable),
-                "mutable" => r.extensibility = Some(Extensibility::Mutable),
-                "extensibility" => {
-                    r.extensibility = match self.word_param(a).as_deref() {
-                        Some("FINAL") => Some(Extensibility::Final),
-                        Some("APPENDABLE") => Some(Extensibility::Appendable),
-                        Some("MUTABLE") => Some(Extensibility::Mutable),
-                        _ => {
-                            self.ann_err(
-                                a,
-                                "`@extensibility` takes FINAL, APPENDABLE or MUTABLE".into(),
-                            );
-                            None
-                        }
-                    }
+                "final" | "appendable" | "mutable" | "extensibility" => {
+                    r.extensibility_loc = Some(a.loc);
+                    r.extensibility = self.extensibility(a, &name);
                 }
                 "value" => r.value = self.single(a),
                 "position" => r.position = self.single(a),
@@ -316,6 +304,26 @@ impl Resolver<'_> {
             }
         }
         r
+    }
+
+    fn extensibility(&mut self, a: &Annotation, name: &str) -> Option<Extensibility> {
+        match name {
+            "final" => Some(Extensibility::Final),
+            "appendable" => Some(Extensibility::Appendable),
+            "mutable" => Some(Extensibility::Mutable),
+            _ => match self.word_param(a).as_deref() {
+                Some("FINAL") => Some(Extensibility::Final),
+                Some("APPENDABLE") => Some(Extensibility::Appendable),
+                Some("MUTABLE") => Some(Extensibility::Mutable),
+                _ => {
+                    self.ann_err(
+                        a,
+                        "`@extensibility` takes FINAL, APPENDABLE or MUTABLE".into(),
+                    );
+                    None
+                }
+            },
+        }
     }
 
     fn id_range(&mut self, a: &Annotation, v: u64) -> Option<u32> {

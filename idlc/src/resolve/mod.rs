@@ -509,17 +509,54 @@ impl<'a> Resolver<'a> {
             fields.extend(self.member(m));
         }
         let nested = anns.nested.unwrap_or(!anns.topic && self.nested_default());
+        let extensibility = self.struct_extensibility(s, &anns, base);
         let st = Struct {
             base,
             fields,
-            extensibility: anns
-                .extensibility
-                .unwrap_or(self.opts.default_extensibility),
+            extensibility,
             autoid: anns.autoid.unwrap_or_default(),
             nested,
         };
         self.model.decls[id].kind = DeclKind::Struct(st);
         self.model.decls[id].verbatim = anns.verbatim;
+    }
+
+    /// XTypes (§7.2.2.4.4.4.3) requires a derived struct to have its base's extensibility: without an annotation
+    /// it inherits it (as Cyclone's idlc does), and a different explicit one is an error.
+    fn struct_extensibility(
+        &mut self,
+        s: &ast::StructDef,
+        anns: &annotations::Anns,
+        base: Option<DeclId>,
+    ) -> Extensibility {
+        let base_ext = base.and_then(|b| match &self.model.decls[b].kind {
+            DeclKind::Struct(bs) => Some((b, bs.extensibility)),
+            _ => None,
+        });
+        match (anns.extensibility, base_ext) {
+            (None, Some((_, be))) => be,
+            (None, None) => self.opts.default_extensibility,
+            (Some(e), Some((b, be))) if e != be => {
+                let bd = &self.model.decls[b];
+                let msg = format!(
+                    "`{}` is {} but its base `{}` is {}",
+                    s.name.name,
+                    e.as_str(),
+                    bd.scoped_name(),
+                    be.as_str()
+                );
+                let d = Diagnostic::error(Code::ExtensibilityMismatch, msg)
+                    .at(anns.extensibility_loc.unwrap_or(s.name.loc), "declared here")
+                    .also(bd.loc, "base declared here")
+                    .help(format!(
+                        "a derived struct must have its base's extensibility: use `@{}` or no annotation",
+                        be.as_str()
+                    ));
+                self.diags.push(d);
+                e
+            }
+            (Some(e), _) => e,
+        }
     }
 
     fn member(&mut self, m: &ast::Member) -> Vec<Field> {
