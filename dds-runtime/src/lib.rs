@@ -13,13 +13,13 @@
 extern crate self as dds_runtime;
 
 pub mod cdr;
-pub mod qos;
-pub mod rtps;
-pub mod xtypes;
 pub mod config;
-pub mod transport;
 pub mod dcps;
 pub mod prelude;
+pub mod qos;
+pub mod rtps;
+pub mod transport;
+pub mod xtypes;
 
 pub use dds_macros::DdsType;
 
