@@ -245,7 +245,7 @@ pub fn derive(
             })
         } else {
             quote!(if st.has_more(r) {
-                p.#ident = ::core::option::Option::Some(<#ty as #cdr::CdrType>::decode_bounded(r, #bound)?);
+                #cdr::members::decode_into_slot::<#ty>(&mut p.#ident, r, #bound)?;
             })
         }
     };
@@ -273,7 +273,7 @@ pub fn derive(
             } = f;
             let t = if f.optional { inner } else { ty };
             quote!(x if x == #id => {
-                p.#ident = ::core::option::Option::Some(<#t as #cdr::CdrType>::decode_bounded(r, #bound)?);
+                #cdr::members::decode_into_slot::<#t>(&mut p.#ident, r, #bound)?;
                 ::core::result::Result::Ok(true)
             })
         })

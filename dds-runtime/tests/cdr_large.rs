@@ -185,3 +185,27 @@ fn struct32k_round_trips_on_a_2mib_stack() {
         }
     });
 }
+
+#[test]
+fn tmp_probe_decode_only() {
+    let mut out = Vec::new();
+    let v = Box::new(<Struct32k as CdrType>::default_value());
+    serialize(&*v, XcdrVersion::Xcdr1, ByteOrder::LittleEndian, &mut out).unwrap();
+    let mut out2 = Vec::new();
+    let u = Box::new(<Unkeyed64k as CdrType>::default_value());
+    serialize(&*u, XcdrVersion::Xcdr1, ByteOrder::LittleEndian, &mut out2).unwrap();
+    for kb in [1024usize, 768, 512, 384, 256] {
+        let o = out.clone();
+        let ok = std::thread::Builder::new().stack_size(kb << 10).spawn(move || {
+            let b: Box<Struct32k> = Box::new(deserialize(&o).unwrap());
+            b.seq
+        }).unwrap().join().is_ok();
+        eprintln!("PROBE s32k {kb} KiB ok={ok}");
+        let o = out2.clone();
+        std::thread::Builder::new().stack_size(kb << 10).spawn(move || {
+            let b: Box<Unkeyed64k> = Box::new(deserialize(&o).unwrap());
+            b.seq
+        }).unwrap().join().unwrap();
+        eprintln!("PROBE u64k {kb} KiB ok");
+    }
+}

@@ -163,6 +163,16 @@ diag_test!(
     "@final struct Base { short s; };\n@extensibility(APPENDABLE) struct Derived : Base { long l; };\n"
 );
 diag_test!(
+    capitalised_builtin_annotation,
+    "W0106",
+    "struct S {\n  @Key long id;\n  long x;\n};\n"
+);
+diag_test!(
+    default_on_discriminator,
+    "W0104",
+    "union U switch (@default(1) long) {\n  case 0: octet a;\n  case 1: short b;\n};\n"
+);
+diag_test!(
     duplicate_member_id,
     "E0407",
     "@mutable struct A {\n  @id(1) long a;\n  @id(1) long b;\n};\n"

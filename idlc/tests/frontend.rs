@@ -297,6 +297,17 @@ fn derived_struct_inherits_base_extensibility() {
 }
 
 #[test]
+fn capitalised_key_still_makes_a_key_with_a_warning() {
+    let c = ok("struct S { @Key long id; @key long b; long c; };\n");
+    let DeclKind::Struct(s) = decl(&c, "S") else {
+        panic!()
+    };
+    assert!(s.fields[0].key && s.fields[1].key && !s.fields[2].key);
+    let w: Vec<_> = c.diags.iter().map(|d| d.code.as_str()).collect();
+    assert_eq!(w, ["idlc::W0106"]);
+}
+
+#[test]
 fn unsupported_constructs_warn_once_each() {
     let c = ok("interface I { void f(); };\nexception Ex { long code; };\nnative N;\nvaluetype V { public long x; };\nstruct S { long x; };\n");
     let w: Vec<_> = c.diags.iter().map(|d| d.code.as_str()).collect();

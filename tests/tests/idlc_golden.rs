@@ -488,7 +488,6 @@ golden! { eprosima_mutable_inheritance:
 
 // An unannotated struct takes its base's extensibility (as Cyclone's idlc has it): mutable here.
 golden! {
-    #[ignore = "FINDINGS.md F1: idlc gives an unannotated derived struct the default extensibility"]
     eprosima_mutable_extensibility_inheritance:
     "mutable" / "MutableExtensibilityInheritance" => mutable::MutableExtensibilityInheritance,
     "basic" => mutable::MutableExtensibilityInheritance {
@@ -499,7 +498,6 @@ golden! {
 
 // The same, final (eprosima final.idl).
 golden! {
-    #[ignore = "FINDINGS.md F1: idlc gives an unannotated derived struct the default extensibility"]
     eprosima_final_extensibility_inheritance:
     "final" / "FinalExtensibilityInheritance" => final_::FinalExtensibilityInheritance,
     "basic" => final_::FinalExtensibilityInheritance {

@@ -254,14 +254,10 @@ impl<T: CdrType, const N: usize> CdrType for [T; N] {
     }
 
     fn decode(r: &mut CdrReader<'_>) -> Result<Self, DecodeError> {
+        // Both branches are tail calls into functions of their own: a debug build then holds no copy of the
+        // array in this frame (a 64 KiB array passed through several frames by value overflowed small stacks).
         if matches!(Self::LAYOUT, Layout::DelimitedArray) && r.is_xcdr2() {
-            r.enter("array")?;
-            let len = r.read_u32("array DHEADER")? as usize;
-            let l = r.begin_limit(len, "array DHEADER")?;
-            let v = Self::decode_flat(r)?;
-            r.end_limit(l);
-            r.leave();
-            Ok(v)
+            decode_delimited_array::<T, N>(r)
         } else {
             Self::decode_flat(r)
         }
@@ -280,20 +276,7 @@ impl<T: CdrType, const N: usize> CdrType for [T; N] {
 
     fn decode_flat(r: &mut CdrReader<'_>) -> Result<Self, DecodeError> {
         if T::LAYOUT.is_array() {
-            let mut err = None;
-            let arr = std::array::from_fn(|_| {
-                if err.is_none() {
-                    match T::decode_flat(r) {
-                        Ok(v) => return v,
-                        Err(e) => err = Some(e),
-                    }
-                }
-                T::default_value()
-            });
-            match err {
-                None => Ok(arr),
-                Some(e) => Err(e),
-            }
+            decode_inner_dimension::<T, N>(r)
         } else {
             T::decode_array::<N>(r)
         }
@@ -315,6 +298,39 @@ impl<T: CdrType, const N: usize> CdrType for [T; N] {
             }
         }
         Some(p)
+    }
+}
+
+/// An XCDR2 array of non-primitive elements: a DHEADER, then the elements.
+fn decode_delimited_array<T: CdrType, const N: usize>(
+    r: &mut CdrReader<'_>,
+) -> Result<[T; N], DecodeError> {
+    r.enter("array")?;
+    let len = r.read_u32("array DHEADER")? as usize;
+    let l = r.begin_limit(len, "array DHEADER")?;
+    let v = <[T; N]>::decode_flat(r)?;
+    r.end_limit(l);
+    r.leave();
+    Ok(v)
+}
+
+/// The outer dimension of a multi-dimensional array: each element is an array written without a header.
+fn decode_inner_dimension<T: CdrType, const N: usize>(
+    r: &mut CdrReader<'_>,
+) -> Result<[T; N], DecodeError> {
+    let mut err = None;
+    let arr = std::array::from_fn(|_| {
+        if err.is_none() {
+            match T::decode_flat(r) {
+                Ok(v) => return v,
+                Err(e) => err = Some(e),
+            }
+        }
+        T::default_value()
+    });
+    match err {
+        None => Ok(arr),
+        Some(e) => Err(e),
     }
 }
 

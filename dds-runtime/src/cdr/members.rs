@@ -265,6 +265,19 @@ pub fn skip_member(r: &mut CdrReader<'_>, m: MemberHeader) -> Result<(), DecodeE
     Ok(())
 }
 
+/// Decodes a struct member into its slot of the struct's decode state. A function of its own so that a debug
+/// build keeps the temporaries of a large member (a `Result`, the moved value, the `Option`) in this frame
+/// instead of one set per member in the struct's frame; optimised builds inline it.
+#[inline]
+pub fn decode_into_slot<T: CdrType>(
+    slot: &mut Option<T>,
+    r: &mut CdrReader<'_>,
+    bound: usize,
+) -> Result<(), DecodeError> {
+    *slot = Some(T::decode_bounded(r, bound)?);
+    Ok(())
+}
+
 /// Decodes an optional member of a final/appendable type (presence byte in XCDR2, parameter in XCDR1).
 pub fn decode_optional<T: CdrType>(
     r: &mut CdrReader<'_>,

@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hasher};
 use std::net::{IpAddr, SocketAddr, SocketAddrV4};
-use std::sync::atomic::{AtomicBool, AtomicU16, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, RwLock, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
@@ -78,7 +78,10 @@ pub(crate) struct Shared {
     participants: Mutex<HashMap<GuidPrefix, DiscoveredParticipant>>,
     /// Bumped whenever the core processed input (acks may have arrived): flow control and
     /// wait_for_acknowledgments wait on it.
-    progress: Mutex<u64>,
+    progress: AtomicU64,
+    /// Threads blocked on `progress_cv`: the notification (a futex syscall) is skipped when there are none.
+    progress_waiters: AtomicUsize,
+    progress_lock: Mutex<()>,
     progress_cv: Condvar,
     /// Bumped when the core's next timeout may have moved earlier than what the timer thread waits for.
     timer_gen: Mutex<TimerState>,
@@ -221,11 +224,7 @@ impl Shared {
         touched: Vec<Arc<dyn ReaderSink>>,
         next_timeout: Option<Instant>,
     ) {
-        {
-            let mut p = lock(&self.progress);
-            *p = p.wrapping_add(1);
-            self.progress_cv.notify_all();
-        }
+        self.bump_progress();
         {
             // Wake the timer thread only when it sleeps past the core's new deadline; when it is busy, the
             // generation bump makes it re-read the deadline before sleeping.
@@ -346,6 +345,31 @@ impl Shared {
         }
     }
 
+    /// Records core progress and wakes whoever waits for it (flow control, wait_for_acknowledgments).
+    fn bump_progress(&self) {
+        self.progress.fetch_add(1, Ordering::SeqCst);
+        // A waiter registers (under `progress_lock`) before re-reading the generation, so either it sees the
+        // new generation or we see it registered and notify it after it released the lock in `wait`.
+        if self.progress_waiters.load(Ordering::SeqCst) > 0 {
+            let _g = lock(&self.progress_lock);
+            self.progress_cv.notify_all();
+        }
+    }
+
+    /// Sleeps until the progress generation differs from `seen` (or a notification / `left` passes).
+    fn wait_progress_for(&self, seen: u64, left: Duration) {
+        let g = lock(&self.progress_lock);
+        self.progress_waiters.fetch_add(1, Ordering::SeqCst);
+        if self.progress.load(Ordering::SeqCst) == seen && !self.stopped.load(Ordering::Acquire) {
+            // Capped so that a missed notification costs at most a few milliseconds.
+            let _g = self
+                .progress_cv
+                .wait_timeout(g, left.min(Duration::from_millis(20)))
+                .unwrap_or_else(|e| e.into_inner());
+        }
+        self.progress_waiters.fetch_sub(1, Ordering::SeqCst);
+    }
+
     /// Waits until `done` holds (re-checked after each core progress) or `deadline` passes.
     pub(crate) fn wait_progress(
         &self,
@@ -353,16 +377,12 @@ impl Shared {
         mut done: impl FnMut() -> bool,
     ) -> bool {
         loop {
-            let seen = *lock(&self.progress);
+            let seen = self.progress.load(Ordering::SeqCst);
             if done() {
                 return true;
             }
             if self.stopped.load(Ordering::Acquire) {
                 return false;
-            }
-            let g = lock(&self.progress);
-            if *g != seen {
-                continue;
             }
             let left = match deadline {
                 Some(d) => match d.checked_duration_since(Instant::now()) {
@@ -371,31 +391,18 @@ impl Shared {
                 },
                 None => Duration::from_millis(500),
             };
-            // Capped so that a missed notification costs at most a few milliseconds.
-            let _g = self
-                .progress_cv
-                .wait_timeout(g, left.min(Duration::from_millis(20)))
-                .unwrap_or_else(|e| e.into_inner());
+            self.wait_progress_for(seen, left);
         }
     }
 
     pub(crate) fn progress_generation(&self) -> u64 {
-        *lock(&self.progress)
+        self.progress.load(Ordering::SeqCst)
     }
 
     /// Waits until the core made progress after generation `seen`, or until `deadline`.
     pub(crate) fn wait_progress_change(&self, seen: u64, deadline: Instant) {
-        let g = lock(&self.progress);
-        if *g != seen || self.stopped.load(Ordering::Acquire) {
-            return;
-        }
-        let left = deadline
-            .saturating_duration_since(Instant::now())
-            .min(Duration::from_millis(20));
-        let _g = self
-            .progress_cv
-            .wait_timeout(g, left)
-            .unwrap_or_else(|e| e.into_inner());
+        let left = deadline.saturating_duration_since(Instant::now());
+        self.wait_progress_for(seen, left);
     }
 
     fn timer_loop(self: Arc<Self>) {
@@ -460,11 +467,7 @@ impl Shared {
             g.generation = g.generation.wrapping_add(1);
             self.timer_cv.notify_all();
         }
-        {
-            let mut p = lock(&self.progress);
-            *p = p.wrapping_add(1);
-            self.progress_cv.notify_all();
-        }
+        self.bump_progress();
         if let Some(h) = lock(&self.timer_thread).take() {
             if h.thread().id() != std::thread::current().id() {
                 let _ = h.join();
@@ -699,7 +702,9 @@ impl DomainParticipantBuilder {
             writers: RwLock::new(HashMap::new()),
             remote_writers: Mutex::new(HashMap::new()),
             participants: Mutex::new(HashMap::new()),
-            progress: Mutex::new(0),
+            progress: AtomicU64::new(0),
+            progress_waiters: AtomicUsize::new(0),
+            progress_lock: Mutex::new(()),
             progress_cv: Condvar::new(),
             timer_gen: Mutex::new(TimerState::default()),
             timer_cv: Condvar::new(),

@@ -1,7 +1,6 @@
 //! `Publisher` and `DataWriter<T>`.
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, Weak};
 use std::time::{Duration, Instant, SystemTime};
 
@@ -112,7 +111,6 @@ impl Publisher {
             listener: Mutex::new(None),
             matched: Mutex::new(Vec::new()),
             handle: Mutex::new(Weak::new()),
-            size_hint: AtomicUsize::new(64),
         });
         // Register before the core can report matches for it; the id is known only after creation, so the
         // core lock is held across both (match events are only polled after `f` returns).
@@ -173,7 +171,6 @@ struct WriterInner<T: DdsType> {
     listener: Mutex<Option<Arc<dyn DataWriterListener<T>>>>,
     matched: Mutex<Vec<Guid>>,
     handle: Mutex<Weak<WriterHandle<T>>>,
-    size_hint: AtomicUsize,
 }
 
 struct WriterHandle<T: DdsType> {
@@ -286,14 +283,27 @@ impl<T: DdsType> DataWriter<T> {
         self.inner.version
     }
 
-    fn serialize(&self, sample: &T) -> DdsResult<Vec<u8>> {
-        let mut buf = Vec::with_capacity(self.inner.size_hint.load(Ordering::Relaxed));
-        cdr::serialize(sample, self.inner.version, ByteOrder::NATIVE, &mut buf)?;
-        self.inner.size_hint.store(
-            buf.len().next_power_of_two().min(1 << 20),
-            Ordering::Relaxed,
-        );
-        Ok(buf)
+    /// Serializes into a per-thread scratch buffer and copies the bytes once into the shared payload: one
+    /// allocation per sample instead of a growing `Vec` plus its conversion into an `Arc<[u8]>`.
+    fn serialize(&self, sample: &T) -> DdsResult<Payload> {
+        thread_local! {
+            static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        SCRATCH.with(|cell| {
+            // A listener writing from inside serialization cannot happen (serialize calls no user code), but
+            // stay safe if the buffer is somehow in use: fall back to a fresh one.
+            let mut fresh = Vec::new();
+            let mut guard = cell.try_borrow_mut().ok();
+            let buf = guard.as_deref_mut().unwrap_or(&mut fresh);
+            buf.clear();
+            cdr::serialize(sample, self.inner.version, ByteOrder::NATIVE, buf)?;
+            let payload = Payload::copy_from_slice(buf);
+            // Do not keep a huge buffer alive for the thread's lifetime after one large sample.
+            if buf.capacity() > 1 << 20 {
+                *buf = Vec::new();
+            }
+            Ok(payload)
+        })
     }
 
     fn key_hash(&self, sample: &T) -> DdsResult<Option<[u8; 16]>> {
@@ -357,7 +367,7 @@ impl<T: DdsType> DataWriter<T> {
         };
         let change = WriteChange {
             kind: ChangeKind::Alive,
-            payload: Payload::from(payload),
+            payload,
             key_hash,
             source_timestamp: Some(wire_time(timestamp)),
         };

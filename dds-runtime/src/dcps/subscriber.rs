@@ -2,6 +2,7 @@
 
 use std::collections::{HashMap, VecDeque};
 use std::pin::Pin;
+use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, Weak};
 use std::task::{Context, Poll, Waker};
 use std::time::{Duration, Instant, SystemTime};
@@ -104,6 +105,7 @@ impl Subscriber {
                 by_hash: HashMap::new(),
             }),
             data_cv: Condvar::new(),
+            data_waiters: AtomicUsize::new(0),
             wakers: Mutex::new(Vec::new()),
             statuses: Mutex::new(ReaderStatuses::default()),
             status_core: Arc::new(StatusCore::default()),
@@ -149,6 +151,9 @@ struct ReaderInner<T: DdsType> {
     pending: Mutex<VecDeque<Pending>>,
     cache: Mutex<CacheState<T>>,
     data_cv: Condvar,
+    /// Threads in `wait_for_data`; registered under the cache lock so that `notify_data` (called after the
+    /// change was made under that lock) skips the futex wake only when nobody can be sleeping.
+    data_waiters: AtomicUsize,
     wakers: Mutex<Vec<Waker>>,
     statuses: Mutex<ReaderStatuses>,
     status_core: Arc<StatusCore>,
@@ -484,12 +489,14 @@ impl<T: DdsType> DataReader<T> {
                 },
                 None => Duration::from_secs(1),
             };
+            self.inner.data_waiters.fetch_add(1, AtomicOrdering::SeqCst);
             st = self
                 .inner
                 .data_cv
                 .wait_timeout(st, left.min(Duration::from_secs(1)))
                 .unwrap_or_else(|e| e.into_inner())
                 .0;
+            self.inner.data_waiters.fetch_sub(1, AtomicOrdering::SeqCst);
         }
     }
 
@@ -644,7 +651,9 @@ impl<T: DdsType> ReaderInner<T> {
     }
 
     fn notify_data(self: &Arc<Self>) {
-        self.data_cv.notify_all();
+        if self.data_waiters.load(AtomicOrdering::SeqCst) > 0 {
+            self.data_cv.notify_all();
+        }
         let wakers = std::mem::take(&mut *lock(&self.wakers));
         for w in wakers {
             w.wake();

@@ -71,4 +71,5 @@ codes! {
     UnknownAnnotation = "W0103": "unknown annotation ignored",
     IgnoredAnnotation = "W0104": "annotation has no effect here",
     Renamed = "W0105": "Rust name changed to avoid a collision",
+    AnnotationCase = "W0106": "built-in annotation name not in lower case",
 }

@@ -206,14 +206,37 @@ impl Resolver<'_> {
                 }
                 continue;
             };
-            if !places.contains(&place) {
+            let spelled = a.name.parts.last().map_or("", |p| p.name.as_str());
+            if spelled != name {
+                // eProsima's examples write `@Key`; IDL names are case-sensitive and Cyclone rejects it.
                 self.diags.push(
                     Diagnostic::warning(
-                        Code::IgnoredAnnotation,
-                        format!("`@{}` has no effect here", a.name.text()),
+                        Code::AnnotationCase,
+                        format!("`@{spelled}` is not the IDL spelling of `@{name}`"),
                     )
-                    .at(a.loc, "ignored"),
+                    .at(a.loc, format!("read as `@{name}`"))
+                    .help(format!(
+                        "write `@{name}`: built-in annotation names are lower case, and other compilers reject `@{spelled}`"
+                    )),
                 );
+            }
+            if !places.contains(&place) {
+                let mut d = Diagnostic::warning(
+                    Code::IgnoredAnnotation,
+                    format!("`@{}` has no effect here", a.name.text()),
+                )
+                .at(a.loc, "ignored");
+                if name == "default" && place == Place::Discriminator {
+                    // eProsima's extension: the discriminator value of a default-constructed union.
+                    d = Diagnostic::warning(
+                        Code::IgnoredAnnotation,
+                        format!("`@{}` on a union discriminator is ignored", a.name.text()),
+                    )
+                    .at(a.loc, "ignored")
+                    .help("IDL 4.2 allows `@default` on members only; the union's `Default` selects its first member")
+                    .note("Cyclone's idlc rejects this annotation");
+                }
+                self.diags.push(d);
                 continue;
             }
             match name.as_str() {

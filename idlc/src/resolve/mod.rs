@@ -545,9 +545,13 @@ impl<'a> Resolver<'a> {
                     bd.scoped_name(),
                     be.as_str()
                 );
+                let base_loc = s.base.as_ref().map_or(bd.loc, |b| b.loc);
                 let d = Diagnostic::error(Code::ExtensibilityMismatch, msg)
-                    .at(anns.extensibility_loc.unwrap_or(s.name.loc), "declared here")
-                    .also(bd.loc, "base declared here")
+                    .at(
+                        anns.extensibility_loc.unwrap_or(s.name.loc),
+                        format!("{} here", e.as_str()),
+                    )
+                    .also(base_loc, format!("this base is {}", be.as_str()))
                     .help(format!(
                         "a derived struct must have its base's extensibility: use `@{}` or no annotation",
                         be.as_str()

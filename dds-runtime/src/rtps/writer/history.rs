@@ -135,8 +135,26 @@ impl HistoryCache {
     }
 
     /// Bytes of the changes at or above `sn`.
+    /// Called after every acknowledgement: walks only the smaller side of `sn` (the total is kept), so a
+    /// volatile writer, whose history starts at the acknowledged floor, pays nothing.
     pub fn bytes_from(&self, sn: SequenceNumber) -> usize {
-        self.changes.range(sn..).map(|(_, c)| c.payload.len()).sum()
+        let (Some((first, _)), Some((last, _))) =
+            (self.changes.first_key_value(), self.changes.last_key_value())
+        else {
+            return 0;
+        };
+        if sn <= *first {
+            return self.bytes;
+        }
+        if sn > *last {
+            return 0;
+        }
+        if sn.0 - first.0 <= last.0 - sn.0 {
+            let below: usize = self.changes.range(..sn).map(|(_, c)| c.payload.len()).sum();
+            self.bytes - below
+        } else {
+            self.changes.range(sn..).map(|(_, c)| c.payload.len()).sum()
+        }
     }
 
     /// Drops disposed+unregistered instances' history beyond their last change (keeps memory bounded for
@@ -188,6 +206,30 @@ mod tests {
             vec![2, 3, 4]
         );
         assert_eq!(h.bytes(), 30);
+    }
+
+    #[test]
+    fn bytes_from_matches_a_full_walk() {
+        let mut h = HistoryCache::new(History::KeepAll, ResourceLimits::default());
+        for sn in 3..40 {
+            h.make_room(&[0; 16], SequenceNumber(1)).unwrap();
+            let mut c = ch(sn, 0);
+            c.payload = vec![0u8; sn as usize].into();
+            h.add(c);
+        }
+        for sn in 0..45 {
+            let walk: usize = h
+                .changes
+                .range(SequenceNumber(sn)..)
+                .map(|(_, c)| c.payload.len())
+                .sum();
+            assert_eq!(h.bytes_from(SequenceNumber(sn)), walk, "from {sn}");
+        }
+        assert_eq!(
+            HistoryCache::new(History::KeepAll, ResourceLimits::default())
+                .bytes_from(SequenceNumber(1)),
+            0
+        );
     }
 
     #[test]
