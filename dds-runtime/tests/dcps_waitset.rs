@@ -140,3 +140,105 @@ fn listener_sees_matches_and_data() {
         .load(Ordering::SeqCst)
         == 10));
 }
+
+struct MatchChanges(Arc<std::sync::Mutex<Vec<(u32, i32)>>>);
+
+impl DataReaderListener<ShapeType> for MatchChanges {
+    fn on_subscription_matched(&self, _r: &DataReader<ShapeType>, s: SubscriptionMatchedStatus) {
+        self.0
+            .lock()
+            .unwrap()
+            .push((s.current_count, s.current_count_change));
+    }
+}
+
+/// Each listener call reports the change since the previous one: +1 on match, -1 on unmatch.
+#[test]
+fn listener_reports_unmatch_as_minus_one() {
+    let p1 = participant(43);
+    let p2 = participant(43);
+    let t1 = p1
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&t2, &DataReaderQos::builder().reliability(reliable()).build())
+        .unwrap();
+    let seen = Arc::new(std::sync::Mutex::new(Vec::new()));
+    r.set_listener(Box::new(MatchChanges(seen.clone())));
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(&t1, &DataWriterQos::default())
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || !seen.lock().unwrap().is_empty()));
+    drop(w);
+    assert!(wait_until(MATCH_TIMEOUT, || seen.lock().unwrap().len() >= 2));
+    assert_eq!(*seen.lock().unwrap(), vec![(1, 1), (0, -1)]);
+}
+
+/// A reliable KEEP_ALL reader with max_samples holds the writer back instead of dropping samples.
+#[test]
+fn full_keep_all_reader_applies_back_pressure_without_loss() {
+    let p1 = participant(44);
+    let p2 = participant(44);
+    let t1 = p1
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(
+            &t2,
+            &DataReaderQos::builder()
+                .reliability(reliable())
+                .history(History::KeepAll)
+                .resource_limits(ResourceLimits {
+                    max_samples: Some(20),
+                    max_instances: None,
+                    max_samples_per_instance: None,
+                })
+                .build(),
+        )
+        .unwrap();
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(
+            &t1,
+            &DataWriterQos::builder()
+                .reliability(Reliability::Reliable {
+                    max_blocking_time: Duration::from_secs(10),
+                })
+                .history(History::KeepAll)
+                .build(),
+        )
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || r
+        .subscription_matched_status()
+        .current_count
+        == 1));
+    for i in 0..100 {
+        w.write(&shape("RED", i)).unwrap();
+    }
+    assert!(wait_until(Duration::from_secs(5), || r.sample_count() == 20));
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(r.sample_count(), 20, "the cache never overflows");
+    assert!(!w.wait_for_acknowledgments(Duration::from_millis(100)).is_ok());
+    let mut got = Vec::new();
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while got.len() < 100 && Instant::now() < deadline {
+        got.extend(r.take().unwrap().into_iter().filter_map(|s| s.data).map(|d| d.x));
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert_eq!(got, (0..100).collect::<Vec<_>>());
+    assert_eq!(r.sample_rejected_status().total_count, 0);
+    assert_eq!(r.sample_lost_status().total_count, 0);
+}

@@ -683,7 +683,13 @@ impl<T: DdsType> WriterSink for WriterInner<T> {
                     pm.current_count = m.len() as u32;
                     pm.last_subscription_handle =
                         InstanceHandle::from_guid_bytes(&reader.to_bytes());
-                    pm.clone()
+                    let out = pm.clone();
+                    // A listener consumes the status: the next callback reports only newer changes.
+                    if listener.is_some() {
+                        pm.total_count_change = 0;
+                        pm.current_count_change = 0;
+                    }
+                    out
                 };
                 tracing::info!(writer = ?lock(&self.id), ?reader, matched, "publication matched");
                 self.status_core.raise(StatusMask::PUBLICATION_MATCHED);

@@ -94,6 +94,12 @@ impl Subscriber {
             type_information: None,
             entity_name: None,
         };
+        let credit_limit = match (&rq.reliability, &rq.history, rq.resource_limits.max_samples) {
+            (crate::qos::Reliability::Reliable { .. }, crate::qos::History::KeepAll, Some(m)) => {
+                Some(m as usize)
+            }
+            _ => None,
+        };
         let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
         cache.set_filter(topic.sample_filter());
         let inner = Arc::new(ReaderInner::<T> {
@@ -113,10 +119,14 @@ impl Subscriber {
             listener: Mutex::new(None),
             matched: Mutex::new(Vec::new()),
             handle: Mutex::new(Weak::new()),
+            credit_limit,
         });
         let sink: Arc<dyn ReaderSink> = inner.clone();
         let id = shared.with_core(|c, now| {
             let id = c.create_reader(now, spec)?;
+            if credit_limit.is_some() {
+                c.set_reader_credit(id, credit_limit);
+            }
             *lock(&inner.id) = id;
             shared.register_reader(id, sink);
             Ok::<_, crate::rtps::CoreError>(id)
@@ -161,6 +171,8 @@ struct ReaderInner<T: DdsType> {
     listener: Mutex<Option<Arc<dyn DataReaderListener<T>>>>,
     matched: Mutex<Vec<Guid>>,
     handle: Mutex<Weak<ReaderHandle<T>>>,
+    /// Reliable KEEP_ALL with max_samples: the core delivers (and acknowledges) only what fits.
+    credit_limit: Option<usize>,
 }
 
 struct ReaderHandle<T: DdsType> {
@@ -341,6 +353,9 @@ impl<T: DdsType> DataReader<T> {
             }
             out
         };
+        if take && !out.is_empty() {
+            self.inner.refresh_credit();
+        }
         // Read conditions may have stopped triggering.
         self.inner.data_signal.notify();
         Ok(out)
@@ -650,6 +665,19 @@ impl<T: DdsType> ReaderInner<T> {
         decode_change::<T>(s, info, by_hash, now)
     }
 
+    /// Gives the core back the room freed by a take. Under the core lock every delivered sample is either
+    /// queued in `pending` or in the cache, so the credit is exact.
+    fn refresh_credit(&self) {
+        let Some(limit) = self.credit_limit else {
+            return;
+        };
+        let id = *lock(&self.id);
+        self.shared.with_core(|c, _| {
+            let held = lock(&self.cache).cache.len() + lock(&self.pending).len();
+            c.set_reader_credit(id, Some(limit.saturating_sub(held)));
+        });
+    }
+
     fn notify_data(self: &Arc<Self>) {
         if self.data_waiters.load(AtomicOrdering::SeqCst) > 0 {
             self.data_cv.notify_all();
@@ -700,7 +728,16 @@ fn decode_change<T: DdsType>(
                 tracing::warn!(error = %e, "cannot compute the instance key");
                 return None;
             }
-            if let Some(kh) = s.key_hash {
+            // Index the key hashes a peer may later send alone (dispose/unregister without payload,
+            // e.g. Fast DDS): the one it sent, else the ones we compute for either representation.
+            let hashes = match s.key_hash {
+                Some(kh) => [Some(kh), None],
+                None => [
+                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr1).ok(),
+                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr2).ok(),
+                ],
+            };
+            for kh in hashes.into_iter().flatten() {
                 if by_hash.len() >= MAX_REMEMBERED_HASHES {
                     by_hash.clear();
                 }
@@ -833,7 +870,14 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
                     sm.current_count = m.len() as u32;
                     sm.last_publication_handle =
                         InstanceHandle::from_guid_bytes(&writer.to_bytes());
-                    sm.clone()
+                    let out = sm.clone();
+                    // A listener consumes the status (DDS 2.2.4.2.1): reset the changes so the next
+                    // callback reports only what happened since this one.
+                    if listener.is_some() && me.is_some() {
+                        sm.total_count_change = 0;
+                        sm.current_count_change = 0;
+                    }
+                    out
                 };
                 tracing::info!(reader = ?lock(&self.id), ?writer, matched, "subscription matched");
                 self.status_core.raise(StatusMask::SUBSCRIPTION_MATCHED);
@@ -1057,5 +1101,34 @@ mod tests {
             None,
         );
         assert!(decode_change::<K>(garbage, info, &mut by_hash, now).is_none());
+    }
+
+    /// Fast DDS disposes with only PID_KEY_HASH; the alive samples before may have come without one.
+    #[test]
+    fn key_hash_only_dispose_maps_to_instance_seen_without_hash() {
+        let now = Instant::now();
+        let info = RemoteWriterInfo::default();
+        let s = K {
+            id: "a-rather-long-key-beyond-16-bytes".into(),
+            v: 1,
+        };
+        let mut expected = Vec::new();
+        cdr::instance_key(&s, &mut expected).unwrap();
+        for version in [XcdrVersion::Xcdr1, XcdrVersion::Xcdr2] {
+            let mut by_hash = HashMap::new();
+            let mut buf = Vec::new();
+            cdr::serialize(&s, version, ByteOrder::NATIVE, &mut buf).unwrap();
+            decode_change::<K>(rs(ChangeKind::Alive, buf, None), info, &mut by_hash, now).unwrap();
+            let kh = cdr::key_hash(&s, version).unwrap();
+            let d = decode_change::<K>(
+                rs(ChangeKind::Dispose, Vec::new(), Some(kh)),
+                info,
+                &mut by_hash,
+                now,
+            )
+            .expect("dispose mapped through the computed key hash");
+            assert_eq!(d.key, expected);
+            assert_eq!(d.kind, ChangeKindLocal::Dispose);
+        }
     }
 }

@@ -385,6 +385,17 @@ impl Participant {
             .unwrap_or_default()
     }
 
+    /// Back-pressure for a reliable reader: it delivers at most `credit` more changes (`None`: no limit)
+    /// until the next call. A change beyond the credit is not acknowledged; the writer repairs it once
+    /// credit is given back. Held changes that now fit are delivered (drain `poll_event`).
+    pub fn set_reader_credit(&mut self, reader: EntityId, credit: Option<usize>) {
+        if let Some(r) = self.readers.get_mut(&reader) {
+            let mut out = Vec::new();
+            r.set_credit(credit, &mut out);
+            self.events.extend(out);
+        }
+    }
+
     pub fn reader_matches(&self, reader: EntityId) -> Vec<Guid> {
         if !self.user_readers.contains(&reader) {
             return Vec::new();

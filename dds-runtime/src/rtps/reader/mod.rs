@@ -56,6 +56,9 @@ pub struct Reader {
     pub guid: Guid,
     params: ReaderParams,
     proxies: BTreeMap<Guid, WriterProxy>,
+    /// Back-pressure: how many more changes reliable proxies may deliver (`None`: no limit). A change
+    /// refused for lack of credit is not stored, so it stays missing and is NACKed, never acknowledged.
+    credit: std::cell::Cell<Option<usize>>,
 }
 
 impl Reader {
@@ -64,6 +67,30 @@ impl Reader {
             guid,
             params,
             proxies: BTreeMap::new(),
+            credit: std::cell::Cell::new(None),
+        }
+    }
+
+    /// Sets the delivery credit and delivers what reliable proxies hold in order within it.
+    pub fn set_credit(&mut self, credit: Option<usize>, out: &mut Vec<Event>) {
+        self.credit.set(credit);
+        let rid = self.guid.entity_id;
+        for p in self.proxies.values_mut() {
+            if p.reliable {
+                Self::drain(rid, p, &self.credit, out);
+            }
+        }
+    }
+
+    /// Consumes one unit of credit; false when none is left.
+    fn take_credit(credit: &std::cell::Cell<Option<usize>>) -> bool {
+        match credit.get() {
+            None => true,
+            Some(0) => false,
+            Some(n) => {
+                credit.set(Some(n - 1));
+                true
+            }
         }
     }
 
@@ -113,9 +140,20 @@ impl Reader {
         }
     }
 
-    fn drain(reader: EntityId, p: &mut WriterProxy, out: &mut Vec<Event>) {
+    fn drain(
+        reader: EntityId,
+        p: &mut WriterProxy,
+        credit: &std::cell::Cell<Option<usize>>,
+        out: &mut Vec<Event>,
+    ) {
         while let Some(e) = p.reorder.first_entry() {
             if *e.key() > p.next_expected {
+                break;
+            }
+            if *e.key() == p.next_expected
+                && matches!(e.get(), Slot::Change(_))
+                && !Self::take_credit(credit)
+            {
                 break;
             }
             let (sn, slot) = e.remove_entry();
@@ -136,9 +174,13 @@ impl Reader {
             }
             p.synced = true;
             if sn == p.next_expected {
+                if matches!(slot, Slot::Change(_)) && !Self::take_credit(&self.credit) {
+                    // No room downstream: treat it as not received, so it is NACKed again later.
+                    return;
+                }
                 Self::deliver(rid, p, sn, slot, out);
                 p.next_expected = sn.next();
-                Self::drain(rid, p, out);
+                Self::drain(rid, p, &self.credit, out);
             } else {
                 let size = slot_size(&slot);
                 if p.reorder.len() < self.params.reorder_max_samples
@@ -333,7 +375,7 @@ impl Reader {
                 p.reorder.entry(sn).or_insert(Slot::Irrelevant);
             }
         }
-        Self::drain(rid, p, out);
+        Self::drain(rid, p, &self.credit, out);
         p.drop_stale_defrag();
     }
 
@@ -384,7 +426,7 @@ impl Reader {
                 });
             }
             p.next_expected = hb.first_sn;
-            Self::drain(rid, p, out);
+            Self::drain(rid, p, &self.credit, out);
             p.drop_stale_defrag();
         }
         p.synced = true;

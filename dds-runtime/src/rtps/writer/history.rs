@@ -138,9 +138,10 @@ impl HistoryCache {
     /// Called after every acknowledgement: walks only the smaller side of `sn` (the total is kept), so a
     /// volatile writer, whose history starts at the acknowledged floor, pays nothing.
     pub fn bytes_from(&self, sn: SequenceNumber) -> usize {
-        let (Some((first, _)), Some((last, _))) =
-            (self.changes.first_key_value(), self.changes.last_key_value())
-        else {
+        let (Some((first, _)), Some((last, _))) = (
+            self.changes.first_key_value(),
+            self.changes.last_key_value(),
+        ) else {
             return 0;
         };
         if sn <= *first {
