@@ -166,7 +166,10 @@ fn listener_reports_unmatch_as_minus_one() {
     let r = p2
         .create_subscriber(&SubscriberQos::default())
         .unwrap()
-        .create_datareader(&t2, &DataReaderQos::builder().reliability(reliable()).build())
+        .create_datareader(
+            &t2,
+            &DataReaderQos::builder().reliability(reliable()).build(),
+        )
         .unwrap();
     let seen = Arc::new(std::sync::Mutex::new(Vec::new()));
     r.set_listener(Box::new(MatchChanges(seen.clone())));
@@ -175,7 +178,10 @@ fn listener_reports_unmatch_as_minus_one() {
         .unwrap()
         .create_datawriter(&t1, &DataWriterQos::default())
         .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || !seen.lock().unwrap().is_empty()));
+    assert!(wait_until(MATCH_TIMEOUT, || !seen
+        .lock()
+        .unwrap()
+        .is_empty()));
     drop(w);
     assert!(wait_until(MATCH_TIMEOUT, || seen.lock().unwrap().len() >= 2));
     assert_eq!(*seen.lock().unwrap(), vec![(1, 1), (0, -1)]);
@@ -231,11 +237,19 @@ fn full_keep_all_reader_applies_back_pressure_without_loss() {
     assert!(wait_until(Duration::from_secs(5), || r.sample_count() == 20));
     std::thread::sleep(Duration::from_millis(300));
     assert_eq!(r.sample_count(), 20, "the cache never overflows");
-    assert!(!w.wait_for_acknowledgments(Duration::from_millis(100)).is_ok());
+    assert!(w
+        .wait_for_acknowledgments(Duration::from_millis(100))
+        .is_err());
     let mut got = Vec::new();
     let deadline = Instant::now() + Duration::from_secs(20);
     while got.len() < 100 && Instant::now() < deadline {
-        got.extend(r.take().unwrap().into_iter().filter_map(|s| s.data).map(|d| d.x));
+        got.extend(
+            r.take()
+                .unwrap()
+                .into_iter()
+                .filter_map(|s| s.data)
+                .map(|d| d.x),
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
     assert_eq!(got, (0..100).collect::<Vec<_>>());

@@ -662,7 +662,10 @@ fn reader_credit_holds_back_acknowledgement_until_space() {
     s.sim.run_for(Duration::from_secs(3));
     let mut got = s.sim.take_samples(1, r);
     assert_eq!(got.len(), 10, "delivery stops at the credit");
-    assert!(!s.sim.nodes[0].p.is_acknowledged(w), "undelivered samples must not be acknowledged");
+    assert!(
+        !s.sim.nodes[0].p.is_acknowledged(w),
+        "undelivered samples must not be acknowledged"
+    );
     assert!(s.sim.nodes[0].p.unacknowledged_bytes(w) >= 40 * 100);
 
     s.sim.nodes[1].p.set_reader_credit(r, Some(15));
@@ -679,7 +682,7 @@ fn reader_credit_holds_back_acknowledgement_until_space() {
         count >= n as usize
     }));
     check_complete_in_order(&got, n, 100);
-    assert!(s
-        .sim
-        .run_until(Duration::from_secs(5), |sim| sim.nodes[0].p.is_acknowledged(w)));
+    assert!(s.sim.run_until(Duration::from_secs(5), |sim| sim.nodes[0]
+        .p
+        .is_acknowledged(w)));
 }
