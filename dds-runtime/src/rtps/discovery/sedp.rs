@@ -53,6 +53,48 @@ struct Common {
     entity_name: Option<String>,
 }
 
+/// The parameters an endpoint announcement cannot do without.
+struct RequiredEndpointFields {
+    guid: Guid,
+    topic_name: String,
+    type_name: String,
+}
+
+/// Walks an endpoint announcement: common parameters go into `Common`, the rest to `read_qos`. An unknown
+/// must-understand parameter rejects the whole announcement; vendor-specific ones are skipped.
+fn decode_endpoint(
+    payload: &[u8],
+    mut read_qos: impl FnMut(u16, &[u8], bool) -> Result<bool, WireError>,
+) -> Result<(Common, RequiredEndpointFields), WireError> {
+    let pl = pl_payload(payload)?;
+    let mut c = Common::default();
+    for p in pl.iter() {
+        if p.id & pid::VENDOR_SPECIFIC != 0 {
+            continue;
+        }
+        let known =
+            read_common(&pl, p.id, p.value, &mut c)? || read_qos(p.id, p.value, pl.little_endian)?;
+        if !known && p.id & pid::MUST_UNDERSTAND != 0 {
+            return Err(WireError::MustUnderstand(p.id));
+        }
+    }
+    let required = RequiredEndpointFields {
+        guid: c
+            .guid
+            .take()
+            .ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
+        topic_name: c
+            .topic_name
+            .take()
+            .ok_or(WireError::Invalid("SEDP without topic name"))?,
+        type_name: c
+            .type_name
+            .take()
+            .ok_or(WireError::Invalid("SEDP without type name"))?,
+    };
+    Ok((c, required))
+}
+
 fn read_common(
     pl: &ParameterList<'_>,
     id: u16,
@@ -151,30 +193,15 @@ impl WriterData {
     }
 
     pub fn decode(payload: &[u8]) -> Result<WriterData, WireError> {
-        let pl = pl_payload(payload)?;
-        let mut c = Common::default();
         let mut qos = WriterQos::default();
-        for p in pl.iter() {
-            if p.id & pid::VENDOR_SPECIFIC != 0 {
-                continue;
-            }
-            let known = read_common(&pl, p.id, p.value, &mut c)?
-                || read_writer_qos(p.id, p.value, pl.little_endian, &mut qos)?;
-            if !known && p.id & pid::MUST_UNDERSTAND != 0 {
-                return Err(WireError::MustUnderstand(p.id));
-            }
-        }
+        let (c, required) = decode_endpoint(payload, |id, value, le| {
+            read_writer_qos(id, value, le, &mut qos)
+        })?;
         Ok(WriterData {
-            guid: c
-                .guid
-                .ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
+            guid: required.guid,
             participant_guid: c.participant_guid,
-            topic_name: c
-                .topic_name
-                .ok_or(WireError::Invalid("SEDP without topic name"))?,
-            type_name: c
-                .type_name
-                .ok_or(WireError::Invalid("SEDP without type name"))?,
+            topic_name: required.topic_name,
+            type_name: required.type_name,
             qos,
             unicast_locators: c.unicast,
             multicast_locators: c.multicast,
@@ -208,30 +235,15 @@ impl ReaderData {
     }
 
     pub fn decode(payload: &[u8]) -> Result<ReaderData, WireError> {
-        let pl = pl_payload(payload)?;
-        let mut c = Common::default();
         let mut qos = ReaderQos::default();
-        for p in pl.iter() {
-            if p.id & pid::VENDOR_SPECIFIC != 0 {
-                continue;
-            }
-            let known = read_common(&pl, p.id, p.value, &mut c)?
-                || read_reader_qos(p.id, p.value, pl.little_endian, &mut qos)?;
-            if !known && p.id & pid::MUST_UNDERSTAND != 0 {
-                return Err(WireError::MustUnderstand(p.id));
-            }
-        }
+        let (c, required) = decode_endpoint(payload, |id, value, le| {
+            read_reader_qos(id, value, le, &mut qos)
+        })?;
         Ok(ReaderData {
-            guid: c
-                .guid
-                .ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
+            guid: required.guid,
             participant_guid: c.participant_guid,
-            topic_name: c
-                .topic_name
-                .ok_or(WireError::Invalid("SEDP without topic name"))?,
-            type_name: c
-                .type_name
-                .ok_or(WireError::Invalid("SEDP without type name"))?,
+            topic_name: required.topic_name,
+            type_name: required.type_name,
             qos,
             unicast_locators: c.unicast,
             multicast_locators: c.multicast,
