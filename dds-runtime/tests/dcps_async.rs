@@ -21,36 +21,9 @@ fn setup(
     DataWriter<ShapeType>,
     DataReader<ShapeType>,
 ) {
-    let p1 = participant(domain);
-    let p2 = participant(domain);
-    let t1 = p1
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let q = DataWriterQos::builder()
-        .reliability(reliable())
-        .history(History::KeepAll)
-        .build();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t1, &q)
-        .unwrap();
-    let rq = DataReaderQos::builder()
-        .reliability(reliable())
-        .history(History::KeepAll)
-        .build();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(&t2, &rq)
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
+    let (p1, p2) = (participant(domain), participant(domain));
+    let (wq, rq) = reliable_keep_all();
+    let (w, r) = matched(&p1, &p2, "Square", &wq, &rq);
     (p1, p2, w, r)
 }
 

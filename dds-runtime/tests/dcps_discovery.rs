@@ -32,30 +32,13 @@ fn two_participants_discover_each_other_and_match() {
         p2.discovered_participants()
     );
 
-    let t1 = p1
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t1, &DataWriterQos::default())
-        .unwrap();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(&t2, &DataReaderQos::default())
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
-    assert!(wait_until(MATCH_TIMEOUT, || r
-        .subscription_matched_status()
-        .current_count
-        == 1));
+    let (w, r) = matched::<ShapeType>(
+        &p1,
+        &p2,
+        "Square",
+        &DataWriterQos::default(),
+        &DataReaderQos::default(),
+    );
     assert_eq!(w.matched_subscriptions().len(), 1);
     assert_eq!(r.matched_publications(), vec![w.instance_handle()]);
 

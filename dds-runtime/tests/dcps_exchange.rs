@@ -6,54 +6,6 @@ use std::time::{Duration, SystemTime};
 use dcps_util::*;
 use dds_runtime::prelude::*;
 
-struct Pair {
-    _p1: DomainParticipant,
-    _p2: DomainParticipant,
-    w: DataWriter<ShapeType>,
-    r: DataReader<ShapeType>,
-}
-
-fn pair(domain: u32, wq: DataWriterQos, rq: DataReaderQos) -> Pair {
-    let p1 = participant(domain);
-    let p2 = participant(domain);
-    let t1 = p1
-        .create_topic::<ShapeType>("Circle", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Circle", &TopicQos::default())
-        .unwrap();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t1, &wq)
-        .unwrap();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(&t2, &rq)
-        .unwrap();
-    assert!(
-        wait_until(MATCH_TIMEOUT, || w
-            .publication_matched_status()
-            .current_count
-            == 1),
-        "no match"
-    );
-    assert!(
-        wait_until(MATCH_TIMEOUT, || r
-            .subscription_matched_status()
-            .current_count
-            == 1),
-        "no match"
-    );
-    Pair {
-        _p1: p1,
-        _p2: p2,
-        w,
-        r,
-    }
-}
-
 fn take_all(r: &DataReader<ShapeType>, n: usize) -> Vec<Sample<ShapeType>> {
     let mut got = Vec::new();
     wait_until(Duration::from_secs(10), || {
@@ -65,24 +17,17 @@ fn take_all(r: &DataReader<ShapeType>, n: usize) -> Vec<Sample<ShapeType>> {
 
 #[test]
 fn reliable_keyed_exchange_in_order_with_sample_info() {
-    let wq = DataWriterQos::builder()
-        .reliability(reliable())
-        .history(History::KeepAll)
-        .build();
-    let rq = DataReaderQos::builder()
-        .reliability(reliable())
-        .history(History::KeepAll)
-        .build();
-    let p = pair(21, wq, rq);
+    let (p1, p2) = (participant(21), participant(21));
+    let (wq, rq) = reliable_keep_all();
+    let (w, r) = matched::<ShapeType>(&p1, &p2, "Circle", &wq, &rq);
     let ts = SystemTime::UNIX_EPOCH + Duration::from_secs(1_700_000_000);
     for i in 0..50 {
         for c in ["RED", "BLUE", "GREEN"] {
-            p.w.write_w_timestamp(&shape(c, i), ts).unwrap();
+            w.write_w_timestamp(&shape(c, i), ts).unwrap();
         }
     }
-    p.w.wait_for_acknowledgments(Duration::from_secs(10))
-        .unwrap();
-    let got = take_all(&p.r, 150);
+    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
+    let got = take_all(&r, 150);
     assert_eq!(got.len(), 150);
     for c in ["RED", "BLUE", "GREEN"] {
         let xs: Vec<i32> = got
@@ -99,10 +44,8 @@ fn reliable_keyed_exchange_in_order_with_sample_info() {
     assert_eq!(s.info.view_state, ViewState::New);
     assert_eq!(s.info.sample_state, SampleState::NotRead);
     assert_eq!(s.info.source_timestamp, ts);
-    assert_eq!(s.info.publication_handle, p.w.instance_handle());
-    let red =
-        p.r.lookup_instance(&shape("RED", 999))
-            .expect("RED instance");
+    assert_eq!(s.info.publication_handle, w.instance_handle());
+    let red = r.lookup_instance(&shape("RED", 999)).expect("RED instance");
     assert_eq!(
         got.iter()
             .find(|s| s.data.as_ref().unwrap().color == "RED")
@@ -111,7 +54,7 @@ fn reliable_keyed_exchange_in_order_with_sample_info() {
             .instance_handle,
         red
     );
-    assert_eq!(p.r.instance_count(), 3);
+    assert_eq!(r.instance_count(), 3);
 }
 
 #[test]
@@ -126,16 +69,16 @@ fn dispose_and_unregister_are_instance_states() {
         .reliability(reliable())
         .history(History::KeepLast(5))
         .build();
-    let p = pair(22, wq, rq);
-    p.w.write(&shape("RED", 1)).unwrap();
-    p.w.write(&shape("BLUE", 2)).unwrap();
-    assert_eq!(take_all(&p.r, 2).len(), 2);
+    let (p1, p2) = (participant(22), participant(22));
+    let (w, r) = matched::<ShapeType>(&p1, &p2, "Circle", &wq, &rq);
+    w.write(&shape("RED", 1)).unwrap();
+    w.write(&shape("BLUE", 2)).unwrap();
+    assert_eq!(take_all(&r, 2).len(), 2);
 
-    p.w.dispose(&shape("RED", 0)).unwrap();
-    p.w.unregister_instance(&shape("BLUE", 0)).unwrap();
-    p.w.wait_for_acknowledgments(Duration::from_secs(5))
-        .unwrap();
-    let got = take_all(&p.r, 2);
+    w.dispose(&shape("RED", 0)).unwrap();
+    w.unregister_instance(&shape("BLUE", 0)).unwrap();
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    let got = take_all(&r, 2);
     assert_eq!(got.len(), 2, "{got:?}");
     let red = got
         .iter()
@@ -151,8 +94,8 @@ fn dispose_and_unregister_are_instance_states() {
     assert_ne!(red.info.instance_handle, blue.info.instance_handle);
 
     // Writing RED again starts a new generation.
-    p.w.write(&shape("RED", 3)).unwrap();
-    let got = take_all(&p.r, 1);
+    w.write(&shape("RED", 3)).unwrap();
+    let got = take_all(&r, 1);
     assert_eq!(got[0].info.instance_state, InstanceState::Alive);
     assert_eq!(got[0].info.disposed_generation_count, 1);
     assert_eq!(got[0].info.view_state, ViewState::New);
@@ -203,30 +146,10 @@ fn transient_local_late_joiner_gets_history() {
 
 #[test]
 fn large_sample_is_fragmented_and_reassembled() {
-    let p1 = participant(24);
-    let p2 = participant(24);
-    let t1 = p1
-        .create_topic::<Blob>("Blob", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<Blob>("Blob", &TopicQos::default())
-        .unwrap();
-    let q = DataWriterQos::builder().reliability(reliable()).build();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t1, &q)
-        .unwrap();
+    let (p1, p2) = (participant(24), participant(24));
+    let wq = DataWriterQos::builder().reliability(reliable()).build();
     let rq = DataReaderQos::builder().reliability(reliable()).build();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(&t2, &rq)
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
+    let (w, r) = matched::<Blob>(&p1, &p2, "Blob", &wq, &rq);
     let data: Vec<u8> = (0..100_000u32).map(|i| (i * 7 % 251) as u8).collect();
     w.write(&Blob {
         id: 7,
@@ -328,19 +251,12 @@ fn content_filtered_topic_filters_on_the_reader() {
     let cft = p2
         .create_content_filtered_topic("FilteredSquare", &t2, "x > %0 AND color = 'RED'", &["10"])
         .unwrap();
-    let wq = DataWriterQos::builder()
-        .reliability(reliable())
-        .history(History::KeepAll)
-        .build();
+    let (wq, rq) = reliable_keep_all();
     let w = p1
         .create_publisher(&PublisherQos::default())
         .unwrap()
         .create_datawriter(&t1, &wq)
         .unwrap();
-    let rq = DataReaderQos::builder()
-        .reliability(reliable())
-        .history(History::KeepAll)
-        .build();
     let r = p2
         .create_subscriber(&SubscriberQos::default())
         .unwrap()
@@ -444,38 +360,12 @@ fn data_representation_xcdr1_and_xcdr2_both_reach_a_default_reader() {
 
 #[test]
 fn flow_control_blocks_and_resumes_without_loss() {
-    let p1 = participant(29);
-    let p2 = participant(29);
-    let t1 = p1
-        .create_topic::<Blob>("Flow", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<Blob>("Flow", &TopicQos::default())
-        .unwrap();
-    let q = DataWriterQos::builder()
-        .reliability(Reliability::Reliable {
-            max_blocking_time: Duration::from_secs(5),
-        })
-        .history(History::KeepAll)
-        .build();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t1, &q)
-        .unwrap();
-    let rq = DataReaderQos::builder()
-        .reliability(reliable())
-        .history(History::KeepAll)
-        .build();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(&t2, &rq)
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
+    let (p1, p2) = (participant(29), participant(29));
+    let (mut wq, rq) = reliable_keep_all();
+    wq.reliability = Reliability::Reliable {
+        max_blocking_time: Duration::from_secs(5),
+    };
+    let (w, r) = matched::<Blob>(&p1, &p2, "Flow", &wq, &rq);
     // 4 MB in 1 KiB samples: well above the writer's unacknowledged-bytes high watermark.
     const N: u32 = 4000;
     let reader = std::thread::spawn(move || {

@@ -109,38 +109,10 @@ fn exclusive_ownership_deadline_and_zero_copy_read() {
 
 #[test]
 fn keep_last_depth_applies_per_instance() {
-    let p1 = participant(72);
-    let p2 = participant(72);
-    let t1 = p1
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(
-            &t1,
-            &DataWriterQos::builder()
-                .reliability(reliable())
-                .history(History::KeepAll)
-                .build(),
-        )
-        .unwrap();
-    let rq = DataReaderQos::builder()
-        .reliability(reliable())
-        .history(History::KeepLast(3))
-        .build();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(&t2, &rq)
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
+    let (p1, p2) = (participant(72), participant(72));
+    let (wq, mut rq) = reliable_keep_all();
+    rq.history = History::KeepLast(3);
+    let (w, r) = matched::<ShapeType>(&p1, &p2, "Square", &wq, &rq);
     for i in 0..10 {
         w.write(&shape("RED", i)).unwrap();
         w.write(&shape("BLUE", i)).unwrap();
@@ -166,35 +138,13 @@ fn keep_last_depth_applies_per_instance() {
 
 #[test]
 fn deleting_a_writer_disposes_its_instances() {
-    let p1 = participant(73);
-    let p2 = participant(73);
-    let t1 = p1
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(
-            &t1,
-            &DataWriterQos::builder().reliability(reliable()).build(),
-        )
-        .unwrap();
+    let (p1, p2) = (participant(73), participant(73));
+    let wq = DataWriterQos::builder().reliability(reliable()).build();
     let rq = DataReaderQos::builder()
         .reliability(reliable())
         .history(History::KeepLast(5))
         .build();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(&t2, &rq)
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
+    let (w, r) = matched::<ShapeType>(&p1, &p2, "Square", &wq, &rq);
     w.write(&shape("RED", 1)).unwrap();
     w.write(&shape("BLUE", 1)).unwrap();
     w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
@@ -213,33 +163,13 @@ fn deleting_a_writer_disposes_its_instances() {
 
 #[test]
 fn lifespan_expires_samples_in_the_reader() {
-    let p1 = participant(74);
-    let p2 = participant(74);
-    let t1 = p1
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
+    let (p1, p2) = (participant(74), participant(74));
     let wq = DataWriterQos::builder()
         .reliability(reliable())
         .lifespan(Duration::from_millis(300))
         .build();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t1, &wq)
-        .unwrap();
     let rq = DataReaderQos::builder().reliability(reliable()).build();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(&t2, &rq)
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
+    let (w, r) = matched::<ShapeType>(&p1, &p2, "Square", &wq, &rq);
     w.write(&shape("RED", 1)).unwrap();
     assert!(r.wait_for_data(Duration::from_secs(5)).unwrap());
     assert_eq!(r.sample_count(), 1);

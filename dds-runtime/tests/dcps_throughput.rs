@@ -18,38 +18,12 @@ struct Payload {
 #[test]
 #[ignore = "measurement; run in release"]
 fn reliable_keep_all_1k_throughput() {
-    let p1 = participant(81);
-    let p2 = participant(81);
-    let t1 = p1
-        .create_topic::<Payload>("Throughput", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<Payload>("Throughput", &TopicQos::default())
-        .unwrap();
-    let q = DataWriterQos::builder()
-        .reliability(Reliability::Reliable {
-            max_blocking_time: Duration::from_secs(10),
-        })
-        .history(History::KeepAll)
-        .build();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t1, &q)
-        .unwrap();
-    let rq = DataReaderQos::builder()
-        .reliability(reliable())
-        .history(History::KeepAll)
-        .build();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(&t2, &rq)
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
+    let (p1, p2) = (participant(81), participant(81));
+    let (mut wq, rq) = reliable_keep_all();
+    wq.reliability = Reliability::Reliable {
+        max_blocking_time: Duration::from_secs(10),
+    };
+    let (w, r) = matched::<Payload>(&p1, &p2, "Throughput", &wq, &rq);
     let run = Duration::from_secs(3);
     let reader = std::thread::spawn(move || {
         let mut n = 0u64;

@@ -227,10 +227,12 @@ fn full_keep_all_reader_applies_back_pressure_without_loss() {
                 .build(),
         )
         .unwrap();
+    // Both sides: a volatile writer that has not matched the reader yet would send into the void.
     assert!(wait_until(MATCH_TIMEOUT, || r
         .subscription_matched_status()
         .current_count
-        == 1));
+        == 1
+        && w.publication_matched_status().current_count == 1));
     for i in 0..100 {
         w.write(&shape("RED", i)).unwrap();
     }

@@ -75,7 +75,8 @@ impl TopicSel {
     }
 }
 
-/// How a reader is serviced; accepted for compatibility, dds-perf always uses a waiting thread.
+/// How a reader is serviced: in a listener on the receive thread (ddsperf's default), by a thread waiting
+/// for data, or by a thread polling at 1 kHz.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TriggerMode {
     Listener,
@@ -94,6 +95,8 @@ pub struct PerfOptions {
     pub history_depth: u32,
     /// `-D`: run time limit.
     pub duration: Option<Duration>,
+    /// How ping and pong readers are serviced (`ping`/`pong` `waitset|listener`); shared by both, like ddsperf.
+    pub pingpong_trigger: TriggerMode,
     /// `-L`: match endpoints in the same participant.
     pub match_local: bool,
     /// `-1`: print sub stats every second even without data.
@@ -130,6 +133,7 @@ impl Default for PerfOptions {
             reliable: true,
             history_depth: 0,
             duration: None,
+            pingpong_trigger: TriggerMode::Listener,
             match_local: false,
             substat_every_second: false,
             collect_stats: false,
@@ -209,6 +213,14 @@ const MODES: &[&str] = &["ping", "pong", "sub", "pub"];
 
 fn is_mode(s: &str) -> bool {
     MODES.contains(&s)
+}
+
+fn pingpong_trigger(s: &str) -> Option<TriggerMode> {
+    match s {
+        "listener" => Some(TriggerMode::Listener),
+        "waitset" => Some(TriggerMode::Waitset),
+        _ => None,
+    }
 }
 
 /// `%lf` followed by an optional unit: "1k" "10kHz" "inf".
@@ -324,6 +336,10 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
             }
         }
     }
+    // ddsperf: ping/pong use a listener unless -L asks for local matching.
+    if o.match_local {
+        o.pingpong_trigger = TriggerMode::Waitset;
+    }
     let modes = &args[i..];
     if modes.is_empty() || (modes.len() == 1 && modes[0] == "help") {
         return Ok(PerfCommand::Help);
@@ -388,7 +404,8 @@ fn parse_modes(o: &mut PerfOptions, a: &[String]) -> Result<(), ArgError> {
                         o.baggage = parse_size(v)
                             .ok_or_else(|| ArgError(format!("{v}: invalid size specification")))?;
                         i += 1;
-                    } else if t == "waitset" || t == "listener" {
+                    } else if let Some(m) = pingpong_trigger(t) {
+                        o.pingpong_trigger = m;
                     } else if let Some(r) = parse_rate(t) {
                         if r < 0.0 {
                             return err(format!("{t}: invalid ping rate"));
@@ -409,9 +426,10 @@ fn parse_modes(o: &mut PerfOptions, a: &[String]) -> Result<(), ArgError> {
             "pong" => {
                 o.pong = true;
                 while i < a.len() && !is_mode(&a[i]) {
-                    if a[i] != "waitset" && a[i] != "listener" {
+                    let Some(m) = pingpong_trigger(&a[i]) else {
                         return err(format!("{}: undefined pong mode", a[i]));
-                    }
+                    };
+                    o.pingpong_trigger = m;
                     i += 1;
                 }
             }
@@ -526,6 +544,13 @@ mod tests {
         assert_eq!(run("ping 10Hz size 100").baggage, 88);
         assert_eq!(run("sanity").ping_interval, Some(Duration::from_secs(1)));
         assert_eq!(run("-k all sub polling").sub, Some(TriggerMode::Polling));
+        assert_eq!(run("pong").pingpong_trigger, TriggerMode::Listener);
+        assert_eq!(run("-L pong").pingpong_trigger, TriggerMode::Waitset);
+        assert_eq!(run("ping waitset").pingpong_trigger, TriggerMode::Waitset);
+        assert_eq!(
+            run("-L pong listener").pingpong_trigger,
+            TriggerMode::Listener
+        );
         assert_eq!(run("-Qsamples:10 -Q minmatch:1 sub").min_samples, 10);
     }
 

@@ -16,6 +16,7 @@
 //! | `DDS_FRAGMENT_SIZE` | DATA_FRAG fragment size | bytes, `256`..=`65000` | `1344` |
 //! | `DDS_MAX_MESSAGE_SIZE` | largest RTPS message (datagram) we send | bytes, `512`..=`65500` | `14720` |
 //! | `DDS_SOCKET_BUFFER_SIZE` | requested SO_RCVBUF / SO_SNDBUF | bytes | `4194304` |
+//! | `DDS_WRITE_BATCH` | write batching: samples share datagrams until full, flushed, or this delay has passed | `off`, `on` (1 ms), or a delay in microseconds | `off` |
 //!
 //! Invalid values are reported as [`ConfigError`] rather than silently ignored.
 
@@ -134,6 +135,9 @@ pub struct Config {
     pub max_message_size: usize,
     /// Requested socket buffer size (receive and send).
     pub socket_buffer_size: usize,
+    /// Write batching: how long a written sample may wait for others to share its datagram. `None` sends
+    /// each write at once (lowest latency); `Some` trades up to that much latency for throughput.
+    pub write_batch_delay: Option<Duration>,
 }
 
 impl Default for Config {
@@ -150,6 +154,7 @@ impl Default for Config {
             fragment_size: 1344,
             max_message_size: 14720,
             socket_buffer_size: 4 << 20,
+            write_batch_delay: None,
         }
     }
 }
@@ -175,6 +180,20 @@ pub fn parse_bool(name: &'static str, v: &str) -> Result<bool, ConfigError> {
         "0" | "off" | "false" | "no" | "disabled" => Ok(false),
         _ => Err(invalid(name, v, "expected on/off")),
     }
+}
+
+/// Default batch delay of `DDS_WRITE_BATCH=on`.
+pub const DEFAULT_WRITE_BATCH_DELAY: Duration = Duration::from_millis(1);
+
+/// `off`, `on` ([`DEFAULT_WRITE_BATCH_DELAY`]) or a delay in microseconds (`0` is off).
+fn parse_batch_delay(v: &str) -> Result<Option<Duration>, ConfigError> {
+    const NAME: &str = "DDS_WRITE_BATCH";
+    if let Ok(us) = v.trim().parse::<u64>() {
+        return Ok((us > 0).then(|| Duration::from_micros(us)));
+    }
+    Ok(parse_bool(NAME, v)
+        .map_err(|_| invalid(NAME, v, "expected off, on or microseconds"))?
+        .then_some(DEFAULT_WRITE_BATCH_DELAY))
 }
 
 impl Config {
@@ -226,6 +245,9 @@ impl Config {
         }
         if let Some(v) = lookup("DDS_SOCKET_BUFFER_SIZE") {
             c.socket_buffer_size = parse_num("DDS_SOCKET_BUFFER_SIZE", &v)?;
+        }
+        if let Some(v) = lookup("DDS_WRITE_BATCH") {
+            c.write_batch_delay = parse_batch_delay(&v)?;
         }
         c.validate()?;
         Ok(c)
@@ -355,5 +377,16 @@ mod tests {
         assert!(env(&[("DDS_PEERS", "host.example")]).is_err());
         assert!(env(&[("DDS_FRAGMENT_SIZE", "20000")]).is_err());
         assert!(env(&[("DDS_PARTICIPANT_INDEX", "40000")]).is_err());
+        assert!(env(&[("DDS_WRITE_BATCH", "soon")]).is_err());
+    }
+
+    #[test]
+    fn write_batch_forms() {
+        let delay = |v: &str| env(&[("DDS_WRITE_BATCH", v)]).unwrap().write_batch_delay;
+        assert_eq!(Config::default().write_batch_delay, None);
+        assert_eq!(delay("off"), None);
+        assert_eq!(delay("0"), None);
+        assert_eq!(delay("on"), Some(DEFAULT_WRITE_BATCH_DELAY));
+        assert_eq!(delay("250"), Some(Duration::from_micros(250)));
     }
 }

@@ -442,38 +442,51 @@ impl<T> ReaderCache<T> {
         mut emit: impl FnMut(&mut Option<T>, SampleInfo),
     ) {
         let limit = sel.max_samples.unwrap_or(usize::MAX);
-        // (seq, handle, index in instance)
-        let mut picked: Vec<(u64, InstanceHandle, usize)> = Vec::new();
-        let range: Box<dyn Iterator<Item = (&InstanceHandle, &Instance<T>)>> = match sel.instance {
-            Some(h) => Box::new(self.instances.range(h..=h)),
-            None => Box::new(self.instances.iter()),
-        };
-        for (h, inst) in range {
+        // Instances with a selected sample, and the selection as (seq, instance ordinal, index in instance).
+        let mut touched: Vec<Touched> = Vec::new();
+        let mut picked: Vec<(u64, usize, usize)> = Vec::new();
+        let mut gather = |h: InstanceHandle, inst: &Instance<T>| {
+            let before = picked.len();
             for (i, s) in inst.samples.iter().enumerate() {
                 if Self::matches(inst, s, sel) {
-                    picked.push((s.seq, *h, i));
+                    picked.push((s.seq, touched.len(), i));
                 }
             }
+            if picked.len() > before {
+                touched.push(Touched {
+                    handle: h,
+                    count: 0,
+                    emitted: 0,
+                    last_index: 0,
+                });
+            }
+        };
+        match sel.instance {
+            Some(h) => {
+                if let Some(inst) = self.instances.get(&h) {
+                    gather(h, inst);
+                }
+            }
+            None => self.instances.iter().for_each(|(h, inst)| gather(*h, inst)),
         }
         picked.sort_unstable_by_key(|p| p.0);
         picked.truncate(limit);
-
-        // Ranks need, per instance, the samples that are in the collection.
-        let mut per_instance: HashMap<InstanceHandle, Vec<usize>> = HashMap::new();
-        for (pos, (_, h, _)) in picked.iter().enumerate() {
-            per_instance.entry(*h).or_default().push(pos);
+        // Ranks count the samples of the same instance later in the collection; the last one (in reception
+        // order) is the instance's most recent sample in the collection.
+        for &(_, t, idx) in &picked {
+            touched[t].count += 1;
+            touched[t].last_index = idx;
         }
-        for (pos, &(_, h, idx)) in picked.iter().enumerate() {
-            let Some(inst) = self.instances.get_mut(&h) else {
+        for &(_, t, idx) in &picked {
+            let tc = &mut touched[t];
+            let Some(inst) = self.instances.get_mut(&tc.handle) else {
                 continue;
             };
-            let positions = &per_instance[&h];
-            let my_rank_pos = positions.iter().position(|p| *p == pos).unwrap_or(0);
-            let sample_rank = (positions.len() - 1 - my_rank_pos) as u32;
-            let last_idx = picked[*positions.last().unwrap_or(&pos)].2;
+            tc.emitted += 1;
+            let sample_rank = (tc.count - tc.emitted) as u32;
             let (mrs_dg, mrs_nw) = inst
                 .samples
-                .get(last_idx)
+                .get(tc.last_index)
                 .map(|s| (s.disposed_gen, s.no_writers_gen))
                 .unwrap_or((0, 0));
             let s = &mut inst.samples[idx];
@@ -488,7 +501,7 @@ impl<T> ReaderCache<T> {
                 instance_state: inst.state,
                 source_timestamp: s.source_timestamp,
                 reception_timestamp: s.reception_timestamp,
-                instance_handle: h,
+                instance_handle: tc.handle,
                 publication_handle: InstanceHandle::from_guid_bytes(&s.writer),
                 publication_guid: s.writer,
                 disposed_generation_count: s.disposed_gen,
@@ -503,29 +516,22 @@ impl<T> ReaderCache<T> {
             emit(&mut s.data, info);
         }
         // View state becomes NOT_NEW for every instance touched.
-        for h in per_instance.keys() {
-            if let Some(inst) = self.instances.get_mut(h) {
+        for t in touched.iter().filter(|t| t.count > 0) {
+            if let Some(inst) = self.instances.get_mut(&t.handle) {
                 inst.view = ViewState::NotNew;
             }
         }
         if take {
-            let mut removed = 0;
-            for h in per_instance.keys() {
-                let Some(inst) = self.instances.get_mut(h) else {
-                    continue;
-                };
-                let mut idxs: Vec<usize> =
-                    picked.iter().filter(|p| p.1 == *h).map(|p| p.2).collect();
-                idxs.sort_unstable_by(|a, b| b.cmp(a));
-                for i in idxs {
-                    inst.samples.remove(i);
-                    removed += 1;
+            // Per instance, highest index first, so that earlier indices stay valid.
+            picked.sort_unstable_by(|a, b| (a.1, b.2).cmp(&(b.1, a.2)));
+            for &(_, t, idx) in &picked {
+                if let Some(inst) = self.instances.get_mut(&touched[t].handle) {
+                    inst.samples.remove(idx);
                 }
             }
-            self.total -= removed;
-            let hs: Vec<InstanceHandle> = per_instance.keys().copied().collect();
-            for h in hs {
-                self.maybe_drop_instance(h);
+            self.total -= picked.len();
+            for t in touched.iter().filter(|t| t.count > 0) {
+                self.maybe_drop_instance(t.handle);
             }
         }
     }
@@ -585,6 +591,16 @@ impl<T> ReaderCache<T> {
         }
         missed
     }
+}
+
+/// An instance with samples in a read/take collection.
+struct Touched {
+    handle: InstanceHandle,
+    /// Its samples in the collection, and how many of them were emitted so far.
+    count: usize,
+    emitted: usize,
+    /// Index (in the instance) of its last sample in the collection.
+    last_index: usize,
 }
 
 #[cfg(test)]

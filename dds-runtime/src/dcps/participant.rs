@@ -139,6 +139,13 @@ fn new_guid_prefix() -> GuidPrefix {
 }
 
 impl Shared {
+    /// Sends held batched writes; free when batching is off.
+    pub(crate) fn flush(&self) {
+        if self.config.write_batch_delay.is_some() {
+            self.with_core(|c, _| c.flush());
+        }
+    }
+
     /// Runs `f` on the core, then (lock released) sends what it queued and dispatches its events.
     pub(crate) fn with_core<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R) -> R {
         let now = Instant::now();
@@ -539,6 +546,7 @@ pub struct DomainParticipantBuilder {
     lease_duration: Option<Duration>,
     fragment_size: Option<usize>,
     max_message_size: Option<usize>,
+    write_batch_delay: Option<Option<Duration>>,
     config: Option<Config>,
     ignore_env: bool,
     user_data: Vec<u8>,
@@ -596,6 +604,15 @@ impl DomainParticipantBuilder {
         self.max_message_size = Some(n);
         self
     }
+    /// Write batching (overrides `DDS_WRITE_BATCH`): with `Some(delay)`, written samples wait up to `delay`
+    /// for others to share their datagram; [`DomainParticipant::flush`] and [`DataWriter::flush`] send them at
+    /// once. `None` sends every write immediately.
+    ///
+    /// [`DataWriter::flush`]: crate::dcps::DataWriter::flush
+    pub fn write_batching(mut self, delay: Option<Duration>) -> Self {
+        self.write_batch_delay = Some(delay);
+        self
+    }
     /// Starts from this configuration instead of the environment.
     pub fn config(mut self, c: Config) -> Self {
         self.config = Some(c);
@@ -651,6 +668,9 @@ impl DomainParticipantBuilder {
         if let Some(n) = self.max_message_size {
             c.max_message_size = n;
         }
+        if let Some(d) = self.write_batch_delay {
+            c.write_batch_delay = d;
+        }
         c.validate()?;
         Ok(c)
     }
@@ -689,6 +709,7 @@ impl DomainParticipantBuilder {
         pc.lease_duration = config.lease_duration;
         pc.max_message_size = config.max_message_size;
         pc.fragment_size = config.fragment_size;
+        pc.write_batch_delay = config.write_batch_delay;
         pc.user_data = self.user_data;
         pc.entity_name = self.name;
 
@@ -755,6 +776,12 @@ impl DomainParticipant {
     /// The domain id.
     pub fn domain_id(&self) -> u32 {
         self.shared.config.domain_id
+    }
+
+    /// Sends the samples that write batching holds back (see
+    /// [`DomainParticipantBuilder::write_batching`]); without batching there is nothing to send.
+    pub fn flush(&self) {
+        self.shared.flush();
     }
 
     /// The effective configuration.

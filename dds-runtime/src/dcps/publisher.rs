@@ -244,6 +244,26 @@ impl<T: DdsType> std::fmt::Debug for DataWriter<T> {
     }
 }
 
+/// Runs `f` on a cleared per-thread buffer (a fresh one if the thread's is in use), so that serializing a
+/// sample or its key allocates nothing once the buffer has grown.
+fn with_scratch<R>(f: impl FnOnce(&mut Vec<u8>) -> R) -> R {
+    thread_local! {
+        static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+    }
+    SCRATCH.with(|cell| {
+        let mut fresh = Vec::new();
+        let mut guard = cell.try_borrow_mut().ok();
+        let buf = guard.as_deref_mut().unwrap_or(&mut fresh);
+        buf.clear();
+        let r = f(buf);
+        // Do not keep a huge buffer alive for the thread's lifetime after one large sample.
+        if buf.capacity() > 1 << 20 {
+            *buf = Vec::new();
+        }
+        r
+    })
+}
+
 fn wire_time(t: SystemTime) -> Time {
     Time::from_unix(t.duration_since(SystemTime::UNIX_EPOCH).unwrap_or_default())
 }
@@ -286,23 +306,9 @@ impl<T: DdsType> DataWriter<T> {
     /// Serializes into a per-thread scratch buffer and copies the bytes once into the shared payload: one
     /// allocation per sample instead of a growing `Vec` plus its conversion into an `Arc<[u8]>`.
     fn serialize(&self, sample: &T) -> DdsResult<Payload> {
-        thread_local! {
-            static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
-        }
-        SCRATCH.with(|cell| {
-            // A listener writing from inside serialization cannot happen (serialize calls no user code), but
-            // stay safe if the buffer is somehow in use: fall back to a fresh one.
-            let mut fresh = Vec::new();
-            let mut guard = cell.try_borrow_mut().ok();
-            let buf = guard.as_deref_mut().unwrap_or(&mut fresh);
-            buf.clear();
+        with_scratch(|buf| {
             cdr::serialize(sample, self.inner.version, ByteOrder::NATIVE, buf)?;
-            let payload = Payload::copy_from_slice(buf);
-            // Do not keep a huge buffer alive for the thread's lifetime after one large sample.
-            if buf.capacity() > 1 << 20 {
-                *buf = Vec::new();
-            }
-            Ok(payload)
+            Ok(Payload::copy_from_slice(buf))
         })
     }
 
@@ -322,7 +328,8 @@ impl<T: DdsType> DataWriter<T> {
             Reliability::Reliable { max_blocking_time } => max_blocking_time,
             Reliability::BestEffort => Duration::ZERO,
         };
-        let deadline = Instant::now().checked_add(max_block);
+        // Only a refused write needs the clock.
+        let mut deadline: Option<Option<Instant>> = None;
         let id = self.id();
         loop {
             let seen = shared.progress_generation();
@@ -330,6 +337,7 @@ impl<T: DdsType> DataWriter<T> {
                 Ok(_) => return Ok(()),
                 Err(WriteError::WouldBlock) => {
                     let now = Instant::now();
+                    let deadline = *deadline.get_or_insert_with(|| now.checked_add(max_block));
                     match deadline {
                         Some(d) if now >= d => return Err(DdsError::Timeout),
                         Some(d) => shared.wait_progress_change(seen, d),
@@ -348,6 +356,12 @@ impl<T: DdsType> DataWriter<T> {
                 Err(e) => return Err(DdsError::Core(e.to_string())),
             }
         }
+    }
+
+    /// Sends at once what write batching holds back; the participant's batches are shared by its writers,
+    /// so this sends theirs too.
+    pub fn flush(&self) {
+        self.inner.shared.flush();
     }
 
     /// Publishes `sample` with the current time as source timestamp.
@@ -383,21 +397,27 @@ impl<T: DdsType> DataWriter<T> {
         create: bool,
         written: bool,
     ) -> DdsResult<Option<(InstanceHandle, Option<[u8; 16]>)>> {
+        let found = with_scratch(|key| -> DdsResult<_> {
+            cdr::instance_key(sample, key)?;
+            let mut inst = lock(&self.inner.instances);
+            let Some(h) = inst.by_key.get(key.as_slice()).copied() else {
+                return Ok(None);
+            };
+            let Some(i) = inst.by_handle.get_mut(&h) else {
+                return Ok(None);
+            };
+            if written {
+                i.last_write = Instant::now();
+            }
+            Ok(Some((h, i.key_hash)))
+        })?;
+        if found.is_some() || !create {
+            return Ok(found);
+        }
         let mut key = Vec::new();
         cdr::instance_key(sample, &mut key)?;
         let now = Instant::now();
         let mut inst = lock(&self.inner.instances);
-        if let Some(h) = inst.by_key.get(&key).copied() {
-            if let Some(i) = inst.by_handle.get_mut(&h) {
-                if written {
-                    i.last_write = now;
-                }
-                return Ok(Some((h, i.key_hash)));
-            }
-        }
-        if !create {
-            return Ok(None);
-        }
         let mut kp = Vec::new();
         cdr::serialize_key(sample, self.inner.version, ByteOrder::NATIVE, &mut kp)?;
         let kh = self.key_hash(sample)?;

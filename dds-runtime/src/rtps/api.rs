@@ -134,6 +134,10 @@ pub struct ParticipantConfig {
     pub writer_linger_duration: Duration,
     /// Upper bound on bytes retransmitted per repair round to one reader (default 256 KiB).
     pub max_repair_bytes: usize,
+    /// Write batching: user DATA waits up to this long for more samples to share its datagram, leaving
+    /// earlier when the datagram is full, on [`Participant::flush`](super::Participant::flush), or with any
+    /// other outgoing traffic. `None` (the default) sends every write at once.
+    pub write_batch_delay: Option<Duration>,
 }
 
 impl ParticipantConfig {
@@ -182,6 +186,7 @@ impl ParticipantConfig {
             reorder_max_bytes: 64 * 1024 * 1024,
             writer_linger_duration: Duration::from_secs(1),
             max_repair_bytes: 256 * 1024,
+            write_batch_delay: None,
         }
     }
 }

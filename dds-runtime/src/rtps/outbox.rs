@@ -1,6 +1,11 @@
 //! Packs outgoing submessages into datagrams per (destinations, INFO_DST) up to max_message_size.
+//!
+//! Open messages normally close at the next drain. Batched writes (`hold`) leave them open until they
+//! fill up, an explicit flush, any unbatched traffic, or the batch delay runs out, so that a burst of small
+//! samples travels in few datagrams.
 
 use std::collections::VecDeque;
+use std::time::{Duration, Instant};
 
 use super::api::Transmit;
 use super::messages::{append, Header, Submessage};
@@ -35,6 +40,12 @@ pub(crate) struct Outbox {
     pending: Vec<Pending>,
     ready: VecDeque<Transmit>,
     pool: Vec<Vec<u8>>,
+    /// While set, pushes do not ask for the open messages to close at the next drain.
+    holding: bool,
+    /// The open messages must close at the next drain.
+    flush_due: bool,
+    /// When the oldest held submessage was queued.
+    held_since: Option<Instant>,
 }
 
 impl Outbox {
@@ -45,7 +56,32 @@ impl Outbox {
             pending: Vec::new(),
             ready: VecDeque::new(),
             pool: Vec::new(),
+            holding: false,
+            flush_due: false,
+            held_since: None,
         }
+    }
+
+    /// Runs `f` with its pushes held back for batching: they leave at the latest `delay` after `now`.
+    pub fn hold<R>(&mut self, now: Instant, f: impl FnOnce(&mut Outbox) -> R) -> R {
+        let before = self.holding;
+        self.holding = true;
+        let r = f(self);
+        self.holding = before;
+        if self.pending.iter().any(|p| p.buf.len() > p.preamble) {
+            self.held_since.get_or_insert(now);
+        }
+        r
+    }
+
+    /// Asks for every open message to be closed at the next drain.
+    pub fn request_flush(&mut self) {
+        self.flush_due = true;
+    }
+
+    /// When held messages must leave, for a batch delay of `delay`.
+    pub fn hold_deadline(&self, delay: Duration) -> Option<Instant> {
+        self.held_since.map(|t| t + delay)
     }
 
     fn open(&mut self, destinations: &[Locator], dst: Option<GuidPrefix>) -> usize {
@@ -86,6 +122,9 @@ impl Outbox {
         if destinations.is_empty() {
             return;
         }
+        if !self.holding {
+            self.flush_due = true;
+        }
         let i = self.open(destinations, dst);
         let p = &mut self.pending[i];
         let before = p.buf.len();
@@ -116,6 +155,8 @@ impl Outbox {
 
     /// Closes every open message.
     pub fn flush(&mut self) {
+        self.flush_due = false;
+        self.held_since = None;
         for p in self.pending.drain(..) {
             if p.buf.len() > p.preamble {
                 self.ready.push_back(Transmit {
@@ -128,8 +169,12 @@ impl Outbox {
         }
     }
 
-    pub fn pop(&mut self) -> Option<Transmit> {
-        if self.ready.is_empty() {
+    /// The next finished datagram. Open messages close first when a flush is due or the held ones have
+    /// waited `batch_delay`.
+    pub fn pop(&mut self, now: Instant, batch_delay: Duration) -> Option<Transmit> {
+        if self.ready.is_empty()
+            && (self.flush_due || self.hold_deadline(batch_delay).is_some_and(|t| t <= now))
+        {
             self.flush();
         }
         self.ready.pop_front()

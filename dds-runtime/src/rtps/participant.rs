@@ -6,6 +6,7 @@ mod discovery;
 mod receive;
 mod timers;
 
+use std::cell::Cell;
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet, VecDeque};
 use std::time::Instant;
 
@@ -49,6 +50,9 @@ pub struct Participant {
     spdp_payload: Vec<u8>,
     spdp_due: Instant,
     pmd_due: Instant,
+    /// A lower bound on every timer (`None`: unknown), so that traffic does not rescan every endpoint.
+    timer_floor: Cell<Option<Instant>>,
+    last_full_scan: Instant,
 }
 
 fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
@@ -65,6 +69,7 @@ fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
         high_watermark: usize::MAX,
         low_watermark: usize::MAX,
         max_repair_bytes: c.max_repair_bytes,
+        piggyback_heartbeat_bytes: 0,
     }
 }
 
@@ -106,6 +111,8 @@ impl Participant {
             spdp_payload: Vec::new(),
             spdp_due: now,
             pmd_due: now,
+            timer_floor: Cell::new(None),
+            last_full_scan: now,
             config,
         };
         let prefix = p.config.guid_prefix;
@@ -156,8 +163,15 @@ impl Participant {
         }
     }
 
-    pub fn poll_transmit(&mut self, _now: Instant) -> Option<Transmit> {
-        self.out.pop()
+    /// The next datagram to send. Held batched writes are included once their delay has run out.
+    pub fn poll_transmit(&mut self, now: Instant) -> Option<Transmit> {
+        self.out
+            .pop(now, self.config.write_batch_delay.unwrap_or_default())
+    }
+
+    /// Releases batched writes at the next [`poll_transmit`](Self::poll_transmit).
+    pub fn flush(&mut self) {
+        self.out.request_flush();
     }
 
     /// Gives a sent datagram's buffer back for reuse (optional; saves an allocation per datagram).
@@ -192,6 +206,7 @@ impl Participant {
     }
 
     pub fn create_writer(&mut self, now: Instant, spec: WriterSpec) -> Result<EntityId, CoreError> {
+        self.timers_changed();
         if spec.topic_name.is_empty() || spec.type_name.is_empty() {
             return Err(CoreError::BadParameter("empty topic or type name"));
         }
@@ -216,6 +231,12 @@ impl Participant {
             high_watermark: c.whc_high_watermark.max(1),
             low_watermark: c.whc_low_watermark.min(c.whc_high_watermark),
             max_repair_bytes: c.max_repair_bytes,
+            // Batched: about one heartbeat per datagram rather than one per sample.
+            piggyback_heartbeat_bytes: if c.write_batch_delay.is_some() {
+                c.max_message_size / 2
+            } else {
+                0
+            },
         };
         self.writers.insert(id, Writer::new(guid, params));
         self.user_writers.insert(id);
@@ -243,6 +264,7 @@ impl Participant {
     }
 
     pub fn create_reader(&mut self, now: Instant, spec: ReaderSpec) -> Result<EntityId, CoreError> {
+        self.timers_changed();
         if spec.topic_name.is_empty() || spec.type_name.is_empty() {
             return Err(CoreError::BadParameter("empty topic or type name"));
         }
@@ -284,6 +306,7 @@ impl Participant {
     /// Deletes a writer. A reliable writer with unacknowledged data lingers (still repairing, refusing writes)
     /// until acknowledged or `writer_linger_duration` passes; then `Event::WriterDeleted`.
     pub fn delete_writer(&mut self, now: Instant, id: EntityId) {
+        self.timers_changed();
         if !self.user_writers.contains(&id) {
             return;
         }
@@ -302,6 +325,7 @@ impl Participant {
     }
 
     pub fn delete_reader(&mut self, now: Instant, id: EntityId) {
+        self.timers_changed();
         if !self.user_readers.remove(&id) {
             return;
         }
@@ -361,7 +385,14 @@ impl Participant {
         let Some(w) = self.writers.get_mut(&writer) else {
             return Err(WriteError::UnknownWriter(writer));
         };
-        w.write(now, change, &mut self.out, &mut self.events)
+        let events = &mut self.events;
+        let r = if self.config.write_batch_delay.is_some() {
+            self.out.hold(now, |out| w.write(now, change, out, events))
+        } else {
+            w.write(now, change, &mut self.out, events)
+        };
+        timers::lower_floor(&self.timer_floor, w.next_timeout());
+        r
     }
 
     pub fn is_acknowledged(&self, writer: EntityId) -> bool {
@@ -389,6 +420,7 @@ impl Participant {
     /// until the next call. A change beyond the credit is not acknowledged; the writer repairs it once
     /// credit is given back. Held changes that now fit are delivered (drain `poll_event`).
     pub fn set_reader_credit(&mut self, reader: EntityId, credit: Option<usize>) {
+        self.timers_changed();
         if let Some(r) = self.readers.get_mut(&reader) {
             let mut out = Vec::new();
             r.set_credit(credit, &mut out);
@@ -422,6 +454,7 @@ impl Participant {
     /// Announces our departure: SPDP dispose to everyone, so peers drop us without waiting for the lease.
     /// Drain `poll_transmit` afterwards.
     pub fn shutdown(&mut self, _now: Instant) {
+        self.timers_changed();
         self.send_spdp_dispose();
     }
 }

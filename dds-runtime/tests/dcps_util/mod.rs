@@ -94,3 +94,54 @@ pub fn reliable() -> Reliability {
 }
 
 pub const MATCH_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Reliable (max_blocking_time 1 s) KEEP_ALL QoS for a writer and for a reader.
+pub fn reliable_keep_all() -> (DataWriterQos, DataReaderQos) {
+    let wq = DataWriterQos::builder()
+        .reliability(reliable())
+        .history(History::KeepAll)
+        .build();
+    let rq = DataReaderQos::builder()
+        .reliability(reliable())
+        .history(History::KeepAll)
+        .build();
+    (wq, rq)
+}
+
+/// A writer on `pw` and a reader on `pr` of `topic` (default topic, publisher and subscriber QoS), once
+/// each has matched the other (within [`MATCH_TIMEOUT`]; panics otherwise).
+pub fn matched<T: DdsType>(
+    pw: &DomainParticipant,
+    pr: &DomainParticipant,
+    topic: &str,
+    wq: &DataWriterQos,
+    rq: &DataReaderQos,
+) -> (DataWriter<T>, DataReader<T>) {
+    let tw = pw
+        .create_topic::<T>(topic, &TopicQos::default())
+        .expect("writer's topic");
+    let tr = pr
+        .create_topic::<T>(topic, &TopicQos::default())
+        .expect("reader's topic");
+    let w = pw
+        .create_publisher(&PublisherQos::default())
+        .and_then(|p| p.create_datawriter(&tw, wq))
+        .expect("datawriter");
+    let r = pr
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| s.create_datareader(&tr, rq))
+        .expect("datareader");
+    assert!(
+        wait_until(MATCH_TIMEOUT, || w.publication_matched_status().current_count == 1),
+        "writer of {topic:?} did not match one reader within {MATCH_TIMEOUT:?}: {:?}, incompatible: {:?}",
+        w.publication_matched_status(),
+        w.offered_incompatible_qos_status()
+    );
+    assert!(
+        wait_until(MATCH_TIMEOUT, || r.subscription_matched_status().current_count == 1),
+        "reader of {topic:?} did not match one writer within {MATCH_TIMEOUT:?}: {:?}, incompatible: {:?}",
+        r.subscription_matched_status(),
+        r.requested_incompatible_qos_status()
+    );
+    (w, r)
+}

@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex, RwLock};
 use std::thread;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
-use dds_examples::perf_args::{self, PerfCommand, PerfOptions, TopicSel};
+use dds_examples::perf_args::{self, PerfCommand, PerfOptions, TopicSel, TriggerMode};
 use dds_examples::perf_sample::PerfSample;
 use dds_examples::perf_stats::{self, LatencyStat, SeqCheck, SubStats, WriteHist};
 use dds_examples::shutdown;
@@ -203,6 +203,7 @@ impl<T: PerfSample> Ctx<T> {
                 println!("[{}] ping write failed: {e}", self.pid);
             }
         }
+        self.ping_writer.flush();
     }
 }
 
@@ -256,6 +257,10 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
     let has_reader = o.sub.is_some();
     let user_data = format!("DDSPerf:{}:{}:{}", u8::from(has_reader), pid, hostname()).into_bytes();
     let mut builder = DomainParticipant::builder().user_data(user_data);
+    // Like ddsperf: a publisher packs its data samples into datagrams; pings and pongs are flushed at once.
+    if o.pub_rate.is_some_and(|r| r > 0.0) && std::env::var_os("DDS_WRITE_BATCH").is_none() {
+        builder = builder.write_batching(Some(dds_runtime::config::DEFAULT_WRITE_BATCH_DELAY));
+    }
     if let Some(d) = o.domain_id {
         builder = builder.domain_id(d);
     }
@@ -317,17 +322,13 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
         let c = ctx.clone();
         threads.push(thread::spawn(move || discovery_loop(&c)));
     }
-    {
-        let c = ctx.clone();
-        threads.push(thread::spawn(move || ping_responder(&c, &ping_reader)));
-    }
-    {
-        let c = ctx.clone();
-        threads.push(thread::spawn(move || pong_receiver(&c, &pong_reader)));
-    }
-    if let Some(r) = data_reader {
-        let c = ctx.clone();
-        threads.push(thread::spawn(move || data_receiver(&c, &r)));
+    let pp = o.pingpong_trigger;
+    let mut listened = vec![
+        service_reader(&ctx, ping_reader, pp, answer_pings, &mut threads),
+        service_reader(&ctx, pong_reader, pp, receive_pongs, &mut threads),
+    ];
+    if let (Some(r), Some(mode)) = (data_reader, o.sub) {
+        listened.push(service_reader(&ctx, r, mode, receive_data, &mut threads));
     }
     if o.pub_rate.is_some_and(|r| r > 0.0) {
         let c = ctx.clone();
@@ -340,6 +341,7 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
     for t in threads {
         let _ = t.join();
     }
+    drop(listened);
     Ok(code)
 }
 
@@ -514,122 +516,154 @@ fn discovery_loop<T: PerfSample>(ctx: &Ctx<T>) {
     }
 }
 
+/// Runs `handle` whenever `reader` has data, the way `mode` says: a listener on the receive thread, a
+/// waiting thread, or a thread polling at 1 kHz. Threads are pushed onto `threads`; a reader served by a
+/// listener is returned, for the caller to keep alive.
+fn service_reader<T: PerfSample>(
+    ctx: &Arc<Ctx<T>>,
+    reader: DataReader<T>,
+    mode: TriggerMode,
+    handle: fn(&Ctx<T>, &DataReader<T>),
+    threads: &mut Vec<thread::JoinHandle<()>>,
+) -> Option<DataReader<T>> {
+    match mode {
+        TriggerMode::Listener => {
+            reader.set_listener(Box::new(OnData {
+                ctx: Arc::downgrade(ctx),
+                handle,
+            }));
+            Some(reader)
+        }
+        TriggerMode::Waitset | TriggerMode::Polling => {
+            let c = ctx.clone();
+            threads.push(thread::spawn(move || {
+                while !c.stopping() {
+                    let ready = if mode == TriggerMode::Polling {
+                        thread::sleep(Duration::from_millis(1));
+                        true
+                    } else {
+                        reader
+                            .wait_for_data(Duration::from_millis(100))
+                            .unwrap_or(false)
+                    };
+                    if ready {
+                        handle(&c, &reader);
+                    }
+                }
+            }));
+            None
+        }
+    }
+}
+
+/// A data-available listener calling a handler (weak: the readers live in the context).
+struct OnData<T: PerfSample> {
+    ctx: std::sync::Weak<Ctx<T>>,
+    handle: fn(&Ctx<T>, &DataReader<T>),
+}
+
+impl<T: PerfSample> DataReaderListener<T> for OnData<T> {
+    fn on_data_available(&self, reader: &DataReader<T>) {
+        if let Some(c) = self.ctx.upgrade() {
+            if !c.stopping() {
+                (self.handle)(&c, reader);
+            }
+        }
+    }
+}
+
 /// Answers pings: echo on the pinging participant's pong writer with the timestamp's lsb set.
-fn ping_responder<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
-    while !ctx.stopping() {
-        if !reader
-            .wait_for_data(Duration::from_millis(100))
-            .unwrap_or(false)
-        {
+fn answer_pings<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
+    let Ok(samples) = reader.take() else { return };
+    for s in samples {
+        let Some(d) = s.data else { continue };
+        if ctx.is_local(&s.info.publication_guid) && !ctx.o.match_local {
             continue;
         }
-        let Ok(samples) = reader.take() else { continue };
-        for s in samples {
-            let Some(d) = s.data else { continue };
-            if ctx.is_local(&s.info.publication_guid) && !ctx.o.match_local {
-                continue;
-            }
-            if let Some(w) = ctx.pong_writer_for(&s.info.publication_guid) {
-                let _ = w.write_w_timestamp(&d, ts(ns_of(s.info.source_timestamp) | 1));
-            }
+        if let Some(w) = ctx.pong_writer_for(&s.info.publication_guid) {
+            let _ = w.write_w_timestamp(&d, ts(ns_of(s.info.source_timestamp) | 1));
+            w.flush();
         }
     }
 }
 
 /// Receives pongs: half the round trip per answering writer; the next ping once all answered.
-fn pong_receiver<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
-    while !ctx.stopping() {
-        if !reader
-            .wait_for_data(Duration::from_millis(100))
-            .unwrap_or(false)
+fn receive_pongs<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
+    let Ok(samples) = reader.take() else { return };
+    let now = now_ns();
+    for s in samples {
+        let Some(d) = s.data else { continue };
+        let sent = ns_of(s.info.source_timestamp);
+        let isping = sent & 1 == 1;
+        let half_rtt = (now - sent) / 2;
         {
+            let mut ps = ctx.pong_stats.lock().expect("pong stats");
+            let g = s.info.publication_guid;
+            match ps.iter_mut().find(|(k, _)| *k == g) {
+                Some((_, st)) => st.record(half_rtt),
+                None => {
+                    let mut st = LatencyStat::new();
+                    st.record(half_rtt);
+                    ps.push((g, st));
+                }
+            }
+        }
+        if !isping {
             continue;
         }
-        let Ok(samples) = reader.take() else { continue };
-        let now = now_ns();
-        for s in samples {
-            let Some(d) = s.data else { continue };
-            let sent = ns_of(s.info.source_timestamp);
-            let isping = sent & 1 == 1;
-            let half_rtt = (now - sent) / 2;
-            {
-                let mut ps = ctx.pong_stats.lock().expect("pong stats");
-                let g = s.info.publication_guid;
-                match ps.iter_mut().find(|(k, _)| *k == g) {
-                    Some((_, st)) => st.record(half_rtt),
-                    None => {
-                        let mut st = LatencyStat::new();
-                        st.record(half_rtt);
-                        ps.push((g, st));
-                    }
-                }
-            }
-            if !isping {
-                continue;
-            }
-            let next = {
-                let mut st = ctx.ping.lock().expect("ping state");
-                if d.seq() != st.seq {
-                    None
+        let next = {
+            let mut st = ctx.ping.lock().expect("ping state");
+            if d.seq() != st.seq {
+                None
+            } else {
+                st.seen += 1;
+                let all = st.seen >= ctx.pongs_expected();
+                if all && ctx.o.ping_interval == Some(Duration::ZERO) {
+                    st.seen = 0;
+                    st.seq = st.seq.wrapping_add(1);
+                    st.sent_at = Some(Instant::now());
+                    Some(st.seq)
                 } else {
-                    st.seen += 1;
-                    let all = st.seen >= ctx.pongs_expected();
-                    if all && ctx.o.ping_interval == Some(Duration::ZERO) {
-                        st.seen = 0;
-                        st.seq = st.seq.wrapping_add(1);
-                        st.sent_at = Some(Instant::now());
-                        Some(st.seq)
-                    } else {
-                        None
-                    }
+                    None
                 }
-            };
-            if let Some(seq) = next {
-                ctx.send_ping(seq);
             }
+        };
+        if let Some(seq) = next {
+            ctx.send_ping(seq);
         }
     }
 }
 
 /// `sub` mode: sequence checking per writer and key, optional latency, and pongs for pinged data.
-fn data_receiver<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
-    while !ctx.stopping() {
-        if !reader
-            .wait_for_data(Duration::from_millis(100))
-            .unwrap_or(false)
+fn receive_data<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
+    let Ok(samples) = reader.select().max_samples(1000).take() else {
+        return;
+    };
+    let mut stats = ctx.sub_stats.lock().expect("sub stats");
+    for s in &samples {
+        let Some(d) = &s.data else { continue };
+        if ctx.is_local(&s.info.publication_guid) && !ctx.o.match_local {
+            continue;
+        }
+        if stats.record(s.info.publication_guid, d.seq(), d.keyval(), d.size()) == SeqCheck::BadKey
         {
-            continue;
+            println!("received key {} >= nkeys {}", d.keyval(), ctx.o.nkeyvals);
+            shutdown::request();
         }
-        let Ok(samples) = reader.select().max_samples(1000).take() else {
-            continue;
-        };
-        let mut stats = ctx.sub_stats.lock().expect("sub stats");
-        for s in &samples {
-            let Some(d) = &s.data else { continue };
-            if ctx.is_local(&s.info.publication_guid) && !ctx.o.match_local {
-                continue;
-            }
-            if stats.record(s.info.publication_guid, d.seq(), d.keyval(), d.size())
-                == SeqCheck::BadKey
-            {
-                println!("received key {} >= nkeys {}", d.keyval(), ctx.o.nkeyvals);
-                shutdown::request();
-            }
-            if ctx.o.sublatency {
-                ctx.sub_latency
-                    .lock()
-                    .expect("sub latency")
-                    .record(now_ns() - ns_of(s.info.source_timestamp));
-            }
+        if ctx.o.sublatency {
+            ctx.sub_latency
+                .lock()
+                .expect("sub latency")
+                .record(now_ns() - ns_of(s.info.source_timestamp));
         }
-        drop(stats);
-        for s in samples {
-            let sent = ns_of(s.info.source_timestamp);
-            if sent & 1 == 1 {
-                if let (Some(d), Some(w)) = (s.data, ctx.pong_writer_for(&s.info.publication_guid))
-                {
-                    let _ = w.write_w_timestamp(&d, ts(sent - 1));
-                }
+    }
+    drop(stats);
+    for s in samples {
+        let sent = ns_of(s.info.source_timestamp);
+        if sent & 1 == 1 {
+            if let (Some(d), Some(w)) = (s.data, ctx.pong_writer_for(&s.info.publication_guid)) {
+                let _ = w.write_w_timestamp(&d, ts(sent - 1));
+                w.flush();
             }
         }
     }
@@ -681,6 +715,7 @@ fn publisher<T: PerfSample>(ctx: &Ctx<T>, w: &DataWriter<T>) {
             batch += 1;
             if batch >= o.burst {
                 batch = 0;
+                w.flush();
                 while !ctx.stopping()
                     && (ntot / u64::from(o.burst)) as f64 / (start.elapsed().as_secs_f64() + 5e-3)
                         > rate

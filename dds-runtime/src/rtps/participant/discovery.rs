@@ -339,6 +339,12 @@ impl Participant {
         let durable = rd.qos.reader.durability >= Durability::TransientLocal;
         let locators =
             self.endpoint_locators(reader.prefix, &rd.unicast_locators, &rd.multicast_locators);
+        // The reader's implementation decides some wire forms (see `ReaderProxy::for_vendor`); our own
+        // readers are not in `participants`.
+        let vendor = self
+            .participants
+            .get(&reader.prefix)
+            .map_or(VendorId::THIS, |p| p.data.vendor_id);
         let Some(w) = self.writers.get_mut(&wid) else {
             return;
         };
@@ -351,7 +357,7 @@ impl Participant {
                 if !has {
                     w.add_proxy(
                         now,
-                        ReaderProxy::new(reader, locators, reliable),
+                        ReaderProxy::new(reader, locators, reliable).for_vendor(vendor),
                         durable,
                         &mut self.events,
                     );

@@ -4,6 +4,7 @@ use std::time::Instant;
 
 use tracing::{debug, trace};
 
+use super::timers::lower_floor;
 use super::Participant;
 use crate::rtps::api::Event;
 use crate::rtps::messages::{MessageIter, Submessage};
@@ -46,6 +47,7 @@ impl Participant {
                     let wguid = Guid::new(src, d.writer_id);
                     if d.writer_id == EntityId::SPDP_WRITER {
                         self.on_spdp(now, src, &d);
+                        self.timers_changed();
                     } else {
                         let scratch = &mut self.scratch;
                         for_readers(&mut self.readers, d.reader_id, wguid, |r| {
@@ -63,8 +65,10 @@ impl Participant {
                 Submessage::Heartbeat(h) => {
                     let wguid = Guid::new(src, h.writer_id);
                     let scratch = &mut self.scratch;
+                    let armed = &self.timer_floor;
                     for_readers(&mut self.readers, h.reader_id, wguid, |r| {
-                        r.on_heartbeat(now, wguid, &h, scratch)
+                        r.on_heartbeat(now, wguid, &h, scratch);
+                        lower_floor(armed, r.next_timeout());
                     });
                 }
                 Submessage::Gap(g) => {
@@ -76,18 +80,27 @@ impl Participant {
                 }
                 Submessage::HeartbeatFrag(h) => {
                     let wguid = Guid::new(src, h.writer_id);
+                    let armed = &self.timer_floor;
                     for_readers(&mut self.readers, h.reader_id, wguid, |r| {
-                        r.on_heartbeat_frag(now, wguid, &h)
+                        r.on_heartbeat_frag(now, wguid, &h);
+                        lower_floor(armed, r.next_timeout());
                     });
                 }
                 Submessage::AckNack(a) => {
                     if let Some(w) = self.writers.get_mut(&a.writer_id) {
                         w.on_acknack(now, Guid::new(src, a.reader_id), &a, &mut self.events);
+                        if w.linger_until.is_some() {
+                            // An acknowledged lingering writer is finished at the next pass.
+                            self.timer_floor.set(Some(now));
+                        } else {
+                            lower_floor(&self.timer_floor, w.next_timeout());
+                        }
                     }
                 }
                 Submessage::NackFrag(n) => {
                     if let Some(w) = self.writers.get_mut(&n.writer_id) {
                         w.on_nack_frag(now, Guid::new(src, n.reader_id), &n);
+                        lower_floor(&self.timer_floor, w.next_timeout());
                     }
                 }
                 Submessage::Pad | Submessage::InfoReply(_) | Submessage::InfoReplyIp4(_) => {}
@@ -106,7 +119,10 @@ impl Participant {
         let mut batch = std::mem::take(&mut self.scratch);
         for ev in batch.drain(..) {
             match ev {
-                Event::Sample(s) if s.reader.is_builtin() => self.on_builtin_sample(now, s),
+                Event::Sample(s) if s.reader.is_builtin() => {
+                    self.on_builtin_sample(now, s);
+                    self.timers_changed();
+                }
                 Event::SampleLost { reader, .. } if reader.is_builtin() => {}
                 e => self.events.push_back(e),
             }

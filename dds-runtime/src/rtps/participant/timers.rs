@@ -1,6 +1,7 @@
 //! Periodic work: SPDP announcements, liveliness messages, leases, writer and reader timers, lingering.
 
-use std::time::Instant;
+use std::cell::Cell;
+use std::time::{Duration, Instant};
 
 use tracing::debug;
 
@@ -12,10 +13,44 @@ use crate::rtps::messages::{Data, ParameterList, Submessage};
 use crate::rtps::outbox::Ts;
 use crate::rtps::types::*;
 
+/// Longest the cached timer floor goes without a full pass over the endpoints (a safety net: every path
+/// that arms a timer also lowers or clears the floor).
+const FULL_SCAN_INTERVAL: Duration = Duration::from_millis(100);
+
+/// Lowers a known timer floor to `t`; an unknown floor stays unknown (it is rescanned anyway).
+pub(super) fn lower_floor(floor: &Cell<Option<Instant>>, t: Option<Instant>) {
+    if let (Some(f), Some(t)) = (floor.get(), t) {
+        if t < f {
+            floor.set(Some(t));
+        }
+    }
+}
+
 impl Participant {
     /// When `handle_timeout` must be called next.
     pub fn poll_timeout(&self) -> Option<Instant> {
-        let mut t = self.spdp_due.min(self.pmd_due);
+        let t = match self.timer_floor.get() {
+            Some(t) => t,
+            None => {
+                let t = self.scan_timers();
+                self.timer_floor.set(Some(t));
+                t
+            }
+        };
+        let held = self
+            .config
+            .write_batch_delay
+            .and_then(|d| self.out.hold_deadline(d));
+        Some(held.map_or(t, |h| h.min(t)))
+    }
+
+    /// The earliest timer of the participant and every endpoint, capped so that a full pass runs at least
+    /// every [`FULL_SCAN_INTERVAL`].
+    fn scan_timers(&self) -> Instant {
+        let mut t = self
+            .spdp_due
+            .min(self.pmd_due)
+            .min(self.last_full_scan + FULL_SCAN_INTERVAL);
         for p in self.participants.values() {
             t = t.min(p.lease_deadline);
         }
@@ -32,11 +67,19 @@ impl Participant {
                 t = t.min(x);
             }
         }
-        Some(t)
+        t
+    }
+
+    /// Timers may have been armed anywhere: the next `poll_timeout` rescans.
+    pub(super) fn timers_changed(&self) {
+        self.timer_floor.set(None);
     }
 
     /// Runs everything due at `now`.
     pub(super) fn service(&mut self, now: Instant) {
+        if self.timer_floor.get().is_some_and(|floor| now < floor) {
+            return;
+        }
         if now >= self.spdp_due {
             self.send_spdp(None);
             self.spdp_due = now + self.config.spdp_interval;
@@ -91,6 +134,8 @@ impl Participant {
                 r.on_timeout(now, &mut self.out);
             }
         }
+        self.last_full_scan = now;
+        self.timers_changed();
     }
 
     /// Sends our SPDP announcement to the SPDP multicast locators and initial peers, or to `to` only.

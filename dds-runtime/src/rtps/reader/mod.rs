@@ -436,6 +436,11 @@ impl Reader {
         }
     }
 
+    /// HEARTBEAT_FRAG (§8.3.7.6): the writer has fragments 1..=last of one sample. Answered with a NACK_FRAG
+    /// for the fragments we lack of a sample we are reassembling. A sample we have (or have skipped) needs
+    /// nothing; one we hold no fragment of is left to the HEARTBEAT/ACKNACK exchange, which asks for whole
+    /// samples. It says nothing about other sequence numbers, so it neither moves `hb_last` nor prompts an
+    /// ACKNACK; its count is its own, apart from HEARTBEAT's.
     pub fn on_heartbeat_frag(&mut self, now: Instant, writer: Guid, hf: &HeartbeatFrag) {
         let delay = self.params.heartbeat_response_delay;
         let Some(p) = self.proxies.get_mut(&writer) else {
@@ -448,67 +453,124 @@ impl Reader {
             return;
         }
         p.last_hbfrag_count = Some(hf.count);
-        p.hb_last = p.hb_last.max(hf.writer_sn);
-        if !p.has(hf.writer_sn) {
-            p.acknack_due.get_or_insert(now + delay);
+        let sn = hf.writer_sn;
+        if p.has(sn) || hf.last_fragment_num == 0 {
+            return;
         }
+        let Some(d) = p.defrag.get(&sn) else {
+            return;
+        };
+        if d.missing(hf.last_fragment_num).is_empty()
+            || (p.nackfrag_req.len() >= self.params.defrag_max_samples.max(1)
+                && !p.nackfrag_req.contains_key(&sn))
+        {
+            return;
+        }
+        let last = p.nackfrag_req.entry(sn).or_insert(0);
+        *last = (*last).max(hf.last_fragment_num);
+        p.nackfrag_due.get_or_insert(now + delay);
     }
 
     pub fn next_timeout(&self) -> Option<Instant> {
-        self.proxies.values().filter_map(|p| p.acknack_due).min()
+        self.proxies
+            .values()
+            .flat_map(|p| [p.acknack_due, p.nackfrag_due])
+            .flatten()
+            .min()
     }
 
-    /// Sends due ACKNACKs (and NACK_FRAGs for partly received samples).
+    /// Sends due ACKNACKs (and NACK_FRAGs for partly received samples), and NACK_FRAGs answering
+    /// HEARTBEAT_FRAGs.
     pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
         let rid = self.guid.entity_id;
         for p in self.proxies.values_mut() {
-            if p.acknack_due.is_none_or(|t| t > now) {
+            if p.acknack_due.is_some_and(|t| t <= now) {
+                Self::send_acknack(rid, p, out);
+            }
+            if p.nackfrag_due.is_some_and(|t| t <= now) {
+                Self::send_requested_nackfrags(rid, p, out);
+            }
+        }
+    }
+
+    /// An ACKNACK for what is missing up to the last heartbeat, and a NACK_FRAG per partly received sample.
+    fn send_acknack(rid: EntityId, p: &mut WriterProxy, out: &mut Outbox) {
+        p.acknack_due = None;
+        let base = p.next_expected;
+        let mut set = SequenceNumberSet::empty(base);
+        let upper = p.hb_last.min(base + 255);
+        let mut sn = base;
+        while sn <= upper {
+            if !p.reorder.contains_key(&sn) && !p.defrag.contains_key(&sn) {
+                set.insert(sn);
+            }
+            sn = sn.next();
+        }
+        p.acknack_count = p.acknack_count.wrapping_add(1);
+        let dest = p.destination().to_vec();
+        let dst = Some(p.guid.prefix);
+        let ack = Submessage::AckNack(AckNack {
+            reader_id: rid,
+            writer_id: p.guid.entity_id,
+            reader_sn_state: set,
+            count: p.acknack_count,
+            final_flag: set.num_bits == 0 && p.synced,
+        });
+        out.push(&dest, dst, Ts::Any, &ack);
+        for (sn, d) in p.defrag.range(base..) {
+            if *sn > p.hb_last {
+                break;
+            }
+            let missing = d.missing(d.total());
+            let Some(&first) = missing.first() else {
                 continue;
-            }
-            p.acknack_due = None;
-            let base = p.next_expected;
-            let mut set = SequenceNumberSet::empty(base);
-            let upper = p.hb_last.min(base + 255);
-            let mut sn = base;
-            while sn <= upper {
-                if !p.reorder.contains_key(&sn) && !p.defrag.contains_key(&sn) {
-                    set.insert(sn);
-                }
-                sn = sn.next();
-            }
-            p.acknack_count = p.acknack_count.wrapping_add(1);
-            let dest = p.destination().to_vec();
-            let dst = Some(p.guid.prefix);
-            let ack = Submessage::AckNack(AckNack {
+            };
+            let mut fs = FragmentNumberSet::empty(first);
+            missing.iter().for_each(|&f| {
+                fs.insert(f);
+            });
+            p.nackfrag_count = p.nackfrag_count.wrapping_add(1);
+            let nf = Submessage::NackFrag(NackFrag {
                 reader_id: rid,
                 writer_id: p.guid.entity_id,
-                reader_sn_state: set,
-                count: p.acknack_count,
-                final_flag: set.num_bits == 0 && p.synced,
+                writer_sn: *sn,
+                fragment_number_state: fs,
+                count: p.nackfrag_count,
             });
-            out.push(&dest, dst, Ts::Any, &ack);
-            for (sn, d) in p.defrag.range(base..) {
-                if *sn > p.hb_last {
-                    break;
-                }
-                let missing = d.missing(d.total());
-                let Some(&first) = missing.first() else {
-                    continue;
-                };
-                let mut fs = FragmentNumberSet::empty(first);
-                missing.iter().for_each(|&f| {
-                    fs.insert(f);
-                });
-                p.nackfrag_count = p.nackfrag_count.wrapping_add(1);
-                let nf = Submessage::NackFrag(NackFrag {
-                    reader_id: rid,
-                    writer_id: p.guid.entity_id,
-                    writer_sn: *sn,
-                    fragment_number_state: fs,
-                    count: p.nackfrag_count,
-                });
-                out.push(&dest, dst, Ts::Any, &nf);
-            }
+            out.push(&dest, dst, Ts::Any, &nf);
+            // Already asked for all it lacks: a pending HEARTBEAT_FRAG answer for it is redundant.
+            p.nackfrag_req.remove(sn);
+        }
+    }
+
+    /// One NACK_FRAG per sample a HEARTBEAT_FRAG asked about and still partly received: the fragments we lack
+    /// up to the last one the writer has.
+    fn send_requested_nackfrags(rid: EntityId, p: &mut WriterProxy, out: &mut Outbox) {
+        p.nackfrag_due = None;
+        let req = std::mem::take(&mut p.nackfrag_req);
+        let dest = p.destination().to_vec();
+        let dst = Some(p.guid.prefix);
+        for (sn, last) in req {
+            let Some(d) = p.defrag.get(&sn) else {
+                continue;
+            };
+            let missing = d.missing(last);
+            let Some(&first) = missing.first() else {
+                continue;
+            };
+            let mut fs = FragmentNumberSet::empty(first);
+            missing.iter().for_each(|&f| {
+                fs.insert(f);
+            });
+            p.nackfrag_count = p.nackfrag_count.wrapping_add(1);
+            let nf = Submessage::NackFrag(NackFrag {
+                reader_id: rid,
+                writer_id: p.guid.entity_id,
+                writer_sn: sn,
+                fragment_number_state: fs,
+                count: p.nackfrag_count,
+            });
+            out.push(&dest, dst, Ts::Any, &nf);
         }
     }
 }

@@ -39,6 +39,11 @@ pub struct WriterProxy {
     pub last_hb_count: Option<i32>,
     pub last_hbfrag_count: Option<i32>,
     pub acknack_due: Option<Instant>,
+    /// Partly received samples a HEARTBEAT_FRAG asked about: sequence number -> last fragment the writer
+    /// has. Answered with NACK_FRAG at `nackfrag_due` (bounded: samples held in `defrag`, at most
+    /// `defrag_max_samples`).
+    pub nackfrag_req: BTreeMap<SequenceNumber, u32>,
+    pub nackfrag_due: Option<Instant>,
     pub acknack_count: i32,
     pub nackfrag_count: i32,
     pub defrag: BTreeMap<SequenceNumber, Defrag>,
@@ -59,6 +64,8 @@ impl WriterProxy {
             last_hb_count: None,
             last_hbfrag_count: None,
             acknack_due: None,
+            nackfrag_req: BTreeMap::new(),
+            nackfrag_due: None,
             acknack_count: 0,
             nackfrag_count: 0,
             defrag: BTreeMap::new(),

@@ -12,7 +12,9 @@ use std::time::{Duration, Instant};
 use crate::qos::{Durability, History, ResourceLimits};
 use crate::rtps::api::{ChangeKind, Event, WriteChange, WriteError};
 use crate::rtps::messages::parameter::pid;
-use crate::rtps::messages::{Data, DataFrag, Gap, Heartbeat, ParameterList, Submessage};
+use crate::rtps::messages::{
+    Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, ParameterList, Submessage,
+};
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
 use reader_proxy::{MAX_REQUESTED, MAX_REQUESTED_FRAG_SAMPLES};
@@ -31,6 +33,8 @@ pub struct WriterParams {
     pub high_watermark: usize,
     pub low_watermark: usize,
     pub max_repair_bytes: usize,
+    /// Bytes written between piggy-backed heartbeats (0: one after every write).
+    pub piggyback_heartbeat_bytes: usize,
 }
 
 /// A local writer's protocol state.
@@ -43,9 +47,16 @@ pub struct Writer {
     proxies: BTreeMap<Guid, ReaderProxy>,
     /// One locator per matched reader, deduplicated: where new data goes.
     data_dest: Vec<Locator>,
+    /// `data_dest` split for key-only changes: readers that want them without serialized key
+    /// (`ReaderProxy::key_hash_only_disposes`), and the rest. `key_hash_dest` empty: no split needed.
+    key_hash_dest: Vec<Locator>,
+    full_key_dest: Vec<Locator>,
     hb_count: i32,
+    /// HEARTBEAT_FRAG count: its own sequence, separate from HEARTBEAT's (§8.3.7.6).
+    hbfrag_count: i32,
     hb_due: Option<Instant>,
     bytes_since_nonfinal_hb: usize,
+    bytes_since_hb: usize,
     unacked_bytes: usize,
     blocked: bool,
     /// Set when deleted: lingers until acknowledged or this deadline.
@@ -61,9 +72,13 @@ impl Writer {
             next_sn: SequenceNumber(1),
             proxies: BTreeMap::new(),
             data_dest: Vec::new(),
+            key_hash_dest: Vec::new(),
+            full_key_dest: Vec::new(),
             hb_count: 0,
+            hbfrag_count: 0,
             hb_due: None,
             bytes_since_nonfinal_hb: 0,
+            bytes_since_hb: 0,
             unacked_bytes: 0,
             blocked: false,
             linger_until: None,
@@ -117,14 +132,42 @@ impl Writer {
     }
 
     fn rebuild_dest(&mut self) {
-        let mut d: Vec<Locator> = self
-            .proxies
-            .values()
-            .filter_map(|p| p.destination().first().copied())
-            .collect();
-        d.sort();
-        d.dedup();
-        self.data_dest = d;
+        let dest = |key_hash_only: Option<bool>| {
+            let mut d: Vec<Locator> = self
+                .proxies
+                .values()
+                .filter(|p| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
+                .filter_map(|p| p.destination().first().copied())
+                .collect();
+            d.sort();
+            d.dedup();
+            d
+        };
+        self.data_dest = dest(None);
+        self.key_hash_dest = dest(Some(true));
+        self.full_key_dest = if self.key_hash_dest.is_empty() {
+            Vec::new()
+        } else {
+            dest(Some(false))
+        };
+    }
+
+    /// A HEARTBEAT_FRAG telling that every fragment of `sn` is available (sent after a fragmented sample to
+    /// reliable readers, so one that missed fragments asks for them with NACK_FRAG at once).
+    fn heartbeat_frag(
+        &mut self,
+        reader_id: EntityId,
+        sn: SequenceNumber,
+        fragments: u32,
+    ) -> Submessage<'static> {
+        self.hbfrag_count = self.hbfrag_count.wrapping_add(1);
+        Submessage::HeartbeatFrag(HeartbeatFrag {
+            reader_id,
+            writer_id: self.guid.entity_id,
+            writer_sn: sn,
+            last_fragment_num: fragments,
+            count: self.hbfrag_count,
+        })
     }
 
     /// After acknowledgements or a change of readers: drop what nobody needs, update flow control.
@@ -191,28 +234,21 @@ impl Writer {
         self.history.add(cc);
         if !self.data_dest.is_empty() {
             let dest = std::mem::take(&mut self.data_dest);
-            if let Some(c) = self.history.get(sn) {
-                send_change(
-                    out,
-                    &dest,
-                    None,
-                    EntityId::UNKNOWN,
-                    self.guid.entity_id,
-                    c,
-                    self.params.fragment_size,
-                    None,
-                );
-            }
+            self.send_new(sn, &dest, out);
             if self.has_reliable_proxy() {
                 self.bytes_since_nonfinal_hb += len;
+                self.bytes_since_hb += len;
                 // Ask for acknowledgements now and then so flow control keeps moving without waiting for the
                 // periodic heartbeat; otherwise the piggy-backed heartbeat only announces.
                 let final_flag = self.bytes_since_nonfinal_hb < self.params.low_watermark / 4;
-                if !final_flag {
-                    self.bytes_since_nonfinal_hb = 0;
+                if !final_flag || self.bytes_since_hb >= self.params.piggyback_heartbeat_bytes {
+                    if !final_flag {
+                        self.bytes_since_nonfinal_hb = 0;
+                    }
+                    self.bytes_since_hb = 0;
+                    let hb = self.heartbeat(EntityId::UNKNOWN, final_flag);
+                    out.push(&dest, None, Ts::Any, &hb);
                 }
-                let hb = self.heartbeat(EntityId::UNKNOWN, final_flag);
-                out.push(&dest, None, Ts::Any, &hb);
             }
             self.data_dest = dest;
         }
@@ -224,6 +260,31 @@ impl Writer {
             self.history.remove_below(self.next_sn);
         }
         Ok(sn)
+    }
+
+    /// Sends a new change to every matched reader (`dest`): one shared send, except that key-only changes go
+    /// in their key-hash-only form to the readers that want it. A fragmented sample is followed by a
+    /// HEARTBEAT_FRAG when reliable readers are matched.
+    fn send_new(&mut self, sn: SequenceNumber, dest: &[Locator], out: &mut Outbox) {
+        let wid = self.guid.entity_id;
+        let frag = self.params.fragment_size;
+        let Some(c) = self.history.get(sn) else {
+            return;
+        };
+        let split = c.kind != ChangeKind::Alive && !self.key_hash_dest.is_empty();
+        let (full, key_hash): (&[Locator], &[Locator]) = if split {
+            (&self.full_key_dest, &self.key_hash_dest)
+        } else {
+            (dest, &[])
+        };
+        let rid = EntityId::UNKNOWN;
+        let fragments = send_change(out, full, None, rid, wid, c, frag, None, false);
+        send_change(out, key_hash, None, rid, wid, c, frag, None, true);
+        if fragments > 0 && !full.is_empty() && self.has_reliable_proxy() {
+            let full = full.to_vec();
+            let hf = self.heartbeat_frag(rid, sn, fragments);
+            out.push(&full, None, Ts::Any, &hf);
+        }
     }
 
     fn heartbeat(&mut self, reader_id: EntityId, final_flag: bool) -> Submessage<'static> {
@@ -329,7 +390,8 @@ impl Writer {
         if progressed {
             self.update_acked(ev);
             if self.is_acknowledged() {
-                self.hb_due = None;
+                // hb_due stays armed: it lapses when it fires, rather than being re-armed (and the timer
+                // thread woken) by every write of a ping-pong exchange.
                 ev.push_back(Event::WriterAcknowledged {
                     writer: self.guid.entity_id,
                 });
@@ -417,14 +479,18 @@ impl Writer {
     fn repair(&mut self, now: Instant, g: Guid, out: &mut Outbox) {
         let frag = self.params.fragment_size;
         let wid = self.guid.entity_id;
+        let reliable_writer = self.params.reliable;
         let Some(p) = self.proxies.get_mut(&g) else {
             return;
         };
         p.repair_due = None;
         let dest: Vec<Locator> = p.destination().to_vec();
         let dst = Some(g.prefix);
+        let key_hash_only = p.key_hash_only_disposes;
         let mut budget = self.params.max_repair_bytes as isize;
         let mut gaps: Vec<SequenceNumber> = Vec::new();
+        // Fragmented samples sent: each is followed by a HEARTBEAT_FRAG for it (reliable readers).
+        let mut fragmented: Vec<(SequenceNumber, u32)> = Vec::new();
         while budget > 0 {
             let Some(sn) = p.requested.pop_first() else {
                 break;
@@ -432,7 +498,20 @@ impl Writer {
             p.requested_frags.remove(&sn);
             match self.history.get(sn) {
                 Some(c) if sn >= p.floor => {
-                    send_change(out, &dest, dst, g.entity_id, wid, c, frag, None);
+                    let n = send_change(
+                        out,
+                        &dest,
+                        dst,
+                        g.entity_id,
+                        wid,
+                        c,
+                        frag,
+                        None,
+                        key_hash_only,
+                    );
+                    if n > 0 {
+                        fragmented.push((sn, n));
+                    }
                     budget -= c.payload.len() as isize + 64;
                 }
                 _ => gaps.push(sn),
@@ -443,8 +522,34 @@ impl Writer {
                 break;
             };
             if let Some(c) = self.history.get(sn) {
-                send_change(out, &dest, dst, g.entity_id, wid, c, frag, Some(&frags));
+                let n = send_change(
+                    out,
+                    &dest,
+                    dst,
+                    g.entity_id,
+                    wid,
+                    c,
+                    frag,
+                    Some(&frags),
+                    key_hash_only,
+                );
+                if n > 0 {
+                    fragmented.push((sn, n));
+                }
                 budget -= (frags.len() * frag) as isize;
+            }
+        }
+        if reliable_writer && p.reliable {
+            for (sn, n) in fragmented {
+                self.hbfrag_count = self.hbfrag_count.wrapping_add(1);
+                let hf = Submessage::HeartbeatFrag(HeartbeatFrag {
+                    reader_id: g.entity_id,
+                    writer_id: wid,
+                    writer_sn: sn,
+                    last_fragment_num: n,
+                    count: self.hbfrag_count,
+                });
+                out.push(&dest, dst, Ts::Any, &hf);
             }
         }
         send_gaps(out, &dest, dst, g.entity_id, wid, &gaps);
@@ -507,6 +612,9 @@ fn inline_qos(c: &CacheChange, buf: &mut [u8; 28]) -> usize {
 }
 
 /// Sends one change as DATA, or as DATA_FRAGs (all, or the listed fragments) when larger than `frag`.
+/// With `key_hash_only`, a key-only change (dispose/unregister) goes as DATA carrying only its inline QoS
+/// (key hash, status info): no serialized key, neither D nor K flag; the key hash identifies the instance.
+/// Returns the sample's number of fragments when it went as DATA_FRAGs, else 0.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn send_change(
     out: &mut Outbox,
@@ -517,7 +625,11 @@ pub(crate) fn send_change(
     c: &CacheChange,
     frag: usize,
     only: Option<&BTreeSet<u32>>,
-) {
+    key_hash_only: bool,
+) -> u32 {
+    if dest.is_empty() {
+        return 0;
+    }
     let mut qbuf = [0u8; 28];
     let qn = inline_qos(c, &mut qbuf);
     let inline_qos = (qn > 0).then_some(ParameterList {
@@ -526,20 +638,20 @@ pub(crate) fn send_change(
     });
     let ts = Ts::Set(c.source_timestamp);
     let len = c.payload.len();
-    if len <= frag || frag == 0 {
-        let alive = c.kind == ChangeKind::Alive;
-        let payload = (alive || len > 0).then_some(&c.payload[..]);
+    let alive = c.kind == ChangeKind::Alive;
+    if len <= frag || frag == 0 || (key_hash_only && !alive) {
+        let payload = (alive || (len > 0 && !key_hash_only)).then_some(&c.payload[..]);
         let d = Submessage::Data(Data {
             reader_id: rid,
             writer_id: wid,
             writer_sn: c.sn,
             inline_qos,
             payload,
-            key_flag: !alive,
+            key_flag: !alive && payload.is_some(),
             non_standard_flag: false,
         });
         out.push(dest, dst, ts, &d);
-        return;
+        return 0;
     }
     let total = len.div_ceil(frag) as u32;
     let mut send = |f: u32| {
@@ -567,4 +679,5 @@ pub(crate) fn send_change(
         Some(set) => set.iter().for_each(|&f| send(f)),
         None => (1..=total).for_each(send),
     }
+    total
 }

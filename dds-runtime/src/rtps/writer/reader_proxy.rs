@@ -26,6 +26,10 @@ pub struct ReaderProxy {
     pub last_nackfrag: Option<i32>,
     /// When to send requested repairs (and a heartbeat addressed to this reader).
     pub repair_due: Option<Instant>,
+    /// Send dispose/unregister (key-only changes) as DATA with only inline QoS (PID_KEY_HASH,
+    /// PID_STATUS_INFO) and no serialized key. Set for Fast DDS readers: Fast DDS 2.9 copies a key payload of
+    /// up to 16 bytes straight into its instance handle, as if it were the key hash.
+    pub key_hash_only_disposes: bool,
 }
 
 impl ReaderProxy {
@@ -41,7 +45,14 @@ impl ReaderProxy {
             last_acknack: None,
             last_nackfrag: None,
             repair_due: None,
+            key_hash_only_disposes: false,
         }
+    }
+
+    /// Adapts the wire form to what the reader's implementation (its participant's vendor) understands.
+    pub fn for_vendor(mut self, vendor: VendorId) -> Self {
+        self.key_hash_only_disposes = vendor == VendorId::FASTDDS;
+        self
     }
 
     pub fn destination(&self) -> &[Locator] {
