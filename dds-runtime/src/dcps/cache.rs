@@ -2,7 +2,9 @@
 //! and the reader-side QoS (history, resource limits, ownership, time-based filter, lifespan, reader data
 //! lifecycle, deadline). Pure data structure: no locking, no I/O, time comes in as arguments.
 
-use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::collections::{BTreeMap, VecDeque};
+
+use foldhash::{HashMap, HashMapExt};
 use std::time::{Duration, Instant, SystemTime};
 
 use crate::qos::{DataReaderQos, History, Ownership, INFINITE};

@@ -1,7 +1,7 @@
 //! `DomainParticipant`: owns the sans-I/O core, the transport and the timer thread, and routes the core's
 //! events to the typed readers and writers.
 
-use std::collections::HashMap;
+use foldhash::{HashMap, HashMapExt};
 use std::hash::{BuildHasher, Hasher};
 use std::net::{IpAddr, SocketAddr, SocketAddrV4};
 use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU64, AtomicUsize, Ordering};
@@ -12,8 +12,8 @@ use std::time::{Duration, Instant, SystemTime};
 use crate::config::{Config, InterfaceSelection, ParticipantIndex, Peer};
 use crate::qos::{PublisherQos, SubscriberQos, TopicQos};
 use crate::rtps::{
-    EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig, ReceivedSample,
-    Transmit,
+    EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig, Payload,
+    ReceivedSample, Transmit,
 };
 use crate::transport::{Channel, Datagram, UdpTransport};
 
@@ -151,7 +151,7 @@ impl Shared {
         let now = Instant::now();
         let mut batch: Vec<Transmit> = Vec::new();
         let mut deferred: Vec<Event> = Vec::new();
-        let mut touched: Vec<Arc<dyn ReaderSink>> = Vec::new();
+        let mut touched: Vec<(EntityId, Arc<dyn ReaderSink>)> = Vec::new();
         let (r, next_timeout) = {
             let mut core = lock(&self.core);
             // Sent datagram buffers go back to the core for reuse (saves an allocation per datagram).
@@ -185,7 +185,7 @@ impl Shared {
         &self,
         ev: Event,
         deferred: &mut Vec<Event>,
-        touched: &mut Vec<Arc<dyn ReaderSink>>,
+        touched: &mut Vec<(EntityId, Arc<dyn ReaderSink>)>,
     ) {
         let (reader, item) = match ev {
             Event::Sample(s) => (s.reader, Pending::Sample(s)),
@@ -206,11 +206,18 @@ impl Shared {
                 return;
             }
         };
+        // Runs of samples for one reader (the common case) skip the registry lookup.
+        if let Some((id, r)) = touched.last() {
+            if *id == reader {
+                r.enqueue(item);
+                return;
+            }
+        }
         let readers = self.readers.read().unwrap_or_else(|e| e.into_inner());
         if let Some(r) = readers.get(&reader) {
             r.enqueue(item);
-            if !touched.iter().any(|t| Arc::ptr_eq(t, r)) {
-                touched.push(r.clone());
+            if !touched.iter().any(|(id, _)| *id == reader) {
+                touched.push((reader, r.clone()));
             }
         }
     }
@@ -228,7 +235,7 @@ impl Shared {
     fn after_unlock(
         &self,
         deferred: Vec<Event>,
-        touched: Vec<Arc<dyn ReaderSink>>,
+        touched: Vec<(EntityId, Arc<dyn ReaderSink>)>,
         next_timeout: Option<Instant>,
     ) {
         self.bump_progress();
@@ -248,7 +255,7 @@ impl Shared {
         for ev in deferred {
             self.dispatch_event(ev);
         }
-        for r in touched {
+        for (_, r) in touched {
             r.process();
         }
     }
@@ -738,9 +745,14 @@ impl DomainParticipantBuilder {
         let rx = Arc::new(move |_ch: Channel, batch: &[Datagram<'_>]| {
             if let Some(s) = weak.upgrade() {
                 if !s.stopped.load(Ordering::Acquire) {
+                    // One copy per datagram out of the reusable receive buffers; samples share it.
+                    let shared: Vec<Payload> = batch
+                        .iter()
+                        .map(|d| Payload::copy_from_slice(d.data))
+                        .collect();
                     s.with_core(|c, now| {
-                        for d in batch {
-                            c.handle_datagram(now, d.data);
+                        for d in &shared {
+                            c.handle_shared_datagram(now, d);
                         }
                     });
                 }

@@ -1,6 +1,6 @@
 //! `Publisher` and `DataWriter<T>`.
 
-use std::collections::HashMap;
+use foldhash::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard, Weak};
 use std::time::{Duration, Instant, SystemTime};
 

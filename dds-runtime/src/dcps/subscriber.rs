@@ -1,6 +1,8 @@
 //! `Subscriber` and `DataReader<T>`.
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::VecDeque;
+
+use foldhash::{HashMap, HashMapExt};
 use std::pin::Pin;
 use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, Weak};
@@ -109,6 +111,7 @@ impl Subscriber {
             cache: Mutex::new(CacheState {
                 cache,
                 by_hash: HashMap::new(),
+                batch: VecDeque::new(),
             }),
             data_cv: Condvar::new(),
             data_waiters: AtomicUsize::new(0),
@@ -153,6 +156,8 @@ struct CacheState<T> {
     cache: ReaderCache<T>,
     /// Key hash → serialized key, learnt from samples that carried both (for key-hash-only disposes).
     by_hash: HashMap<[u8; 16], Vec<u8>>,
+    /// The queue being processed, swapped with `pending` (one lock round per batch, buffers reused).
+    batch: VecDeque<Pending>,
 }
 
 struct ReaderInner<T: DdsType> {
@@ -655,16 +660,6 @@ impl<T: DdsType> ReaderInner<T> {
         })
     }
 
-    fn decode(
-        &self,
-        s: ReceivedSample,
-        by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
-        now: Instant,
-    ) -> Option<Incoming<T>> {
-        let info = self.shared.remote_writer(&s.writer);
-        decode_change::<T>(s, info, by_hash, now)
-    }
-
     /// Gives the core back the room freed by a take. Under the core lock every delivered sample is either
     /// queued in `pending` or in the cache, so the credit is exact.
     fn refresh_credit(&self) {
@@ -703,8 +698,8 @@ fn decode_change<T: DdsType>(
     info: RemoteWriterInfo,
     by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
     now: Instant,
+    rx_time: SystemTime,
 ) -> Option<Incoming<T>> {
-    let rx_time = SystemTime::now();
     let source_timestamp = system_time(s.source_timestamp);
     let kind = match s.kind {
         ChangeKind::Alive => ChangeKindLocal::Alive,
@@ -796,16 +791,30 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
 
     fn process(self: Arc<Self>) {
         let now = Instant::now();
+        let rx_time = SystemTime::now();
         let mut any = false;
         let mut rejected = Vec::new();
         {
             let mut guard = lock(&self.cache);
             let st = &mut *guard;
-            // Popping under the cache lock keeps the core's order even with several receive threads.
-            while let Some(item) = lock(&self.pending).pop_front() {
+            // Taking the queue under the cache lock keeps the core's order even with several receive threads.
+            let mut batch = std::mem::take(&mut st.batch);
+            std::mem::swap(&mut batch, &mut *lock(&self.pending));
+            // Consecutive samples mostly come from one writer: look its QoS up once per run.
+            let mut writer_info: Option<(Guid, RemoteWriterInfo)> = None;
+            for item in batch.drain(..) {
                 match item {
                     Pending::Sample(s) => {
-                        let Some(inc) = self.decode(s, &mut st.by_hash, now) else {
+                        let info = match writer_info {
+                            Some((g, info)) if g == s.writer => info,
+                            _ => {
+                                let info = self.shared.remote_writer(&s.writer);
+                                writer_info = Some((s.writer, info));
+                                info
+                            }
+                        };
+                        let Some(inc) = decode_change::<T>(s, info, &mut st.by_hash, now, rx_time)
+                        else {
                             continue;
                         };
                         match st.cache.insert(inc, now) {
@@ -817,6 +826,7 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
                     Pending::WriterGone(g) => any |= st.cache.writer_gone(g.to_bytes(), now),
                 }
             }
+            st.batch = batch;
         }
         if !rejected.is_empty() {
             let status = {
@@ -1070,6 +1080,7 @@ mod tests {
             info,
             &mut by_hash,
             now,
+            SystemTime::now(),
         )
         .unwrap();
         assert_eq!(alive.data.as_ref(), Some(&s));
@@ -1079,8 +1090,14 @@ mod tests {
 
         let mut kp = Vec::new();
         cdr::serialize_key(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut kp).unwrap();
-        let d =
-            decode_change::<K>(rs(ChangeKind::Dispose, kp, None), info, &mut by_hash, now).unwrap();
+        let d = decode_change::<K>(
+            rs(ChangeKind::Dispose, kp, None),
+            info,
+            &mut by_hash,
+            now,
+            SystemTime::now(),
+        )
+        .unwrap();
         assert_eq!(d.key, expected, "by key payload");
         assert_eq!(d.kind, ChangeKindLocal::Dispose);
 
@@ -1089,18 +1106,19 @@ mod tests {
             info,
             &mut by_hash,
             now,
+            SystemTime::now(),
         )
         .unwrap();
         assert_eq!(u.key, expected, "by a key hash seen before");
 
         let unknown = rs(ChangeKind::Dispose, Vec::new(), Some([9; 16]));
-        assert!(decode_change::<K>(unknown, info, &mut by_hash, now).is_none());
+        assert!(decode_change::<K>(unknown, info, &mut by_hash, now, SystemTime::now()).is_none());
         let garbage = rs(
             ChangeKind::Alive,
             vec![0, 7, 0, 0, 0xff, 0xff, 0xff, 0x7f],
             None,
         );
-        assert!(decode_change::<K>(garbage, info, &mut by_hash, now).is_none());
+        assert!(decode_change::<K>(garbage, info, &mut by_hash, now, SystemTime::now()).is_none());
     }
 
     /// Fast DDS disposes with only PID_KEY_HASH; the alive samples before may have come without one.
@@ -1118,13 +1136,21 @@ mod tests {
             let mut by_hash = HashMap::new();
             let mut buf = Vec::new();
             cdr::serialize(&s, version, ByteOrder::NATIVE, &mut buf).unwrap();
-            decode_change::<K>(rs(ChangeKind::Alive, buf, None), info, &mut by_hash, now).unwrap();
+            decode_change::<K>(
+                rs(ChangeKind::Alive, buf, None),
+                info,
+                &mut by_hash,
+                now,
+                SystemTime::now(),
+            )
+            .unwrap();
             let kh = cdr::key_hash(&s, version).unwrap();
             let d = decode_change::<K>(
                 rs(ChangeKind::Dispose, Vec::new(), Some(kh)),
                 info,
                 &mut by_hash,
                 now,
+                SystemTime::now(),
             )
             .expect("dispose mapped through the computed key hash");
             assert_eq!(d.key, expected);

@@ -31,6 +31,25 @@ impl Payload {
     pub fn copy_from_slice(b: &[u8]) -> Self {
         Payload::new(Arc::<[u8]>::from(b))
     }
+    /// `part` as a sub-range of `whole` when it lies inside it (no copy), else a copy of `part`.
+    pub fn share_or_copy(whole: Option<&Payload>, part: &[u8]) -> Payload {
+        if let Some(w) = whole {
+            let base = w.as_ptr() as usize;
+            let start = part.as_ptr() as usize;
+            if start >= base && start + part.len() <= base + w.len() {
+                return w.slice(start - base..start - base + part.len());
+            }
+        }
+        Payload::copy_from_slice(part)
+    }
+    /// The same bytes, copied into a buffer of their own if they are a slice of a larger one, so that
+    /// keeping them does not keep the rest alive.
+    pub fn compact(self) -> Payload {
+        match &self.buf {
+            Some(b) if b.len() > self.len() => Payload::copy_from_slice(&self),
+            _ => self,
+        }
+    }
     /// A sub-range sharing the same buffer; clamps out-of-range bounds.
     pub fn slice(&self, range: std::ops::Range<usize>) -> Payload {
         let end = (self.start + range.end).min(self.end);
@@ -421,4 +440,37 @@ pub enum WriteError {
     TooLarge(usize),
     #[error("keyed writer needs a key hash")]
     MissingKeyHash,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Payload;
+
+    #[test]
+    fn share_or_copy_shares_only_what_lies_inside() {
+        let whole = Payload::from(vec![1u8, 2, 3, 4, 5, 6]);
+        let inside = Payload::share_or_copy(Some(&whole), &whole[2..5]);
+        assert_eq!(&inside[..], &[3, 4, 5]);
+        assert_eq!(inside.as_ptr(), whole[2..].as_ptr(), "no copy");
+        let elsewhere = [3u8, 4, 5];
+        let copied = Payload::share_or_copy(Some(&whole), &elsewhere);
+        assert_eq!(&copied[..], &[3, 4, 5]);
+        assert_ne!(copied.as_ptr(), elsewhere.as_ptr());
+        assert_eq!(&Payload::share_or_copy(None, &whole[..2])[..], &[1, 2]);
+    }
+
+    #[test]
+    fn compact_drops_the_rest_of_the_buffer() {
+        let whole = Payload::from(vec![9u8; 1000]);
+        let part = whole.slice(10..20);
+        let compacted = part.clone().compact();
+        assert_eq!(compacted, part);
+        assert_ne!(compacted.as_ptr(), part.as_ptr());
+        let alone = Payload::from(vec![7u8; 10]);
+        assert_eq!(
+            alone.clone().compact().as_ptr(),
+            alone.as_ptr(),
+            "already compact"
+        );
+    }
 }

@@ -7,7 +7,9 @@ mod receive;
 mod timers;
 
 use std::cell::Cell;
-use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet, VecDeque};
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
+
+use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
 use std::time::Instant;
 
 use super::api::*;
@@ -50,6 +52,9 @@ pub struct Participant {
     spdp_payload: Vec<u8>,
     spdp_due: Instant,
     pmd_due: Instant,
+    /// Local readers matched with a remote writer, for DATA addressed to any reader (ENTITYID_UNKNOWN). Cleared
+    /// whenever a reader gains a writer; ids of readers that lost it are skipped by a `has_proxy` check.
+    readers_by_writer: HashMap<Guid, Vec<EntityId>>,
     /// A lower bound on every timer (`None`: unknown), so that traffic does not rescan every endpoint.
     timer_floor: Cell<Option<Instant>>,
     last_full_scan: Instant,
@@ -111,6 +116,7 @@ impl Participant {
             spdp_payload: Vec::new(),
             spdp_due: now,
             pmd_due: now,
+            readers_by_writer: HashMap::new(),
             timer_floor: Cell::new(None),
             last_full_scan: now,
             config,
@@ -231,9 +237,9 @@ impl Participant {
             high_watermark: c.whc_high_watermark.max(1),
             low_watermark: c.whc_low_watermark.min(c.whc_high_watermark),
             max_repair_bytes: c.max_repair_bytes,
-            // Batched: about one heartbeat per datagram rather than one per sample.
+            // Batched: about one heartbeat per full datagram rather than one per sample.
             piggyback_heartbeat_bytes: if c.write_batch_delay.is_some() {
-                c.max_message_size / 2
+                c.max_message_size
             } else {
                 0
             },

@@ -125,6 +125,7 @@ impl Participant {
                         now,
                         WriterProxy::new(Guid::new(prefix, theirs), meta.clone(), true),
                     );
+                    self.readers_by_writer.clear();
                 }
             }
         }
@@ -138,6 +139,7 @@ impl Participant {
         if self.participants.remove(&prefix).is_none() {
             return;
         }
+        self.readers_by_writer.retain(|w, _| w.prefix != prefix);
         for (ours, theirs, _) in builtin::WRITER_PAIRS {
             if let Some(w) = self.writers.get_mut(&ours) {
                 w.remove_proxy(&Guid::new(prefix, theirs), &mut self.events);
@@ -422,6 +424,7 @@ impl Participant {
             MatchResult::Match => {
                 if !has {
                     r.add_proxy(now, WriterProxy::new(writer, locators, reliable));
+                    self.readers_by_writer.clear();
                     self.events.push_back(Event::SubscriptionMatched {
                         reader: rid,
                         writer,
@@ -455,6 +458,7 @@ impl Participant {
     /// A publication is gone: unmatch it from local readers.
     pub(super) fn forget_writer(&mut self, g: Guid) {
         self.known_writers.remove(&g);
+        self.readers_by_writer.remove(&g);
         for (id, r) in self.readers.iter_mut() {
             if self.user_readers.contains(id) && r.remove_proxy(&g) {
                 self.events.push_back(Event::SubscriptionMatched {

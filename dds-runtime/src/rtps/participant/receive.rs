@@ -1,12 +1,15 @@
 //! Incoming datagrams: the receiver state (§8.3.4) and dispatch of submessages to writers and readers.
 
+use std::collections::BTreeMap;
 use std::time::Instant;
+
+use foldhash::HashMap;
 
 use tracing::{debug, trace};
 
 use super::timers::lower_floor;
 use super::Participant;
-use crate::rtps::api::Event;
+use crate::rtps::api::{Event, Payload};
 use crate::rtps::messages::{MessageIter, Submessage};
 use crate::rtps::reader::Reader;
 use crate::rtps::types::*;
@@ -14,6 +17,16 @@ use crate::rtps::types::*;
 impl Participant {
     /// Processes one datagram. Never panics; malformed input is dropped with a `tracing` event.
     pub fn handle_datagram(&mut self, now: Instant, data: &[u8]) {
+        self.receive(now, data, None);
+    }
+
+    /// Like [`handle_datagram`](Self::handle_datagram), for a datagram already in shared memory: delivered
+    /// samples share its buffer rather than copying their payloads out of it.
+    pub fn handle_shared_datagram(&mut self, now: Instant, datagram: &Payload) {
+        self.receive(now, datagram, Some(datagram));
+    }
+
+    fn receive(&mut self, now: Instant, data: &[u8], shared: Option<&Payload>) {
         let (header, subs) = match MessageIter::parse(data) {
             Ok(x) => x,
             Err(e) => {
@@ -50,41 +63,65 @@ impl Participant {
                         self.timers_changed();
                     } else {
                         let scratch = &mut self.scratch;
-                        for_readers(&mut self.readers, d.reader_id, wguid, |r| {
-                            r.on_data(wguid, &d, ts, scratch)
-                        });
+                        for_readers(
+                            &mut self.readers,
+                            &mut self.readers_by_writer,
+                            d.reader_id,
+                            wguid,
+                            |r| r.on_data(wguid, &d, ts, shared, scratch),
+                        );
                     }
                 }
                 Submessage::DataFrag(d) => {
                     let wguid = Guid::new(src, d.writer_id);
                     let scratch = &mut self.scratch;
-                    for_readers(&mut self.readers, d.reader_id, wguid, |r| {
-                        r.on_data_frag(wguid, &d, ts, scratch)
-                    });
+                    for_readers(
+                        &mut self.readers,
+                        &mut self.readers_by_writer,
+                        d.reader_id,
+                        wguid,
+                        |r| r.on_data_frag(wguid, &d, ts, scratch),
+                    );
                 }
                 Submessage::Heartbeat(h) => {
                     let wguid = Guid::new(src, h.writer_id);
                     let scratch = &mut self.scratch;
                     let armed = &self.timer_floor;
-                    for_readers(&mut self.readers, h.reader_id, wguid, |r| {
-                        r.on_heartbeat(now, wguid, &h, scratch);
-                        lower_floor(armed, r.next_timeout());
-                    });
+                    for_readers(
+                        &mut self.readers,
+                        &mut self.readers_by_writer,
+                        h.reader_id,
+                        wguid,
+                        |r| {
+                            r.on_heartbeat(now, wguid, &h, scratch);
+                            lower_floor(armed, r.next_timeout());
+                        },
+                    );
                 }
                 Submessage::Gap(g) => {
                     let wguid = Guid::new(src, g.writer_id);
                     let scratch = &mut self.scratch;
-                    for_readers(&mut self.readers, g.reader_id, wguid, |r| {
-                        r.on_gap(wguid, &g, scratch)
-                    });
+                    for_readers(
+                        &mut self.readers,
+                        &mut self.readers_by_writer,
+                        g.reader_id,
+                        wguid,
+                        |r| r.on_gap(wguid, &g, scratch),
+                    );
                 }
                 Submessage::HeartbeatFrag(h) => {
                     let wguid = Guid::new(src, h.writer_id);
                     let armed = &self.timer_floor;
-                    for_readers(&mut self.readers, h.reader_id, wguid, |r| {
-                        r.on_heartbeat_frag(now, wguid, &h);
-                        lower_floor(armed, r.next_timeout());
-                    });
+                    for_readers(
+                        &mut self.readers,
+                        &mut self.readers_by_writer,
+                        h.reader_id,
+                        wguid,
+                        |r| {
+                            r.on_heartbeat_frag(now, wguid, &h);
+                            lower_floor(armed, r.next_timeout());
+                        },
+                    );
                 }
                 Submessage::AckNack(a) => {
                     if let Some(w) = self.writers.get_mut(&a.writer_id) {
@@ -131,9 +168,12 @@ impl Participant {
     }
 }
 
-/// Runs `f` on the addressed reader, or on every reader matched with `writer` when the reader id is UNKNOWN.
+/// Runs `f` on the addressed reader, or on every reader matched with `writer` when the reader id is UNKNOWN
+/// (looked up through `index`, which is filled here and only for writers some reader is matched with, so that
+/// unknown writers cannot grow it).
 fn for_readers(
-    readers: &mut std::collections::BTreeMap<EntityId, Reader>,
+    readers: &mut BTreeMap<EntityId, Reader>,
+    index: &mut HashMap<Guid, Vec<EntityId>>,
     reader_id: EntityId,
     writer: Guid,
     mut f: impl FnMut(&mut Reader),
@@ -146,9 +186,22 @@ fn for_readers(
         }
         return;
     }
-    for r in readers.values_mut() {
-        if r.has_proxy(&writer) {
-            f(r);
+    if !index.contains_key(&writer) {
+        let ids: Vec<EntityId> = readers
+            .iter()
+            .filter(|(_, r)| r.has_proxy(&writer))
+            .map(|(id, _)| *id)
+            .collect();
+        if ids.is_empty() {
+            return;
+        }
+        index.insert(writer, ids);
+    }
+    for id in &index[&writer] {
+        if let Some(r) = readers.get_mut(id) {
+            if r.has_proxy(&writer) {
+                f(r);
+            }
         }
     }
 }

@@ -187,6 +187,14 @@ impl Reader {
                     && p.reorder_bytes + size <= self.params.reorder_max_bytes
                 {
                     p.reorder_bytes += size;
+                    // Held for a while: it must not pin the whole datagram it arrived in.
+                    let slot = match slot {
+                        Slot::Change(mut c) => {
+                            c.payload = c.payload.compact();
+                            Slot::Change(c)
+                        }
+                        other => other,
+                    };
                     p.reorder.insert(sn, slot);
                 }
             }
@@ -208,15 +216,37 @@ impl Reader {
         p.drop_stale_defrag();
     }
 
-    pub fn on_data(&mut self, writer: Guid, d: &Data<'_>, ts: Option<Time>, out: &mut Vec<Event>) {
-        let Some(mut p) = self.proxies.remove(&writer) else {
-            return;
-        };
+    /// A DATA from `writer`. `datagram`, when given, is the shared buffer `d` was parsed from: the sample's
+    /// payload then shares it instead of being copied.
+    pub fn on_data(
+        &mut self,
+        writer: Guid,
+        d: &Data<'_>,
+        ts: Option<Time>,
+        datagram: Option<&Payload>,
+        out: &mut Vec<Event>,
+    ) {
+        // Taken out (O(1)) rather than removed and re-inserted, so that `accept` may borrow `self`.
+        let mut proxies = std::mem::take(&mut self.proxies);
+        if let Some(p) = proxies.get_mut(&writer) {
+            self.data(p, writer, d, ts, datagram, out);
+        }
+        self.proxies = proxies;
+    }
+
+    fn data(
+        &self,
+        p: &mut WriterProxy,
+        writer: Guid,
+        d: &Data<'_>,
+        ts: Option<Time>,
+        datagram: Option<&Payload>,
+        out: &mut Vec<Event>,
+    ) {
         if !inline_qos_understood(d.inline_qos.as_ref()) {
             // §9.4.2.11: a sample with a must-understand parameter we do not know is dropped; the sequence
             // number is consumed so a reliable stream does not stall on it.
-            self.accept(&mut p, d.writer_sn, Slot::Irrelevant, out);
-            self.proxies.insert(writer, p);
+            self.accept(p, d.writer_sn, Slot::Irrelevant, out);
             return;
         }
         let status = d.inline_qos.and_then(|q| q.status_info());
@@ -235,13 +265,14 @@ impl Reader {
             None if kind == ChangeKind::Alive => Slot::Irrelevant,
             b => Slot::Change(PendingChange {
                 kind,
-                payload: b.map(Payload::copy_from_slice).unwrap_or_default(),
+                payload: b
+                    .map(|b| Payload::share_or_copy(datagram, b))
+                    .unwrap_or_default(),
                 key_hash,
                 source_timestamp: ts,
             }),
         };
-        self.accept(&mut p, d.writer_sn, slot, out);
-        self.proxies.insert(writer, p);
+        self.accept(p, d.writer_sn, slot, out);
     }
 
     pub fn on_data_frag(
@@ -251,11 +282,11 @@ impl Reader {
         ts: Option<Time>,
         out: &mut Vec<Event>,
     ) {
-        let Some(mut p) = self.proxies.remove(&writer) else {
-            return;
-        };
-        self.data_frag(&mut p, d, ts, out);
-        self.proxies.insert(writer, p);
+        let mut proxies = std::mem::take(&mut self.proxies);
+        if let Some(p) = proxies.get_mut(&writer) {
+            self.data_frag(p, d, ts, out);
+        }
+        self.proxies = proxies;
     }
 
     fn data_frag(

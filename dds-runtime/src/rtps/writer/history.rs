@@ -1,6 +1,8 @@
 //! The writer history cache: changes by sequence number, with KEEP_LAST per instance and resource limits.
 
-use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::collections::{BTreeMap, VecDeque};
+
+use foldhash::{HashMap, HashMapExt};
 
 use crate::qos::{History, ResourceLimits};
 use crate::rtps::api::{ChangeKind, Payload};

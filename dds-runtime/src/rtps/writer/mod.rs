@@ -238,9 +238,10 @@ impl Writer {
             if self.has_reliable_proxy() {
                 self.bytes_since_nonfinal_hb += len;
                 self.bytes_since_hb += len;
-                // Ask for acknowledgements now and then so flow control keeps moving without waiting for the
-                // periodic heartbeat; otherwise the piggy-backed heartbeat only announces.
-                let final_flag = self.bytes_since_nonfinal_hb < self.params.low_watermark / 4;
+                // Ask for acknowledgements every quarter of the high watermark, so that flow control keeps
+                // moving without waiting for the periodic heartbeat (and without an ACKNACK per datagram);
+                // otherwise the piggy-backed heartbeat only announces.
+                let final_flag = self.bytes_since_nonfinal_hb < self.params.high_watermark / 4;
                 if !final_flag || self.bytes_since_hb >= self.params.piggyback_heartbeat_bytes {
                     if !final_flag {
                         self.bytes_since_nonfinal_hb = 0;
