@@ -1,5 +1,6 @@
 //! Incoming datagrams: the receiver state (§8.3.4) and dispatch of submessages to writers and readers.
 
+use std::collections::hash_map::Entry;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -186,18 +187,21 @@ fn for_readers(
         }
         return;
     }
-    if !index.contains_key(&writer) {
-        let ids: Vec<EntityId> = readers
-            .iter()
-            .filter(|(_, r)| r.has_proxy(&writer))
-            .map(|(id, _)| *id)
-            .collect();
-        if ids.is_empty() {
-            return;
+    let ids = match index.entry(writer) {
+        Entry::Occupied(e) => e.into_mut(),
+        Entry::Vacant(e) => {
+            let ids: Vec<EntityId> = readers
+                .iter()
+                .filter(|(_, r)| r.has_proxy(&writer))
+                .map(|(id, _)| *id)
+                .collect();
+            if ids.is_empty() {
+                return;
+            }
+            e.insert(ids)
         }
-        index.insert(writer, ids);
-    }
-    for id in &index[&writer] {
+    };
+    for id in ids.iter() {
         if let Some(r) = readers.get_mut(id) {
             if r.has_proxy(&writer) {
                 f(r);
