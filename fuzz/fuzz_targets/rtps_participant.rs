@@ -102,7 +102,9 @@ fuzz_target!(|data: &[u8]| {
         let mut msg = b"RTPS\x02\x05\x01\x10".to_vec();
         msg.extend_from_slice(&PEER.0);
         msg.extend_from_slice(chunk);
+        // Both receive paths: copying payloads out, and samples sharing the datagram's buffer.
         p.handle_datagram(now, &msg);
+        p.handle_shared_datagram(now, &Payload::from(msg));
         p.handle_datagram(now, chunk);
     }
     let later = now + Duration::from_secs(1);

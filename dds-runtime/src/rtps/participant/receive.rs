@@ -86,18 +86,9 @@ impl Participant {
                 }
                 Submessage::Heartbeat(h) => {
                     let wguid = Guid::new(src, h.writer_id);
-                    let scratch = &mut self.scratch;
-                    let armed = &self.timer_floor;
-                    for_readers(
-                        &mut self.readers,
-                        &mut self.readers_by_writer,
-                        h.reader_id,
-                        wguid,
-                        |r| {
-                            r.on_heartbeat(now, wguid, &h, scratch);
-                            lower_floor(armed, r.next_timeout());
-                        },
-                    );
+                    self.for_readers_arming(h.reader_id, wguid, |r, scratch| {
+                        r.on_heartbeat(now, wguid, &h, scratch)
+                    });
                 }
                 Submessage::Gap(g) => {
                     let wguid = Guid::new(src, g.writer_id);
@@ -112,17 +103,9 @@ impl Participant {
                 }
                 Submessage::HeartbeatFrag(h) => {
                     let wguid = Guid::new(src, h.writer_id);
-                    let armed = &self.timer_floor;
-                    for_readers(
-                        &mut self.readers,
-                        &mut self.readers_by_writer,
-                        h.reader_id,
-                        wguid,
-                        |r| {
-                            r.on_heartbeat_frag(now, wguid, &h);
-                            lower_floor(armed, r.next_timeout());
-                        },
-                    );
+                    self.for_readers_arming(h.reader_id, wguid, |r, _| {
+                        r.on_heartbeat_frag(now, wguid, &h)
+                    });
                 }
                 Submessage::AckNack(a) => {
                     if let Some(w) = self.writers.get_mut(&a.writer_id) {
@@ -147,6 +130,27 @@ impl Participant {
             self.route_deliveries(now);
         }
         self.service(now);
+    }
+
+    /// `for_readers` for a submessage that may arm reader timers: the timer floor follows.
+    fn for_readers_arming(
+        &mut self,
+        reader_id: EntityId,
+        writer: Guid,
+        mut f: impl FnMut(&mut Reader, &mut Vec<Event>),
+    ) {
+        let scratch = &mut self.scratch;
+        let floor = &self.timer_floor;
+        for_readers(
+            &mut self.readers,
+            &mut self.readers_by_writer,
+            reader_id,
+            writer,
+            |r| {
+                f(r, scratch);
+                lower_floor(floor, r.next_timeout());
+            },
+        );
     }
 
     /// Hands what readers delivered to discovery (builtin readers) or to the application (events).

@@ -552,22 +552,15 @@ impl Reader {
             if *sn > p.hb_last {
                 break;
             }
-            let missing = d.missing(d.total());
-            let Some(&first) = missing.first() else {
+            let Some(nf) = nack_frag(
+                rid,
+                p.guid,
+                &mut p.nackfrag_count,
+                *sn,
+                &d.missing(d.total()),
+            ) else {
                 continue;
             };
-            let mut fs = FragmentNumberSet::empty(first);
-            missing.iter().for_each(|&f| {
-                fs.insert(f);
-            });
-            p.nackfrag_count = p.nackfrag_count.wrapping_add(1);
-            let nf = Submessage::NackFrag(NackFrag {
-                reader_id: rid,
-                writer_id: p.guid.entity_id,
-                writer_sn: *sn,
-                fragment_number_state: fs,
-                count: p.nackfrag_count,
-            });
             out.push(&dest, dst, Ts::Any, &nf);
             // Already asked for all it lacks: a pending HEARTBEAT_FRAG answer for it is redundant.
             p.nackfrag_req.remove(sn);
@@ -585,23 +578,32 @@ impl Reader {
             let Some(d) = p.defrag.get(&sn) else {
                 continue;
             };
-            let missing = d.missing(last);
-            let Some(&first) = missing.first() else {
-                continue;
-            };
-            let mut fs = FragmentNumberSet::empty(first);
-            missing.iter().for_each(|&f| {
-                fs.insert(f);
-            });
-            p.nackfrag_count = p.nackfrag_count.wrapping_add(1);
-            let nf = Submessage::NackFrag(NackFrag {
-                reader_id: rid,
-                writer_id: p.guid.entity_id,
-                writer_sn: sn,
-                fragment_number_state: fs,
-                count: p.nackfrag_count,
-            });
-            out.push(&dest, dst, Ts::Any, &nf);
+            if let Some(nf) = nack_frag(rid, p.guid, &mut p.nackfrag_count, sn, &d.missing(last)) {
+                out.push(&dest, dst, Ts::Any, &nf);
+            }
         }
     }
+}
+
+/// A NACK_FRAG asking `writer` for the `missing` fragments of `sn` (counted), or `None` when none is missing.
+fn nack_frag(
+    rid: EntityId,
+    writer: Guid,
+    count: &mut i32,
+    sn: SequenceNumber,
+    missing: &[u32],
+) -> Option<Submessage<'static>> {
+    let (&first, _) = missing.split_first()?;
+    let mut fs = FragmentNumberSet::empty(first);
+    missing.iter().for_each(|&f| {
+        fs.insert(f);
+    });
+    *count = count.wrapping_add(1);
+    Some(Submessage::NackFrag(NackFrag {
+        reader_id: rid,
+        writer_id: writer.entity_id,
+        writer_sn: sn,
+        fragment_number_state: fs,
+        count: *count,
+    }))
 }

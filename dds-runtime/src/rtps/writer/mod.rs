@@ -492,6 +492,22 @@ impl Writer {
         let mut gaps: Vec<SequenceNumber> = Vec::new();
         // Fragmented samples sent: each is followed by a HEARTBEAT_FRAG for it (reliable readers).
         let mut fragmented: Vec<(SequenceNumber, u32)> = Vec::new();
+        let mut resend = |c: &CacheChange, only: Option<&BTreeSet<u32>>| {
+            let n = send_change(
+                out,
+                &dest,
+                dst,
+                g.entity_id,
+                wid,
+                c,
+                frag,
+                only,
+                key_hash_only,
+            );
+            if n > 0 {
+                fragmented.push((c.sn, n));
+            }
+        };
         while budget > 0 {
             let Some(sn) = p.requested.pop_first() else {
                 break;
@@ -499,20 +515,7 @@ impl Writer {
             p.requested_frags.remove(&sn);
             match self.history.get(sn) {
                 Some(c) if sn >= p.floor => {
-                    let n = send_change(
-                        out,
-                        &dest,
-                        dst,
-                        g.entity_id,
-                        wid,
-                        c,
-                        frag,
-                        None,
-                        key_hash_only,
-                    );
-                    if n > 0 {
-                        fragmented.push((sn, n));
-                    }
+                    resend(c, None);
                     budget -= c.payload.len() as isize + 64;
                 }
                 _ => gaps.push(sn),
@@ -523,20 +526,7 @@ impl Writer {
                 break;
             };
             if let Some(c) = self.history.get(sn) {
-                let n = send_change(
-                    out,
-                    &dest,
-                    dst,
-                    g.entity_id,
-                    wid,
-                    c,
-                    frag,
-                    Some(&frags),
-                    key_hash_only,
-                );
-                if n > 0 {
-                    fragmented.push((sn, n));
-                }
+                resend(c, Some(&frags));
                 budget -= (frags.len() * frag) as isize;
             }
         }
