@@ -1,4 +1,4 @@
-//! Interoperability tests: our release binaries (`shape_main`, `dds-perf`) against Cyclone DDS (python
+//! Interoperability tests: our release binaries (`shapes`, `shape_main`, `dds-perf`) against Cyclone DDS (python
 //! `cyclonedds` 11), Fast DDS 2.9 (C++ peer in tests/peers/fastdds) and Cyclone's `ddsperf` 0.10.2, plus a
 //! tshark dissection check of our traffic.
 //!
@@ -9,6 +9,7 @@
 mod interop {
     pub mod ddsperf;
     pub mod harness;
+    pub mod main_job;
     pub mod shapes;
     pub mod tshark;
 }

@@ -26,16 +26,19 @@ struct Args {
     count: Option<u64>,
     rate_hz: f64,
     quiet: bool,
+    /// Data representation written: XCDR1 by default, like the OMG suite's shape_main (`-x 1`).
+    xcdr2: bool,
 }
 
 const USAGE: &str =
     "usage: shapes [--pub-only | --sub-only] [-t|--topic NAME] [-c|--color COLOR]...
-              [-d|--domain ID] [--duration SECS] [--count N] [--rate HZ] [-q|--quiet]
+              [-d|--domain ID] [--duration SECS] [--count N] [--rate HZ] [-x|--xcdr 1|2] [-q|--quiet]
 
   Runs a publisher of bouncing shapes and a subscriber in one process (two participants, real RTPS)
   and prints what the subscriber receives. Defaults: topic Square, colors BLUE and RED, domain 0,
   10 samples/s per color, stops after 10 s (or after N received samples with --count) and prints a
-  summary. --quiet prints only the summary.";
+  summary. Samples are written in XCDR1 (-x 2: XCDR2), as shape_main does; the subscriber accepts
+  both. --quiet prints only the summary.";
 
 fn parse_args(argv: &[String]) -> Result<Option<Args>, String> {
     let mut a = Args {
@@ -48,6 +51,7 @@ fn parse_args(argv: &[String]) -> Result<Option<Args>, String> {
         count: None,
         rate_hz: 10.0,
         quiet: false,
+        xcdr2: false,
     };
     let mut it = argv.iter();
     while let Some(arg) = it.next() {
@@ -66,6 +70,13 @@ fn parse_args(argv: &[String]) -> Result<Option<Args>, String> {
             "--pub-only" | "--pub" => a.subscribe = false,
             "--sub-only" | "--sub" => a.publish = false,
             "-q" | "--quiet" => a.quiet = true,
+            "-x" | "--xcdr" => {
+                a.xcdr2 = match value("--xcdr")?.as_str() {
+                    "1" => false,
+                    "2" => true,
+                    _ => return Err("--xcdr must be 1 or 2".into()),
+                }
+            }
             "-t" | "--topic" => a.topic = value("--topic")?,
             "-c" | "--color" => a.colors.push(value("--color")?),
             "-d" | "--domain" => {
@@ -186,10 +197,18 @@ fn run(a: &Args) -> DdsResult<u8> {
     let reliable = DataWriterQos::builder()
         .reliability(Reliability::RELIABLE)
         .history(History::KeepLast(1))
+        .data_representation(if a.xcdr2 {
+            DataRepresentation::xcdr2()
+        } else {
+            DataRepresentation::xcdr1()
+        })
         .build();
+    let both =
+        DataRepresentation([DataRepresentation::xcdr1().0, DataRepresentation::xcdr2().0].concat());
     let reader_qos = DataReaderQos::builder()
         .reliability(Reliability::RELIABLE)
         .history(History::KeepLast(8))
+        .data_representation(both)
         .build();
 
     // Separate participants: what the subscriber prints has gone through the stack's sockets.
