@@ -98,6 +98,8 @@ pub(crate) struct ReaderCache<T> {
     keyed: bool,
     instances: BTreeMap<InstanceHandle, Instance<T>>,
     by_key: HashMap<Vec<u8>, InstanceHandle>,
+    /// The key buffer of the last sample of a known instance, for the next sample's key.
+    spare_key: Vec<u8>,
     next_handle: u64,
     next_seq: u64,
     total: usize,
@@ -115,6 +117,7 @@ impl<T> ReaderCache<T> {
             keyed,
             instances: BTreeMap::new(),
             by_key: HashMap::new(),
+            spare_key: Vec::new(),
             next_handle: 1,
             next_seq: 0,
             total: 0,
@@ -177,6 +180,13 @@ impl<T> ReaderCache<T> {
     }
 
     /// Applies one change. `now` is the monotonic time of reception.
+    /// An empty buffer for the next sample's instance key (reusing the last one's allocation).
+    pub fn take_key_buffer(&mut self) -> Vec<u8> {
+        let mut k = std::mem::take(&mut self.spare_key);
+        k.clear();
+        k
+    }
+
     pub fn insert(&mut self, mut inc: Incoming<T>, now: Instant) -> Outcome {
         let alive = inc.kind == ChangeKindLocal::Alive;
         if alive {
@@ -192,7 +202,11 @@ impl<T> ReaderCache<T> {
             Vec::new()
         };
         let handle = match self.by_key.get(&key) {
-            Some(h) => *h,
+            Some(h) => {
+                let h = *h;
+                self.spare_key = key;
+                h
+            }
             None if !alive && inc.kind == ChangeKindLocal::Unregister => return Outcome::Filtered,
             None => {
                 let holder = inc.key_holder.take();

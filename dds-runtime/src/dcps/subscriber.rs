@@ -697,6 +697,7 @@ fn decode_change<T: DdsType>(
     s: ReceivedSample,
     info: RemoteWriterInfo,
     by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
+    mut key: Vec<u8>,
     now: Instant,
     rx_time: SystemTime,
 ) -> Option<Incoming<T>> {
@@ -707,7 +708,7 @@ fn decode_change<T: DdsType>(
         ChangeKind::Unregister => ChangeKindLocal::Unregister,
         ChangeKind::DisposeUnregister => ChangeKindLocal::DisposeUnregister,
     };
-    let mut key = Vec::new();
+    key.clear();
     let mut data = None;
     let mut key_holder = None;
     if kind == ChangeKindLocal::Alive {
@@ -813,7 +814,9 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
                                 info
                             }
                         };
-                        let Some(inc) = decode_change::<T>(s, info, &mut st.by_hash, now, rx_time)
+                        let key = st.cache.take_key_buffer();
+                        let Some(inc) =
+                            decode_change::<T>(s, info, &mut st.by_hash, key, now, rx_time)
                         else {
                             continue;
                         };
@@ -1079,6 +1082,7 @@ mod tests {
             rs(ChangeKind::Alive, buf, Some(kh)),
             info,
             &mut by_hash,
+            Vec::new(),
             now,
             SystemTime::now(),
         )
@@ -1094,6 +1098,7 @@ mod tests {
             rs(ChangeKind::Dispose, kp, None),
             info,
             &mut by_hash,
+            Vec::new(),
             now,
             SystemTime::now(),
         )
@@ -1105,6 +1110,7 @@ mod tests {
             rs(ChangeKind::Unregister, Vec::new(), Some(kh)),
             info,
             &mut by_hash,
+            Vec::new(),
             now,
             SystemTime::now(),
         )
@@ -1112,13 +1118,29 @@ mod tests {
         assert_eq!(u.key, expected, "by a key hash seen before");
 
         let unknown = rs(ChangeKind::Dispose, Vec::new(), Some([9; 16]));
-        assert!(decode_change::<K>(unknown, info, &mut by_hash, now, SystemTime::now()).is_none());
+        assert!(decode_change::<K>(
+            unknown,
+            info,
+            &mut by_hash,
+            Vec::new(),
+            now,
+            SystemTime::now()
+        )
+        .is_none());
         let garbage = rs(
             ChangeKind::Alive,
             vec![0, 7, 0, 0, 0xff, 0xff, 0xff, 0x7f],
             None,
         );
-        assert!(decode_change::<K>(garbage, info, &mut by_hash, now, SystemTime::now()).is_none());
+        assert!(decode_change::<K>(
+            garbage,
+            info,
+            &mut by_hash,
+            Vec::new(),
+            now,
+            SystemTime::now()
+        )
+        .is_none());
     }
 
     /// Fast DDS disposes with only PID_KEY_HASH; the alive samples before may have come without one.
@@ -1140,6 +1162,7 @@ mod tests {
                 rs(ChangeKind::Alive, buf, None),
                 info,
                 &mut by_hash,
+                Vec::new(),
                 now,
                 SystemTime::now(),
             )
@@ -1149,6 +1172,7 @@ mod tests {
                 rs(ChangeKind::Dispose, Vec::new(), Some(kh)),
                 info,
                 &mut by_hash,
+                Vec::new(),
                 now,
                 SystemTime::now(),
             )
