@@ -688,8 +688,9 @@ fn publisher<T: PerfSample>(ctx: &Ctx<T>, w: &DataWriter<T>) {
             rnd ^= rnd << 17;
             (rnd >> 11) as f64 / (1u64 << 53) as f64 <= o.ping_fraction
         };
-        let t0 = Instant::now();
-        let stamp = (now_ns() & !1) | i64::from(want_pong);
+        // One clock read for the timestamp and one after the write give the write's duration.
+        let t0 = now_ns();
+        let stamp = (t0 & !1) | i64::from(want_pong);
         match w.write_w_timestamp(&sample, ts(stamp)) {
             Ok(()) => {}
             Err(DdsError::Timeout) => {
@@ -706,7 +707,7 @@ fn publisher<T: PerfSample>(ctx: &Ctx<T>, w: &DataWriter<T>) {
         ctx.pub_hist
             .lock()
             .expect("pub hist")
-            .record(t0.elapsed().as_nanos() as u64);
+            .record((now_ns() - t0).max(0) as u64);
         ntot += 1;
         sample.set_seq(sample.seq().wrapping_add(1));
         keyval = (keyval + 1) % nkeys;
