@@ -3,9 +3,9 @@
 //! lifecycle, deadline). Pure data structure: no locking, no I/O, time comes in as arguments.
 
 use std::collections::{BTreeMap, VecDeque};
+use std::time::{Duration, Instant, SystemTime};
 
 use foldhash::{HashMap, HashMapExt};
-use std::time::{Duration, Instant, SystemTime};
 
 use crate::qos::{DataReaderQos, History, Ownership, INFINITE};
 

@@ -1,13 +1,14 @@
 //! `DomainParticipant`: owns the sans-I/O core, the transport and the timer thread, and routes the core's
 //! events to the typed readers and writers.
 
-use foldhash::{HashMap, HashMapExt};
 use std::hash::{BuildHasher, Hasher};
 use std::net::{IpAddr, SocketAddr, SocketAddrV4};
 use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, RwLock, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
+
+use foldhash::{HashMap, HashMapExt};
 
 use crate::config::{Config, InterfaceSelection, ParticipantIndex, Peer};
 use crate::qos::{PublisherQos, SubscriberQos, TopicQos};

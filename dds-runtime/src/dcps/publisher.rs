@@ -1,8 +1,9 @@
 //! `Publisher` and `DataWriter<T>`.
 
-use foldhash::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard, Weak};
 use std::time::{Duration, Instant, SystemTime};
+
+use foldhash::HashMap;
 
 use crate::cdr::{self, ByteOrder, DdsType, XcdrVersion};
 use crate::qos::{
@@ -418,6 +419,12 @@ impl<T: DdsType> DataWriter<T> {
         cdr::instance_key(sample, &mut key)?;
         let now = Instant::now();
         let mut inst = lock(&self.inner.instances);
+        // Another thread may have registered it since the lookup above.
+        if let Some(h) = inst.by_key.get(&key).copied() {
+            if let Some(i) = inst.by_handle.get(&h) {
+                return Ok(Some((h, i.key_hash)));
+            }
+        }
         let mut kp = Vec::new();
         cdr::serialize_key(sample, self.inner.version, ByteOrder::NATIVE, &mut kp)?;
         let kh = self.key_hash(sample)?;

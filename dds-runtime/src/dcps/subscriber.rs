@@ -1,13 +1,13 @@
 //! `Subscriber` and `DataReader<T>`.
 
 use std::collections::VecDeque;
-
-use foldhash::{HashMap, HashMapExt};
 use std::pin::Pin;
 use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, Weak};
 use std::task::{Context, Poll, Waker};
 use std::time::{Duration, Instant, SystemTime};
+
+use foldhash::{HashMap, HashMapExt};
 
 use crate::cdr::{self, DdsType};
 use crate::qos::{

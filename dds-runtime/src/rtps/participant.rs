@@ -8,9 +8,9 @@ mod timers;
 
 use std::cell::Cell;
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
+use std::time::Instant;
 
 use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
-use std::time::Instant;
 
 use super::api::*;
 use super::discovery::{ParticipantData, ReaderData, WriterData};

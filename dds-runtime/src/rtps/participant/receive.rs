@@ -5,7 +5,6 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use foldhash::HashMap;
-
 use tracing::{debug, trace};
 
 use super::timers::lower_floor;
