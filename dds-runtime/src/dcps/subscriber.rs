@@ -1066,11 +1066,22 @@ mod tests {
         }
     }
 
+    /// `decode_change` from a writer with default QoS, now.
+    fn decode(s: ReceivedSample, by_hash: &mut HashMap<[u8; 16], Vec<u8>>) -> Option<Incoming<K>> {
+        let now = Instant::now();
+        decode_change::<K>(
+            s,
+            RemoteWriterInfo::default(),
+            by_hash,
+            Vec::new(),
+            now,
+            SystemTime::now(),
+        )
+    }
+
     #[test]
     fn key_only_changes_map_by_key_payload_or_known_hash() {
         let mut by_hash = HashMap::new();
-        let now = Instant::now();
-        let info = RemoteWriterInfo::default();
         let s = K {
             id: "a".into(),
             v: 1,
@@ -1078,15 +1089,7 @@ mod tests {
         let mut buf = Vec::new();
         cdr::serialize(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut buf).unwrap();
         let kh = cdr::key_hash(&s, XcdrVersion::Xcdr2).unwrap();
-        let alive = decode_change::<K>(
-            rs(ChangeKind::Alive, buf, Some(kh)),
-            info,
-            &mut by_hash,
-            Vec::new(),
-            now,
-            SystemTime::now(),
-        )
-        .unwrap();
+        let alive = decode(rs(ChangeKind::Alive, buf, Some(kh)), &mut by_hash).unwrap();
         assert_eq!(alive.data.as_ref(), Some(&s));
         let mut expected = Vec::new();
         cdr::instance_key(&s, &mut expected).unwrap();
@@ -1094,60 +1097,30 @@ mod tests {
 
         let mut kp = Vec::new();
         cdr::serialize_key(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut kp).unwrap();
-        let d = decode_change::<K>(
-            rs(ChangeKind::Dispose, kp, None),
-            info,
-            &mut by_hash,
-            Vec::new(),
-            now,
-            SystemTime::now(),
-        )
-        .unwrap();
+        let d = decode(rs(ChangeKind::Dispose, kp, None), &mut by_hash).unwrap();
         assert_eq!(d.key, expected, "by key payload");
         assert_eq!(d.kind, ChangeKindLocal::Dispose);
 
-        let u = decode_change::<K>(
+        let u = decode(
             rs(ChangeKind::Unregister, Vec::new(), Some(kh)),
-            info,
             &mut by_hash,
-            Vec::new(),
-            now,
-            SystemTime::now(),
         )
         .unwrap();
         assert_eq!(u.key, expected, "by a key hash seen before");
 
         let unknown = rs(ChangeKind::Dispose, Vec::new(), Some([9; 16]));
-        assert!(decode_change::<K>(
-            unknown,
-            info,
-            &mut by_hash,
-            Vec::new(),
-            now,
-            SystemTime::now()
-        )
-        .is_none());
+        assert!(decode(unknown, &mut by_hash).is_none());
         let garbage = rs(
             ChangeKind::Alive,
             vec![0, 7, 0, 0, 0xff, 0xff, 0xff, 0x7f],
             None,
         );
-        assert!(decode_change::<K>(
-            garbage,
-            info,
-            &mut by_hash,
-            Vec::new(),
-            now,
-            SystemTime::now()
-        )
-        .is_none());
+        assert!(decode(garbage, &mut by_hash).is_none());
     }
 
     /// Fast DDS disposes with only PID_KEY_HASH; the alive samples before may have come without one.
     #[test]
     fn key_hash_only_dispose_maps_to_instance_seen_without_hash() {
-        let now = Instant::now();
-        let info = RemoteWriterInfo::default();
         let s = K {
             id: "a-rather-long-key-beyond-16-bytes".into(),
             v: 1,
@@ -1158,25 +1131,10 @@ mod tests {
             let mut by_hash = HashMap::new();
             let mut buf = Vec::new();
             cdr::serialize(&s, version, ByteOrder::NATIVE, &mut buf).unwrap();
-            decode_change::<K>(
-                rs(ChangeKind::Alive, buf, None),
-                info,
-                &mut by_hash,
-                Vec::new(),
-                now,
-                SystemTime::now(),
-            )
-            .unwrap();
+            decode(rs(ChangeKind::Alive, buf, None), &mut by_hash).unwrap();
             let kh = cdr::key_hash(&s, version).unwrap();
-            let d = decode_change::<K>(
-                rs(ChangeKind::Dispose, Vec::new(), Some(kh)),
-                info,
-                &mut by_hash,
-                Vec::new(),
-                now,
-                SystemTime::now(),
-            )
-            .expect("dispose mapped through the computed key hash");
+            let d = decode(rs(ChangeKind::Dispose, Vec::new(), Some(kh)), &mut by_hash)
+                .expect("dispose mapped through the computed key hash");
             assert_eq!(d.key, expected);
             assert_eq!(d.kind, ChangeKindLocal::Dispose);
         }
