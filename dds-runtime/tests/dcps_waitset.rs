@@ -12,20 +12,11 @@ use dds_runtime::prelude::*;
 fn waitset_wakes_on_data_status_and_guard() {
     let p1 = participant(41);
     let p2 = participant(41);
-    let t1 = p1
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(
-            &t2,
-            &DataReaderQos::builder().reliability(reliable()).build(),
-        )
-        .unwrap();
+    let r = reader::<ShapeType>(
+        &p2,
+        "Square",
+        &DataReaderQos::builder().reliability(reliable()).build(),
+    );
 
     let ws = WaitSet::new();
     let sc = r.status_condition();
@@ -45,14 +36,11 @@ fn waitset_wakes_on_data_status_and_guard() {
     ));
 
     // Status condition: the writer appears.
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(
-            &t1,
-            &DataWriterQos::builder().reliability(reliable()).build(),
-        )
-        .unwrap();
+    let w = writer::<ShapeType>(
+        &p1,
+        "Square",
+        &DataWriterQos::builder().reliability(reliable()).build(),
+    );
     let got = ws.wait(MATCH_TIMEOUT).unwrap();
     assert!(got.iter().any(|c| matches!(c, Condition::Status(_))));
     assert_eq!(r.subscription_matched_status().current_count, 1);
@@ -98,36 +86,24 @@ impl DataReaderListener<ShapeType> for Counter {
 fn listener_sees_matches_and_data() {
     let p1 = participant(42);
     let p2 = participant(42);
-    let t1 = p1
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(
-            &t2,
-            &DataReaderQos::builder()
-                .reliability(reliable())
-                .history(History::KeepAll)
-                .build(),
-        )
-        .unwrap();
+    let r = reader::<ShapeType>(
+        &p2,
+        "Square",
+        &DataReaderQos::builder()
+            .reliability(reliable())
+            .history(History::KeepAll)
+            .build(),
+    );
     let (data, matched) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
     r.set_listener(Box::new(Counter(data.clone(), matched.clone())));
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(
-            &t1,
-            &DataWriterQos::builder()
-                .reliability(reliable())
-                .history(History::KeepAll)
-                .build(),
-        )
-        .unwrap();
+    let w = writer::<ShapeType>(
+        &p1,
+        "Square",
+        &DataWriterQos::builder()
+            .reliability(reliable())
+            .history(History::KeepAll)
+            .build(),
+    );
     assert!(wait_until(MATCH_TIMEOUT, || matched.load(Ordering::SeqCst) == 1));
     assert!(wait_until(MATCH_TIMEOUT, || w
         .publication_matched_status()
@@ -157,27 +133,14 @@ impl DataReaderListener<ShapeType> for MatchChanges {
 fn listener_reports_unmatch_as_minus_one() {
     let p1 = participant(43);
     let p2 = participant(43);
-    let t1 = p1
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(
-            &t2,
-            &DataReaderQos::builder().reliability(reliable()).build(),
-        )
-        .unwrap();
+    let r = reader::<ShapeType>(
+        &p2,
+        "Square",
+        &DataReaderQos::builder().reliability(reliable()).build(),
+    );
     let seen = Arc::new(std::sync::Mutex::new(Vec::new()));
     r.set_listener(Box::new(MatchChanges(seen.clone())));
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t1, &DataWriterQos::default())
-        .unwrap();
+    let w = writer::<ShapeType>(&p1, "Square", &DataWriterQos::default());
     assert!(wait_until(MATCH_TIMEOUT, || !seen
         .lock()
         .unwrap()
@@ -192,41 +155,29 @@ fn listener_reports_unmatch_as_minus_one() {
 fn full_keep_all_reader_applies_back_pressure_without_loss() {
     let p1 = participant(44);
     let p2 = participant(44);
-    let t1 = p1
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let t2 = p2
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .unwrap()
-        .create_datareader(
-            &t2,
-            &DataReaderQos::builder()
-                .reliability(reliable())
-                .history(History::KeepAll)
-                .resource_limits(ResourceLimits {
-                    max_samples: Some(20),
-                    max_instances: None,
-                    max_samples_per_instance: None,
-                })
-                .build(),
-        )
-        .unwrap();
-    let w = p1
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(
-            &t1,
-            &DataWriterQos::builder()
-                .reliability(Reliability::Reliable {
-                    max_blocking_time: Duration::from_secs(10),
-                })
-                .history(History::KeepAll)
-                .build(),
-        )
-        .unwrap();
+    let r = reader::<ShapeType>(
+        &p2,
+        "Square",
+        &DataReaderQos::builder()
+            .reliability(reliable())
+            .history(History::KeepAll)
+            .resource_limits(ResourceLimits {
+                max_samples: Some(20),
+                max_instances: None,
+                max_samples_per_instance: None,
+            })
+            .build(),
+    );
+    let w = writer::<ShapeType>(
+        &p1,
+        "Square",
+        &DataWriterQos::builder()
+            .reliability(Reliability::Reliable {
+                max_blocking_time: Duration::from_secs(10),
+            })
+            .history(History::KeepAll)
+            .build(),
+    );
     // Both sides: a volatile writer that has not matched the reader yet would send into the void.
     assert!(wait_until(MATCH_TIMEOUT, || r
         .subscription_matched_status()

@@ -108,6 +108,26 @@ pub fn reliable_keep_all() -> (DataWriterQos, DataReaderQos) {
     (wq, rq)
 }
 
+/// A writer of `topic` on `p`, with default topic and publisher QoS.
+pub fn writer<T: DdsType>(p: &DomainParticipant, topic: &str, wq: &DataWriterQos) -> DataWriter<T> {
+    let t = p
+        .create_topic::<T>(topic, &TopicQos::default())
+        .expect("writer's topic");
+    p.create_publisher(&PublisherQos::default())
+        .and_then(|publ| publ.create_datawriter(&t, wq))
+        .expect("datawriter")
+}
+
+/// A reader of `topic` on `p`, with default topic and subscriber QoS.
+pub fn reader<T: DdsType>(p: &DomainParticipant, topic: &str, rq: &DataReaderQos) -> DataReader<T> {
+    let t = p
+        .create_topic::<T>(topic, &TopicQos::default())
+        .expect("reader's topic");
+    p.create_subscriber(&SubscriberQos::default())
+        .and_then(|sub| sub.create_datareader(&t, rq))
+        .expect("datareader")
+}
+
 /// A writer on `pw` and a reader on `pr` of `topic` (default topic, publisher and subscriber QoS), once
 /// each has matched the other (within [`MATCH_TIMEOUT`]; panics otherwise).
 pub fn matched<T: DdsType>(
@@ -117,20 +137,8 @@ pub fn matched<T: DdsType>(
     wq: &DataWriterQos,
     rq: &DataReaderQos,
 ) -> (DataWriter<T>, DataReader<T>) {
-    let tw = pw
-        .create_topic::<T>(topic, &TopicQos::default())
-        .expect("writer's topic");
-    let tr = pr
-        .create_topic::<T>(topic, &TopicQos::default())
-        .expect("reader's topic");
-    let w = pw
-        .create_publisher(&PublisherQos::default())
-        .and_then(|p| p.create_datawriter(&tw, wq))
-        .expect("datawriter");
-    let r = pr
-        .create_subscriber(&SubscriberQos::default())
-        .and_then(|s| s.create_datareader(&tr, rq))
-        .expect("datareader");
+    let w = writer::<T>(pw, topic, wq);
+    let r = reader::<T>(pr, topic, rq);
     assert!(
         wait_until(MATCH_TIMEOUT, || w.publication_matched_status().current_count == 1),
         "writer of {topic:?} did not match one reader within {MATCH_TIMEOUT:?}: {:?}, incompatible: {:?}",
