@@ -77,12 +77,12 @@ pub fn upper_camel(s: &str) -> String {
     r
 }
 
-pub fn screaming(s: &str) -> String {
+pub(super) fn screaming(s: &str) -> String {
     snake(s).to_uppercase()
 }
 
 /// Makes a name usable as an identifier: raw identifier for keywords, suffix for the four that cannot be raw.
-pub fn ident(s: &str) -> String {
+pub(super) fn ident(s: &str) -> String {
     match s {
         "self" | "Self" | "super" | "crate" | "_" => format!("{s}_"),
         _ if KEYWORDS.contains(&s) => format!("r#{s}"),
@@ -91,12 +91,12 @@ pub fn ident(s: &str) -> String {
 }
 
 /// The name without a raw prefix, for comparing with the IDL name.
-pub fn bare(s: &str) -> &str {
+pub(super) fn bare(s: &str) -> &str {
     s.strip_prefix("r#").unwrap_or(s)
 }
 
 /// Escapes text for a Rust string literal.
-pub fn lit_str(s: &str) -> String {
+pub(super) fn lit_str(s: &str) -> String {
     format!("{s:?}")
 }
 
