@@ -36,6 +36,7 @@ fn words(s: &str) -> Vec<String> {
     out
 }
 
+/// `snake_case` (modules, fields, bitset accessors); a leading digit gets a `_`.
 pub fn snake(s: &str) -> String {
     let w = words(s);
     if w.is_empty() {
@@ -52,6 +53,7 @@ pub fn snake(s: &str) -> String {
     r
 }
 
+/// `UpperCamelCase` (types, enumerators, union variants); a name already in camel case is kept as written.
 pub fn upper_camel(s: &str) -> String {
     // Already acceptable camel case (acronyms allowed): keep the author's spelling.
     let has_lower = s.chars().any(|c| c.is_lowercase());

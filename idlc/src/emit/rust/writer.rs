@@ -155,14 +155,27 @@ impl Writer {
         self.line(")]");
     }
 
+    /// `one` when it fits, else `first` and then `second` one level deeper when that fits. False (nothing
+    /// written) when neither does.
+    fn one_or_broken(&mut self, one: &str, first: &str, second: &str) -> bool {
+        let second = format!("{INDENT}{second}");
+        if self.fits(one) {
+            self.line(one);
+        } else if self.fits(&second) {
+            self.line(first);
+            self.line(&second);
+        } else {
+            return false;
+        }
+        true
+    }
+
     /// `{lhs} = {rhs}{end}`, broken after `=` when it does not fit on one line.
     pub(super) fn assign(&mut self, lhs: &str, rhs: &str, end: &str) {
-        let one = format!("{lhs} = {rhs}{end}");
-        if self.fits(&one) {
-            self.line(&one);
-        } else {
-            self.line(&format!("{lhs} ="));
-            self.line(&format!("{INDENT}{rhs}{end}"));
+        let (first, second) = (format!("{lhs} ="), format!("{rhs}{end}"));
+        if !self.one_or_broken(&format!("{lhs} = {rhs}{end}"), &first, &second) {
+            self.line(&first);
+            self.line(&format!("{INDENT}{second}"));
         }
     }
 
@@ -170,40 +183,32 @@ impl Writer {
     /// per line.
     pub(super) fn field(&mut self, head: &str, ty: &str) {
         let one = format!("{head}: {ty},");
-        if self.fits(&one) {
-            self.line(&one);
-        } else if self.fits(&format!("{INDENT}{ty},")) {
-            self.line(&format!("{head}:"));
-            self.line(&format!("{INDENT}{ty},"));
-        } else if let Some((outer, args)) = split_generics(ty) {
-            let open = format!("{head}: {outer}<");
-            let pad = if self.fits(&open) {
-                self.line(&open);
-                ""
-            } else {
-                self.line(&format!("{head}:"));
-                self.line(&format!("{INDENT}{outer}<"));
-                INDENT
-            };
-            for a in args {
-                self.line(&format!("{pad}{INDENT}{a},"));
-            }
-            self.line(&format!("{pad}>,"));
-        } else {
-            self.line(&one);
+        if self.one_or_broken(&one, &format!("{head}:"), &format!("{ty},")) {
+            return;
         }
+        let Some((outer, args)) = split_generics(ty) else {
+            self.line(&one);
+            return;
+        };
+        let open = format!("{head}: {outer}<");
+        let pad = if self.fits(&open) {
+            self.line(&open);
+            ""
+        } else {
+            self.line(&format!("{head}:"));
+            self.line(&format!("{INDENT}{outer}<"));
+            INDENT
+        };
+        for a in args {
+            self.line(&format!("{pad}{INDENT}{a},"));
+        }
+        self.line(&format!("{pad}>,"));
     }
 
     /// `{lhs} = {left} {op} {right};`: on one line, else broken after `=`, else before `op`.
     pub(super) fn assign_binary(&mut self, lhs: &str, left: &str, op: &str, right: &str) {
-        let rhs = format!("{left} {op} {right}");
-        let one = format!("{lhs} = {rhs};");
-        if self.fits(&one) {
-            self.line(&one);
-        } else if self.fits(&format!("{INDENT}{rhs};")) {
-            self.line(&format!("{lhs} ="));
-            self.line(&format!("{INDENT}{rhs};"));
-        } else {
+        let rhs = format!("{left} {op} {right};");
+        if !self.one_or_broken(&format!("{lhs} = {rhs}"), &format!("{lhs} ="), &rhs) {
             self.line(&format!("{lhs} = {left}"));
             self.line(&format!("{INDENT}{op} {right};"));
         }
@@ -285,8 +290,10 @@ mod tests {
 
     #[test]
     fn blank_line_between_items_only() {
-        let mut w = Writer::default();
-        w.fresh = true;
+        let mut w = Writer {
+            fresh: true,
+            ..Writer::default()
+        };
         w.item();
         w.line("pub const A: u8 = 1;");
         w.item();
