@@ -1,4 +1,4 @@
-//! Rust back end. The emitter walks the model and writes each declaration straight into a [`Writer`]
+//! Rust back end. The emitter walks the model and writes each declaration straight into a `Writer`
 //! (`writer.rs`), which lays the code out as rustfmt does. There are no templates, nothing is parsed back and
 //! no state outlives one call of [`emit`]: the same model and options always give the same text.
 //!
