@@ -12,20 +12,28 @@ use crate::model::Extensibility;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+/// Why [`Builder::compile`] failed.
 #[derive(thiserror::Error)]
 pub enum Error {
     /// The IDL has errors; `rendered` holds the full diagnostics.
     #[error("{rendered}\nidlc: {count} error(s) in {file}")]
     Idl {
+        /// The input file, as given.
         file: String,
+        /// How many errors (warnings not counted).
         count: usize,
+        /// Every diagnostic of the file, rendered as text.
         rendered: String,
     },
+    /// The generated file could not be written.
     #[error("idlc: cannot write {path}: {source}")]
     Io {
+        /// The file idlc tried to write.
         path: PathBuf,
+        /// What the operating system said.
         source: std::io::Error,
     },
+    /// Neither [`Builder::out_dir`] nor `$OUT_DIR` says where to write.
     #[error(
         "idlc: OUT_DIR is not set and no out_dir was given (are we running outside build.rs?)"
     )]
@@ -39,6 +47,8 @@ impl fmt::Debug for Error {
     }
 }
 
+/// Compiles IDL files to Rust from `build.rs`: set options with the chained methods, then call
+/// [`Builder::compile`].
 #[derive(Clone, Debug, Default)]
 pub struct Builder {
     opts: Options,
@@ -47,6 +57,8 @@ pub struct Builder {
 }
 
 impl Builder {
+    /// A builder with the defaults: no include directories or macros, `@appendable` as the default
+    /// extensibility, no serde derives, `::dds_runtime` as the runtime path, output to `$OUT_DIR`.
     pub fn new() -> Self {
         Self::default()
     }
@@ -63,6 +75,7 @@ impl Builder {
         });
         self
     }
+    /// Extensibility of types without an annotation (default [`Extensibility::Appendable`]).
     pub fn default_extensibility(mut self, ext: Extensibility) -> Self {
         self.opts.default_extensibility = ext;
         self

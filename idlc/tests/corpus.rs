@@ -53,7 +53,7 @@ fn expected_failures() -> BTreeMap<String, (String, String)> {
         .collect()
 }
 
-pub fn module_name(rel: &str) -> String {
+fn module_name(rel: &str) -> String {
     let s: String = rel
         .trim_end_matches(".idl")
         .chars()

@@ -2,16 +2,19 @@
 
 macro_rules! codes {
     ($($name:ident = $code:literal : $desc:literal,)*) => {
+        /// What a diagnostic is about; each has a stable code such as `idlc::E0201`.
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-        pub enum Code { $($name,)* }
+        pub enum Code { $(#[doc = $desc] $name,)* }
         impl Code {
             /// The code as shown, e.g. `idlc::E0201`.
             pub fn as_str(self) -> &'static str {
                 match self { $(Code::$name => concat!("idlc::", $code),)* }
             }
+            /// One line saying what the code means.
             pub fn description(self) -> &'static str {
                 match self { $(Code::$name => $desc,)* }
             }
+            /// Every code, in numbering order.
             pub const ALL: &'static [Code] = &[$(Code::$name,)*];
         }
     };

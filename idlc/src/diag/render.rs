@@ -1,12 +1,16 @@
-//! Rendering through miette: a snippet of the right file, carets, labels, help and the code.
+//! Rendering through miette. With the `fancy` feature (on for the command line): a snippet of the right
+//! file, carets, labels, help and the code. Without it (`build.rs` use): the same facts as plain sentences.
 use super::{Diagnostic, Severity};
 use crate::source::SourceDb;
-use miette::{GraphicalReportHandler, GraphicalTheme, LabeledSpan, NamedSource};
+use miette::{LabeledSpan, NamedSource};
 use std::fmt;
 
+/// How diagnostics are drawn.
 #[derive(Clone, Copy, Debug)]
 pub struct RenderOptions {
+    /// ANSI colours (only with the `fancy` feature).
     pub color: bool,
+    /// Line width to wrap messages at (only with the `fancy` feature).
     pub width: usize,
 }
 
@@ -108,19 +112,30 @@ pub fn render(db: &SourceDb, diag: &Diagnostic, opts: RenderOptions) -> String {
         file,
         help,
     };
+    let mut out = String::new();
+    if draw(&mut out, &report, opts).is_err() {
+        out = format!("{}: {}", diag.code.as_str(), diag.message);
+    }
+    out
+}
+
+#[cfg(feature = "fancy")]
+fn draw(out: &mut String, report: &Report<'_>, opts: RenderOptions) -> fmt::Result {
+    use miette::{GraphicalReportHandler, GraphicalTheme};
     let theme = if opts.color {
         GraphicalTheme::unicode()
     } else {
         GraphicalTheme::unicode_nocolor()
     };
-    let handler = GraphicalReportHandler::new_themed(theme)
+    GraphicalReportHandler::new_themed(theme)
         .with_width(opts.width)
-        .with_links(false);
-    let mut out = String::new();
-    if handler.render_report(&mut out, &report).is_err() {
-        out = format!("{}: {}", diag.code.as_str(), diag.message);
-    }
-    out
+        .with_links(false)
+        .render_report(out, report)
+}
+
+#[cfg(not(feature = "fancy"))]
+fn draw(out: &mut String, report: &Report<'_>, _opts: RenderOptions) -> fmt::Result {
+    miette::NarratableReportHandler::new().render_report(out, report)
 }
 
 /// Renders several diagnostics, separated by blank lines.

@@ -1,3 +1,3 @@
-//! Back ends: Rust source (askama templates, formatted with prettyplease) and the JSON type model.
+//! Back ends: Rust source (written directly, laid out as rustfmt would) and the JSON type model.
 pub mod json;
 pub mod rust;

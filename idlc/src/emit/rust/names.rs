@@ -36,6 +36,7 @@ fn words(s: &str) -> Vec<String> {
     out
 }
 
+/// `snake_case` (modules, fields, bitset accessors); a leading digit gets a `_`.
 pub fn snake(s: &str) -> String {
     let w = words(s);
     if w.is_empty() {
@@ -52,6 +53,7 @@ pub fn snake(s: &str) -> String {
     r
 }
 
+/// `UpperCamelCase` (types, enumerators, union variants); a name already in camel case is kept as written.
 pub fn upper_camel(s: &str) -> String {
     // Already acceptable camel case (acronyms allowed): keep the author's spelling.
     let has_lower = s.chars().any(|c| c.is_lowercase());
@@ -77,12 +79,12 @@ pub fn upper_camel(s: &str) -> String {
     r
 }
 
-pub fn screaming(s: &str) -> String {
+pub(super) fn screaming(s: &str) -> String {
     snake(s).to_uppercase()
 }
 
 /// Makes a name usable as an identifier: raw identifier for keywords, suffix for the four that cannot be raw.
-pub fn ident(s: &str) -> String {
+pub(super) fn ident(s: &str) -> String {
     match s {
         "self" | "Self" | "super" | "crate" | "_" => format!("{s}_"),
         _ if KEYWORDS.contains(&s) => format!("r#{s}"),
@@ -91,12 +93,12 @@ pub fn ident(s: &str) -> String {
 }
 
 /// The name without a raw prefix, for comparing with the IDL name.
-pub fn bare(s: &str) -> &str {
+pub(super) fn bare(s: &str) -> &str {
     s.strip_prefix("r#").unwrap_or(s)
 }
 
 /// Escapes text for a Rust string literal.
-pub fn lit_str(s: &str) -> String {
+pub(super) fn lit_str(s: &str) -> String {
     format!("{s:?}")
 }
 

@@ -6,13 +6,13 @@ use crate::model::{DeclId, DeclKind, Type};
 /// Where a type appears: a struct field can carry `#[dds(bound = N)]`; anywhere else bounds must live in the
 /// type (`BoundedString<N>`, `BoundedSeq<T, N>`).
 #[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Pos {
+pub(super) enum Pos {
     Field,
     Nested,
 }
 
 impl Emitter<'_> {
-    pub fn prim(&self, p: Prim) -> String {
+    pub(super) fn prim(&self, p: Prim) -> String {
         let rt = &self.opts.runtime_crate;
         match p {
             Prim::Bool => "bool".into(),
@@ -34,7 +34,7 @@ impl Emitter<'_> {
     }
 
     /// `std` names, fully qualified where the module declares a type of the same name.
-    pub fn std(&self, short: &'static str) -> String {
+    pub(super) fn std(&self, short: &'static str) -> String {
         if !self.shadowed.contains(short) {
             return short.to_string();
         }
@@ -49,7 +49,7 @@ impl Emitter<'_> {
     }
 
     /// The Rust spelling of a type, relative to the module being emitted.
-    pub fn rust_type(&self, t: &Type, pos: Pos) -> String {
+    pub(super) fn rust_type(&self, t: &Type, pos: Pos) -> String {
         let rt = &self.opts.runtime_crate;
         match t {
             Type::Prim { prim } => self.prim(*prim),
@@ -101,7 +101,7 @@ impl Emitter<'_> {
     }
 
     /// The bound to put on a field of this type (through aliases).
-    pub fn field_bound(&self, t: &Type) -> Option<u64> {
+    pub(super) fn field_bound(&self, t: &Type) -> Option<u64> {
         match self.model.resolve_alias(t) {
             Type::String { bound, .. } | Type::Sequence { bound, .. } | Type::Map { bound, .. } => {
                 *bound
@@ -111,11 +111,6 @@ impl Emitter<'_> {
     }
 
     /// `Eq` and `Hash` are derivable (no floating point anywhere inside).
-    pub fn eq_hash(&self, t: &Type) -> bool {
-        let mut visiting = Vec::new();
-        self.eq_hash_in(t, &mut visiting)
-    }
-
     fn eq_hash_in(&self, t: &Type, visiting: &mut Vec<DeclId>) -> bool {
         match t {
             // LongDouble is a byte carrier with Eq and Hash.
@@ -131,7 +126,7 @@ impl Emitter<'_> {
         }
     }
 
-    pub fn decl_eq_hash(&self, id: DeclId, visiting: &mut Vec<DeclId>) -> bool {
+    pub(super) fn decl_eq_hash(&self, id: DeclId, visiting: &mut Vec<DeclId>) -> bool {
         if let Some(v) = self.eq_cache.borrow().get(&id) {
             return *v;
         }
@@ -141,7 +136,7 @@ impl Emitter<'_> {
         visiting.push(id);
         let r = match &self.model.decls[id].kind {
             DeclKind::Struct(s) => {
-                s.base.is_none_or(|b| self.decl_eq_hash(b, visiting))
+                s.base.map_or(true, |b| self.decl_eq_hash(b, visiting))
                     && s.fields.iter().all(|f| self.eq_hash_in(&f.ty, visiting))
             }
             DeclKind::Union(u) => {
@@ -159,7 +154,7 @@ impl Emitter<'_> {
     }
 
     /// `Default` holds for the type as spelled (arrays longer than 32 have no `Default`).
-    pub fn has_default(&self, t: &Type) -> bool {
+    pub(super) fn has_default(&self, t: &Type) -> bool {
         match t {
             Type::Array { elem, dims } => dims.iter().all(|d| *d <= 32) && self.has_default(elem),
             Type::Named { .. } => match self.model.resolve_alias(t) {
@@ -171,7 +166,7 @@ impl Emitter<'_> {
     }
 
     /// An expression producing the default value of a type.
-    pub fn default_expr(&self, t: &Type) -> String {
+    pub(super) fn default_expr(&self, t: &Type) -> String {
         let t = match t {
             Type::Named { .. } if !self.has_default(t) => self.model.resolve_alias(t),
             _ => t,

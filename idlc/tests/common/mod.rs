@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 use std::path::{Path, PathBuf};
 
-pub fn workspace_root() -> PathBuf {
+pub(crate) fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .expect("idlc lives in the workspace")
@@ -10,7 +10,7 @@ pub fn workspace_root() -> PathBuf {
 }
 
 /// The shared IDL corpus: `$IDL_CORPUS`, else `../shared/idl-corpus` next to the workspace.
-pub fn corpus_dir() -> Option<PathBuf> {
+pub(crate) fn corpus_dir() -> Option<PathBuf> {
     if let Some(p) = std::env::var_os("IDL_CORPUS") {
         let p = PathBuf::from(p);
         return p.is_dir().then_some(p);
@@ -19,22 +19,22 @@ pub fn corpus_dir() -> Option<PathBuf> {
     p.is_dir().then(|| p.canonicalize().unwrap_or(p))
 }
 
-pub fn target_dir() -> PathBuf {
+pub(crate) fn target_dir() -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| workspace_root().join("target"))
 }
 
 /// A scratch crate depending on dds-runtime, holding generated modules; built with the workspace's target dir.
-pub struct ScratchCrate {
-    pub dir: PathBuf,
+pub(crate) struct ScratchCrate {
+    pub(crate) dir: PathBuf,
     modules: Vec<(String, String)>,
     extra_lib: String,
     dev: bool,
 }
 
 impl ScratchCrate {
-    pub fn new(name: &str) -> Self {
+    pub(crate) fn new(name: &str) -> Self {
         let dir = target_dir().join("idlc-scratch").join(name);
         let _ = std::fs::remove_dir_all(dir.join("src"));
         std::fs::create_dir_all(dir.join("src/gen")).expect("create scratch dir");
@@ -46,18 +46,18 @@ impl ScratchCrate {
         }
     }
 
-    pub fn add_module(&mut self, name: &str, code: &str) {
+    pub(crate) fn add_module(&mut self, name: &str, code: &str) {
         std::fs::write(self.dir.join("src/gen").join(format!("{name}.rs")), code)
             .expect("write module");
         self.modules.push((name.to_string(), name.to_string()));
     }
 
-    pub fn add_lib_code(&mut self, code: &str) {
+    pub(crate) fn add_lib_code(&mut self, code: &str) {
         self.extra_lib.push_str(code);
     }
 
     /// Builds (`cargo build`, or `cargo test` with `test`); returns (success, combined output).
-    pub fn build(&self, test: bool) -> (bool, String) {
+    pub(crate) fn build(&self, test: bool) -> (bool, String) {
         let name = self
             .dir
             .file_name()
