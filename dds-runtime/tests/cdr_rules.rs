@@ -599,7 +599,7 @@ fn union_discriminators_and_defaults() {
 }
 
 mod rt {
-    pub use dds_runtime::*;
+    pub(crate) use dds_runtime::*;
 }
 
 #[derive(DdsType, Debug, PartialEq)]

@@ -2,12 +2,13 @@
 mod dcps_util;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use dcps_util::*;
 use dds_runtime::config::{Config, InterfaceSelection, ParticipantIndex};
-use dds_runtime::transport::{ports, Channel, Datagram, UdpTransport};
+use dds_runtime::rtps::discovery::ports;
+use dds_runtime::transport::{Channel, Datagram, ReceivePath, UdpTransport};
 
 fn cfg(domain: u32, index: ParticipantIndex) -> Config {
     Config {
@@ -89,4 +90,61 @@ fn multicast_off_binds_no_group_socket() {
     let t = UdpTransport::bind(&c).unwrap();
     assert!(t.spdp_multicast().is_none());
     assert!(!t.multicast_enabled());
+}
+
+/// Sends `n` numbered datagrams to a transport reading its sockets `path`'s way; each arrives once, whole,
+/// from the sender's address.
+fn receives_every_datagram(path: ReceivePath, domain: u32) {
+    let rx = UdpTransport::bind(&cfg(domain, ParticipantIndex::None)).unwrap();
+    let tx = UdpTransport::bind(&cfg(domain, ParticipantIndex::None)).unwrap();
+    let got = Arc::new(Mutex::new(Vec::new()));
+    let g = got.clone();
+    let from = tx.metatraffic_unicast().port();
+    rx.start_with(
+        Arc::new(move |ch, batch: &[Datagram<'_>]| {
+            let mut g = g.lock().unwrap();
+            g.extend(batch.iter().map(|d| (ch, d.from.port(), d.data.to_vec())));
+        }),
+        path,
+    )
+    .unwrap();
+    // Bursts of 20 small datagrams, so that the batched path reads several per call and no socket buffer
+    // overflows.
+    let n = 200u16;
+    for burst in (0..n).collect::<Vec<_>>().chunks(20) {
+        for &i in burst {
+            let payload: Vec<u8> = i.to_be_bytes().repeat(usize::from(i % 50) + 1);
+            tx.send_to(&payload, rx.user_unicast());
+        }
+        let sent = usize::from(burst[burst.len() - 1] + 1);
+        assert!(wait_until(Duration::from_secs(5), || got
+            .lock()
+            .unwrap()
+            .len()
+            >= sent));
+    }
+    let mut got = got.lock().unwrap().clone();
+    assert_eq!(got.len(), usize::from(n));
+    got.sort_by_key(|(_, _, d)| u16::from_be_bytes([d[0], d[1]]));
+    for (i, (ch, port, d)) in (0..n).zip(&got) {
+        assert_eq!((*ch, *port), (Channel::UserUnicast, from));
+        assert_eq!(d.len(), 2 * (usize::from(i % 50) + 1));
+        assert_eq!(d[..2], i.to_be_bytes());
+    }
+    assert_eq!(rx.stats().received.load(Ordering::SeqCst), u64::from(n));
+    rx.shutdown();
+    tx.shutdown();
+}
+
+#[test]
+fn portable_receive_path_delivers_every_datagram() {
+    require_netns();
+    assert_eq!(ReceivePath::OneByOne.effective(), ReceivePath::OneByOne);
+    receives_every_datagram(ReceivePath::OneByOne, 53);
+}
+
+#[test]
+fn batched_receive_path_delivers_every_datagram() {
+    require_netns();
+    receives_every_datagram(ReceivePath::Batched, 54);
 }

@@ -1,4 +1,6 @@
 #![deny(warnings)]
+// The workspace lints are for library APIs; the bitflags! types below are test fixtures.
+#![allow(missing_docs)]
 //! Byte-exact vectors produced by Cyclone DDS 11.0.1's Python serializer (`IdlStruct.serialize`,
 //! `__idl__.serialize_key`). Our payloads are padded to 4 bytes with the count in the header options (as
 //! Cyclone's C core writes them); the Python serializer leaves them unpadded, so bodies are compared.

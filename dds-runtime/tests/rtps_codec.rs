@@ -360,7 +360,7 @@ fn fixtures() -> Vec<Vec<u8>> {
 /// A participant that knows the Cyclone peers of the fixtures, so hostile input reaches deep code paths.
 fn primed_participant(now: Instant) -> Participant {
     let mut p = Participant::new(
-        ParticipantConfig::new(0, 3, GuidPrefix([7; 12]), [127, 0, 0, 1]),
+        ParticipantConfig::new(0, 3, GuidPrefix([7; 12]), [127, 0, 0, 1]).unwrap(),
         now,
     );
     let rq = dds_runtime::qos::DataReaderQos::builder()

@@ -188,7 +188,10 @@ fn cyclone_fragments_and_status_info() {
 fn cyclone_writer_delivers_to_our_reader() {
     let now = Instant::now();
     let prefix = GuidPrefix([0x01, 0xdd, 0, 0, 0, 0, 0, 0, 0, 0, 0, 9]);
-    let mut p = Participant::new(ParticipantConfig::new(0, 5, prefix, [127, 0, 0, 1]), now);
+    let mut p = Participant::new(
+        ParticipantConfig::new(0, 5, prefix, [127, 0, 0, 1]).unwrap(),
+        now,
+    );
     let rq = DataReaderQos::builder()
         .reliability(Reliability::RELIABLE)
         .durability(Durability::TransientLocal)
@@ -278,7 +281,7 @@ fn cyclone_writer_delivers_to_our_reader() {
 fn must_understand_inline_qos_drops_only_that_sample() {
     let now = Instant::now();
     let mut p = Participant::new(
-        ParticipantConfig::new(0, 5, GuidPrefix([9; 12]), [127, 0, 0, 1]),
+        ParticipantConfig::new(0, 5, GuidPrefix([9; 12]), [127, 0, 0, 1]).unwrap(),
         now,
     );
     let rq = DataReaderQos::builder()

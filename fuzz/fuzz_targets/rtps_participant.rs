@@ -75,7 +75,7 @@ fn discovery() -> &'static Vec<Vec<u8>> {
 
 fuzz_target!(|data: &[u8]| {
     let now = Instant::now();
-    let mut c = ParticipantConfig::new(0, 0, GuidPrefix([7; 12]), [127, 0, 0, 1]);
+    let mut c = ParticipantConfig::new(0, 0, GuidPrefix([7; 12]), [127, 0, 0, 1]).unwrap();
     c.defrag_max_bytes = 1 << 20;
     let mut p = Participant::new(c, now);
     let wq = DataWriterQos::builder()

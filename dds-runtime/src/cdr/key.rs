@@ -3,11 +3,10 @@
 use md5::{Digest, Md5};
 
 use super::error::{DecodeError, EncodeError};
-use super::header::{ByteOrder, EncapsulationHeader, XcdrVersion};
-use super::reader::CdrReader;
+use super::header::{ByteOrder, XcdrVersion};
+use super::payload::{decode_payload, encode_payload};
 use super::traits::DdsType;
 use super::writer::{CdrWriter, EncodeMode};
-use super::{finish_payload, start_payload};
 
 /// Appends a key-only payload (encapsulation header, then the key members in declaration order, framed as the
 /// type's extensibility requires), as carried by DATA(K) and dispose/unregister messages.
@@ -17,22 +16,12 @@ pub fn serialize_key<T: DdsType>(
     order: ByteOrder,
     out: &mut Vec<u8>,
 ) -> Result<(), EncodeError> {
-    let start = start_payload::<T>(version, order, out);
-    let r = sample.encode(&mut CdrWriter::new(out, version, order, EncodeMode::Key));
-    finish_payload(start, r, out)
+    encode_payload(sample, version, order, EncodeMode::Key, out)
 }
 
 /// Decodes a key-only payload; members that are not keys get their default values.
 pub fn deserialize_key<T: DdsType>(payload: &[u8]) -> Result<T, DecodeError> {
-    let h = EncapsulationHeader::parse(payload)?;
-    let mut r = CdrReader::new(
-        payload,
-        EncapsulationHeader::SIZE,
-        h.version()?,
-        h.byte_order(),
-        true,
-    );
-    T::decode(&mut r)
+    decode_payload(payload, true)
 }
 
 /// Writes the big-endian key stream libddsc hashes: key members only, in member-id order, plain (no DHEADER,

@@ -158,35 +158,6 @@ pub trait CdrType: Sized {
     }
 }
 
-/// The members of a struct, without the struct's own framing, so a derived struct (`#[dds(base)]`) can put
-/// its base's members first inside its own DHEADER or parameter list. Generated; not for hand-written code.
-#[doc(hidden)]
-pub trait StructMembers: CdrType {
-    /// Per-member decode state (each member `None` until read).
-    type Partial: Default;
-    /// Whether the struct or its base has key members.
-    const HAS_KEYS: bool;
-    /// Encodes the members (only keys in key modes when the struct has keys).
-    fn encode_members(&self, w: &mut CdrWriter<'_>, ext: Extensibility) -> Result<(), EncodeError>;
-    /// Decodes the members of a final/appendable encoding in declaration order.
-    fn decode_members_in_order(
-        r: &mut CdrReader<'_>,
-        st: &super::members::StructDecoder,
-        p: &mut Self::Partial,
-    ) -> Result<(), DecodeError>;
-    /// Decodes the member with this id from a mutable encoding; `false` if the id is not a member.
-    fn decode_member_by_id(
-        r: &mut CdrReader<'_>,
-        id: u32,
-        p: &mut Self::Partial,
-    ) -> Result<bool, DecodeError>;
-    /// Builds the value, defaulting members that were not read.
-    fn finish(p: Self::Partial) -> Self;
-    /// Key-size scan over the members.
-    fn key_members_max_end(start: usize, version: XcdrVersion, ext: Extensibility)
-        -> Option<usize>;
-}
-
 /// Type metadata for the XTypes TypeObject generator (filled in later; the hook is here so the derive can grow
 /// into it without changing the trait).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

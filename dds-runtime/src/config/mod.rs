@@ -23,22 +23,90 @@
 use std::net::{IpAddr, Ipv4Addr, SocketAddrV4};
 use std::time::Duration;
 
-/// Highest valid domain id for UDPv4 with the default port parameters (PB + DG·232 + offsets < 65536).
-pub const MAX_DOMAIN_ID: u32 = 232;
+use crate::rtps::discovery::ports::{self, PortError};
 
-/// Why a configuration value was rejected.
+/// Highest valid domain id for UDPv4 with the default port parameters (PB + DG·232 + offsets < 65536).
+pub const MAX_DOMAIN_ID: u32 = ports::MAX_DOMAIN_ID;
+
+/// Why a configuration value was rejected. `name` is the environment variable or the [`Config`] field.
 #[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ConfigError {
-    /// An environment variable or builder value could not be parsed or is out of range.
-    #[error("invalid value {value:?} for {name}: {reason}")]
-    Invalid {
+    /// A numeric setting is not a number.
+    #[error("invalid value {value:?} for {name}: not a number")]
+    NotANumber {
         /// Variable or setting name.
         name: &'static str,
         /// The value given.
         value: String,
-        /// What is wrong with it.
-        reason: &'static str,
     },
+    /// A switch is none of `on`/`off`, `true`/`false`, `yes`/`no`, `1`/`0`.
+    #[error("invalid value {value:?} for {name}: expected on/off")]
+    NotOnOff {
+        /// Variable or setting name.
+        name: &'static str,
+        /// The value given.
+        value: String,
+    },
+    /// `DDS_WRITE_BATCH` is neither `on`/`off` nor a number of microseconds.
+    #[error("invalid value {value:?} for DDS_WRITE_BATCH: expected off, on or microseconds")]
+    WriteBatch {
+        /// The value given.
+        value: String,
+    },
+    /// A peer is not an IPv4 address or `address:port`.
+    #[error("invalid value {value:?} for DDS_PEERS: expected an IPv4 address or address:port")]
+    Peer {
+        /// The value given.
+        value: String,
+    },
+    /// A size is outside its range.
+    #[error("invalid value {value} for {name}: must be {min}..={max}")]
+    OutOfRange {
+        /// Setting name.
+        name: &'static str,
+        /// The value given.
+        value: usize,
+        /// Smallest accepted value.
+        min: usize,
+        /// Largest accepted value.
+        max: usize,
+    },
+    /// The fragment size leaves no room for the RTPS headers below the largest message.
+    #[error("fragment_size {fragment_size} must leave room for RTPS headers below max_message_size {max_message_size}")]
+    FragmentTooLarge {
+        /// The fragment size given.
+        fragment_size: usize,
+        /// The largest message size given.
+        max_message_size: usize,
+    },
+    /// The SPDP interval is zero or longer than the lease duration.
+    #[error("spdp_interval {spdp_interval:?} must be non-zero and not longer than the lease duration {lease_duration:?}")]
+    SpdpInterval {
+        /// The interval given.
+        spdp_interval: Duration,
+        /// The lease duration given.
+        lease_duration: Duration,
+    },
+    /// The domain id or a participant index gives a port above 65535.
+    #[error("invalid {name}: {source}")]
+    Port {
+        /// Setting name (`domain_id`, `participant_index` or `max_participant_index`).
+        name: &'static str,
+        /// Which port does not fit.
+        #[source]
+        source: PortError,
+    },
+}
+
+impl From<PortError> for ConfigError {
+    fn from(source: PortError) -> Self {
+        let name = match source {
+            PortError::Domain { .. } => "domain_id",
+            _ => "participant_index",
+        };
+        ConfigError::Port { name, source }
+    }
 }
 
 /// Which network interface the participant uses.
@@ -102,10 +170,8 @@ impl Peer {
         if s.eq_ignore_ascii_case("localhost") {
             return Ok(Peer::Address(Ipv4Addr::LOCALHOST));
         }
-        Err(ConfigError::Invalid {
-            name: "DDS_PEERS",
+        Err(ConfigError::Peer {
             value: s.to_string(),
-            reason: "expected an IPv4 address or address:port",
         })
     }
 }
@@ -159,26 +225,22 @@ impl Default for Config {
     }
 }
 
-fn invalid(name: &'static str, value: &str, reason: &'static str) -> ConfigError {
-    ConfigError::Invalid {
-        name,
-        value: value.to_string(),
-        reason,
-    }
-}
-
 fn parse_num<N: std::str::FromStr>(name: &'static str, v: &str) -> Result<N, ConfigError> {
-    v.trim()
-        .parse::<N>()
-        .map_err(|_| invalid(name, v, "not a number"))
+    v.trim().parse::<N>().map_err(|_| ConfigError::NotANumber {
+        name,
+        value: v.to_string(),
+    })
 }
 
-/// Parses `on`/`off`, `true`/`false`, `yes`/`no`, `1`/`0`.
-pub fn parse_bool(name: &'static str, v: &str) -> Result<bool, ConfigError> {
+/// Parses `on`/`off`, `true`/`false`, `yes`/`no`, `enabled`/`disabled`, `1`/`0`.
+fn parse_bool(name: &'static str, v: &str) -> Result<bool, ConfigError> {
     match v.trim().to_ascii_lowercase().as_str() {
         "1" | "on" | "true" | "yes" | "enabled" => Ok(true),
         "0" | "off" | "false" | "no" | "disabled" => Ok(false),
-        _ => Err(invalid(name, v, "expected on/off")),
+        _ => Err(ConfigError::NotOnOff {
+            name,
+            value: v.to_string(),
+        }),
     }
 }
 
@@ -187,13 +249,27 @@ pub const DEFAULT_WRITE_BATCH_DELAY: Duration = Duration::from_millis(1);
 
 /// `off`, `on` ([`DEFAULT_WRITE_BATCH_DELAY`]) or a delay in microseconds (`0` is off).
 fn parse_batch_delay(v: &str) -> Result<Option<Duration>, ConfigError> {
-    const NAME: &str = "DDS_WRITE_BATCH";
     if let Ok(us) = v.trim().parse::<u64>() {
         return Ok((us > 0).then(|| Duration::from_micros(us)));
     }
-    Ok(parse_bool(NAME, v)
-        .map_err(|_| invalid(NAME, v, "expected off, on or microseconds"))?
-        .then_some(DEFAULT_WRITE_BATCH_DELAY))
+    let on = parse_bool("DDS_WRITE_BATCH", v).map_err(|_| ConfigError::WriteBatch {
+        value: v.to_string(),
+    })?;
+    Ok(on.then_some(DEFAULT_WRITE_BATCH_DELAY))
+}
+
+/// Checks that `value` lies in `min..=max`.
+fn in_range(name: &'static str, value: usize, min: usize, max: usize) -> Result<(), ConfigError> {
+    if (min..=max).contains(&value) {
+        Ok(())
+    } else {
+        Err(ConfigError::OutOfRange {
+            name,
+            value,
+            min,
+            max,
+        })
+    }
 }
 
 impl Config {
@@ -255,60 +331,29 @@ impl Config {
 
     /// Checks ranges and relations between values.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        if self.domain_id > MAX_DOMAIN_ID {
-            return Err(invalid(
-                "domain_id",
-                &self.domain_id.to_string(),
-                "must be 0..=232",
-            ));
-        }
-        if !(256..=65000).contains(&self.fragment_size) {
-            return Err(invalid(
-                "fragment_size",
-                &self.fragment_size.to_string(),
-                "must be 256..=65000",
-            ));
-        }
-        if !(512..=65500).contains(&self.max_message_size) {
-            return Err(invalid(
-                "max_message_size",
-                &self.max_message_size.to_string(),
-                "must be 512..=65500",
-            ));
-        }
+        ports::spdp_multicast(self.domain_id)?;
+        in_range("fragment_size", self.fragment_size, 256, 65000)?;
+        in_range("max_message_size", self.max_message_size, 512, 65500)?;
         if self.fragment_size + 64 > self.max_message_size {
-            return Err(invalid(
-                "fragment_size",
-                &self.fragment_size.to_string(),
-                "must leave room for RTPS headers below max_message_size",
-            ));
+            return Err(ConfigError::FragmentTooLarge {
+                fragment_size: self.fragment_size,
+                max_message_size: self.max_message_size,
+            });
         }
         if self.spdp_interval.is_zero() || self.lease_duration < self.spdp_interval {
-            return Err(invalid(
-                "spdp_interval",
-                &format!("{:?}", self.spdp_interval),
-                "must be non-zero and not longer than the lease duration",
-            ));
+            return Err(ConfigError::SpdpInterval {
+                spdp_interval: self.spdp_interval,
+                lease_duration: self.lease_duration,
+            });
         }
-        let top = crate::transport::ports::metatraffic_unicast(
-            self.domain_id,
-            self.max_participant_index,
-        );
-        if top.is_none() {
-            return Err(invalid(
-                "max_participant_index",
-                &self.max_participant_index.to_string(),
-                "ports would exceed 65535",
-            ));
-        }
-        if let ParticipantIndex::Fixed(i) = self.participant_index {
-            if crate::transport::ports::user_unicast(self.domain_id, i).is_none() {
-                return Err(invalid(
-                    "participant_index",
-                    &i.to_string(),
-                    "ports would exceed 65535",
-                ));
+        ports::check(self.domain_id, self.max_participant_index).map_err(|source| {
+            ConfigError::Port {
+                name: "max_participant_index",
+                source,
             }
+        })?;
+        if let ParticipantIndex::Fixed(i) = self.participant_index {
+            ports::check(self.domain_id, i)?;
         }
         Ok(())
     }
@@ -371,13 +416,85 @@ mod tests {
 
     #[test]
     fn bad_values_are_errors() {
-        assert!(env(&[("DDS_DOMAIN_ID", "x")]).is_err());
-        assert!(env(&[("DDS_DOMAIN_ID", "233")]).is_err());
-        assert!(env(&[("DDS_MULTICAST", "maybe")]).is_err());
-        assert!(env(&[("DDS_PEERS", "host.example")]).is_err());
-        assert!(env(&[("DDS_FRAGMENT_SIZE", "20000")]).is_err());
-        assert!(env(&[("DDS_PARTICIPANT_INDEX", "40000")]).is_err());
-        assert!(env(&[("DDS_WRITE_BATCH", "soon")]).is_err());
+        assert!(matches!(
+            env(&[("DDS_DOMAIN_ID", "x")]),
+            Err(ConfigError::NotANumber { name: "DDS_DOMAIN_ID", value }) if value == "x"
+        ));
+        assert_eq!(
+            env(&[("DDS_DOMAIN_ID", "233")]),
+            Err(ConfigError::Port {
+                name: "domain_id",
+                source: PortError::Domain { domain: 233 }
+            })
+        );
+        assert!(matches!(
+            env(&[("DDS_MULTICAST", "maybe")]),
+            Err(ConfigError::NotOnOff { name: "DDS_MULTICAST", value }) if value == "maybe"
+        ));
+        assert!(matches!(
+            env(&[("DDS_PEERS", "host.example")]),
+            Err(ConfigError::Peer { value }) if value == "host.example"
+        ));
+        assert_eq!(
+            env(&[("DDS_FRAGMENT_SIZE", "20000")]),
+            Err(ConfigError::FragmentTooLarge {
+                fragment_size: 20000,
+                max_message_size: 14720
+            })
+        );
+        assert_eq!(
+            env(&[("DDS_PARTICIPANT_INDEX", "40000")]),
+            Err(ConfigError::Port {
+                name: "participant_index",
+                source: PortError::ParticipantIndex {
+                    domain: 0,
+                    index: 40000
+                }
+            })
+        );
+        assert!(matches!(
+            env(&[("DDS_WRITE_BATCH", "soon")]),
+            Err(ConfigError::WriteBatch { value }) if value == "soon"
+        ));
+    }
+
+    #[test]
+    fn ranges_and_relations_are_checked() {
+        assert_eq!(
+            env(&[("DDS_FRAGMENT_SIZE", "100")]),
+            Err(ConfigError::OutOfRange {
+                name: "fragment_size",
+                value: 100,
+                min: 256,
+                max: 65000
+            })
+        );
+        assert_eq!(
+            env(&[("DDS_MAX_MESSAGE_SIZE", "70000")]),
+            Err(ConfigError::OutOfRange {
+                name: "max_message_size",
+                value: 70000,
+                min: 512,
+                max: 65500
+            })
+        );
+        assert!(matches!(
+            env(&[("DDS_SPDP_INTERVAL_MS", "0")]),
+            Err(ConfigError::SpdpInterval { .. })
+        ));
+        assert_eq!(
+            env(&[
+                ("DDS_DOMAIN_ID", "232"),
+                ("DDS_MAX_PARTICIPANT_INDEX", "100")
+            ]),
+            Err(ConfigError::Port {
+                name: "max_participant_index",
+                source: PortError::ParticipantIndex {
+                    domain: 232,
+                    index: 100
+                }
+            })
+        );
     }
 
     #[test]

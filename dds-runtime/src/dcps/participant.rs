@@ -697,7 +697,8 @@ impl DomainParticipantBuilder {
             transport.participant_index().unwrap_or(0),
             prefix,
             ip,
-        );
+        )
+        .map_err(crate::config::ConfigError::from)?;
         pc.metatraffic_unicast = vec![locator(transport.metatraffic_unicast())];
         pc.default_unicast = vec![locator(transport.user_unicast())];
         pc.metatraffic_multicast = transport

@@ -5,7 +5,7 @@ use std::ops::Deref;
 use std::sync::Arc;
 use std::time::Duration;
 
-use super::discovery::{ParticipantData, ReaderData, WriterData};
+use super::discovery::{ports, ParticipantData, ReaderData, WriterData};
 use super::types::*;
 use crate::qos::{QosPolicyId, ReaderQos, WriterQos};
 use crate::xtypes::TypeInformation;
@@ -161,30 +161,29 @@ pub struct ParticipantConfig {
 
 impl ParticipantConfig {
     /// A configuration for one IPv4 unicast address with the standard ports (PB 7400, DG 250, PG 2, d0..d3 =
-    /// 0, 10, 1, 11) and SPDP multicast to 239.255.0.1.
+    /// 0, 10, 1, 11) and SPDP multicast to 239.255.0.1. Fails when a port would exceed 65535.
     pub fn new(
         domain_id: u32,
         participant_id: u32,
         guid_prefix: GuidPrefix,
         unicast_ip: [u8; 4],
-    ) -> Self {
-        use super::discovery::ports;
-        let mc = [239, 255, 0, 1];
-        ParticipantConfig {
+    ) -> Result<Self, ports::PortError> {
+        let mc = ports::SPDP_MULTICAST_GROUP.octets();
+        Ok(ParticipantConfig {
             domain_id,
             participant_id,
             guid_prefix,
             vendor_id: VendorId::THIS,
             metatraffic_unicast: vec![Locator::udpv4(
                 unicast_ip,
-                ports::metatraffic_unicast(domain_id, participant_id),
+                ports::metatraffic_unicast(domain_id, participant_id)?,
             )],
-            metatraffic_multicast: vec![Locator::udpv4(mc, ports::spdp_multicast(domain_id))],
+            metatraffic_multicast: vec![Locator::udpv4(mc, ports::spdp_multicast(domain_id)?)],
             default_unicast: vec![Locator::udpv4(
                 unicast_ip,
-                ports::user_unicast(domain_id, participant_id),
+                ports::user_unicast(domain_id, participant_id)?,
             )],
-            default_multicast: vec![Locator::udpv4(mc, ports::user_multicast(domain_id))],
+            default_multicast: vec![Locator::udpv4(mc, ports::user_multicast(domain_id)?)],
             spdp_interval: Duration::from_secs(3),
             lease_duration: Duration::from_secs(10),
             initial_peers: Vec::new(),
@@ -206,7 +205,7 @@ impl ParticipantConfig {
             writer_linger_duration: Duration::from_secs(1),
             max_repair_bytes: 256 * 1024,
             write_batch_delay: None,
-        }
+        })
     }
 }
 

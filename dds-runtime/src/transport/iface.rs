@@ -1,8 +1,10 @@
 //! Network interface discovery and selection (IPv4 only).
+//!
+//! On Unix the list comes from `getifaddrs`; elsewhere from [`list_portable`], which knows only the loopback
+//! address and the address the host would send multicast from.
 
-use std::ffi::CStr;
 use std::io;
-use std::net::Ipv4Addr;
+use std::net::{Ipv4Addr, SocketAddrV4, UdpSocket};
 
 use crate::config::InterfaceSelection;
 
@@ -25,6 +27,49 @@ pub struct Interface {
 
 /// All IPv4 interface addresses of this host (of this network namespace).
 pub fn list() -> io::Result<Vec<Interface>> {
+    os_list()
+}
+
+#[cfg(not(unix))]
+fn os_list() -> io::Result<Vec<Interface>> {
+    list_portable()
+}
+
+/// The portable fallback of [`list`]: loopback (`lo`, index 0), and the address the host picks as the source
+/// of a datagram to the SPDP multicast group (`default`, index 0: multicast is joined by address), when there
+/// is a route. Connecting a UDP socket sends nothing.
+pub fn list_portable() -> io::Result<Vec<Interface>> {
+    let mut out = vec![Interface {
+        name: "lo".into(),
+        index: 0,
+        addr: Ipv4Addr::LOCALHOST,
+        up: true,
+        loopback: true,
+        multicast: true,
+    }];
+    let probe = UdpSocket::bind(SocketAddrV4::new(Ipv4Addr::UNSPECIFIED, 0))?;
+    let group = crate::rtps::discovery::ports::SPDP_MULTICAST_GROUP;
+    if probe.connect(SocketAddrV4::new(group, 7400)).is_ok() {
+        if let Ok(std::net::SocketAddr::V4(a)) = probe.local_addr() {
+            if !a.ip().is_loopback() && !a.ip().is_unspecified() {
+                out.push(Interface {
+                    name: "default".into(),
+                    index: 0,
+                    addr: *a.ip(),
+                    up: true,
+                    loopback: false,
+                    multicast: true,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Every AF_INET address of `getifaddrs`.
+#[cfg(unix)]
+fn os_list() -> io::Result<Vec<Interface>> {
+    use std::ffi::CStr;
     let mut out = Vec::new();
     let mut head: *mut libc::ifaddrs = std::ptr::null_mut();
     // SAFETY: getifaddrs fills `head` with a list we free below with freeifaddrs.
@@ -151,5 +196,21 @@ mod tests {
     fn host_has_some_ipv4_interface() {
         let all = list().unwrap();
         assert!(all.iter().any(|i| i.loopback), "{all:?}");
+    }
+
+    #[test]
+    fn portable_list_has_loopback_first() {
+        let all = list_portable().unwrap();
+        assert_eq!(all[0].addr, Ipv4Addr::LOCALHOST);
+        assert!(
+            all.iter().all(|i| i.up && !i.addr.is_unspecified()),
+            "{all:?}"
+        );
+        assert_eq!(
+            select(&InterfaceSelection::Name("lo".into()), &all)
+                .unwrap()
+                .addr,
+            Ipv4Addr::LOCALHOST
+        );
     }
 }

@@ -1,4 +1,5 @@
-//! UDPv4 transport: interface selection, the RTPS port formula, participant index probing, the shared
+//! UDPv4 transport: interface selection, participant index probing (with the core's port formula,
+//! [`crate::rtps::discovery::ports`]), the shared
 //! SPDP multicast socket and receive threads.
 //!
 //! The transport knows nothing of RTPS messages. Receive threads hand every datagram to a
@@ -13,12 +14,18 @@
 //! - when multicast is on, the SPDP multicast socket: `SO_REUSEADDR` + `SO_REUSEPORT` on the domain's
 //!   discovery port, joined to 239.255.0.1 on the selected interface only (`IP_MULTICAST_ALL` off).
 //!
-//! Receive threads read with `recvmmsg` (up to 8 datagrams per call) and hand the whole batch to the
-//! receiver, so the core's lock is taken once per batch. Sends are one `sendto` per datagram.
+//! On Linux, receive threads read with `recvmmsg` (up to 8 datagrams per call) and hand the whole batch to
+//! the receiver, so the core's lock is taken once per batch; elsewhere, or with [`ReceivePath::OneByOne`],
+//! they read one datagram per `recv_from`. Sends are one `sendto` per datagram. Options that only Linux has
+//! (`SO_RCVBUFFORCE`, `IP_MULTICAST_ALL`) are set only there.
 
 pub mod iface;
-pub mod ports;
+#[cfg(target_os = "linux")]
+mod mmsg;
+mod recv;
+mod socket;
 mod udp;
 
 pub use iface::Interface;
+pub use recv::ReceivePath;
 pub use udp::{Channel, Datagram, Receiver, TransportStats, UdpTransport};

@@ -6,6 +6,7 @@
 pub struct TypeInformation(pub Vec<u8>);
 
 impl TypeInformation {
+    /// The serialized bytes, as received or to be announced.
     pub fn as_bytes(&self) -> &[u8] {
         &self.0
     }

@@ -95,7 +95,7 @@ pub fn prefix(i: usize) -> GuidPrefix {
 }
 
 pub fn config(i: usize) -> ParticipantConfig {
-    let mut c = ParticipantConfig::new(0, 0, prefix(i), [10, 0, 0, i as u8 + 1]);
+    let mut c = ParticipantConfig::new(0, 0, prefix(i), [10, 0, 0, i as u8 + 1]).unwrap();
     c.spdp_interval = Duration::from_millis(500);
     c.lease_duration = Duration::from_secs(3);
     c

@@ -11,7 +11,7 @@ use proptest::prelude::*;
 
 #[derive(DdsType, Debug, PartialEq, Clone, Copy)]
 #[dds(name = "Fam::Color")]
-pub enum Color {
+pub(crate) enum Color {
     Red,
     Green = 5,
     Blue,
@@ -19,7 +19,7 @@ pub enum Color {
 
 #[derive(DdsType, Debug, PartialEq, Clone, Copy)]
 #[dds(bit_bound = 8)]
-pub enum Small {
+pub(crate) enum Small {
     A,
     B,
     C,
@@ -27,7 +27,7 @@ pub enum Small {
 
 #[derive(DdsType, Debug, PartialEq, Clone, Copy)]
 #[dds(bit_bound = 16)]
-pub enum Medium {
+pub(crate) enum Medium {
     X,
     Y,
 }
@@ -35,7 +35,7 @@ pub enum Medium {
 bitflags::bitflags! {
     #[derive(DdsType, Debug, PartialEq, Eq, Clone, Copy)]
     #[dds(bitmask, bit_bound = 12)]
-    pub struct Flags: u16 {
+    pub(crate) struct Flags: u16 {
         const A = 1;
         const B = 1 << 11;
     }
@@ -44,7 +44,7 @@ bitflags::bitflags! {
 bitflags::bitflags! {
     #[derive(DdsType, Debug, PartialEq, Eq, Clone, Copy)]
     #[dds(bitmask, bit_bound = 64)]
-    pub struct WideFlags: u64 {
+    pub(crate) struct WideFlags: u64 {
         const HIGH = 1 << 63;
         const LOW = 1;
     }
@@ -53,15 +53,15 @@ bitflags::bitflags! {
 /// A bitset's storage: a transparent newtype.
 #[derive(DdsType, Debug, PartialEq, Clone, Copy)]
 #[dds(transparent)]
-pub struct Bits(pub u32);
+pub(crate) struct Bits(pub u32);
 
 #[derive(DdsType, Debug, PartialEq, Clone)]
 #[dds(transparent)]
-pub struct Name(#[dds(bound = 16)] pub String);
+pub(crate) struct Name(#[dds(bound = 16)] pub String);
 
 #[derive(DdsType, Debug, PartialEq, Clone)]
 #[dds(discriminator = Color)]
-pub enum Choice {
+pub(crate) enum Choice {
     #[dds(case = Color::Red)]
     Int(i32),
     #[dds(case = Color::Green)]
@@ -72,7 +72,7 @@ pub enum Choice {
 
 #[derive(DdsType, Debug, PartialEq, Clone)]
 #[dds(final, discriminator = i16)]
-pub enum Tagged {
+pub(crate) enum Tagged {
     #[dds(case = -3)]
     Neg(f64),
     #[dds(case = 7)]
@@ -83,76 +83,76 @@ pub enum Tagged {
 
 #[derive(DdsType, Debug, PartialEq, Clone)]
 #[dds(mutable)]
-pub struct InnerM {
-    pub a: u8,
-    pub b: Option<String>,
-    pub c: [u64; 2],
+pub(crate) struct InnerM {
+    pub(crate) a: u8,
+    pub(crate) b: Option<String>,
+    pub(crate) c: [u64; 2],
 }
 
 #[derive(DdsType, Debug, PartialEq, Clone)]
 #[dds(appendable)]
-pub struct InnerA {
-    pub x: i64,
-    pub y: Vec<InnerM>,
+pub(crate) struct InnerA {
+    pub(crate) x: i64,
+    pub(crate) y: Vec<InnerM>,
 }
 
 #[derive(DdsType, Debug, PartialEq, Clone)]
 #[dds(final)]
-pub struct InnerF {
-    pub p: u8,
-    pub q: f64,
+pub(crate) struct InnerF {
+    pub(crate) p: u8,
+    pub(crate) q: f64,
 }
 
 macro_rules! family {
     ($name:ident, $ext:literal) => {
         #[derive(DdsType, Debug, PartialEq, Clone)]
         #[dds(extensibility = $ext)]
-        pub struct $name {
+        pub(crate) struct $name {
             #[dds(key)]
-            pub id: u32,
-            pub b: bool,
-            pub o: u8,
-            pub i8_: i8,
-            pub c: char,
-            pub wc: WChar,
-            pub s16: i16,
-            pub u16_: u16,
-            pub s32: i32,
-            pub u32_: u32,
-            pub s64: i64,
-            pub u64_: u64,
-            pub f: f32,
-            pub d: f64,
-            pub ld: LongDouble,
-            pub s: String,
+            pub(crate) id: u32,
+            pub(crate) b: bool,
+            pub(crate) o: u8,
+            pub(crate) i8_: i8,
+            pub(crate) c: char,
+            pub(crate) wc: WChar,
+            pub(crate) s16: i16,
+            pub(crate) u16_: u16,
+            pub(crate) s32: i32,
+            pub(crate) u32_: u32,
+            pub(crate) s64: i64,
+            pub(crate) u64_: u64,
+            pub(crate) f: f32,
+            pub(crate) d: f64,
+            pub(crate) ld: LongDouble,
+            pub(crate) s: String,
             #[dds(bound = 8)]
-            pub bs: String,
-            pub ws: WString,
-            pub vu: Vec<u16>,
-            pub vb: Vec<bool>,
-            pub vf: Vec<f64>,
-            pub vs: Vec<String>,
-            pub vv: Vec<Vec<i64>>,
-            pub arr: [[i16; 2]; 3],
-            pub sarr: [String; 2],
-            pub map: BTreeMap<i32, String>,
-            pub e: Color,
-            pub e8: Small,
-            pub e16: Medium,
-            pub ve: Vec<Small>,
-            pub fl: Flags,
-            pub wf: WideFlags,
-            pub bits: Bits,
-            pub name: Name,
-            pub u: Choice,
-            pub t: Tagged,
-            pub opt: Option<i64>,
-            pub optv: Option<Vec<u8>>,
-            pub ia: InnerA,
-            pub im: InnerM,
-            pub fi: [InnerF; 2],
+            pub(crate) bs: String,
+            pub(crate) ws: WString,
+            pub(crate) vu: Vec<u16>,
+            pub(crate) vb: Vec<bool>,
+            pub(crate) vf: Vec<f64>,
+            pub(crate) vs: Vec<String>,
+            pub(crate) vv: Vec<Vec<i64>>,
+            pub(crate) arr: [[i16; 2]; 3],
+            pub(crate) sarr: [String; 2],
+            pub(crate) map: BTreeMap<i32, String>,
+            pub(crate) e: Color,
+            pub(crate) e8: Small,
+            pub(crate) e16: Medium,
+            pub(crate) ve: Vec<Small>,
+            pub(crate) fl: Flags,
+            pub(crate) wf: WideFlags,
+            pub(crate) bits: Bits,
+            pub(crate) name: Name,
+            pub(crate) u: Choice,
+            pub(crate) t: Tagged,
+            pub(crate) opt: Option<i64>,
+            pub(crate) optv: Option<Vec<u8>>,
+            pub(crate) ia: InnerA,
+            pub(crate) im: InnerM,
+            pub(crate) fi: [InnerF; 2],
             #[dds(external)]
-            pub ext: Box<InnerF>,
+            pub(crate) ext: Box<InnerF>,
         }
     };
 }
@@ -161,19 +161,19 @@ family!(FamFinal, "final");
 family!(FamAppendable, "appendable");
 family!(FamMutable, "mutable");
 
-pub fn latin1() -> impl Strategy<Value = char> {
+pub(crate) fn latin1() -> impl Strategy<Value = char> {
     (0u8..=255).prop_map(char::from)
 }
 
-pub fn text() -> impl Strategy<Value = String> {
+pub(crate) fn text() -> impl Strategy<Value = String> {
     "[a-zA-Z0-9 éß€]{0,12}"
 }
 
-pub fn finite64() -> impl Strategy<Value = f64> {
+pub(crate) fn finite64() -> impl Strategy<Value = f64> {
     any::<f64>().prop_filter("finite", |v| v.is_finite())
 }
 
-pub fn inner_m() -> impl Strategy<Value = InnerM> {
+pub(crate) fn inner_m() -> impl Strategy<Value = InnerM> {
     (any::<u8>(), proptest::option::of(text()), any::<[u64; 2]>()).prop_map(|(a, b, c)| InnerM {
         a,
         b,
@@ -181,19 +181,19 @@ pub fn inner_m() -> impl Strategy<Value = InnerM> {
     })
 }
 
-pub fn inner_a() -> impl Strategy<Value = InnerA> {
+pub(crate) fn inner_a() -> impl Strategy<Value = InnerA> {
     (any::<i64>(), proptest::collection::vec(inner_m(), 0..3)).prop_map(|(x, y)| InnerA { x, y })
 }
 
-pub fn inner_f() -> impl Strategy<Value = InnerF> {
+pub(crate) fn inner_f() -> impl Strategy<Value = InnerF> {
     (any::<u8>(), finite64()).prop_map(|(p, q)| InnerF { p, q })
 }
 
-pub fn color() -> impl Strategy<Value = Color> {
+pub(crate) fn color() -> impl Strategy<Value = Color> {
     prop_oneof![Just(Color::Red), Just(Color::Green), Just(Color::Blue)]
 }
 
-pub fn choice() -> impl Strategy<Value = Choice> {
+pub(crate) fn choice() -> impl Strategy<Value = Choice> {
     prop_oneof![
         any::<i32>().prop_map(Choice::Int),
         text().prop_map(Choice::Text),
@@ -201,7 +201,7 @@ pub fn choice() -> impl Strategy<Value = Choice> {
     ]
 }
 
-pub fn tagged() -> impl Strategy<Value = Tagged> {
+pub(crate) fn tagged() -> impl Strategy<Value = Tagged> {
     prop_oneof![
         finite64().prop_map(Tagged::Neg),
         Just(Tagged::Empty),
@@ -212,7 +212,7 @@ pub fn tagged() -> impl Strategy<Value = Tagged> {
 /// Everything but the id, as one tuple per group (proptest tuples stop at 12).
 macro_rules! family_strategy {
     ($fn:ident, $name:ident) => {
-        pub fn $fn() -> impl Strategy<Value = $name> {
+        pub(crate) fn $fn() -> impl Strategy<Value = $name> {
             let prims = (
                 any::<u32>(),
                 any::<bool>(),

@@ -1,0 +1,74 @@
+//! Whole payloads: the encapsulation header, then the sample, then the padding recorded in the header options.
+
+use super::error::{DecodeError, EncodeError};
+use super::header::{ByteOrder, EncapsulationHeader, XcdrVersion};
+use super::reader::CdrReader;
+use super::traits::DdsType;
+use super::writer::{CdrWriter, EncodeMode};
+
+fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut Vec<u8>) -> usize {
+    let start = out.len();
+    out.extend_from_slice(
+        &EncapsulationHeader::for_type(version, T::EXTENSIBILITY, order).to_bytes(),
+    );
+    start
+}
+
+/// Pads the payload to a multiple of 4 and records the padding in the header options, as Cyclone DDS does;
+/// on error removes what was appended.
+fn finish_payload(
+    start: usize,
+    r: Result<(), EncodeError>,
+    out: &mut Vec<u8>,
+) -> Result<(), EncodeError> {
+    if let Err(e) = r {
+        out.truncate(start);
+        return Err(e);
+    }
+    let pad = (out.len() - start).wrapping_neg() & 3;
+    out.extend_from_slice(&[0u8; 3][..pad]);
+    out[start + 3] = (out[start + 3] & !3) | pad as u8;
+    Ok(())
+}
+
+/// Appends the encapsulation header and the encoding of `sample` in `mode`, then pads (see [`finish_payload`]).
+pub(crate) fn encode_payload<T: DdsType>(
+    sample: &T,
+    version: XcdrVersion,
+    order: ByteOrder,
+    mode: EncodeMode,
+    out: &mut Vec<u8>,
+) -> Result<(), EncodeError> {
+    let start = start_payload::<T>(version, order, out);
+    let r = sample.encode(&mut CdrWriter::new(out, version, order, mode));
+    finish_payload(start, r, out)
+}
+
+/// Decodes a payload that starts with its encapsulation header; `key_only` for a key-only payload.
+pub(crate) fn decode_payload<T: DdsType>(payload: &[u8], key_only: bool) -> Result<T, DecodeError> {
+    let h = EncapsulationHeader::parse(payload)?;
+    let mut r = CdrReader::new(
+        payload,
+        EncapsulationHeader::SIZE,
+        h.version()?,
+        h.byte_order(),
+        key_only,
+    );
+    T::decode(&mut r)
+}
+
+/// Appends the encapsulation header and the encoding of `sample` to `out`. Allocates nothing when `out` has
+/// enough capacity.
+pub fn serialize<T: DdsType>(
+    sample: &T,
+    version: XcdrVersion,
+    order: ByteOrder,
+    out: &mut Vec<u8>,
+) -> Result<(), EncodeError> {
+    encode_payload(sample, version, order, EncodeMode::Sample, out)
+}
+
+/// Decodes a payload that starts with its encapsulation header. Never panics; see [`DecodeError`].
+pub fn deserialize<T: DdsType>(payload: &[u8]) -> Result<T, DecodeError> {
+    decode_payload(payload, false)
+}
