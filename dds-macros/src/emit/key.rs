@@ -7,7 +7,7 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::{base_in_consts, bound_option, ext_tokens, Members};
+use super::{base_in_consts, bound_option, ext_tokens, union_case_consts, Members};
 use crate::attrs::Ext;
 use crate::model::{Container, Enum, Field, Struct, Union};
 
@@ -83,19 +83,16 @@ fn scan(c: &Container, f: &Field) -> TokenStream {
 pub(super) fn struct_key_max_end(c: &Container, ext: Ext) -> TokenStream {
     let cdr = c.cdr();
     let ext_t = ext_tokens(c, ext);
-    quote! {
-        fn key_max_end(
-            start: usize,
-            version: #cdr::XcdrVersion,
-            _bound: ::core::option::Option<usize>,
-        ) -> ::core::option::Option<usize> {
+    key_max_end_fn(
+        c,
+        quote! {
             if start > 64 {
                 return ::core::option::Option::None;
             }
             // The hashed key stream is plain: no DHEADER, EMHEADER or parameter list.
             <Self as #cdr::StructMembers>::key_members_max_end(start, version, #ext_t)
-        }
-    }
+        },
+    )
 }
 
 /// A struct's `CdrType::KEY_HAS_MUTABLE`: a mutable type on the key path (the struct itself, its key members
@@ -118,17 +115,8 @@ pub(super) fn struct_key_has_mutable(c: &Container, s: &Struct, m: &Members) -> 
 
 /// A union's `CdrType::KEY_HAS_MUTABLE`.
 pub(super) fn union_key_has_mutable(c: &Container, u: &Union) -> TokenStream {
-    let cdr = c.cdr();
     let is_mutable = u.ext == Ext::Mutable;
-    let terms = u
-        .cases
-        .iter()
-        .filter_map(|k| k.payload.as_ref())
-        .filter(|p| !p.self_ref)
-        .map(|p| {
-            let ty = p.ty;
-            quote!(<#ty as #cdr::CdrType>::KEY_HAS_MUTABLE)
-        });
+    let terms = union_case_consts(c, u, "KEY_HAS_MUTABLE");
     quote!(#is_mutable #(|| #terms)*)
 }
 
@@ -143,12 +131,9 @@ pub(super) fn union_key_max_end(c: &Container, u: &Union) -> TokenStream {
             end = end.max(<#ty as #cdr::CdrType>::key_max_end(p, version, #bo)?);
         })
     });
-    quote! {
-        fn key_max_end(
-            start: usize,
-            version: #cdr::XcdrVersion,
-            _bound: ::core::option::Option<usize>,
-        ) -> ::core::option::Option<usize> {
+    key_max_end_fn(
+        c,
+        quote! {
             if start > 64 {
                 return ::core::option::Option::None;
             }
@@ -157,22 +142,34 @@ pub(super) fn union_key_max_end(c: &Container, u: &Union) -> TokenStream {
             let mut end = p;
             #(#terms)*
             ::core::option::Option::Some(end)
-        }
-    }
+        },
+    )
 }
 
 /// An enum's `CdrType::key_max_end`: one primitive of the enum's size.
 pub(super) fn enum_key_max_end(c: &Container, e: &Enum) -> TokenStream {
     let cdr = c.cdr();
     let size = usize::from(e.size());
+    key_max_end_fn(
+        c,
+        quote! {
+            let size = #size;
+            ::core::option::Option::Some(#cdr::members::prim_end(start, size, version))
+        },
+    )
+}
+
+/// `CdrType::key_max_end` (the largest end of the plain key stream from `start`, or `None` past 16 bytes'
+/// reach) with `body`; the bound argument is not used.
+pub(super) fn key_max_end_fn(c: &Container, body: TokenStream) -> TokenStream {
+    let cdr = c.cdr();
     quote! {
         fn key_max_end(
             start: usize,
             version: #cdr::XcdrVersion,
             _bound: ::core::option::Option<usize>,
         ) -> ::core::option::Option<usize> {
-            let size = #size;
-            ::core::option::Option::Some(#cdr::members::prim_end(start, size, version))
+            #body
         }
     }
 }

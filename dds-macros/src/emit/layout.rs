@@ -4,7 +4,7 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::{base_in_consts, Members};
+use super::{base_in_consts, union_case_consts, Members};
 use crate::attrs::Ext;
 use crate::model::{Container, MemberId, Struct, Union};
 
@@ -62,14 +62,6 @@ pub(super) fn union_xcdr1_plain(c: &Container, u: &Union) -> TokenStream {
     let cdr = c.cdr();
     let is_final = u.ext == Ext::Final;
     let disc = &u.disc;
-    let terms = u
-        .cases
-        .iter()
-        .filter_map(|k| k.payload.as_ref())
-        .filter(|p| !p.self_ref)
-        .map(|p| {
-            let ty = p.ty;
-            quote!(<#ty as #cdr::CdrType>::XCDR1_PLAIN)
-        });
+    let terms = union_case_consts(c, u, "XCDR1_PLAIN");
     quote!(#is_final && <#disc as #cdr::CdrType>::XCDR1_PLAIN #(&& #terms)*)
 }

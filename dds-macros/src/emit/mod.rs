@@ -255,6 +255,21 @@ fn base_in_consts<'a>(c: &Container, s: &Struct<'a>) -> Option<&'a syn::Type> {
         .filter(|bt| !mentions(bt, c.ident()))
 }
 
+/// `<T as CdrType>::NAME` for the payload type of every union case that may appear in constants.
+fn union_case_consts(c: &Container, u: &Union, name: &str) -> Vec<TokenStream> {
+    let cdr = c.cdr();
+    let name = syn::Ident::new(name, proc_macro2::Span::call_site());
+    u.cases
+        .iter()
+        .filter_map(|k| k.payload.as_ref())
+        .filter(|p| !p.self_ref)
+        .map(|p| {
+            let ty = p.ty;
+            quote!(<#ty as #cdr::CdrType>::#name)
+        })
+        .collect()
+}
+
 /// A struct member's id as an expression.
 fn member_id(c: &Container, s: &Struct, id: MemberId) -> TokenStream {
     let cdr = c.cdr();

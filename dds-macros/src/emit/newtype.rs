@@ -3,7 +3,7 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::{describe, impl_attrs};
+use super::{describe, impl_attrs, key};
 use crate::attrs::Ext;
 use crate::model::{Bitmask, Container, Transparent};
 
@@ -87,6 +87,10 @@ pub(super) fn bitmask(c: &Container, b: &Bitmask) -> TokenStream {
     let type_name = &c.type_name;
     let bf = quote!(#rt::__private::bitflags::Flags);
     let attrs = impl_attrs();
+    let key_max_end = key::key_max_end_fn(
+        c,
+        quote!(::core::option::Option::Some(#cdr::members::prim_end(start, #size_usize, version))),
+    );
     let dds_type = describe::dds_type(c, &c.input.generics, Ext::Final, quote!(false), quote!(&[]));
     quote! {
         #attrs
@@ -119,13 +123,7 @@ pub(super) fn bitmask(c: &Container, b: &Bitmask) -> TokenStream {
                 <Self as #bf>::empty()
             }
 
-            fn key_max_end(
-                start: usize,
-                version: #cdr::XcdrVersion,
-                _bound: ::core::option::Option<usize>,
-            ) -> ::core::option::Option<usize> {
-                ::core::option::Option::Some(#cdr::members::prim_end(start, #size_usize, version))
-            }
+            #key_max_end
         }
 
         #dds_type
