@@ -267,3 +267,38 @@ pub(crate) fn parse_int_expr(e: &Expr) -> Result<i64> {
         _ => Err(syn::Error::new_spanned(e, "expected an integer literal")),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_unknown_item_is_reported_and_the_items_after_it_still_read() {
+        let attrs: [Attribute; 2] = [
+            syn::parse_quote!(#[dds(keyy = 3, key, tag(x), bound = 4)]),
+            syn::parse_quote!(#[dds(hashid = "h")]),
+        ];
+        let mut cx = Ctxt::default();
+        let a = parse_field_attrs(&mut cx, &attrs);
+        assert!(a.key.is_some() && a.bound.is_some());
+        assert_eq!(a.hashid, HashId::Of("h".into()));
+        let errors = cx.finish().unwrap_err();
+        assert_eq!(errors.into_iter().count(), 2);
+    }
+
+    #[test]
+    fn a_bad_value_is_reported_and_parsing_goes_on() {
+        let attr: Attribute =
+            syn::parse_quote!(#[dds(extensibility = "flexible", autoid = "x", id = 5, mutable)]);
+        let mut cx = Ctxt::default();
+        let t = parse_type_attrs(&mut cx, std::slice::from_ref(&attr));
+        assert_eq!(t.ext, Some(Ext::Mutable));
+        assert_eq!(cx.finish().unwrap_err().into_iter().count(), 3);
+    }
+
+    #[test]
+    fn negative_and_parenthesized_integers() {
+        assert_eq!(parse_int_expr(&syn::parse_quote!(-(3))).unwrap(), -3);
+        assert!(parse_int_expr(&syn::parse_quote!(A::B)).is_err());
+    }
+}

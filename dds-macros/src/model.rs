@@ -503,3 +503,55 @@ impl<'a> Union<'a> {
 pub(crate) fn is_boxed(f: &Field) -> bool {
     box_inner(f.inner).is_some()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn struct_ids(input: DeriveInput) -> (Vec<MemberId>, MemberId) {
+        let mut cx = Ctxt::default();
+        let c = Container::from_ast(&mut cx, &input).expect("a struct");
+        assert!(cx.finish().is_ok());
+        let Data::Struct(s) = c.data else {
+            panic!("not a struct")
+        };
+        (s.fields.iter().map(|f| f.id).collect(), s.next_id)
+    }
+
+    #[test]
+    fn ids_are_sequential_and_continue_after_an_explicit_or_hashed_id() {
+        use MemberId::Absolute as A;
+        let (ids, next) = struct_ids(syn::parse_quote! {
+            struct S { a: u8, #[dds(id = 10)] b: u8, c: u8, #[dds(hashid)] d: u8, e: u8 }
+        });
+        let h = hash_id("d");
+        assert_eq!(ids, [A(0), A(10), A(11), A(h), A(h + 1)]);
+        assert_eq!(next, A(h + 2));
+    }
+
+    #[test]
+    fn hashid_of_a_string_and_autoid_hash() {
+        let (ids, _) = struct_ids(syn::parse_quote! {
+            #[dds(autoid = "hash")]
+            struct S { #[dds(name = "wire")] a: u8, #[dds(hashid = "other")] b: u8, #[dds(id = 3)] c: u8 }
+        });
+        let expected = [hash_id("wire"), hash_id("other"), 3].map(MemberId::Absolute);
+        assert_eq!(ids, expected);
+    }
+
+    #[test]
+    fn ids_after_a_base_are_relative_until_an_explicit_id() {
+        use MemberId::{Absolute as A, AfterBase as B};
+        let (ids, next) = struct_ids(syn::parse_quote! {
+            struct D { #[dds(base)] base: Base, a: u8, b: u8, #[dds(id = 7)] c: u8, d: u8 }
+        });
+        assert_eq!(ids, [B(0), B(1), A(7), A(8)]);
+        assert_eq!(next, A(9));
+    }
+
+    #[test]
+    fn hash_id_is_md5_little_endian_masked_to_28_bits() {
+        // MD5("color") = 70dda5df...: 0xdfa5dd70 & 0x0fffffff.
+        assert_eq!(hash_id("color"), 0x0fa5_dd70);
+    }
+}
