@@ -1,60 +1,117 @@
-//! Parsing of `#[dds(...)]` attributes.
+//! Parsing of `#[dds(...)]` attributes into plain values. An attribute that cannot be read is reported to the
+//! [`Ctxt`] and parsing goes on with the next one; whether the values fit the item they sit on is
+//! [`check`](crate::check)'s business.
 
+use proc_macro2::Span;
+use syn::meta::ParseNestedMeta;
 use syn::spanned::Spanned;
 use syn::{Attribute, Expr, LitInt, LitStr, Path, Result, Type};
 
+use crate::ctxt::Ctxt;
+
 /// XTypes extensibility as written in the attribute.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
-pub enum Ext {
+pub(crate) enum Ext {
+    /// `@final`: no DHEADER, members in order.
     Final,
+    /// `@appendable`: a DHEADER in XCDR2.
     Appendable,
+    /// `@mutable`: member headers (EMHEADER or parameter list).
     Mutable,
+}
+
+/// `@hashid` on a member: absent, `hashid` (hash of the member name) or `hashid = "string"`.
+#[derive(Clone, PartialEq, Eq, Debug, Default)]
+pub(crate) enum HashId {
+    /// No `hashid` attribute.
+    #[default]
+    Unset,
+    /// `hashid`: the id is the hash of the member's wire name.
+    OfName,
+    /// `hashid = "string"`: the id is the hash of the given string.
+    Of(String),
 }
 
 /// Type-level attributes.
 #[derive(Default)]
-pub struct TypeAttrs {
-    pub name: Option<String>,
-    pub ext: Option<Ext>,
-    pub nested: bool,
-    pub autoid_hash: bool,
-    pub bit_bound: Option<(u32, proc_macro2::Span)>,
-    pub discriminator: Option<Type>,
-    pub bitmask: bool,
-    pub transparent: bool,
-    pub krate: Option<Path>,
+pub(crate) struct TypeAttrs {
+    pub(crate) name: Option<String>,
+    pub(crate) ext: Option<Ext>,
+    /// `autoid = "hash"`: members without an id take the hash of their name.
+    pub(crate) autoid_hash: bool,
+    pub(crate) bit_bound: Option<(u32, Span)>,
+    pub(crate) discriminator: Option<Type>,
+    pub(crate) bitmask: bool,
+    pub(crate) transparent: bool,
+    pub(crate) krate: Option<Path>,
 }
 
 /// Field (struct member, union case payload) attributes.
 #[derive(Default)]
-pub struct FieldAttrs {
-    pub key: Option<proc_macro2::Span>,
-    pub id: Option<u32>,
-    pub hashid: Option<Option<String>>,
-    pub name: Option<String>,
-    pub optional: bool,
-    pub external: bool,
-    pub must_understand: bool,
-    pub default: Option<Expr>,
-    pub bound: Option<Expr>,
-    pub base: bool,
-    pub non_serialized: bool,
+pub(crate) struct FieldAttrs {
+    /// Where `key` was written, for errors.
+    pub(crate) key: Option<Span>,
+    pub(crate) id: Option<u32>,
+    pub(crate) hashid: HashId,
+    pub(crate) name: Option<String>,
+    pub(crate) optional: bool,
+    pub(crate) external: bool,
+    pub(crate) must_understand: bool,
+    pub(crate) default: Option<Expr>,
+    pub(crate) bound: Option<Expr>,
+    pub(crate) base: bool,
+    pub(crate) non_serialized: bool,
     /// The field's type leads back to this type (mutual recursion): left out of the compile-time constants.
-    pub recursive: bool,
+    pub(crate) recursive: bool,
 }
 
 /// Enum variant attributes (enumerators and union cases).
 #[derive(Default)]
-pub struct VariantAttrs {
-    pub value: Option<i64>,
-    pub cases: Vec<Expr>,
-    pub default: bool,
-    pub id: Option<u32>,
-    pub name: Option<String>,
+pub(crate) struct VariantAttrs {
+    pub(crate) value: Option<i64>,
+    pub(crate) cases: Vec<Expr>,
+    pub(crate) default: bool,
+    pub(crate) id: Option<u32>,
+    pub(crate) name: Option<String>,
 }
 
-fn lit_u32(l: &LitInt) -> Result<u32> {
-    l.base10_parse::<u32>()
+/// Runs `one` on every item of every `#[dds(...)]` attribute. An item `one` does not know is reported and
+/// skipped; a malformed attribute is reported and the rest of that attribute skipped.
+fn each_item(
+    cx: &mut Ctxt,
+    attrs: &[Attribute],
+    what: &str,
+    mut one: impl FnMut(&mut Ctxt, &ParseNestedMeta) -> Result<bool>,
+) {
+    for attr in attrs.iter().filter(|a| a.path().is_ident("dds")) {
+        let parsed = attr.parse_nested_meta(|m| {
+            if !one(cx, &m)? {
+                cx.syn_error(m.error(format!("unknown {what} attribute; see docs/derive.md")));
+                skip_value(&m)?;
+            }
+            Ok(())
+        });
+        cx.ok(parsed);
+    }
+}
+
+/// Consumes `= value` or `(...)` after an unknown name, so that the items after it are still read.
+fn skip_value(m: &ParseNestedMeta) -> Result<()> {
+    if m.input.peek(syn::Token![=]) {
+        m.value()?.parse::<Expr>()?;
+    } else if m.input.peek(syn::token::Paren) {
+        m.input.parse::<proc_macro2::TokenTree>()?;
+    }
+    Ok(())
+}
+
+fn lit_u32(cx: &mut Ctxt, m: &ParseNestedMeta) -> Result<Option<u32>> {
+    let l: LitInt = m.value()?.parse()?;
+    Ok(cx.ok(l.base10_parse::<u32>()))
+}
+
+fn lit_str(m: &ParseNestedMeta) -> Result<String> {
+    Ok(m.value()?.parse::<LitStr>()?.value())
 }
 
 fn ext_from(s: &LitStr) -> Result<Ext> {
@@ -69,134 +126,132 @@ fn ext_from(s: &LitStr) -> Result<Ext> {
     }
 }
 
-fn set_ext(slot: &mut Option<Ext>, v: Ext, span: &impl quote::ToTokens) -> Result<()> {
+fn set_ext(cx: &mut Ctxt, slot: &mut Option<Ext>, v: Ext, at: &impl quote::ToTokens) {
     if slot.is_some() {
-        return Err(syn::Error::new_spanned(span, "extensibility given twice"));
+        cx.error_spanned_by(at, "extensibility given twice");
     }
     *slot = Some(v);
-    Ok(())
 }
 
-pub fn parse_type_attrs(attrs: &[Attribute]) -> Result<TypeAttrs> {
+/// The attributes of the deriving type.
+pub(crate) fn parse_type_attrs(cx: &mut Ctxt, attrs: &[Attribute]) -> TypeAttrs {
     let mut t = TypeAttrs::default();
-    for attr in attrs.iter().filter(|a| a.path().is_ident("dds")) {
-        attr.parse_nested_meta(|m| {
-            let p = &m.path;
-            if p.is_ident("name") {
-                t.name = Some(m.value()?.parse::<LitStr>()?.value());
-            } else if p.is_ident("extensibility") {
-                let s: LitStr = m.value()?.parse()?;
-                set_ext(&mut t.ext, ext_from(&s)?, &s)?;
-            } else if p.is_ident("final") {
-                set_ext(&mut t.ext, Ext::Final, p)?;
-            } else if p.is_ident("appendable") {
-                set_ext(&mut t.ext, Ext::Appendable, p)?;
-            } else if p.is_ident("mutable") {
-                set_ext(&mut t.ext, Ext::Mutable, p)?;
-            } else if p.is_ident("nested") {
-                t.nested = true;
-            } else if p.is_ident("autoid") {
-                let s: LitStr = m.value()?.parse()?;
-                t.autoid_hash = match s.value().as_str() {
-                    "sequential" => false,
-                    "hash" => true,
-                    _ => {
-                        return Err(syn::Error::new_spanned(
-                            &s,
-                            "autoid must be \"sequential\" or \"hash\"",
-                        ))
-                    }
-                };
-            } else if p.is_ident("bit_bound") {
-                let l: LitInt = m.value()?.parse()?;
-                t.bit_bound = Some((lit_u32(&l)?, l.span()));
-            } else if p.is_ident("discriminator") {
-                t.discriminator = Some(m.value()?.parse::<Type>()?);
-            } else if p.is_ident("bitmask") {
-                t.bitmask = true;
-            } else if p.is_ident("transparent") {
-                t.transparent = true;
-            } else if p.is_ident("crate") {
-                let s: LitStr = m.value()?.parse()?;
-                t.krate = Some(s.parse()?);
-            } else {
-                return Err(m.error("unknown type attribute; see docs/derive.md"));
-            }
-            Ok(())
-        })?;
-    }
-    Ok(t)
+    each_item(cx, attrs, "type", |cx, m| type_item(cx, &mut t, m));
+    t
 }
 
-pub fn parse_field_attrs(attrs: &[Attribute]) -> Result<FieldAttrs> {
+fn type_item(cx: &mut Ctxt, t: &mut TypeAttrs, m: &ParseNestedMeta) -> Result<bool> {
+    let p = &m.path;
+    let shorthand = [
+        ("final", Ext::Final),
+        ("appendable", Ext::Appendable),
+        ("mutable", Ext::Mutable),
+    ];
+    if let Some((_, ext)) = shorthand.iter().find(|(n, _)| p.is_ident(n)) {
+        set_ext(cx, &mut t.ext, *ext, p);
+    } else if p.is_ident("name") {
+        t.name = Some(lit_str(m)?);
+    } else if p.is_ident("extensibility") {
+        let s: LitStr = m.value()?.parse()?;
+        if let Some(ext) = cx.ok(ext_from(&s)) {
+            set_ext(cx, &mut t.ext, ext, &s);
+        }
+    } else if p.is_ident("nested") {
+        // Metadata only: every type can be nested.
+    } else if p.is_ident("autoid") {
+        let s: LitStr = m.value()?.parse()?;
+        match s.value().as_str() {
+            "sequential" => t.autoid_hash = false,
+            "hash" => t.autoid_hash = true,
+            _ => cx.error_spanned_by(&s, "autoid must be \"sequential\" or \"hash\""),
+        }
+    } else if p.is_ident("bit_bound") {
+        let l: LitInt = m.value()?.parse()?;
+        t.bit_bound = cx.ok(l.base10_parse::<u32>()).map(|b| (b, l.span()));
+    } else if p.is_ident("discriminator") {
+        t.discriminator = Some(m.value()?.parse::<Type>()?);
+    } else if p.is_ident("bitmask") {
+        t.bitmask = true;
+    } else if p.is_ident("transparent") {
+        t.transparent = true;
+    } else if p.is_ident("crate") {
+        let s: LitStr = m.value()?.parse()?;
+        t.krate = cx.ok(s.parse());
+    } else {
+        return Ok(false);
+    }
+    Ok(true)
+}
+
+/// The attributes of a struct field or of a union case's payload.
+pub(crate) fn parse_field_attrs(cx: &mut Ctxt, attrs: &[Attribute]) -> FieldAttrs {
     let mut f = FieldAttrs::default();
-    for attr in attrs.iter().filter(|a| a.path().is_ident("dds")) {
-        attr.parse_nested_meta(|m| {
-            let p = &m.path;
-            if p.is_ident("key") {
-                f.key = Some(p.span());
-            } else if p.is_ident("id") {
-                f.id = Some(lit_u32(&m.value()?.parse::<LitInt>()?)?);
-            } else if p.is_ident("hashid") {
-                f.hashid = Some(if m.input.peek(syn::Token![=]) {
-                    Some(m.value()?.parse::<LitStr>()?.value())
-                } else {
-                    None
-                });
-            } else if p.is_ident("name") {
-                f.name = Some(m.value()?.parse::<LitStr>()?.value());
-            } else if p.is_ident("optional") {
-                f.optional = true;
-            } else if p.is_ident("external") {
-                f.external = true;
-            } else if p.is_ident("must_understand") {
-                f.must_understand = true;
-            } else if p.is_ident("default") {
-                f.default = Some(m.value()?.parse::<Expr>()?);
-            } else if p.is_ident("bound") {
-                f.bound = Some(m.value()?.parse::<Expr>()?);
-            } else if p.is_ident("base") {
-                f.base = true;
-            } else if p.is_ident("non_serialized") {
-                f.non_serialized = true;
-            } else if p.is_ident("recursive") {
-                f.recursive = true;
-            } else {
-                return Err(m.error("unknown field attribute; see docs/derive.md"));
-            }
-            Ok(())
-        })?;
-    }
-    Ok(f)
+    each_item(cx, attrs, "field", |cx, m| field_item(cx, &mut f, m));
+    f
 }
 
-pub fn parse_variant_attrs(attrs: &[Attribute]) -> Result<VariantAttrs> {
+fn field_item(cx: &mut Ctxt, f: &mut FieldAttrs, m: &ParseNestedMeta) -> Result<bool> {
+    let p = &m.path;
+    let flags = [
+        ("optional", &mut f.optional),
+        ("external", &mut f.external),
+        ("must_understand", &mut f.must_understand),
+        ("base", &mut f.base),
+        ("non_serialized", &mut f.non_serialized),
+        ("recursive", &mut f.recursive),
+    ];
+    if let Some((_, flag)) = flags.into_iter().find(|(n, _)| p.is_ident(n)) {
+        *flag = true;
+    } else if p.is_ident("key") {
+        f.key = Some(p.span());
+    } else if p.is_ident("id") {
+        f.id = lit_u32(cx, m)?;
+    } else if p.is_ident("hashid") {
+        f.hashid = if m.input.peek(syn::Token![=]) {
+            HashId::Of(lit_str(m)?)
+        } else {
+            HashId::OfName
+        };
+    } else if p.is_ident("name") {
+        f.name = Some(lit_str(m)?);
+    } else if p.is_ident("default") {
+        f.default = Some(m.value()?.parse::<Expr>()?);
+    } else if p.is_ident("bound") {
+        f.bound = Some(m.value()?.parse::<Expr>()?);
+    } else {
+        return Ok(false);
+    }
+    Ok(true)
+}
+
+/// The attributes of an enum variant (an enumerator or a union case).
+pub(crate) fn parse_variant_attrs(cx: &mut Ctxt, attrs: &[Attribute]) -> VariantAttrs {
     let mut v = VariantAttrs::default();
-    for attr in attrs.iter().filter(|a| a.path().is_ident("dds")) {
-        attr.parse_nested_meta(|m| {
-            let p = &m.path;
-            if p.is_ident("value") {
-                let e: Expr = m.value()?.parse()?;
-                v.value = Some(parse_int_expr(&e)?);
-            } else if p.is_ident("case") {
-                v.cases.push(m.value()?.parse::<Expr>()?);
-            } else if p.is_ident("default") {
-                v.default = true;
-            } else if p.is_ident("id") {
-                v.id = Some(lit_u32(&m.value()?.parse::<LitInt>()?)?);
-            } else if p.is_ident("name") {
-                v.name = Some(m.value()?.parse::<LitStr>()?.value());
-            } else {
-                return Err(m.error("unknown variant attribute; see docs/derive.md"));
-            }
-            Ok(())
-        })?;
-    }
-    Ok(v)
+    each_item(cx, attrs, "variant", |cx, m| variant_item(cx, &mut v, m));
+    v
 }
 
-/// An integer literal, possibly negated.
-pub fn parse_int_expr(e: &Expr) -> Result<i64> {
+fn variant_item(cx: &mut Ctxt, v: &mut VariantAttrs, m: &ParseNestedMeta) -> Result<bool> {
+    let p = &m.path;
+    if p.is_ident("value") {
+        let e: Expr = m.value()?.parse()?;
+        v.value = cx.ok(parse_int_expr(&e));
+    } else if p.is_ident("case") {
+        v.cases.push(m.value()?.parse::<Expr>()?);
+    } else if p.is_ident("default") {
+        v.default = true;
+    } else if p.is_ident("id") {
+        v.id = lit_u32(cx, m)?;
+    } else if p.is_ident("name") {
+        v.name = Some(lit_str(m)?);
+    } else {
+        return Ok(false);
+    }
+    Ok(true)
+}
+
+/// An integer literal, possibly negated or parenthesized.
+pub(crate) fn parse_int_expr(e: &Expr) -> Result<i64> {
     match e {
         Expr::Lit(syn::ExprLit {
             lit: syn::Lit::Int(l),
@@ -213,9 +268,37 @@ pub fn parse_int_expr(e: &Expr) -> Result<i64> {
     }
 }
 
-/// `@hashid`: MD5 of the name, first 4 bytes little-endian, masked to 28 bits.
-pub fn hash_id(name: &str) -> u32 {
-    use md5::{Digest, Md5};
-    let d = Md5::digest(name.as_bytes());
-    u32::from_le_bytes([d[0], d[1], d[2], d[3]]) & 0x0fff_ffff
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_unknown_item_is_reported_and_the_items_after_it_still_read() {
+        let attrs: [Attribute; 2] = [
+            syn::parse_quote!(#[dds(keyy = 3, key, tag(x), bound = 4)]),
+            syn::parse_quote!(#[dds(hashid = "h")]),
+        ];
+        let mut cx = Ctxt::default();
+        let a = parse_field_attrs(&mut cx, &attrs);
+        assert!(a.key.is_some() && a.bound.is_some());
+        assert_eq!(a.hashid, HashId::Of("h".into()));
+        let errors = cx.finish().unwrap_err();
+        assert_eq!(errors.into_iter().count(), 2);
+    }
+
+    #[test]
+    fn a_bad_value_is_reported_and_parsing_goes_on() {
+        let attr: Attribute =
+            syn::parse_quote!(#[dds(extensibility = "flexible", autoid = "x", id = 5, mutable)]);
+        let mut cx = Ctxt::default();
+        let t = parse_type_attrs(&mut cx, std::slice::from_ref(&attr));
+        assert_eq!(t.ext, Some(Ext::Mutable));
+        assert_eq!(cx.finish().unwrap_err().into_iter().count(), 3);
+    }
+
+    #[test]
+    fn negative_and_parenthesized_integers() {
+        assert_eq!(parse_int_expr(&syn::parse_quote!(-(3))).unwrap(), -3);
+        assert!(parse_int_expr(&syn::parse_quote!(A::B)).is_err());
+    }
 }

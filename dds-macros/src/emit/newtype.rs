@@ -1,39 +1,18 @@
-//! `#[derive(DdsType)]` for one-field tuple structs: `transparent` (typedefs, bitset storage) and `bitmask`.
+//! One-field tuple structs: `transparent` (typedefs, bitset storage) and `bitmask` (`bitflags` structs).
 
 use proc_macro2::TokenStream;
 use quote::quote;
-use syn::{DataStruct, DeriveInput, Fields, Result};
 
-use crate::attrs::{parse_field_attrs, TypeAttrs};
-use crate::util::impl_attrs;
-
-fn single_field<'a>(
-    input: &'a DeriveInput,
-    data: &'a DataStruct,
-    what: &str,
-) -> Result<&'a syn::Field> {
-    match &data.fields {
-        Fields::Unnamed(u) if u.unnamed.len() == 1 => Ok(&u.unnamed[0]),
-        _ => Err(syn::Error::new_spanned(
-            &input.ident,
-            format!("`#[dds({what})]` needs a tuple struct with exactly one field"),
-        )),
-    }
-}
+use super::{describe, impl_attrs, key};
+use crate::attrs::Ext;
+use crate::model::{Bitmask, Container, Transparent};
 
 /// A typedef: encoded exactly as its field.
-pub fn derive_transparent(
-    input: &DeriveInput,
-    data: &DataStruct,
-    _ta: &TypeAttrs,
-    rt: &TokenStream,
-) -> Result<TokenStream> {
-    let cdr = quote!(#rt::cdr);
-    let name = &input.ident;
-    let f = single_field(input, data, "transparent")?;
-    let fa = parse_field_attrs(&f.attrs)?;
-    let ty = &f.ty;
-    let (enc, dec, bo) = match &fa.bound {
+pub(super) fn transparent(c: &Container, t: &Transparent) -> TokenStream {
+    let cdr = c.cdr();
+    let name = c.ident();
+    let ty = t.ty;
+    let (enc, dec, bo) = match &t.bound {
         Some(b) => (
             quote!(<#ty as #cdr::CdrType>::encode_bounded(&self.0, w, (#b) as usize)),
             quote!(<#ty as #cdr::CdrType>::decode_bounded(r, (#b) as usize)),
@@ -45,9 +24,9 @@ pub fn derive_transparent(
             quote!(bound),
         ),
     };
-    let (impl_g, ty_g, where_c) = input.generics.split_for_impl();
+    let (impl_g, ty_g, where_c) = c.input.generics.split_for_impl();
     let attrs = impl_attrs();
-    Ok(quote! {
+    quote! {
         #attrs
         impl #impl_g #cdr::CdrType for #name #ty_g #where_c {
             const LAYOUT: #cdr::Layout = <#ty as #cdr::CdrType>::LAYOUT;
@@ -78,55 +57,42 @@ pub fn derive_transparent(
                 <#ty as #cdr::CdrType>::key_max_end(start, version, #bo)
             }
         }
-    })
+    }
 }
 
 /// A `bitflags` 2 struct: an unsigned integer sized by `bit_bound` (default 32) in both XCDR versions.
-pub fn derive_bitmask(
-    input: &DeriveInput,
-    data: &DataStruct,
-    ta: &TypeAttrs,
-    rt: &TokenStream,
-) -> Result<TokenStream> {
-    let cdr = quote!(#rt::cdr);
-    let name = &input.ident;
-    single_field(input, data, "bitmask")?;
-    let bit_bound = match ta.bit_bound {
-        Some((b, span)) if !(1..=64).contains(&b) => {
-            return Err(syn::Error::new(
-                span,
-                "a bitmask's bit_bound must be in 1..=64",
-            ));
-        }
-        Some((b, _)) => b,
-        None => 32,
-    };
-    let (size, write, read): (u8, TokenStream, TokenStream) = if bit_bound <= 8 {
-        (
+pub(super) fn bitmask(c: &Container, b: &Bitmask) -> TokenStream {
+    let cdr = c.cdr();
+    let rt = c.runtime();
+    let name = c.ident();
+    let (size, write, read): (u8, TokenStream, TokenStream) = match b.bit_bound {
+        0..=8 => (
             1,
             quote!(w.write_u8(v as u8)),
             quote!(u64::from(r.read_u8("bitmask")?)),
-        )
-    } else if bit_bound <= 16 {
-        (
+        ),
+        9..=16 => (
             2,
             quote!(w.write_u16(v as u16)),
             quote!(u64::from(r.read_u16("bitmask")?)),
-        )
-    } else if bit_bound <= 32 {
-        (
+        ),
+        17..=32 => (
             4,
             quote!(w.write_u32(v as u32)),
             quote!(u64::from(r.read_u32("bitmask")?)),
-        )
-    } else {
-        (8, quote!(w.write_u64(v)), quote!(r.read_u64("bitmask")?))
+        ),
+        _ => (8, quote!(w.write_u64(v)), quote!(r.read_u64("bitmask")?)),
     };
-    let size_usize = size as usize;
-    let type_name = ta.name.clone().unwrap_or_else(|| name.to_string());
+    let size_usize = usize::from(size);
+    let type_name = &c.type_name;
     let bf = quote!(#rt::__private::bitflags::Flags);
     let attrs = impl_attrs();
-    Ok(quote! {
+    let key_max_end = key::key_max_end_fn(
+        c,
+        quote!(::core::option::Option::Some(#cdr::members::prim_end(start, #size_usize, version))),
+    );
+    let dds_type = describe::dds_type(c, &c.input.generics, Ext::Final, quote!(false), quote!(&[]));
+    quote! {
         #attrs
         impl #cdr::CdrType for #name {
             const LAYOUT: #cdr::Layout = #cdr::Layout::Enumerated(#size);
@@ -157,28 +123,9 @@ pub fn derive_bitmask(
                 <Self as #bf>::empty()
             }
 
-            fn key_max_end(
-                start: usize,
-                version: #cdr::XcdrVersion,
-                _bound: ::core::option::Option<usize>,
-            ) -> ::core::option::Option<usize> {
-                ::core::option::Option::Some(#cdr::members::prim_end(start, #size_usize, version))
-            }
+            #key_max_end
         }
 
-        #attrs
-        impl #cdr::DdsType for #name {
-            const TYPE_NAME: &'static str = #type_name;
-            const EXTENSIBILITY: #cdr::Extensibility = #cdr::Extensibility::Final;
-            const IS_KEYED: bool = false;
-
-            fn type_descriptor() -> #cdr::TypeDescriptor {
-                #cdr::TypeDescriptor {
-                    type_name: #type_name,
-                    extensibility: #cdr::Extensibility::Final,
-                    members: &[],
-                }
-            }
-        }
-    })
+        #dds_type
+    }
 }
