@@ -119,7 +119,7 @@ fn keep_last_depth_applies_per_instance() {
     }
     w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
     assert!(wait_until(Duration::from_secs(5), || r.sample_count() == 6));
-    let blue = r.lookup_instance(&shape("BLUE", 0)).unwrap();
+    let blue = r.lookup_instance(&shape("BLUE", 0)).unwrap().unwrap();
     let got = r.take_instance(blue).unwrap();
     assert_eq!(
         got.iter()

@@ -3,7 +3,7 @@
 use std::collections::VecDeque;
 use std::pin::Pin;
 use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
-use std::sync::{Arc, Condvar, Mutex, MutexGuard, Weak};
+use std::sync::{Arc, Condvar, Mutex};
 use std::task::{Context, Poll, Waker};
 use std::time::{Duration, Instant, SystemTime};
 
@@ -14,13 +14,15 @@ use crate::qos::{
     DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos, XCDR2_DATA_REPRESENTATION,
     XCDR_DATA_REPRESENTATION,
 };
-use crate::rtps::{ChangeKind, EntityId, Event, Guid, ReaderSpec, ReceivedSample};
+use crate::rtps::{ChangeKind, Event, Guid, ReaderSpec, ReceivedSample};
 
-use super::cache::{ChangeKindLocal, Incoming, Outcome, ReaderCache, Selection};
-use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition, StatusCore};
+use super::cache::{Incoming, Outcome, ReaderCache, Selection};
+use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition};
+use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
+use super::endpoint::EndpointState;
 use super::error::{DdsError, DdsResult};
 use super::listener::DataReaderListener;
-use super::participant::{DomainParticipant, Pending, ReaderSink, RemoteWriterInfo, Shared};
+use super::participant::DomainParticipant;
 use super::sample::{
     InstanceHandle, InstanceStateMask, Sample, SampleInfo, SampleStateMask, ViewStateMask,
 };
@@ -28,11 +30,8 @@ use super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, LivelinessChangedStatus, ReaderStatuses,
     SampleLostStatus, SampleRejectedStatus, StatusMask, SubscriptionMatchedStatus,
 };
+use super::sync::{lock, recover};
 use super::topic::{Topic, TopicDescription};
-
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
-}
 
 /// Groups readers; carries the partition and presentation QoS.
 #[derive(Clone)]
@@ -77,8 +76,8 @@ impl Subscriber {
         topic: &D,
         qos: &DataReaderQos,
     ) -> DdsResult<DataReader<T>> {
-        let shared = self.participant.shared.clone();
-        shared.check_alive()?;
+        let driver = self.participant.driver().clone();
+        driver.check_alive()?;
         let mut rq = qos.clone();
         if rq.data_representation.0.is_empty() {
             rq.data_representation =
@@ -105,8 +104,7 @@ impl Subscriber {
         let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
         cache.set_filter(topic.sample_filter());
         let inner = Arc::new(ReaderInner::<T> {
-            shared: shared.clone(),
-            id: Mutex::new(EntityId::UNKNOWN),
+            state: EndpointState::new(driver.clone()),
             pending: Mutex::new(VecDeque::new()),
             cache: Mutex::new(CacheState {
                 cache,
@@ -116,32 +114,24 @@ impl Subscriber {
             data_cv: Condvar::new(),
             data_waiters: AtomicUsize::new(0),
             wakers: Mutex::new(Vec::new()),
-            statuses: Mutex::new(ReaderStatuses::default()),
-            status_core: Arc::new(StatusCore::default()),
             data_signal: Signal::default(),
-            listener: Mutex::new(None),
-            matched: Mutex::new(Vec::new()),
-            handle: Mutex::new(Weak::new()),
             credit_limit,
         });
-        let sink: Arc<dyn ReaderSink> = inner.clone();
-        let id = shared.with_core(|c, now| {
+        let sink: Arc<dyn Endpoint> = inner.clone();
+        let id = driver.create_endpoint(sink, |c, now| {
             let id = c.create_reader(now, spec)?;
             if credit_limit.is_some() {
                 c.set_reader_credit(id, credit_limit);
             }
-            *lock(&inner.id) = id;
-            shared.register_reader(id, sink);
-            Ok::<_, crate::rtps::CoreError>(id)
-        });
-        let id = id.map_err(|e| DdsError::Core(e.to_string()))?;
-        let handle = Arc::new(ReaderHandle {
-            participant: self.participant.clone(),
+            inner.state.set_id(id);
+            Ok(id)
+        })?;
+        let owner = ReaderOwner {
             topic: t.clone(),
             subscriber: self.clone(),
-            id,
-        });
-        *lock(&inner.handle) = Arc::downgrade(&handle);
+        };
+        let handle = Arc::new(EndpointHandle::new(driver, id, owner));
+        inner.state.set_handle(&handle);
         tracing::info!(
             topic = t.name(),
             type_name = T::TYPE_NAME,
@@ -160,9 +150,14 @@ struct CacheState<T> {
     batch: VecDeque<Pending>,
 }
 
+/// What a reader's handle keeps alive.
+struct ReaderOwner<T> {
+    topic: Topic<T>,
+    subscriber: Subscriber,
+}
+
 struct ReaderInner<T: DdsType> {
-    shared: Arc<Shared>,
-    id: Mutex<EntityId>,
+    state: EndpointState<ReaderStatuses, dyn DataReaderListener<T>, ReaderOwner<T>>,
     pending: Mutex<VecDeque<Pending>>,
     cache: Mutex<CacheState<T>>,
     data_cv: Condvar,
@@ -170,33 +165,9 @@ struct ReaderInner<T: DdsType> {
     /// change was made under that lock) skips the futex wake only when nobody can be sleeping.
     data_waiters: AtomicUsize,
     wakers: Mutex<Vec<Waker>>,
-    statuses: Mutex<ReaderStatuses>,
-    status_core: Arc<StatusCore>,
     data_signal: Signal,
-    listener: Mutex<Option<Arc<dyn DataReaderListener<T>>>>,
-    matched: Mutex<Vec<Guid>>,
-    handle: Mutex<Weak<ReaderHandle<T>>>,
     /// Reliable KEEP_ALL with max_samples: the core delivers (and acknowledges) only what fits.
     credit_limit: Option<usize>,
-}
-
-struct ReaderHandle<T: DdsType> {
-    participant: DomainParticipant,
-    topic: Topic<T>,
-    subscriber: Subscriber,
-    id: EntityId,
-}
-
-impl<T: DdsType> Drop for ReaderHandle<T> {
-    fn drop(&mut self) {
-        let shared = &self.participant.shared;
-        shared.unregister_reader(self.id);
-        if shared.check_alive().is_ok() {
-            let id = self.id;
-            shared.with_core(|c, now| c.delete_reader(now, id));
-        }
-        tracing::debug!(id = ?self.id, "reader deleted");
-    }
 }
 
 /// Reads samples of type `T`. Cheap to clone; the reader is deleted when the last clone (and the last
@@ -211,7 +182,7 @@ impl<T: DdsType> Drop for ReaderHandle<T> {
 /// (coherent/ordered access), liveliness kinds other than what the core reports.
 pub struct DataReader<T: DdsType> {
     inner: Arc<ReaderInner<T>>,
-    handle: Arc<ReaderHandle<T>>,
+    handle: Arc<EndpointHandle<ReaderOwner<T>>>,
 }
 
 impl<T: DdsType> Clone for DataReader<T> {
@@ -226,8 +197,8 @@ impl<T: DdsType> Clone for DataReader<T> {
 impl<T: DdsType> std::fmt::Debug for DataReader<T> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("DataReader")
-            .field("topic", &self.handle.topic.name())
-            .field("id", &self.handle.id)
+            .field("topic", &self.handle.owner().topic.name())
+            .field("id", &self.handle.id())
             .finish()
     }
 }
@@ -303,7 +274,7 @@ impl<T: DdsType> DataReader<T> {
         next_after: Option<InstanceHandle>,
         emit: impl FnMut(&mut Option<T>, SampleInfo),
     ) -> DdsResult<()> {
-        self.inner.shared.check_alive()?;
+        self.inner.state.driver.check_alive()?;
         {
             let mut st = lock(&self.inner.cache);
             if let Some(prev) = next_after {
@@ -319,7 +290,10 @@ impl<T: DdsType> DataReader<T> {
                 ..Selection::default()
             };
             if !st.cache.has_matching(&unread) {
-                self.inner.status_core.clear(StatusMask::DATA_AVAILABLE);
+                self.inner
+                    .state
+                    .status_core()
+                    .clear(StatusMask::DATA_AVAILABLE);
             }
         }
         self.inner.data_signal.notify();
@@ -338,7 +312,7 @@ impl<T: DdsType> DataReader<T> {
         take: bool,
         copy: Option<fn(&T) -> T>,
     ) -> DdsResult<Vec<Sample<T>>> {
-        self.inner.shared.check_alive()?;
+        self.inner.state.driver.check_alive()?;
         let out = {
             let mut st = lock(&self.inner.cache);
             if let Some(prev) = next_after {
@@ -354,7 +328,10 @@ impl<T: DdsType> DataReader<T> {
                 ..Selection::default()
             };
             if !st.cache.has_matching(&unread) {
-                self.inner.status_core.clear(StatusMask::DATA_AVAILABLE);
+                self.inner
+                    .state
+                    .status_core()
+                    .clear(StatusMask::DATA_AVAILABLE);
             }
             out
         };
@@ -467,16 +444,14 @@ impl<T: DdsType> DataReader<T> {
             .take()
     }
 
-    /// The handle of the instance whose key equals the key of `key_sample` (other members are ignored).
-    pub fn lookup_instance(&self, key_sample: &T) -> Option<InstanceHandle> {
-        let key = if T::IS_KEYED {
-            let mut k = Vec::new();
-            cdr::instance_key(key_sample, &mut k).ok()?;
-            k
-        } else {
-            Vec::new()
-        };
-        lock(&self.inner.cache).cache.lookup(&key)
+    /// The handle of the instance whose key equals the key of `key_sample` (other members are ignored);
+    /// `None` when the reader holds no such instance.
+    pub fn lookup_instance(&self, key_sample: &T) -> DdsResult<Option<InstanceHandle>> {
+        let mut key = Vec::new();
+        if T::IS_KEYED {
+            cdr::instance_key(key_sample, &mut key)?;
+        }
+        Ok(lock(&self.inner.cache).cache.lookup(&key))
     }
 
     /// Number of instances held.
@@ -501,7 +476,7 @@ impl<T: DdsType> DataReader<T> {
             if st.cache.has_matching(&unread) {
                 return Ok(true);
             }
-            self.inner.shared.check_alive()?;
+            self.inner.state.driver.check_alive()?;
             let left = match deadline {
                 Some(d) => match d.checked_duration_since(Instant::now()) {
                     Some(l) if !l.is_zero() => l,
@@ -510,12 +485,12 @@ impl<T: DdsType> DataReader<T> {
                 None => Duration::from_secs(1),
             };
             self.inner.data_waiters.fetch_add(1, AtomicOrdering::SeqCst);
-            st = self
-                .inner
-                .data_cv
-                .wait_timeout(st, left.min(Duration::from_secs(1)))
-                .unwrap_or_else(|e| e.into_inner())
-                .0;
+            st = recover(
+                self.inner
+                    .data_cv
+                    .wait_timeout(st, left.min(Duration::from_secs(1))),
+            )
+            .0;
             self.inner.data_waiters.fetch_sub(1, AtomicOrdering::SeqCst);
         }
     }
@@ -546,103 +521,103 @@ impl<T: DdsType> DataReader<T> {
     /// The reader's status condition.
     pub fn status_condition(&self) -> StatusCondition {
         StatusCondition {
-            core: self.inner.status_core.clone(),
+            core: self.inner.state.status_core().clone(),
         }
     }
 
     /// Installs a listener (replacing any previous one).
     pub fn set_listener(&self, listener: Box<dyn DataReaderListener<T>>) {
-        *lock(&self.inner.listener) = Some(Arc::from(listener));
+        self.inner.state.set_listener(Some(Arc::from(listener)));
     }
 
     /// Removes the listener.
     pub fn clear_listener(&self) {
-        *lock(&self.inner.listener) = None;
+        self.inner.state.set_listener(None);
     }
 
     /// The topic.
     pub fn topic(&self) -> &Topic<T> {
-        &self.handle.topic
+        &self.handle.owner().topic
     }
 
     /// The subscriber.
     pub fn subscriber(&self) -> &Subscriber {
-        &self.handle.subscriber
+        &self.handle.owner().subscriber
     }
 
     /// The reader's GUID.
-    pub fn guid(&self) -> [u8; 16] {
-        Guid::new(self.inner.shared.guid_prefix, self.handle.id).to_bytes()
+    pub fn guid(&self) -> Guid {
+        self.handle.guid()
+    }
+
+    /// The reader's handle (as writers see it in their matched subscriptions).
+    pub fn instance_handle(&self) -> InstanceHandle {
+        InstanceHandle::from_guid(self.guid())
     }
 
     /// Handles of the matched writers.
     pub fn matched_publications(&self) -> Vec<InstanceHandle> {
-        lock(&self.inner.matched)
-            .iter()
-            .map(|g| InstanceHandle::from_guid_bytes(&g.to_bytes()))
+        self.inner
+            .state
+            .matched()
+            .into_iter()
+            .map(InstanceHandle::from_guid)
             .collect()
+    }
+
+    /// GUIDs of the matched writers.
+    pub fn matched_publication_guids(&self) -> Vec<Guid> {
+        self.inner.state.matched()
     }
 
     /// SUBSCRIPTION_MATCHED (resets the change counts).
     pub fn subscription_matched_status(&self) -> SubscriptionMatchedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.subscription_matched.clone();
-        st.subscription_matched.total_count_change = 0;
-        st.subscription_matched.current_count_change = 0;
         self.inner
-            .status_core
-            .clear(StatusMask::SUBSCRIPTION_MATCHED);
-        s
+            .state
+            .take_status(StatusMask::SUBSCRIPTION_MATCHED, |s| {
+                &mut s.subscription_matched
+            })
     }
 
     /// REQUESTED_INCOMPATIBLE_QOS (resets the change count).
     pub fn requested_incompatible_qos_status(&self) -> IncompatibleQosStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.requested_incompatible_qos.clone();
-        st.requested_incompatible_qos.total_count_change = 0;
         self.inner
-            .status_core
-            .clear(StatusMask::REQUESTED_INCOMPATIBLE_QOS);
-        s
+            .state
+            .take_status(StatusMask::REQUESTED_INCOMPATIBLE_QOS, |s| {
+                &mut s.requested_incompatible_qos
+            })
     }
 
     /// SAMPLE_LOST (resets the change count).
     pub fn sample_lost_status(&self) -> SampleLostStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.sample_lost.clone();
-        st.sample_lost.total_count_change = 0;
-        self.inner.status_core.clear(StatusMask::SAMPLE_LOST);
-        s
+        self.inner
+            .state
+            .take_status(StatusMask::SAMPLE_LOST, |s| &mut s.sample_lost)
     }
 
     /// SAMPLE_REJECTED (resets the change count).
     pub fn sample_rejected_status(&self) -> SampleRejectedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.sample_rejected.clone();
-        st.sample_rejected.total_count_change = 0;
-        self.inner.status_core.clear(StatusMask::SAMPLE_REJECTED);
-        s
+        self.inner
+            .state
+            .take_status(StatusMask::SAMPLE_REJECTED, |s| &mut s.sample_rejected)
     }
 
     /// LIVELINESS_CHANGED (resets the change counts).
     pub fn liveliness_changed_status(&self) -> LivelinessChangedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.liveliness_changed.clone();
-        st.liveliness_changed.alive_count_change = 0;
-        st.liveliness_changed.not_alive_count_change = 0;
-        self.inner.status_core.clear(StatusMask::LIVELINESS_CHANGED);
-        s
+        self.inner
+            .state
+            .take_status(StatusMask::LIVELINESS_CHANGED, |s| {
+                &mut s.liveliness_changed
+            })
     }
 
     /// REQUESTED_DEADLINE_MISSED (resets the change count).
     pub fn requested_deadline_missed_status(&self) -> DeadlineMissedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.requested_deadline_missed.clone();
-        st.requested_deadline_missed.total_count_change = 0;
         self.inner
-            .status_core
-            .clear(StatusMask::REQUESTED_DEADLINE_MISSED);
-        s
+            .state
+            .take_status(StatusMask::REQUESTED_DEADLINE_MISSED, |s| {
+                &mut s.requested_deadline_missed
+            })
     }
 }
 
@@ -652,12 +627,12 @@ fn system_time(t: Option<crate::rtps::Time>) -> Option<SystemTime> {
 }
 
 impl<T: DdsType> ReaderInner<T> {
-    fn reader_handle(self: &Arc<Self>) -> Option<DataReader<T>> {
-        let handle = lock(&self.handle).upgrade()?;
-        Some(DataReader {
-            inner: self.clone(),
-            handle,
-        })
+    /// The public reader, for listeners.
+    fn reader(
+        self: &Arc<Self>,
+    ) -> impl FnOnce(Arc<EndpointHandle<ReaderOwner<T>>>) -> DataReader<T> {
+        let inner = self.clone();
+        move |handle| DataReader { inner, handle }
     }
 
     /// Gives the core back the room freed by a take. Under the core lock every delivered sample is either
@@ -666,8 +641,8 @@ impl<T: DdsType> ReaderInner<T> {
         let Some(limit) = self.credit_limit else {
             return;
         };
-        let id = *lock(&self.id);
-        self.shared.with_core(|c, _| {
+        let id = self.state.id();
+        self.state.driver.with_core(|c, _| {
             let held = lock(&self.cache).cache.len() + lock(&self.pending).len();
             c.set_reader_credit(id, Some(limit.saturating_sub(held)));
         });
@@ -681,12 +656,10 @@ impl<T: DdsType> ReaderInner<T> {
         for w in wakers {
             w.wake();
         }
-        self.status_core.raise(StatusMask::DATA_AVAILABLE);
+        self.state.status_core().raise(StatusMask::DATA_AVAILABLE);
         self.data_signal.notify();
-        let listener = lock(&self.listener).clone();
-        if let (Some(l), Some(r)) = (listener, self.reader_handle()) {
-            l.on_data_available(&r);
-        }
+        self.state
+            .call_listener(self.reader(), |l, r| l.on_data_available(r));
     }
 }
 
@@ -702,16 +675,11 @@ fn decode_change<T: DdsType>(
     rx_time: SystemTime,
 ) -> Option<Incoming<T>> {
     let source_timestamp = system_time(s.source_timestamp);
-    let kind = match s.kind {
-        ChangeKind::Alive => ChangeKindLocal::Alive,
-        ChangeKind::Dispose => ChangeKindLocal::Dispose,
-        ChangeKind::Unregister => ChangeKindLocal::Unregister,
-        ChangeKind::DisposeUnregister => ChangeKindLocal::DisposeUnregister,
-    };
+    let kind = s.kind;
     key.clear();
     let mut data = None;
     let mut key_holder = None;
-    if kind == ChangeKindLocal::Alive {
+    if kind == ChangeKind::Alive {
         let d = match cdr::deserialize::<T>(&s.payload) {
             Ok(d) => d,
             Err(e) => {
@@ -767,7 +735,7 @@ fn decode_change<T: DdsType>(
         }
     }
     Some(Incoming {
-        writer: s.writer.to_bytes(),
+        writer: s.writer,
         kind,
         data,
         key,
@@ -785,7 +753,7 @@ fn decode_change<T: DdsType>(
     })
 }
 
-impl<T: DdsType> ReaderSink for ReaderInner<T> {
+impl<T: DdsType> Endpoint for ReaderInner<T> {
     fn enqueue(&self, item: Pending) {
         lock(&self.pending).push_back(item);
     }
@@ -809,7 +777,7 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
                         let info = match writer_info {
                             Some((g, info)) if g == s.writer => info,
                             _ => {
-                                let info = self.shared.remote_writer(&s.writer);
+                                let info = self.state.driver.remote_writer(&s.writer);
                                 writer_info = Some((s.writer, info));
                                 info
                             }
@@ -826,32 +794,27 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
                             Outcome::Rejected { reason, handle } => rejected.push((reason, handle)),
                         }
                     }
-                    Pending::WriterGone(g) => any |= st.cache.writer_gone(g.to_bytes(), now),
+                    Pending::WriterGone(g) => any |= st.cache.writer_gone(g, now),
                 }
             }
             st.batch = batch;
         }
         if !rejected.is_empty() {
-            let status = {
-                let mut st = lock(&self.statuses);
-                for (reason, handle) in &rejected {
-                    let sr = &mut st.sample_rejected;
-                    sr.total_count += 1;
-                    sr.total_count_change += 1;
-                    sr.last_reason = *reason;
-                    sr.last_instance_handle = *handle;
-                }
-                st.sample_rejected.clone()
-            };
             tracing::debug!(
                 count = rejected.len(),
                 "samples rejected by resource limits"
             );
-            self.status_core.raise(StatusMask::SAMPLE_REJECTED);
-            let listener = lock(&self.listener).clone();
-            if let (Some(l), Some(r)) = (listener, self.reader_handle()) {
-                l.on_sample_rejected(&r, status);
-            }
+            self.state.signal(
+                StatusMask::SAMPLE_REJECTED,
+                |st| {
+                    for (reason, handle) in &rejected {
+                        st.sample_rejected.record(*reason, *handle);
+                    }
+                    &mut st.sample_rejected
+                },
+                self.reader(),
+                |l, r, s| l.on_sample_rejected(r, s),
+            );
         }
         if any {
             self.notify_data();
@@ -859,107 +822,64 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
     }
 
     fn on_event(self: Arc<Self>, ev: &Event) {
-        let listener = lock(&self.listener).clone();
-        let me = self.reader_handle();
+        let id = self.state.id();
         match ev {
             Event::SubscriptionMatched {
                 writer, matched, ..
             } => {
-                let status = {
-                    let mut m = lock(&self.matched);
-                    let mut st = lock(&self.statuses);
-                    let sm = &mut st.subscription_matched;
-                    if *matched {
-                        if !m.contains(writer) {
-                            m.push(*writer);
-                            sm.total_count += 1;
-                            sm.total_count_change += 1;
-                            sm.current_count_change += 1;
-                        }
-                    } else if let Some(p) = m.iter().position(|g| g == writer) {
-                        m.remove(p);
-                        sm.current_count_change -= 1;
-                    }
-                    sm.current_count = m.len() as u32;
-                    sm.last_publication_handle =
-                        InstanceHandle::from_guid_bytes(&writer.to_bytes());
-                    let out = sm.clone();
-                    // A listener consumes the status (DDS 2.2.4.2.1): reset the changes so the next
-                    // callback reports only what happened since this one.
-                    if listener.is_some() && me.is_some() {
-                        sm.total_count_change = 0;
-                        sm.current_count_change = 0;
-                    }
-                    out
-                };
-                tracing::info!(reader = ?lock(&self.id), ?writer, matched, "subscription matched");
-                self.status_core.raise(StatusMask::SUBSCRIPTION_MATCHED);
-                if let (Some(l), Some(r)) = (listener, me) {
-                    l.on_subscription_matched(&r, status);
-                }
+                tracing::info!(reader = ?id, ?writer, matched, "subscription matched");
+                self.state.record_match(
+                    StatusMask::SUBSCRIPTION_MATCHED,
+                    |st| &mut st.subscription_matched,
+                    (*writer, *matched),
+                    self.reader(),
+                    |l, r, s| l.on_subscription_matched(r, s),
+                );
             }
             Event::RequestedIncompatibleQos { policy, writer, .. } => {
-                let status = {
-                    let mut st = lock(&self.statuses);
-                    st.requested_incompatible_qos.record(*policy);
-                    st.requested_incompatible_qos.clone()
-                };
-                tracing::warn!(reader = ?lock(&self.id), ?writer, ?policy, "requested incompatible QoS");
-                self.status_core
-                    .raise(StatusMask::REQUESTED_INCOMPATIBLE_QOS);
-                if let (Some(l), Some(r)) = (listener, me) {
-                    l.on_requested_incompatible_qos(&r, status);
-                }
+                tracing::warn!(reader = ?id, ?writer, ?policy, "requested incompatible QoS");
+                self.state.signal(
+                    StatusMask::REQUESTED_INCOMPATIBLE_QOS,
+                    |st| {
+                        st.requested_incompatible_qos.record(*policy);
+                        &mut st.requested_incompatible_qos
+                    },
+                    self.reader(),
+                    |l, r, s| l.on_requested_incompatible_qos(r, s),
+                );
             }
             Event::LivelinessChanged { writer, alive, .. } => {
-                let status = {
-                    let mut st = lock(&self.statuses);
-                    let lc = &mut st.liveliness_changed;
-                    if *alive {
-                        lc.alive_count += 1;
-                        lc.alive_count_change += 1;
-                        if lc.not_alive_count > 0 {
-                            lc.not_alive_count -= 1;
-                            lc.not_alive_count_change -= 1;
-                        }
-                    } else {
-                        lc.not_alive_count += 1;
-                        lc.not_alive_count_change += 1;
-                        if lc.alive_count > 0 {
-                            lc.alive_count -= 1;
-                            lc.alive_count_change -= 1;
-                        }
-                    }
-                    lc.last_publication_handle =
-                        InstanceHandle::from_guid_bytes(&writer.to_bytes());
-                    lc.clone()
-                };
+                let (target, status) = self.state.update(
+                    |st| {
+                        st.liveliness_changed.record(*writer, *alive);
+                        &mut st.liveliness_changed
+                    },
+                    false,
+                );
                 if !*alive {
-                    let changed = lock(&self.cache)
-                        .cache
-                        .writer_gone(writer.to_bytes(), Instant::now());
+                    let changed = lock(&self.cache).cache.writer_gone(*writer, Instant::now());
                     if changed {
                         self.notify_data();
                     }
                 }
-                self.status_core.raise(StatusMask::LIVELINESS_CHANGED);
-                if let (Some(l), Some(r)) = (listener, me) {
-                    l.on_liveliness_changed(&r, status);
-                }
+                self.state.deliver(
+                    StatusMask::LIVELINESS_CHANGED,
+                    target,
+                    status,
+                    self.reader(),
+                    |l, r, s| l.on_liveliness_changed(r, s),
+                );
             }
             Event::SampleLost { count, .. } => {
-                let status = {
-                    let mut st = lock(&self.statuses);
-                    let n = u32::try_from(*count).unwrap_or(u32::MAX);
-                    st.sample_lost.total_count = st.sample_lost.total_count.saturating_add(n);
-                    st.sample_lost.total_count_change =
-                        st.sample_lost.total_count_change.saturating_add(n);
-                    st.sample_lost.clone()
-                };
-                self.status_core.raise(StatusMask::SAMPLE_LOST);
-                if let (Some(l), Some(r)) = (listener, me) {
-                    l.on_sample_lost(&r, status);
-                }
+                self.state.signal(
+                    StatusMask::SAMPLE_LOST,
+                    |st| {
+                        st.sample_lost.record(*count);
+                        &mut st.sample_lost
+                    },
+                    self.reader(),
+                    |l, r, s| l.on_sample_lost(r, s),
+                );
             }
             _ => {}
         }
@@ -970,20 +890,15 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
         if missed.is_empty() {
             return;
         }
-        let status = {
-            let mut st = lock(&self.statuses);
-            let dm = &mut st.requested_deadline_missed;
-            dm.total_count += missed.len() as u32;
-            dm.total_count_change += missed.len() as u32;
-            dm.last_instance_handle = *missed.last().unwrap_or(&InstanceHandle::NIL);
-            dm.clone()
-        };
-        self.status_core
-            .raise(StatusMask::REQUESTED_DEADLINE_MISSED);
-        let listener = lock(&self.listener).clone();
-        if let (Some(l), Some(r)) = (listener, self.reader_handle()) {
-            l.on_requested_deadline_missed(&r, status);
-        }
+        self.state.signal(
+            StatusMask::REQUESTED_DEADLINE_MISSED,
+            |st| {
+                st.requested_deadline_missed.record(&missed);
+                &mut st.requested_deadline_missed
+            },
+            self.reader(),
+            |l, r, s| l.on_requested_deadline_missed(r, s),
+        );
     }
 }
 
@@ -1023,7 +938,7 @@ impl<T: DdsType> futures_core::Stream for SampleStream<T> {
         if let Some(s) = take() {
             return Poll::Ready(Some(s));
         }
-        if r.inner.shared.check_alive().is_err() {
+        if r.inner.state.driver.check_alive().is_err() {
             return Poll::Ready(None);
         }
         {
@@ -1044,7 +959,7 @@ impl<T: DdsType> futures_core::Stream for SampleStream<T> {
 mod tests {
     use super::*;
     use crate::cdr::{ByteOrder, XcdrVersion};
-    use crate::rtps::{GuidPrefix, Payload, SequenceNumber};
+    use crate::rtps::{EntityId, GuidPrefix, Payload, SequenceNumber};
 
     #[derive(dds_macros::DdsType, Debug, Clone, PartialEq, Default)]
     #[dds(name = "test::K", appendable)]
@@ -1099,7 +1014,7 @@ mod tests {
         cdr::serialize_key(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut kp).unwrap();
         let d = decode(rs(ChangeKind::Dispose, kp, None), &mut by_hash).unwrap();
         assert_eq!(d.key, expected, "by key payload");
-        assert_eq!(d.kind, ChangeKindLocal::Dispose);
+        assert_eq!(d.kind, ChangeKind::Dispose);
 
         let u = decode(
             rs(ChangeKind::Unregister, Vec::new(), Some(kh)),
@@ -1136,7 +1051,7 @@ mod tests {
             let d = decode(rs(ChangeKind::Dispose, Vec::new(), Some(kh)), &mut by_hash)
                 .expect("dispose mapped through the computed key hash");
             assert_eq!(d.key, expected);
-            assert_eq!(d.kind, ChangeKindLocal::Dispose);
+            assert_eq!(d.kind, ChangeKind::Dispose);
         }
     }
 }
