@@ -98,6 +98,21 @@ pub(crate) struct ReaderCache<T> {
     filter: Option<Filter<T>>,
 }
 
+/// The sample a read (copying the data with `copy`, if any) or a take (moving it out) returns for `slot`.
+pub(crate) fn to_sample<T>(
+    slot: &mut Option<T>,
+    info: SampleInfo,
+    take: bool,
+    copy: Option<fn(&T) -> T>,
+) -> Sample<T> {
+    let data = match (take, copy) {
+        (true, _) => slot.take(),
+        (false, Some(f)) => slot.as_ref().map(f),
+        (false, None) => None,
+    };
+    Sample { data, info }
+}
+
 fn finite(d: Duration) -> Option<Duration> {
     (d != INFINITE && d < Duration::from_secs(100 * 365 * 86400)).then_some(d)
 }
@@ -427,7 +442,8 @@ impl<T> ReaderCache<T> {
     }
 
     /// Reads (`take == false`, data cloned by `copy`) or takes the selected samples, in reception order.
-    pub(crate) fn collect(
+    #[cfg(test)]
+    fn collect(
         &mut self,
         sel: &Selection,
         take: bool,
@@ -435,12 +451,7 @@ impl<T> ReaderCache<T> {
     ) -> Vec<Sample<T>> {
         let mut out = Vec::new();
         self.collect_with(sel, take, |slot, info| {
-            let data = match (take, copy) {
-                (true, _) => slot.take(),
-                (false, Some(f)) => slot.as_ref().map(f),
-                (false, None) => None,
-            };
-            out.push(Sample { data, info });
+            out.push(to_sample(slot, info, take, copy))
         });
         out
     }

@@ -29,6 +29,7 @@
 
 mod cache;
 pub mod condition;
+mod decode;
 mod driver;
 mod endpoint;
 mod error;

@@ -1,22 +1,19 @@
 //! `DomainParticipant`, the entry point of the DCPS API, and its builder. The machinery behind it (core,
-//! transport, timer thread, routing) is the [`Driver`](super::driver::Driver).
+//! transport, timer thread, routing) is the [`Driver`](super::driver::Driver). The factories of the other
+//! entities (`create_topic`, `create_publisher`, ...) live with the entity they create, so that this module
+//! depends on none of them.
 
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::cdr::DdsType;
 use crate::config::{Config, InterfaceSelection, ParticipantIndex, Peer};
-use crate::qos::{PublisherQos, SubscriberQos, TopicQos};
 use crate::rtps::{EntityId, Guid, GuidPrefix};
 use crate::transport::UdpTransport;
 
 use super::condition::StatusCondition;
 use super::driver::Driver;
-use super::error::{DdsError, DdsResult};
-use super::publisher::Publisher;
+use super::error::DdsResult;
 use super::sample::InstanceHandle;
-use super::subscriber::Subscriber;
-use super::topic::Topic;
 
 /// A participant discovered through SPDP.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -286,27 +283,6 @@ impl DomainParticipant {
             .into_iter()
             .map(DiscoveredParticipant::new)
             .collect()
-    }
-
-    /// Creates a topic of type `T`.
-    pub fn create_topic<T: DdsType>(&self, name: &str, qos: &TopicQos) -> DdsResult<Topic<T>> {
-        self.driver.check_alive()?;
-        if name.is_empty() || name.len() > 256 {
-            return Err(DdsError::BadParameter(format!("topic name {name:?}")));
-        }
-        Ok(Topic::new(self.clone(), name, qos.clone()))
-    }
-
-    /// Creates a publisher.
-    pub fn create_publisher(&self, qos: &PublisherQos) -> DdsResult<Publisher> {
-        self.driver.check_alive()?;
-        Ok(Publisher::new(self.clone(), qos.clone()))
-    }
-
-    /// Creates a subscriber.
-    pub fn create_subscriber(&self, qos: &SubscriberQos) -> DdsResult<Subscriber> {
-        self.driver.check_alive()?;
-        Ok(Subscriber::new(self.clone(), qos.clone()))
     }
 
     /// The participant's status condition.

@@ -18,7 +18,6 @@ use super::condition::StatusCondition;
 use super::driver::{Endpoint, EndpointHandle};
 use super::endpoint::EndpointState;
 use super::error::{DdsError, DdsResult};
-use super::listener::DataWriterListener;
 use super::participant::DomainParticipant;
 use super::sample::InstanceHandle;
 use super::status::{
@@ -27,6 +26,17 @@ use super::status::{
 };
 use super::sync::lock;
 use super::topic::Topic;
+
+/// Callbacks of a [`DataWriter`] (see [`crate::dcps::listener`]). Every method has an empty default.
+#[allow(unused_variables)]
+pub trait DataWriterListener<T: DdsType>: Send + Sync {
+    /// A reader matched or unmatched.
+    fn on_publication_matched(&self, writer: &DataWriter<T>, status: PublicationMatchedStatus) {}
+    /// A reader was found with incompatible QoS.
+    fn on_offered_incompatible_qos(&self, writer: &DataWriter<T>, status: IncompatibleQosStatus) {}
+    /// The writer missed its offered deadline for an instance.
+    fn on_offered_deadline_missed(&self, writer: &DataWriter<T>, status: DeadlineMissedStatus) {}
+}
 
 /// Groups writers; carries the partition and presentation QoS.
 #[derive(Clone)]
@@ -42,9 +52,7 @@ impl std::fmt::Debug for Publisher {
 }
 
 /// The XCDR version a writer with `rep` uses, and the representation list it announces.
-pub(crate) fn writer_version<T: DdsType>(
-    rep: &DataRepresentation,
-) -> (XcdrVersion, DataRepresentation) {
+fn writer_version<T: DdsType>(rep: &DataRepresentation) -> (XcdrVersion, DataRepresentation) {
     if rep.0.is_empty() {
         let v = T::DEFAULT_VERSION;
         let id = match v {
@@ -59,14 +67,18 @@ pub(crate) fn writer_version<T: DdsType>(
     }
 }
 
-impl Publisher {
-    pub(crate) fn new(participant: DomainParticipant, qos: PublisherQos) -> Self {
-        Publisher {
-            participant,
-            qos: Arc::new(qos),
-        }
+impl DomainParticipant {
+    /// Creates a publisher.
+    pub fn create_publisher(&self, qos: &PublisherQos) -> DdsResult<Publisher> {
+        self.driver().check_alive()?;
+        Ok(Publisher {
+            participant: self.clone(),
+            qos: Arc::new(qos.clone()),
+        })
     }
+}
 
+impl Publisher {
     /// The publisher QoS.
     pub fn qos(&self) -> &PublisherQos {
         &self.qos

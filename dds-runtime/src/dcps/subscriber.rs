@@ -14,14 +14,14 @@ use crate::qos::{
     DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos, XCDR2_DATA_REPRESENTATION,
     XCDR_DATA_REPRESENTATION,
 };
-use crate::rtps::{ChangeKind, Event, Guid, ReaderSpec, ReceivedSample};
+use crate::rtps::{Event, Guid, ReaderSpec};
 
-use super::cache::{Incoming, Outcome, ReaderCache, Selection};
+use super::cache::{to_sample, Outcome, ReaderCache, Selection};
 use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition};
+use super::decode::decode_change;
 use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
 use super::endpoint::EndpointState;
 use super::error::{DdsError, DdsResult};
-use super::listener::DataReaderListener;
 use super::participant::DomainParticipant;
 use super::sample::{
     InstanceHandle, InstanceStateMask, Sample, SampleInfo, SampleStateMask, ViewStateMask,
@@ -32,6 +32,26 @@ use super::status::{
 };
 use super::sync::{lock, recover};
 use super::topic::{Topic, TopicDescription};
+
+/// Callbacks of a [`DataReader`] (see [`crate::dcps::listener`]). Every method has an empty default.
+#[allow(unused_variables)]
+pub trait DataReaderListener<T: DdsType>: Send + Sync {
+    /// New samples (or instance state changes) are available.
+    fn on_data_available(&self, reader: &DataReader<T>) {}
+    /// A writer matched or unmatched.
+    fn on_subscription_matched(&self, reader: &DataReader<T>, status: SubscriptionMatchedStatus) {}
+    /// A writer was found with incompatible QoS.
+    fn on_requested_incompatible_qos(&self, reader: &DataReader<T>, status: IncompatibleQosStatus) {
+    }
+    /// Samples were lost.
+    fn on_sample_lost(&self, reader: &DataReader<T>, status: SampleLostStatus) {}
+    /// A sample was rejected by a resource limit.
+    fn on_sample_rejected(&self, reader: &DataReader<T>, status: SampleRejectedStatus) {}
+    /// A matched writer's liveliness changed.
+    fn on_liveliness_changed(&self, reader: &DataReader<T>, status: LivelinessChangedStatus) {}
+    /// An instance missed its deadline.
+    fn on_requested_deadline_missed(&self, reader: &DataReader<T>, status: DeadlineMissedStatus) {}
+}
 
 /// Groups readers; carries the partition and presentation QoS.
 #[derive(Clone)]
@@ -48,17 +68,18 @@ impl std::fmt::Debug for Subscriber {
     }
 }
 
-/// Most key hashes remembered per reader for mapping key-hash-only disposes to instances.
-const MAX_REMEMBERED_HASHES: usize = 65536;
+impl DomainParticipant {
+    /// Creates a subscriber.
+    pub fn create_subscriber(&self, qos: &SubscriberQos) -> DdsResult<Subscriber> {
+        self.driver().check_alive()?;
+        Ok(Subscriber {
+            participant: self.clone(),
+            qos: Arc::new(qos.clone()),
+        })
+    }
+}
 
 impl Subscriber {
-    pub(crate) fn new(participant: DomainParticipant, qos: SubscriberQos) -> Self {
-        Subscriber {
-            participant,
-            qos: Arc::new(qos),
-        }
-    }
-
     /// The subscriber QoS.
     pub fn qos(&self) -> &SubscriberQos {
         &self.qos
@@ -249,12 +270,10 @@ impl<'a, T: DdsType> Selector<'a, T> {
     /// cache, marks them read and returns how many there were. The cache lock is held during the calls:
     /// keep `f` short and do not call back into this reader from it.
     pub fn read_with(self, mut f: impl FnMut(Option<&T>, &SampleInfo)) -> DdsResult<usize> {
-        let mut n = 0;
-        self.reader.visit(self.sel, self.next_after, |slot, info| {
-            n += 1;
-            f(slot.as_ref(), &info);
-        })?;
-        Ok(n)
+        self.reader
+            .visit(self.sel, self.next_after, false, |slot, info| {
+                f(slot.as_ref(), &info)
+            })
     }
 
     /// Reads (copies) the selected samples.
@@ -268,23 +287,30 @@ impl<'a, T: DdsType> Selector<'a, T> {
 }
 
 impl<T: DdsType> DataReader<T> {
+    /// Core of read and take: calls `emit` with each selected sample's data slot and info (with `take` the
+    /// samples leave the cache), then updates DATA_AVAILABLE, the read conditions and the reader's credit.
     fn visit(
         &self,
         mut sel: Selection,
         next_after: Option<InstanceHandle>,
-        emit: impl FnMut(&mut Option<T>, SampleInfo),
-    ) -> DdsResult<()> {
+        take: bool,
+        mut emit: impl FnMut(&mut Option<T>, SampleInfo),
+    ) -> DdsResult<usize> {
         self.inner.state.driver.check_alive()?;
+        let mut n = 0;
         {
             let mut st = lock(&self.inner.cache);
             if let Some(prev) = next_after {
                 sel.instance = None;
                 match st.cache.next_instance(prev, &sel) {
                     Some(h) => sel.instance = Some(h),
-                    None => return Ok(()),
+                    None => return Ok(0),
                 }
             }
-            st.cache.collect_with(&sel, false, emit);
+            st.cache.collect_with(&sel, take, |slot, info| {
+                n += 1;
+                emit(slot, info);
+            });
             let unread = Selection {
                 sample_states: SampleStateMask::NOT_READ,
                 ..Selection::default()
@@ -296,8 +322,12 @@ impl<T: DdsType> DataReader<T> {
                     .clear(StatusMask::DATA_AVAILABLE);
             }
         }
+        if take && n > 0 {
+            self.inner.refresh_credit();
+        }
+        // Read conditions may have stopped triggering.
         self.inner.data_signal.notify();
-        Ok(())
+        Ok(n)
     }
 
     /// Zero-copy read of all samples, see [`Selector::read_with`].
@@ -305,41 +335,18 @@ impl<T: DdsType> DataReader<T> {
         self.select().read_with(f)
     }
 
+    /// Read or take into samples; a read copies the data with `copy`.
     fn collect(
         &self,
-        mut sel: Selection,
+        sel: Selection,
         next_after: Option<InstanceHandle>,
         take: bool,
         copy: Option<fn(&T) -> T>,
     ) -> DdsResult<Vec<Sample<T>>> {
-        self.inner.state.driver.check_alive()?;
-        let out = {
-            let mut st = lock(&self.inner.cache);
-            if let Some(prev) = next_after {
-                sel.instance = None;
-                match st.cache.next_instance(prev, &sel) {
-                    Some(h) => sel.instance = Some(h),
-                    None => return Ok(Vec::new()),
-                }
-            }
-            let out = st.cache.collect(&sel, take, copy);
-            let unread = Selection {
-                sample_states: SampleStateMask::NOT_READ,
-                ..Selection::default()
-            };
-            if !st.cache.has_matching(&unread) {
-                self.inner
-                    .state
-                    .status_core()
-                    .clear(StatusMask::DATA_AVAILABLE);
-            }
-            out
-        };
-        if take && !out.is_empty() {
-            self.inner.refresh_credit();
-        }
-        // Read conditions may have stopped triggering.
-        self.inner.data_signal.notify();
+        let mut out = Vec::new();
+        self.visit(sel, next_after, take, |slot, info| {
+            out.push(to_sample(slot, info, take, copy))
+        })?;
         Ok(out)
     }
 
@@ -621,11 +628,6 @@ impl<T: DdsType> DataReader<T> {
     }
 }
 
-fn system_time(t: Option<crate::rtps::Time>) -> Option<SystemTime> {
-    t.and_then(|t| t.to_unix())
-        .map(|d| SystemTime::UNIX_EPOCH + d)
-}
-
 impl<T: DdsType> ReaderInner<T> {
     /// The public reader, for listeners.
     fn reader(
@@ -661,96 +663,6 @@ impl<T: DdsType> ReaderInner<T> {
         self.state
             .call_listener(self.reader(), |l, r| l.on_data_available(r));
     }
-}
-
-/// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped to an
-/// instance. Instances are identified by `cdr::instance_key`; a key-only change without a decodable key
-/// payload is mapped through its key hash to an instance seen before with the same hash.
-fn decode_change<T: DdsType>(
-    s: ReceivedSample,
-    info: RemoteWriterInfo,
-    by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
-    mut key: Vec<u8>,
-    now: Instant,
-    rx_time: SystemTime,
-) -> Option<Incoming<T>> {
-    let source_timestamp = system_time(s.source_timestamp);
-    let kind = s.kind;
-    key.clear();
-    let mut data = None;
-    let mut key_holder = None;
-    if kind == ChangeKind::Alive {
-        let d = match cdr::deserialize::<T>(&s.payload) {
-            Ok(d) => d,
-            Err(e) => {
-                tracing::warn!(writer = ?s.writer, seq = s.sequence.0, error = %e, "dropping undecodable sample");
-                return None;
-            }
-        };
-        if T::IS_KEYED {
-            if let Err(e) = cdr::instance_key(&d, &mut key) {
-                tracing::warn!(error = %e, "cannot compute the instance key");
-                return None;
-            }
-            // Index the key hashes a peer may later send alone (dispose/unregister without payload,
-            // e.g. Fast DDS): the one it sent, else the ones we compute for either representation.
-            let hashes = match s.key_hash {
-                Some(kh) => [Some(kh), None],
-                None => [
-                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr1).ok(),
-                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr2).ok(),
-                ],
-            };
-            for kh in hashes.into_iter().flatten() {
-                if by_hash.len() >= MAX_REMEMBERED_HASHES {
-                    by_hash.clear();
-                }
-                by_hash.entry(kh).or_insert_with(|| key.clone());
-            }
-        }
-        data = Some(d);
-    } else if T::IS_KEYED {
-        if !s.payload.is_empty() {
-            match cdr::deserialize_key::<T>(&s.payload) {
-                Ok(k) => {
-                    if let Err(e) = cdr::instance_key(&k, &mut key) {
-                        tracing::warn!(error = %e, "cannot compute the instance key");
-                        return None;
-                    }
-                    key_holder = Some(k);
-                }
-                Err(e) => {
-                    tracing::debug!(error = %e, "undecodable key payload; trying the key hash")
-                }
-            }
-        }
-        if key_holder.is_none() {
-            match s.key_hash.and_then(|kh| by_hash.get(&kh).cloned()) {
-                Some(k) => key = k,
-                None => {
-                    tracing::debug!(writer = ?s.writer, kind = ?s.kind, "key-only change for an unknown instance");
-                    return None;
-                }
-            }
-        }
-    }
-    Some(Incoming {
-        writer: s.writer,
-        kind,
-        data,
-        key,
-        key_holder,
-        source_timestamp: source_timestamp.unwrap_or(rx_time),
-        reception_timestamp: rx_time,
-        strength: info.strength,
-        expires: info.lifespan.and_then(|l| {
-            // Lifespan counts from the source timestamp; its age so far is spent already.
-            let age = source_timestamp
-                .and_then(|t| rx_time.duration_since(t).ok())
-                .unwrap_or_default();
-            now.checked_add(l.saturating_sub(age))
-        }),
-    })
 }
 
 impl<T: DdsType> Endpoint for ReaderInner<T> {
@@ -951,107 +863,6 @@ impl<T: DdsType> futures_core::Stream for SampleStream<T> {
         match take() {
             Some(s) => Poll::Ready(Some(s)),
             None => Poll::Pending,
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::cdr::{ByteOrder, XcdrVersion};
-    use crate::rtps::{EntityId, GuidPrefix, Payload, SequenceNumber};
-
-    #[derive(dds_macros::DdsType, Debug, Clone, PartialEq, Default)]
-    #[dds(name = "test::K", appendable)]
-    struct K {
-        #[dds(key)]
-        id: String,
-        v: i32,
-    }
-
-    fn rs(kind: ChangeKind, payload: Vec<u8>, key_hash: Option<[u8; 16]>) -> ReceivedSample {
-        ReceivedSample {
-            reader: EntityId([0, 0, 1, 7]),
-            writer: Guid::new(GuidPrefix([1; 12]), EntityId([0, 0, 1, 2])),
-            sequence: SequenceNumber(1),
-            kind,
-            payload: Payload::from(payload),
-            key_hash,
-            source_timestamp: None,
-        }
-    }
-
-    /// `decode_change` from a writer with default QoS, now.
-    fn decode(s: ReceivedSample, by_hash: &mut HashMap<[u8; 16], Vec<u8>>) -> Option<Incoming<K>> {
-        let now = Instant::now();
-        decode_change::<K>(
-            s,
-            RemoteWriterInfo::default(),
-            by_hash,
-            Vec::new(),
-            now,
-            SystemTime::now(),
-        )
-    }
-
-    #[test]
-    fn key_only_changes_map_by_key_payload_or_known_hash() {
-        let mut by_hash = HashMap::new();
-        let s = K {
-            id: "a".into(),
-            v: 1,
-        };
-        let mut buf = Vec::new();
-        cdr::serialize(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut buf).unwrap();
-        let kh = cdr::key_hash(&s, XcdrVersion::Xcdr2).unwrap();
-        let alive = decode(rs(ChangeKind::Alive, buf, Some(kh)), &mut by_hash).unwrap();
-        assert_eq!(alive.data.as_ref(), Some(&s));
-        let mut expected = Vec::new();
-        cdr::instance_key(&s, &mut expected).unwrap();
-        assert_eq!(alive.key, expected);
-
-        let mut kp = Vec::new();
-        cdr::serialize_key(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut kp).unwrap();
-        let d = decode(rs(ChangeKind::Dispose, kp, None), &mut by_hash).unwrap();
-        assert_eq!(d.key, expected, "by key payload");
-        assert_eq!(d.kind, ChangeKind::Dispose);
-
-        let u = decode(
-            rs(ChangeKind::Unregister, Vec::new(), Some(kh)),
-            &mut by_hash,
-        )
-        .unwrap();
-        assert_eq!(u.key, expected, "by a key hash seen before");
-
-        let unknown = rs(ChangeKind::Dispose, Vec::new(), Some([9; 16]));
-        assert!(decode(unknown, &mut by_hash).is_none());
-        let garbage = rs(
-            ChangeKind::Alive,
-            vec![0, 7, 0, 0, 0xff, 0xff, 0xff, 0x7f],
-            None,
-        );
-        assert!(decode(garbage, &mut by_hash).is_none());
-    }
-
-    /// Fast DDS disposes with only PID_KEY_HASH; the alive samples before may have come without one.
-    #[test]
-    fn key_hash_only_dispose_maps_to_instance_seen_without_hash() {
-        let s = K {
-            id: "a-rather-long-key-beyond-16-bytes".into(),
-            v: 1,
-        };
-        let mut expected = Vec::new();
-        cdr::instance_key(&s, &mut expected).unwrap();
-        for version in [XcdrVersion::Xcdr1, XcdrVersion::Xcdr2] {
-            let mut by_hash = HashMap::new();
-            let mut buf = Vec::new();
-            cdr::serialize(&s, version, ByteOrder::NATIVE, &mut buf).unwrap();
-            decode(rs(ChangeKind::Alive, buf, None), &mut by_hash).unwrap();
-            let kh = cdr::key_hash(&s, version).unwrap();
-            let d = decode(rs(ChangeKind::Dispose, Vec::new(), Some(kh)), &mut by_hash)
-                .expect("dispose mapped through the computed key hash");
-            assert_eq!(d.key, expected);
-            assert_eq!(d.kind, ChangeKind::Dispose);
         }
     }
 }

@@ -42,16 +42,6 @@ impl<T: DdsType> std::fmt::Debug for Topic<T> {
 }
 
 impl<T: DdsType> Topic<T> {
-    pub(crate) fn new(participant: DomainParticipant, name: &str, qos: TopicQos) -> Self {
-        Topic {
-            inner: Arc::new(TopicInner {
-                participant,
-                name: name.to_string(),
-                qos,
-            }),
-            _t: PhantomData,
-        }
-    }
     /// The topic name.
     pub fn name(&self) -> &str {
         &self.inner.name
@@ -138,6 +128,22 @@ impl<T: DdsType + FilterFields> TopicDescription<T> for ContentFilteredTopic<T> 
 }
 
 impl DomainParticipant {
+    /// Creates a topic of type `T`.
+    pub fn create_topic<T: DdsType>(&self, name: &str, qos: &TopicQos) -> DdsResult<Topic<T>> {
+        self.driver().check_alive()?;
+        if name.is_empty() || name.len() > 256 {
+            return Err(DdsError::BadParameter(format!("topic name {name:?}")));
+        }
+        Ok(Topic {
+            inner: Arc::new(TopicInner {
+                participant: self.clone(),
+                name: name.to_string(),
+                qos: qos.clone(),
+            }),
+            _t: PhantomData,
+        })
+    }
+
     /// A content-filtered view of `topic` (SQL subset, see [`crate::dcps::filter`]); `%N` in the expression
     /// refers to `params[N]`.
     pub fn create_content_filtered_topic<T: DdsType + FilterFields, S: AsRef<str>>(
