@@ -1,6 +1,6 @@
 //! WaitSet and its conditions: [`GuardCondition`], [`StatusCondition`], [`ReadCondition`].
 //!
-//! Every condition owns a [`Signal`]; whoever changes what a condition looks at calls `Signal::notify`,
+//! Every condition owns a signal; whoever changes what a condition looks at calls `Signal::notify`,
 //! which wakes the waitsets the condition is attached to. `WaitSet::wait` re-evaluates the trigger values
 //! after each wakeup, so spurious notifications are harmless.
 

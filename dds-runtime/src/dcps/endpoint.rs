@@ -128,7 +128,7 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
     /// Applies `update` to a status. With `consume`, a listener consumes the change counts (DDS 2.2.4.2.1):
     /// the next callback reports only what happened since this one.
     #[allow(clippy::type_complexity)]
-    pub(crate) fn update<T: Status>(
+    fn update<T: Status>(
         &self,
         update: impl FnOnce(&mut S) -> &mut T,
         consume: bool,
@@ -146,7 +146,7 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
     }
 
     /// Raises `mask`, then (no lock held) calls the listener.
-    pub(crate) fn deliver<T, E>(
+    fn deliver<T, E>(
         &self,
         mask: StatusMask,
         target: Option<(Arc<L>, Arc<EndpointHandle<O>>)>,

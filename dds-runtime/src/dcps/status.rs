@@ -18,29 +18,35 @@ pub(crate) trait MatchedStatus: Status {
     fn record_match(&mut self, list: &mut Vec<Guid>, remote: Guid, matched: bool);
 }
 
-/// The counts of a matched status, shared by both sides.
-struct MatchCounts<'a> {
-    total: &'a mut u32,
-    total_change: &'a mut u32,
-    current: &'a mut u32,
-    current_change: &'a mut i32,
-}
-
-impl MatchCounts<'_> {
-    fn record(self, list: &mut Vec<Guid>, remote: Guid, matched: bool) {
-        if matched {
-            if !list.contains(&remote) {
-                list.push(remote);
-                *self.total += 1;
-                *self.total_change += 1;
-                *self.current_change += 1;
+/// `Status` and `MatchedStatus` for PUBLICATION_MATCHED and SUBSCRIPTION_MATCHED, which differ only in the
+/// name of the last remote handle.
+macro_rules! matched_status {
+    ($status:ty, $last_handle:ident) => {
+        impl Status for $status {
+            fn reset_changes(&mut self) {
+                self.total_count_change = 0;
+                self.current_count_change = 0;
             }
-        } else if let Some(p) = list.iter().position(|g| *g == remote) {
-            list.remove(p);
-            *self.current_change -= 1;
         }
-        *self.current = u32::try_from(list.len()).unwrap_or(u32::MAX);
-    }
+
+        impl MatchedStatus for $status {
+            fn record_match(&mut self, list: &mut Vec<Guid>, remote: Guid, matched: bool) {
+                if matched {
+                    if !list.contains(&remote) {
+                        list.push(remote);
+                        self.total_count += 1;
+                        self.total_count_change += 1;
+                        self.current_count_change += 1;
+                    }
+                } else if let Some(p) = list.iter().position(|g| *g == remote) {
+                    list.remove(p);
+                    self.current_count_change -= 1;
+                }
+                self.current_count = u32::try_from(list.len()).unwrap_or(u32::MAX);
+                self.$last_handle = InstanceHandle::from_guid(remote);
+            }
+        }
+    };
 }
 
 bitflags::bitflags! {
@@ -210,45 +216,8 @@ pub struct LivelinessChangedStatus {
     pub last_publication_handle: InstanceHandle,
 }
 
-impl Status for PublicationMatchedStatus {
-    fn reset_changes(&mut self) {
-        self.total_count_change = 0;
-        self.current_count_change = 0;
-    }
-}
-
-impl MatchedStatus for PublicationMatchedStatus {
-    fn record_match(&mut self, list: &mut Vec<Guid>, remote: Guid, matched: bool) {
-        MatchCounts {
-            total: &mut self.total_count,
-            total_change: &mut self.total_count_change,
-            current: &mut self.current_count,
-            current_change: &mut self.current_count_change,
-        }
-        .record(list, remote, matched);
-        self.last_subscription_handle = InstanceHandle::from_guid(remote);
-    }
-}
-
-impl Status for SubscriptionMatchedStatus {
-    fn reset_changes(&mut self) {
-        self.total_count_change = 0;
-        self.current_count_change = 0;
-    }
-}
-
-impl MatchedStatus for SubscriptionMatchedStatus {
-    fn record_match(&mut self, list: &mut Vec<Guid>, remote: Guid, matched: bool) {
-        MatchCounts {
-            total: &mut self.total_count,
-            total_change: &mut self.total_count_change,
-            current: &mut self.current_count,
-            current_change: &mut self.current_count_change,
-        }
-        .record(list, remote, matched);
-        self.last_publication_handle = InstanceHandle::from_guid(remote);
-    }
-}
+matched_status!(PublicationMatchedStatus, last_subscription_handle);
+matched_status!(SubscriptionMatchedStatus, last_publication_handle);
 
 impl Status for IncompatibleQosStatus {
     fn reset_changes(&mut self) {

@@ -761,23 +761,18 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                 );
             }
             Event::LivelinessChanged { writer, alive, .. } => {
-                let (target, status) = self.state.update(
-                    |st| {
-                        st.liveliness_changed.record(*writer, *alive);
-                        &mut st.liveliness_changed
-                    },
-                    false,
-                );
                 if !*alive {
                     let changed = lock(&self.cache).cache.writer_gone(*writer, Instant::now());
                     if changed {
                         self.notify_data();
                     }
                 }
-                self.state.deliver(
+                self.state.signal(
                     StatusMask::LIVELINESS_CHANGED,
-                    target,
-                    status,
+                    |st| {
+                        st.liveliness_changed.record(*writer, *alive);
+                        &mut st.liveliness_changed
+                    },
                     self.reader(),
                     |l, r, s| l.on_liveliness_changed(r, s),
                 );
