@@ -3,12 +3,22 @@
 
 use std::sync::{Arc, Mutex, OnceLock, Weak};
 
+use crate::qos::History;
 use crate::rtps::{EntityId, Guid};
 
 use super::condition::StatusCore;
 use super::driver::{Driver, EndpointHandle};
+use super::error::{DdsError, DdsResult};
 use super::status::{MatchedStatus, Status, StatusMask};
 use super::sync::lock;
+
+/// Refuses a KEEP_LAST history of depth 0, for a reader as for a writer.
+pub(crate) fn check_history(h: &History) -> DdsResult<()> {
+    match h {
+        History::KeepLast(0) => Err(DdsError::BadParameter("history depth 0".into())),
+        _ => Ok(()),
+    }
+}
 
 /// The side-independent state of an endpoint. `S` holds its statuses, `L` is its listener trait and `O` what
 /// its handle keeps alive (see [`EndpointHandle`]).

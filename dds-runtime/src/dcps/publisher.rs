@@ -16,7 +16,7 @@ use crate::rtps::{
 
 use super::condition::StatusCondition;
 use super::driver::{Endpoint, EndpointHandle};
-use super::endpoint::EndpointState;
+use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
 use super::participant::DomainParticipant;
 use super::sample::InstanceHandle;
@@ -97,13 +97,10 @@ impl Publisher {
         qos: &DataWriterQos,
     ) -> DdsResult<DataWriter<T>> {
         let driver = self.participant.driver().clone();
-        driver.check_alive()?;
         let (version, rep) = writer_version::<T>(&qos.data_representation);
         let mut wq = qos.clone();
         wq.data_representation = rep;
-        if let crate::qos::History::KeepLast(0) = wq.history {
-            return Err(DdsError::BadParameter("history depth 0".into()));
-        }
+        check_history(&wq.history)?;
         let spec = WriterSpec {
             topic_name: topic.name().to_string(),
             type_name: T::TYPE_NAME.to_string(),

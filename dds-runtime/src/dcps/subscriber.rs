@@ -20,7 +20,7 @@ use super::cache::{to_sample, Outcome, ReaderCache, Selection};
 use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition};
 use super::decode::decode_change;
 use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
-use super::endpoint::EndpointState;
+use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
 use super::participant::DomainParticipant;
 use super::sample::{
@@ -98,15 +98,12 @@ impl Subscriber {
         qos: &DataReaderQos,
     ) -> DdsResult<DataReader<T>> {
         let driver = self.participant.driver().clone();
-        driver.check_alive()?;
         let mut rq = qos.clone();
         if rq.data_representation.0.is_empty() {
             rq.data_representation =
                 DataRepresentation(vec![XCDR_DATA_REPRESENTATION, XCDR2_DATA_REPRESENTATION]);
         }
-        if let crate::qos::History::KeepLast(0) = rq.history {
-            return Err(DdsError::BadParameter("history depth 0".into()));
-        }
+        check_history(&rq.history)?;
         let t = topic.topic();
         let spec = ReaderSpec {
             topic_name: t.name().to_string(),
