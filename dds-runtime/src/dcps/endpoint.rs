@@ -2,12 +2,13 @@
 //! condition, their listener, the list of matched remote endpoints and the way back to a public handle.
 
 use std::sync::{Arc, Mutex, OnceLock, Weak};
+use std::time::Instant;
 
 use crate::qos::History;
-use crate::rtps::{EntityId, Guid};
+use crate::rtps::{CoreError, EntityId, Guid, Participant};
 
 use super::condition::StatusCore;
-use super::driver::{Driver, EndpointHandle};
+use super::driver::{Driver, Endpoint, EndpointHandle};
 use super::error::{DdsError, DdsResult};
 use super::status::{MatchedStatus, Status, StatusMask};
 use super::sync::lock;
@@ -48,20 +49,28 @@ impl<S: Default, L: ?Sized, O> EndpointState<S, L, O> {
 }
 
 impl<S, L: ?Sized, O> EndpointState<S, L, O> {
-    /// Records the entity id the core gave the endpoint.
-    pub(crate) fn set_id(&self, id: EntityId) {
-        // Set once, at creation.
-        let _ = self.id.set(id);
+    /// Creates the endpoint in the core with `create` (see [`Driver::create_endpoint`]), with `sink` as
+    /// its driver-facing side, and returns its handle.
+    pub(crate) fn create(
+        &self,
+        sink: Arc<dyn Endpoint>,
+        owner: O,
+        create: impl FnOnce(&mut Participant, Instant) -> Result<EntityId, CoreError>,
+    ) -> DdsResult<Arc<EndpointHandle<O>>> {
+        let id = self.driver.create_endpoint(sink, |c, now| {
+            let id = create(c, now)?;
+            // Set once, here: the core reports nothing for the endpoint before `create` returns.
+            let _ = self.id.set(id);
+            Ok(id)
+        })?;
+        let handle = Arc::new(EndpointHandle::new(self.driver.clone(), id, owner));
+        *lock(&self.handle) = Arc::downgrade(&handle);
+        Ok(handle)
     }
 
     /// The entity id (`UNKNOWN` until created).
     pub(crate) fn id(&self) -> EntityId {
         self.id.get().copied().unwrap_or(EntityId::UNKNOWN)
-    }
-
-    /// Remembers the public handle, so that listeners can be given the entity.
-    pub(crate) fn set_handle(&self, h: &Arc<EndpointHandle<O>>) {
-        *lock(&self.handle) = Arc::downgrade(h);
     }
 
     /// The public handle, while some clone of the entity exists.

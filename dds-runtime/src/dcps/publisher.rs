@@ -115,18 +115,15 @@ impl Publisher {
             version,
             instances: Mutex::new(WriterInstances::default()),
         });
-        let sink: Arc<dyn Endpoint> = inner.clone();
-        let id = driver.create_endpoint(sink, |c, now| {
-            let id = c.create_writer(now, spec)?;
-            inner.state.set_id(id);
-            Ok(id)
-        })?;
         let owner = WriterOwner {
             topic: topic.clone(),
             publisher: self.clone(),
         };
-        let handle = Arc::new(EndpointHandle::new(driver, id, owner));
-        inner.state.set_handle(&handle);
+        let sink: Arc<dyn Endpoint> = inner.clone();
+        let handle = inner
+            .state
+            .create(sink, owner, |c, now| c.create_writer(now, spec))?;
+        let id = handle.id();
         tracing::info!(
             topic = topic.name(),
             type_name = T::TYPE_NAME,

@@ -135,21 +135,19 @@ impl Subscriber {
             data_signal: Signal::default(),
             credit_limit,
         });
-        let sink: Arc<dyn Endpoint> = inner.clone();
-        let id = driver.create_endpoint(sink, |c, now| {
-            let id = c.create_reader(now, spec)?;
-            if credit_limit.is_some() {
-                c.set_reader_credit(id, credit_limit);
-            }
-            inner.state.set_id(id);
-            Ok(id)
-        })?;
         let owner = ReaderOwner {
             topic: t.clone(),
             subscriber: self.clone(),
         };
-        let handle = Arc::new(EndpointHandle::new(driver, id, owner));
-        inner.state.set_handle(&handle);
+        let sink: Arc<dyn Endpoint> = inner.clone();
+        let handle = inner.state.create(sink, owner, |c, now| {
+            let id = c.create_reader(now, spec)?;
+            if credit_limit.is_some() {
+                c.set_reader_credit(id, credit_limit);
+            }
+            Ok(id)
+        })?;
+        let id = handle.id();
         tracing::info!(
             topic = t.name(),
             type_name = T::TYPE_NAME,
