@@ -1,7 +1,18 @@
-//! `use dds_runtime::prelude::*;` brings in the DCPS API, the QoS policies and the derive.
+//! `use dds_runtime::prelude::*;` brings in what a program using the DCPS API writes: the entities, their
+//! QoS policies, samples and statuses, conditions, listeners, the derive and the configuration types.
+//! Helpers (QoS matching, wire forms) stay in their modules.
 
 pub use crate::cdr::{DdsType, XcdrVersion};
 pub use crate::config::{Config, ParticipantIndex};
 pub use crate::dcps::*;
-pub use crate::qos::*;
+pub use crate::qos::{
+    DataReaderQos, DataReaderQosBuilder, DataRepresentation, DataWriterQos, DataWriterQosBuilder,
+    Deadline, DestinationOrder, Durability, DurabilityService, GroupData, History, LatencyBudget,
+    Lifespan, Liveliness, LivelinessKind, Ownership, OwnershipStrength, Partition, Presentation,
+    PresentationAccessScope, PublisherQos, PublisherQosBuilder, QosPolicyId, ReaderDataLifecycle,
+    Reliability, ResourceLimits, SubscriberQos, SubscriberQosBuilder, TimeBasedFilter, TopicData,
+    TopicQos, TopicQosBuilder, TransportPriority, TypeConsistencyEnforcement, TypeConsistencyKind,
+    UserData, WriterDataLifecycle, INFINITE, XCDR2_DATA_REPRESENTATION, XCDR_DATA_REPRESENTATION,
+    XML_DATA_REPRESENTATION,
+};
 pub use crate::DdsType;

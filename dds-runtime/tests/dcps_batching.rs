@@ -16,7 +16,7 @@ fn batched_burst_shares_datagrams_and_flush_sends_the_rest() {
         .domain_id(domain)
         .interface("lo")
         .spdp_interval(Duration::from_millis(200))
-        .write_batching(Some(Duration::from_secs(10)))
+        .write_batching(WriteBatching::Delay(Duration::from_secs(10)))
         .build()
         .unwrap();
     let plain = participant(domain);

@@ -45,7 +45,10 @@ fn reliable_keyed_exchange_in_order_with_sample_info() {
     assert_eq!(s.info.sample_state, SampleState::NotRead);
     assert_eq!(s.info.source_timestamp, ts);
     assert_eq!(s.info.publication_handle, w.instance_handle());
-    let red = r.lookup_instance(&shape("RED", 999)).expect("RED instance");
+    let red = r
+        .lookup_instance(&shape("RED", 999))
+        .unwrap()
+        .expect("RED instance");
     assert_eq!(
         got.iter()
             .find(|s| s.data.as_ref().unwrap().color == "RED")

@@ -8,9 +8,11 @@ use dds_runtime::prelude::*;
 
 fn assert_send_sync<T: Send + Sync>() {}
 
+/// A static assertion: this test does not compile if an entity stops being `Send + Sync`.
 #[test]
 fn entities_are_send_and_sync() {
     assert_send_sync::<DomainParticipant>();
+    assert_send_sync::<DomainParticipantBuilder>();
     assert_send_sync::<Topic<ShapeType>>();
     assert_send_sync::<ContentFilteredTopic<ShapeType>>();
     assert_send_sync::<Publisher>();
@@ -18,6 +20,9 @@ fn entities_are_send_and_sync() {
     assert_send_sync::<DataWriter<ShapeType>>();
     assert_send_sync::<DataReader<ShapeType>>();
     assert_send_sync::<SampleStream<ShapeType>>();
+    assert_send_sync::<Selector<'static, ShapeType>>();
+    assert_send_sync::<Sample<ShapeType>>();
+    assert_send_sync::<DiscoveredParticipant>();
     assert_send_sync::<WaitSet>();
     assert_send_sync::<ReadCondition>();
     assert_send_sync::<StatusCondition>();
@@ -119,7 +124,7 @@ fn keep_last_depth_applies_per_instance() {
     }
     w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
     assert!(wait_until(Duration::from_secs(5), || r.sample_count() == 6));
-    let blue = r.lookup_instance(&shape("BLUE", 0)).unwrap();
+    let blue = r.lookup_instance(&shape("BLUE", 0)).unwrap().unwrap();
     let got = r.take_instance(blue).unwrap();
     assert_eq!(
         got.iter()

@@ -8,6 +8,7 @@ use std::time::{Duration, Instant, SystemTime};
 use foldhash::{HashMap, HashMapExt};
 
 use crate::qos::{DataReaderQos, History, Ownership, INFINITE};
+use crate::rtps::{ChangeKind, Guid};
 
 use super::sample::{
     InstanceHandle, InstanceState, InstanceStateMask, Sample, SampleInfo, SampleState,
@@ -15,29 +16,20 @@ use super::sample::{
 };
 use super::status::SampleRejectedReason;
 
-/// What a change does to its instance.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum ChangeKindLocal {
-    Alive,
-    Dispose,
-    Unregister,
-    DisposeUnregister,
-}
-
 /// One decoded change arriving from a writer.
 pub(crate) struct Incoming<T> {
-    pub writer: [u8; 16],
-    pub kind: ChangeKindLocal,
-    pub data: Option<T>,
+    pub(crate) writer: Guid,
+    pub(crate) kind: ChangeKind,
+    pub(crate) data: Option<T>,
     /// Serialized key (`cdr::instance_key`), or the 16-byte key hash when nothing better is known.
-    pub key: Vec<u8>,
+    pub(crate) key: Vec<u8>,
     /// A sample holding (at least) the key values, for `get_key_value`.
-    pub key_holder: Option<T>,
-    pub source_timestamp: SystemTime,
-    pub reception_timestamp: SystemTime,
-    pub strength: i32,
+    pub(crate) key_holder: Option<T>,
+    pub(crate) source_timestamp: SystemTime,
+    pub(crate) reception_timestamp: SystemTime,
+    pub(crate) strength: i32,
     /// When the sample expires (writer's lifespan), if known.
-    pub expires: Option<Instant>,
+    pub(crate) expires: Option<Instant>,
 }
 
 /// What happened to an incoming change.
@@ -59,7 +51,7 @@ struct Stored<T> {
     read: bool,
     source_timestamp: SystemTime,
     reception_timestamp: SystemTime,
-    writer: [u8; 16],
+    writer: Guid,
     disposed_gen: u32,
     no_writers_gen: u32,
     seq: u64,
@@ -73,8 +65,8 @@ struct Instance<T> {
     view: ViewState,
     disposed_gen: u32,
     no_writers_gen: u32,
-    writers: HashMap<[u8; 16], i32>,
-    owner: Option<([u8; 16], i32)>,
+    writers: HashMap<Guid, i32>,
+    owner: Option<(Guid, i32)>,
     samples: VecDeque<Stored<T>>,
     last_accepted: Option<Instant>,
     last_data: Instant,
@@ -84,11 +76,11 @@ struct Instance<T> {
 /// Which samples a read/take returns.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Selection {
-    pub max_samples: Option<usize>,
-    pub sample_states: SampleStateMask,
-    pub view_states: ViewStateMask,
-    pub instance_states: InstanceStateMask,
-    pub instance: Option<InstanceHandle>,
+    pub(crate) max_samples: Option<usize>,
+    pub(crate) sample_states: SampleStateMask,
+    pub(crate) view_states: ViewStateMask,
+    pub(crate) instance_states: InstanceStateMask,
+    pub(crate) instance: Option<InstanceHandle>,
 }
 
 type Filter<T> = Box<dyn Fn(&T) -> bool + Send + Sync>;
@@ -106,12 +98,27 @@ pub(crate) struct ReaderCache<T> {
     filter: Option<Filter<T>>,
 }
 
+/// The sample a read (copying the data with `copy`, if any) or a take (moving it out) returns for `slot`.
+pub(crate) fn to_sample<T>(
+    slot: &mut Option<T>,
+    info: SampleInfo,
+    take: bool,
+    copy: Option<fn(&T) -> T>,
+) -> Sample<T> {
+    let data = match (take, copy) {
+        (true, _) => slot.take(),
+        (false, Some(f)) => slot.as_ref().map(f),
+        (false, None) => None,
+    };
+    Sample { data, info }
+}
+
 fn finite(d: Duration) -> Option<Duration> {
     (d != INFINITE && d < Duration::from_secs(100 * 365 * 86400)).then_some(d)
 }
 
 impl<T> ReaderCache<T> {
-    pub fn new(qos: DataReaderQos, keyed: bool) -> Self {
+    pub(crate) fn new(qos: DataReaderQos, keyed: bool) -> Self {
         ReaderCache {
             qos,
             keyed,
@@ -125,23 +132,23 @@ impl<T> ReaderCache<T> {
         }
     }
 
-    pub fn set_filter(&mut self, f: Option<Filter<T>>) {
+    pub(crate) fn set_filter(&mut self, f: Option<Filter<T>>) {
         self.filter = f;
     }
 
-    pub fn lookup(&self, key: &[u8]) -> Option<InstanceHandle> {
+    pub(crate) fn lookup(&self, key: &[u8]) -> Option<InstanceHandle> {
         self.by_key.get(key).copied()
     }
 
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.total
     }
 
-    pub fn instance_count(&self) -> usize {
+    pub(crate) fn instance_count(&self) -> usize {
         self.instances.len()
     }
 
-    pub fn instance_state(&self, h: InstanceHandle) -> Option<InstanceState> {
+    pub(crate) fn instance_state(&self, h: InstanceHandle) -> Option<InstanceState> {
         self.instances.get(&h).map(|i| i.state)
     }
 
@@ -181,14 +188,14 @@ impl<T> ReaderCache<T> {
 
     /// Applies one change. `now` is the monotonic time of reception.
     /// An empty buffer for the next sample's instance key (reusing the last one's allocation).
-    pub fn take_key_buffer(&mut self) -> Vec<u8> {
+    pub(crate) fn take_key_buffer(&mut self) -> Vec<u8> {
         let mut k = std::mem::take(&mut self.spare_key);
         k.clear();
         k
     }
 
-    pub fn insert(&mut self, mut inc: Incoming<T>, now: Instant) -> Outcome {
-        let alive = inc.kind == ChangeKindLocal::Alive;
+    pub(crate) fn insert(&mut self, mut inc: Incoming<T>, now: Instant) -> Outcome {
+        let alive = inc.kind == ChangeKind::Alive;
         if alive {
             match (&inc.data, &self.filter) {
                 (None, _) => return Outcome::Filtered,
@@ -207,7 +214,7 @@ impl<T> ReaderCache<T> {
                 self.spare_key = key;
                 h
             }
-            None if !alive && inc.kind == ChangeKindLocal::Unregister => return Outcome::Filtered,
+            None if !alive && inc.kind == ChangeKind::Unregister => return Outcome::Filtered,
             None => {
                 let holder = inc.key_holder.take();
                 match self.new_instance(key, holder, now) {
@@ -248,7 +255,7 @@ impl<T> ReaderCache<T> {
             if !owner_ok {
                 if matches!(
                     inc.kind,
-                    ChangeKindLocal::Unregister | ChangeKindLocal::DisposeUnregister
+                    ChangeKind::Unregister | ChangeKind::DisposeUnregister
                 ) {
                     inst.writers.remove(&inc.writer);
                 }
@@ -329,7 +336,7 @@ impl<T> ReaderCache<T> {
         let before = inst.state;
         if matches!(
             inc.kind,
-            ChangeKindLocal::Dispose | ChangeKindLocal::DisposeUnregister
+            ChangeKind::Dispose | ChangeKind::DisposeUnregister
         ) {
             if inst.state == InstanceState::NotAliveNoWriters {
                 inst.no_writers_gen += 1;
@@ -338,7 +345,7 @@ impl<T> ReaderCache<T> {
         }
         if matches!(
             inc.kind,
-            ChangeKindLocal::Unregister | ChangeKindLocal::DisposeUnregister
+            ChangeKind::Unregister | ChangeKind::DisposeUnregister
         ) {
             inst.writers.remove(&inc.writer);
             if inst.owner.is_some_and(|(g, _)| g == inc.writer) {
@@ -374,7 +381,7 @@ impl<T> ReaderCache<T> {
 
     /// A writer is gone (unmatched or lost): its instances lose it as if it had unregistered them.
     /// Returns whether any instance changed state.
-    pub fn writer_gone(&mut self, writer: [u8; 16], now: Instant) -> bool {
+    pub(crate) fn writer_gone(&mut self, writer: Guid, now: Instant) -> bool {
         let handles: Vec<InstanceHandle> = self
             .instances
             .iter()
@@ -389,7 +396,7 @@ impl<T> ReaderCache<T> {
             let key = inst.key.clone();
             let inc = Incoming {
                 writer,
-                kind: ChangeKindLocal::Unregister,
+                kind: ChangeKind::Unregister,
                 data: None,
                 key,
                 key_holder: None,
@@ -415,14 +422,18 @@ impl<T> ReaderCache<T> {
     }
 
     /// Whether some sample matches the masks (ReadCondition trigger, DATA_AVAILABLE).
-    pub fn has_matching(&self, sel: &Selection) -> bool {
+    pub(crate) fn has_matching(&self, sel: &Selection) -> bool {
         self.instances
             .values()
             .any(|i| i.samples.iter().any(|s| Self::matches(i, s, sel)))
     }
 
     /// The smallest instance handle above `prev` that has a matching sample.
-    pub fn next_instance(&self, prev: InstanceHandle, sel: &Selection) -> Option<InstanceHandle> {
+    pub(crate) fn next_instance(
+        &self,
+        prev: InstanceHandle,
+        sel: &Selection,
+    ) -> Option<InstanceHandle> {
         use std::ops::Bound::{Excluded, Unbounded};
         self.instances
             .range((Excluded(prev), Unbounded))
@@ -431,7 +442,8 @@ impl<T> ReaderCache<T> {
     }
 
     /// Reads (`take == false`, data cloned by `copy`) or takes the selected samples, in reception order.
-    pub fn collect(
+    #[cfg(test)]
+    fn collect(
         &mut self,
         sel: &Selection,
         take: bool,
@@ -439,19 +451,14 @@ impl<T> ReaderCache<T> {
     ) -> Vec<Sample<T>> {
         let mut out = Vec::new();
         self.collect_with(sel, take, |slot, info| {
-            let data = match (take, copy) {
-                (true, _) => slot.take(),
-                (false, Some(f)) => slot.as_ref().map(f),
-                (false, None) => None,
-            };
-            out.push(Sample { data, info });
+            out.push(to_sample(slot, info, take, copy))
         });
         out
     }
 
     /// Core of read/take: calls `emit` with each selected sample's data slot and info, in reception order;
     /// with `take` the samples are removed afterwards (whatever `emit` left in the slot is dropped).
-    pub fn collect_with(
+    pub(crate) fn collect_with(
         &mut self,
         sel: &Selection,
         take: bool,
@@ -518,7 +525,7 @@ impl<T> ReaderCache<T> {
                 source_timestamp: s.source_timestamp,
                 reception_timestamp: s.reception_timestamp,
                 instance_handle: tc.handle,
-                publication_handle: InstanceHandle::from_guid_bytes(&s.writer),
+                publication_handle: InstanceHandle::from_guid(s.writer),
                 publication_guid: s.writer,
                 disposed_generation_count: s.disposed_gen,
                 no_writers_generation_count: s.no_writers_gen,
@@ -565,7 +572,7 @@ impl<T> ReaderCache<T> {
     }
 
     /// Time-driven QoS: lifespan expiry, autopurge, deadline. Returns the instances whose deadline was missed.
-    pub fn tick(&mut self, now: Instant) -> Vec<InstanceHandle> {
+    pub(crate) fn tick(&mut self, now: Instant) -> Vec<InstanceHandle> {
         let lc = self.qos.reader_data_lifecycle;
         let nowriter = finite(lc.autopurge_nowriter_samples_delay);
         let disposed = finite(lc.autopurge_disposed_samples_delay);
@@ -575,7 +582,8 @@ impl<T> ReaderCache<T> {
         let mut removed = 0;
         for (h, inst) in self.instances.iter_mut() {
             let before = inst.samples.len();
-            inst.samples.retain(|s| s.expires.is_none_or(|e| e > now));
+            inst.samples
+                .retain(|s| !s.expires.is_some_and(|e| e <= now));
             removed += before - inst.samples.len();
             if let Some(since) = inst.not_alive_since {
                 let delay = match inst.state {
@@ -624,11 +632,11 @@ mod tests {
     use super::*;
     use crate::qos::{ReaderDataLifecycle, ResourceLimits, TimeBasedFilter};
 
-    fn inc(w: u8, kind: ChangeKindLocal, key: u8, v: i32) -> Incoming<i32> {
+    fn inc(w: u8, kind: ChangeKind, key: u8, v: i32) -> Incoming<i32> {
         Incoming {
-            writer: [w; 16],
+            writer: Guid::from_bytes([w; 16]),
             kind,
-            data: (kind == ChangeKindLocal::Alive).then_some(v),
+            data: (kind == ChangeKind::Alive).then_some(v),
             key: vec![key],
             key_holder: None,
             source_timestamp: SystemTime::now(),
@@ -656,9 +664,9 @@ mod tests {
         let mut c = ReaderCache::new(qos, true);
         let now = Instant::now();
         for v in 0..5 {
-            c.insert(inc(1, ChangeKindLocal::Alive, 1, v), now);
+            c.insert(inc(1, ChangeKind::Alive, 1, v), now);
         }
-        c.insert(inc(1, ChangeKindLocal::Alive, 2, 100), now);
+        c.insert(inc(1, ChangeKind::Alive, 2, 100), now);
         assert_eq!(c.len(), 3);
         let r = c.collect(&all(), false, CP);
         assert_eq!(
@@ -672,7 +680,7 @@ mod tests {
         assert!(r.iter().all(|s| s.info.sample_state == SampleState::Read));
         assert!(r.iter().all(|s| s.info.view_state == ViewState::NotNew));
         // Dispose key 1: state visible on the retained samples.
-        c.insert(inc(1, ChangeKindLocal::Dispose, 1, 0), now);
+        c.insert(inc(1, ChangeKind::Dispose, 1, 0), now);
         let h1 = c.lookup(&[1]).unwrap();
         let r = c.collect(
             &Selection {
@@ -688,7 +696,7 @@ mod tests {
             .all(|s| s.info.instance_state == InstanceState::NotAliveDisposed));
         assert!(!r[2].info.valid_data);
         // Rebirth: new generation, view NEW again.
-        c.insert(inc(1, ChangeKindLocal::Alive, 1, 7), now);
+        c.insert(inc(1, ChangeKind::Alive, 1, 7), now);
         let r = c.collect(
             &Selection {
                 instance: Some(h1),
@@ -700,7 +708,7 @@ mod tests {
         assert_eq!(r[0].info.disposed_generation_count, 1);
         assert_eq!(r[0].info.view_state, ViewState::New);
         // Unregister by the only writer: NOT_ALIVE_NO_WRITERS, then forgotten once taken.
-        c.insert(inc(1, ChangeKindLocal::Unregister, 1, 0), now);
+        c.insert(inc(1, ChangeKind::Unregister, 1, 0), now);
         let r = c.collect(
             &Selection {
                 instance: Some(h1),
@@ -722,22 +730,22 @@ mod tests {
         };
         let mut c = ReaderCache::new(qos, true);
         let now = Instant::now();
-        c.insert(inc(5, ChangeKindLocal::Alive, 1, 1), now);
+        c.insert(inc(5, ChangeKind::Alive, 1, 1), now);
         assert_eq!(
-            c.insert(inc(2, ChangeKindLocal::Alive, 1, 2), now),
+            c.insert(inc(2, ChangeKind::Alive, 1, 2), now),
             Outcome::Filtered
         );
         assert!(matches!(
-            c.insert(inc(9, ChangeKindLocal::Alive, 1, 3), now),
+            c.insert(inc(9, ChangeKind::Alive, 1, 3), now),
             Outcome::Accepted { .. }
         ));
         assert_eq!(
-            c.insert(inc(5, ChangeKindLocal::Alive, 1, 4), now),
+            c.insert(inc(5, ChangeKind::Alive, 1, 4), now),
             Outcome::Filtered
         );
-        c.insert(inc(9, ChangeKindLocal::Unregister, 1, 0), now);
+        c.insert(inc(9, ChangeKind::Unregister, 1, 0), now);
         assert!(matches!(
-            c.insert(inc(5, ChangeKindLocal::Alive, 1, 5), now),
+            c.insert(inc(5, ChangeKind::Alive, 1, 5), now),
             Outcome::Accepted { .. }
         ));
         let r: Vec<i32> = c
@@ -768,18 +776,18 @@ mod tests {
         };
         let mut c = ReaderCache::new(qos, true);
         let now = Instant::now();
-        c.insert(inc(1, ChangeKindLocal::Alive, 1, 1), now);
-        c.insert(inc(1, ChangeKindLocal::Alive, 2, 2), now);
+        c.insert(inc(1, ChangeKind::Alive, 1, 1), now);
+        c.insert(inc(1, ChangeKind::Alive, 2, 2), now);
         assert!(matches!(
-            c.insert(inc(1, ChangeKindLocal::Alive, 3, 3), now),
+            c.insert(inc(1, ChangeKind::Alive, 3, 3), now),
             Outcome::Rejected {
                 reason: SampleRejectedReason::ByInstancesLimit,
                 ..
             }
         ));
-        c.insert(inc(1, ChangeKindLocal::Alive, 2, 3), now);
+        c.insert(inc(1, ChangeKind::Alive, 2, 3), now);
         assert!(matches!(
-            c.insert(inc(1, ChangeKindLocal::Alive, 2, 4), now),
+            c.insert(inc(1, ChangeKind::Alive, 2, 4), now),
             Outcome::Rejected {
                 reason: SampleRejectedReason::BySamplesLimit,
                 ..
@@ -787,10 +795,10 @@ mod tests {
         ));
         c.set_filter(Some(Box::new(|x: &i32| *x > 10)));
         assert_eq!(
-            c.insert(inc(1, ChangeKindLocal::Alive, 1, 5), now),
+            c.insert(inc(1, ChangeKind::Alive, 1, 5), now),
             Outcome::Filtered
         );
-        assert!(c.writer_gone([1; 16], now));
+        assert!(c.writer_gone(Guid::from_bytes([1; 16]), now));
         c.tick(now + Duration::from_millis(20));
         assert_eq!(c.len(), 0);
         assert_eq!(c.instance_count(), 0);
@@ -808,17 +816,17 @@ mod tests {
         };
         let mut c = ReaderCache::new(qos, true);
         let t0 = Instant::now();
-        c.insert(inc(1, ChangeKindLocal::Alive, 1, 1), t0);
+        c.insert(inc(1, ChangeKind::Alive, 1, 1), t0);
         assert_eq!(
             c.insert(
-                inc(1, ChangeKindLocal::Alive, 1, 2),
+                inc(1, ChangeKind::Alive, 1, 2),
                 t0 + Duration::from_millis(50)
             ),
             Outcome::Filtered
         );
         assert!(matches!(
             c.insert(
-                inc(1, ChangeKindLocal::Alive, 1, 3),
+                inc(1, ChangeKind::Alive, 1, 3),
                 t0 + Duration::from_millis(150)
             ),
             Outcome::Accepted { .. }

@@ -1,6 +1,6 @@
 //! WaitSet and its conditions: [`GuardCondition`], [`StatusCondition`], [`ReadCondition`].
 //!
-//! Every condition owns a [`Signal`]; whoever changes what a condition looks at calls `Signal::notify`,
+//! Every condition owns a signal; whoever changes what a condition looks at calls `Signal::notify`,
 //! which wakes the waitsets the condition is attached to. `WaitSet::wait` re-evaluates the trigger values
 //! after each wakeup, so spurious notifications are harmless.
 
@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 use super::error::{DdsError, DdsResult};
 use super::sample::{InstanceStateMask, SampleStateMask, ViewStateMask};
 use super::status::StatusMask;
+use super::sync::{lock, recover};
 
 /// One waitset's wakeup channel: a generation counter under a mutex, and a condvar.
 #[derive(Debug, Default)]
@@ -21,7 +22,7 @@ pub(crate) struct WaitSetCore {
 
 impl WaitSetCore {
     fn wake(&self) {
-        let mut g = self.generation.lock().unwrap_or_else(|e| e.into_inner());
+        let mut g = lock(&self.generation);
         *g = g.wrapping_add(1);
         self.cv.notify_all();
     }
@@ -35,7 +36,7 @@ pub(crate) struct Signal {
 
 impl Signal {
     pub(crate) fn notify(&self) {
-        let mut ws = self.waitsets.lock().unwrap_or_else(|e| e.into_inner());
+        let mut ws = lock(&self.waitsets);
         ws.retain(|w| match w.upgrade() {
             Some(w) => {
                 w.wake();
@@ -45,17 +46,11 @@ impl Signal {
         });
     }
     fn attach(&self, w: &Arc<WaitSetCore>) {
-        self.waitsets
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push(Arc::downgrade(w));
+        lock(&self.waitsets).push(Arc::downgrade(w));
     }
     fn detach(&self, w: &Arc<WaitSetCore>) {
         let p = Arc::as_ptr(w);
-        self.waitsets
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .retain(|x| x.as_ptr() != p);
+        lock(&self.waitsets).retain(|x| x.as_ptr() != p);
     }
 }
 
@@ -254,7 +249,7 @@ impl WaitSet {
     /// Attaches a condition (attaching the same one twice is a no-op).
     pub fn attach_condition(&self, c: impl Into<Condition>) {
         let c = c.into();
-        let mut cs = self.conditions.lock().unwrap_or_else(|e| e.into_inner());
+        let mut cs = lock(&self.conditions);
         if cs.iter().any(|x| x.same(&c)) {
             return;
         }
@@ -266,7 +261,7 @@ impl WaitSet {
     /// Detaches a condition; `BadParameter` if it was not attached.
     pub fn detach_condition(&self, c: impl Into<Condition>) -> DdsResult<()> {
         let c = c.into();
-        let mut cs = self.conditions.lock().unwrap_or_else(|e| e.into_inner());
+        let mut cs = lock(&self.conditions);
         let Some(pos) = cs.iter().position(|x| x.same(&c)) else {
             return Err(DdsError::BadParameter("condition not attached".into()));
         };
@@ -277,10 +272,7 @@ impl WaitSet {
 
     /// The attached conditions.
     pub fn conditions(&self) -> Vec<Condition> {
-        self.conditions
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone()
+        lock(&self.conditions).clone()
     }
 
     /// Waits until at least one attached condition triggers and returns the triggered ones;
@@ -288,11 +280,7 @@ impl WaitSet {
     pub fn wait(&self, timeout: Duration) -> DdsResult<Vec<Condition>> {
         let deadline = Instant::now().checked_add(timeout);
         loop {
-            let seen = *self
-                .core
-                .generation
-                .lock()
-                .unwrap_or_else(|e| e.into_inner());
+            let seen = *lock(&self.core.generation);
             let triggered: Vec<Condition> = self
                 .conditions()
                 .into_iter()
@@ -301,11 +289,7 @@ impl WaitSet {
             if !triggered.is_empty() {
                 return Ok(triggered);
             }
-            let g = self
-                .core
-                .generation
-                .lock()
-                .unwrap_or_else(|e| e.into_inner());
+            let g = lock(&self.core.generation);
             if *g != seen {
                 continue;
             }
@@ -316,18 +300,14 @@ impl WaitSet {
                 },
                 None => Duration::from_secs(3600),
             };
-            let _unused = self
-                .core
-                .cv
-                .wait_timeout(g, left)
-                .unwrap_or_else(|e| e.into_inner());
+            let _unused = recover(self.core.cv.wait_timeout(g, left));
         }
     }
 }
 
 impl Drop for WaitSet {
     fn drop(&mut self) {
-        let cs = std::mem::take(&mut *self.conditions.lock().unwrap_or_else(|e| e.into_inner()));
+        let cs = std::mem::take(&mut *lock(&self.conditions));
         for c in cs {
             c.signal().detach(&self.core);
         }

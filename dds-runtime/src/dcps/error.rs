@@ -2,9 +2,11 @@
 
 use crate::cdr::{DecodeError, EncodeError};
 use crate::config::ConfigError;
+use crate::rtps::{CoreError, WriteError};
 
 /// Errors returned by DCPS operations (DDS 1.4 §2.2.1.1 return codes, plus Rust-side causes).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum DdsError {
     /// A blocking operation (write under flow control, wait_for_acknowledgments, a wait) ran out of time.
     #[error("timed out")]
@@ -36,9 +38,12 @@ pub enum DdsError {
     /// The feature is not implemented.
     #[error("unsupported: {0}")]
     Unsupported(&'static str),
-    /// The protocol core refused the operation.
+    /// The protocol core refused to create an entity.
     #[error("rtps: {0}")]
-    Core(String),
+    Core(#[from] CoreError),
+    /// The protocol core refused a write for a reason not covered by another variant.
+    #[error("rtps write: {0}")]
+    Write(#[source] WriteError),
 }
 
 /// `Result<T, DdsError>`.

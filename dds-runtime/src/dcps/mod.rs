@@ -29,6 +29,9 @@
 
 mod cache;
 pub mod condition;
+mod decode;
+mod driver;
+mod endpoint;
 mod error;
 pub mod filter;
 pub mod listener;
@@ -37,13 +40,18 @@ mod publisher;
 pub mod sample;
 pub mod status;
 mod subscriber;
+mod sync;
 mod topic;
 
+/// GUIDs name entities in the DCPS API ([`DataWriter::guid`], [`SampleInfo::publication_guid`], ...).
+pub use crate::rtps::{Guid, GuidPrefix};
 pub use condition::{Condition, GuardCondition, ReadCondition, StatusCondition, WaitSet};
 pub use error::{DdsError, DdsResult};
 pub use filter::{ContentFilter, FieldValue, FilterFields};
 pub use listener::{DataReaderListener, DataWriterListener};
-pub use participant::{DiscoveredParticipant, DomainParticipant, DomainParticipantBuilder};
+pub use participant::{
+    DiscoveredParticipant, DomainParticipant, DomainParticipantBuilder, WriteBatching,
+};
 pub use publisher::{DataWriter, Publisher};
 pub use sample::{
     InstanceHandle, InstanceState, InstanceStateMask, Sample, SampleInfo, SampleState,

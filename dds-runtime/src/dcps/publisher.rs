@@ -1,6 +1,6 @@
 //! `Publisher` and `DataWriter<T>`.
 
-use std::sync::{Arc, Mutex, MutexGuard, Weak};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime};
 
 use foldhash::HashMap;
@@ -14,19 +14,28 @@ use crate::rtps::{
     ChangeKind, EntityId, Event, Guid, Payload, Time, WriteChange, WriteError, WriterSpec,
 };
 
-use super::condition::{StatusCondition, StatusCore};
+use super::condition::StatusCondition;
+use super::driver::{Endpoint, EndpointHandle};
+use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
-use super::listener::DataWriterListener;
-use super::participant::{DomainParticipant, Shared, WriterSink};
+use super::participant::DomainParticipant;
 use super::sample::InstanceHandle;
 use super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, PublicationMatchedStatus, StatusMask,
     WriterStatuses,
 };
+use super::sync::lock;
 use super::topic::Topic;
 
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
+/// Callbacks of a [`DataWriter`] (see [`crate::dcps::listener`]). Every method has an empty default.
+#[allow(unused_variables)]
+pub trait DataWriterListener<T: DdsType>: Send + Sync {
+    /// A reader matched or unmatched.
+    fn on_publication_matched(&self, writer: &DataWriter<T>, status: PublicationMatchedStatus) {}
+    /// A reader was found with incompatible QoS.
+    fn on_offered_incompatible_qos(&self, writer: &DataWriter<T>, status: IncompatibleQosStatus) {}
+    /// The writer missed its offered deadline for an instance.
+    fn on_offered_deadline_missed(&self, writer: &DataWriter<T>, status: DeadlineMissedStatus) {}
 }
 
 /// Groups writers; carries the partition and presentation QoS.
@@ -43,9 +52,7 @@ impl std::fmt::Debug for Publisher {
 }
 
 /// The XCDR version a writer with `rep` uses, and the representation list it announces.
-pub(crate) fn writer_version<T: DdsType>(
-    rep: &DataRepresentation,
-) -> (XcdrVersion, DataRepresentation) {
+fn writer_version<T: DdsType>(rep: &DataRepresentation) -> (XcdrVersion, DataRepresentation) {
     if rep.0.is_empty() {
         let v = T::DEFAULT_VERSION;
         let id = match v {
@@ -60,14 +67,18 @@ pub(crate) fn writer_version<T: DdsType>(
     }
 }
 
-impl Publisher {
-    pub(crate) fn new(participant: DomainParticipant, qos: PublisherQos) -> Self {
-        Publisher {
-            participant,
-            qos: Arc::new(qos),
-        }
+impl DomainParticipant {
+    /// Creates a publisher.
+    pub fn create_publisher(&self, qos: &PublisherQos) -> DdsResult<Publisher> {
+        self.driver().check_alive()?;
+        Ok(Publisher {
+            participant: self.clone(),
+            qos: Arc::new(qos.clone()),
+        })
     }
+}
 
+impl Publisher {
     /// The publisher QoS.
     pub fn qos(&self) -> &PublisherQos {
         &self.qos
@@ -85,14 +96,11 @@ impl Publisher {
         topic: &Topic<T>,
         qos: &DataWriterQos,
     ) -> DdsResult<DataWriter<T>> {
-        let shared = self.participant.shared.clone();
-        shared.check_alive()?;
+        let driver = self.participant.driver().clone();
         let (version, rep) = writer_version::<T>(&qos.data_representation);
         let mut wq = qos.clone();
         wq.data_representation = rep;
-        if let crate::qos::History::KeepLast(0) = wq.history {
-            return Err(DdsError::BadParameter("history depth 0".into()));
-        }
+        check_history(&wq.history)?;
         let spec = WriterSpec {
             topic_name: topic.name().to_string(),
             type_name: T::TYPE_NAME.to_string(),
@@ -102,35 +110,20 @@ impl Publisher {
             entity_name: None,
         };
         let inner = Arc::new(WriterInner::<T> {
-            shared: shared.clone(),
-            id: Mutex::new(EntityId::UNKNOWN),
+            state: EndpointState::new(driver.clone()),
             qos: wq,
             version,
             instances: Mutex::new(WriterInstances::default()),
-            statuses: Mutex::new(WriterStatuses::default()),
-            status_core: Arc::new(StatusCore::default()),
-            listener: Mutex::new(None),
-            matched: Mutex::new(Vec::new()),
-            handle: Mutex::new(Weak::new()),
         });
-        // Register before the core can report matches for it; the id is known only after creation, so the
-        // core lock is held across both (match events are only polled after `f` returns).
-        let sink: Arc<dyn WriterSink> = inner.clone();
-        let id = shared.with_core(|c, now| {
-            let id = c.create_writer(now, spec)?;
-            *lock(&inner.id) = id;
-            shared.register_writer(id, sink);
-            Ok::<_, crate::rtps::CoreError>(id)
-        });
-        let id = id.map_err(|e| DdsError::Core(e.to_string()))?;
-        let handle = Arc::new(WriterHandle {
-            inner: inner.clone(),
-            participant: self.participant.clone(),
+        let owner = WriterOwner {
             topic: topic.clone(),
             publisher: self.clone(),
-            id,
-        });
-        *lock(&inner.handle) = Arc::downgrade(&handle);
+        };
+        let sink: Arc<dyn Endpoint> = inner.clone();
+        let handle = inner
+            .state
+            .create(sink, owner, |c, now| c.create_writer(now, spec))?;
+        let id = handle.id();
         tracing::info!(
             topic = topic.name(),
             type_name = T::TYPE_NAME,
@@ -161,58 +154,17 @@ struct WriterInstances {
     keyless_last_write: Option<Instant>,
 }
 
+/// What a writer's handle keeps alive.
+struct WriterOwner<T> {
+    topic: Topic<T>,
+    publisher: Publisher,
+}
+
 struct WriterInner<T: DdsType> {
-    shared: Arc<Shared>,
-    id: Mutex<EntityId>,
+    state: EndpointState<WriterStatuses, dyn DataWriterListener<T>, WriterOwner<T>>,
     qos: DataWriterQos,
     version: XcdrVersion,
     instances: Mutex<WriterInstances>,
-    statuses: Mutex<WriterStatuses>,
-    status_core: Arc<StatusCore>,
-    listener: Mutex<Option<Arc<dyn DataWriterListener<T>>>>,
-    matched: Mutex<Vec<Guid>>,
-    handle: Mutex<Weak<WriterHandle<T>>>,
-}
-
-struct WriterHandle<T: DdsType> {
-    inner: Arc<WriterInner<T>>,
-    participant: DomainParticipant,
-    topic: Topic<T>,
-    publisher: Publisher,
-    id: EntityId,
-}
-
-impl<T: DdsType> Drop for WriterHandle<T> {
-    fn drop(&mut self) {
-        let shared = &self.participant.shared;
-        shared.unregister_writer(self.id);
-        if shared.check_alive().is_ok() {
-            let id = self.id;
-            // Like Cyclone: a deleted writer unregisters its instances (disposing them too with
-            // autodispose_unregistered_instances), so readers see the state change, not just the unmatch.
-            let kind = self.inner.unregister_kind();
-            let ts = Some(wire_time(SystemTime::now()));
-            let changes: Vec<WriteChange> = lock(&self.inner.instances)
-                .by_handle
-                .values()
-                .map(|i| WriteChange {
-                    kind,
-                    payload: i.key_payload.clone(),
-                    key_hash: i.key_hash,
-                    source_timestamp: ts,
-                })
-                .collect();
-            shared.with_core(|c, now| {
-                for ch in changes {
-                    if let Err(e) = c.write(now, id, ch) {
-                        tracing::debug!(error = %e, "unregister on delete not sent");
-                    }
-                }
-                c.delete_writer(now, id)
-            });
-        }
-        tracing::debug!(id = ?self.id, "writer deleted");
-    }
 }
 
 /// Writes samples of type `T`. Cheap to clone; the writer is deleted when the last clone is dropped (a
@@ -224,7 +176,7 @@ impl<T: DdsType> Drop for WriterHandle<T> {
 /// Lifespan is announced and applied by readers. Liveliness other than automatic is not implemented.
 pub struct DataWriter<T: DdsType> {
     inner: Arc<WriterInner<T>>,
-    handle: Arc<WriterHandle<T>>,
+    handle: Arc<EndpointHandle<WriterOwner<T>>>,
 }
 
 impl<T: DdsType> Clone for DataWriter<T> {
@@ -239,8 +191,8 @@ impl<T: DdsType> Clone for DataWriter<T> {
 impl<T: DdsType> std::fmt::Debug for DataWriter<T> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("DataWriter")
-            .field("topic", &self.handle.topic.name())
-            .field("id", &self.handle.id)
+            .field("topic", &self.handle.owner().topic.name())
+            .field("id", &self.handle.id())
             .finish()
     }
 }
@@ -271,27 +223,27 @@ fn wire_time(t: SystemTime) -> Time {
 
 impl<T: DdsType> DataWriter<T> {
     fn id(&self) -> EntityId {
-        self.handle.id
+        self.handle.id()
     }
 
     /// The writer's GUID.
-    pub fn guid(&self) -> [u8; 16] {
-        Guid::new(self.inner.shared.guid_prefix, self.id()).to_bytes()
+    pub fn guid(&self) -> Guid {
+        self.handle.guid()
     }
 
     /// The writer's handle (as readers see it in `SampleInfo::publication_handle`).
     pub fn instance_handle(&self) -> InstanceHandle {
-        InstanceHandle::from_guid_bytes(&self.guid())
+        InstanceHandle::from_guid(self.guid())
     }
 
     /// The topic.
     pub fn topic(&self) -> &Topic<T> {
-        &self.handle.topic
+        &self.handle.owner().topic
     }
 
     /// The publisher.
     pub fn publisher(&self) -> &Publisher {
-        &self.handle.publisher
+        &self.handle.owner().publisher
     }
 
     /// The QoS in effect (with the data representation resolved).
@@ -323,8 +275,8 @@ impl<T: DdsType> DataWriter<T> {
 
     /// Hands one change to the core, waiting up to max_blocking_time while flow control refuses it.
     fn submit(&self, change: WriteChange) -> DdsResult<()> {
-        let shared = &self.inner.shared;
-        shared.check_alive()?;
+        let driver = &self.inner.state.driver;
+        driver.check_alive()?;
         let max_block = match self.inner.qos.reliability {
             Reliability::Reliable { max_blocking_time } => max_blocking_time,
             Reliability::BestEffort => Duration::ZERO,
@@ -333,18 +285,18 @@ impl<T: DdsType> DataWriter<T> {
         let mut deadline: Option<Option<Instant>> = None;
         let id = self.id();
         loop {
-            let seen = shared.progress_generation();
-            match shared.with_core(|c, now| c.write(now, id, change.clone())) {
+            let seen = driver.progress_generation();
+            match driver.with_core(|c, now| c.write(now, id, change.clone())) {
                 Ok(_) => return Ok(()),
                 Err(WriteError::WouldBlock) => {
                     let now = Instant::now();
                     let deadline = *deadline.get_or_insert_with(|| now.checked_add(max_block));
                     match deadline {
                         Some(d) if now >= d => return Err(DdsError::Timeout),
-                        Some(d) => shared.wait_progress_change(seen, d),
-                        None => shared.wait_progress_change(seen, now + Duration::from_millis(20)),
+                        Some(d) => driver.wait_progress_change(seen, d),
+                        None => driver.wait_progress_change(seen, now + Duration::from_millis(20)),
                     }
-                    shared.check_alive()?;
+                    driver.check_alive()?;
                 }
                 Err(WriteError::TooLarge(n)) => {
                     return Err(DdsError::BadParameter(format!(
@@ -354,7 +306,7 @@ impl<T: DdsType> DataWriter<T> {
                 Err(WriteError::Deleted) | Err(WriteError::UnknownWriter(_)) => {
                     return Err(DdsError::AlreadyDeleted)
                 }
-                Err(e) => return Err(DdsError::Core(e.to_string())),
+                Err(e) => return Err(DdsError::Write(e)),
             }
         }
     }
@@ -362,7 +314,7 @@ impl<T: DdsType> DataWriter<T> {
     /// Sends at once what write batching holds back; the participant's batches are shared by its writers,
     /// so this sends theirs too.
     pub fn flush(&self) {
-        self.inner.shared.flush();
+        self.inner.state.driver.flush();
     }
 
     /// Publishes `sample` with the current time as source timestamp.
@@ -544,82 +496,74 @@ impl<T: DdsType> DataWriter<T> {
 
     /// Blocks until every matched reliable reader acknowledged everything written, or `Timeout`.
     pub fn wait_for_acknowledgments(&self, timeout: Duration) -> DdsResult<()> {
-        let shared = &self.inner.shared;
-        shared.check_alive()?;
+        let driver = &self.inner.state.driver;
+        driver.check_alive()?;
         let id = self.id();
         let deadline = Instant::now().checked_add(timeout);
-        if shared.wait_progress(deadline, || shared.with_core(|c, _| c.is_acknowledged(id))) {
+        if driver.wait_progress(deadline, || driver.with_core(|c, _| c.is_acknowledged(id))) {
             Ok(())
         } else {
-            shared.check_alive()?;
+            driver.check_alive()?;
             Err(DdsError::Timeout)
         }
     }
 
     /// PUBLICATION_MATCHED (resets the change counts).
     pub fn publication_matched_status(&self) -> PublicationMatchedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.publication_matched.clone();
-        st.publication_matched.total_count_change = 0;
-        st.publication_matched.current_count_change = 0;
         self.inner
-            .status_core
-            .clear(StatusMask::PUBLICATION_MATCHED);
-        s
+            .state
+            .take_status(StatusMask::PUBLICATION_MATCHED, |s| {
+                &mut s.publication_matched
+            })
     }
 
     /// OFFERED_INCOMPATIBLE_QOS (resets the change count).
     pub fn offered_incompatible_qos_status(&self) -> IncompatibleQosStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.offered_incompatible_qos.clone();
-        st.offered_incompatible_qos.total_count_change = 0;
         self.inner
-            .status_core
-            .clear(StatusMask::OFFERED_INCOMPATIBLE_QOS);
-        s
+            .state
+            .take_status(StatusMask::OFFERED_INCOMPATIBLE_QOS, |s| {
+                &mut s.offered_incompatible_qos
+            })
     }
 
     /// OFFERED_DEADLINE_MISSED (resets the change count). Checked every 50 ms per written instance.
     pub fn offered_deadline_missed_status(&self) -> DeadlineMissedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.offered_deadline_missed.clone();
-        st.offered_deadline_missed.total_count_change = 0;
         self.inner
-            .status_core
-            .clear(StatusMask::OFFERED_DEADLINE_MISSED);
-        s
+            .state
+            .take_status(StatusMask::OFFERED_DEADLINE_MISSED, |s| {
+                &mut s.offered_deadline_missed
+            })
     }
 
     /// Handles of the matched readers.
     pub fn matched_subscriptions(&self) -> Vec<InstanceHandle> {
-        lock(&self.inner.matched)
-            .iter()
-            .map(|g| InstanceHandle::from_guid_bytes(&g.to_bytes()))
+        self.inner
+            .state
+            .matched()
+            .into_iter()
+            .map(InstanceHandle::from_guid)
             .collect()
     }
 
     /// GUIDs of the matched readers.
-    pub fn matched_subscription_guids(&self) -> Vec<[u8; 16]> {
-        lock(&self.inner.matched)
-            .iter()
-            .map(|g| g.to_bytes())
-            .collect()
+    pub fn matched_subscription_guids(&self) -> Vec<Guid> {
+        self.inner.state.matched()
     }
 
     /// Installs a listener (replacing any previous one).
     pub fn set_listener(&self, listener: Box<dyn DataWriterListener<T>>) {
-        *lock(&self.inner.listener) = Some(Arc::from(listener));
+        self.inner.state.set_listener(Some(Arc::from(listener)));
     }
 
     /// Removes the listener.
     pub fn clear_listener(&self) {
-        *lock(&self.inner.listener) = None;
+        self.inner.state.set_listener(None);
     }
 
     /// The writer's status condition.
     pub fn status_condition(&self) -> StatusCondition {
         StatusCondition {
-            core: self.inner.status_core.clone(),
+            core: self.inner.state.status_core().clone(),
         }
     }
 }
@@ -637,16 +581,16 @@ impl<T: DdsType> WriterInner<T> {
         }
     }
 
-    fn writer_handle(self: &Arc<Self>) -> Option<DataWriter<T>> {
-        let handle = lock(&self.handle).upgrade()?;
-        Some(DataWriter {
-            inner: self.clone(),
-            handle,
-        })
+    /// The public writer, for listeners.
+    fn writer(
+        self: &Arc<Self>,
+    ) -> impl FnOnce(Arc<EndpointHandle<WriterOwner<T>>>) -> DataWriter<T> {
+        let inner = self.clone();
+        move |handle| DataWriter { inner, handle }
     }
 }
 
-impl<T: DdsType> WriterSink for WriterInner<T> {
+impl<T: DdsType> Endpoint for WriterInner<T> {
     fn tick(self: Arc<Self>, now: Instant) {
         let period = self.qos.deadline.0;
         if period == crate::qos::INFINITE || period.is_zero() {
@@ -671,72 +615,62 @@ impl<T: DdsType> WriterSink for WriterInner<T> {
         if missed.is_empty() {
             return;
         }
-        let status = {
-            let mut st = lock(&self.statuses);
-            let dm = &mut st.offered_deadline_missed;
-            dm.total_count += missed.len() as u32;
-            dm.total_count_change += missed.len() as u32;
-            dm.last_instance_handle = *missed.last().unwrap_or(&InstanceHandle::NIL);
-            dm.clone()
-        };
-        self.status_core.raise(StatusMask::OFFERED_DEADLINE_MISSED);
-        let listener = lock(&self.listener).clone();
-        if let (Some(l), Some(w)) = (listener, self.writer_handle()) {
-            l.on_offered_deadline_missed(&w, status);
-        }
+        self.state.signal(
+            StatusMask::OFFERED_DEADLINE_MISSED,
+            |st| {
+                st.offered_deadline_missed.record(&missed);
+                &mut st.offered_deadline_missed
+            },
+            self.writer(),
+            |l, w, s| l.on_offered_deadline_missed(w, s),
+        );
     }
 
     fn on_event(self: Arc<Self>, ev: &Event) {
-        let listener = lock(&self.listener).clone();
+        let id = self.state.id();
         match ev {
             Event::PublicationMatched {
                 reader, matched, ..
             } => {
-                let status = {
-                    let mut m = lock(&self.matched);
-                    let mut st = lock(&self.statuses);
-                    let pm = &mut st.publication_matched;
-                    if *matched {
-                        if !m.contains(reader) {
-                            m.push(*reader);
-                            pm.total_count += 1;
-                            pm.total_count_change += 1;
-                            pm.current_count_change += 1;
-                        }
-                    } else if let Some(p) = m.iter().position(|g| g == reader) {
-                        m.remove(p);
-                        pm.current_count_change -= 1;
-                    }
-                    pm.current_count = m.len() as u32;
-                    pm.last_subscription_handle =
-                        InstanceHandle::from_guid_bytes(&reader.to_bytes());
-                    let out = pm.clone();
-                    // A listener consumes the status: the next callback reports only newer changes.
-                    if listener.is_some() {
-                        pm.total_count_change = 0;
-                        pm.current_count_change = 0;
-                    }
-                    out
-                };
-                tracing::info!(writer = ?lock(&self.id), ?reader, matched, "publication matched");
-                self.status_core.raise(StatusMask::PUBLICATION_MATCHED);
-                if let (Some(l), Some(w)) = (listener, self.writer_handle()) {
-                    l.on_publication_matched(&w, status);
-                }
+                tracing::info!(writer = ?id, ?reader, matched, "publication matched");
+                self.state.record_match(
+                    StatusMask::PUBLICATION_MATCHED,
+                    |st| &mut st.publication_matched,
+                    (*reader, *matched),
+                    self.writer(),
+                    |l, w, s| l.on_publication_matched(w, s),
+                );
             }
             Event::OfferedIncompatibleQos { policy, reader, .. } => {
-                let status = {
-                    let mut st = lock(&self.statuses);
-                    st.offered_incompatible_qos.record(*policy);
-                    st.offered_incompatible_qos.clone()
-                };
-                tracing::warn!(writer = ?lock(&self.id), ?reader, ?policy, "offered incompatible QoS");
-                self.status_core.raise(StatusMask::OFFERED_INCOMPATIBLE_QOS);
-                if let (Some(l), Some(w)) = (listener, self.writer_handle()) {
-                    l.on_offered_incompatible_qos(&w, status);
-                }
+                tracing::warn!(writer = ?id, ?reader, ?policy, "offered incompatible QoS");
+                self.state.signal(
+                    StatusMask::OFFERED_INCOMPATIBLE_QOS,
+                    |st| {
+                        st.offered_incompatible_qos.record(*policy);
+                        &mut st.offered_incompatible_qos
+                    },
+                    self.writer(),
+                    |l, w, s| l.on_offered_incompatible_qos(w, s),
+                );
             }
             _ => {}
         }
+    }
+
+    /// Like Cyclone: a deleted writer unregisters its instances (disposing them too with
+    /// autodispose_unregistered_instances), so readers see the state change, not just the unmatch.
+    fn farewell(&self) -> Vec<WriteChange> {
+        let kind = self.unregister_kind();
+        let ts = Some(wire_time(SystemTime::now()));
+        lock(&self.instances)
+            .by_handle
+            .values()
+            .map(|i| WriteChange {
+                kind,
+                payload: i.key_payload.clone(),
+                key_hash: i.key_hash,
+                source_timestamp: ts,
+            })
+            .collect()
     }
 }

@@ -2,6 +2,8 @@
 
 use std::time::SystemTime;
 
+use crate::rtps::Guid;
+
 /// Identifies an instance (in a reader or writer), a publication or a subscription. [`InstanceHandle::NIL`]
 /// is "no handle". Instance handles are local to the entity that returned them; publication and
 /// subscription handles are derived from the remote entity's GUID and are stable within the process.
@@ -17,11 +19,11 @@ impl InstanceHandle {
         self.0 == 0
     }
 
-    /// The handle for an RTPS GUID (16 bytes): FNV-1a, never NIL.
-    pub fn from_guid_bytes(b: &[u8; 16]) -> Self {
+    /// The handle for an RTPS GUID: FNV-1a of its 16 bytes, never NIL.
+    pub fn from_guid(g: Guid) -> Self {
         let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        for x in b {
-            h ^= u64::from(*x);
+        for x in g.to_bytes() {
+            h ^= u64::from(x);
             h = h.wrapping_mul(0x0100_0000_01b3);
         }
         InstanceHandle(h.max(1))
@@ -179,6 +181,7 @@ impl Default for InstanceStateMask {
 
 /// Everything the reader knows about one sample (DDS 1.4 §2.2.2.5.5).
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct SampleInfo {
     /// Read before or not.
     pub sample_state: SampleState,
@@ -195,7 +198,7 @@ pub struct SampleInfo {
     /// The writer (derived from its GUID).
     pub publication_handle: InstanceHandle,
     /// The writer's GUID.
-    pub publication_guid: [u8; 16],
+    pub publication_guid: Guid,
     /// Times the instance went from disposed to alive before this sample.
     pub disposed_generation_count: u32,
     /// Times the instance went from no-writers to alive before this sample.

@@ -1,8 +1,53 @@
 //! Communication statuses (DDS 1.4 §2.2.4.1). Getters return the status and reset its `*_change` counts.
 
 use crate::qos::QosPolicyId;
+use crate::rtps::Guid;
 
 use super::sample::InstanceHandle;
+
+/// A communication status whose `*_change` counts reset when the application reads it (or a listener
+/// consumes it).
+pub(crate) trait Status: Clone {
+    /// Zeroes the `*_change` counts.
+    fn reset_changes(&mut self);
+}
+
+/// PUBLICATION_MATCHED and SUBSCRIPTION_MATCHED: the same counts, about the other side.
+pub(crate) trait MatchedStatus: Status {
+    /// Records that `remote` matched or unmatched; `list` holds the currently matched GUIDs.
+    fn record_match(&mut self, list: &mut Vec<Guid>, remote: Guid, matched: bool);
+}
+
+/// `Status` and `MatchedStatus` for PUBLICATION_MATCHED and SUBSCRIPTION_MATCHED, which differ only in the
+/// name of the last remote handle.
+macro_rules! matched_status {
+    ($status:ty, $last_handle:ident) => {
+        impl Status for $status {
+            fn reset_changes(&mut self) {
+                self.total_count_change = 0;
+                self.current_count_change = 0;
+            }
+        }
+
+        impl MatchedStatus for $status {
+            fn record_match(&mut self, list: &mut Vec<Guid>, remote: Guid, matched: bool) {
+                if matched {
+                    if !list.contains(&remote) {
+                        list.push(remote);
+                        self.total_count += 1;
+                        self.total_count_change += 1;
+                        self.current_count_change += 1;
+                    }
+                } else if let Some(p) = list.iter().position(|g| *g == remote) {
+                    list.remove(p);
+                    self.current_count_change -= 1;
+                }
+                self.current_count = u32::try_from(list.len()).unwrap_or(u32::MAX);
+                self.$last_handle = InstanceHandle::from_guid(remote);
+            }
+        }
+    };
+}
 
 bitflags::bitflags! {
     /// A set of status kinds (`StatusMask`), with the DDS bit values.
@@ -39,6 +84,7 @@ bitflags::bitflags! {
 
 /// PUBLICATION_MATCHED.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct PublicationMatchedStatus {
     /// Readers ever matched.
     pub total_count: u32,
@@ -54,6 +100,7 @@ pub struct PublicationMatchedStatus {
 
 /// SUBSCRIPTION_MATCHED.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct SubscriptionMatchedStatus {
     /// Writers ever matched.
     pub total_count: u32,
@@ -69,6 +116,7 @@ pub struct SubscriptionMatchedStatus {
 
 /// OFFERED_INCOMPATIBLE_QOS and REQUESTED_INCOMPATIBLE_QOS.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct IncompatibleQosStatus {
     /// Incompatible remote entities seen.
     pub total_count: u32,
@@ -99,6 +147,7 @@ pub type RequestedIncompatibleQosStatus = IncompatibleQosStatus;
 
 /// OFFERED_DEADLINE_MISSED and REQUESTED_DEADLINE_MISSED.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct DeadlineMissedStatus {
     /// Missed deadlines.
     pub total_count: u32,
@@ -115,6 +164,7 @@ pub type OfferedDeadlineMissedStatus = DeadlineMissedStatus;
 
 /// SAMPLE_LOST.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct SampleLostStatus {
     /// Samples lost.
     pub total_count: u32,
@@ -138,6 +188,7 @@ pub enum SampleRejectedReason {
 
 /// SAMPLE_REJECTED.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct SampleRejectedStatus {
     /// Samples rejected.
     pub total_count: u32,
@@ -151,6 +202,7 @@ pub struct SampleRejectedStatus {
 
 /// LIVELINESS_CHANGED.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct LivelinessChangedStatus {
     /// Matched writers currently alive.
     pub alive_count: u32,
@@ -164,21 +216,106 @@ pub struct LivelinessChangedStatus {
     pub last_publication_handle: InstanceHandle,
 }
 
+matched_status!(PublicationMatchedStatus, last_subscription_handle);
+matched_status!(SubscriptionMatchedStatus, last_publication_handle);
+
+impl Status for IncompatibleQosStatus {
+    fn reset_changes(&mut self) {
+        self.total_count_change = 0;
+    }
+}
+
+impl Status for DeadlineMissedStatus {
+    fn reset_changes(&mut self) {
+        self.total_count_change = 0;
+    }
+}
+
+impl DeadlineMissedStatus {
+    /// Records the instances whose deadline passed.
+    pub(crate) fn record(&mut self, missed: &[InstanceHandle]) {
+        let n = u32::try_from(missed.len()).unwrap_or(u32::MAX);
+        self.total_count = self.total_count.saturating_add(n);
+        self.total_count_change = self.total_count_change.saturating_add(n);
+        self.last_instance_handle = *missed.last().unwrap_or(&InstanceHandle::NIL);
+    }
+}
+
+impl Status for SampleLostStatus {
+    fn reset_changes(&mut self) {
+        self.total_count_change = 0;
+    }
+}
+
+impl SampleLostStatus {
+    /// Records `count` lost samples.
+    pub(crate) fn record(&mut self, count: u64) {
+        let n = u32::try_from(count).unwrap_or(u32::MAX);
+        self.total_count = self.total_count.saturating_add(n);
+        self.total_count_change = self.total_count_change.saturating_add(n);
+    }
+}
+
+impl Status for SampleRejectedStatus {
+    fn reset_changes(&mut self) {
+        self.total_count_change = 0;
+    }
+}
+
+impl SampleRejectedStatus {
+    /// Records one rejected sample.
+    pub(crate) fn record(&mut self, reason: SampleRejectedReason, handle: InstanceHandle) {
+        self.total_count += 1;
+        self.total_count_change += 1;
+        self.last_reason = reason;
+        self.last_instance_handle = handle;
+    }
+}
+
+impl Status for LivelinessChangedStatus {
+    fn reset_changes(&mut self) {
+        self.alive_count_change = 0;
+        self.not_alive_count_change = 0;
+    }
+}
+
+impl LivelinessChangedStatus {
+    /// Records that `writer` became alive or not alive.
+    pub(crate) fn record(&mut self, writer: Guid, alive: bool) {
+        if alive {
+            self.alive_count += 1;
+            self.alive_count_change += 1;
+            if self.not_alive_count > 0 {
+                self.not_alive_count -= 1;
+                self.not_alive_count_change -= 1;
+            }
+        } else {
+            self.not_alive_count += 1;
+            self.not_alive_count_change += 1;
+            if self.alive_count > 0 {
+                self.alive_count -= 1;
+                self.alive_count_change -= 1;
+            }
+        }
+        self.last_publication_handle = InstanceHandle::from_guid(writer);
+    }
+}
+
 /// The statuses of a data writer.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct WriterStatuses {
-    pub publication_matched: PublicationMatchedStatus,
-    pub offered_incompatible_qos: IncompatibleQosStatus,
-    pub offered_deadline_missed: DeadlineMissedStatus,
+    pub(crate) publication_matched: PublicationMatchedStatus,
+    pub(crate) offered_incompatible_qos: IncompatibleQosStatus,
+    pub(crate) offered_deadline_missed: DeadlineMissedStatus,
 }
 
 /// The statuses of a data reader.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct ReaderStatuses {
-    pub subscription_matched: SubscriptionMatchedStatus,
-    pub requested_incompatible_qos: IncompatibleQosStatus,
-    pub requested_deadline_missed: DeadlineMissedStatus,
-    pub sample_lost: SampleLostStatus,
-    pub sample_rejected: SampleRejectedStatus,
-    pub liveliness_changed: LivelinessChangedStatus,
+    pub(crate) subscription_matched: SubscriptionMatchedStatus,
+    pub(crate) requested_incompatible_qos: IncompatibleQosStatus,
+    pub(crate) requested_deadline_missed: DeadlineMissedStatus,
+    pub(crate) sample_lost: SampleLostStatus,
+    pub(crate) sample_rejected: SampleRejectedStatus,
+    pub(crate) liveliness_changed: LivelinessChangedStatus,
 }

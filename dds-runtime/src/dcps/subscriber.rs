@@ -3,7 +3,7 @@
 use std::collections::VecDeque;
 use std::pin::Pin;
 use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
-use std::sync::{Arc, Condvar, Mutex, MutexGuard, Weak};
+use std::sync::{Arc, Condvar, Mutex};
 use std::task::{Context, Poll, Waker};
 use std::time::{Duration, Instant, SystemTime};
 
@@ -14,13 +14,15 @@ use crate::qos::{
     DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos, XCDR2_DATA_REPRESENTATION,
     XCDR_DATA_REPRESENTATION,
 };
-use crate::rtps::{ChangeKind, EntityId, Event, Guid, ReaderSpec, ReceivedSample};
+use crate::rtps::{Event, Guid, ReaderSpec};
 
-use super::cache::{ChangeKindLocal, Incoming, Outcome, ReaderCache, Selection};
-use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition, StatusCore};
+use super::cache::{to_sample, Outcome, ReaderCache, Selection};
+use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition};
+use super::decode::decode_change;
+use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
+use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
-use super::listener::DataReaderListener;
-use super::participant::{DomainParticipant, Pending, ReaderSink, RemoteWriterInfo, Shared};
+use super::participant::DomainParticipant;
 use super::sample::{
     InstanceHandle, InstanceStateMask, Sample, SampleInfo, SampleStateMask, ViewStateMask,
 };
@@ -28,10 +30,27 @@ use super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, LivelinessChangedStatus, ReaderStatuses,
     SampleLostStatus, SampleRejectedStatus, StatusMask, SubscriptionMatchedStatus,
 };
+use super::sync::{lock, recover};
 use super::topic::{Topic, TopicDescription};
 
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
+/// Callbacks of a [`DataReader`] (see [`crate::dcps::listener`]). Every method has an empty default.
+#[allow(unused_variables)]
+pub trait DataReaderListener<T: DdsType>: Send + Sync {
+    /// New samples (or instance state changes) are available.
+    fn on_data_available(&self, reader: &DataReader<T>) {}
+    /// A writer matched or unmatched.
+    fn on_subscription_matched(&self, reader: &DataReader<T>, status: SubscriptionMatchedStatus) {}
+    /// A writer was found with incompatible QoS.
+    fn on_requested_incompatible_qos(&self, reader: &DataReader<T>, status: IncompatibleQosStatus) {
+    }
+    /// Samples were lost.
+    fn on_sample_lost(&self, reader: &DataReader<T>, status: SampleLostStatus) {}
+    /// A sample was rejected by a resource limit.
+    fn on_sample_rejected(&self, reader: &DataReader<T>, status: SampleRejectedStatus) {}
+    /// A matched writer's liveliness changed.
+    fn on_liveliness_changed(&self, reader: &DataReader<T>, status: LivelinessChangedStatus) {}
+    /// An instance missed its deadline.
+    fn on_requested_deadline_missed(&self, reader: &DataReader<T>, status: DeadlineMissedStatus) {}
 }
 
 /// Groups readers; carries the partition and presentation QoS.
@@ -49,17 +68,18 @@ impl std::fmt::Debug for Subscriber {
     }
 }
 
-/// Most key hashes remembered per reader for mapping key-hash-only disposes to instances.
-const MAX_REMEMBERED_HASHES: usize = 65536;
+impl DomainParticipant {
+    /// Creates a subscriber.
+    pub fn create_subscriber(&self, qos: &SubscriberQos) -> DdsResult<Subscriber> {
+        self.driver().check_alive()?;
+        Ok(Subscriber {
+            participant: self.clone(),
+            qos: Arc::new(qos.clone()),
+        })
+    }
+}
 
 impl Subscriber {
-    pub(crate) fn new(participant: DomainParticipant, qos: SubscriberQos) -> Self {
-        Subscriber {
-            participant,
-            qos: Arc::new(qos),
-        }
-    }
-
     /// The subscriber QoS.
     pub fn qos(&self) -> &SubscriberQos {
         &self.qos
@@ -77,16 +97,13 @@ impl Subscriber {
         topic: &D,
         qos: &DataReaderQos,
     ) -> DdsResult<DataReader<T>> {
-        let shared = self.participant.shared.clone();
-        shared.check_alive()?;
+        let driver = self.participant.driver().clone();
         let mut rq = qos.clone();
         if rq.data_representation.0.is_empty() {
             rq.data_representation =
                 DataRepresentation(vec![XCDR_DATA_REPRESENTATION, XCDR2_DATA_REPRESENTATION]);
         }
-        if let crate::qos::History::KeepLast(0) = rq.history {
-            return Err(DdsError::BadParameter("history depth 0".into()));
-        }
+        check_history(&rq.history)?;
         let t = topic.topic();
         let spec = ReaderSpec {
             topic_name: t.name().to_string(),
@@ -105,8 +122,7 @@ impl Subscriber {
         let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
         cache.set_filter(topic.sample_filter());
         let inner = Arc::new(ReaderInner::<T> {
-            shared: shared.clone(),
-            id: Mutex::new(EntityId::UNKNOWN),
+            state: EndpointState::new(driver.clone()),
             pending: Mutex::new(VecDeque::new()),
             cache: Mutex::new(CacheState {
                 cache,
@@ -116,32 +132,22 @@ impl Subscriber {
             data_cv: Condvar::new(),
             data_waiters: AtomicUsize::new(0),
             wakers: Mutex::new(Vec::new()),
-            statuses: Mutex::new(ReaderStatuses::default()),
-            status_core: Arc::new(StatusCore::default()),
             data_signal: Signal::default(),
-            listener: Mutex::new(None),
-            matched: Mutex::new(Vec::new()),
-            handle: Mutex::new(Weak::new()),
             credit_limit,
         });
-        let sink: Arc<dyn ReaderSink> = inner.clone();
-        let id = shared.with_core(|c, now| {
+        let owner = ReaderOwner {
+            topic: t.clone(),
+            subscriber: self.clone(),
+        };
+        let sink: Arc<dyn Endpoint> = inner.clone();
+        let handle = inner.state.create(sink, owner, |c, now| {
             let id = c.create_reader(now, spec)?;
             if credit_limit.is_some() {
                 c.set_reader_credit(id, credit_limit);
             }
-            *lock(&inner.id) = id;
-            shared.register_reader(id, sink);
-            Ok::<_, crate::rtps::CoreError>(id)
-        });
-        let id = id.map_err(|e| DdsError::Core(e.to_string()))?;
-        let handle = Arc::new(ReaderHandle {
-            participant: self.participant.clone(),
-            topic: t.clone(),
-            subscriber: self.clone(),
-            id,
-        });
-        *lock(&inner.handle) = Arc::downgrade(&handle);
+            Ok(id)
+        })?;
+        let id = handle.id();
         tracing::info!(
             topic = t.name(),
             type_name = T::TYPE_NAME,
@@ -160,9 +166,14 @@ struct CacheState<T> {
     batch: VecDeque<Pending>,
 }
 
+/// What a reader's handle keeps alive.
+struct ReaderOwner<T> {
+    topic: Topic<T>,
+    subscriber: Subscriber,
+}
+
 struct ReaderInner<T: DdsType> {
-    shared: Arc<Shared>,
-    id: Mutex<EntityId>,
+    state: EndpointState<ReaderStatuses, dyn DataReaderListener<T>, ReaderOwner<T>>,
     pending: Mutex<VecDeque<Pending>>,
     cache: Mutex<CacheState<T>>,
     data_cv: Condvar,
@@ -170,33 +181,9 @@ struct ReaderInner<T: DdsType> {
     /// change was made under that lock) skips the futex wake only when nobody can be sleeping.
     data_waiters: AtomicUsize,
     wakers: Mutex<Vec<Waker>>,
-    statuses: Mutex<ReaderStatuses>,
-    status_core: Arc<StatusCore>,
     data_signal: Signal,
-    listener: Mutex<Option<Arc<dyn DataReaderListener<T>>>>,
-    matched: Mutex<Vec<Guid>>,
-    handle: Mutex<Weak<ReaderHandle<T>>>,
     /// Reliable KEEP_ALL with max_samples: the core delivers (and acknowledges) only what fits.
     credit_limit: Option<usize>,
-}
-
-struct ReaderHandle<T: DdsType> {
-    participant: DomainParticipant,
-    topic: Topic<T>,
-    subscriber: Subscriber,
-    id: EntityId,
-}
-
-impl<T: DdsType> Drop for ReaderHandle<T> {
-    fn drop(&mut self) {
-        let shared = &self.participant.shared;
-        shared.unregister_reader(self.id);
-        if shared.check_alive().is_ok() {
-            let id = self.id;
-            shared.with_core(|c, now| c.delete_reader(now, id));
-        }
-        tracing::debug!(id = ?self.id, "reader deleted");
-    }
 }
 
 /// Reads samples of type `T`. Cheap to clone; the reader is deleted when the last clone (and the last
@@ -211,7 +198,7 @@ impl<T: DdsType> Drop for ReaderHandle<T> {
 /// (coherent/ordered access), liveliness kinds other than what the core reports.
 pub struct DataReader<T: DdsType> {
     inner: Arc<ReaderInner<T>>,
-    handle: Arc<ReaderHandle<T>>,
+    handle: Arc<EndpointHandle<ReaderOwner<T>>>,
 }
 
 impl<T: DdsType> Clone for DataReader<T> {
@@ -226,8 +213,8 @@ impl<T: DdsType> Clone for DataReader<T> {
 impl<T: DdsType> std::fmt::Debug for DataReader<T> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("DataReader")
-            .field("topic", &self.handle.topic.name())
-            .field("id", &self.handle.id)
+            .field("topic", &self.handle.owner().topic.name())
+            .field("id", &self.handle.id())
             .finish()
     }
 }
@@ -278,12 +265,10 @@ impl<'a, T: DdsType> Selector<'a, T> {
     /// cache, marks them read and returns how many there were. The cache lock is held during the calls:
     /// keep `f` short and do not call back into this reader from it.
     pub fn read_with(self, mut f: impl FnMut(Option<&T>, &SampleInfo)) -> DdsResult<usize> {
-        let mut n = 0;
-        self.reader.visit(self.sel, self.next_after, |slot, info| {
-            n += 1;
-            f(slot.as_ref(), &info);
-        })?;
-        Ok(n)
+        self.reader
+            .visit(self.sel, self.next_after, false, |slot, info| {
+                f(slot.as_ref(), &info)
+            })
     }
 
     /// Reads (copies) the selected samples.
@@ -297,33 +282,47 @@ impl<'a, T: DdsType> Selector<'a, T> {
 }
 
 impl<T: DdsType> DataReader<T> {
+    /// Core of read and take: calls `emit` with each selected sample's data slot and info (with `take` the
+    /// samples leave the cache), then updates DATA_AVAILABLE, the read conditions and the reader's credit.
     fn visit(
         &self,
         mut sel: Selection,
         next_after: Option<InstanceHandle>,
-        emit: impl FnMut(&mut Option<T>, SampleInfo),
-    ) -> DdsResult<()> {
-        self.inner.shared.check_alive()?;
+        take: bool,
+        mut emit: impl FnMut(&mut Option<T>, SampleInfo),
+    ) -> DdsResult<usize> {
+        self.inner.state.driver.check_alive()?;
+        let mut n = 0;
         {
             let mut st = lock(&self.inner.cache);
             if let Some(prev) = next_after {
                 sel.instance = None;
                 match st.cache.next_instance(prev, &sel) {
                     Some(h) => sel.instance = Some(h),
-                    None => return Ok(()),
+                    None => return Ok(0),
                 }
             }
-            st.cache.collect_with(&sel, false, emit);
+            st.cache.collect_with(&sel, take, |slot, info| {
+                n += 1;
+                emit(slot, info);
+            });
             let unread = Selection {
                 sample_states: SampleStateMask::NOT_READ,
                 ..Selection::default()
             };
             if !st.cache.has_matching(&unread) {
-                self.inner.status_core.clear(StatusMask::DATA_AVAILABLE);
+                self.inner
+                    .state
+                    .status_core()
+                    .clear(StatusMask::DATA_AVAILABLE);
             }
         }
+        if take && n > 0 {
+            self.inner.refresh_credit();
+        }
+        // Read conditions may have stopped triggering.
         self.inner.data_signal.notify();
-        Ok(())
+        Ok(n)
     }
 
     /// Zero-copy read of all samples, see [`Selector::read_with`].
@@ -331,38 +330,18 @@ impl<T: DdsType> DataReader<T> {
         self.select().read_with(f)
     }
 
+    /// Read or take into samples; a read copies the data with `copy`.
     fn collect(
         &self,
-        mut sel: Selection,
+        sel: Selection,
         next_after: Option<InstanceHandle>,
         take: bool,
         copy: Option<fn(&T) -> T>,
     ) -> DdsResult<Vec<Sample<T>>> {
-        self.inner.shared.check_alive()?;
-        let out = {
-            let mut st = lock(&self.inner.cache);
-            if let Some(prev) = next_after {
-                sel.instance = None;
-                match st.cache.next_instance(prev, &sel) {
-                    Some(h) => sel.instance = Some(h),
-                    None => return Ok(Vec::new()),
-                }
-            }
-            let out = st.cache.collect(&sel, take, copy);
-            let unread = Selection {
-                sample_states: SampleStateMask::NOT_READ,
-                ..Selection::default()
-            };
-            if !st.cache.has_matching(&unread) {
-                self.inner.status_core.clear(StatusMask::DATA_AVAILABLE);
-            }
-            out
-        };
-        if take && !out.is_empty() {
-            self.inner.refresh_credit();
-        }
-        // Read conditions may have stopped triggering.
-        self.inner.data_signal.notify();
+        let mut out = Vec::new();
+        self.visit(sel, next_after, take, |slot, info| {
+            out.push(to_sample(slot, info, take, copy))
+        })?;
         Ok(out)
     }
 
@@ -467,16 +446,14 @@ impl<T: DdsType> DataReader<T> {
             .take()
     }
 
-    /// The handle of the instance whose key equals the key of `key_sample` (other members are ignored).
-    pub fn lookup_instance(&self, key_sample: &T) -> Option<InstanceHandle> {
-        let key = if T::IS_KEYED {
-            let mut k = Vec::new();
-            cdr::instance_key(key_sample, &mut k).ok()?;
-            k
-        } else {
-            Vec::new()
-        };
-        lock(&self.inner.cache).cache.lookup(&key)
+    /// The handle of the instance whose key equals the key of `key_sample` (other members are ignored);
+    /// `None` when the reader holds no such instance.
+    pub fn lookup_instance(&self, key_sample: &T) -> DdsResult<Option<InstanceHandle>> {
+        let mut key = Vec::new();
+        if T::IS_KEYED {
+            cdr::instance_key(key_sample, &mut key)?;
+        }
+        Ok(lock(&self.inner.cache).cache.lookup(&key))
     }
 
     /// Number of instances held.
@@ -501,7 +478,7 @@ impl<T: DdsType> DataReader<T> {
             if st.cache.has_matching(&unread) {
                 return Ok(true);
             }
-            self.inner.shared.check_alive()?;
+            self.inner.state.driver.check_alive()?;
             let left = match deadline {
                 Some(d) => match d.checked_duration_since(Instant::now()) {
                     Some(l) if !l.is_zero() => l,
@@ -510,12 +487,12 @@ impl<T: DdsType> DataReader<T> {
                 None => Duration::from_secs(1),
             };
             self.inner.data_waiters.fetch_add(1, AtomicOrdering::SeqCst);
-            st = self
-                .inner
-                .data_cv
-                .wait_timeout(st, left.min(Duration::from_secs(1)))
-                .unwrap_or_else(|e| e.into_inner())
-                .0;
+            st = recover(
+                self.inner
+                    .data_cv
+                    .wait_timeout(st, left.min(Duration::from_secs(1))),
+            )
+            .0;
             self.inner.data_waiters.fetch_sub(1, AtomicOrdering::SeqCst);
         }
     }
@@ -546,118 +523,113 @@ impl<T: DdsType> DataReader<T> {
     /// The reader's status condition.
     pub fn status_condition(&self) -> StatusCondition {
         StatusCondition {
-            core: self.inner.status_core.clone(),
+            core: self.inner.state.status_core().clone(),
         }
     }
 
     /// Installs a listener (replacing any previous one).
     pub fn set_listener(&self, listener: Box<dyn DataReaderListener<T>>) {
-        *lock(&self.inner.listener) = Some(Arc::from(listener));
+        self.inner.state.set_listener(Some(Arc::from(listener)));
     }
 
     /// Removes the listener.
     pub fn clear_listener(&self) {
-        *lock(&self.inner.listener) = None;
+        self.inner.state.set_listener(None);
     }
 
     /// The topic.
     pub fn topic(&self) -> &Topic<T> {
-        &self.handle.topic
+        &self.handle.owner().topic
     }
 
     /// The subscriber.
     pub fn subscriber(&self) -> &Subscriber {
-        &self.handle.subscriber
+        &self.handle.owner().subscriber
     }
 
     /// The reader's GUID.
-    pub fn guid(&self) -> [u8; 16] {
-        Guid::new(self.inner.shared.guid_prefix, self.handle.id).to_bytes()
+    pub fn guid(&self) -> Guid {
+        self.handle.guid()
+    }
+
+    /// The reader's handle (as writers see it in their matched subscriptions).
+    pub fn instance_handle(&self) -> InstanceHandle {
+        InstanceHandle::from_guid(self.guid())
     }
 
     /// Handles of the matched writers.
     pub fn matched_publications(&self) -> Vec<InstanceHandle> {
-        lock(&self.inner.matched)
-            .iter()
-            .map(|g| InstanceHandle::from_guid_bytes(&g.to_bytes()))
+        self.inner
+            .state
+            .matched()
+            .into_iter()
+            .map(InstanceHandle::from_guid)
             .collect()
+    }
+
+    /// GUIDs of the matched writers.
+    pub fn matched_publication_guids(&self) -> Vec<Guid> {
+        self.inner.state.matched()
     }
 
     /// SUBSCRIPTION_MATCHED (resets the change counts).
     pub fn subscription_matched_status(&self) -> SubscriptionMatchedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.subscription_matched.clone();
-        st.subscription_matched.total_count_change = 0;
-        st.subscription_matched.current_count_change = 0;
         self.inner
-            .status_core
-            .clear(StatusMask::SUBSCRIPTION_MATCHED);
-        s
+            .state
+            .take_status(StatusMask::SUBSCRIPTION_MATCHED, |s| {
+                &mut s.subscription_matched
+            })
     }
 
     /// REQUESTED_INCOMPATIBLE_QOS (resets the change count).
     pub fn requested_incompatible_qos_status(&self) -> IncompatibleQosStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.requested_incompatible_qos.clone();
-        st.requested_incompatible_qos.total_count_change = 0;
         self.inner
-            .status_core
-            .clear(StatusMask::REQUESTED_INCOMPATIBLE_QOS);
-        s
+            .state
+            .take_status(StatusMask::REQUESTED_INCOMPATIBLE_QOS, |s| {
+                &mut s.requested_incompatible_qos
+            })
     }
 
     /// SAMPLE_LOST (resets the change count).
     pub fn sample_lost_status(&self) -> SampleLostStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.sample_lost.clone();
-        st.sample_lost.total_count_change = 0;
-        self.inner.status_core.clear(StatusMask::SAMPLE_LOST);
-        s
+        self.inner
+            .state
+            .take_status(StatusMask::SAMPLE_LOST, |s| &mut s.sample_lost)
     }
 
     /// SAMPLE_REJECTED (resets the change count).
     pub fn sample_rejected_status(&self) -> SampleRejectedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.sample_rejected.clone();
-        st.sample_rejected.total_count_change = 0;
-        self.inner.status_core.clear(StatusMask::SAMPLE_REJECTED);
-        s
+        self.inner
+            .state
+            .take_status(StatusMask::SAMPLE_REJECTED, |s| &mut s.sample_rejected)
     }
 
     /// LIVELINESS_CHANGED (resets the change counts).
     pub fn liveliness_changed_status(&self) -> LivelinessChangedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.liveliness_changed.clone();
-        st.liveliness_changed.alive_count_change = 0;
-        st.liveliness_changed.not_alive_count_change = 0;
-        self.inner.status_core.clear(StatusMask::LIVELINESS_CHANGED);
-        s
+        self.inner
+            .state
+            .take_status(StatusMask::LIVELINESS_CHANGED, |s| {
+                &mut s.liveliness_changed
+            })
     }
 
     /// REQUESTED_DEADLINE_MISSED (resets the change count).
     pub fn requested_deadline_missed_status(&self) -> DeadlineMissedStatus {
-        let mut st = lock(&self.inner.statuses);
-        let s = st.requested_deadline_missed.clone();
-        st.requested_deadline_missed.total_count_change = 0;
         self.inner
-            .status_core
-            .clear(StatusMask::REQUESTED_DEADLINE_MISSED);
-        s
+            .state
+            .take_status(StatusMask::REQUESTED_DEADLINE_MISSED, |s| {
+                &mut s.requested_deadline_missed
+            })
     }
 }
 
-fn system_time(t: Option<crate::rtps::Time>) -> Option<SystemTime> {
-    t.and_then(|t| t.to_unix())
-        .map(|d| SystemTime::UNIX_EPOCH + d)
-}
-
 impl<T: DdsType> ReaderInner<T> {
-    fn reader_handle(self: &Arc<Self>) -> Option<DataReader<T>> {
-        let handle = lock(&self.handle).upgrade()?;
-        Some(DataReader {
-            inner: self.clone(),
-            handle,
-        })
+    /// The public reader, for listeners.
+    fn reader(
+        self: &Arc<Self>,
+    ) -> impl FnOnce(Arc<EndpointHandle<ReaderOwner<T>>>) -> DataReader<T> {
+        let inner = self.clone();
+        move |handle| DataReader { inner, handle }
     }
 
     /// Gives the core back the room freed by a take. Under the core lock every delivered sample is either
@@ -666,8 +638,8 @@ impl<T: DdsType> ReaderInner<T> {
         let Some(limit) = self.credit_limit else {
             return;
         };
-        let id = *lock(&self.id);
-        self.shared.with_core(|c, _| {
+        let id = self.state.id();
+        self.state.driver.with_core(|c, _| {
             let held = lock(&self.cache).cache.len() + lock(&self.pending).len();
             c.set_reader_credit(id, Some(limit.saturating_sub(held)));
         });
@@ -681,111 +653,14 @@ impl<T: DdsType> ReaderInner<T> {
         for w in wakers {
             w.wake();
         }
-        self.status_core.raise(StatusMask::DATA_AVAILABLE);
+        self.state.status_core().raise(StatusMask::DATA_AVAILABLE);
         self.data_signal.notify();
-        let listener = lock(&self.listener).clone();
-        if let (Some(l), Some(r)) = (listener, self.reader_handle()) {
-            l.on_data_available(&r);
-        }
+        self.state
+            .call_listener(self.reader(), |l, r| l.on_data_available(r));
     }
 }
 
-/// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped to an
-/// instance. Instances are identified by `cdr::instance_key`; a key-only change without a decodable key
-/// payload is mapped through its key hash to an instance seen before with the same hash.
-fn decode_change<T: DdsType>(
-    s: ReceivedSample,
-    info: RemoteWriterInfo,
-    by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
-    mut key: Vec<u8>,
-    now: Instant,
-    rx_time: SystemTime,
-) -> Option<Incoming<T>> {
-    let source_timestamp = system_time(s.source_timestamp);
-    let kind = match s.kind {
-        ChangeKind::Alive => ChangeKindLocal::Alive,
-        ChangeKind::Dispose => ChangeKindLocal::Dispose,
-        ChangeKind::Unregister => ChangeKindLocal::Unregister,
-        ChangeKind::DisposeUnregister => ChangeKindLocal::DisposeUnregister,
-    };
-    key.clear();
-    let mut data = None;
-    let mut key_holder = None;
-    if kind == ChangeKindLocal::Alive {
-        let d = match cdr::deserialize::<T>(&s.payload) {
-            Ok(d) => d,
-            Err(e) => {
-                tracing::warn!(writer = ?s.writer, seq = s.sequence.0, error = %e, "dropping undecodable sample");
-                return None;
-            }
-        };
-        if T::IS_KEYED {
-            if let Err(e) = cdr::instance_key(&d, &mut key) {
-                tracing::warn!(error = %e, "cannot compute the instance key");
-                return None;
-            }
-            // Index the key hashes a peer may later send alone (dispose/unregister without payload,
-            // e.g. Fast DDS): the one it sent, else the ones we compute for either representation.
-            let hashes = match s.key_hash {
-                Some(kh) => [Some(kh), None],
-                None => [
-                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr1).ok(),
-                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr2).ok(),
-                ],
-            };
-            for kh in hashes.into_iter().flatten() {
-                if by_hash.len() >= MAX_REMEMBERED_HASHES {
-                    by_hash.clear();
-                }
-                by_hash.entry(kh).or_insert_with(|| key.clone());
-            }
-        }
-        data = Some(d);
-    } else if T::IS_KEYED {
-        if !s.payload.is_empty() {
-            match cdr::deserialize_key::<T>(&s.payload) {
-                Ok(k) => {
-                    if let Err(e) = cdr::instance_key(&k, &mut key) {
-                        tracing::warn!(error = %e, "cannot compute the instance key");
-                        return None;
-                    }
-                    key_holder = Some(k);
-                }
-                Err(e) => {
-                    tracing::debug!(error = %e, "undecodable key payload; trying the key hash")
-                }
-            }
-        }
-        if key_holder.is_none() {
-            match s.key_hash.and_then(|kh| by_hash.get(&kh).cloned()) {
-                Some(k) => key = k,
-                None => {
-                    tracing::debug!(writer = ?s.writer, kind = ?s.kind, "key-only change for an unknown instance");
-                    return None;
-                }
-            }
-        }
-    }
-    Some(Incoming {
-        writer: s.writer.to_bytes(),
-        kind,
-        data,
-        key,
-        key_holder,
-        source_timestamp: source_timestamp.unwrap_or(rx_time),
-        reception_timestamp: rx_time,
-        strength: info.strength,
-        expires: info.lifespan.and_then(|l| {
-            // Lifespan counts from the source timestamp; its age so far is spent already.
-            let age = source_timestamp
-                .and_then(|t| rx_time.duration_since(t).ok())
-                .unwrap_or_default();
-            now.checked_add(l.saturating_sub(age))
-        }),
-    })
-}
-
-impl<T: DdsType> ReaderSink for ReaderInner<T> {
+impl<T: DdsType> Endpoint for ReaderInner<T> {
     fn enqueue(&self, item: Pending) {
         lock(&self.pending).push_back(item);
     }
@@ -809,7 +684,7 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
                         let info = match writer_info {
                             Some((g, info)) if g == s.writer => info,
                             _ => {
-                                let info = self.shared.remote_writer(&s.writer);
+                                let info = self.state.driver.remote_writer(&s.writer);
                                 writer_info = Some((s.writer, info));
                                 info
                             }
@@ -826,32 +701,27 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
                             Outcome::Rejected { reason, handle } => rejected.push((reason, handle)),
                         }
                     }
-                    Pending::WriterGone(g) => any |= st.cache.writer_gone(g.to_bytes(), now),
+                    Pending::WriterGone(g) => any |= st.cache.writer_gone(g, now),
                 }
             }
             st.batch = batch;
         }
         if !rejected.is_empty() {
-            let status = {
-                let mut st = lock(&self.statuses);
-                for (reason, handle) in &rejected {
-                    let sr = &mut st.sample_rejected;
-                    sr.total_count += 1;
-                    sr.total_count_change += 1;
-                    sr.last_reason = *reason;
-                    sr.last_instance_handle = *handle;
-                }
-                st.sample_rejected.clone()
-            };
             tracing::debug!(
                 count = rejected.len(),
                 "samples rejected by resource limits"
             );
-            self.status_core.raise(StatusMask::SAMPLE_REJECTED);
-            let listener = lock(&self.listener).clone();
-            if let (Some(l), Some(r)) = (listener, self.reader_handle()) {
-                l.on_sample_rejected(&r, status);
-            }
+            self.state.signal(
+                StatusMask::SAMPLE_REJECTED,
+                |st| {
+                    for (reason, handle) in &rejected {
+                        st.sample_rejected.record(*reason, *handle);
+                    }
+                    &mut st.sample_rejected
+                },
+                self.reader(),
+                |l, r, s| l.on_sample_rejected(r, s),
+            );
         }
         if any {
             self.notify_data();
@@ -859,107 +729,59 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
     }
 
     fn on_event(self: Arc<Self>, ev: &Event) {
-        let listener = lock(&self.listener).clone();
-        let me = self.reader_handle();
+        let id = self.state.id();
         match ev {
             Event::SubscriptionMatched {
                 writer, matched, ..
             } => {
-                let status = {
-                    let mut m = lock(&self.matched);
-                    let mut st = lock(&self.statuses);
-                    let sm = &mut st.subscription_matched;
-                    if *matched {
-                        if !m.contains(writer) {
-                            m.push(*writer);
-                            sm.total_count += 1;
-                            sm.total_count_change += 1;
-                            sm.current_count_change += 1;
-                        }
-                    } else if let Some(p) = m.iter().position(|g| g == writer) {
-                        m.remove(p);
-                        sm.current_count_change -= 1;
-                    }
-                    sm.current_count = m.len() as u32;
-                    sm.last_publication_handle =
-                        InstanceHandle::from_guid_bytes(&writer.to_bytes());
-                    let out = sm.clone();
-                    // A listener consumes the status (DDS 2.2.4.2.1): reset the changes so the next
-                    // callback reports only what happened since this one.
-                    if listener.is_some() && me.is_some() {
-                        sm.total_count_change = 0;
-                        sm.current_count_change = 0;
-                    }
-                    out
-                };
-                tracing::info!(reader = ?lock(&self.id), ?writer, matched, "subscription matched");
-                self.status_core.raise(StatusMask::SUBSCRIPTION_MATCHED);
-                if let (Some(l), Some(r)) = (listener, me) {
-                    l.on_subscription_matched(&r, status);
-                }
+                tracing::info!(reader = ?id, ?writer, matched, "subscription matched");
+                self.state.record_match(
+                    StatusMask::SUBSCRIPTION_MATCHED,
+                    |st| &mut st.subscription_matched,
+                    (*writer, *matched),
+                    self.reader(),
+                    |l, r, s| l.on_subscription_matched(r, s),
+                );
             }
             Event::RequestedIncompatibleQos { policy, writer, .. } => {
-                let status = {
-                    let mut st = lock(&self.statuses);
-                    st.requested_incompatible_qos.record(*policy);
-                    st.requested_incompatible_qos.clone()
-                };
-                tracing::warn!(reader = ?lock(&self.id), ?writer, ?policy, "requested incompatible QoS");
-                self.status_core
-                    .raise(StatusMask::REQUESTED_INCOMPATIBLE_QOS);
-                if let (Some(l), Some(r)) = (listener, me) {
-                    l.on_requested_incompatible_qos(&r, status);
-                }
+                tracing::warn!(reader = ?id, ?writer, ?policy, "requested incompatible QoS");
+                self.state.signal(
+                    StatusMask::REQUESTED_INCOMPATIBLE_QOS,
+                    |st| {
+                        st.requested_incompatible_qos.record(*policy);
+                        &mut st.requested_incompatible_qos
+                    },
+                    self.reader(),
+                    |l, r, s| l.on_requested_incompatible_qos(r, s),
+                );
             }
             Event::LivelinessChanged { writer, alive, .. } => {
-                let status = {
-                    let mut st = lock(&self.statuses);
-                    let lc = &mut st.liveliness_changed;
-                    if *alive {
-                        lc.alive_count += 1;
-                        lc.alive_count_change += 1;
-                        if lc.not_alive_count > 0 {
-                            lc.not_alive_count -= 1;
-                            lc.not_alive_count_change -= 1;
-                        }
-                    } else {
-                        lc.not_alive_count += 1;
-                        lc.not_alive_count_change += 1;
-                        if lc.alive_count > 0 {
-                            lc.alive_count -= 1;
-                            lc.alive_count_change -= 1;
-                        }
-                    }
-                    lc.last_publication_handle =
-                        InstanceHandle::from_guid_bytes(&writer.to_bytes());
-                    lc.clone()
-                };
                 if !*alive {
-                    let changed = lock(&self.cache)
-                        .cache
-                        .writer_gone(writer.to_bytes(), Instant::now());
+                    let changed = lock(&self.cache).cache.writer_gone(*writer, Instant::now());
                     if changed {
                         self.notify_data();
                     }
                 }
-                self.status_core.raise(StatusMask::LIVELINESS_CHANGED);
-                if let (Some(l), Some(r)) = (listener, me) {
-                    l.on_liveliness_changed(&r, status);
-                }
+                self.state.signal(
+                    StatusMask::LIVELINESS_CHANGED,
+                    |st| {
+                        st.liveliness_changed.record(*writer, *alive);
+                        &mut st.liveliness_changed
+                    },
+                    self.reader(),
+                    |l, r, s| l.on_liveliness_changed(r, s),
+                );
             }
             Event::SampleLost { count, .. } => {
-                let status = {
-                    let mut st = lock(&self.statuses);
-                    let n = u32::try_from(*count).unwrap_or(u32::MAX);
-                    st.sample_lost.total_count = st.sample_lost.total_count.saturating_add(n);
-                    st.sample_lost.total_count_change =
-                        st.sample_lost.total_count_change.saturating_add(n);
-                    st.sample_lost.clone()
-                };
-                self.status_core.raise(StatusMask::SAMPLE_LOST);
-                if let (Some(l), Some(r)) = (listener, me) {
-                    l.on_sample_lost(&r, status);
-                }
+                self.state.signal(
+                    StatusMask::SAMPLE_LOST,
+                    |st| {
+                        st.sample_lost.record(*count);
+                        &mut st.sample_lost
+                    },
+                    self.reader(),
+                    |l, r, s| l.on_sample_lost(r, s),
+                );
             }
             _ => {}
         }
@@ -970,20 +792,15 @@ impl<T: DdsType> ReaderSink for ReaderInner<T> {
         if missed.is_empty() {
             return;
         }
-        let status = {
-            let mut st = lock(&self.statuses);
-            let dm = &mut st.requested_deadline_missed;
-            dm.total_count += missed.len() as u32;
-            dm.total_count_change += missed.len() as u32;
-            dm.last_instance_handle = *missed.last().unwrap_or(&InstanceHandle::NIL);
-            dm.clone()
-        };
-        self.status_core
-            .raise(StatusMask::REQUESTED_DEADLINE_MISSED);
-        let listener = lock(&self.listener).clone();
-        if let (Some(l), Some(r)) = (listener, self.reader_handle()) {
-            l.on_requested_deadline_missed(&r, status);
-        }
+        self.state.signal(
+            StatusMask::REQUESTED_DEADLINE_MISSED,
+            |st| {
+                st.requested_deadline_missed.record(&missed);
+                &mut st.requested_deadline_missed
+            },
+            self.reader(),
+            |l, r, s| l.on_requested_deadline_missed(r, s),
+        );
     }
 }
 
@@ -1023,7 +840,7 @@ impl<T: DdsType> futures_core::Stream for SampleStream<T> {
         if let Some(s) = take() {
             return Poll::Ready(Some(s));
         }
-        if r.inner.shared.check_alive().is_err() {
+        if r.inner.state.driver.check_alive().is_err() {
             return Poll::Ready(None);
         }
         {
@@ -1036,107 +853,6 @@ impl<T: DdsType> futures_core::Stream for SampleStream<T> {
         match take() {
             Some(s) => Poll::Ready(Some(s)),
             None => Poll::Pending,
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::cdr::{ByteOrder, XcdrVersion};
-    use crate::rtps::{GuidPrefix, Payload, SequenceNumber};
-
-    #[derive(dds_macros::DdsType, Debug, Clone, PartialEq, Default)]
-    #[dds(name = "test::K", appendable)]
-    struct K {
-        #[dds(key)]
-        id: String,
-        v: i32,
-    }
-
-    fn rs(kind: ChangeKind, payload: Vec<u8>, key_hash: Option<[u8; 16]>) -> ReceivedSample {
-        ReceivedSample {
-            reader: EntityId([0, 0, 1, 7]),
-            writer: Guid::new(GuidPrefix([1; 12]), EntityId([0, 0, 1, 2])),
-            sequence: SequenceNumber(1),
-            kind,
-            payload: Payload::from(payload),
-            key_hash,
-            source_timestamp: None,
-        }
-    }
-
-    /// `decode_change` from a writer with default QoS, now.
-    fn decode(s: ReceivedSample, by_hash: &mut HashMap<[u8; 16], Vec<u8>>) -> Option<Incoming<K>> {
-        let now = Instant::now();
-        decode_change::<K>(
-            s,
-            RemoteWriterInfo::default(),
-            by_hash,
-            Vec::new(),
-            now,
-            SystemTime::now(),
-        )
-    }
-
-    #[test]
-    fn key_only_changes_map_by_key_payload_or_known_hash() {
-        let mut by_hash = HashMap::new();
-        let s = K {
-            id: "a".into(),
-            v: 1,
-        };
-        let mut buf = Vec::new();
-        cdr::serialize(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut buf).unwrap();
-        let kh = cdr::key_hash(&s, XcdrVersion::Xcdr2).unwrap();
-        let alive = decode(rs(ChangeKind::Alive, buf, Some(kh)), &mut by_hash).unwrap();
-        assert_eq!(alive.data.as_ref(), Some(&s));
-        let mut expected = Vec::new();
-        cdr::instance_key(&s, &mut expected).unwrap();
-        assert_eq!(alive.key, expected);
-
-        let mut kp = Vec::new();
-        cdr::serialize_key(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut kp).unwrap();
-        let d = decode(rs(ChangeKind::Dispose, kp, None), &mut by_hash).unwrap();
-        assert_eq!(d.key, expected, "by key payload");
-        assert_eq!(d.kind, ChangeKindLocal::Dispose);
-
-        let u = decode(
-            rs(ChangeKind::Unregister, Vec::new(), Some(kh)),
-            &mut by_hash,
-        )
-        .unwrap();
-        assert_eq!(u.key, expected, "by a key hash seen before");
-
-        let unknown = rs(ChangeKind::Dispose, Vec::new(), Some([9; 16]));
-        assert!(decode(unknown, &mut by_hash).is_none());
-        let garbage = rs(
-            ChangeKind::Alive,
-            vec![0, 7, 0, 0, 0xff, 0xff, 0xff, 0x7f],
-            None,
-        );
-        assert!(decode(garbage, &mut by_hash).is_none());
-    }
-
-    /// Fast DDS disposes with only PID_KEY_HASH; the alive samples before may have come without one.
-    #[test]
-    fn key_hash_only_dispose_maps_to_instance_seen_without_hash() {
-        let s = K {
-            id: "a-rather-long-key-beyond-16-bytes".into(),
-            v: 1,
-        };
-        let mut expected = Vec::new();
-        cdr::instance_key(&s, &mut expected).unwrap();
-        for version in [XcdrVersion::Xcdr1, XcdrVersion::Xcdr2] {
-            let mut by_hash = HashMap::new();
-            let mut buf = Vec::new();
-            cdr::serialize(&s, version, ByteOrder::NATIVE, &mut buf).unwrap();
-            decode(rs(ChangeKind::Alive, buf, None), &mut by_hash).unwrap();
-            let kh = cdr::key_hash(&s, version).unwrap();
-            let d = decode(rs(ChangeKind::Dispose, Vec::new(), Some(kh)), &mut by_hash)
-                .expect("dispose mapped through the computed key hash");
-            assert_eq!(d.key, expected);
-            assert_eq!(d.kind, ChangeKindLocal::Dispose);
         }
     }
 }

@@ -9,6 +9,7 @@ use crate::qos::TopicQos;
 use super::error::{DdsError, DdsResult};
 use super::filter::{ContentFilter, FilterFields};
 use super::participant::DomainParticipant;
+use super::sync::{read, write};
 
 struct TopicInner {
     participant: DomainParticipant,
@@ -41,16 +42,6 @@ impl<T: DdsType> std::fmt::Debug for Topic<T> {
 }
 
 impl<T: DdsType> Topic<T> {
-    pub(crate) fn new(participant: DomainParticipant, name: &str, qos: TopicQos) -> Self {
-        Topic {
-            inner: Arc::new(TopicInner {
-                participant,
-                name: name.to_string(),
-                qos,
-            }),
-            _t: PhantomData,
-        }
-    }
     /// The topic name.
     pub fn name(&self) -> &str {
         &self.inner.name
@@ -113,27 +104,16 @@ impl<T: DdsType + FilterFields> ContentFilteredTopic<T> {
     }
     /// The filter expression.
     pub fn filter_expression(&self) -> String {
-        self.filter
-            .read()
-            .unwrap_or_else(|e| e.into_inner())
-            .expression()
-            .to_string()
+        read(&self.filter).expression().to_string()
     }
     /// The current parameters.
     pub fn expression_parameters(&self) -> Vec<String> {
-        self.filter
-            .read()
-            .unwrap_or_else(|e| e.into_inner())
-            .parameters()
-            .to_vec()
+        read(&self.filter).parameters().to_vec()
     }
     /// Changes the parameters; readers created on this topic apply them to samples received from now on.
     pub fn set_expression_parameters<S: AsRef<str>>(&self, params: &[S]) -> DdsResult<()> {
         let params: Vec<String> = params.iter().map(|s| s.as_ref().to_string()).collect();
-        self.filter
-            .write()
-            .unwrap_or_else(|e| e.into_inner())
-            .set_parameters(&params)
+        write(&self.filter).set_parameters(&params)
     }
 }
 
@@ -143,13 +123,27 @@ impl<T: DdsType + FilterFields> TopicDescription<T> for ContentFilteredTopic<T> 
     }
     fn sample_filter(&self) -> Option<SampleFilter<T>> {
         let f = self.filter.clone();
-        Some(Box::new(move |s: &T| {
-            f.read().unwrap_or_else(|e| e.into_inner()).matches(s)
-        }))
+        Some(Box::new(move |s: &T| read(&f).matches(s)))
     }
 }
 
 impl DomainParticipant {
+    /// Creates a topic of type `T`.
+    pub fn create_topic<T: DdsType>(&self, name: &str, qos: &TopicQos) -> DdsResult<Topic<T>> {
+        self.driver().check_alive()?;
+        if name.is_empty() || name.len() > 256 {
+            return Err(DdsError::BadParameter(format!("topic name {name:?}")));
+        }
+        Ok(Topic {
+            inner: Arc::new(TopicInner {
+                participant: self.clone(),
+                name: name.to_string(),
+                qos: qos.clone(),
+            }),
+            _t: PhantomData,
+        })
+    }
+
     /// A content-filtered view of `topic` (SQL subset, see [`crate::dcps::filter`]); `%N` in the expression
     /// refers to `params[N]`.
     pub fn create_content_filtered_topic<T: DdsType + FilterFields, S: AsRef<str>>(

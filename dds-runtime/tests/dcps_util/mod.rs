@@ -8,7 +8,7 @@ use dds_runtime::prelude::*;
 /// The shapes demo type (@appendable, keyed on color), as the OMG interop suite uses it.
 #[derive(DdsType, Debug, Clone, PartialEq, Default)]
 #[dds(name = "ShapeType", appendable)]
-pub struct ShapeType {
+pub(crate) struct ShapeType {
     #[dds(key)]
     pub color: String,
     pub x: i32,
@@ -28,7 +28,7 @@ impl FilterFields for ShapeType {
     }
 }
 
-pub fn shape(color: &str, x: i32) -> ShapeType {
+pub(crate) fn shape(color: &str, x: i32) -> ShapeType {
     ShapeType {
         color: color.into(),
         x,
@@ -40,14 +40,14 @@ pub fn shape(color: &str, x: i32) -> ShapeType {
 /// A @final keyed type with a large unbounded member (fragmentation).
 #[derive(DdsType, Debug, Clone, PartialEq, Default)]
 #[dds(name = "test::Blob", final)]
-pub struct Blob {
+pub(crate) struct Blob {
     #[dds(key)]
     pub id: u32,
     pub data: Vec<u8>,
 }
 
 /// Refuses to open sockets outside the private network namespace.
-pub fn require_netns() {
+pub(crate) fn require_netns() {
     assert_eq!(
         std::env::var("DDS_IN_NETNS").as_deref(),
         Ok("1"),
@@ -55,7 +55,7 @@ pub fn require_netns() {
     );
 }
 
-pub fn init_tracing() {
+pub(crate) fn init_tracing() {
     let _ = tracing_subscriber::fmt()
         .with_env_filter(tracing_subscriber::EnvFilter::from_env("DDS_LOG"))
         .with_test_writer()
@@ -63,7 +63,7 @@ pub fn init_tracing() {
 }
 
 /// A participant on `lo` in `domain`, with fast discovery.
-pub fn participant(domain: u32) -> DomainParticipant {
+pub(crate) fn participant(domain: u32) -> DomainParticipant {
     require_netns();
     init_tracing();
     DomainParticipant::builder()
@@ -76,7 +76,7 @@ pub fn participant(domain: u32) -> DomainParticipant {
 }
 
 /// Polls `f` until it holds or `timeout` passes.
-pub fn wait_until(timeout: Duration, mut f: impl FnMut() -> bool) -> bool {
+pub(crate) fn wait_until(timeout: Duration, mut f: impl FnMut() -> bool) -> bool {
     let end = Instant::now() + timeout;
     while Instant::now() < end {
         if f() {
@@ -87,16 +87,16 @@ pub fn wait_until(timeout: Duration, mut f: impl FnMut() -> bool) -> bool {
     f()
 }
 
-pub fn reliable() -> Reliability {
+pub(crate) fn reliable() -> Reliability {
     Reliability::Reliable {
         max_blocking_time: Duration::from_secs(1),
     }
 }
 
-pub const MATCH_TIMEOUT: Duration = Duration::from_secs(10);
+pub(crate) const MATCH_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// Reliable (max_blocking_time 1 s) KEEP_ALL QoS for a writer and for a reader.
-pub fn reliable_keep_all() -> (DataWriterQos, DataReaderQos) {
+pub(crate) fn reliable_keep_all() -> (DataWriterQos, DataReaderQos) {
     let wq = DataWriterQos::builder()
         .reliability(reliable())
         .history(History::KeepAll)
@@ -109,7 +109,11 @@ pub fn reliable_keep_all() -> (DataWriterQos, DataReaderQos) {
 }
 
 /// A writer of `topic` on `p`, with default topic and publisher QoS.
-pub fn writer<T: DdsType>(p: &DomainParticipant, topic: &str, wq: &DataWriterQos) -> DataWriter<T> {
+pub(crate) fn writer<T: DdsType>(
+    p: &DomainParticipant,
+    topic: &str,
+    wq: &DataWriterQos,
+) -> DataWriter<T> {
     let t = p
         .create_topic::<T>(topic, &TopicQos::default())
         .expect("writer's topic");
@@ -119,7 +123,11 @@ pub fn writer<T: DdsType>(p: &DomainParticipant, topic: &str, wq: &DataWriterQos
 }
 
 /// A reader of `topic` on `p`, with default topic and subscriber QoS.
-pub fn reader<T: DdsType>(p: &DomainParticipant, topic: &str, rq: &DataReaderQos) -> DataReader<T> {
+pub(crate) fn reader<T: DdsType>(
+    p: &DomainParticipant,
+    topic: &str,
+    rq: &DataReaderQos,
+) -> DataReader<T> {
     let t = p
         .create_topic::<T>(topic, &TopicQos::default())
         .expect("reader's topic");
@@ -130,7 +138,7 @@ pub fn reader<T: DdsType>(p: &DomainParticipant, topic: &str, rq: &DataReaderQos
 
 /// A writer on `pw` and a reader on `pr` of `topic` (default topic, publisher and subscriber QoS), once
 /// each has matched the other (within [`MATCH_TIMEOUT`]; panics otherwise).
-pub fn matched<T: DdsType>(
+pub(crate) fn matched<T: DdsType>(
     pw: &DomainParticipant,
     pr: &DomainParticipant,
     topic: &str,

@@ -163,7 +163,7 @@ impl<T: PerfSample> Ctx<T> {
             .participant
             .discovered_participants()
             .into_iter()
-            .map(|p| p.guid_prefix)
+            .map(|p| p.guid_prefix.0)
             .collect();
         if self.o.match_local {
             prefixes.push(self.own_prefix);
@@ -259,13 +259,15 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
     let mut builder = DomainParticipant::builder().user_data(user_data);
     // Like ddsperf: a publisher packs its data samples into datagrams; pings and pongs are flushed at once.
     if o.pub_rate.is_some_and(|r| r > 0.0) && std::env::var_os("DDS_WRITE_BATCH").is_none() {
-        builder = builder.write_batching(Some(dds_runtime::config::DEFAULT_WRITE_BATCH_DELAY));
+        builder = builder.write_batching(WriteBatching::Delay(
+            dds_runtime::config::DEFAULT_WRITE_BATCH_DELAY,
+        ));
     }
     if let Some(d) = o.domain_id {
         builder = builder.domain_id(d);
     }
     let participant = builder.build()?;
-    let own_prefix = participant.guid_prefix();
+    let own_prefix = participant.guid_prefix().0;
     let rel = if o.reliable { 'R' } else { 'U' };
     let suffix = T::TOPIC.suffix();
     let tq = TopicQos::default();
@@ -577,10 +579,10 @@ fn answer_pings<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
     let Ok(samples) = reader.take() else { return };
     for s in samples {
         let Some(d) = s.data else { continue };
-        if ctx.is_local(&s.info.publication_guid) && !ctx.o.match_local {
+        if ctx.is_local(&s.info.publication_guid.to_bytes()) && !ctx.o.match_local {
             continue;
         }
-        if let Some(w) = ctx.pong_writer_for(&s.info.publication_guid) {
+        if let Some(w) = ctx.pong_writer_for(&s.info.publication_guid.to_bytes()) {
             let _ = w.write_w_timestamp(&d, ts(ns_of(s.info.source_timestamp) | 1));
             w.flush();
         }
@@ -598,7 +600,7 @@ fn receive_pongs<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
         let half_rtt = (now - sent) / 2;
         {
             let mut ps = ctx.pong_stats.lock().expect("pong stats");
-            let g = s.info.publication_guid;
+            let g = s.info.publication_guid.to_bytes();
             match ps.iter_mut().find(|(k, _)| *k == g) {
                 Some((_, st)) => st.record(half_rtt),
                 None => {
@@ -642,10 +644,15 @@ fn receive_data<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
     let mut stats = ctx.sub_stats.lock().expect("sub stats");
     for s in &samples {
         let Some(d) = &s.data else { continue };
-        if ctx.is_local(&s.info.publication_guid) && !ctx.o.match_local {
+        if ctx.is_local(&s.info.publication_guid.to_bytes()) && !ctx.o.match_local {
             continue;
         }
-        if stats.record(s.info.publication_guid, d.seq(), d.keyval(), d.size()) == SeqCheck::BadKey
+        if stats.record(
+            s.info.publication_guid.to_bytes(),
+            d.seq(),
+            d.keyval(),
+            d.size(),
+        ) == SeqCheck::BadKey
         {
             println!("received key {} >= nkeys {}", d.keyval(), ctx.o.nkeyvals);
             shutdown::request();
@@ -661,7 +668,10 @@ fn receive_data<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
     for s in samples {
         let sent = ns_of(s.info.source_timestamp);
         if sent & 1 == 1 {
-            if let (Some(d), Some(w)) = (s.data, ctx.pong_writer_for(&s.info.publication_guid)) {
+            if let (Some(d), Some(w)) = (
+                s.data,
+                ctx.pong_writer_for(&s.info.publication_guid.to_bytes()),
+            ) {
                 let _ = w.write_w_timestamp(&d, ts(sent - 1));
                 w.flush();
             }

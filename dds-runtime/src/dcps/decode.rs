@@ -1,0 +1,212 @@
+//! Turns a change received by a reader into a cache input: decodes the sample (or its key) and maps
+//! key-only changes to their instance.
+
+use std::time::{Instant, SystemTime};
+
+use foldhash::HashMap;
+
+use crate::cdr::{self, DdsType};
+use crate::rtps::{ChangeKind, ReceivedSample};
+
+use super::cache::Incoming;
+use super::driver::RemoteWriterInfo;
+
+/// Most key hashes remembered per reader for mapping key-hash-only disposes to instances.
+const MAX_REMEMBERED_HASHES: usize = 65536;
+
+fn system_time(t: Option<crate::rtps::Time>) -> Option<SystemTime> {
+    t.and_then(|t| t.to_unix())
+        .map(|d| SystemTime::UNIX_EPOCH + d)
+}
+
+/// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped to an
+/// instance. Instances are identified by `cdr::instance_key`; a key-only change without a decodable key
+/// payload is mapped through its key hash to an instance seen before with the same hash.
+pub(crate) fn decode_change<T: DdsType>(
+    s: ReceivedSample,
+    info: RemoteWriterInfo,
+    by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
+    mut key: Vec<u8>,
+    now: Instant,
+    rx_time: SystemTime,
+) -> Option<Incoming<T>> {
+    let source_timestamp = system_time(s.source_timestamp);
+    let kind = s.kind;
+    key.clear();
+    let mut data = None;
+    let mut key_holder = None;
+    if kind == ChangeKind::Alive {
+        let d = match cdr::deserialize::<T>(&s.payload) {
+            Ok(d) => d,
+            Err(e) => {
+                tracing::warn!(writer = ?s.writer, seq = s.sequence.0, error = %e, "dropping undecodable sample");
+                return None;
+            }
+        };
+        if T::IS_KEYED {
+            if let Err(e) = cdr::instance_key(&d, &mut key) {
+                tracing::warn!(error = %e, "cannot compute the instance key");
+                return None;
+            }
+            // Index the key hashes a peer may later send alone (dispose/unregister without payload,
+            // e.g. Fast DDS): the one it sent, else the ones we compute for either representation.
+            let hashes = match s.key_hash {
+                Some(kh) => [Some(kh), None],
+                None => [
+                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr1).ok(),
+                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr2).ok(),
+                ],
+            };
+            for kh in hashes.into_iter().flatten() {
+                if by_hash.len() >= MAX_REMEMBERED_HASHES {
+                    by_hash.clear();
+                }
+                by_hash.entry(kh).or_insert_with(|| key.clone());
+            }
+        }
+        data = Some(d);
+    } else if T::IS_KEYED {
+        if !s.payload.is_empty() {
+            match cdr::deserialize_key::<T>(&s.payload) {
+                Ok(k) => {
+                    if let Err(e) = cdr::instance_key(&k, &mut key) {
+                        tracing::warn!(error = %e, "cannot compute the instance key");
+                        return None;
+                    }
+                    key_holder = Some(k);
+                }
+                Err(e) => {
+                    tracing::debug!(error = %e, "undecodable key payload; trying the key hash")
+                }
+            }
+        }
+        if key_holder.is_none() {
+            match s.key_hash.and_then(|kh| by_hash.get(&kh).cloned()) {
+                Some(k) => key = k,
+                None => {
+                    tracing::debug!(writer = ?s.writer, kind = ?s.kind, "key-only change for an unknown instance");
+                    return None;
+                }
+            }
+        }
+    }
+    Some(Incoming {
+        writer: s.writer,
+        kind,
+        data,
+        key,
+        key_holder,
+        source_timestamp: source_timestamp.unwrap_or(rx_time),
+        reception_timestamp: rx_time,
+        strength: info.strength,
+        expires: info.lifespan.and_then(|l| {
+            // Lifespan counts from the source timestamp; its age so far is spent already.
+            let age = source_timestamp
+                .and_then(|t| rx_time.duration_since(t).ok())
+                .unwrap_or_default();
+            now.checked_add(l.saturating_sub(age))
+        }),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cdr::{ByteOrder, XcdrVersion};
+    use crate::rtps::{EntityId, Guid, GuidPrefix, Payload, SequenceNumber};
+    use foldhash::HashMapExt;
+
+    #[derive(dds_macros::DdsType, Debug, Clone, PartialEq, Default)]
+    #[dds(name = "test::K", appendable)]
+    struct K {
+        #[dds(key)]
+        id: String,
+        v: i32,
+    }
+
+    fn rs(kind: ChangeKind, payload: Vec<u8>, key_hash: Option<[u8; 16]>) -> ReceivedSample {
+        ReceivedSample {
+            reader: EntityId([0, 0, 1, 7]),
+            writer: Guid::new(GuidPrefix([1; 12]), EntityId([0, 0, 1, 2])),
+            sequence: SequenceNumber(1),
+            kind,
+            payload: Payload::from(payload),
+            key_hash,
+            source_timestamp: None,
+        }
+    }
+
+    /// `decode_change` from a writer with default QoS, now.
+    fn decode(s: ReceivedSample, by_hash: &mut HashMap<[u8; 16], Vec<u8>>) -> Option<Incoming<K>> {
+        let now = Instant::now();
+        decode_change::<K>(
+            s,
+            RemoteWriterInfo::default(),
+            by_hash,
+            Vec::new(),
+            now,
+            SystemTime::now(),
+        )
+    }
+
+    #[test]
+    fn key_only_changes_map_by_key_payload_or_known_hash() {
+        let mut by_hash = HashMap::new();
+        let s = K {
+            id: "a".into(),
+            v: 1,
+        };
+        let mut buf = Vec::new();
+        cdr::serialize(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut buf).unwrap();
+        let kh = cdr::key_hash(&s, XcdrVersion::Xcdr2).unwrap();
+        let alive = decode(rs(ChangeKind::Alive, buf, Some(kh)), &mut by_hash).unwrap();
+        assert_eq!(alive.data.as_ref(), Some(&s));
+        let mut expected = Vec::new();
+        cdr::instance_key(&s, &mut expected).unwrap();
+        assert_eq!(alive.key, expected);
+
+        let mut kp = Vec::new();
+        cdr::serialize_key(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut kp).unwrap();
+        let d = decode(rs(ChangeKind::Dispose, kp, None), &mut by_hash).unwrap();
+        assert_eq!(d.key, expected, "by key payload");
+        assert_eq!(d.kind, ChangeKind::Dispose);
+
+        let u = decode(
+            rs(ChangeKind::Unregister, Vec::new(), Some(kh)),
+            &mut by_hash,
+        )
+        .unwrap();
+        assert_eq!(u.key, expected, "by a key hash seen before");
+
+        let unknown = rs(ChangeKind::Dispose, Vec::new(), Some([9; 16]));
+        assert!(decode(unknown, &mut by_hash).is_none());
+        let garbage = rs(
+            ChangeKind::Alive,
+            vec![0, 7, 0, 0, 0xff, 0xff, 0xff, 0x7f],
+            None,
+        );
+        assert!(decode(garbage, &mut by_hash).is_none());
+    }
+
+    /// Fast DDS disposes with only PID_KEY_HASH; the alive samples before may have come without one.
+    #[test]
+    fn key_hash_only_dispose_maps_to_instance_seen_without_hash() {
+        let s = K {
+            id: "a-rather-long-key-beyond-16-bytes".into(),
+            v: 1,
+        };
+        let mut expected = Vec::new();
+        cdr::instance_key(&s, &mut expected).unwrap();
+        for version in [XcdrVersion::Xcdr1, XcdrVersion::Xcdr2] {
+            let mut by_hash = HashMap::new();
+            let mut buf = Vec::new();
+            cdr::serialize(&s, version, ByteOrder::NATIVE, &mut buf).unwrap();
+            decode(rs(ChangeKind::Alive, buf, None), &mut by_hash).unwrap();
+            let kh = cdr::key_hash(&s, version).unwrap();
+            let d = decode(rs(ChangeKind::Dispose, Vec::new(), Some(kh)), &mut by_hash)
+                .expect("dispose mapped through the computed key hash");
+            assert_eq!(d.key, expected);
+            assert_eq!(d.kind, ChangeKind::Dispose);
+        }
+    }
+}

@@ -1,0 +1,626 @@
+//! The participant's driver: owns the sans-I/O core, the transport and the timer thread, runs the core under
+//! its lock, sends what it queued and routes its events to the endpoints (typed readers and writers) through
+//! the type-erased [`Endpoint`] trait. The entity modules depend on this module, never on each other's
+//! internals; the driver knows no entity type.
+
+use std::hash::{BuildHasher, Hasher};
+use std::net::{IpAddr, SocketAddr, SocketAddrV4};
+use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex, RwLock, Weak};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant, SystemTime};
+
+use foldhash::{HashMap, HashMapExt};
+
+use crate::config::Config;
+use crate::rtps::{
+    CoreError, EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig, Payload,
+    ReceivedSample, Transmit, WriteChange,
+};
+use crate::transport::{Channel, Datagram, UdpTransport};
+
+use super::condition::StatusCore;
+use super::error::{DdsError, DdsResult};
+use super::sync::{lock, read, recover, write};
+
+/// What a reader cache is fed with, in the order the core produced it.
+pub(crate) enum Pending {
+    /// A change from a matched writer.
+    Sample(ReceivedSample),
+    /// The writer unmatched (deleted, lost, or QoS changed).
+    WriterGone(Guid),
+}
+
+/// The type-erased side of a typed reader or writer that the driver calls. Readers and writers differ
+/// where DDS makes them differ: only readers receive samples, only writers say goodbye with changes.
+pub(crate) trait Endpoint: Send + Sync {
+    /// Queues a change for this reader. Called with the core lock held: must only queue.
+    fn enqueue(&self, _item: Pending) {}
+    /// Drains the queue into the cache and notifies; called without the core lock.
+    fn process(self: Arc<Self>) {}
+    /// A status event for this endpoint; called without the core lock.
+    fn on_event(self: Arc<Self>, ev: &Event);
+    /// Time-driven QoS (deadlines, lifespan, autopurge).
+    fn tick(self: Arc<Self>, now: Instant);
+    /// Changes the core sends before deleting the endpoint (a writer unregisters its instances).
+    fn farewell(&self) -> Vec<WriteChange> {
+        Vec::new()
+    }
+}
+
+/// What we learnt about a remote writer in SEDP that the reader-side QoS needs.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct RemoteWriterInfo {
+    /// Its ownership strength.
+    pub(crate) strength: i32,
+    /// Its lifespan, when finite.
+    pub(crate) lifespan: Option<Duration>,
+}
+
+/// Drives one participant: the core, its sockets, its timer thread and the registry of endpoints.
+pub(crate) struct Driver {
+    core: Mutex<Participant>,
+    pub(crate) transport: UdpTransport,
+    pub(crate) config: Config,
+    pub(crate) guid_prefix: GuidPrefix,
+    /// Readers and writers by entity id (the ids of the two kinds never collide).
+    endpoints: RwLock<HashMap<EntityId, Arc<dyn Endpoint>>>,
+    remote_writers: Mutex<HashMap<Guid, RemoteWriterInfo>>,
+    participants: Mutex<Vec<GuidPrefix>>,
+    /// Bumped whenever the core processed input (acks may have arrived): flow control and
+    /// wait_for_acknowledgments wait on it.
+    progress: AtomicU64,
+    /// Threads blocked on `progress_cv`: the notification (a futex syscall) is skipped when there are none.
+    progress_waiters: AtomicUsize,
+    progress_lock: Mutex<()>,
+    progress_cv: Condvar,
+    /// Bumped when the core's next timeout may have moved earlier than what the timer thread waits for.
+    timer_gen: Mutex<TimerState>,
+    timer_cv: Condvar,
+    stopped: AtomicBool,
+    timer_thread: Mutex<Option<JoinHandle<()>>>,
+    /// The participant's status condition.
+    pub(crate) status: Arc<StatusCore>,
+    /// Payload buffers of sent datagrams, handed back to the core at the next `with_core`.
+    spare_buffers: Mutex<Vec<Vec<u8>>>,
+}
+
+/// Most sent buffers kept for recycling.
+const MAX_SPARE_BUFFERS: usize = 32;
+
+/// Period of the endpoints' time-driven QoS checks.
+const ENDPOINT_TICK: Duration = Duration::from_millis(50);
+
+#[derive(Default)]
+struct TimerState {
+    generation: u64,
+    /// `Some(t)` while the timer thread sleeps until `t`; `None` while it works.
+    waiting_until: Option<Instant>,
+}
+
+fn to_socket(l: &Locator) -> Option<SocketAddrV4> {
+    match l.to_socket_addr()? {
+        SocketAddr::V4(a) => Some(a),
+        SocketAddr::V6(_) => None,
+    }
+}
+
+fn locator(a: SocketAddrV4) -> Locator {
+    Locator::udpv4(a.ip().octets(), a.port())
+}
+
+static PREFIX_COUNTER: AtomicU16 = AtomicU16::new(0);
+
+/// Vendor id first (as Cyclone and Fast DDS do), then randomness, the process id and a counter.
+fn new_guid_prefix() -> GuidPrefix {
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u128(
+        SystemTime::now()
+            .duration_since(SystemTime::UNIX_EPOCH)
+            .unwrap_or_default()
+            .as_nanos(),
+    );
+    let r = h.finish().to_be_bytes();
+    let pid = std::process::id().to_be_bytes();
+    let c = PREFIX_COUNTER.fetch_add(1, Ordering::Relaxed).to_be_bytes();
+    let v = crate::rtps::VendorId::THIS.0;
+    GuidPrefix([
+        v[0], v[1], r[0], r[1], r[2], r[3], pid[0], pid[1], pid[2], pid[3], c[0], c[1],
+    ])
+}
+
+/// The core's configuration for a participant on `transport`.
+fn core_config(
+    config: &Config,
+    transport: &UdpTransport,
+    prefix: GuidPrefix,
+    user_data: Vec<u8>,
+    name: Option<String>,
+) -> DdsResult<ParticipantConfig> {
+    let ip = match IpAddr::V4(transport.interface().addr) {
+        IpAddr::V4(a) => a.octets(),
+        IpAddr::V6(_) => [127, 0, 0, 1],
+    };
+    let mut pc = ParticipantConfig::new(
+        config.domain_id,
+        transport.participant_index().unwrap_or(0),
+        prefix,
+        ip,
+    )
+    .map_err(crate::config::ConfigError::from)?;
+    pc.metatraffic_unicast = vec![locator(transport.metatraffic_unicast())];
+    pc.default_unicast = vec![locator(transport.user_unicast())];
+    pc.metatraffic_multicast = transport
+        .spdp_multicast()
+        .map(locator)
+        .into_iter()
+        .collect();
+    // We do not listen on the user multicast port: peers send user data unicast.
+    pc.default_multicast = Vec::new();
+    pc.initial_peers = transport
+        .spdp_peers()
+        .iter()
+        .copied()
+        .map(locator)
+        .collect();
+    pc.spdp_interval = config.spdp_interval;
+    pc.lease_duration = config.lease_duration;
+    pc.max_message_size = config.max_message_size;
+    pc.fragment_size = config.fragment_size;
+    pc.write_batch_delay = config.write_batch_delay;
+    pc.user_data = user_data;
+    pc.entity_name = name;
+    Ok(pc)
+}
+
+impl Driver {
+    /// Binds the sockets, starts the receive and timer threads and begins SPDP.
+    pub(crate) fn start(
+        config: Config,
+        user_data: Vec<u8>,
+        name: Option<String>,
+    ) -> DdsResult<Arc<Driver>> {
+        let transport = UdpTransport::bind(&config)?;
+        let prefix = new_guid_prefix();
+        let pc = core_config(&config, &transport, prefix, user_data, name)?;
+        let driver = Arc::new(Driver {
+            core: Mutex::new(Participant::new(pc, Instant::now())),
+            transport,
+            config,
+            guid_prefix: prefix,
+            endpoints: RwLock::new(HashMap::new()),
+            remote_writers: Mutex::new(HashMap::new()),
+            participants: Mutex::new(Vec::new()),
+            progress: AtomicU64::new(0),
+            progress_waiters: AtomicUsize::new(0),
+            progress_lock: Mutex::new(()),
+            progress_cv: Condvar::new(),
+            timer_gen: Mutex::new(TimerState::default()),
+            timer_cv: Condvar::new(),
+            stopped: AtomicBool::new(false),
+            timer_thread: Mutex::new(None),
+            status: Arc::new(StatusCore::default()),
+            spare_buffers: Mutex::new(Vec::new()),
+        });
+        let weak: Weak<Driver> = Arc::downgrade(&driver);
+        let rx = Arc::new(move |_ch: Channel, batch: &[Datagram<'_>]| {
+            if let Some(d) = weak.upgrade() {
+                d.receive(batch);
+            }
+        });
+        driver.transport.start(rx)?;
+        let d2 = driver.clone();
+        let h = std::thread::Builder::new()
+            .name("dds-timer".into())
+            .spawn(move || d2.timer_loop())?;
+        *lock(&driver.timer_thread) = Some(h);
+        // The first SPDP announcement goes out now rather than at the first timeout.
+        driver.with_core(|c, now| c.handle_timeout(now));
+        tracing::info!(prefix = ?prefix, domain = driver.config.domain_id, "participant created");
+        Ok(driver)
+    }
+
+    /// Feeds a batch of received datagrams to the core (on a receive thread).
+    fn receive(&self, batch: &[Datagram<'_>]) {
+        if self.stopped.load(Ordering::Acquire) {
+            return;
+        }
+        // One copy per datagram out of the reusable receive buffers; samples share it.
+        let shared: Vec<Payload> = batch
+            .iter()
+            .map(|d| Payload::copy_from_slice(d.data))
+            .collect();
+        self.with_core(|c, now| {
+            for d in &shared {
+                c.handle_shared_datagram(now, d);
+            }
+        });
+    }
+
+    /// Sends held batched writes; free when batching is off.
+    pub(crate) fn flush(&self) {
+        if self.config.write_batch_delay.is_some() {
+            self.with_core(|c, _| c.flush());
+        }
+    }
+
+    /// Runs `f` on the core, then (lock released) sends what it queued and dispatches its events.
+    pub(crate) fn with_core<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R) -> R {
+        let now = Instant::now();
+        let mut batch: Vec<Transmit> = Vec::new();
+        let mut deferred: Vec<Event> = Vec::new();
+        let mut touched: Vec<(EntityId, Arc<dyn Endpoint>)> = Vec::new();
+        let (r, next_timeout) = {
+            let mut core = lock(&self.core);
+            // Sent datagram buffers go back to the core for reuse (saves an allocation per datagram).
+            for buf in std::mem::take(&mut *lock(&self.spare_buffers)) {
+                core.recycle(buf);
+            }
+            let r = f(&mut core, now);
+            while let Some(t) = core.poll_transmit(now) {
+                batch.push(t);
+            }
+            while let Some(ev) = core.poll_event() {
+                self.route_locked(ev, &mut deferred, &mut touched);
+            }
+            (r, core.poll_timeout())
+        };
+        self.send_batch(&batch);
+        {
+            let mut spare = lock(&self.spare_buffers);
+            for t in batch {
+                if spare.len() < MAX_SPARE_BUFFERS {
+                    spare.push(t.payload);
+                }
+            }
+        }
+        self.after_unlock(deferred, touched, next_timeout);
+        r
+    }
+
+    /// Under the core lock: samples go to their reader's queue (keeps order); the rest is deferred.
+    fn route_locked(
+        &self,
+        ev: Event,
+        deferred: &mut Vec<Event>,
+        touched: &mut Vec<(EntityId, Arc<dyn Endpoint>)>,
+    ) {
+        let (reader, item) = match ev {
+            Event::Sample(s) => (s.reader, Pending::Sample(s)),
+            Event::SubscriptionMatched {
+                reader,
+                writer,
+                matched: false,
+            } => {
+                deferred.push(Event::SubscriptionMatched {
+                    reader,
+                    writer,
+                    matched: false,
+                });
+                (reader, Pending::WriterGone(writer))
+            }
+            other => {
+                deferred.push(other);
+                return;
+            }
+        };
+        // Runs of samples for one reader (the common case) skip the registry lookup.
+        if let Some((id, r)) = touched.last() {
+            if *id == reader {
+                r.enqueue(item);
+                return;
+            }
+        }
+        if let Some(r) = self.endpoint(reader) {
+            r.enqueue(item);
+            if !touched.iter().any(|(id, _)| *id == reader) {
+                touched.push((reader, r));
+            }
+        }
+    }
+
+    fn send_batch(&self, batch: &[Transmit]) {
+        for t in batch {
+            for d in &t.destinations {
+                if let Some(a) = to_socket(d) {
+                    self.transport.send_to(&t.payload, a);
+                }
+            }
+        }
+    }
+
+    fn after_unlock(
+        &self,
+        deferred: Vec<Event>,
+        touched: Vec<(EntityId, Arc<dyn Endpoint>)>,
+        next_timeout: Option<Instant>,
+    ) {
+        self.bump_progress();
+        {
+            // Wake the timer thread only when it sleeps past the core's new deadline; when it is busy, the
+            // generation bump makes it re-read the deadline before sleeping.
+            let mut t = lock(&self.timer_gen);
+            match (t.waiting_until, next_timeout) {
+                (None, _) => t.generation = t.generation.wrapping_add(1),
+                (Some(w), Some(n)) if n < w => {
+                    t.generation = t.generation.wrapping_add(1);
+                    self.timer_cv.notify_all();
+                }
+                _ => {}
+            }
+        }
+        for ev in deferred {
+            self.dispatch_event(ev);
+        }
+        for (_, r) in touched {
+            r.process();
+        }
+    }
+
+    fn endpoint(&self, id: EntityId) -> Option<Arc<dyn Endpoint>> {
+        read(&self.endpoints).get(&id).cloned()
+    }
+
+    fn dispatch_event(&self, ev: Event) {
+        tracing::debug!(event = ?ev, "core event");
+        match &ev {
+            Event::PublicationMatched { writer: id, .. }
+            | Event::OfferedIncompatibleQos { writer: id, .. }
+            | Event::SubscriptionMatched { reader: id, .. }
+            | Event::RequestedIncompatibleQos { reader: id, .. }
+            | Event::LivelinessChanged { reader: id, .. }
+            | Event::SampleLost { reader: id, .. } => {
+                if let Some(e) = self.endpoint(*id) {
+                    e.on_event(&ev);
+                }
+            }
+            Event::ParticipantDiscovered(p) => {
+                let prefix = p.guid_prefix;
+                let mut known = lock(&self.participants);
+                if !known.contains(&prefix) {
+                    known.push(prefix);
+                }
+                tracing::info!(peer = ?prefix, "participant discovered");
+            }
+            Event::ParticipantLost { guid_prefix } => {
+                lock(&self.participants).retain(|p| p != guid_prefix);
+                tracing::info!(peer = ?guid_prefix, "participant lost");
+            }
+            Event::PublicationDiscovered(w) => {
+                let (guid, info) = remote_writer_info(w);
+                lock(&self.remote_writers).insert(guid, info);
+            }
+            Event::PublicationRemoved { guid } => {
+                lock(&self.remote_writers).remove(guid);
+            }
+            _ => {}
+        }
+    }
+
+    /// The GUID prefixes of the remote participants currently known through SPDP.
+    pub(crate) fn discovered_participants(&self) -> Vec<GuidPrefix> {
+        lock(&self.participants).clone()
+    }
+
+    /// The reader-side QoS a remote writer announced.
+    pub(crate) fn remote_writer(&self, g: &Guid) -> RemoteWriterInfo {
+        lock(&self.remote_writers)
+            .get(g)
+            .copied()
+            .unwrap_or_default()
+    }
+
+    /// Creates an endpoint in the core with `create` and registers `sink` for it. Registration happens
+    /// before the core can report matches for it: the core lock is held across both (match events are
+    /// only polled after `create` returns).
+    pub(crate) fn create_endpoint(
+        &self,
+        sink: Arc<dyn Endpoint>,
+        create: impl FnOnce(&mut Participant, Instant) -> Result<EntityId, CoreError>,
+    ) -> DdsResult<EntityId> {
+        self.check_alive()?;
+        let id = self.with_core(|c, now| {
+            let id = create(c, now)?;
+            write(&self.endpoints).insert(id, sink);
+            Ok::<_, CoreError>(id)
+        })?;
+        Ok(id)
+    }
+
+    /// Forgets the endpoint and, while the participant runs, sends its farewell changes and deletes it in
+    /// the core (a reliable writer lingers there until its data is acknowledged).
+    pub(crate) fn delete_endpoint(&self, id: EntityId) {
+        let sink = write(&self.endpoints).remove(&id);
+        if self.check_alive().is_err() {
+            return;
+        }
+        let farewell = sink.map(|s| s.farewell()).unwrap_or_default();
+        self.with_core(|c, now| {
+            for ch in farewell {
+                if let Err(e) = c.write(now, id, ch) {
+                    tracing::debug!(error = %e, "farewell change not sent");
+                }
+            }
+            if id.is_writer() {
+                c.delete_writer(now, id);
+            } else {
+                c.delete_reader(now, id);
+            }
+        });
+        tracing::debug!(?id, "endpoint deleted");
+    }
+
+    /// `Err(AlreadyDeleted)` once the participant shut down.
+    pub(crate) fn check_alive(&self) -> DdsResult<()> {
+        if self.stopped.load(Ordering::Acquire) {
+            Err(DdsError::AlreadyDeleted)
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Records core progress and wakes whoever waits for it (flow control, wait_for_acknowledgments).
+    fn bump_progress(&self) {
+        self.progress.fetch_add(1, Ordering::SeqCst);
+        // A waiter registers (under `progress_lock`) before re-reading the generation, so either it sees the
+        // new generation or we see it registered and notify it after it released the lock in `wait`.
+        if self.progress_waiters.load(Ordering::SeqCst) > 0 {
+            let _g = lock(&self.progress_lock);
+            self.progress_cv.notify_all();
+        }
+    }
+
+    /// Sleeps until the progress generation differs from `seen` (or a notification / `left` passes).
+    fn wait_progress_for(&self, seen: u64, left: Duration) {
+        let g = lock(&self.progress_lock);
+        self.progress_waiters.fetch_add(1, Ordering::SeqCst);
+        if self.progress.load(Ordering::SeqCst) == seen && !self.stopped.load(Ordering::Acquire) {
+            // Capped so that a missed notification costs at most a few milliseconds.
+            let _g = recover(
+                self.progress_cv
+                    .wait_timeout(g, left.min(Duration::from_millis(20))),
+            );
+        }
+        self.progress_waiters.fetch_sub(1, Ordering::SeqCst);
+    }
+
+    /// Waits until `done` holds (re-checked after each core progress) or `deadline` passes.
+    pub(crate) fn wait_progress(
+        &self,
+        deadline: Option<Instant>,
+        mut done: impl FnMut() -> bool,
+    ) -> bool {
+        loop {
+            let seen = self.progress.load(Ordering::SeqCst);
+            if done() {
+                return true;
+            }
+            if self.stopped.load(Ordering::Acquire) {
+                return false;
+            }
+            let left = match deadline {
+                Some(d) => match d.checked_duration_since(Instant::now()) {
+                    Some(l) if !l.is_zero() => l,
+                    _ => return done(),
+                },
+                None => Duration::from_millis(500),
+            };
+            self.wait_progress_for(seen, left);
+        }
+    }
+
+    /// The current progress generation (see [`Driver::wait_progress_change`]).
+    pub(crate) fn progress_generation(&self) -> u64 {
+        self.progress.load(Ordering::SeqCst)
+    }
+
+    /// Waits until the core made progress after generation `seen`, or until `deadline`.
+    pub(crate) fn wait_progress_change(&self, seen: u64, deadline: Instant) {
+        let left = deadline.saturating_duration_since(Instant::now());
+        self.wait_progress_for(seen, left);
+    }
+
+    fn timer_loop(self: Arc<Self>) {
+        let mut next_tick = Instant::now() + ENDPOINT_TICK;
+        while !self.stopped.load(Ordering::Acquire) {
+            let seen = lock(&self.timer_gen).generation;
+            let next_core = lock(&self.core).poll_timeout();
+            let now = Instant::now();
+            if next_core.is_some_and(|t| t <= now) {
+                self.with_core(|c, now| c.handle_timeout(now));
+                continue;
+            }
+            if now >= next_tick {
+                next_tick = now + ENDPOINT_TICK;
+                let endpoints: Vec<Arc<dyn Endpoint>> =
+                    read(&self.endpoints).values().cloned().collect();
+                for e in endpoints {
+                    e.tick(now);
+                }
+                continue;
+            }
+            let until = next_core.map_or(next_tick, |t| t.min(next_tick));
+            let mut g = lock(&self.timer_gen);
+            if g.generation != seen {
+                continue;
+            }
+            g.waiting_until = Some(until);
+            let mut g = recover(
+                self.timer_cv
+                    .wait_timeout(g, until.saturating_duration_since(now)),
+            )
+            .0;
+            g.waiting_until = None;
+        }
+    }
+
+    /// Announces the departure, stops the threads and closes the sockets (once).
+    pub(crate) fn shutdown(&self) {
+        if self.stopped.swap(true, Ordering::AcqRel) {
+            return;
+        }
+        tracing::info!(prefix = ?self.guid_prefix, "participant shutting down");
+        // Tell peers we leave (SPDP dispose) while the sockets are still open.
+        self.with_core(|c, now| c.shutdown(now));
+        {
+            let mut g = lock(&self.timer_gen);
+            g.generation = g.generation.wrapping_add(1);
+            self.timer_cv.notify_all();
+        }
+        self.bump_progress();
+        if let Some(h) = lock(&self.timer_thread).take() {
+            if h.thread().id() != std::thread::current().id() {
+                let _ = h.join();
+            }
+        }
+        self.transport.shutdown();
+        // Readers and writers point back at us: forget them to break the cycle.
+        write(&self.endpoints).clear();
+    }
+}
+
+fn remote_writer_info(w: &crate::rtps::discovery::WriterData) -> (Guid, RemoteWriterInfo) {
+    let q = &w.qos.writer;
+    let lifespan = (q.lifespan.0 != crate::qos::INFINITE).then_some(q.lifespan.0);
+    (
+        w.guid,
+        RemoteWriterInfo {
+            strength: q.ownership_strength.0,
+            lifespan,
+        },
+    )
+}
+
+/// Deletes its endpoint when dropped: the last clone of a `DataWriter` or `DataReader` (and of its
+/// streams) holds the last `Arc` of it. `owner` keeps what the entity refers to (topic, publisher or
+/// subscriber, and through them the participant) alive until the endpoint is deleted.
+pub(crate) struct EndpointHandle<O> {
+    driver: Arc<Driver>,
+    id: EntityId,
+    owner: O,
+}
+
+impl<O> EndpointHandle<O> {
+    /// A handle of the endpoint `id`.
+    pub(crate) fn new(driver: Arc<Driver>, id: EntityId, owner: O) -> Self {
+        EndpointHandle { driver, id, owner }
+    }
+    /// The endpoint's entity id.
+    pub(crate) fn id(&self) -> EntityId {
+        self.id
+    }
+    /// The endpoint's GUID.
+    pub(crate) fn guid(&self) -> Guid {
+        Guid::new(self.driver.guid_prefix, self.id)
+    }
+    /// What the entity refers to.
+    pub(crate) fn owner(&self) -> &O {
+        &self.owner
+    }
+}
+
+impl<O> Drop for EndpointHandle<O> {
+    fn drop(&mut self) {
+        self.driver.delete_endpoint(self.id);
+    }
+}
