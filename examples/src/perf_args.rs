@@ -158,8 +158,13 @@ impl Default for PerfOptions {
 /// What to do.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PerfCommand {
+    /// Run with these options.
     Run(PerfOptions),
-    Help,
+    /// Print the usage: asked for (`-h`, `--help`, `help`; exit 0), or no mode given (exit 3, as ddsperf).
+    Usage {
+        /// `-h`, `--help` or `help`.
+        requested: bool,
+    },
 }
 
 /// An argument error (ddsperf exits with 3).
@@ -181,7 +186,7 @@ fn err<T>(s: impl Into<String>) -> Result<T, ArgError> {
 /// The usage text.
 pub fn usage(prog: &str) -> String {
     format!(
-        "{prog} help                (this text)
+        "{prog} help | -h | --help  (this text)
 {prog} sanity              (ping 1Hz)
 {prog} [OPTIONS] MODE...
 
@@ -282,6 +287,9 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
         if a == "--" {
             break;
         }
+        if a == "--help" {
+            return Ok(PerfCommand::Usage { requested: true });
+        }
         let chars: Vec<char> = a[1..].chars().collect();
         let mut j = 0;
         while j < chars.len() {
@@ -309,7 +317,7 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
                 'l' => o.sublatency = true,
                 'L' => o.match_local = true,
                 'u' => o.reliable = false,
-                'h' => return Ok(PerfCommand::Help),
+                'h' => return Ok(PerfCommand::Usage { requested: true }),
                 'd' => return err(format!("-d {val}: network load reporting not supported")),
                 'D' => o.duration = parse_seconds(&val),
                 'i' => {
@@ -341,8 +349,11 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
         o.pingpong_trigger = TriggerMode::Waitset;
     }
     let modes = &args[i..];
-    if modes.is_empty() || (modes.len() == 1 && modes[0] == "help") {
-        return Ok(PerfCommand::Help);
+    if modes.is_empty() {
+        return Ok(PerfCommand::Usage { requested: false });
+    }
+    if modes.len() == 1 && modes[0] == "help" {
+        return Ok(PerfCommand::Usage { requested: true });
     }
     if modes.len() == 1 && modes[0] == "sanity" {
         o.ping_interval = Some(Duration::from_secs(1));
@@ -504,7 +515,7 @@ mod tests {
         let a: Vec<String> = s.split_whitespace().map(String::from).collect();
         match parse(&a).expect("parses") {
             PerfCommand::Run(o) => o,
-            PerfCommand::Help => panic!("help"),
+            PerfCommand::Usage { .. } => panic!("usage"),
         }
     }
 
@@ -564,6 +575,23 @@ mod tests {
         assert!(fails("sub bogus"));
         assert!(fails("frob"));
         assert!(fails("-Q what:1 sub"));
+    }
+
+    #[test]
+    fn help_and_usage() {
+        let parse_str = |s: &str| {
+            let a: Vec<String> = s.split_whitespace().map(String::from).collect();
+            parse(&a)
+        };
+        for asked in ["--help", "-h", "help", "-u --help sub"] {
+            assert_eq!(
+                parse_str(asked),
+                Ok(PerfCommand::Usage { requested: true }),
+                "{asked}"
+            );
+        }
+        assert_eq!(parse_str(""), Ok(PerfCommand::Usage { requested: false }));
+        assert_eq!(parse_str("-u"), Ok(PerfCommand::Usage { requested: false }));
     }
 
     #[test]

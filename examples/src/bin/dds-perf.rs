@@ -29,9 +29,9 @@ fn main() -> ExitCode {
     let prog = std::env::args().next().unwrap_or_else(|| "dds-perf".into());
     let o = match perf_args::parse(&args) {
         Ok(PerfCommand::Run(o)) => o,
-        Ok(PerfCommand::Help) => {
+        Ok(PerfCommand::Usage { requested }) => {
             print!("{}", perf_args::usage(&prog));
-            return ExitCode::from(3);
+            return ExitCode::from(if requested { 0 } else { 3 });
         }
         Err(e) => {
             println!("{e}");
