@@ -222,7 +222,8 @@ fn panel_lines(app: &App, now: Instant) -> Vec<Line<'static>> {
     lines.push(heading("Participants heard"));
     for (p, (n, ours)) in app.board.participants() {
         let who = if ours { "ours" } else { p.vendor() };
-        lines.push(Line::raw(format!("{p} {who}: {n}")));
+        // Vendor, the first two groups of the GUID prefix, shapes heard from it.
+        lines.push(Line::raw(format!("{who:<12}{:.17} {n:>3}", p.to_string())));
     }
     lines
 }
