@@ -79,17 +79,24 @@ impl TopicSel {
 /// for data, or by a thread polling at 1 kHz.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TriggerMode {
+    /// `listener`: serviced on the receive thread.
     Listener,
+    /// `waitset`: a thread waits for data.
     Waitset,
+    /// `polling`: a thread polls at 1 kHz.
     Polling,
 }
 
 /// Everything the command line sets.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PerfOptions {
+    /// `-T`: the topic and type.
     pub topic: TopicSel,
+    /// `-i`: the domain (`None`: the default domain).
     pub domain_id: Option<u32>,
+    /// `-n`: number of key values the data cycles through.
     pub nkeyvals: u32,
+    /// Reliable unless `-u`.
     pub reliable: bool,
     /// 0: KEEP_ALL, otherwise KEEP_LAST n.
     pub history_depth: u32,
@@ -101,16 +108,25 @@ pub struct PerfOptions {
     pub match_local: bool,
     /// `-1`: print sub stats every second even without data.
     pub substat_every_second: bool,
+    /// `-c`: collect CPU and network statistics (accepted, not reported).
     pub collect_stats: bool,
+    /// `-X`: extended statistics (accepted, not reported).
     pub extended_stats: bool,
+    /// `-l`: report latency in `sub` mode.
     pub sublatency: bool,
+    /// `-Q samples:N`: fewer received samples is a failure.
     pub min_samples: u64,
+    /// `-Q roundtrips:N`: fewer round trips is a failure.
     pub min_roundtrips: u64,
+    /// `-Q minmatch:N`: wait for this many matched participants.
     pub min_match: u32,
+    /// `-Q maxwait:DUR`: how long to wait for `minmatch`.
     pub maxwait: Option<Duration>,
+    /// `-Q initwait:DUR`: wait this long after matching before starting.
     pub initwait: Option<Duration>,
     /// `pub` rate in samples/s; `None`: not publishing; `Some(INFINITY)`: as fast as possible.
     pub pub_rate: Option<f64>,
+    /// `pub burst N`: samples written per wake-up.
     pub burst: u32,
     /// Fraction of published samples that double as pings, 0..=1.
     pub ping_fraction: f64,

@@ -29,6 +29,7 @@ pub struct LatencyStat {
 }
 
 impl LatencyStat {
+    /// An empty interval.
     pub fn new() -> Self {
         LatencyStat {
             min: i64::MAX,
@@ -37,6 +38,7 @@ impl LatencyStat {
         }
     }
 
+    /// Adds a latency of `ns` nanoseconds.
     pub fn record(&mut self, ns: i64) {
         self.min = self.min.min(ns);
         self.max = self.max.max(ns);
@@ -48,6 +50,7 @@ impl LatencyStat {
         self.total += 1;
     }
 
+    /// Latencies in this interval.
     pub fn count(&self) -> u32 {
         self.cnt
     }
@@ -84,12 +87,19 @@ impl LatencyStat {
 /// Percentiles of one interval, in microseconds.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LatencySummary {
+    /// Mean.
     pub mean_us: f64,
+    /// Minimum.
     pub min_us: f64,
+    /// Median.
     pub p50_us: f64,
+    /// 90th percentile.
     pub p90_us: f64,
+    /// 99th percentile.
     pub p99_us: f64,
+    /// Maximum.
     pub max_us: f64,
+    /// Latencies summarised.
     pub count: u32,
 }
 
@@ -138,7 +148,10 @@ pub enum SeqCheck {
     /// The expected sequence number (or the first from this writer).
     InOrder,
     /// A gap (or reordering): `lost` more samples counted as lost.
-    Gap { lost: u32 },
+    Gap {
+        /// Sequence numbers skipped.
+        lost: u32,
+    },
     /// Behind the expected number (reordered or duplicated): neither a gap nor a loss.
     Late,
     /// `keyval` outside 0..nkeys: ddsperf exits with 3.
@@ -146,6 +159,7 @@ pub enum SeqCheck {
 }
 
 impl SubStats {
+    /// Statistics for data cycling through `nkeys` key values.
     pub fn new(nkeys: u32) -> Self {
         SubStats {
             nkeys: nkeys.max(1),
@@ -307,6 +321,7 @@ fn fmt_g3(v: f64) -> String {
 }
 
 impl WriteHist {
+    /// Adds a write that took `ns` nanoseconds.
     pub fn record(&mut self, ns: u64) {
         self.min = self.min.min(ns);
         self.max = self.max.max(ns);

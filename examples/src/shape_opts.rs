@@ -40,11 +40,17 @@ pub enum AccessScope {
 /// All options of shape_main, with its defaults.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShapeOptions {
+    /// `-v d`: debug verbosity.
     pub debug: bool,
+    /// `-d`: the domain.
     pub domain_id: u32,
+    /// `-P`: publish.
     pub publish: bool,
+    /// `-S`: subscribe.
     pub subscribe: bool,
+    /// RELIABLE (`-r`, the default) or BEST_EFFORT (`-b`).
     pub reliable: bool,
+    /// `-D`: durability kind.
     pub durability: DurabilityArg,
     /// 1 or 2.
     pub xcdr: u8,
@@ -52,32 +58,55 @@ pub struct ShapeOptions {
     pub history_depth: Option<u32>,
     /// `None`: shared ownership.
     pub ownership_strength: Option<i32>,
+    /// `-t`: the topic name (required).
     pub topic: Option<String>,
+    /// `-c`: colour published, or the only colour printed by a subscriber.
     pub color: Option<String>,
+    /// `-p`: a partition name.
     pub partition: Option<String>,
+    /// `--time-filter`: minimum separation of a reader's samples (zero: off).
     pub time_filter: Duration,
+    /// `-f`: deadline period (zero: off).
     pub deadline: Duration,
+    /// `--lifespan`: lifespan of written samples (zero: infinite).
     pub lifespan: Duration,
+    /// `-w`: print the samples written.
     pub print_writer_samples: bool,
+    /// `-z`: size of the shapes written (0: growing).
     pub shapesize: i32,
+    /// `-R`: read instead of take.
     pub use_read: bool,
+    /// `--write-period`: time between two writes.
     pub write_period: Duration,
+    /// `--read-period`: time between two reads or takes.
     pub read_period: Duration,
     /// 0: run until interrupted.
     pub num_iterations: u32,
+    /// `--num-instances`: colours written (COLOR, COLOR1, COLOR2, ...).
     pub num_instances: u32,
+    /// `--num-topics`: topics created (TOPIC, TOPIC1, ...).
     pub num_topics: u32,
+    /// `--final-instance-state`: what a publisher does with its instances at the end.
     pub final_instance_state: Option<FinalInstanceState>,
+    /// `--access-scope`: presentation access scope.
     pub access_scope: Option<AccessScope>,
+    /// `--coherent`: coherent access.
     pub coherent: bool,
+    /// `--ordered`: ordered access.
     pub ordered: bool,
+    /// `--coherent-sample-count`: samples per coherent set.
     pub coherent_sample_count: u32,
+    /// `--additional-payload-size`: bytes of 255 appended to each sample.
     pub additional_payload_size: u32,
     /// `true` unless `--take-read`: use take/read_next_instance.
     pub take_read_next_instance: bool,
+    /// `--periodic-announcement`: SPDP period (zero: the default).
     pub periodic_announcement: Duration,
+    /// `--datafrag-size`: fragment size (0: the default).
     pub datafrag_size: u32,
+    /// `--cft`: content filter expression.
     pub cft_expression: Option<String>,
+    /// `--size-modulo`: wraps the growing shapesize of `-z 0`.
     pub size_modulo: i32,
 }
 
@@ -127,7 +156,9 @@ impl Default for ShapeOptions {
 pub enum Parsed {
     /// Run with these options; `warnings` are printed first (shape_main prints them as errors but runs).
     Run {
+        /// The options.
         options: Box<ShapeOptions>,
+        /// Warnings about options ignored in this role.
         warnings: Vec<String>,
     },
     /// `-h`/`--help`.
