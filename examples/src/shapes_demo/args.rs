@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use clap::Parser;
 
-/// `shapes`: bouncing shapes published and subscribed over real RTPS (two participants in one process).
+/// Bouncing shapes published and subscribed over real RTPS (two participants in one process).
 ///
 /// In a terminal it shows them moving in a window (keys: p publish, t topic, c colour, s subscribe,
 /// space pause, q quit); otherwise, or with --batch, it prints one line per sample and, after --duration

@@ -231,6 +231,60 @@ fn panel_lines(app: &App, now: Instant) -> Vec<Line<'static>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shapes_demo::origin::WriterId;
+    use crate::shapes_demo::session::{Received, ReceivedEvent, Session, SessionConfig};
+    use crate::topic_types::ShapeType;
+    use ratatui::backend::TestBackend;
+    use ratatui::Terminal;
+    use std::time::Duration;
+
+    #[test]
+    fn window_shows_received_shapes_in_world_and_panel() {
+        // No DDS entity exists until something is published or subscribed: this test opens no socket.
+        let session = Session::new(SessionConfig {
+            domain: 0,
+            xcdr2: false,
+            rate_hz: 10.0,
+        });
+        let mut app = App::new(session, "Square", 0);
+        let mut cyclone = [0u8; 16];
+        cyclone[..2].copy_from_slice(&[0x01, 0x10]);
+        let received = Received {
+            topic: "Circle".into(),
+            writer: WriterId(cyclone),
+            event: ReceivedEvent::Data {
+                shape: ShapeType {
+                    color: "GREEN".into(),
+                    x: 120,
+                    y: 135,
+                    shapesize: 30,
+                    ..Default::default()
+                },
+                latency: Duration::ZERO,
+            },
+        };
+        app.board.apply(&received, false, Instant::now());
+        let mut terminal = Terminal::new(TestBackend::new(100, 30)).expect("test terminal");
+        terminal.draw(|f| draw(f, &app)).expect("draws");
+        let buf = terminal.backend().buffer().clone();
+        let row =
+            |y: u16| -> String { (0..100).map(|x| buf[(x, y)].symbol().to_string()).collect() };
+        let screen: Vec<String> = (0..30).map(row).collect();
+        let world_width = 100 - usize::from(PANEL_WIDTH);
+        let circle_cells: Vec<(u16, u16)> = (0..30u16)
+            .flat_map(|y| (0..world_width as u16).map(move |x| (x, y)))
+            .filter(|&(x, y)| buf[(x, y)].symbol() == "●")
+            .collect();
+        assert!(!circle_cells.is_empty(), "{}", screen.join("\n"));
+        assert!(circle_cells
+            .iter()
+            .all(|&(x, y)| buf[(x, y)].fg == Color::Green));
+        assert!(screen
+            .iter()
+            .any(|l| l.contains("● GREEN") && l.contains("Cyclone DDS")));
+        assert!(screen.iter().any(|l| l.contains("next: ■ PURPLE Square")));
+        assert!(screen[29].contains("p publish"));
+    }
 
     #[test]
     fn world_corners_map_to_the_area_corners() {
