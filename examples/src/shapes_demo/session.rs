@@ -184,7 +184,8 @@ impl Session {
     /// position and velocity, so that shapes do not move in lockstep).
     pub fn publish(&mut self, topic: &str, color: &str, index: usize) -> DdsResult<()> {
         self.ensure_writer(topic)?;
-        let i = index as i32;
+        // The pattern repeats; the modulo keeps the arithmetic small for any index.
+        let i = (index % 1000) as i32;
         self.publications.push(Publication {
             topic: topic.to_string(),
             shape: ShapeType {
