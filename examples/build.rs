@@ -2,6 +2,10 @@
 fn main() {
     idlc::Builder::new()
         .include_dir("../idl")
-        .compile(&["../idl/shapes.idl", "../idl/ddsperf_types.idl"])
+        .compile(&[
+            "../idl/shapes.idl",
+            "../idl/ddsperf_types.idl",
+            "../idl/hello.idl",
+        ])
         .unwrap();
 }

@@ -3,8 +3,11 @@
 pub mod perf_args;
 pub mod perf_sample;
 pub mod perf_stats;
+pub mod shape_motion;
 pub mod shape_opts;
 pub mod shape_output;
+pub mod shapes_demo;
+pub mod shapes_ui;
 pub mod shutdown;
 pub mod topic_types;
 

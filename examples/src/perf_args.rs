@@ -79,17 +79,24 @@ impl TopicSel {
 /// for data, or by a thread polling at 1 kHz.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TriggerMode {
+    /// `listener`: serviced on the receive thread.
     Listener,
+    /// `waitset`: a thread waits for data.
     Waitset,
+    /// `polling`: a thread polls at 1 kHz.
     Polling,
 }
 
 /// Everything the command line sets.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PerfOptions {
+    /// `-T`: the topic and type.
     pub topic: TopicSel,
+    /// `-i`: the domain (`None`: the default domain).
     pub domain_id: Option<u32>,
+    /// `-n`: number of key values the data cycles through.
     pub nkeyvals: u32,
+    /// Reliable unless `-u`.
     pub reliable: bool,
     /// 0: KEEP_ALL, otherwise KEEP_LAST n.
     pub history_depth: u32,
@@ -101,16 +108,25 @@ pub struct PerfOptions {
     pub match_local: bool,
     /// `-1`: print sub stats every second even without data.
     pub substat_every_second: bool,
+    /// `-c`: collect CPU and network statistics (accepted, not reported).
     pub collect_stats: bool,
+    /// `-X`: extended statistics (accepted, not reported).
     pub extended_stats: bool,
+    /// `-l`: report latency in `sub` mode.
     pub sublatency: bool,
+    /// `-Q samples:N`: fewer received samples is a failure.
     pub min_samples: u64,
+    /// `-Q roundtrips:N`: fewer round trips is a failure.
     pub min_roundtrips: u64,
+    /// `-Q minmatch:N`: wait for this many matched participants.
     pub min_match: u32,
+    /// `-Q maxwait:DUR`: how long to wait for `minmatch`.
     pub maxwait: Option<Duration>,
+    /// `-Q initwait:DUR`: wait this long after matching before starting.
     pub initwait: Option<Duration>,
     /// `pub` rate in samples/s; `None`: not publishing; `Some(INFINITY)`: as fast as possible.
     pub pub_rate: Option<f64>,
+    /// `pub burst N`: samples written per wake-up.
     pub burst: u32,
     /// Fraction of published samples that double as pings, 0..=1.
     pub ping_fraction: f64,
@@ -158,8 +174,13 @@ impl Default for PerfOptions {
 /// What to do.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PerfCommand {
+    /// Run with these options.
     Run(PerfOptions),
-    Help,
+    /// Print the usage: asked for (`-h`, `--help`, `help`; exit 0), or no mode given (exit 3, as ddsperf).
+    Usage {
+        /// `-h`, `--help` or `help`.
+        requested: bool,
+    },
 }
 
 /// An argument error (ddsperf exits with 3).
@@ -181,7 +202,7 @@ fn err<T>(s: impl Into<String>) -> Result<T, ArgError> {
 /// The usage text.
 pub fn usage(prog: &str) -> String {
     format!(
-        "{prog} help                (this text)
+        "{prog} help | -h | --help  (this text)
 {prog} sanity              (ping 1Hz)
 {prog} [OPTIONS] MODE...
 
@@ -282,6 +303,9 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
         if a == "--" {
             break;
         }
+        if a == "--help" {
+            return Ok(PerfCommand::Usage { requested: true });
+        }
         let chars: Vec<char> = a[1..].chars().collect();
         let mut j = 0;
         while j < chars.len() {
@@ -309,7 +333,7 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
                 'l' => o.sublatency = true,
                 'L' => o.match_local = true,
                 'u' => o.reliable = false,
-                'h' => return Ok(PerfCommand::Help),
+                'h' => return Ok(PerfCommand::Usage { requested: true }),
                 'd' => return err(format!("-d {val}: network load reporting not supported")),
                 'D' => o.duration = parse_seconds(&val),
                 'i' => {
@@ -341,8 +365,11 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
         o.pingpong_trigger = TriggerMode::Waitset;
     }
     let modes = &args[i..];
-    if modes.is_empty() || (modes.len() == 1 && modes[0] == "help") {
-        return Ok(PerfCommand::Help);
+    if modes.is_empty() {
+        return Ok(PerfCommand::Usage { requested: false });
+    }
+    if modes.len() == 1 && modes[0] == "help" {
+        return Ok(PerfCommand::Usage { requested: true });
     }
     if modes.len() == 1 && modes[0] == "sanity" {
         o.ping_interval = Some(Duration::from_secs(1));
@@ -504,7 +531,7 @@ mod tests {
         let a: Vec<String> = s.split_whitespace().map(String::from).collect();
         match parse(&a).expect("parses") {
             PerfCommand::Run(o) => o,
-            PerfCommand::Help => panic!("help"),
+            PerfCommand::Usage { .. } => panic!("usage"),
         }
     }
 
@@ -564,6 +591,23 @@ mod tests {
         assert!(fails("sub bogus"));
         assert!(fails("frob"));
         assert!(fails("-Q what:1 sub"));
+    }
+
+    #[test]
+    fn help_and_usage() {
+        let parse_str = |s: &str| {
+            let a: Vec<String> = s.split_whitespace().map(String::from).collect();
+            parse(&a)
+        };
+        for asked in ["--help", "-h", "help", "-u --help sub"] {
+            assert_eq!(
+                parse_str(asked),
+                Ok(PerfCommand::Usage { requested: true }),
+                "{asked}"
+            );
+        }
+        assert_eq!(parse_str(""), Ok(PerfCommand::Usage { requested: false }));
+        assert_eq!(parse_str("-u"), Ok(PerfCommand::Usage { requested: false }));
     }
 
     #[test]

@@ -13,7 +13,9 @@ pub trait PerfSample: DdsType + Clone + Send + Sync + 'static {
     const TOPIC: TopicSel;
     /// A sample with `seq`, key value 0 and `baggage` bytes of payload (KS only).
     fn make(seq: u32, baggage: u32) -> Self;
+    /// The sequence number the publisher stamps.
     fn seq(&self) -> u32;
+    /// Stamps the sequence number.
     fn set_seq(&mut self, seq: u32);
     /// 0 for unkeyed types.
     fn keyval(&self) -> u32;

@@ -29,6 +29,7 @@ pub struct LatencyStat {
 }
 
 impl LatencyStat {
+    /// An empty interval.
     pub fn new() -> Self {
         LatencyStat {
             min: i64::MAX,
@@ -37,6 +38,7 @@ impl LatencyStat {
         }
     }
 
+    /// Adds a latency of `ns` nanoseconds.
     pub fn record(&mut self, ns: i64) {
         self.min = self.min.min(ns);
         self.max = self.max.max(ns);
@@ -48,6 +50,7 @@ impl LatencyStat {
         self.total += 1;
     }
 
+    /// Latencies in this interval.
     pub fn count(&self) -> u32 {
         self.cnt
     }
@@ -84,12 +87,19 @@ impl LatencyStat {
 /// Percentiles of one interval, in microseconds.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LatencySummary {
+    /// Mean.
     pub mean_us: f64,
+    /// Minimum.
     pub min_us: f64,
+    /// Median.
     pub p50_us: f64,
+    /// 90th percentile.
     pub p90_us: f64,
+    /// 99th percentile.
     pub p99_us: f64,
+    /// Maximum.
     pub max_us: f64,
+    /// Latencies summarised.
     pub count: u32,
 }
 
@@ -138,12 +148,18 @@ pub enum SeqCheck {
     /// The expected sequence number (or the first from this writer).
     InOrder,
     /// A gap (or reordering): `lost` more samples counted as lost.
-    Gap { lost: u32 },
+    Gap {
+        /// Sequence numbers skipped.
+        lost: u32,
+    },
+    /// Behind the expected number (reordered or duplicated): neither a gap nor a loss.
+    Late,
     /// `keyval` outside 0..nkeys: ddsperf exits with 3.
     BadKey,
 }
 
 impl SubStats {
+    /// Statistics for data cycling through `nkeys` key values.
     pub fn new(nkeys: u32) -> Self {
         SubStats {
             nkeys: nkeys.max(1),
@@ -158,17 +174,23 @@ impl SubStats {
         }
         let nkeys = self.nkeys;
         if let Some(p) = self.pubs.get_mut(&writer) {
-            let e = p.expected[keyval as usize];
-            p.expected[keyval as usize] = seq.wrapping_add(nkeys);
             p.now.nrecv += 1;
             p.now.bytes += u64::from(size);
-            let lost = seq.wrapping_sub(e);
-            p.now.nlost += u64::from(lost);
             p.last_size = size;
-            return if lost == 0 {
+            let e = &mut p.expected[keyval as usize];
+            // Distance from the expected number, modulo 2^32: the upper half is behind it.
+            let ahead = seq.wrapping_sub(*e);
+            if ahead > u32::MAX / 2 {
+                // Late (reordered) or duplicate: already counted when the gap was seen; the
+                // expectation stays where it is.
+                return SeqCheck::Late;
+            }
+            *e = seq.wrapping_add(nkeys);
+            p.now.nlost += u64::from(ahead);
+            return if ahead == 0 {
                 SeqCheck::InOrder
             } else {
-                SeqCheck::Gap { lost }
+                SeqCheck::Gap { lost: ahead }
             };
         }
         // First sample from this writer: the writer cycles through the keys, so the next expected
@@ -299,6 +321,7 @@ fn fmt_g3(v: f64) -> String {
 }
 
 impl WriteHist {
+    /// Adds a write that took `ns` nanoseconds.
     pub fn record(&mut self, ns: u64) {
         self.min = self.min.min(ns);
         self.max = self.max.max(ns);
@@ -367,6 +390,30 @@ mod tests {
         assert_eq!(s.total_lost(), 2);
         assert_eq!(s.total_received(), 5);
         assert_eq!(s.record(w, 0, 7, 100), SeqCheck::BadKey);
+    }
+
+    #[test]
+    fn late_samples_are_not_lost_again() {
+        // Issue 11: a block arriving late once counted as 2^32 - k - 1 lost samples ("lost 4294967296").
+        let w = [2u8; 16];
+        let mut s = SubStats::new(1);
+        for seq in 0..3 {
+            assert_eq!(s.record(w, seq, 0, 16), SeqCheck::InOrder);
+        }
+        assert_eq!(s.record(w, 5, 0, 16), SeqCheck::Gap { lost: 2 });
+        assert_eq!(s.record(w, 3, 0, 16), SeqCheck::Late);
+        assert_eq!(s.record(w, 4, 0, 16), SeqCheck::Late);
+        assert_eq!(s.record(w, 5, 0, 16), SeqCheck::Late);
+        assert_eq!(s.record(w, 6, 0, 16), SeqCheck::InOrder);
+        assert_eq!(s.total_lost(), 2);
+        assert_eq!(s.total_received(), 8);
+        // Across the wrap of the 32-bit sequence number.
+        let w = [3u8; 16];
+        assert_eq!(s.record(w, u32::MAX - 1, 0, 16), SeqCheck::InOrder);
+        assert_eq!(s.record(w, u32::MAX, 0, 16), SeqCheck::InOrder);
+        assert_eq!(s.record(w, 0, 0, 16), SeqCheck::InOrder);
+        assert_eq!(s.record(w, 2, 0, 16), SeqCheck::Gap { lost: 1 });
+        assert_eq!(s.total_lost(), 3);
     }
 
     #[test]

@@ -40,11 +40,17 @@ pub enum AccessScope {
 /// All options of shape_main, with its defaults.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShapeOptions {
+    /// `-v d`: debug verbosity.
     pub debug: bool,
+    /// `-d`: the domain.
     pub domain_id: u32,
+    /// `-P`: publish.
     pub publish: bool,
+    /// `-S`: subscribe.
     pub subscribe: bool,
+    /// RELIABLE (`-r`, the default) or BEST_EFFORT (`-b`).
     pub reliable: bool,
+    /// `-D`: durability kind.
     pub durability: DurabilityArg,
     /// 1 or 2.
     pub xcdr: u8,
@@ -52,32 +58,55 @@ pub struct ShapeOptions {
     pub history_depth: Option<u32>,
     /// `None`: shared ownership.
     pub ownership_strength: Option<i32>,
+    /// `-t`: the topic name (required).
     pub topic: Option<String>,
+    /// `-c`: colour published, or the only colour printed by a subscriber.
     pub color: Option<String>,
+    /// `-p`: a partition name.
     pub partition: Option<String>,
+    /// `--time-filter`: minimum separation of a reader's samples (zero: off).
     pub time_filter: Duration,
+    /// `-f`: deadline period (zero: off).
     pub deadline: Duration,
+    /// `--lifespan`: lifespan of written samples (zero: infinite).
     pub lifespan: Duration,
+    /// `-w`: print the samples written.
     pub print_writer_samples: bool,
+    /// `-z`: size of the shapes written (0: growing).
     pub shapesize: i32,
+    /// `-R`: read instead of take.
     pub use_read: bool,
+    /// `--write-period`: time between two writes.
     pub write_period: Duration,
+    /// `--read-period`: time between two reads or takes.
     pub read_period: Duration,
     /// 0: run until interrupted.
     pub num_iterations: u32,
+    /// `--num-instances`: colours written (COLOR, COLOR1, COLOR2, ...).
     pub num_instances: u32,
+    /// `--num-topics`: topics created (TOPIC, TOPIC1, ...).
     pub num_topics: u32,
+    /// `--final-instance-state`: what a publisher does with its instances at the end.
     pub final_instance_state: Option<FinalInstanceState>,
+    /// `--access-scope`: presentation access scope.
     pub access_scope: Option<AccessScope>,
+    /// `--coherent`: coherent access.
     pub coherent: bool,
+    /// `--ordered`: ordered access.
     pub ordered: bool,
+    /// `--coherent-sample-count`: samples per coherent set.
     pub coherent_sample_count: u32,
+    /// `--additional-payload-size`: bytes of 255 appended to each sample.
     pub additional_payload_size: u32,
     /// `true` unless `--take-read`: use take/read_next_instance.
     pub take_read_next_instance: bool,
+    /// `--periodic-announcement`: SPDP period (zero: the default).
     pub periodic_announcement: Duration,
+    /// `--datafrag-size`: fragment size (0: the default).
     pub datafrag_size: u32,
+    /// `--cft`: content filter expression.
     pub cft_expression: Option<String>,
+    /// `--size-modulo`: wraps the growing shapesize of `-z 0`.
     pub size_modulo: i32,
 }
 
@@ -127,7 +156,9 @@ impl Default for ShapeOptions {
 pub enum Parsed {
     /// Run with these options; `warnings` are printed first (shape_main prints them as errors but runs).
     Run {
+        /// The options.
         options: Box<ShapeOptions>,
+        /// Warnings about options ignored in this role.
         warnings: Vec<String>,
     },
     /// `-h`/`--help`.
@@ -191,100 +222,112 @@ pub fn usage(prog: &str) -> String {
     )
 }
 
-/// Short options that take an argument (getopt string "hPSbrRwc:d:D:f:k:p:s:x:t:v:z:").
-const SHORT_WITH_ARG: &str = "cdDfkpsxtvz";
-const SHORT_FLAGS: &str = "hPSbrRw";
-const LONG_WITH_ARG: &[&str] = &[
-    "write-period",
-    "read-period",
-    "final-instance-state",
-    "access-scope",
-    "coherent-sample-count",
-    "additional-payload-size",
-    "num-topics",
-    "lifespan",
-    "num-instances",
-    "num-iterations",
-    "time-filter",
-    "periodic-announcement",
-    "datafrag-size",
-    "cft",
-    "size-modulo",
+/// shape_main's getopt_long table (getopt string "hPSbrRwc:d:D:f:k:p:s:x:t:v:z:" and the long options): each
+/// option as the token [`parse`] matches on (`-c`, `--write-period`), and whether it takes a value.
+const OPTIONS: &[(&str, bool)] = &[
+    ("-h", false),
+    ("--help", false),
+    ("-P", false),
+    ("-S", false),
+    ("-b", false),
+    ("-r", false),
+    ("-R", false),
+    ("-w", false),
+    ("-c", true),
+    ("-d", true),
+    ("-D", true),
+    ("-f", true),
+    ("-k", true),
+    ("-p", true),
+    ("-s", true),
+    ("-x", true),
+    ("-t", true),
+    ("-v", true),
+    ("-z", true),
+    ("--write-period", true),
+    ("--read-period", true),
+    ("--final-instance-state", true),
+    ("--access-scope", true),
+    ("--coherent-sample-count", true),
+    ("--additional-payload-size", true),
+    ("--num-topics", true),
+    ("--lifespan", true),
+    ("--num-instances", true),
+    ("--num-iterations", true),
+    ("--time-filter", true),
+    ("--periodic-announcement", true),
+    ("--datafrag-size", true),
+    ("--cft", true),
+    ("--size-modulo", true),
+    ("--coherent", false),
+    ("--ordered", false),
+    ("--take-read", false),
 ];
-const LONG_FLAGS: &[&str] = &["help", "coherent", "ordered", "take-read"];
 
-/// Splits argv (without the program name) into (option, value) pairs the way getopt_long does:
-/// `-x2`, `-x 2`, `-Pw`, `--num-iterations=5`, `--num-iterations 5`, unambiguous long prefixes.
+/// The clap argument of one [`OPTIONS`] entry, with the token as its id.
+fn arg(token: &'static str, takes_value: bool) -> clap::Arg {
+    let a = clap::Arg::new(token).value_name("VALUE");
+    let a = match token.strip_prefix("--") {
+        Some(long) => a.long(long),
+        None => a.short(token.chars().nth(1).unwrap_or('?')),
+    };
+    if takes_value {
+        // getopt takes the next word as the value whatever it looks like (`-s -1`).
+        a.action(clap::ArgAction::Append)
+            .num_args(1)
+            .allow_hyphen_values(true)
+    } else {
+        a.action(clap::ArgAction::Count)
+    }
+}
+
+/// shape_main's command line for clap: getopt_long's syntax (`-x2`, `-x 2`, `-Pw`, `--num-iterations=5`,
+/// `--num-iterations 5`, unambiguous long prefixes, repeated options); words that are not options are
+/// ignored, as shape_main does.
+fn command() -> clap::Command {
+    clap::Command::new("shape_main")
+        .disable_help_flag(true)
+        .disable_version_flag(true)
+        .infer_long_args(true)
+        .args(OPTIONS.iter().map(|&(t, v)| arg(t, v)))
+        .arg(
+            clap::Arg::new("ignored")
+                .num_args(0..)
+                .action(clap::ArgAction::Append)
+                .hide(true),
+        )
+}
+
+/// Splits argv (without the program name) into (option, value) pairs in command-line order.
 fn tokenize(args: &[String]) -> Result<Vec<(String, Option<String>)>, String> {
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < args.len() {
-        let a = &args[i];
-        i += 1;
-        if let Some(long) = a.strip_prefix("--") {
-            let (name, inline) = match long.split_once('=') {
-                Some((n, v)) => (n, Some(v.to_string())),
-                None => (long, None),
-            };
-            let all = LONG_WITH_ARG.iter().chain(LONG_FLAGS.iter());
-            let exact = all.clone().find(|n| **n == name);
-            let candidates: Vec<&&str> = all.filter(|n| n.starts_with(name)).collect();
-            let full = match (exact, candidates.as_slice()) {
-                (Some(n), _) => *n,
-                (None, [one]) => **one,
-                (None, []) => return Err(format!("unrecognized option '--{name}'")),
-                (None, _) => return Err(format!("option '--{name}' is ambiguous")),
-            };
-            if LONG_WITH_ARG.contains(&full) {
-                let v = match inline {
-                    Some(v) => v,
-                    None => {
-                        let v = args
-                            .get(i)
-                            .cloned()
-                            .ok_or_else(|| format!("option '--{full}' requires an argument"))?;
-                        i += 1;
-                        v
-                    }
-                };
-                out.push((format!("--{full}"), Some(v)));
-            } else {
-                if inline.is_some() {
-                    return Err(format!("option '--{full}' doesn't allow an argument"));
-                }
-                out.push((format!("--{full}"), None));
-            }
-        } else if let Some(shorts) = a.strip_prefix('-').filter(|s| !s.is_empty()) {
-            let chars: Vec<char> = shorts.chars().collect();
-            let mut j = 0;
-            while j < chars.len() {
-                let c = chars[j];
-                j += 1;
-                if SHORT_WITH_ARG.contains(c) {
-                    let rest: String = chars[j..].iter().collect();
-                    let v = if !rest.is_empty() {
-                        rest
-                    } else {
-                        let v = args
-                            .get(i)
-                            .cloned()
-                            .ok_or_else(|| format!("option requires an argument -- '{c}'"))?;
-                        i += 1;
-                        v
-                    };
-                    out.push((format!("-{c}"), Some(v)));
-                    break;
-                } else if SHORT_FLAGS.contains(c) {
-                    out.push((format!("-{c}"), None));
-                } else {
-                    return Err(format!("invalid option -- '{c}'"));
-                }
-            }
+    let m = command()
+        .try_get_matches_from(std::iter::once("shape_main".to_string()).chain(args.iter().cloned()))
+        .map_err(|e| {
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or_default();
+            first.strip_prefix("error: ").unwrap_or(first).to_string()
+        })?;
+    let mut out: Vec<(usize, String, Option<String>)> = Vec::new();
+    for &(id, takes_value) in OPTIONS {
+        if m.value_source(id) != Some(clap::parser::ValueSource::CommandLine) {
+            continue;
+        }
+        let Some(indices) = m.indices_of(id) else {
+            continue;
+        };
+        if takes_value {
+            let values = m.get_many::<String>(id).into_iter().flatten();
+            out.extend(
+                indices
+                    .zip(values)
+                    .map(|(i, v)| (i, id.to_string(), Some(v.clone()))),
+            );
         } else {
-            // getopt permutes non-options to the end; shape_main ignores them.
+            out.extend(indices.map(|i| (i, id.to_string(), None)));
         }
     }
-    Ok(out)
+    out.sort_by_key(|(i, _, _)| *i);
+    Ok(out.into_iter().map(|(_, o, v)| (o, v)).collect())
 }
 
 /// sscanf("%d")-like: leading integer, rest ignored; `None` when there is no number.
@@ -612,6 +655,28 @@ mod tests {
         .is_err());
         assert!(parse(&args("-S -t Square -c RED --cft x")).is_err());
         assert_eq!(parse(&args("-h")), Ok(Parsed::Help));
+        assert_eq!(parse(&args("--help")), Ok(Parsed::Help));
+        assert!(parse(&args("-P -t Square -q")).is_err());
+        assert!(parse(&args("-P -t")).is_err());
+        assert!(parse(&args("-P -t Square --co")).is_err());
+        assert!(parse(&args("-P -t Square --coh")).is_err());
+    }
+
+    #[test]
+    fn getopt_order_values_and_leftovers() {
+        let (o, _) = run("-b -P -r -t Square");
+        assert!(o.reliable);
+        let (o, _) = run("-r -P -b -t Square");
+        assert!(!o.reliable);
+        let (o, _) = run("stray -P -s -1 -t A -t B --ord --lifespan=7 more");
+        assert_eq!(o.ownership_strength, None);
+        assert_eq!(o.topic.as_deref(), Some("B"));
+        assert!(o.ordered);
+        assert_eq!(o.lifespan, Duration::from_millis(7));
+        let (o, _) = run("-P -t Square -s 5 -d 3 -v d");
+        assert_eq!(o.ownership_strength, Some(5));
+        assert_eq!(o.domain_id, 3);
+        assert!(o.debug);
     }
 
     #[test]

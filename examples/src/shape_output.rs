@@ -70,10 +70,12 @@ pub fn instance_state_line(topic: &str, color: &str, state: NotAlive) -> String 
     format!("{topic:<10} {color:<10} {s}")
 }
 
+/// The writer listener's `on_publication_matched` line.
 pub fn publication_matched_line(topic: &str, type_name: &str, current: u32, change: i32) -> String {
     format!("on_publication_matched() topic: '{topic}'  type: '{type_name}' : matched readers {current} (change = {change})")
 }
 
+/// The reader listener's `on_subscription_matched` line.
 pub fn subscription_matched_line(
     topic: &str,
     type_name: &str,
@@ -87,6 +89,7 @@ fn policy_number(id: Option<QosPolicyId>) -> u32 {
     id.map(|p| p as u32).unwrap_or(0)
 }
 
+/// The writer listener's `on_offered_incompatible_qos` line: policy number and name.
 pub fn offered_incompatible_line(topic: &str, type_name: &str, id: Option<QosPolicyId>) -> String {
     format!(
         "on_offered_incompatible_qos() topic: '{topic}'  type: '{type_name}' : {} ({})",
@@ -95,6 +98,7 @@ pub fn offered_incompatible_line(topic: &str, type_name: &str, id: Option<QosPol
     )
 }
 
+/// The reader listener's `on_requested_incompatible_qos` line: policy number and name.
 pub fn requested_incompatible_line(
     topic: &str,
     type_name: &str,

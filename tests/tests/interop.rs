@@ -12,4 +12,5 @@ mod interop {
     pub mod main_job;
     pub mod shapes;
     pub mod tshark;
+    pub mod tui;
 }

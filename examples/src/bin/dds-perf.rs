@@ -29,9 +29,9 @@ fn main() -> ExitCode {
     let prog = std::env::args().next().unwrap_or_else(|| "dds-perf".into());
     let o = match perf_args::parse(&args) {
         Ok(PerfCommand::Run(o)) => o,
-        Ok(PerfCommand::Help) => {
+        Ok(PerfCommand::Usage { requested }) => {
             print!("{}", perf_args::usage(&prog));
-            return ExitCode::from(3);
+            return ExitCode::from(if requested { 0 } else { 3 });
         }
         Err(e) => {
             println!("{e}");
@@ -440,7 +440,7 @@ fn ping_timer<T: PerfSample>(ctx: &Ctx<T>, now: Instant) -> Instant {
     let expected = ctx.pongs_expected();
     if st.sent_at.is_some() && st.seen < expected {
         st.timeouts += 1;
-        if st.warn_after.is_none_or(|w| now > w) {
+        if st.warn_after.map_or(true, |w| now > w) {
             println!(
                 "[{}] ping timed out (total {} times) ... sending new ping",
                 ctx.pid, st.timeouts

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 use std::process::ExitCode;
 use std::time::Duration;
 
+use dds_examples::shape_motion::{Motion, WORLD_HEIGHT, WORLD_WIDTH};
 use dds_examples::shape_opts::{
     self, AccessScope, DurabilityArg, FinalInstanceState, Parsed, ShapeOptions,
 };
@@ -321,38 +322,6 @@ impl App {
     }
 }
 
-/// The interop suite's bouncing shape (shape_main's moveShape).
-struct Mover {
-    xvel: i32,
-    yvel: i32,
-}
-
-const DA_WIDTH: i32 = 240;
-const DA_HEIGHT: i32 = 270;
-
-impl Mover {
-    fn step(&mut self, s: &mut ShapeType) {
-        s.x += self.xvel;
-        s.y += self.yvel;
-        if s.x < 0 {
-            s.x = 0;
-            self.xvel = -self.xvel;
-        }
-        if s.x > DA_WIDTH {
-            s.x = DA_WIDTH;
-            self.xvel = -self.xvel;
-        }
-        if s.y < 0 {
-            s.y = 0;
-            self.yvel = -self.yvel;
-        }
-        if s.y > DA_HEIGHT {
-            s.y = DA_HEIGHT;
-            self.yvel = -self.yvel;
-        }
-    }
-}
-
 /// A small xorshift generator seeded from the clock and pid: positions only need to differ per run.
 fn seed_rng() -> impl FnMut() -> u32 {
     let nanos = std::time::SystemTime::now()
@@ -385,16 +354,16 @@ fn run_publisher(o: &ShapeOptions, writers: &[DataWriter<ShapeType>]) -> DdsResu
     let mut rng = seed_rng();
     let mut shape = ShapeType {
         color: o.color.clone().unwrap_or_else(|| "BLUE".into()),
-        x: (rng() % DA_WIDTH as u32) as i32,
-        y: (rng() % DA_HEIGHT as u32) as i32,
+        x: (rng() % WORLD_WIDTH as u32) as i32,
+        y: (rng() % WORLD_HEIGHT as u32) as i32,
         shapesize: o.shapesize,
         additional_payload_size: vec![255; o.additional_payload_size as usize],
     };
     // Velocities 1..=5 in either direction, like shape_main.
     let mut velocity = || (1 + (rng() % 5) as i32) * if rng() % 2 == 1 { -1 } else { 1 };
-    let mut mover = Mover {
-        xvel: velocity(),
-        yvel: velocity(),
+    let mut mover = Motion {
+        dx: velocity(),
+        dy: velocity(),
     };
     let colors = instance_colors(o);
     let mut n = 0u32;
@@ -473,7 +442,7 @@ fn run_subscriber(o: &ShapeOptions, readers: &[DataReader<ShapeType>]) -> DdsRes
                     let handle = s.info.instance_handle;
                     if let Some(d) = &s.data {
                         colors.insert((i, handle), d.color.clone());
-                        if o.color.as_ref().is_none_or(|c| *c == d.color) {
+                        if o.color.as_ref().map_or(true, |c| *c == d.color) {
                             println!(
                                 "{}",
                                 shape_output::sample_line(
@@ -493,7 +462,7 @@ fn run_subscriber(o: &ShapeOptions, readers: &[DataReader<ShapeType>]) -> DdsRes
                         InstanceState::NotAliveNoWriters => NotAlive::NoWriters,
                     };
                     let color = colors.get(&(i, handle)).cloned().unwrap_or_default();
-                    if o.color.as_ref().is_none_or(|c| *c == color) {
+                    if o.color.as_ref().map_or(true, |c| *c == color) {
                         println!(
                             "{}",
                             shape_output::instance_state_line(&topic, &color, state)

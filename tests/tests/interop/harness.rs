@@ -120,6 +120,15 @@ pub fn tshark() -> Result<PathBuf, Skip> {
     Ok(found.expect("checked"))
 }
 
+/// `tmux`, for the terminal UI test. Skipped (with a message) when absent, in CI too: the UI is checked
+/// where tmux is installed.
+pub fn tmux() -> Result<PathBuf, Skip> {
+    which("tmux").ok_or_else(|| {
+        eprintln!("SKIP: tmux not installed (apt-get install tmux)");
+        Skip
+    })
+}
+
 fn which(name: &str) -> Option<PathBuf> {
     std::env::var_os("PATH")?
         .to_str()?
