@@ -46,13 +46,13 @@ impl std::fmt::Debug for Publisher {
 pub(crate) fn writer_version<T: DdsType>(
     rep: &DataRepresentation,
 ) -> (XcdrVersion, DataRepresentation) {
-    if rep.0.is_empty() {
+    if rep.ids().is_empty() {
         let v = T::DEFAULT_VERSION;
         let id = match v {
             XcdrVersion::Xcdr1 => XCDR_DATA_REPRESENTATION,
             XcdrVersion::Xcdr2 => XCDR2_DATA_REPRESENTATION,
         };
-        (v, DataRepresentation(vec![id]))
+        (v, DataRepresentation::any_of([id]))
     } else if rep.offered() == XCDR2_DATA_REPRESENTATION {
         (XcdrVersion::Xcdr2, rep.clone())
     } else {

@@ -10,10 +10,7 @@ use std::time::{Duration, Instant, SystemTime};
 use foldhash::{HashMap, HashMapExt};
 
 use crate::cdr::{self, DdsType};
-use crate::qos::{
-    DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos, XCDR2_DATA_REPRESENTATION,
-    XCDR_DATA_REPRESENTATION,
-};
+use crate::qos::{DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos};
 use crate::rtps::{ChangeKind, EntityId, Event, Guid, ReaderSpec, ReceivedSample};
 
 use super::cache::{ChangeKindLocal, Incoming, Outcome, ReaderCache, Selection};
@@ -80,9 +77,8 @@ impl Subscriber {
         let shared = self.participant.shared.clone();
         shared.check_alive()?;
         let mut rq = qos.clone();
-        if rq.data_representation.0.is_empty() {
-            rq.data_representation =
-                DataRepresentation(vec![XCDR_DATA_REPRESENTATION, XCDR2_DATA_REPRESENTATION]);
+        if rq.data_representation.ids().is_empty() {
+            rq.data_representation = DataRepresentation::accept_both();
         }
         if let crate::qos::History::KeepLast(0) = rq.history {
             return Err(DdsError::BadParameter("history depth 0".into()));

@@ -224,6 +224,6 @@ impl From<i32> for TransportPriority {
 }
 impl From<Vec<i16>> for DataRepresentation {
     fn from(v: Vec<i16>) -> Self {
-        DataRepresentation(v)
+        DataRepresentation::any_of(v)
     }
 }

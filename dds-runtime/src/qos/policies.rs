@@ -2,6 +2,8 @@
 
 use std::time::Duration;
 
+use crate::cdr::XcdrVersion;
+
 /// `DURATION_INFINITE`: maps to the wire value {0x7fffffff, 0xffffffff}.
 pub const INFINITE: Duration = Duration::MAX;
 
@@ -202,21 +204,45 @@ impl Default for ReaderDataLifecycle {
     }
 }
 
-/// Data representation ids (XTypes 1.3 §7.6.3.1.1).
+/// Data representation id of XCDR1 (XTypes 1.3 §7.6.3.1.1), the default when a list is empty.
 pub const XCDR_DATA_REPRESENTATION: i16 = 0;
+/// Data representation id of XML (XTypes 1.3 §7.6.3.1.1); not supported for data, but may be announced.
 pub const XML_DATA_REPRESENTATION: i16 = 1;
+/// Data representation id of XCDR2 (XTypes 1.3 §7.6.3.1.1).
 pub const XCDR2_DATA_REPRESENTATION: i16 = 2;
 
-/// An empty list means the default, XCDR1. Writers use (and offer) only the first element.
+/// DATA_REPRESENTATION: the representation ids a writer offers (it uses only the first) or a reader accepts.
+/// An empty list means the default, XCDR1.
+///
+/// ```
+/// use dds_runtime::qos::DataRepresentation;
+/// use dds_runtime::cdr::XcdrVersion;
+/// assert_eq!(DataRepresentation::from(XcdrVersion::Xcdr2), DataRepresentation::xcdr2());
+/// assert!(DataRepresentation::accept_both().accepts(0) && DataRepresentation::accept_both().accepts(2));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct DataRepresentation(pub Vec<i16>);
+pub struct DataRepresentation(Vec<i16>);
 
 impl DataRepresentation {
+    /// XCDR1 only.
     pub fn xcdr1() -> Self {
         DataRepresentation(vec![XCDR_DATA_REPRESENTATION])
     }
+    /// XCDR2 only.
     pub fn xcdr2() -> Self {
         DataRepresentation(vec![XCDR2_DATA_REPRESENTATION])
+    }
+    /// XCDR1 and XCDR2 (for a reader: accepts either; for a writer: offers XCDR1).
+    pub fn accept_both() -> Self {
+        Self::any_of([XCDR_DATA_REPRESENTATION, XCDR2_DATA_REPRESENTATION])
+    }
+    /// The given representation ids, in order of preference.
+    pub fn any_of(ids: impl IntoIterator<Item = i16>) -> Self {
+        DataRepresentation(ids.into_iter().collect())
+    }
+    /// The representation ids as listed (empty: the default, XCDR1).
+    pub fn ids(&self) -> &[i16] {
+        &self.0
     }
     /// What a writer with this policy offers.
     pub fn offered(&self) -> i16 {
@@ -228,6 +254,15 @@ impl DataRepresentation {
             id == XCDR_DATA_REPRESENTATION
         } else {
             self.0.contains(&id)
+        }
+    }
+}
+
+impl From<XcdrVersion> for DataRepresentation {
+    fn from(v: XcdrVersion) -> Self {
+        match v {
+            XcdrVersion::Xcdr1 => Self::xcdr1(),
+            XcdrVersion::Xcdr2 => Self::xcdr2(),
         }
     }
 }

@@ -281,56 +281,40 @@ impl WriteChange {
     }
 }
 
-/// A local writer to create.
+/// A local endpoint to create: a writer (`Q` = [`WriterQos`], see [`WriterSpec`]) or a reader (`Q` =
+/// [`ReaderQos`], see [`ReaderSpec`]).
 #[derive(Debug, Clone)]
-pub struct WriterSpec {
+pub struct EndpointSpec<Q> {
+    /// The topic name (must not be empty).
     pub topic_name: String,
+    /// The registered type name (must not be empty).
     pub type_name: String,
+    /// Whether the type has key members (decides the entity kind and, for writers, KEEP_LAST per instance).
     pub keyed: bool,
-    /// Writer, publisher and topic QoS as announced; the data representation is `qos.writer.data_representation`.
-    pub qos: WriterQos,
+    /// Endpoint, group and topic QoS as announced. The data representation is
+    /// `qos.writer.data_representation` (offered) or `qos.reader.data_representation` (accepted).
+    pub qos: Q,
+    /// XTypes TYPE_INFORMATION to announce, kept opaque.
     pub type_information: Option<TypeInformation>,
+    /// PID_ENTITY_NAME to announce.
     pub entity_name: Option<String>,
 }
 
-impl WriterSpec {
-    pub fn new(
-        topic_name: impl Into<String>,
-        type_name: impl Into<String>,
-        keyed: bool,
-        qos: impl Into<WriterQos>,
-    ) -> Self {
-        WriterSpec {
-            topic_name: topic_name.into(),
-            type_name: type_name.into(),
-            keyed,
-            qos: qos.into(),
-            type_information: None,
-            entity_name: None,
-        }
-    }
-}
+/// A local writer to create.
+pub type WriterSpec = EndpointSpec<WriterQos>;
 
 /// A local reader to create.
-#[derive(Debug, Clone)]
-pub struct ReaderSpec {
-    pub topic_name: String,
-    pub type_name: String,
-    pub keyed: bool,
-    /// Reader, subscriber and topic QoS; accepted representations are `qos.reader.data_representation`.
-    pub qos: ReaderQos,
-    pub type_information: Option<TypeInformation>,
-    pub entity_name: Option<String>,
-}
+pub type ReaderSpec = EndpointSpec<ReaderQos>;
 
-impl ReaderSpec {
+impl<Q> EndpointSpec<Q> {
+    /// An endpoint without type information or entity name.
     pub fn new(
         topic_name: impl Into<String>,
         type_name: impl Into<String>,
         keyed: bool,
-        qos: impl Into<ReaderQos>,
+        qos: impl Into<Q>,
     ) -> Self {
-        ReaderSpec {
+        EndpointSpec {
             topic_name: topic_name.into(),
             type_name: type_name.into(),
             keyed,
@@ -356,6 +340,7 @@ pub struct ReceivedSample {
 
 /// What the core reports to the DCPS layer.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Event {
     Sample(ReceivedSample),
     PublicationMatched {
@@ -416,7 +401,9 @@ pub enum Event {
     },
 }
 
+/// Why the core refused to create an endpoint.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
 pub enum CoreError {
     #[error("no such entity {0:?}")]
     UnknownEntity(EntityId),

@@ -203,8 +203,7 @@ fn run(a: &Args) -> DdsResult<u8> {
             DataRepresentation::xcdr1()
         })
         .build();
-    let both =
-        DataRepresentation([DataRepresentation::xcdr1().0, DataRepresentation::xcdr2().0].concat());
+    let both = DataRepresentation::accept_both();
     let reader_qos = DataReaderQos::builder()
         .reliability(Reliability::RELIABLE)
         .history(History::KeepLast(8))

@@ -108,13 +108,13 @@ impl ParticipantData {
                 p.u32(self.properties.len() as u32);
                 for (k, v) in &self.properties {
                     for s in [k, v] {
-                        while !p.out.len().is_multiple_of(4) {
+                        while p.out.len() % 4 != 0 {
                             p.u8(0);
                         }
                         put_string(p, s);
                     }
                 }
-                while !p.out.len().is_multiple_of(4) {
+                while p.out.len() % 4 != 0 {
                     p.u8(0);
                 }
                 // No binary properties.

@@ -479,8 +479,8 @@ pub fn append(
     sub: &Submessage<'_>,
     little_endian: bool,
 ) {
-    if !out.len().is_multiple_of(4) {
-        while !out.len().is_multiple_of(4) {
+    if out.len() % 4 != 0 {
+        while out.len() % 4 != 0 {
             out.push(0);
         }
         if let Some(h) = *last_header {

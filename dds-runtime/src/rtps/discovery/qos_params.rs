@@ -2,8 +2,7 @@
 
 use std::time::Duration;
 
-use super::compat::{ReaderQos, WriterQos};
-use super::policies::*;
+use crate::qos::*;
 use crate::rtps::messages::parameter::{pid, put_string, ParameterWriter};
 use crate::rtps::messages::{Cursor, WireError};
 
@@ -82,7 +81,7 @@ fn write_group(
                 let _ = start;
                 put_string(p, s);
                 // Each string is 4-aligned relative to the parameter value; the value starts 4-aligned.
-                while !p.out.len().is_multiple_of(4) {
+                while p.out.len() % 4 != 0 {
                     p.u8(0);
                 }
             }
@@ -110,12 +109,13 @@ fn write_history(w: &mut ParameterWriter<'_>, h: History, rl: &ResourceLimits) {
 }
 
 fn write_data_representation(w: &mut ParameterWriter<'_>, d: &DataRepresentation) {
-    if d.0.is_empty() {
+    let ids = d.ids();
+    if ids.is_empty() {
         return;
     }
     w.param(pid::DATA_REPRESENTATION, |p| {
-        p.u32(d.0.len() as u32);
-        for v in &d.0 {
+        p.u32(ids.len() as u32);
+        for v in ids {
             p.u16(*v as u16);
         }
     });
@@ -306,7 +306,7 @@ fn read_common(id: u16, c: &mut Cursor<'_>, q: Common<'_>) -> Result<bool, WireE
             for _ in 0..n {
                 v.push(c.i16()?);
             }
-            q.representation.0 = v;
+            *q.representation = DataRepresentation::any_of(v);
         }
         pid::PRESENTATION => {
             let scope = match c.u32()? {
