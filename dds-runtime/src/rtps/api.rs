@@ -103,74 +103,137 @@ impl fmt::Debug for Payload {
     }
 }
 
-/// Everything the core needs to know about the local participant. Build with [`ParticipantConfig::new`], which
-/// fills in the standard ports for one unicast address, then adjust fields.
-#[derive(Debug, Clone)]
-pub struct ParticipantConfig {
-    pub domain_id: u32,
+/// Defines [`ParticipantConfig`] (read-only getters) and [`ParticipantConfigBuilder`] (one setter per field)
+/// from one list. `copy` fields are returned by value, `ref` fields by reference.
+macro_rules! participant_config {
+    ($($(#[$doc:meta])* $field:ident: $ty:ty = $kind:ident,)*) => {
+        /// Everything the core needs to know about the local participant. Build it with
+        /// [`ParticipantConfig::builder`] (standard ports for one unicast address) or
+        /// [`ParticipantConfigBuilder::default`]; read it back with the getters.
+        ///
+        /// ```
+        /// use std::time::Duration;
+        /// use dds_runtime::rtps::{GuidPrefix, ParticipantConfig};
+        /// let c = ParticipantConfig::builder(0, 1, GuidPrefix([7; 12]), [127, 0, 0, 1])
+        ///     .lease_duration(Duration::from_secs(3))
+        ///     .build();
+        /// assert_eq!(c.lease_duration(), Duration::from_secs(3));
+        /// assert_eq!(c.default_unicast()[0].port, 7413);
+        /// ```
+        #[derive(Debug, Clone)]
+        pub struct ParticipantConfig {
+            $(pub(crate) $field: $ty,)*
+        }
+
+        impl ParticipantConfig {
+            $(participant_config!(@get $kind $(#[$doc])* $field: $ty);)*
+        }
+
+        /// Builds a [`ParticipantConfig`]; every setter replaces one value.
+        #[derive(Debug, Clone)]
+        pub struct ParticipantConfigBuilder(ParticipantConfig);
+
+        impl ParticipantConfigBuilder {
+            $(
+                $(#[$doc])*
+                pub fn $field(mut self, value: impl Into<$ty>) -> Self {
+                    self.0.$field = value.into();
+                    self
+                }
+            )*
+        }
+    };
+    (@get copy $(#[$doc:meta])* $field:ident: $ty:ty) => {
+        $(#[$doc])*
+        pub fn $field(&self) -> $ty {
+            self.$field
+        }
+    };
+    (@get ref $(#[$doc:meta])* $field:ident: $ty:ty) => {
+        $(#[$doc])*
+        pub fn $field(&self) -> &$ty {
+            &self.$field
+        }
+    };
+}
+
+participant_config! {
+    /// The DDS domain id.
+    domain_id: u32 = copy,
     /// The participant index used in the port formula (chosen by the transport).
-    pub participant_id: u32,
-    pub guid_prefix: GuidPrefix,
-    /// Defaults to [`VendorId::THIS`] (0x01dd).
-    pub vendor_id: VendorId,
-    pub metatraffic_unicast: Vec<Locator>,
-    pub metatraffic_multicast: Vec<Locator>,
-    pub default_unicast: Vec<Locator>,
-    pub default_multicast: Vec<Locator>,
+    participant_id: u32 = copy,
+    /// The GUID prefix of the participant and all its endpoints.
+    guid_prefix: GuidPrefix = copy,
+    /// The vendor id in every message header; defaults to [`VendorId::THIS`] (0x01dd).
+    vendor_id: VendorId = copy,
+    /// Where peers send discovery traffic to us unicast.
+    metatraffic_unicast: Vec<Locator> = ref,
+    /// The SPDP multicast destinations (default 239.255.0.1 at the domain's SPDP port).
+    metatraffic_multicast: Vec<Locator> = ref,
+    /// Where peers send user data to us unicast.
+    default_unicast: Vec<Locator> = ref,
+    /// Where peers may send user data to us by multicast.
+    default_multicast: Vec<Locator> = ref,
     /// Period of SPDP announcements (default 3 s).
-    pub spdp_interval: Duration,
+    spdp_interval: Duration = copy,
     /// Lease announced to peers (default 10 s, like Cyclone).
-    pub lease_duration: Duration,
+    lease_duration: Duration = copy,
     /// Unicast SPDP destinations in addition to the multicast ones.
-    pub initial_peers: Vec<Locator>,
+    initial_peers: Vec<Locator> = ref,
     /// Datagram payload limit for packing (default 14720, Cyclone's MaxMessageSize).
-    pub max_message_size: usize,
+    max_message_size: usize = copy,
     /// Samples larger than this go out as DATA_FRAG with fragments of this size (default 1344; ≤ 65535).
-    pub fragment_size: usize,
-    pub user_data: Vec<u8>,
-    pub entity_name: Option<String>,
-    pub properties: Vec<(String, String)>,
+    fragment_size: usize = copy,
+    /// USER_DATA announced in SPDP.
+    user_data: Vec<u8> = ref,
+    /// PID_ENTITY_NAME announced in SPDP.
+    entity_name: Option<String> = ref,
+    /// PID_PROPERTY_LIST announced in SPDP (name, value).
+    properties: Vec<(String, String)> = ref,
     /// Period of heartbeats while data is unacknowledged (default 100 ms).
-    pub heartbeat_period: Duration,
+    heartbeat_period: Duration = copy,
     /// Delay before answering a NACK, so that requests merge (default 5 ms).
-    pub nack_response_delay: Duration,
+    nack_response_delay: Duration = copy,
     /// Delay before answering a HEARTBEAT with an ACKNACK (default 0).
-    pub heartbeat_response_delay: Duration,
-    /// Flow control: `write` refuses (WouldBlock) once this many bytes are unacknowledged (default 512 KiB) …
-    pub whc_high_watermark: usize,
-    /// … until they drop below this (default 128 KiB).
-    pub whc_low_watermark: usize,
+    heartbeat_response_delay: Duration = copy,
+    /// Flow control: `write` refuses (WouldBlock) once this many bytes are unacknowledged (default 512 KiB),
+    /// until they drop below [`whc_low_watermark`](Self::whc_low_watermark).
+    whc_high_watermark: usize = copy,
+    /// Flow control: where a blocked writer is released (default 128 KiB).
+    whc_low_watermark: usize = copy,
     /// Largest sample accepted from the network (default 64 MiB); bigger ones are dropped and acknowledged.
-    pub max_sample_size: usize,
-    /// Per remote writer: samples defragmented at once (default 8) and bytes held in fragments (default 16 MiB).
-    pub defrag_max_samples: usize,
-    pub defrag_max_bytes: usize,
-    /// Per remote writer: out-of-order samples held for reordering (default 1024) and their bytes (default
-    /// 64 MiB); beyond either, later samples are dropped and requested again once the gap is filled.
-    pub reorder_max_samples: usize,
-    pub reorder_max_bytes: usize,
+    max_sample_size: usize = copy,
+    /// Per remote writer: samples defragmented at once (default 8).
+    defrag_max_samples: usize = copy,
+    /// Per remote writer: bytes held in fragments, overhead counted (default 16 MiB).
+    defrag_max_bytes: usize = copy,
+    /// Per remote writer: out-of-order samples held for reordering (default 1024); beyond it, later samples
+    /// are dropped and requested again once the gap is filled.
+    reorder_max_samples: usize = copy,
+    /// Per remote writer: bytes of out-of-order samples held for reordering (default 64 MiB).
+    reorder_max_bytes: usize = copy,
     /// How long a deleted reliable writer lingers waiting for acknowledgements (default 1 s).
-    pub writer_linger_duration: Duration,
+    writer_linger_duration: Duration = copy,
     /// Upper bound on bytes retransmitted per repair round to one reader (default 256 KiB).
-    pub max_repair_bytes: usize,
+    max_repair_bytes: usize = copy,
     /// Write batching: user DATA waits up to this long for more samples to share its datagram, leaving
     /// earlier when the datagram is full, on [`Participant::flush`](super::Participant::flush), or with any
     /// other outgoing traffic. `None` (the default) sends every write at once.
-    pub write_batch_delay: Option<Duration>,
+    write_batch_delay: Option<Duration> = copy,
 }
 
 impl ParticipantConfig {
-    /// A configuration for one IPv4 unicast address with the standard ports (PB 7400, DG 250, PG 2, d0..d3 =
-    /// 0, 10, 1, 11) and SPDP multicast to 239.255.0.1.
-    pub fn new(
+    /// A builder for one IPv4 unicast address with the standard ports (PB 7400, DG 250, PG 2, d0..d3 =
+    /// 0, 10, 1, 11), SPDP multicast to 239.255.0.1 and the defaults documented on each field.
+    pub fn builder(
         domain_id: u32,
         participant_id: u32,
         guid_prefix: GuidPrefix,
         unicast_ip: [u8; 4],
-    ) -> Self {
+    ) -> ParticipantConfigBuilder {
         use super::discovery::ports;
         let mc = [239, 255, 0, 1];
-        ParticipantConfig {
+        ParticipantConfigBuilder(ParticipantConfig {
             domain_id,
             participant_id,
             guid_prefix,
@@ -206,7 +269,49 @@ impl ParticipantConfig {
             writer_linger_duration: Duration::from_secs(1),
             max_repair_bytes: 256 * 1024,
             write_batch_delay: None,
-        }
+        })
+    }
+
+    /// [`builder`](Self::builder) with nothing changed.
+    pub fn new(
+        domain_id: u32,
+        participant_id: u32,
+        guid_prefix: GuidPrefix,
+        unicast_ip: [u8; 4],
+    ) -> Self {
+        Self::builder(domain_id, participant_id, guid_prefix, unicast_ip).build()
+    }
+
+    /// A builder starting from this configuration.
+    pub fn to_builder(&self) -> ParticipantConfigBuilder {
+        ParticipantConfigBuilder(self.clone())
+    }
+}
+
+/// Domain 0, participant index 0, a zero GUID prefix and 127.0.0.1 (see [`ParticipantConfig::builder`]).
+impl Default for ParticipantConfig {
+    fn default() -> Self {
+        ParticipantConfigBuilder::default().build()
+    }
+}
+
+/// Domain 0, participant index 0, a zero GUID prefix and 127.0.0.1 (see [`ParticipantConfig::builder`]).
+impl Default for ParticipantConfigBuilder {
+    fn default() -> Self {
+        ParticipantConfig::builder(0, 0, GuidPrefix::default(), [127, 0, 0, 1])
+    }
+}
+
+impl ParticipantConfigBuilder {
+    /// The finished configuration.
+    pub fn build(self) -> ParticipantConfig {
+        self.0
+    }
+}
+
+impl From<ParticipantConfigBuilder> for ParticipantConfig {
+    fn from(b: ParticipantConfigBuilder) -> Self {
+        b.build()
     }
 }
 

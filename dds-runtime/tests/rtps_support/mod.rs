@@ -94,11 +94,10 @@ pub fn prefix(i: usize) -> GuidPrefix {
     GuidPrefix(p)
 }
 
-pub fn config(i: usize) -> ParticipantConfig {
-    let mut c = ParticipantConfig::new(0, 0, prefix(i), [10, 0, 0, i as u8 + 1]);
-    c.spdp_interval = Duration::from_millis(500);
-    c.lease_duration = Duration::from_secs(3);
-    c
+pub fn config(i: usize) -> ParticipantConfigBuilder {
+    ParticipantConfig::builder(0, 0, prefix(i), [10, 0, 0, i as u8 + 1])
+        .spdp_interval(Duration::from_millis(500))
+        .lease_duration(Duration::from_secs(3))
 }
 
 impl Sim {
@@ -117,8 +116,8 @@ impl Sim {
         }
     }
 
-    pub fn add(&mut self, config: ParticipantConfig) -> usize {
-        let p = Participant::new(config, self.now);
+    pub fn add(&mut self, config: impl Into<ParticipantConfig>) -> usize {
+        let p = Participant::new(config.into(), self.now);
         self.nodes.push(Node {
             p,
             events: Vec::new(),
@@ -142,9 +141,9 @@ impl Sim {
             .filter(|(_, n)| {
                 let c = n.p.config();
                 if l.is_multicast() {
-                    c.metatraffic_multicast.contains(l) || c.default_multicast.contains(l)
+                    c.metatraffic_multicast().contains(l) || c.default_multicast().contains(l)
                 } else {
-                    c.metatraffic_unicast.contains(l) || c.default_unicast.contains(l)
+                    c.metatraffic_unicast().contains(l) || c.default_unicast().contains(l)
                 }
             })
             .map(|(i, _)| i)
