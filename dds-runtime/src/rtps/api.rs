@@ -6,6 +6,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::discovery::{ParticipantData, ReaderData, WriterData};
+use super::messages::flags::StatusInfo;
 use super::types::*;
 use crate::qos::{QosPolicyId, ReaderQos, WriterQos};
 use crate::xtypes::TypeInformation;
@@ -322,30 +323,41 @@ pub struct Transmit {
     pub payload: Vec<u8>,
 }
 
+/// What a change does to its instance (PID_STATUS_INFO on the wire).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ChangeKind {
+    /// A new value of the instance.
     Alive,
+    /// The instance was disposed.
     Dispose,
+    /// The writer unregistered the instance.
     Unregister,
+    /// Both at once (e.g. Cyclone's autodispose on unregister).
     DisposeUnregister,
 }
 
 impl ChangeKind {
-    /// PID_STATUS_INFO flags (0x01 disposed, 0x02 unregistered).
+    /// The PID_STATUS_INFO flag bits of this kind.
     pub fn status_info(self) -> u8 {
-        match self {
-            ChangeKind::Alive => 0,
-            ChangeKind::Dispose => 1,
-            ChangeKind::Unregister => 2,
-            ChangeKind::DisposeUnregister => 3,
-        }
+        let flags = match self {
+            ChangeKind::Alive => StatusInfo::empty(),
+            ChangeKind::Dispose => StatusInfo::DISPOSED,
+            ChangeKind::Unregister => StatusInfo::UNREGISTERED,
+            ChangeKind::DisposeUnregister => StatusInfo::DISPOSED | StatusInfo::UNREGISTERED,
+        };
+        flags.bits()
     }
+    /// The kind for PID_STATUS_INFO flag bits (other bits than disposed and unregistered are ignored).
     pub fn from_status_info(flags: u8) -> Self {
-        match flags & 3 {
-            0 => ChangeKind::Alive,
-            1 => ChangeKind::Dispose,
-            2 => ChangeKind::Unregister,
-            _ => ChangeKind::DisposeUnregister,
+        let flags = StatusInfo::from_bits_truncate(flags);
+        match (
+            flags.contains(StatusInfo::DISPOSED),
+            flags.contains(StatusInfo::UNREGISTERED),
+        ) {
+            (false, false) => ChangeKind::Alive,
+            (true, false) => ChangeKind::Dispose,
+            (false, true) => ChangeKind::Unregister,
+            (true, true) => ChangeKind::DisposeUnregister,
         }
     }
 }

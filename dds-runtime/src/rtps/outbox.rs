@@ -25,8 +25,9 @@ struct Pending {
     destinations: Vec<Locator>,
     dst: Option<GuidPrefix>,
     buf: Vec<u8>,
-    /// The INFO_TS state the receiver will be in: None = nothing sent yet in this message.
-    ts: Option<Option<Time>>,
+    /// The timestamp in force at the receiver after this message so far: `None` before any INFO_TS (a
+    /// message starts without one) and after an invalidating INFO_TS alike.
+    ts: Option<Time>,
     preamble: usize,
     /// Start of the last submessage, whose length grows when the next one needs alignment padding.
     last_header: Option<usize>,
@@ -190,10 +191,9 @@ impl Outbox {
 
 fn write_ts(p: &mut Pending, ts: Ts) {
     if let Ts::Set(t) = ts {
-        // Nothing sent yet means no timestamp in force at the receiver.
-        if p.ts.unwrap_or(None) != t {
+        if p.ts != t {
             append(&mut p.buf, &mut p.last_header, &Submessage::InfoTs(t), true);
-            p.ts = Some(t);
+            p.ts = t;
         }
     }
 }

@@ -40,7 +40,7 @@ impl<'a> Iterator for MessageIter<'a> {
         let sid = self.rest[0];
         let flags = self.rest[1];
         let raw = [self.rest[2], self.rest[3]];
-        let len = if flags & 1 != 0 {
+        let len = if flags & super::FLAG_E != 0 {
             u16::from_le_bytes(raw)
         } else {
             u16::from_be_bytes(raw)

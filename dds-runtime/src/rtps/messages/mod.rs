@@ -5,6 +5,7 @@
 
 mod codec;
 mod cursor;
+pub mod flags;
 mod header;
 pub mod parameter;
 mod submessages;

@@ -1,6 +1,7 @@
 //! Submessage structures (§9.4.5), decoded by borrowing from the datagram, and their encoders.
 
 use super::cursor::Put;
+use super::flags::*;
 use super::{id, Cursor, ParameterList, WireError};
 use crate::rtps::types::*;
 
@@ -187,7 +188,7 @@ impl<'a> Submessage<'a> {
                     writer_id,
                     reader_sn_state,
                     count,
-                    final_flag: flags & 0x02 != 0,
+                    final_flag: AckNackFlags::from_bits_retain(flags).contains(AckNackFlags::FINAL),
                 })
             }
             id::HEARTBEAT => {
@@ -200,14 +201,15 @@ impl<'a> Submessage<'a> {
                 if first_sn.0 < 1 || last_sn.0 < first_sn.0 - 1 {
                     return Err(WireError::Invalid("HEARTBEAT sequence numbers"));
                 }
+                let f = HeartbeatFlags::from_bits_retain(flags);
                 Submessage::Heartbeat(Heartbeat {
                     reader_id,
                     writer_id,
                     first_sn,
                     last_sn,
                     count,
-                    final_flag: flags & 0x02 != 0,
-                    liveliness_flag: flags & 0x04 != 0,
+                    final_flag: f.contains(HeartbeatFlags::FINAL),
+                    liveliness_flag: f.contains(HeartbeatFlags::LIVELINESS),
                 })
             }
             id::GAP => {
@@ -226,7 +228,7 @@ impl<'a> Submessage<'a> {
                 })
             }
             id::INFO_TS => {
-                if flags & 0x02 != 0 {
+                if InfoTsFlags::from_bits_retain(flags).contains(InfoTsFlags::INVALIDATE) {
                     Submessage::InfoTs(None)
                 } else {
                     Submessage::InfoTs(Some(c.time()?))
@@ -247,7 +249,9 @@ impl<'a> Submessage<'a> {
             id::INFO_DST => Submessage::InfoDst(c.guid_prefix()?),
             id::INFO_REPLY => {
                 let unicast = locator_list(&mut c)?;
-                let multicast = if flags & 0x02 != 0 {
+                let multicast = if InfoReplyFlags::from_bits_retain(flags)
+                    .contains(InfoReplyFlags::MULTICAST)
+                {
                     Some(locator_list(&mut c)?)
                 } else {
                     None
@@ -260,7 +264,9 @@ impl<'a> Submessage<'a> {
             }
             id::INFO_REPLY_IP4 => {
                 let unicast = ip4_locator(&mut c)?;
-                let multicast = if flags & 0x02 != 0 {
+                let multicast = if InfoReplyFlags::from_bits_retain(flags)
+                    .contains(InfoReplyFlags::MULTICAST)
+                {
                     Some(ip4_locator(&mut c)?)
                 } else {
                     None
@@ -311,53 +317,68 @@ impl<'a> Submessage<'a> {
         })
     }
 
+    /// The submessage id and the flag bits this submessage is encoded with.
+    fn kind_and_flags(&self, little_endian: bool) -> (u8, u8) {
+        let e = if little_endian { FLAG_E } else { 0 };
+        let (sid, flags) = match self {
+            Submessage::Pad => (id::PAD, 0),
+            Submessage::AckNack(a) => (
+                id::ACKNACK,
+                AckNackFlags::FINAL.bits() * u8::from(a.final_flag),
+            ),
+            Submessage::Heartbeat(h) => {
+                let mut f = HeartbeatFlags::empty();
+                f.set(HeartbeatFlags::FINAL, h.final_flag);
+                f.set(HeartbeatFlags::LIVELINESS, h.liveliness_flag);
+                (id::HEARTBEAT, f.bits())
+            }
+            Submessage::Gap(_) => (id::GAP, 0),
+            Submessage::InfoTs(t) => (
+                id::INFO_TS,
+                InfoTsFlags::INVALIDATE.bits() * u8::from(t.is_none()),
+            ),
+            Submessage::InfoSrc(_) => (id::INFO_SRC, 0),
+            Submessage::InfoDst(_) => (id::INFO_DST, 0),
+            Submessage::InfoReply(r) => (
+                id::INFO_REPLY,
+                InfoReplyFlags::MULTICAST.bits() * u8::from(r.multicast.is_some()),
+            ),
+            Submessage::InfoReplyIp4(r) => (
+                id::INFO_REPLY_IP4,
+                InfoReplyFlags::MULTICAST.bits() * u8::from(r.multicast.is_some()),
+            ),
+            Submessage::Data(d) => {
+                let mut f = DataFlags::empty();
+                f.set(DataFlags::INLINE_QOS, d.inline_qos.is_some());
+                if d.payload.is_some() {
+                    f |= if d.key_flag {
+                        DataFlags::KEY
+                    } else {
+                        DataFlags::DATA
+                    };
+                }
+                f.set(DataFlags::NON_STANDARD, d.non_standard_flag);
+                (id::DATA, f.bits())
+            }
+            Submessage::DataFrag(d) => {
+                let mut f = DataFragFlags::empty();
+                f.set(DataFragFlags::INLINE_QOS, d.inline_qos.is_some());
+                f.set(DataFragFlags::KEY, d.key_flag);
+                f.set(DataFragFlags::NON_STANDARD, d.non_standard_flag);
+                (id::DATA_FRAG, f.bits())
+            }
+            Submessage::HeartbeatFrag(_) => (id::HEARTBEAT_FRAG, 0),
+            Submessage::NackFrag(_) => (id::NACK_FRAG, 0),
+            Submessage::Unknown { id, flags, .. } => (*id, *flags & !FLAG_E),
+        };
+        (sid, flags | e)
+    }
+
     /// Appends this submessage (header included) in the given byte order, unpadded. Use [`append`] to add it
     /// to a message that may already hold submessages.
     pub fn encode(&self, out: &mut Vec<u8>, little_endian: bool) {
         let start = out.len();
-        let e = if little_endian { FLAG_E } else { 0 };
-        let (sid, flags) = match self {
-            Submessage::Pad => (id::PAD, e),
-            Submessage::AckNack(a) => (id::ACKNACK, e | if a.final_flag { 0x02 } else { 0 }),
-            Submessage::Heartbeat(h) => (
-                id::HEARTBEAT,
-                e | if h.final_flag { 0x02 } else { 0 } | if h.liveliness_flag { 0x04 } else { 0 },
-            ),
-            Submessage::Gap(_) => (id::GAP, e),
-            Submessage::InfoTs(t) => (id::INFO_TS, e | if t.is_none() { 0x02 } else { 0 }),
-            Submessage::InfoSrc(_) => (id::INFO_SRC, e),
-            Submessage::InfoDst(_) => (id::INFO_DST, e),
-            Submessage::InfoReply(r) => (
-                id::INFO_REPLY,
-                e | if r.multicast.is_some() { 0x02 } else { 0 },
-            ),
-            Submessage::InfoReplyIp4(r) => (
-                id::INFO_REPLY_IP4,
-                e | if r.multicast.is_some() { 0x02 } else { 0 },
-            ),
-            Submessage::Data(d) => {
-                let mut f = e;
-                if d.inline_qos.is_some() {
-                    f |= 0x02;
-                }
-                if d.payload.is_some() {
-                    f |= if d.key_flag { 0x08 } else { 0x04 };
-                }
-                if d.non_standard_flag {
-                    f |= 0x10;
-                }
-                (id::DATA, f)
-            }
-            Submessage::DataFrag(d) => (
-                id::DATA_FRAG,
-                e | if d.inline_qos.is_some() { 0x02 } else { 0 }
-                    | if d.key_flag { 0x04 } else { 0 }
-                    | if d.non_standard_flag { 0x08 } else { 0 },
-            ),
-            Submessage::HeartbeatFrag(_) => (id::HEARTBEAT_FRAG, e),
-            Submessage::NackFrag(_) => (id::NACK_FRAG, e),
-            Submessage::Unknown { id, flags, .. } => (*id, (*flags & !FLAG_E) | e),
-        };
+        let (sid, flags) = self.kind_and_flags(little_endian);
         out.push(sid);
         out.push(flags);
         out.extend_from_slice(&[0, 0]);
@@ -553,11 +574,12 @@ fn data_prefix<'a>(
 fn decode_data<'a>(flags: u8, mut c: Cursor<'a>) -> Result<Data<'a>, WireError> {
     let le = c.little_endian;
     let (reader_id, writer_id, writer_sn) = data_prefix(&mut c, 20)?;
+    let f = DataFlags::from_bits_retain(flags);
     let (q, d, k, n) = (
-        flags & 0x02 != 0,
-        flags & 0x04 != 0,
-        flags & 0x08 != 0,
-        flags & 0x10 != 0,
+        f.contains(DataFlags::INLINE_QOS),
+        f.contains(DataFlags::DATA),
+        f.contains(DataFlags::KEY),
+        f.contains(DataFlags::NON_STANDARD),
     );
     if d && k {
         return Err(WireError::Invalid("DATA with both D and K"));
@@ -604,8 +626,9 @@ fn decode_data_frag<'a>(flags: u8, mut c: Cursor<'a>) -> Result<DataFrag<'a>, Wi
     if first_byte >= sample_size as u64 {
         return Err(WireError::Invalid("DATA_FRAG beyond sample"));
     }
+    let flags = DataFragFlags::from_bits_retain(flags);
     let mut rest = c.rest();
-    let inline_qos = if flags & 0x02 != 0 {
+    let inline_qos = if flags.contains(DataFragFlags::INLINE_QOS) {
         let (pl, r) = ParameterList::parse(rest, le)?;
         rest = r;
         Some(pl)
@@ -628,7 +651,7 @@ fn decode_data_frag<'a>(flags: u8, mut c: Cursor<'a>) -> Result<DataFrag<'a>, Wi
         sample_size,
         inline_qos,
         payload: &rest[..want],
-        key_flag: flags & 0x04 != 0,
-        non_standard_flag: flags & 0x08 != 0,
+        key_flag: flags.contains(DataFragFlags::KEY),
+        non_standard_flag: flags.contains(DataFragFlags::NON_STANDARD),
     })
 }

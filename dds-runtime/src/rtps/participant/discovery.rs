@@ -54,7 +54,7 @@ impl Participant {
 
     pub(super) fn on_spdp(&mut self, now: Instant, src: GuidPrefix, d: &Data<'_>) {
         let status = d.inline_qos.and_then(|q| q.status_info()).unwrap_or(0);
-        if status & 0x03 != 0 {
+        if ChangeKind::from_status_info(status) != ChangeKind::Alive {
             let guid = d
                 .inline_qos
                 .and_then(|q| q.key_hash())
