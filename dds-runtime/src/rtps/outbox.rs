@@ -50,7 +50,7 @@ pub(crate) struct Outbox {
 }
 
 impl Outbox {
-    pub fn new(header: Header, max_message_size: usize) -> Self {
+    pub(crate) fn new(header: Header, max_message_size: usize) -> Self {
         Outbox {
             header,
             max: max_message_size.max(128),
@@ -64,7 +64,7 @@ impl Outbox {
     }
 
     /// Runs `f` with its pushes held back for batching: they leave at the latest `delay` after `now`.
-    pub fn hold<R>(&mut self, now: Instant, f: impl FnOnce(&mut Outbox) -> R) -> R {
+    pub(crate) fn hold<R>(&mut self, now: Instant, f: impl FnOnce(&mut Outbox) -> R) -> R {
         let before = self.holding;
         self.holding = true;
         let r = f(self);
@@ -76,12 +76,12 @@ impl Outbox {
     }
 
     /// Asks for every open message to be closed at the next drain.
-    pub fn request_flush(&mut self) {
+    pub(crate) fn request_flush(&mut self) {
         self.flush_due = true;
     }
 
     /// When held messages must leave, for a batch delay of `delay`.
-    pub fn hold_deadline(&self, delay: Duration) -> Option<Instant> {
+    pub(crate) fn hold_deadline(&self, delay: Duration) -> Option<Instant> {
         self.held_since.map(|t| t + delay)
     }
 
@@ -113,7 +113,7 @@ impl Outbox {
     }
 
     /// Appends `sub` to the message for (destinations, dst); starts a new datagram when it would not fit.
-    pub fn push(
+    pub(crate) fn push(
         &mut self,
         destinations: &[Locator],
         dst: Option<GuidPrefix>,
@@ -155,7 +155,7 @@ impl Outbox {
     }
 
     /// Closes every open message.
-    pub fn flush(&mut self) {
+    pub(crate) fn flush(&mut self) {
         self.flush_due = false;
         self.held_since = None;
         for p in self.pending.drain(..) {
@@ -172,7 +172,7 @@ impl Outbox {
 
     /// The next finished datagram. Open messages close first when a flush is due or the held ones have
     /// waited `batch_delay`.
-    pub fn pop(&mut self, now: Instant, batch_delay: Duration) -> Option<Transmit> {
+    pub(crate) fn pop(&mut self, now: Instant, batch_delay: Duration) -> Option<Transmit> {
         if self.ready.is_empty()
             && (self.flush_due || self.hold_deadline(batch_delay).is_some_and(|t| t <= now))
         {
@@ -182,7 +182,7 @@ impl Outbox {
     }
 
     /// Returns a datagram buffer for reuse.
-    pub fn recycle(&mut self, buf: Vec<u8>) {
+    pub(crate) fn recycle(&mut self, buf: Vec<u8>) {
         if self.pool.len() < 64 {
             self.pool.push(buf);
         }

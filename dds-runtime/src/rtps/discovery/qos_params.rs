@@ -122,7 +122,7 @@ fn write_data_representation(w: &mut ParameterWriter<'_>, d: &DataRepresentation
 }
 
 /// Appends the QoS parameters of a publication (DiscoveredWriterData).
-pub fn write_writer_qos(w: &mut ParameterWriter<'_>, q: &WriterQos) {
+pub(super) fn write_writer_qos(w: &mut ParameterWriter<'_>, q: &WriterQos) {
     let d = &q.writer;
     write_common(
         w,
@@ -164,7 +164,7 @@ pub fn write_writer_qos(w: &mut ParameterWriter<'_>, q: &WriterQos) {
 }
 
 /// Appends the QoS parameters of a subscription (DiscoveredReaderData).
-pub fn write_reader_qos(w: &mut ParameterWriter<'_>, q: &ReaderQos) {
+pub(super) fn write_reader_qos(w: &mut ParameterWriter<'_>, q: &ReaderQos) {
     let d = &q.reader;
     write_common(
         w,
@@ -339,7 +339,7 @@ fn read_common(id: u16, c: &mut Cursor<'_>, q: Common<'_>) -> Result<bool, WireE
 }
 
 /// Decodes one publication QoS parameter into `q`. Ok(false): not a QoS parameter this function knows.
-pub fn read_writer_qos(
+pub(super) fn read_writer_qos(
     id: u16,
     value: &[u8],
     little_endian: bool,
@@ -398,7 +398,7 @@ pub fn read_writer_qos(
 }
 
 /// Decodes one subscription QoS parameter into `q`. Ok(false): not a QoS parameter this function knows.
-pub fn read_reader_qos(
+pub(super) fn read_reader_qos(
     id: u16,
     value: &[u8],
     little_endian: bool,

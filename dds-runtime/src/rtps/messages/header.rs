@@ -3,7 +3,7 @@
 use super::{Cursor, WireError};
 use crate::rtps::types::{GuidPrefix, ProtocolVersion, VendorId};
 
-pub const HEADER_LEN: usize = 20;
+pub(crate) const HEADER_LEN: usize = 20;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Header {

@@ -11,8 +11,9 @@ pub mod parameter;
 mod submessages;
 
 pub use codec::{MessageBuilder, MessageIter};
-pub use cursor::Cursor;
-pub use header::{Header, HEADER_LEN};
+pub(crate) use cursor::Cursor;
+pub use header::Header;
+pub(crate) use header::HEADER_LEN;
 pub use parameter::{Parameter, ParameterList, ParameterWriter};
 pub use submessages::*;
 
