@@ -20,6 +20,7 @@ pub struct Payload {
 }
 
 impl Payload {
+    /// Shares `bytes` whole.
     pub fn new(bytes: impl Into<Arc<[u8]>>) -> Self {
         let buf: Arc<[u8]> = bytes.into();
         let end = buf.len();
@@ -29,6 +30,7 @@ impl Payload {
             end,
         }
     }
+    /// A copy of `b` in a buffer of its own.
     pub fn copy_from_slice(b: &[u8]) -> Self {
         Payload::new(Arc::<[u8]>::from(b))
     }
@@ -319,7 +321,9 @@ impl From<ParticipantConfigBuilder> for ParticipantConfig {
 /// One datagram to send to every destination.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Transmit {
+    /// Send the payload to each of these.
     pub destinations: Vec<Locator>,
+    /// One RTPS message.
     pub payload: Vec<u8>,
 }
 
@@ -365,6 +369,7 @@ impl ChangeKind {
 /// One change to write.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct WriteChange {
+    /// What the change does to its instance.
     pub kind: ChangeKind,
     /// Serialized sample (with encapsulation header); for non-Alive kinds the serialized key (may be empty).
     pub payload: Payload,
@@ -376,6 +381,7 @@ pub struct WriteChange {
 }
 
 impl WriteChange {
+    /// A new value (kind [`ChangeKind::Alive`]) with no key hash and no timestamp.
     pub fn alive(payload: impl Into<Payload>) -> Self {
         WriteChange {
             kind: ChangeKind::Alive,
@@ -384,14 +390,17 @@ impl WriteChange {
             source_timestamp: None,
         }
     }
+    /// Sets the key hash (required for keyed writers).
     pub fn with_key_hash(mut self, key_hash: [u8; 16]) -> Self {
         self.key_hash = Some(key_hash);
         self
     }
+    /// Sets the source timestamp sent in INFO_TS.
     pub fn with_timestamp(mut self, t: Time) -> Self {
         self.source_timestamp = Some(t);
         self
     }
+    /// Sets the kind (dispose, unregister).
     pub fn with_kind(mut self, kind: ChangeKind) -> Self {
         self.kind = kind;
         self
@@ -445,13 +454,19 @@ impl<Q> EndpointSpec<Q> {
 /// A received change delivered to a local reader.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReceivedSample {
+    /// The local reader it is for.
     pub reader: EntityId,
+    /// The remote (or local) writer that wrote it.
     pub writer: Guid,
+    /// The writer's sequence number.
     pub sequence: SequenceNumber,
+    /// What the change does to its instance.
     pub kind: ChangeKind,
     /// Serialized sample, or serialized key (possibly empty) when `kind` is not Alive.
     pub payload: Payload,
+    /// PID_KEY_HASH, when the writer sent one (Cyclone does not).
     pub key_hash: Option<[u8; 16]>,
+    /// The writer's INFO_TS, if any.
     pub source_timestamp: Option<Time>,
 }
 
@@ -459,61 +474,96 @@ pub struct ReceivedSample {
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum Event {
+    /// A change for a local reader.
     Sample(ReceivedSample),
+    /// A local writer matched or unmatched a reader.
     PublicationMatched {
+        /// The local writer.
         writer: EntityId,
+        /// The reader.
         reader: Guid,
+        /// `true` when matched, `false` when no longer.
         matched: bool,
     },
+    /// A local reader matched or unmatched a writer.
     SubscriptionMatched {
+        /// The local reader.
         reader: EntityId,
+        /// The writer.
         writer: Guid,
+        /// `true` when matched, `false` when no longer.
         matched: bool,
     },
+    /// A local writer and a reader on its topic have incompatible QoS (reported once per pair).
     OfferedIncompatibleQos {
+        /// The local writer.
         writer: EntityId,
+        /// The reader.
         reader: Guid,
+        /// The first incompatible policy.
         policy: QosPolicyId,
     },
+    /// A local reader and a writer on its topic have incompatible QoS (reported once per pair).
     RequestedIncompatibleQos {
+        /// The local reader.
         reader: EntityId,
+        /// The writer.
         writer: Guid,
+        /// The first incompatible policy.
         policy: QosPolicyId,
     },
+    /// A remote participant appeared.
     ParticipantDiscovered(Box<ParticipantData>),
+    /// A remote participant left or its lease expired.
     ParticipantLost {
+        /// Its GUID prefix.
         guid_prefix: GuidPrefix,
     },
+    /// A publication (remote or local) appeared.
     PublicationDiscovered(Box<WriterData>),
+    /// A known publication is gone.
     PublicationRemoved {
+        /// Its GUID.
         guid: Guid,
     },
+    /// A subscription (remote or local) appeared.
     SubscriptionDiscovered(Box<ReaderData>),
+    /// A known subscription is gone.
     SubscriptionRemoved {
+        /// Its GUID.
         guid: Guid,
     },
     /// A matched remote writer's liveliness changed (automatic: participant lease; manual: its messages).
     LivelinessChanged {
+        /// The local reader.
         reader: EntityId,
+        /// The matched writer.
         writer: Guid,
+        /// Whether the writer is alive now.
         alive: bool,
     },
     /// Samples from `writer` that `reader` will never get (writer no longer had them, or buffers overflowed).
     SampleLost {
+        /// The local reader.
         reader: EntityId,
+        /// The writer.
         writer: Guid,
+        /// How many changes were lost.
         count: u64,
     },
     /// A deleted writer finished lingering and is gone.
     WriterDeleted {
+        /// The local writer.
         writer: EntityId,
     },
     /// Flow control released a writer that returned WouldBlock: unacknowledged bytes fell below the low watermark.
     WriterUnblocked {
+        /// The local writer.
         writer: EntityId,
     },
     /// Every matched reliable reader acknowledged everything the writer wrote (wait_for_acknowledgments).
     WriterAcknowledged {
+        /// The local writer.
         writer: EntityId,
     },
 }
@@ -522,26 +572,34 @@ pub enum Event {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum CoreError {
+    /// No local endpoint has this id.
     #[error("no such entity {0:?}")]
     UnknownEntity(EntityId),
+    /// All 2^24 entity keys are used up.
     #[error("out of entity ids")]
     OutOfEntityIds,
+    /// A spec was refused; the text says why.
     #[error("bad parameter: {0}")]
     BadParameter(&'static str),
 }
 
+/// Why [`Participant::write`](super::Participant::write) refused a change.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum WriteError {
     /// Flow control or KEEP_ALL resource limits refuse the change for now; retry after acknowledgements
     /// arrive (within the writer's max_blocking_time).
     #[error("writer would block")]
     WouldBlock,
+    /// No local user writer has this id.
     #[error("no such writer {0:?}")]
     UnknownWriter(EntityId),
+    /// The writer is lingering after deletion.
     #[error("writer is being deleted")]
     Deleted,
+    /// The serialized size exceeds what a sample can have.
     #[error("sample of {0} bytes exceeds the maximum sample size")]
     TooLarge(usize),
+    /// A keyed writer got a change without a key hash.
     #[error("keyed writer needs a key hash")]
     MissingKeyHash,
 }

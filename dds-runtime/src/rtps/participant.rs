@@ -113,6 +113,7 @@ fn reader_params(c: &ParticipantConfig, reliable: bool) -> ReaderParams {
 }
 
 impl Participant {
+    /// A participant with its builtin endpoints, announcing itself from `now` on (drain `poll_transmit`).
     pub fn new(mut config: ParticipantConfig, now: Instant) -> Self {
         // Fragments must fit the 16-bit fragmentSize field and leave room for headers in a datagram.
         config.fragment_size = config.fragment_size.clamp(64, 65000);
@@ -161,9 +162,11 @@ impl Participant {
         p
     }
 
+    /// The configuration it runs with (the fragment size clamped to 64..=65000).
     pub fn config(&self) -> &ParticipantConfig {
         &self.config
     }
+    /// Our GUID prefix.
     pub fn guid_prefix(&self) -> GuidPrefix {
         self.config.guid_prefix
     }
@@ -207,6 +210,7 @@ impl Participant {
         self.out.recycle(buf);
     }
 
+    /// The next event for the DCPS layer, in order.
     pub fn poll_event(&mut self) -> Option<Event> {
         loop {
             let e = self.events.pop_front()?;
@@ -220,6 +224,7 @@ impl Participant {
         }
     }
 
+    /// Runs the work due at `now` (heartbeats, repairs, SPDP, leases, lingering writers, batch deadlines).
     pub fn handle_timeout(&mut self, now: Instant) {
         self.service(now);
     }
@@ -312,6 +317,7 @@ impl Participant {
         self.service(now);
     }
 
+    /// Deletes a reader at once: unmatch events and an SEDP dispose.
     pub fn delete_reader(&mut self, now: Instant, id: EntityId) {
         self.timers_changed();
         if !self.user_readers.remove(&id) {
@@ -361,6 +367,8 @@ impl Participant {
         self.events.push_back(Event::WriterDeleted { writer: id });
     }
 
+    /// Queues one change of a user writer. `Err(WouldBlock)` when flow control or KEEP_ALL resource limits
+    /// refuse it: call again after acknowledgements arrive ([`Event::WriterUnblocked`]).
     pub fn write(
         &mut self,
         now: Instant,
@@ -383,6 +391,7 @@ impl Participant {
         r
     }
 
+    /// Whether every matched reliable reader acknowledged everything the writer wrote (true for unknown ids).
     pub fn is_acknowledged(&self, writer: EntityId) -> bool {
         self.writers
             .get(&writer)
@@ -394,6 +403,7 @@ impl Participant {
         self.writers.get(&writer).map_or(0, |w| w.unacked_bytes())
     }
 
+    /// The readers a local user writer is matched with.
     pub fn writer_matches(&self, writer: EntityId) -> Vec<Guid> {
         if !self.user_writers.contains(&writer) {
             return Vec::new();
@@ -416,6 +426,7 @@ impl Participant {
         }
     }
 
+    /// The writers a local user reader is matched with.
     pub fn reader_matches(&self, reader: EntityId) -> Vec<Guid> {
         if !self.user_readers.contains(&reader) {
             return Vec::new();
@@ -435,6 +446,7 @@ impl Participant {
     pub fn publication(&self, guid: &Guid) -> Option<&WriterData> {
         self.known_writers.get(guid)
     }
+    /// A known subscription (remote or local).
     pub fn subscription(&self, guid: &Guid) -> Option<&ReaderData> {
         self.known_readers.get(guid)
     }

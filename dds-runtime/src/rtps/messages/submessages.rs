@@ -8,31 +8,50 @@ use crate::rtps::types::*;
 /// Submessage flag bits shared by all: E (endianness).
 pub const FLAG_E: u8 = 0x01;
 
+/// ACKNACK (§9.4.5.2): a reader's positive and negative acknowledgements.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct AckNack {
+    /// The reader acknowledging (may be ENTITYID_UNKNOWN).
     pub reader_id: EntityId,
+    /// The writer acknowledged.
     pub writer_id: EntityId,
+    /// Everything below the base is acknowledged; set bits are missing.
     pub reader_sn_state: SequenceNumberSet,
+    /// Counts ACKNACKs from this reader to this writer, to drop duplicates.
     pub count: i32,
+    /// F: no answer is required.
     pub final_flag: bool,
 }
 
+/// HEARTBEAT (§9.4.5.6): the range of sequence numbers a writer has available.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Heartbeat {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer announcing.
     pub writer_id: EntityId,
+    /// The first sequence number still available.
     pub first_sn: SequenceNumber,
+    /// The last sequence number written.
     pub last_sn: SequenceNumber,
+    /// Counts HEARTBEATs from this writer, to drop duplicates.
     pub count: i32,
+    /// F: the readers need not answer.
     pub final_flag: bool,
+    /// L: the heartbeat asserts liveliness.
     pub liveliness_flag: bool,
 }
 
+/// GAP (§9.4.5.5): sequence numbers that will never be sent to the reader.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Gap {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer.
     pub writer_id: EntityId,
+    /// The first irrelevant sequence number of the contiguous range.
     pub gap_start: SequenceNumber,
+    /// The range ends before the base; set bits are irrelevant too.
     pub gap_list: SequenceNumberSet,
 }
 
@@ -47,10 +66,14 @@ impl Gap {
     }
 }
 
+/// INFO_SRC (§9.4.5.8): the source of the following submessages.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct InfoSource {
+    /// The source's protocol version.
     pub version: ProtocolVersion,
+    /// The source's vendor.
     pub vendor_id: VendorId,
+    /// The source's GUID prefix.
     pub guid_prefix: GuidPrefix,
 }
 
@@ -72,9 +95,11 @@ impl PartialEq for InfoReply<'_> {
 impl Eq for InfoReply<'_> {}
 
 impl<'a> InfoReply<'a> {
+    /// The unicast locators to reply to.
     pub fn unicast(&self) -> impl Iterator<Item = Locator> + 'a {
         locators(self.unicast, self.little_endian)
     }
+    /// The multicast locators to reply to (none without the M flag).
     pub fn multicast(&self) -> impl Iterator<Item = Locator> + 'a {
         locators(self.multicast.unwrap_or(&[]), self.little_endian)
     }
@@ -85,39 +110,58 @@ fn locators(b: &[u8], le: bool) -> impl Iterator<Item = Locator> + '_ {
         .filter_map(move |c| Cursor::new(c, le).locator().ok())
 }
 
+/// INFO_REPLY_IP4 (§9.4.5.11): where to reply, IPv4 form.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct InfoReplyIp4 {
+    /// The unicast locator to reply to.
     pub unicast: Locator,
+    /// The multicast locator to reply to (M flag).
     pub multicast: Option<Locator>,
 }
 
 /// DATA (§9.4.5.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Data<'a> {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer.
     pub writer_id: EntityId,
+    /// The change's sequence number.
     pub writer_sn: SequenceNumber,
+    /// Inline QoS (Q flag): key hash, status info and the like.
     pub inline_qos: Option<ParameterList<'a>>,
     /// The serialized payload (D flag) or serialized key (K flag).
     pub payload: Option<&'a [u8]>,
+    /// K: the payload is a serialized key.
     pub key_flag: bool,
+    /// N: the payload is not serialized by standard means.
     pub non_standard_flag: bool,
 }
 
 /// DATA_FRAG (§9.4.5.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DataFrag<'a> {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer.
     pub writer_id: EntityId,
+    /// The change's sequence number.
     pub writer_sn: SequenceNumber,
     /// 1-based number of the first fragment in this submessage.
     pub fragment_starting_num: u32,
+    /// How many fragments this submessage carries.
     pub fragments_in_submessage: u16,
+    /// The size of every fragment but the last.
     pub fragment_size: u16,
+    /// The size of the whole serialized sample.
     pub sample_size: u32,
+    /// Inline QoS (Q flag), in the submessage with the first fragment.
     pub inline_qos: Option<ParameterList<'a>>,
+    /// The fragments' bytes, cut at the end of the sample.
     pub payload: &'a [u8],
+    /// K: the fragments are of a serialized key.
     pub key_flag: bool,
+    /// N: the payload is not serialized by standard means.
     pub non_standard_flag: bool,
 }
 
@@ -128,45 +172,72 @@ impl DataFrag<'_> {
     }
 }
 
+/// HEARTBEAT_FRAG (§9.4.5.7): the fragments available of one sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct HeartbeatFrag {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer.
     pub writer_id: EntityId,
+    /// The sample's sequence number.
     pub writer_sn: SequenceNumber,
+    /// The last fragment available.
     pub last_fragment_num: u32,
+    /// Counts HEARTBEAT_FRAGs from this writer, to drop duplicates.
     pub count: i32,
 }
 
+/// NACK_FRAG (§9.4.5.12): the fragments a reader is missing from one sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct NackFrag {
+    /// The reader asking.
     pub reader_id: EntityId,
+    /// The writer asked.
     pub writer_id: EntityId,
+    /// The sample's sequence number.
     pub writer_sn: SequenceNumber,
+    /// The missing fragments.
     pub fragment_number_state: FragmentNumberSet,
+    /// Counts NACK_FRAGs from this reader to this writer, to drop duplicates.
     pub count: i32,
 }
 
 /// One decoded submessage.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Submessage<'a> {
+    /// PAD: nothing.
     Pad,
+    /// ACKNACK.
     AckNack(AckNack),
+    /// HEARTBEAT.
     Heartbeat(Heartbeat),
+    /// GAP.
     Gap(Gap),
     /// INFO_TS; `None` when the I flag invalidates the timestamp.
     InfoTs(Option<Time>),
+    /// INFO_SRC.
     InfoSrc(InfoSource),
+    /// INFO_DST: the GUID prefix of the participant the following submessages are for.
     InfoDst(GuidPrefix),
+    /// INFO_REPLY.
     InfoReply(InfoReply<'a>),
+    /// INFO_REPLY_IP4.
     InfoReplyIp4(InfoReplyIp4),
+    /// DATA.
     Data(Data<'a>),
+    /// DATA_FRAG.
     DataFrag(DataFrag<'a>),
+    /// HEARTBEAT_FRAG.
     HeartbeatFrag(HeartbeatFrag),
+    /// NACK_FRAG.
     NackFrag(NackFrag),
     /// Unknown or vendor-specific (id >= 0x80) submessages, skipped by the receiver.
     Unknown {
+        /// The submessage id.
         id: u8,
+        /// The flag bits as received.
         flags: u8,
+        /// The body, undecoded.
         body: &'a [u8],
     },
 }
