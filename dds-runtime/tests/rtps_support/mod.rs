@@ -240,7 +240,11 @@ impl Sim {
     }
 
     /// Runs until `cond` holds or `limit` of simulated time passes; returns whether `cond` held.
-    pub(crate) fn run_until(&mut self, limit: Duration, mut cond: impl FnMut(&mut Sim) -> bool) -> bool {
+    pub(crate) fn run_until(
+        &mut self,
+        limit: Duration,
+        mut cond: impl FnMut(&mut Sim) -> bool,
+    ) -> bool {
         let end = self.now + limit;
         loop {
             self.pump();

@@ -38,27 +38,22 @@ fn write_reliability(w: &mut ParameterWriter<'_>, r: Reliability) {
     });
 }
 
-#[allow(clippy::too_many_arguments)]
-fn write_common(
-    w: &mut ParameterWriter<'_>,
-    durability: Durability,
-    deadline: Deadline,
-    latency: LatencyBudget,
-    liveliness: Liveliness,
-    reliability: Reliability,
-    order: DestinationOrder,
-    ownership: Ownership,
-) {
-    w.u32(pid::DURABILITY, durability as u32);
-    w.duration(pid::DEADLINE, deadline.0);
-    w.duration(pid::LATENCY_BUDGET, latency.0);
-    w.param(pid::LIVELINESS, |p| {
-        p.u32(liveliness.kind as u32);
-        p.duration(liveliness.lease_duration);
-    });
-    write_reliability(w, reliability);
-    w.u32(pid::DESTINATION_ORDER, order as u32);
-    w.u32(pid::OWNERSHIP, ownership as u32);
+/// Appends the policies that open both a publication's and a subscription's QoS. `$d` is a
+/// `DataWriterQos` or a `DataReaderQos`: they name these policies alike.
+macro_rules! write_shared {
+    ($w:expr, $d:expr) => {{
+        let (w, d) = ($w, $d);
+        w.u32(pid::DURABILITY, d.durability as u32);
+        w.duration(pid::DEADLINE, d.deadline.0);
+        w.duration(pid::LATENCY_BUDGET, d.latency_budget.0);
+        w.param(pid::LIVELINESS, |p| {
+            p.u32(d.liveliness.kind as u32);
+            p.duration(d.liveliness.lease_duration);
+        });
+        write_reliability(w, d.reliability);
+        w.u32(pid::DESTINATION_ORDER, d.destination_order as u32);
+        w.u32(pid::OWNERSHIP, d.ownership as u32);
+    }};
 }
 
 fn write_group(
@@ -124,16 +119,7 @@ fn write_data_representation(w: &mut ParameterWriter<'_>, d: &DataRepresentation
 /// Appends the QoS parameters of a publication (DiscoveredWriterData).
 pub(super) fn write_writer_qos(w: &mut ParameterWriter<'_>, q: &WriterQos) {
     let d = &q.writer;
-    write_common(
-        w,
-        d.durability,
-        d.deadline,
-        d.latency_budget,
-        d.liveliness,
-        d.reliability,
-        d.destination_order,
-        d.ownership,
-    );
+    write_shared!(&mut *w, d);
     let ds = d.durability_service;
     let (hk, hd) = history_kind(ds.history);
     w.param(pid::DURABILITY_SERVICE, |p| {
@@ -166,16 +152,7 @@ pub(super) fn write_writer_qos(w: &mut ParameterWriter<'_>, q: &WriterQos) {
 /// Appends the QoS parameters of a subscription (DiscoveredReaderData).
 pub(super) fn write_reader_qos(w: &mut ParameterWriter<'_>, q: &ReaderQos) {
     let d = &q.reader;
-    write_common(
-        w,
-        d.durability,
-        d.deadline,
-        d.latency_budget,
-        d.liveliness,
-        d.reliability,
-        d.destination_order,
-        d.ownership,
-    );
+    write_shared!(&mut *w, d);
     w.duration(
         pid::TIME_BASED_FILTER,
         d.time_based_filter.minimum_separation,
@@ -210,132 +187,117 @@ pub(super) fn write_reader_qos(w: &mut ParameterWriter<'_>, q: &ReaderQos) {
     );
 }
 
-/// The policies both endpoint kinds share, as decoded.
-struct Common<'q> {
-    durability: &'q mut Durability,
-    deadline: &'q mut Deadline,
-    latency: &'q mut LatencyBudget,
-    liveliness: &'q mut Liveliness,
-    reliability: &'q mut Reliability,
-    order: &'q mut DestinationOrder,
-    ownership: &'q mut Ownership,
-    history: &'q mut History,
-    limits: &'q mut ResourceLimits,
-    user_data: &'q mut UserData,
-    representation: &'q mut DataRepresentation,
-    presentation: &'q mut Presentation,
-    partition: &'q mut Partition,
-    group_data: &'q mut GroupData,
-    topic_data: &'q mut TopicData,
-}
-
-/// Decodes one shared policy; Ok(false) when `id` is not one of them.
-fn read_common(id: u16, c: &mut Cursor<'_>, q: Common<'_>) -> Result<bool, WireError> {
-    match id {
-        pid::DURABILITY => {
-            *q.durability = match c.u32()? {
-                0 => Durability::Volatile,
-                1 => Durability::TransientLocal,
-                2 => Durability::Transient,
-                3 => Durability::Persistent,
-                _ => return Err(WireError::Invalid("durability kind")),
+/// Decodes one of the policies a publication and a subscription share into `$q` (a `WriterQos` or a
+/// `ReaderQos`; `$own` names its endpoint part, `writer` or `reader`), and evaluates to `Ok(true)`;
+/// returns `Ok(false)` from the enclosing function when `$id` is not one of them.
+macro_rules! read_shared {
+    ($id:expr, $c:expr, $q:expr, $own:ident) => {{
+        match $id {
+            pid::DURABILITY => {
+                $q.$own.durability = match $c.u32()? {
+                    0 => Durability::Volatile,
+                    1 => Durability::TransientLocal,
+                    2 => Durability::Transient,
+                    3 => Durability::Persistent,
+                    _ => return Err(WireError::Invalid("durability kind")),
+                }
             }
-        }
-        pid::DEADLINE => q.deadline.0 = c.duration()?,
-        pid::LATENCY_BUDGET => q.latency.0 = c.duration()?,
-        pid::LIVELINESS => {
-            let kind = match c.u32()? {
-                0 => crate::qos::LivelinessKind::Automatic,
-                1 => crate::qos::LivelinessKind::ManualByParticipant,
-                2 => crate::qos::LivelinessKind::ManualByTopic,
-                _ => return Err(WireError::Invalid("liveliness kind")),
-            };
-            *q.liveliness = Liveliness {
-                kind,
-                lease_duration: c.duration()?,
-            };
-        }
-        pid::RELIABILITY => {
-            let kind = c.u32()?;
-            let mbt = c.duration().unwrap_or(Duration::from_millis(100));
-            *q.reliability = match kind {
-                1 => Reliability::BestEffort,
-                // 3 was RELIABLE in some pre-2.0 implementations.
-                2 | 3 => Reliability::Reliable {
-                    max_blocking_time: mbt,
-                },
-                _ => return Err(WireError::Invalid("reliability kind")),
-            };
-        }
-        pid::DESTINATION_ORDER => {
-            *q.order = if c.u32()? == 1 {
-                DestinationOrder::BySourceTimestamp
-            } else {
-                DestinationOrder::ByReceptionTimestamp
+            pid::DEADLINE => $q.$own.deadline.0 = $c.duration()?,
+            pid::LATENCY_BUDGET => $q.$own.latency_budget.0 = $c.duration()?,
+            pid::LIVELINESS => {
+                let kind = match $c.u32()? {
+                    0 => crate::qos::LivelinessKind::Automatic,
+                    1 => crate::qos::LivelinessKind::ManualByParticipant,
+                    2 => crate::qos::LivelinessKind::ManualByTopic,
+                    _ => return Err(WireError::Invalid("liveliness kind")),
+                };
+                $q.$own.liveliness = Liveliness {
+                    kind,
+                    lease_duration: $c.duration()?,
+                };
             }
-        }
-        pid::OWNERSHIP => {
-            *q.ownership = if c.u32()? == 1 {
-                Ownership::Exclusive
-            } else {
-                Ownership::Shared
+            pid::RELIABILITY => {
+                let kind = $c.u32()?;
+                let mbt = $c.duration().unwrap_or(Duration::from_millis(100));
+                $q.$own.reliability = match kind {
+                    1 => Reliability::BestEffort,
+                    // 3 was RELIABLE in some pre-2.0 implementations.
+                    2 | 3 => Reliability::Reliable {
+                        max_blocking_time: mbt,
+                    },
+                    _ => return Err(WireError::Invalid("reliability kind")),
+                };
             }
-        }
-        pid::HISTORY => {
-            let k = c.u32()?;
-            let d = c.i32()?;
-            *q.history = history_from(k, d);
-        }
-        pid::RESOURCE_LIMITS => {
-            *q.limits = ResourceLimits {
-                max_samples: unlimit(c.i32()?),
-                max_instances: unlimit(c.i32()?),
-                max_samples_per_instance: unlimit(c.i32()?),
+            pid::DESTINATION_ORDER => {
+                $q.$own.destination_order = if $c.u32()? == 1 {
+                    DestinationOrder::BySourceTimestamp
+                } else {
+                    DestinationOrder::ByReceptionTimestamp
+                }
             }
-        }
-        pid::USER_DATA => q.user_data.0 = c.octets()?.to_vec(),
-        pid::TOPIC_DATA => q.topic_data.0 = c.octets()?.to_vec(),
-        pid::GROUP_DATA => q.group_data.0 = c.octets()?.to_vec(),
-        pid::DATA_REPRESENTATION => {
-            let n = c.u32()? as usize;
-            // Bound the allocation by what the parameter actually holds.
-            if n > c.remaining() / 2 {
-                return Err(WireError::Truncated);
+            pid::OWNERSHIP => {
+                $q.$own.ownership = if $c.u32()? == 1 {
+                    Ownership::Exclusive
+                } else {
+                    Ownership::Shared
+                }
             }
-            let mut v = Vec::with_capacity(n);
-            for _ in 0..n {
-                v.push(c.i16()?);
+            pid::HISTORY => {
+                let k = $c.u32()?;
+                let d = $c.i32()?;
+                $q.$own.history = history_from(k, d);
             }
-            *q.representation = DataRepresentation::any_of(v);
-        }
-        pid::PRESENTATION => {
-            let scope = match c.u32()? {
-                0 => crate::qos::PresentationAccessScope::Instance,
-                1 => crate::qos::PresentationAccessScope::Topic,
-                2 => crate::qos::PresentationAccessScope::Group,
-                _ => return Err(WireError::Invalid("presentation scope")),
-            };
-            *q.presentation = Presentation {
-                access_scope: scope,
-                coherent_access: c.u8()? != 0,
-                ordered_access: c.u8()? != 0,
-            };
-        }
-        pid::PARTITION => {
-            let n = c.u32()? as usize;
-            if n > c.remaining() / 4 {
-                return Err(WireError::Truncated);
+            pid::RESOURCE_LIMITS => {
+                $q.$own.resource_limits = ResourceLimits {
+                    max_samples: unlimit($c.i32()?),
+                    max_instances: unlimit($c.i32()?),
+                    max_samples_per_instance: unlimit($c.i32()?),
+                }
             }
-            let mut v = Vec::with_capacity(n);
-            for _ in 0..n {
-                c.align(4)?;
-                v.push(c.string()?.to_owned());
+            pid::USER_DATA => $q.$own.user_data.0 = $c.octets()?.to_vec(),
+            pid::TOPIC_DATA => $q.topic_data.0 = $c.octets()?.to_vec(),
+            pid::GROUP_DATA => $q.group_data.0 = $c.octets()?.to_vec(),
+            pid::DATA_REPRESENTATION => {
+                let n = $c.u32()? as usize;
+                // Bound the allocation by what the parameter actually holds.
+                if n > $c.remaining() / 2 {
+                    return Err(WireError::Truncated);
+                }
+                let mut v = Vec::with_capacity(n);
+                for _ in 0..n {
+                    v.push($c.i16()?);
+                }
+                $q.$own.data_representation = DataRepresentation::any_of(v);
             }
-            q.partition.0 = v;
+            pid::PRESENTATION => {
+                let scope = match $c.u32()? {
+                    0 => crate::qos::PresentationAccessScope::Instance,
+                    1 => crate::qos::PresentationAccessScope::Topic,
+                    2 => crate::qos::PresentationAccessScope::Group,
+                    _ => return Err(WireError::Invalid("presentation scope")),
+                };
+                $q.presentation = Presentation {
+                    access_scope: scope,
+                    coherent_access: $c.u8()? != 0,
+                    ordered_access: $c.u8()? != 0,
+                };
+            }
+            pid::PARTITION => {
+                let n = $c.u32()? as usize;
+                if n > $c.remaining() / 4 {
+                    return Err(WireError::Truncated);
+                }
+                let mut v = Vec::with_capacity(n);
+                for _ in 0..n {
+                    $c.align(4)?;
+                    v.push($c.string()?.to_owned());
+                }
+                $q.partition.0 = v;
+            }
+            _ => return Ok(false),
         }
-        _ => return Ok(false),
-    }
-    Ok(true)
+        Ok(true)
+    }};
 }
 
 /// Decodes one publication QoS parameter into `q`. Ok(false): not a QoS parameter this function knows.
@@ -373,27 +335,7 @@ pub(super) fn read_writer_qos(
             d.transport_priority.0 = c.i32()?;
             Ok(true)
         }
-        _ => read_common(
-            id,
-            &mut c,
-            Common {
-                durability: &mut d.durability,
-                deadline: &mut d.deadline,
-                latency: &mut d.latency_budget,
-                liveliness: &mut d.liveliness,
-                reliability: &mut d.reliability,
-                order: &mut d.destination_order,
-                ownership: &mut d.ownership,
-                history: &mut d.history,
-                limits: &mut d.resource_limits,
-                user_data: &mut d.user_data,
-                representation: &mut d.data_representation,
-                presentation: &mut q.presentation,
-                partition: &mut q.partition,
-                group_data: &mut q.group_data,
-                topic_data: &mut q.topic_data,
-            },
-        ),
+        _ => read_shared!(id, c, q, writer),
     }
 }
 
@@ -453,26 +395,6 @@ pub(super) fn read_reader_qos(
             };
             Ok(true)
         }
-        _ => read_common(
-            id,
-            &mut c,
-            Common {
-                durability: &mut d.durability,
-                deadline: &mut d.deadline,
-                latency: &mut d.latency_budget,
-                liveliness: &mut d.liveliness,
-                reliability: &mut d.reliability,
-                order: &mut d.destination_order,
-                ownership: &mut d.ownership,
-                history: &mut d.history,
-                limits: &mut d.resource_limits,
-                user_data: &mut d.user_data,
-                representation: &mut d.data_representation,
-                presentation: &mut q.presentation,
-                partition: &mut q.partition,
-                group_data: &mut q.group_data,
-                topic_data: &mut q.topic_data,
-            },
-        ),
+        _ => read_shared!(id, c, q, reader),
     }
 }
