@@ -2,6 +2,7 @@
 
 use std::time::Duration;
 
+use super::EndpointQos;
 use crate::qos::*;
 use crate::rtps::messages::parameter::{pid, put_string, ParameterWriter};
 use crate::rtps::messages::{Cursor, WireError};
@@ -114,77 +115,6 @@ fn write_data_representation(w: &mut ParameterWriter<'_>, d: &DataRepresentation
             p.u16(*v as u16);
         }
     });
-}
-
-/// Appends the QoS parameters of a publication (DiscoveredWriterData).
-pub(super) fn write_writer_qos(w: &mut ParameterWriter<'_>, q: &WriterQos) {
-    let d = &q.writer;
-    write_shared!(&mut *w, d);
-    let ds = d.durability_service;
-    let (hk, hd) = history_kind(ds.history);
-    w.param(pid::DURABILITY_SERVICE, |p| {
-        p.duration(ds.service_cleanup_delay);
-        p.u32(hk);
-        p.i32(hd);
-        p.i32(limit(ds.max_samples));
-        p.i32(limit(ds.max_instances));
-        p.i32(limit(ds.max_samples_per_instance));
-    });
-    w.i32(pid::OWNERSHIP_STRENGTH, d.ownership_strength.0);
-    w.duration(pid::LIFESPAN, d.lifespan.0);
-    write_history(w, d.history, &d.resource_limits);
-    if d.transport_priority.0 != 0 {
-        w.i32(pid::TRANSPORT_PRIORITY, d.transport_priority.0);
-    }
-    if !d.user_data.0.is_empty() {
-        w.octets(pid::USER_DATA, &d.user_data.0);
-    }
-    write_data_representation(w, &d.data_representation);
-    write_group(
-        w,
-        q.presentation,
-        &q.partition,
-        &q.group_data,
-        &q.topic_data,
-    );
-}
-
-/// Appends the QoS parameters of a subscription (DiscoveredReaderData).
-pub(super) fn write_reader_qos(w: &mut ParameterWriter<'_>, q: &ReaderQos) {
-    let d = &q.reader;
-    write_shared!(&mut *w, d);
-    w.duration(
-        pid::TIME_BASED_FILTER,
-        d.time_based_filter.minimum_separation,
-    );
-    write_history(w, d.history, &d.resource_limits);
-    if !d.user_data.0.is_empty() {
-        w.octets(pid::USER_DATA, &d.user_data.0);
-    }
-    write_data_representation(w, &d.data_representation);
-    let tc = d.type_consistency;
-    w.param(pid::TYPE_CONSISTENCY, |p| {
-        p.u16(match tc.kind {
-            TypeConsistencyKind::DisallowTypeCoercion => 0,
-            TypeConsistencyKind::AllowTypeCoercion => 1,
-        });
-        for b in [
-            tc.ignore_sequence_bounds,
-            tc.ignore_string_bounds,
-            tc.ignore_member_names,
-            tc.prevent_type_widening,
-            tc.force_type_validation,
-        ] {
-            p.u8(b as u8);
-        }
-    });
-    write_group(
-        w,
-        q.presentation,
-        &q.partition,
-        &q.group_data,
-        &q.topic_data,
-    );
 }
 
 /// Decodes one of the policies a publication and a subscription share into `$q` (a `WriterQos` or a
@@ -300,101 +230,180 @@ macro_rules! read_shared {
     }};
 }
 
-/// Decodes one publication QoS parameter into `q`. Ok(false): not a QoS parameter this function knows.
-pub(super) fn read_writer_qos(
-    id: u16,
-    value: &[u8],
-    little_endian: bool,
-    q: &mut WriterQos,
-) -> Result<bool, WireError> {
-    let mut c = Cursor::new(value, little_endian);
-    let d = &mut q.writer;
-    match id {
-        pid::DURABILITY_SERVICE => {
-            let delay = c.duration()?;
-            let k = c.u32()?;
-            let depth = c.i32()?;
-            d.durability_service = DurabilityService {
-                service_cleanup_delay: delay,
-                history: history_from(k, depth),
-                max_samples: unlimit(c.i32()?),
-                max_instances: unlimit(c.i32()?),
-                max_samples_per_instance: unlimit(c.i32()?),
-            };
-            Ok(true)
+impl EndpointQos for WriterQos {
+    /// Appends the QoS parameters of a publication (DiscoveredWriterData).
+    fn write_params(&self, w: &mut ParameterWriter<'_>) {
+        let q = self;
+        let d = &q.writer;
+        write_shared!(&mut *w, d);
+        let ds = d.durability_service;
+        let (hk, hd) = history_kind(ds.history);
+        w.param(pid::DURABILITY_SERVICE, |p| {
+            p.duration(ds.service_cleanup_delay);
+            p.u32(hk);
+            p.i32(hd);
+            p.i32(limit(ds.max_samples));
+            p.i32(limit(ds.max_instances));
+            p.i32(limit(ds.max_samples_per_instance));
+        });
+        w.i32(pid::OWNERSHIP_STRENGTH, d.ownership_strength.0);
+        w.duration(pid::LIFESPAN, d.lifespan.0);
+        write_history(w, d.history, &d.resource_limits);
+        if d.transport_priority.0 != 0 {
+            w.i32(pid::TRANSPORT_PRIORITY, d.transport_priority.0);
         }
-        pid::OWNERSHIP_STRENGTH => {
-            d.ownership_strength.0 = c.i32()?;
-            Ok(true)
+        if !d.user_data.0.is_empty() {
+            w.octets(pid::USER_DATA, &d.user_data.0);
         }
-        pid::LIFESPAN => {
-            d.lifespan.0 = c.duration()?;
-            Ok(true)
+        write_data_representation(w, &d.data_representation);
+        write_group(
+            w,
+            q.presentation,
+            &q.partition,
+            &q.group_data,
+            &q.topic_data,
+        );
+    }
+
+    /// Decodes one publication QoS parameter; `Ok(false)` when it is not one.
+    fn read_param(
+        &mut self,
+        id: u16,
+        value: &[u8],
+        little_endian: bool,
+    ) -> Result<bool, WireError> {
+        let q = self;
+        let mut c = Cursor::new(value, little_endian);
+        let d = &mut q.writer;
+        match id {
+            pid::DURABILITY_SERVICE => {
+                let delay = c.duration()?;
+                let k = c.u32()?;
+                let depth = c.i32()?;
+                d.durability_service = DurabilityService {
+                    service_cleanup_delay: delay,
+                    history: history_from(k, depth),
+                    max_samples: unlimit(c.i32()?),
+                    max_instances: unlimit(c.i32()?),
+                    max_samples_per_instance: unlimit(c.i32()?),
+                };
+                Ok(true)
+            }
+            pid::OWNERSHIP_STRENGTH => {
+                d.ownership_strength.0 = c.i32()?;
+                Ok(true)
+            }
+            pid::LIFESPAN => {
+                d.lifespan.0 = c.duration()?;
+                Ok(true)
+            }
+            pid::TRANSPORT_PRIORITY => {
+                d.transport_priority.0 = c.i32()?;
+                Ok(true)
+            }
+            _ => read_shared!(id, c, q, writer),
         }
-        pid::TRANSPORT_PRIORITY => {
-            d.transport_priority.0 = c.i32()?;
-            Ok(true)
-        }
-        _ => read_shared!(id, c, q, writer),
     }
 }
 
-/// Decodes one subscription QoS parameter into `q`. Ok(false): not a QoS parameter this function knows.
-pub(super) fn read_reader_qos(
-    id: u16,
-    value: &[u8],
-    little_endian: bool,
-    q: &mut ReaderQos,
-) -> Result<bool, WireError> {
-    let mut c = Cursor::new(value, little_endian);
-    let d = &mut q.reader;
-    match id {
-        pid::TIME_BASED_FILTER => {
-            d.time_based_filter.minimum_separation = c.duration()?;
-            Ok(true)
+impl EndpointQos for ReaderQos {
+    /// Appends the QoS parameters of a subscription (DiscoveredReaderData).
+    fn write_params(&self, w: &mut ParameterWriter<'_>) {
+        let q = self;
+        let d = &q.reader;
+        write_shared!(&mut *w, d);
+        w.duration(
+            pid::TIME_BASED_FILTER,
+            d.time_based_filter.minimum_separation,
+        );
+        write_history(w, d.history, &d.resource_limits);
+        if !d.user_data.0.is_empty() {
+            w.octets(pid::USER_DATA, &d.user_data.0);
         }
-        pid::TYPE_CONSISTENCY => {
-            let kind = c.u16()?;
-            let mut b = [false; 5];
-            for x in b.iter_mut() {
-                // Older senders stop after the kind; absent flags keep their defaults.
-                match c.u8() {
-                    Ok(v) => *x = v != 0,
-                    Err(_) => break,
-                }
+        write_data_representation(w, &d.data_representation);
+        let tc = d.type_consistency;
+        w.param(pid::TYPE_CONSISTENCY, |p| {
+            p.u16(match tc.kind {
+                TypeConsistencyKind::DisallowTypeCoercion => 0,
+                TypeConsistencyKind::AllowTypeCoercion => 1,
+            });
+            for b in [
+                tc.ignore_sequence_bounds,
+                tc.ignore_string_bounds,
+                tc.ignore_member_names,
+                tc.prevent_type_widening,
+                tc.force_type_validation,
+            ] {
+                p.u8(b as u8);
             }
-            let dflt = TypeConsistencyEnforcement::default();
-            let full = value.len() >= 7;
-            d.type_consistency = TypeConsistencyEnforcement {
-                kind: if kind == 0 {
-                    TypeConsistencyKind::DisallowTypeCoercion
-                } else {
-                    TypeConsistencyKind::AllowTypeCoercion
-                },
-                ignore_sequence_bounds: if full {
-                    b[0]
-                } else {
-                    dflt.ignore_sequence_bounds
-                },
-                ignore_string_bounds: if full {
-                    b[1]
-                } else {
-                    dflt.ignore_string_bounds
-                },
-                ignore_member_names: if full { b[2] } else { dflt.ignore_member_names },
-                prevent_type_widening: if full {
-                    b[3]
-                } else {
-                    dflt.prevent_type_widening
-                },
-                force_type_validation: if full {
-                    b[4]
-                } else {
-                    dflt.force_type_validation
-                },
-            };
-            Ok(true)
+        });
+        write_group(
+            w,
+            q.presentation,
+            &q.partition,
+            &q.group_data,
+            &q.topic_data,
+        );
+    }
+
+    /// Decodes one subscription QoS parameter; `Ok(false)` when it is not one.
+    fn read_param(
+        &mut self,
+        id: u16,
+        value: &[u8],
+        little_endian: bool,
+    ) -> Result<bool, WireError> {
+        let q = self;
+        let mut c = Cursor::new(value, little_endian);
+        let d = &mut q.reader;
+        match id {
+            pid::TIME_BASED_FILTER => {
+                d.time_based_filter.minimum_separation = c.duration()?;
+                Ok(true)
+            }
+            pid::TYPE_CONSISTENCY => {
+                let kind = c.u16()?;
+                let mut b = [false; 5];
+                for x in b.iter_mut() {
+                    // Older senders stop after the kind; absent flags keep their defaults.
+                    match c.u8() {
+                        Ok(v) => *x = v != 0,
+                        Err(_) => break,
+                    }
+                }
+                let dflt = TypeConsistencyEnforcement::default();
+                let full = value.len() >= 7;
+                d.type_consistency = TypeConsistencyEnforcement {
+                    kind: if kind == 0 {
+                        TypeConsistencyKind::DisallowTypeCoercion
+                    } else {
+                        TypeConsistencyKind::AllowTypeCoercion
+                    },
+                    ignore_sequence_bounds: if full {
+                        b[0]
+                    } else {
+                        dflt.ignore_sequence_bounds
+                    },
+                    ignore_string_bounds: if full {
+                        b[1]
+                    } else {
+                        dflt.ignore_string_bounds
+                    },
+                    ignore_member_names: if full { b[2] } else { dflt.ignore_member_names },
+                    prevent_type_widening: if full {
+                        b[3]
+                    } else {
+                        dflt.prevent_type_widening
+                    },
+                    force_type_validation: if full {
+                        b[4]
+                    } else {
+                        dflt.force_type_validation
+                    },
+                };
+                Ok(true)
+            }
+            _ => read_shared!(id, c, q, reader),
         }
-        _ => read_shared!(id, c, q, reader),
     }
 }

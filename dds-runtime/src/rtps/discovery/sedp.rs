@@ -1,6 +1,5 @@
 //! DiscoveredWriterData / DiscoveredReaderData (§8.5.4, §9.6.2.2) and their parameter-list form.
 
-use super::qos_params::{read_reader_qos, read_writer_qos, write_reader_qos, write_writer_qos};
 use super::{pl_payload, PL_CDR_LE};
 use crate::qos::{ReaderQos, WriterQos};
 use crate::rtps::messages::parameter::{pid, ParameterWriter};
@@ -49,34 +48,6 @@ pub trait EndpointQos: Default {
     /// Decodes one parameter into `self`; `Ok(false)` when it is not a QoS parameter of this direction.
     fn read_param(&mut self, id: u16, value: &[u8], little_endian: bool)
         -> Result<bool, WireError>;
-}
-
-impl EndpointQos for WriterQos {
-    fn write_params(&self, w: &mut ParameterWriter<'_>) {
-        write_writer_qos(w, self);
-    }
-    fn read_param(
-        &mut self,
-        id: u16,
-        value: &[u8],
-        little_endian: bool,
-    ) -> Result<bool, WireError> {
-        read_writer_qos(id, value, little_endian, self)
-    }
-}
-
-impl EndpointQos for ReaderQos {
-    fn write_params(&self, w: &mut ParameterWriter<'_>) {
-        write_reader_qos(w, self);
-    }
-    fn read_param(
-        &mut self,
-        id: u16,
-        value: &[u8],
-        little_endian: bool,
-    ) -> Result<bool, WireError> {
-        read_reader_qos(id, value, little_endian, self)
-    }
 }
 
 impl<Q: EndpointQos> EndpointData<Q> {
