@@ -57,6 +57,19 @@ macro_rules! write_shared {
     }};
 }
 
+/// Appends the group and topic part of a `WriterQos` or `ReaderQos` (they name it alike).
+macro_rules! write_group_of {
+    ($w:expr, $q:expr) => {
+        write_group(
+            $w,
+            $q.presentation,
+            &$q.partition,
+            &$q.group_data,
+            &$q.topic_data,
+        )
+    };
+}
+
 fn write_group(
     w: &mut ParameterWriter<'_>,
     pres: Presentation,
@@ -73,8 +86,6 @@ fn write_group(
         w.param(pid::PARTITION, |p| {
             p.u32(part.0.len() as u32);
             for s in &part.0 {
-                let start = p.out.len();
-                let _ = start;
                 put_string(p, s);
                 // Each string is 4-aligned relative to the parameter value; the value starts 4-aligned.
                 while p.out.len() % 4 != 0 {
@@ -256,13 +267,7 @@ impl EndpointQos for WriterQos {
             w.octets(pid::USER_DATA, &d.user_data.0);
         }
         write_data_representation(w, &d.data_representation);
-        write_group(
-            w,
-            q.presentation,
-            &q.partition,
-            &q.group_data,
-            &q.topic_data,
-        );
+        write_group_of!(w, q);
     }
 
     /// Decodes one publication QoS parameter; `Ok(false)` when it is not one.
@@ -337,13 +342,7 @@ impl EndpointQos for ReaderQos {
                 p.u8(b as u8);
             }
         });
-        write_group(
-            w,
-            q.presentation,
-            &q.partition,
-            &q.group_data,
-            &q.topic_data,
-        );
+        write_group_of!(w, q);
     }
 
     /// Decodes one subscription QoS parameter; `Ok(false)` when it is not one.
