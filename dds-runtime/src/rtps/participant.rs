@@ -19,7 +19,7 @@ use super::outbox::Outbox;
 use super::reader::{Reader, ReaderParams};
 use super::types::*;
 use super::writer::{Writer, WriterParams};
-use crate::qos::{DataWriterQos, Durability, History, ResourceLimits};
+use crate::qos::{DataWriterQos, Durability, History, ReaderQos, ResourceLimits, WriterQos};
 
 /// A discovered remote participant.
 #[derive(Debug)]
@@ -340,7 +340,7 @@ impl Participant {
             ChangeKind::DisposeUnregister,
             Vec::new(),
         );
-        self.forget_reader(guid);
+        self.forget_endpoint::<ReaderQos>(guid);
         self.service(now);
     }
 
@@ -363,7 +363,7 @@ impl Participant {
             ChangeKind::DisposeUnregister,
             Vec::new(),
         );
-        self.forget_writer(guid);
+        self.forget_endpoint::<WriterQos>(guid);
         self.events.push_back(Event::WriterDeleted { writer: id });
     }
 

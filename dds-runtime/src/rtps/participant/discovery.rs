@@ -171,7 +171,7 @@ impl Participant {
                     });
                 }
             }
-            self.forget_writer(g);
+            self.forget_endpoint::<WriterQos>(g);
             self.events.push_back(Event::PublicationRemoved { guid: g });
         }
         let readers: Vec<Guid> = self
@@ -181,7 +181,7 @@ impl Participant {
             .copied()
             .collect();
         for g in readers {
-            self.forget_reader(g);
+            self.forget_endpoint::<ReaderQos>(g);
             self.events
                 .push_back(Event::SubscriptionRemoved { guid: g });
         }
@@ -211,7 +211,7 @@ impl Participant {
         if s.kind != ChangeKind::Alive {
             if let Some(g) = endpoint_of(s) {
                 if g.prefix == s.writer.prefix && Q::known(self).contains_key(&g) {
-                    Q::forget(self, g);
+                    self.forget_endpoint::<Q>(g);
                     self.events.push_back(Q::removed(g));
                 }
             }
@@ -306,19 +306,7 @@ impl Participant {
                 self.incompatible.remove(&(local.id(), remote));
             }
             other => {
-                if has {
-                    match local {
-                        Local::Writer(id) => {
-                            if let Some(w) = self.writers.get_mut(&id) {
-                                w.remove_proxy(&remote, &mut self.events);
-                            }
-                        }
-                        Local::Reader(id) => {
-                            if let Some(r) = self.readers.get_mut(&id) {
-                                r.remove_proxy(&remote);
-                            }
-                        }
-                    }
+                if has && self.remove_proxy(local, remote) {
                     self.events.push_back(local.matched(remote, false));
                 }
                 if let MatchResult::Incompatible(policy) = other {
@@ -377,32 +365,27 @@ impl Participant {
         }
     }
 
-    /// A publication is gone: unmatch it from local readers.
-    pub(super) fn forget_writer(&mut self, g: Guid) {
-        self.known_writers.remove(&g);
-        self.readers_by_writer.remove(&g);
-        for (id, r) in self.readers.iter_mut() {
-            if self.user_readers.contains(id) && r.remove_proxy(&g) {
-                self.events.push_back(Event::SubscriptionMatched {
-                    reader: *id,
-                    writer: g,
-                    matched: false,
-                });
-            }
+    /// Removes `local`'s proxy for `remote`; whether it had one.
+    fn remove_proxy(&mut self, local: Local, remote: Guid) -> bool {
+        match local {
+            Local::Writer(id) => self
+                .writers
+                .get_mut(&id)
+                .is_some_and(|w| w.remove_proxy(&remote, &mut self.events)),
+            Local::Reader(id) => self
+                .readers
+                .get_mut(&id)
+                .is_some_and(|r| r.remove_proxy(&remote)),
         }
-        self.incompatible.retain(|(_, x)| *x != g);
     }
 
-    /// A subscription is gone: unmatch it from local writers.
-    pub(super) fn forget_reader(&mut self, g: Guid) {
-        self.known_readers.remove(&g);
-        for (id, w) in self.writers.iter_mut() {
-            if self.user_writers.contains(id) && w.remove_proxy(&g, &mut self.events) {
-                self.events.push_back(Event::PublicationMatched {
-                    writer: *id,
-                    reader: g,
-                    matched: false,
-                });
+    /// A known endpoint of direction `Q` is gone: unmatch it from every local endpoint of the other direction.
+    pub(super) fn forget_endpoint<Q: Direction>(&mut self, g: Guid) {
+        Q::known_mut(self).remove(&g);
+        self.readers_by_writer.remove(&g);
+        for local in Q::local_peers(self) {
+            if self.remove_proxy(local, g) {
+                self.events.push_back(local.matched(g, false));
             }
         }
         self.incompatible.retain(|(_, x)| *x != g);
@@ -486,8 +469,6 @@ pub(super) trait Direction: EndpointQos + Clone {
     fn local_peers(p: &Participant) -> Vec<Local>;
     /// Known endpoints of the other direction.
     fn known_peers(p: &Participant) -> Vec<Guid>;
-    /// Unmatches a known endpoint that is gone.
-    fn forget(p: &mut Participant, guid: Guid);
     /// The discovery event for a new endpoint.
     fn discovered(d: EndpointData<Self>) -> Event;
     /// The event for an endpoint that is gone.
@@ -511,9 +492,6 @@ impl Direction for WriterQos {
     }
     fn known_peers(p: &Participant) -> Vec<Guid> {
         p.known_readers.keys().copied().collect()
-    }
-    fn forget(p: &mut Participant, guid: Guid) {
-        p.forget_writer(guid);
     }
     fn discovered(d: EndpointData<Self>) -> Event {
         Event::PublicationDiscovered(Box::new(d))
@@ -540,9 +518,6 @@ impl Direction for ReaderQos {
     }
     fn known_peers(p: &Participant) -> Vec<Guid> {
         p.known_writers.keys().copied().collect()
-    }
-    fn forget(p: &mut Participant, guid: Guid) {
-        p.forget_reader(guid);
     }
     fn discovered(d: EndpointData<Self>) -> Event {
         Event::SubscriptionDiscovered(Box::new(d))
