@@ -20,9 +20,7 @@ fn matched(batch: Option<Duration>) -> (Sim, EntityId, EntityId) {
 fn matched_with(seed: u64, faults: Faults, batch: Option<Duration>) -> (Sim, EntityId, EntityId) {
     let mut sim = Sim::new(seed, faults);
     sim.faults_on_discovery = false;
-    let mut c = config(0);
-    c.write_batch_delay = batch;
-    sim.add(c);
+    sim.add(config(0).write_batch_delay(batch));
     sim.add(config(1));
     let now = sim.now;
     let keep_all = History::KeepAll;
@@ -161,7 +159,7 @@ fn flush_sends_a_partial_batch_at_once() {
 #[test]
 fn full_datagrams_leave_without_waiting_and_carry_few_heartbeats() {
     let (mut sim, w, r) = matched(Some(Duration::from_secs(1)));
-    let max = sim.nodes[0].p.config().max_message_size;
+    let max = sim.nodes[0].p.config().max_message_size();
     let mut grams = Vec::new();
     for i in 0..200 {
         grams.extend(write_and_drain(&mut sim, w, i, 1024));
@@ -192,7 +190,7 @@ fn other_traffic_takes_held_samples_along() {
     let (mut sim, w, _r) = matched(Some(Duration::from_secs(1)));
     assert!(write_and_drain(&mut sim, w, 0, 100).is_empty());
     // A periodic heartbeat (unbatched) is due within the heartbeat period; it closes the batch with it.
-    let hb_at = sim.nodes[0].p.config().heartbeat_period;
+    let hb_at = sim.nodes[0].p.config().heartbeat_period();
     let t = sim.now + hb_at;
     sim.nodes[0].p.handle_timeout(t);
     let grams: Vec<Transmit> = std::iter::from_fn(|| sim.nodes[0].p.poll_transmit(t)).collect();

@@ -140,18 +140,7 @@ fn cyclone_sedp_with_type_information() {
     }
     assert!(r.type_information.is_some());
     // They match each other.
-    let m = dds_runtime::rtps::discovery::matching::match_endpoints(
-        dds_runtime::rtps::discovery::matching::WriterView {
-            topic_name: &w.topic_name,
-            type_name: &w.type_name,
-            qos: &w.qos,
-        },
-        dds_runtime::rtps::discovery::matching::ReaderView {
-            topic_name: &r.topic_name,
-            type_name: &r.type_name,
-            qos: &r.qos,
-        },
-    );
+    let m = dds_runtime::rtps::discovery::matching::match_endpoints(&w, &r);
     assert_eq!(
         m,
         dds_runtime::rtps::discovery::matching::MatchResult::Match

@@ -318,7 +318,7 @@ fn flow_control_blocks_until_acknowledged() {
         && !s.nodes[1].p.reader_matches(r).is_empty()));
     // The reader goes silent: nothing it sends (acknowledgements) arrives.
     sim.nodes[1].up = false;
-    let high = sim.nodes[0].p.config().whc_high_watermark;
+    let high = sim.nodes[0].p.config().whc_high_watermark();
     let mut written = 0usize;
     let err = loop {
         let now = sim.now;
@@ -476,7 +476,7 @@ fn samples_are_packed_into_datagrams() {
             .write(now, s.w, WriteChange::alive(sample(i, 200)))
             .unwrap();
     }
-    let max = s.sim.nodes[0].p.config().max_message_size;
+    let max = s.sim.nodes[0].p.config().max_message_size();
     let mut datagrams = Vec::new();
     while let Some(t) = s.sim.nodes[0].p.poll_transmit(now) {
         datagrams.push(t);

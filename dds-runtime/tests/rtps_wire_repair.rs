@@ -44,10 +44,10 @@ impl Net {
         (0..sim.nodes.len())
             .filter(|&i| {
                 let c = sim.nodes[i].p.config();
-                c.default_unicast.contains(l)
-                    || c.metatraffic_unicast.contains(l)
-                    || c.default_multicast.contains(l)
-                    || c.metatraffic_multicast.contains(l)
+                c.default_unicast().contains(l)
+                    || c.metatraffic_unicast().contains(l)
+                    || c.default_multicast().contains(l)
+                    || c.metatraffic_multicast().contains(l)
             })
             .collect()
     }
@@ -184,9 +184,7 @@ const SERIALIZED_KEY: [u8; 8] = [0, 1, 0, 0, 7, 0, 0, 0];
 fn vendor_setup(reliable: bool) -> (Sim, EntityId, EntityId, EntityId) {
     let mut sim = Sim::new(11, Faults::NONE);
     sim.add(config(0));
-    let mut c = config(1);
-    c.vendor_id = VendorId::FASTDDS;
-    sim.add(c);
+    sim.add(config(1).vendor_id(VendorId::FASTDDS));
     sim.add(config(2));
     let now = sim.now;
     let wq = DataWriterQos::builder().history(History::KeepAll).build();

@@ -75,8 +75,10 @@ fn discovery() -> &'static Vec<Vec<u8>> {
 
 fuzz_target!(|data: &[u8]| {
     let now = Instant::now();
-    let mut c = ParticipantConfig::new(0, 0, GuidPrefix([7; 12]), [127, 0, 0, 1]).unwrap();
-    c.defrag_max_bytes = 1 << 20;
+    let c = ParticipantConfig::builder(0, 0, GuidPrefix([7; 12]), [127, 0, 0, 1])
+        .expect("domain 0 ports are in range")
+        .defrag_max_bytes(1usize << 20)
+        .build();
     let mut p = Participant::new(c, now);
     let wq = DataWriterQos::builder()
         .durability(Durability::TransientLocal)

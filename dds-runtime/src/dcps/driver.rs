@@ -141,35 +141,27 @@ fn core_config(
         IpAddr::V4(a) => a.octets(),
         IpAddr::V6(_) => [127, 0, 0, 1],
     };
-    let mut pc = ParticipantConfig::new(
+    let pc = ParticipantConfig::builder(
         config.domain_id,
         transport.participant_index().unwrap_or(0),
         prefix,
         ip,
     )
-    .map_err(crate::config::ConfigError::from)?;
-    pc.metatraffic_unicast = vec![locator(transport.metatraffic_unicast())];
-    pc.default_unicast = vec![locator(transport.user_unicast())];
-    pc.metatraffic_multicast = transport
-        .spdp_multicast()
-        .map(locator)
-        .into_iter()
-        .collect();
+    .map_err(crate::config::ConfigError::from)?
+    .metatraffic_unicast(vec![locator(transport.metatraffic_unicast())])
+    .default_unicast(vec![locator(transport.user_unicast())])
+    .metatraffic_multicast(transport.spdp_multicast().map(locator).into_iter().collect::<Vec<_>>())
     // We do not listen on the user multicast port: peers send user data unicast.
-    pc.default_multicast = Vec::new();
-    pc.initial_peers = transport
-        .spdp_peers()
-        .iter()
-        .copied()
-        .map(locator)
-        .collect();
-    pc.spdp_interval = config.spdp_interval;
-    pc.lease_duration = config.lease_duration;
-    pc.max_message_size = config.max_message_size;
-    pc.fragment_size = config.fragment_size;
-    pc.write_batch_delay = config.write_batch_delay;
-    pc.user_data = user_data;
-    pc.entity_name = name;
+    .default_multicast(Vec::new())
+    .initial_peers(transport.spdp_peers().iter().copied().map(locator).collect::<Vec<_>>())
+    .spdp_interval(config.spdp_interval)
+    .lease_duration(config.lease_duration)
+    .max_message_size(config.max_message_size)
+    .fragment_size(config.fragment_size)
+    .write_batch_delay(config.write_batch_delay)
+    .user_data(user_data)
+    .entity_name(name)
+    .build();
     Ok(pc)
 }
 

@@ -52,14 +52,12 @@ impl std::fmt::Debug for Publisher {
 }
 
 /// The XCDR version a writer with `rep` uses, and the representation list it announces.
-fn writer_version<T: DdsType>(rep: &DataRepresentation) -> (XcdrVersion, DataRepresentation) {
-    if rep.0.is_empty() {
+pub(crate) fn writer_version<T: DdsType>(
+    rep: &DataRepresentation,
+) -> (XcdrVersion, DataRepresentation) {
+    if rep.ids().is_empty() {
         let v = T::DEFAULT_VERSION;
-        let id = match v {
-            XcdrVersion::Xcdr1 => XCDR_DATA_REPRESENTATION,
-            XcdrVersion::Xcdr2 => XCDR2_DATA_REPRESENTATION,
-        };
-        (v, DataRepresentation(vec![id]))
+        (v, v.into())
     } else if rep.offered() == XCDR2_DATA_REPRESENTATION {
         (XcdrVersion::Xcdr2, rep.clone())
     } else {

@@ -10,10 +10,7 @@ use std::time::{Duration, Instant, SystemTime};
 use foldhash::{HashMap, HashMapExt};
 
 use crate::cdr::{self, DdsType};
-use crate::qos::{
-    DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos, XCDR2_DATA_REPRESENTATION,
-    XCDR_DATA_REPRESENTATION,
-};
+use crate::qos::{DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos};
 use crate::rtps::{Event, Guid, ReaderSpec};
 
 use super::cache::{to_sample, Outcome, ReaderCache, Selection};
@@ -99,9 +96,8 @@ impl Subscriber {
     ) -> DdsResult<DataReader<T>> {
         let driver = self.participant.driver().clone();
         let mut rq = qos.clone();
-        if rq.data_representation.0.is_empty() {
-            rq.data_representation =
-                DataRepresentation(vec![XCDR_DATA_REPRESENTATION, XCDR2_DATA_REPRESENTATION]);
+        if rq.data_representation.ids().is_empty() {
+            rq.data_representation = DataRepresentation::accept_both();
         }
         check_history(&rq.history)?;
         let t = topic.topic();

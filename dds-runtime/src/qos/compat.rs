@@ -6,14 +6,20 @@ use super::policies::*;
 /// Everything a writer announces in SEDP: its own QoS plus the publisher's and the topic's parts.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct WriterQos {
+    /// The writer's own QoS.
     pub writer: DataWriterQos,
+    /// The publisher's PRESENTATION.
     pub presentation: Presentation,
+    /// The publisher's PARTITION.
     pub partition: Partition,
+    /// The publisher's GROUP_DATA.
     pub group_data: GroupData,
+    /// The topic's TOPIC_DATA.
     pub topic_data: TopicData,
 }
 
 impl WriterQos {
+    /// The announced QoS of a writer of `publisher` on a topic with `topic` QoS.
     pub fn new(writer: DataWriterQos, publisher: &PublisherQos, topic: &TopicQos) -> Self {
         WriterQos {
             writer,
@@ -37,14 +43,20 @@ impl From<DataWriterQos> for WriterQos {
 /// Everything a reader announces in SEDP.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct ReaderQos {
+    /// The reader's own QoS.
     pub reader: DataReaderQos,
+    /// The subscriber's PRESENTATION.
     pub presentation: Presentation,
+    /// The subscriber's PARTITION.
     pub partition: Partition,
+    /// The subscriber's GROUP_DATA.
     pub group_data: GroupData,
+    /// The topic's TOPIC_DATA.
     pub topic_data: TopicData,
 }
 
 impl ReaderQos {
+    /// The announced QoS of a reader of `subscriber` on a topic with `topic` QoS.
     pub fn new(reader: DataReaderQos, subscriber: &SubscriberQos, topic: &TopicQos) -> Self {
         ReaderQos {
             reader,

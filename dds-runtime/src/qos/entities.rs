@@ -8,7 +8,10 @@ macro_rules! qos_set {
         $(#[$meta])*
         #[derive(Debug, Clone, PartialEq, Eq)]
         pub struct $name {
-            $(pub $field: $ty,)*
+            $(
+                #[doc = concat!("The `", stringify!($field), "` policy; default `", stringify!($default), "`.")]
+                pub $field: $ty,
+            )*
         }
 
         impl Default for $name {
@@ -18,6 +21,7 @@ macro_rules! qos_set {
         }
 
         impl $name {
+            /// A builder starting from the defaults.
             pub fn builder() -> $builder {
                 $builder(Self::default())
             }
@@ -29,11 +33,13 @@ macro_rules! qos_set {
 
         impl $builder {
             $(
+                #[doc = concat!("Sets the `", stringify!($field), "` policy.")]
                 pub fn $field(mut self, value: impl Into<$ty>) -> Self {
                     self.0.$field = value.into();
                     self
                 }
             )*
+            /// The finished QoS set.
             pub fn build(self) -> $name {
                 self.0
             }
@@ -224,6 +230,6 @@ impl From<i32> for TransportPriority {
 }
 impl From<Vec<i16>> for DataRepresentation {
     fn from(v: Vec<i16>) -> Self {
-        DataRepresentation(v)
+        DataRepresentation::any_of(v)
     }
 }

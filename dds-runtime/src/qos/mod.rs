@@ -1,9 +1,9 @@
-//! QoS policies, their builders, requested/offered compatibility and their wire (parameter-list) form.
+//! QoS policies as plain values, their builders and requested/offered compatibility. Their wire
+//! (parameter-list) form lives with discovery, in `rtps::discovery`.
 
 mod compat;
 mod entities;
 mod policies;
-pub mod wire;
 
 pub use compat::{check_compatible, fnmatch, partitions_match, ReaderQos, WriterQos};
 pub use entities::*;

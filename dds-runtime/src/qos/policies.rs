@@ -2,6 +2,8 @@
 
 use std::time::Duration;
 
+use crate::cdr::XcdrVersion;
+
 /// `DURATION_INFINITE`: maps to the wire value {0x7fffffff, 0xffffffff}.
 pub const INFINITE: Duration = Duration::MAX;
 
@@ -9,36 +11,66 @@ pub const INFINITE: Duration = Duration::MAX;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[repr(u32)]
 pub enum QosPolicyId {
+    /// USER_DATA.
     UserData = 1,
+    /// DURABILITY.
     Durability = 2,
+    /// PRESENTATION.
     Presentation = 3,
+    /// DEADLINE.
     Deadline = 4,
+    /// LATENCY_BUDGET.
     LatencyBudget = 5,
+    /// OWNERSHIP.
     Ownership = 6,
+    /// OWNERSHIP_STRENGTH.
     OwnershipStrength = 7,
+    /// LIVELINESS.
     Liveliness = 8,
+    /// TIME_BASED_FILTER.
     TimeBasedFilter = 9,
+    /// PARTITION.
     Partition = 10,
+    /// RELIABILITY.
     Reliability = 11,
+    /// DESTINATION_ORDER.
     DestinationOrder = 12,
+    /// HISTORY.
     History = 13,
+    /// RESOURCE_LIMITS.
     ResourceLimits = 14,
+    /// ENTITY_FACTORY.
     EntityFactory = 15,
+    /// WRITER_DATA_LIFECYCLE.
     WriterDataLifecycle = 16,
+    /// READER_DATA_LIFECYCLE.
     ReaderDataLifecycle = 17,
+    /// TOPIC_DATA.
     TopicData = 18,
+    /// GROUP_DATA.
     GroupData = 19,
+    /// TRANSPORT_PRIORITY.
     TransportPriority = 20,
+    /// LIFESPAN.
     Lifespan = 21,
+    /// DURABILITY_SERVICE.
     DurabilityService = 22,
+    /// DATA_REPRESENTATION.
     DataRepresentation = 23,
+    /// TYPE_CONSISTENCY_ENFORCEMENT.
     TypeConsistencyEnforcement = 24,
 }
 
+/// RELIABILITY: whether lost samples are repaired.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Reliability {
+    /// Samples may be lost; no acknowledgements, no repairs.
     BestEffort,
-    Reliable { max_blocking_time: Duration },
+    /// Every sample is delivered, in order, repaired when lost.
+    Reliable {
+        /// How long `write` may block on flow control or full resources.
+        max_blocking_time: Duration,
+    },
 }
 
 impl Reliability {
@@ -47,6 +79,7 @@ impl Reliability {
         max_blocking_time: Duration::from_millis(100),
     };
 
+    /// Whether this is [`Reliability::Reliable`].
     pub fn is_reliable(&self) -> bool {
         matches!(self, Reliability::Reliable { .. })
     }
@@ -55,16 +88,23 @@ impl Reliability {
 /// Ordered: a writer offering a kind satisfies readers requesting the same or a lower kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum Durability {
+    /// Samples exist only while the writer sends them.
     #[default]
     Volatile,
+    /// The writer keeps its history for late-joining readers.
     TransientLocal,
+    /// As TransientLocal here (no durability service).
     Transient,
+    /// As TransientLocal here (no durability service).
     Persistent,
 }
 
+/// HISTORY: how many samples per instance are kept.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum History {
+    /// The last `n` samples per instance.
     KeepLast(u32),
+    /// Every sample, up to the resource limits.
     KeepAll,
 }
 
@@ -77,20 +117,26 @@ impl Default for History {
 /// `None` means LENGTH_UNLIMITED.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct ResourceLimits {
+    /// Most samples held in total.
     pub max_samples: Option<u32>,
+    /// Most instances held.
     pub max_instances: Option<u32>,
+    /// Most samples held per instance.
     pub max_samples_per_instance: Option<u32>,
 }
 
+/// PARTITION: names (or fnmatch patterns) of the partitions of a publisher or subscriber; empty is "".
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Partition(pub Vec<String>);
 
 impl Partition {
+    /// Partitions with these names.
     pub fn new<I: IntoIterator<Item = S>, S: Into<String>>(names: I) -> Self {
         Partition(names.into_iter().map(Into::into).collect())
     }
 }
 
+/// DEADLINE: the longest period between samples of an instance (default infinite).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Deadline(pub Duration);
 impl Default for Deadline {
@@ -99,20 +145,28 @@ impl Default for Deadline {
     }
 }
 
+/// LATENCY_BUDGET: the acceptable delay (a hint; default zero).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct LatencyBudget(pub Duration);
 
+/// LIVELINESS kind: who asserts that a writer is alive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum LivelinessKind {
+    /// The infrastructure, by the participant's lease.
     #[default]
     Automatic,
+    /// The application, for the whole participant.
     ManualByParticipant,
+    /// The application, per writer.
     ManualByTopic,
 }
 
+/// LIVELINESS: how a writer's liveliness is asserted and how long it lasts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Liveliness {
+    /// Who asserts liveliness.
     pub kind: LivelinessKind,
+    /// How long a writer stays alive without an assertion.
     pub lease_duration: Duration,
 }
 impl Default for Liveliness {
@@ -124,38 +178,54 @@ impl Default for Liveliness {
     }
 }
 
+/// OWNERSHIP: whether several writers may update the same instance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Ownership {
+    /// Every writer's samples are delivered.
     #[default]
     Shared,
+    /// Only the strongest writer's samples are delivered.
     Exclusive,
 }
 
+/// OWNERSHIP_STRENGTH: the writer's strength under exclusive ownership.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct OwnershipStrength(pub i32);
 
+/// DESTINATION_ORDER: which timestamp orders samples of an instance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum DestinationOrder {
+    /// The order in which samples arrive.
     #[default]
     ByReceptionTimestamp,
+    /// The writers' source timestamps.
     BySourceTimestamp,
 }
 
+/// PRESENTATION access scope: the extent of coherent and ordered access.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum PresentationAccessScope {
+    /// Per instance.
     #[default]
     Instance,
+    /// Per topic.
     Topic,
+    /// Across the topics of a publisher or subscriber.
     Group,
 }
 
+/// PRESENTATION: coherent and ordered access of a publisher or subscriber.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Presentation {
+    /// The scope of the guarantees below.
     pub access_scope: PresentationAccessScope,
+    /// Changes made in a coherent set are delivered together.
     pub coherent_access: bool,
+    /// Changes are delivered in the order they were made.
     pub ordered_access: bool,
 }
 
+/// LIFESPAN: how long a sample stays valid after it was written (default infinite).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Lifespan(pub Duration);
 impl Default for Lifespan {
@@ -164,20 +234,27 @@ impl Default for Lifespan {
     }
 }
 
+/// TIME_BASED_FILTER: the reader wants at most one sample per instance per period.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct TimeBasedFilter {
+    /// The shortest time between two delivered samples of an instance.
     pub minimum_separation: Duration,
 }
 
+/// USER_DATA: application octets announced with a participant, writer or reader.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct UserData(pub Vec<u8>);
+/// TOPIC_DATA: application octets announced with a topic.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct TopicData(pub Vec<u8>);
+/// GROUP_DATA: application octets announced with a publisher or subscriber.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct GroupData(pub Vec<u8>);
 
+/// WRITER_DATA_LIFECYCLE.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct WriterDataLifecycle {
+    /// Whether unregistering an instance also disposes it (default true).
     pub autodispose_unregistered_instances: bool,
 }
 impl Default for WriterDataLifecycle {
@@ -188,9 +265,12 @@ impl Default for WriterDataLifecycle {
     }
 }
 
+/// READER_DATA_LIFECYCLE.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ReaderDataLifecycle {
+    /// How long samples of instances without writers are kept (default infinite).
     pub autopurge_nowriter_samples_delay: Duration,
+    /// How long samples of disposed instances are kept (default infinite).
     pub autopurge_disposed_samples_delay: Duration,
 }
 impl Default for ReaderDataLifecycle {
@@ -202,21 +282,45 @@ impl Default for ReaderDataLifecycle {
     }
 }
 
-/// Data representation ids (XTypes 1.3 §7.6.3.1.1).
+/// Data representation id of XCDR1 (XTypes 1.3 §7.6.3.1.1), the default when a list is empty.
 pub const XCDR_DATA_REPRESENTATION: i16 = 0;
+/// Data representation id of XML (XTypes 1.3 §7.6.3.1.1); not supported for data, but may be announced.
 pub const XML_DATA_REPRESENTATION: i16 = 1;
+/// Data representation id of XCDR2 (XTypes 1.3 §7.6.3.1.1).
 pub const XCDR2_DATA_REPRESENTATION: i16 = 2;
 
-/// An empty list means the default, XCDR1. Writers use (and offer) only the first element.
+/// DATA_REPRESENTATION: the representation ids a writer offers (it uses only the first) or a reader accepts.
+/// An empty list means the default, XCDR1.
+///
+/// ```
+/// use dds_runtime::qos::DataRepresentation;
+/// use dds_runtime::cdr::XcdrVersion;
+/// assert_eq!(DataRepresentation::from(XcdrVersion::Xcdr2), DataRepresentation::xcdr2());
+/// assert!(DataRepresentation::accept_both().accepts(0) && DataRepresentation::accept_both().accepts(2));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct DataRepresentation(pub Vec<i16>);
+pub struct DataRepresentation(Vec<i16>);
 
 impl DataRepresentation {
+    /// XCDR1 only.
     pub fn xcdr1() -> Self {
         DataRepresentation(vec![XCDR_DATA_REPRESENTATION])
     }
+    /// XCDR2 only.
     pub fn xcdr2() -> Self {
         DataRepresentation(vec![XCDR2_DATA_REPRESENTATION])
+    }
+    /// XCDR1 and XCDR2 (for a reader: accepts either; for a writer: offers XCDR1).
+    pub fn accept_both() -> Self {
+        Self::any_of([XCDR_DATA_REPRESENTATION, XCDR2_DATA_REPRESENTATION])
+    }
+    /// The given representation ids, in order of preference.
+    pub fn any_of(ids: impl IntoIterator<Item = i16>) -> Self {
+        DataRepresentation(ids.into_iter().collect())
+    }
+    /// The representation ids as listed (empty: the default, XCDR1).
+    pub fn ids(&self) -> &[i16] {
+        &self.0
     }
     /// What a writer with this policy offers.
     pub fn offered(&self) -> i16 {
@@ -232,15 +336,31 @@ impl DataRepresentation {
     }
 }
 
+impl From<XcdrVersion> for DataRepresentation {
+    fn from(v: XcdrVersion) -> Self {
+        match v {
+            XcdrVersion::Xcdr1 => Self::xcdr1(),
+            XcdrVersion::Xcdr2 => Self::xcdr2(),
+        }
+    }
+}
+
+/// TRANSPORT_PRIORITY: a hint to the transport (announced, not used).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct TransportPriority(pub i32);
 
+/// DURABILITY_SERVICE: settings of a durability service (announced, not used).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DurabilityService {
+    /// How long the service keeps data of instances without writers.
     pub service_cleanup_delay: Duration,
+    /// The service's history.
     pub history: History,
+    /// The service's limit on samples.
     pub max_samples: Option<u32>,
+    /// The service's limit on instances.
     pub max_instances: Option<u32>,
+    /// The service's limit on samples per instance.
     pub max_samples_per_instance: Option<u32>,
 }
 impl Default for DurabilityService {
@@ -255,9 +375,12 @@ impl Default for DurabilityService {
     }
 }
 
+/// TYPE_CONSISTENCY_ENFORCEMENT kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum TypeConsistencyKind {
+    /// The reader's and writer's types must be equal.
     DisallowTypeCoercion,
+    /// The writer's type must be assignable to the reader's.
     #[default]
     AllowTypeCoercion,
 }
@@ -265,11 +388,17 @@ pub enum TypeConsistencyKind {
 /// XTypes 1.3 §7.6.3.4.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TypeConsistencyEnforcement {
+    /// Whether types must be equal or assignable.
     pub kind: TypeConsistencyKind,
+    /// Sequence bounds do not count.
     pub ignore_sequence_bounds: bool,
+    /// String bounds do not count.
     pub ignore_string_bounds: bool,
+    /// Member names do not count.
     pub ignore_member_names: bool,
+    /// Types may not be widened.
     pub prevent_type_widening: bool,
+    /// Type information must be validated.
     pub force_type_validation: bool,
 }
 impl Default for TypeConsistencyEnforcement {

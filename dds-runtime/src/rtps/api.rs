@@ -6,6 +6,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::discovery::{ports, ParticipantData, ReaderData, WriterData};
+use super::messages::flags::StatusInfo;
 use super::types::*;
 use crate::qos::{QosPolicyId, ReaderQos, WriterQos};
 use crate::xtypes::TypeInformation;
@@ -19,6 +20,7 @@ pub struct Payload {
 }
 
 impl Payload {
+    /// Shares `bytes` whole.
     pub fn new(bytes: impl Into<Arc<[u8]>>) -> Self {
         let buf: Arc<[u8]> = bytes.into();
         let end = buf.len();
@@ -28,6 +30,7 @@ impl Payload {
             end,
         }
     }
+    /// A copy of `b` in a buffer of its own.
     pub fn copy_from_slice(b: &[u8]) -> Self {
         Payload::new(Arc::<[u8]>::from(b))
     }
@@ -103,73 +106,137 @@ impl fmt::Debug for Payload {
     }
 }
 
-/// Everything the core needs to know about the local participant. Build with [`ParticipantConfig::new`], which
-/// fills in the standard ports for one unicast address, then adjust fields.
-#[derive(Debug, Clone)]
-pub struct ParticipantConfig {
-    pub domain_id: u32,
+/// Defines [`ParticipantConfig`] (read-only getters) and [`ParticipantConfigBuilder`] (one setter per field)
+/// from one list. `copy` fields are returned by value, `ref` fields by reference.
+macro_rules! participant_config {
+    ($($(#[$doc:meta])* $field:ident: $ty:ty = $kind:ident,)*) => {
+        /// Everything the core needs to know about the local participant. Build it with
+        /// [`ParticipantConfig::builder`] (standard ports for one unicast address) or
+        /// [`ParticipantConfigBuilder::default`]; read it back with the getters.
+        ///
+        /// ```
+        /// use std::time::Duration;
+        /// use dds_runtime::rtps::{GuidPrefix, ParticipantConfig};
+        /// let c = ParticipantConfig::builder(0, 1, GuidPrefix([7; 12]), [127, 0, 0, 1])
+        ///     .lease_duration(Duration::from_secs(3))
+        ///     .build();
+        /// assert_eq!(c.lease_duration(), Duration::from_secs(3));
+        /// assert_eq!(c.default_unicast()[0].port, 7413);
+        /// ```
+        #[derive(Debug, Clone)]
+        pub struct ParticipantConfig {
+            $(pub(crate) $field: $ty,)*
+        }
+
+        impl ParticipantConfig {
+            $(participant_config!(@get $kind $(#[$doc])* $field: $ty);)*
+        }
+
+        /// Builds a [`ParticipantConfig`]; every setter replaces one value.
+        #[derive(Debug, Clone)]
+        pub struct ParticipantConfigBuilder(ParticipantConfig);
+
+        impl ParticipantConfigBuilder {
+            $(
+                $(#[$doc])*
+                pub fn $field(mut self, value: impl Into<$ty>) -> Self {
+                    self.0.$field = value.into();
+                    self
+                }
+            )*
+        }
+    };
+    (@get copy $(#[$doc:meta])* $field:ident: $ty:ty) => {
+        $(#[$doc])*
+        pub fn $field(&self) -> $ty {
+            self.$field
+        }
+    };
+    (@get ref $(#[$doc:meta])* $field:ident: $ty:ty) => {
+        $(#[$doc])*
+        pub fn $field(&self) -> &$ty {
+            &self.$field
+        }
+    };
+}
+
+participant_config! {
+    /// The DDS domain id.
+    domain_id: u32 = copy,
     /// The participant index used in the port formula (chosen by the transport).
-    pub participant_id: u32,
-    pub guid_prefix: GuidPrefix,
-    /// Defaults to [`VendorId::THIS`] (0x01dd).
-    pub vendor_id: VendorId,
-    pub metatraffic_unicast: Vec<Locator>,
-    pub metatraffic_multicast: Vec<Locator>,
-    pub default_unicast: Vec<Locator>,
-    pub default_multicast: Vec<Locator>,
+    participant_id: u32 = copy,
+    /// The GUID prefix of the participant and all its endpoints.
+    guid_prefix: GuidPrefix = copy,
+    /// The vendor id in every message header; defaults to [`VendorId::THIS`] (0x01dd).
+    vendor_id: VendorId = copy,
+    /// Where peers send discovery traffic to us unicast.
+    metatraffic_unicast: Vec<Locator> = ref,
+    /// The SPDP multicast destinations (default 239.255.0.1 at the domain's SPDP port).
+    metatraffic_multicast: Vec<Locator> = ref,
+    /// Where peers send user data to us unicast.
+    default_unicast: Vec<Locator> = ref,
+    /// Where peers may send user data to us by multicast.
+    default_multicast: Vec<Locator> = ref,
     /// Period of SPDP announcements (default 3 s).
-    pub spdp_interval: Duration,
+    spdp_interval: Duration = copy,
     /// Lease announced to peers (default 10 s, like Cyclone).
-    pub lease_duration: Duration,
+    lease_duration: Duration = copy,
     /// Unicast SPDP destinations in addition to the multicast ones.
-    pub initial_peers: Vec<Locator>,
+    initial_peers: Vec<Locator> = ref,
     /// Datagram payload limit for packing (default 14720, Cyclone's MaxMessageSize).
-    pub max_message_size: usize,
+    max_message_size: usize = copy,
     /// Samples larger than this go out as DATA_FRAG with fragments of this size (default 1344; ≤ 65535).
-    pub fragment_size: usize,
-    pub user_data: Vec<u8>,
-    pub entity_name: Option<String>,
-    pub properties: Vec<(String, String)>,
+    fragment_size: usize = copy,
+    /// USER_DATA announced in SPDP.
+    user_data: Vec<u8> = ref,
+    /// PID_ENTITY_NAME announced in SPDP.
+    entity_name: Option<String> = ref,
+    /// PID_PROPERTY_LIST announced in SPDP (name, value).
+    properties: Vec<(String, String)> = ref,
     /// Period of heartbeats while data is unacknowledged (default 100 ms).
-    pub heartbeat_period: Duration,
+    heartbeat_period: Duration = copy,
     /// Delay before answering a NACK, so that requests merge (default 5 ms).
-    pub nack_response_delay: Duration,
+    nack_response_delay: Duration = copy,
     /// Delay before answering a HEARTBEAT with an ACKNACK (default 0).
-    pub heartbeat_response_delay: Duration,
-    /// Flow control: `write` refuses (WouldBlock) once this many bytes are unacknowledged (default 512 KiB) …
-    pub whc_high_watermark: usize,
-    /// … until they drop below this (default 128 KiB).
-    pub whc_low_watermark: usize,
+    heartbeat_response_delay: Duration = copy,
+    /// Flow control: `write` refuses (WouldBlock) once this many bytes are unacknowledged (default 512 KiB),
+    /// until they drop below [`whc_low_watermark`](Self::whc_low_watermark).
+    whc_high_watermark: usize = copy,
+    /// Flow control: where a blocked writer is released (default 128 KiB).
+    whc_low_watermark: usize = copy,
     /// Largest sample accepted from the network (default 64 MiB); bigger ones are dropped and acknowledged.
-    pub max_sample_size: usize,
-    /// Per remote writer: samples defragmented at once (default 8) and bytes held in fragments (default 16 MiB).
-    pub defrag_max_samples: usize,
-    pub defrag_max_bytes: usize,
-    /// Per remote writer: out-of-order samples held for reordering (default 1024) and their bytes (default
-    /// 64 MiB); beyond either, later samples are dropped and requested again once the gap is filled.
-    pub reorder_max_samples: usize,
-    pub reorder_max_bytes: usize,
+    max_sample_size: usize = copy,
+    /// Per remote writer: samples defragmented at once (default 8).
+    defrag_max_samples: usize = copy,
+    /// Per remote writer: bytes held in fragments, overhead counted (default 16 MiB).
+    defrag_max_bytes: usize = copy,
+    /// Per remote writer: out-of-order samples held for reordering (default 1024); beyond it, later samples
+    /// are dropped and requested again once the gap is filled.
+    reorder_max_samples: usize = copy,
+    /// Per remote writer: bytes of out-of-order samples held for reordering (default 64 MiB).
+    reorder_max_bytes: usize = copy,
     /// How long a deleted reliable writer lingers waiting for acknowledgements (default 1 s).
-    pub writer_linger_duration: Duration,
+    writer_linger_duration: Duration = copy,
     /// Upper bound on bytes retransmitted per repair round to one reader (default 256 KiB).
-    pub max_repair_bytes: usize,
+    max_repair_bytes: usize = copy,
     /// Write batching: user DATA waits up to this long for more samples to share its datagram, leaving
     /// earlier when the datagram is full, on [`Participant::flush`](super::Participant::flush), or with any
     /// other outgoing traffic. `None` (the default) sends every write at once.
-    pub write_batch_delay: Option<Duration>,
+    write_batch_delay: Option<Duration> = copy,
 }
 
 impl ParticipantConfig {
-    /// A configuration for one IPv4 unicast address with the standard ports (PB 7400, DG 250, PG 2, d0..d3 =
-    /// 0, 10, 1, 11) and SPDP multicast to 239.255.0.1. Fails when a port would exceed 65535.
-    pub fn new(
+    /// A builder for one IPv4 unicast address with the standard ports (PB 7400, DG 250, PG 2, d0..d3 =
+    /// 0, 10, 1, 11), SPDP multicast to 239.255.0.1 and the defaults documented on each field. Fails when a
+    /// port would exceed 65535.
+    pub fn builder(
         domain_id: u32,
         participant_id: u32,
         guid_prefix: GuidPrefix,
         unicast_ip: [u8; 4],
-    ) -> Result<Self, ports::PortError> {
+    ) -> Result<ParticipantConfigBuilder, ports::PortError> {
         let mc = ports::SPDP_MULTICAST_GROUP.octets();
-        Ok(ParticipantConfig {
+        Ok(ParticipantConfigBuilder(ParticipantConfig {
             domain_id,
             participant_id,
             guid_prefix,
@@ -205,41 +272,98 @@ impl ParticipantConfig {
             writer_linger_duration: Duration::from_secs(1),
             max_repair_bytes: 256 * 1024,
             write_batch_delay: None,
-        })
+        }))
+    }
+
+    /// [`builder`](Self::builder) with nothing changed.
+    pub fn new(
+        domain_id: u32,
+        participant_id: u32,
+        guid_prefix: GuidPrefix,
+        unicast_ip: [u8; 4],
+    ) -> Result<Self, ports::PortError> {
+        Ok(Self::builder(domain_id, participant_id, guid_prefix, unicast_ip)?.build())
+    }
+
+    /// A builder starting from this configuration.
+    pub fn to_builder(&self) -> ParticipantConfigBuilder {
+        ParticipantConfigBuilder(self.clone())
+    }
+}
+
+/// Domain 0, participant index 0, a zero GUID prefix and 127.0.0.1 (see [`ParticipantConfig::builder`]).
+impl Default for ParticipantConfig {
+    fn default() -> Self {
+        ParticipantConfigBuilder::default().build()
+    }
+}
+
+/// Domain 0, participant index 0, a zero GUID prefix and 127.0.0.1 (see [`ParticipantConfig::builder`]).
+impl Default for ParticipantConfigBuilder {
+    fn default() -> Self {
+        // Domain 0 and participant index 0 give the lowest ports, which are always in range.
+        ParticipantConfig::builder(0, 0, GuidPrefix::default(), [127, 0, 0, 1])
+            .expect("the ports of domain 0, participant 0 are in range")
+    }
+}
+
+impl ParticipantConfigBuilder {
+    /// The finished configuration.
+    pub fn build(self) -> ParticipantConfig {
+        self.0
+    }
+}
+
+impl From<ParticipantConfigBuilder> for ParticipantConfig {
+    fn from(b: ParticipantConfigBuilder) -> Self {
+        b.build()
     }
 }
 
 /// One datagram to send to every destination.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Transmit {
+    /// Send the payload to each of these.
     pub destinations: Vec<Locator>,
+    /// One RTPS message.
     pub payload: Vec<u8>,
 }
 
+/// What a change does to its instance (PID_STATUS_INFO on the wire).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ChangeKind {
+    /// A new value of the instance.
     Alive,
+    /// The instance was disposed.
     Dispose,
+    /// The writer unregistered the instance.
     Unregister,
+    /// Both at once (e.g. Cyclone's autodispose on unregister).
     DisposeUnregister,
 }
 
 impl ChangeKind {
-    /// PID_STATUS_INFO flags (0x01 disposed, 0x02 unregistered).
+    /// The PID_STATUS_INFO flag bits of this kind.
     pub fn status_info(self) -> u8 {
-        match self {
-            ChangeKind::Alive => 0,
-            ChangeKind::Dispose => 1,
-            ChangeKind::Unregister => 2,
-            ChangeKind::DisposeUnregister => 3,
-        }
+        let flags = match self {
+            ChangeKind::Alive => StatusInfo::empty(),
+            ChangeKind::Dispose => StatusInfo::DISPOSED,
+            ChangeKind::Unregister => StatusInfo::UNREGISTERED,
+            ChangeKind::DisposeUnregister => StatusInfo::DISPOSED | StatusInfo::UNREGISTERED,
+        };
+        flags.bits()
     }
+    /// The kind for PID_STATUS_INFO flag bits (other bits than disposed and unregistered are ignored).
     pub fn from_status_info(flags: u8) -> Self {
-        match flags & 3 {
-            0 => ChangeKind::Alive,
-            1 => ChangeKind::Dispose,
-            2 => ChangeKind::Unregister,
-            _ => ChangeKind::DisposeUnregister,
+        let flags = StatusInfo::from_bits_truncate(flags);
+        match (
+            flags.contains(StatusInfo::DISPOSED),
+            flags.contains(StatusInfo::UNREGISTERED),
+        ) {
+            (false, false) => ChangeKind::Alive,
+            (true, false) => ChangeKind::Dispose,
+            (false, true) => ChangeKind::Unregister,
+            (true, true) => ChangeKind::DisposeUnregister,
         }
     }
 }
@@ -247,6 +371,7 @@ impl ChangeKind {
 /// One change to write.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct WriteChange {
+    /// What the change does to its instance.
     pub kind: ChangeKind,
     /// Serialized sample (with encapsulation header); for non-Alive kinds the serialized key (may be empty).
     pub payload: Payload,
@@ -258,6 +383,7 @@ pub struct WriteChange {
 }
 
 impl WriteChange {
+    /// A new value (kind [`ChangeKind::Alive`]) with no key hash and no timestamp.
     pub fn alive(payload: impl Into<Payload>) -> Self {
         WriteChange {
             kind: ChangeKind::Alive,
@@ -266,70 +392,57 @@ impl WriteChange {
             source_timestamp: None,
         }
     }
+    /// Sets the key hash (required for keyed writers).
     pub fn with_key_hash(mut self, key_hash: [u8; 16]) -> Self {
         self.key_hash = Some(key_hash);
         self
     }
+    /// Sets the source timestamp sent in INFO_TS.
     pub fn with_timestamp(mut self, t: Time) -> Self {
         self.source_timestamp = Some(t);
         self
     }
+    /// Sets the kind (dispose, unregister).
     pub fn with_kind(mut self, kind: ChangeKind) -> Self {
         self.kind = kind;
         self
     }
 }
 
-/// A local writer to create.
+/// A local endpoint to create: a writer (`Q` = [`WriterQos`], see [`WriterSpec`]) or a reader (`Q` =
+/// [`ReaderQos`], see [`ReaderSpec`]).
 #[derive(Debug, Clone)]
-pub struct WriterSpec {
+pub struct EndpointSpec<Q> {
+    /// The topic name (must not be empty).
     pub topic_name: String,
+    /// The registered type name (must not be empty).
     pub type_name: String,
+    /// Whether the type has key members (decides the entity kind and, for writers, KEEP_LAST per instance).
     pub keyed: bool,
-    /// Writer, publisher and topic QoS as announced; the data representation is `qos.writer.data_representation`.
-    pub qos: WriterQos,
+    /// Endpoint, group and topic QoS as announced. The data representation is
+    /// `qos.writer.data_representation` (offered) or `qos.reader.data_representation` (accepted).
+    pub qos: Q,
+    /// XTypes TYPE_INFORMATION to announce, kept opaque.
     pub type_information: Option<TypeInformation>,
+    /// PID_ENTITY_NAME to announce.
     pub entity_name: Option<String>,
 }
 
-impl WriterSpec {
-    pub fn new(
-        topic_name: impl Into<String>,
-        type_name: impl Into<String>,
-        keyed: bool,
-        qos: impl Into<WriterQos>,
-    ) -> Self {
-        WriterSpec {
-            topic_name: topic_name.into(),
-            type_name: type_name.into(),
-            keyed,
-            qos: qos.into(),
-            type_information: None,
-            entity_name: None,
-        }
-    }
-}
+/// A local writer to create.
+pub type WriterSpec = EndpointSpec<WriterQos>;
 
 /// A local reader to create.
-#[derive(Debug, Clone)]
-pub struct ReaderSpec {
-    pub topic_name: String,
-    pub type_name: String,
-    pub keyed: bool,
-    /// Reader, subscriber and topic QoS; accepted representations are `qos.reader.data_representation`.
-    pub qos: ReaderQos,
-    pub type_information: Option<TypeInformation>,
-    pub entity_name: Option<String>,
-}
+pub type ReaderSpec = EndpointSpec<ReaderQos>;
 
-impl ReaderSpec {
+impl<Q> EndpointSpec<Q> {
+    /// An endpoint without type information or entity name.
     pub fn new(
         topic_name: impl Into<String>,
         type_name: impl Into<String>,
         keyed: bool,
-        qos: impl Into<ReaderQos>,
+        qos: impl Into<Q>,
     ) -> Self {
-        ReaderSpec {
+        EndpointSpec {
             topic_name: topic_name.into(),
             type_name: type_name.into(),
             keyed,
@@ -343,100 +456,152 @@ impl ReaderSpec {
 /// A received change delivered to a local reader.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReceivedSample {
+    /// The local reader it is for.
     pub reader: EntityId,
+    /// The remote (or local) writer that wrote it.
     pub writer: Guid,
+    /// The writer's sequence number.
     pub sequence: SequenceNumber,
+    /// What the change does to its instance.
     pub kind: ChangeKind,
     /// Serialized sample, or serialized key (possibly empty) when `kind` is not Alive.
     pub payload: Payload,
+    /// PID_KEY_HASH, when the writer sent one (Cyclone does not).
     pub key_hash: Option<[u8; 16]>,
+    /// The writer's INFO_TS, if any.
     pub source_timestamp: Option<Time>,
 }
 
 /// What the core reports to the DCPS layer.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Event {
+    /// A change for a local reader.
     Sample(ReceivedSample),
+    /// A local writer matched or unmatched a reader.
     PublicationMatched {
+        /// The local writer.
         writer: EntityId,
+        /// The reader.
         reader: Guid,
+        /// `true` when matched, `false` when no longer.
         matched: bool,
     },
+    /// A local reader matched or unmatched a writer.
     SubscriptionMatched {
+        /// The local reader.
         reader: EntityId,
+        /// The writer.
         writer: Guid,
+        /// `true` when matched, `false` when no longer.
         matched: bool,
     },
+    /// A local writer and a reader on its topic have incompatible QoS (reported once per pair).
     OfferedIncompatibleQos {
+        /// The local writer.
         writer: EntityId,
+        /// The reader.
         reader: Guid,
+        /// The first incompatible policy.
         policy: QosPolicyId,
     },
+    /// A local reader and a writer on its topic have incompatible QoS (reported once per pair).
     RequestedIncompatibleQos {
+        /// The local reader.
         reader: EntityId,
+        /// The writer.
         writer: Guid,
+        /// The first incompatible policy.
         policy: QosPolicyId,
     },
+    /// A remote participant appeared.
     ParticipantDiscovered(Box<ParticipantData>),
+    /// A remote participant left or its lease expired.
     ParticipantLost {
+        /// Its GUID prefix.
         guid_prefix: GuidPrefix,
     },
+    /// A publication (remote or local) appeared.
     PublicationDiscovered(Box<WriterData>),
+    /// A known publication is gone.
     PublicationRemoved {
+        /// Its GUID.
         guid: Guid,
     },
+    /// A subscription (remote or local) appeared.
     SubscriptionDiscovered(Box<ReaderData>),
+    /// A known subscription is gone.
     SubscriptionRemoved {
+        /// Its GUID.
         guid: Guid,
     },
     /// A matched remote writer's liveliness changed (automatic: participant lease; manual: its messages).
     LivelinessChanged {
+        /// The local reader.
         reader: EntityId,
+        /// The matched writer.
         writer: Guid,
+        /// Whether the writer is alive now.
         alive: bool,
     },
     /// Samples from `writer` that `reader` will never get (writer no longer had them, or buffers overflowed).
     SampleLost {
+        /// The local reader.
         reader: EntityId,
+        /// The writer.
         writer: Guid,
+        /// How many changes were lost.
         count: u64,
     },
     /// A deleted writer finished lingering and is gone.
     WriterDeleted {
+        /// The local writer.
         writer: EntityId,
     },
     /// Flow control released a writer that returned WouldBlock: unacknowledged bytes fell below the low watermark.
     WriterUnblocked {
+        /// The local writer.
         writer: EntityId,
     },
     /// Every matched reliable reader acknowledged everything the writer wrote (wait_for_acknowledgments).
     WriterAcknowledged {
+        /// The local writer.
         writer: EntityId,
     },
 }
 
+/// Why the core refused to create an endpoint.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
 pub enum CoreError {
+    /// No local endpoint has this id.
     #[error("no such entity {0:?}")]
     UnknownEntity(EntityId),
+    /// All 2^24 entity keys are used up.
     #[error("out of entity ids")]
     OutOfEntityIds,
+    /// A spec was refused; the text says why.
     #[error("bad parameter: {0}")]
     BadParameter(&'static str),
 }
 
+/// Why [`Participant::write`](super::Participant::write) refused a change.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum WriteError {
     /// Flow control or KEEP_ALL resource limits refuse the change for now; retry after acknowledgements
     /// arrive (within the writer's max_blocking_time).
     #[error("writer would block")]
     WouldBlock,
+    /// No local user writer has this id.
     #[error("no such writer {0:?}")]
     UnknownWriter(EntityId),
+    /// The writer is lingering after deletion.
     #[error("writer is being deleted")]
     Deleted,
+    /// The serialized size exceeds what a sample can have.
     #[error("sample of {0} bytes exceeds the maximum sample size")]
     TooLarge(usize),
+    /// A keyed writer got a change without a key hash.
     #[error("keyed writer needs a key hash")]
     MissingKeyHash,
 }

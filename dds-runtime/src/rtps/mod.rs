@@ -8,9 +8,9 @@ pub mod discovery;
 pub mod messages;
 mod outbox;
 mod participant;
-pub mod reader;
+pub(crate) mod reader;
 pub mod types;
-pub mod writer;
+pub(crate) mod writer;
 
 mod api;
 

@@ -25,8 +25,9 @@ struct Pending {
     destinations: Vec<Locator>,
     dst: Option<GuidPrefix>,
     buf: Vec<u8>,
-    /// The INFO_TS state the receiver will be in: None = nothing sent yet in this message.
-    ts: Option<Option<Time>>,
+    /// The timestamp in force at the receiver after this message so far: `None` before any INFO_TS (a
+    /// message starts without one) and after an invalidating INFO_TS alike.
+    ts: Option<Time>,
     preamble: usize,
     /// Start of the last submessage, whose length grows when the next one needs alignment padding.
     last_header: Option<usize>,
@@ -49,7 +50,7 @@ pub(crate) struct Outbox {
 }
 
 impl Outbox {
-    pub fn new(header: Header, max_message_size: usize) -> Self {
+    pub(crate) fn new(header: Header, max_message_size: usize) -> Self {
         Outbox {
             header,
             max: max_message_size.max(128),
@@ -63,7 +64,7 @@ impl Outbox {
     }
 
     /// Runs `f` with its pushes held back for batching: they leave at the latest `delay` after `now`.
-    pub fn hold<R>(&mut self, now: Instant, f: impl FnOnce(&mut Outbox) -> R) -> R {
+    pub(crate) fn hold<R>(&mut self, now: Instant, f: impl FnOnce(&mut Outbox) -> R) -> R {
         let before = self.holding;
         self.holding = true;
         let r = f(self);
@@ -75,12 +76,12 @@ impl Outbox {
     }
 
     /// Asks for every open message to be closed at the next drain.
-    pub fn request_flush(&mut self) {
+    pub(crate) fn request_flush(&mut self) {
         self.flush_due = true;
     }
 
     /// When held messages must leave, for a batch delay of `delay`.
-    pub fn hold_deadline(&self, delay: Duration) -> Option<Instant> {
+    pub(crate) fn hold_deadline(&self, delay: Duration) -> Option<Instant> {
         self.held_since.map(|t| t + delay)
     }
 
@@ -112,7 +113,7 @@ impl Outbox {
     }
 
     /// Appends `sub` to the message for (destinations, dst); starts a new datagram when it would not fit.
-    pub fn push(
+    pub(crate) fn push(
         &mut self,
         destinations: &[Locator],
         dst: Option<GuidPrefix>,
@@ -154,7 +155,7 @@ impl Outbox {
     }
 
     /// Closes every open message.
-    pub fn flush(&mut self) {
+    pub(crate) fn flush(&mut self) {
         self.flush_due = false;
         self.held_since = None;
         for p in self.pending.drain(..) {
@@ -171,7 +172,7 @@ impl Outbox {
 
     /// The next finished datagram. Open messages close first when a flush is due or the held ones have
     /// waited `batch_delay`.
-    pub fn pop(&mut self, now: Instant, batch_delay: Duration) -> Option<Transmit> {
+    pub(crate) fn pop(&mut self, now: Instant, batch_delay: Duration) -> Option<Transmit> {
         if self.ready.is_empty()
             && (self.flush_due || self.hold_deadline(batch_delay).is_some_and(|t| t <= now))
         {
@@ -181,7 +182,7 @@ impl Outbox {
     }
 
     /// Returns a datagram buffer for reuse.
-    pub fn recycle(&mut self, buf: Vec<u8>) {
+    pub(crate) fn recycle(&mut self, buf: Vec<u8>) {
         if self.pool.len() < 64 {
             self.pool.push(buf);
         }
@@ -190,10 +191,9 @@ impl Outbox {
 
 fn write_ts(p: &mut Pending, ts: Ts) {
     if let Ts::Set(t) = ts {
-        // Nothing sent yet means no timestamp in force at the receiver.
-        if p.ts.unwrap_or(None) != t {
+        if p.ts != t {
             append(&mut p.buf, &mut p.last_header, &Submessage::InfoTs(t), true);
-            p.ts = Some(t);
+            p.ts = t;
         }
     }
 }

@@ -13,13 +13,13 @@ use std::time::Instant;
 use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
 
 use super::api::*;
-use super::discovery::{ParticipantData, ReaderData, WriterData};
+use super::discovery::{EndpointData, ParticipantData, ReaderData, WriterData};
 use super::messages::Header;
 use super::outbox::Outbox;
 use super::reader::{Reader, ReaderParams};
 use super::types::*;
 use super::writer::{Writer, WriterParams};
-use crate::qos::{Durability, History, ResourceLimits};
+use crate::qos::{DataWriterQos, Durability, History, ReaderQos, ResourceLimits, WriterQos};
 
 /// A discovered remote participant.
 #[derive(Debug)]
@@ -78,6 +78,28 @@ fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
     }
 }
 
+fn user_writer_params(c: &ParticipantConfig, q: &DataWriterQos, keyed: bool) -> WriterParams {
+    WriterParams {
+        reliable: q.reliability.is_reliable(),
+        durability: q.durability,
+        history: q.history,
+        limits: q.resource_limits,
+        keyed,
+        heartbeat_period: c.heartbeat_period,
+        nack_response_delay: c.nack_response_delay,
+        fragment_size: c.fragment_size,
+        high_watermark: c.whc_high_watermark.max(1),
+        low_watermark: c.whc_low_watermark.min(c.whc_high_watermark),
+        max_repair_bytes: c.max_repair_bytes,
+        // Batched: about one heartbeat per full datagram rather than one per sample.
+        piggyback_heartbeat_bytes: if c.write_batch_delay.is_some() {
+            c.max_message_size
+        } else {
+            0
+        },
+    }
+}
+
 fn reader_params(c: &ParticipantConfig, reliable: bool) -> ReaderParams {
     ReaderParams {
         reliable,
@@ -91,6 +113,7 @@ fn reader_params(c: &ParticipantConfig, reliable: bool) -> ReaderParams {
 }
 
 impl Participant {
+    /// A participant with its builtin endpoints, announcing itself from `now` on (drain `poll_transmit`).
     pub fn new(mut config: ParticipantConfig, now: Instant) -> Self {
         // Fragments must fit the 16-bit fragmentSize field and leave room for headers in a datagram.
         config.fragment_size = config.fragment_size.clamp(64, 65000);
@@ -139,9 +162,11 @@ impl Participant {
         p
     }
 
+    /// The configuration it runs with (the fragment size clamped to 64..=65000).
     pub fn config(&self) -> &ParticipantConfig {
         &self.config
     }
+    /// Our GUID prefix.
     pub fn guid_prefix(&self) -> GuidPrefix {
         self.config.guid_prefix
     }
@@ -185,6 +210,7 @@ impl Participant {
         self.out.recycle(buf);
     }
 
+    /// The next event for the DCPS layer, in order.
     pub fn poll_event(&mut self) -> Option<Event> {
         loop {
             let e = self.events.pop_front()?;
@@ -198,6 +224,7 @@ impl Participant {
         }
     }
 
+    /// Runs the work due at `now` (heartbeats, repairs, SPDP, leases, lingering writers, batch deadlines).
     pub fn handle_timeout(&mut self, now: Instant) {
         self.service(now);
     }
@@ -211,81 +238,19 @@ impl Participant {
         Ok(EntityId::new([k[1], k[2], k[3]], kind))
     }
 
-    pub fn create_writer(&mut self, now: Instant, spec: WriterSpec) -> Result<EntityId, CoreError> {
+    /// Checks a spec and gives the new endpoint an entity id (`kinds`: without key, with key).
+    fn new_endpoint<Q>(
+        &mut self,
+        spec: EndpointSpec<Q>,
+        kinds: [u8; 2],
+    ) -> Result<EndpointData<Q>, CoreError> {
         self.timers_changed();
         if spec.topic_name.is_empty() || spec.type_name.is_empty() {
             return Err(CoreError::BadParameter("empty topic or type name"));
         }
-        let kind = if spec.keyed {
-            entity_kind::USER_WRITER_WITH_KEY
-        } else {
-            entity_kind::USER_WRITER_NO_KEY
-        };
-        let id = self.alloc_entity(kind)?;
+        let id = self.alloc_entity(kinds[usize::from(spec.keyed)])?;
         let guid = Guid::new(self.config.guid_prefix, id);
-        let q = &spec.qos.writer;
-        let c = &self.config;
-        let params = WriterParams {
-            reliable: q.reliability.is_reliable(),
-            durability: q.durability,
-            history: q.history,
-            limits: q.resource_limits,
-            keyed: spec.keyed,
-            heartbeat_period: c.heartbeat_period,
-            nack_response_delay: c.nack_response_delay,
-            fragment_size: c.fragment_size,
-            high_watermark: c.whc_high_watermark.max(1),
-            low_watermark: c.whc_low_watermark.min(c.whc_high_watermark),
-            max_repair_bytes: c.max_repair_bytes,
-            // Batched: about one heartbeat per full datagram rather than one per sample.
-            piggyback_heartbeat_bytes: if c.write_batch_delay.is_some() {
-                c.max_message_size
-            } else {
-                0
-            },
-        };
-        self.writers.insert(id, Writer::new(guid, params));
-        self.user_writers.insert(id);
-        let data = WriterData {
-            guid,
-            participant_guid: Some(Guid::new(guid.prefix, EntityId::PARTICIPANT)),
-            topic_name: spec.topic_name,
-            type_name: spec.type_name,
-            qos: spec.qos,
-            unicast_locators: Vec::new(),
-            multicast_locators: Vec::new(),
-            type_information: spec.type_information,
-            entity_name: spec.entity_name,
-        };
-        self.announce(
-            now,
-            EntityId::SEDP_PUBLICATIONS_WRITER,
-            guid,
-            ChangeKind::Alive,
-            data.encode(),
-        );
-        self.on_writer_known(now, data);
-        self.service(now);
-        Ok(id)
-    }
-
-    pub fn create_reader(&mut self, now: Instant, spec: ReaderSpec) -> Result<EntityId, CoreError> {
-        self.timers_changed();
-        if spec.topic_name.is_empty() || spec.type_name.is_empty() {
-            return Err(CoreError::BadParameter("empty topic or type name"));
-        }
-        let kind = if spec.keyed {
-            entity_kind::USER_READER_WITH_KEY
-        } else {
-            entity_kind::USER_READER_NO_KEY
-        };
-        let id = self.alloc_entity(kind)?;
-        let guid = Guid::new(self.config.guid_prefix, id);
-        let reliable = spec.qos.reader.reliability.is_reliable();
-        self.readers
-            .insert(id, Reader::new(guid, reader_params(&self.config, reliable)));
-        self.user_readers.insert(id);
-        let data = ReaderData {
+        Ok(EndpointData {
             guid,
             participant_guid: Some(Guid::new(guid.prefix, EntityId::PARTICIPANT)),
             topic_name: spec.topic_name,
@@ -296,16 +261,38 @@ impl Participant {
             expects_inline_qos: false,
             type_information: spec.type_information,
             entity_name: spec.entity_name,
-        };
-        self.announce(
-            now,
-            EntityId::SEDP_SUBSCRIPTIONS_WRITER,
-            guid,
-            ChangeKind::Alive,
-            data.encode(),
-        );
-        self.on_reader_known(now, data);
-        self.service(now);
+        })
+    }
+
+    /// Creates a local writer and announces it in SEDP; it matches local and remote readers from then on.
+    pub fn create_writer(&mut self, now: Instant, spec: WriterSpec) -> Result<EntityId, CoreError> {
+        let keyed = spec.keyed;
+        let kinds = [
+            entity_kind::USER_WRITER_NO_KEY,
+            entity_kind::USER_WRITER_WITH_KEY,
+        ];
+        let data = self.new_endpoint(spec, kinds)?;
+        let id = data.guid.entity_id;
+        let params = user_writer_params(&self.config, &data.qos.writer, keyed);
+        self.writers.insert(id, Writer::new(data.guid, params));
+        self.user_writers.insert(id);
+        self.publish_endpoint(now, data);
+        Ok(id)
+    }
+
+    /// Creates a local reader and announces it in SEDP; it matches local and remote writers from then on.
+    pub fn create_reader(&mut self, now: Instant, spec: ReaderSpec) -> Result<EntityId, CoreError> {
+        let kinds = [
+            entity_kind::USER_READER_NO_KEY,
+            entity_kind::USER_READER_WITH_KEY,
+        ];
+        let data = self.new_endpoint(spec, kinds)?;
+        let id = data.guid.entity_id;
+        let reliable = data.qos.reader.reliability.is_reliable();
+        let params = reader_params(&self.config, reliable);
+        self.readers.insert(id, Reader::new(data.guid, params));
+        self.user_readers.insert(id);
+        self.publish_endpoint(now, data);
         Ok(id)
     }
 
@@ -330,6 +317,7 @@ impl Participant {
         self.service(now);
     }
 
+    /// Deletes a reader at once: unmatch events and an SEDP dispose.
     pub fn delete_reader(&mut self, now: Instant, id: EntityId) {
         self.timers_changed();
         if !self.user_readers.remove(&id) {
@@ -352,7 +340,7 @@ impl Participant {
             ChangeKind::DisposeUnregister,
             Vec::new(),
         );
-        self.forget_reader(guid);
+        self.forget_endpoint::<ReaderQos>(guid);
         self.service(now);
     }
 
@@ -375,10 +363,12 @@ impl Participant {
             ChangeKind::DisposeUnregister,
             Vec::new(),
         );
-        self.forget_writer(guid);
+        self.forget_endpoint::<WriterQos>(guid);
         self.events.push_back(Event::WriterDeleted { writer: id });
     }
 
+    /// Queues one change of a user writer. `Err(WouldBlock)` when flow control or KEEP_ALL resource limits
+    /// refuse it: call again after acknowledgements arrive ([`Event::WriterUnblocked`]).
     pub fn write(
         &mut self,
         now: Instant,
@@ -401,10 +391,11 @@ impl Participant {
         r
     }
 
+    /// Whether every matched reliable reader acknowledged everything the writer wrote (true for unknown ids).
     pub fn is_acknowledged(&self, writer: EntityId) -> bool {
         self.writers
             .get(&writer)
-            .is_none_or(|w| w.is_acknowledged())
+            .map_or(true, |w| w.is_acknowledged())
     }
 
     /// Bytes written but not yet acknowledged by every reliable reader (what flow control looks at).
@@ -412,6 +403,7 @@ impl Participant {
         self.writers.get(&writer).map_or(0, |w| w.unacked_bytes())
     }
 
+    /// The readers a local user writer is matched with.
     pub fn writer_matches(&self, writer: EntityId) -> Vec<Guid> {
         if !self.user_writers.contains(&writer) {
             return Vec::new();
@@ -434,6 +426,7 @@ impl Participant {
         }
     }
 
+    /// The writers a local user reader is matched with.
     pub fn reader_matches(&self, reader: EntityId) -> Vec<Guid> {
         if !self.user_readers.contains(&reader) {
             return Vec::new();
@@ -453,6 +446,7 @@ impl Participant {
     pub fn publication(&self, guid: &Guid) -> Option<&WriterData> {
         self.known_writers.get(guid)
     }
+    /// A known subscription (remote or local).
     pub fn subscription(&self, guid: &Guid) -> Option<&ReaderData> {
         self.known_readers.get(guid)
     }

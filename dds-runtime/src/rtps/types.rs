@@ -3,10 +3,12 @@
 use std::fmt;
 use std::time::Duration;
 
+/// The 12-byte prefix shared by a participant and all its entities (§8.2.4.3).
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 pub struct GuidPrefix(pub [u8; 12]);
 
 impl GuidPrefix {
+    /// GUIDPREFIX_UNKNOWN.
     pub const UNKNOWN: GuidPrefix = GuidPrefix([0; 12]);
 }
 
@@ -22,6 +24,7 @@ impl fmt::Debug for GuidPrefix {
     }
 }
 
+/// The 4-byte id of an entity within its participant (§9.3.1.2): a 3-byte key and a kind octet.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 pub struct EntityId(pub [u8; 4]);
 
@@ -33,76 +36,114 @@ impl fmt::Debug for EntityId {
 
 /// Entity kinds: the last byte of an [`EntityId`].
 pub mod entity_kind {
+    /// A user writer of a keyed topic.
     pub const USER_WRITER_WITH_KEY: u8 = 0x02;
+    /// A user writer of a keyless topic.
     pub const USER_WRITER_NO_KEY: u8 = 0x03;
+    /// A user reader of a keyless topic.
     pub const USER_READER_NO_KEY: u8 = 0x04;
+    /// A user reader of a keyed topic.
     pub const USER_READER_WITH_KEY: u8 = 0x07;
+    /// A builtin participant.
     pub const BUILTIN_PARTICIPANT: u8 = 0xc1;
+    /// A builtin writer of a keyed topic.
     pub const BUILTIN_WRITER_WITH_KEY: u8 = 0xc2;
+    /// A builtin writer of a keyless topic.
     pub const BUILTIN_WRITER_NO_KEY: u8 = 0xc3;
+    /// A builtin reader of a keyless topic.
     pub const BUILTIN_READER_NO_KEY: u8 = 0xc4;
+    /// A builtin reader of a keyed topic.
     pub const BUILTIN_READER_WITH_KEY: u8 = 0xc7;
 }
 
 impl EntityId {
+    /// ENTITYID_UNKNOWN: any reader (as a DATA destination) or unknown.
     pub const UNKNOWN: EntityId = EntityId([0, 0, 0, 0]);
+    /// The participant itself.
     pub const PARTICIPANT: EntityId = EntityId([0, 0, 1, 0xc1]);
+    /// SEDP topics writer (not implemented).
     pub const SEDP_TOPICS_WRITER: EntityId = EntityId([0, 0, 2, 0xc2]);
+    /// SEDP topics reader (not implemented).
     pub const SEDP_TOPICS_READER: EntityId = EntityId([0, 0, 2, 0xc7]);
+    /// SEDP publications writer: announces our writers.
     pub const SEDP_PUBLICATIONS_WRITER: EntityId = EntityId([0, 0, 3, 0xc2]);
+    /// SEDP publications reader: learns remote writers.
     pub const SEDP_PUBLICATIONS_READER: EntityId = EntityId([0, 0, 3, 0xc7]);
+    /// SEDP subscriptions writer: announces our readers.
     pub const SEDP_SUBSCRIPTIONS_WRITER: EntityId = EntityId([0, 0, 4, 0xc2]);
+    /// SEDP subscriptions reader: learns remote readers.
     pub const SEDP_SUBSCRIPTIONS_READER: EntityId = EntityId([0, 0, 4, 0xc7]);
+    /// SPDP writer: announces the participant.
     pub const SPDP_WRITER: EntityId = EntityId([0, 1, 0, 0xc2]);
+    /// SPDP reader: learns remote participants.
     pub const SPDP_READER: EntityId = EntityId([0, 1, 0, 0xc7]);
+    /// Participant message writer (liveliness).
     pub const P2P_MESSAGE_WRITER: EntityId = EntityId([0, 2, 0, 0xc2]);
+    /// Participant message reader (liveliness).
     pub const P2P_MESSAGE_READER: EntityId = EntityId([0, 2, 0, 0xc7]);
+    /// XTypes type lookup request writer.
     pub const TYPELOOKUP_REQUEST_WRITER: EntityId = EntityId([0, 3, 0, 0xc3]);
+    /// XTypes type lookup request reader.
     pub const TYPELOOKUP_REQUEST_READER: EntityId = EntityId([0, 3, 0, 0xc4]);
+    /// XTypes type lookup reply writer.
     pub const TYPELOOKUP_REPLY_WRITER: EntityId = EntityId([0, 3, 1, 0xc3]);
+    /// XTypes type lookup reply reader.
     pub const TYPELOOKUP_REPLY_READER: EntityId = EntityId([0, 3, 1, 0xc4]);
 
+    /// An id from its 3-byte key and kind octet (see [`entity_kind`]).
     pub fn new(key: [u8; 3], kind: u8) -> Self {
         EntityId([key[0], key[1], key[2], kind])
     }
+    /// The kind octet (see [`entity_kind`]).
     pub fn kind(&self) -> u8 {
         self.0[3]
     }
+    /// Whether this is a builtin (discovery or liveliness) entity.
     pub fn is_builtin(&self) -> bool {
         self.0[3] & 0xc0 == 0xc0
     }
+    /// Whether this entity is a writer.
     pub fn is_writer(&self) -> bool {
         matches!(self.0[3] & 0x3f, 0x02 | 0x03)
     }
+    /// Whether this entity is a reader.
     pub fn is_reader(&self) -> bool {
         matches!(self.0[3] & 0x3f, 0x04 | 0x07)
     }
+    /// Whether the entity's topic is keyed.
     pub fn is_keyed(&self) -> bool {
         matches!(self.0[3] & 0x3f, 0x02 | 0x07)
     }
 }
 
+/// A globally unique entity id (§8.2.4.1): participant prefix plus entity id.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 pub struct Guid {
+    /// The participant's GUID prefix.
     pub prefix: GuidPrefix,
+    /// The entity within the participant.
     pub entity_id: EntityId,
 }
 
 impl Guid {
+    /// GUID_UNKNOWN.
     pub const UNKNOWN: Guid = Guid {
         prefix: GuidPrefix::UNKNOWN,
         entity_id: EntityId::UNKNOWN,
     };
 
+    /// The GUID of `entity_id` in the participant `prefix`.
     pub fn new(prefix: GuidPrefix, entity_id: EntityId) -> Self {
         Guid { prefix, entity_id }
     }
+    /// The 16 bytes on the wire (also the key hash of builtin topics).
     pub fn to_bytes(&self) -> [u8; 16] {
         let mut b = [0u8; 16];
         b[..12].copy_from_slice(&self.prefix.0);
         b[12..].copy_from_slice(&self.entity_id.0);
         b
     }
+    /// From the 16 bytes on the wire.
     pub fn from_bytes(b: [u8; 16]) -> Self {
         let mut p = [0u8; 12];
         p.copy_from_slice(&b[..12]);
@@ -124,40 +165,57 @@ impl fmt::Debug for Guid {
 pub struct VendorId(pub [u8; 2]);
 
 impl VendorId {
+    /// No vendor given.
     pub const UNKNOWN: VendorId = VendorId([0, 0]);
+    /// RTI Connext.
     pub const RTI: VendorId = VendorId([1, 1]);
+    /// OpenDDS.
     pub const OPENDDS: VendorId = VendorId([1, 3]);
+    /// eProsima Fast DDS.
     pub const FASTDDS: VendorId = VendorId([1, 0x0f]);
+    /// Eclipse Cyclone DDS.
     pub const CYCLONE: VendorId = VendorId([1, 0x10]);
     /// Ours. The OMG list assigns 0x0101..=0x0121 (as of 2025; RustDDS 0x0112, Dust DDS 0x0121 among them);
     /// 0x01dd ("DDs") is far above the last assigned id and is not known to be used by anyone.
     pub const THIS: VendorId = VendorId([0x01, 0xdd]);
 }
 
+/// An RTPS protocol version.
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Debug)]
 pub struct ProtocolVersion {
+    /// Major version; messages with another major version are dropped.
     pub major: u8,
+    /// Minor version.
     pub minor: u8,
 }
 
 impl ProtocolVersion {
+    /// RTPS 2.5, the version we speak.
     pub const V2_5: ProtocolVersion = ProtocolVersion { major: 2, minor: 5 };
 }
 
 /// A locator. `address` holds IPv4 addresses in its last 4 bytes.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Locator {
+    /// The transport kind (`KIND_*`).
     pub kind: i32,
+    /// The port.
     pub port: u32,
+    /// The address; IPv4 addresses in the last four bytes.
     pub address: [u8; 16],
 }
 
 impl Locator {
+    /// LOCATOR_KIND_INVALID.
     pub const KIND_INVALID: i32 = -1;
+    /// LOCATOR_KIND_RESERVED.
     pub const KIND_RESERVED: i32 = 0;
+    /// LOCATOR_KIND_UDPv4.
     pub const KIND_UDPV4: i32 = 1;
+    /// LOCATOR_KIND_UDPv6.
     pub const KIND_UDPV6: i32 = 2;
 
+    /// A UDPv4 locator.
     pub fn udpv4(ip: [u8; 4], port: u16) -> Self {
         let mut address = [0u8; 16];
         address[12..].copy_from_slice(&ip);
@@ -178,6 +236,7 @@ impl Locator {
             ]
         })
     }
+    /// Whether the address is an IPv4 or IPv6 multicast address.
     pub fn is_multicast(&self) -> bool {
         match self.kind {
             Self::KIND_UDPV4 => (224..=239).contains(&self.address[12]),
@@ -185,6 +244,7 @@ impl Locator {
             _ => false,
         }
     }
+    /// The socket address of a UDP locator; `None` for other kinds.
     pub fn to_socket_addr(&self) -> Option<std::net::SocketAddr> {
         let port = u16::try_from(self.port).ok()?;
         match self.kind {
@@ -193,6 +253,7 @@ impl Locator {
             _ => None,
         }
     }
+    /// The UDP locator for a socket address.
     pub fn from_socket_addr(a: std::net::SocketAddr) -> Self {
         match a {
             std::net::SocketAddr::V4(v4) => Locator::udpv4(v4.ip().octets(), v4.port()),
@@ -219,16 +280,21 @@ impl fmt::Debug for Locator {
 pub struct SequenceNumber(pub i64);
 
 impl SequenceNumber {
+    /// SEQUENCENUMBER_UNKNOWN.
     pub const UNKNOWN: SequenceNumber = SequenceNumber((-1i64) << 32);
+    /// From the high and low halves on the wire.
     pub fn from_parts(high: i32, low: u32) -> Self {
         SequenceNumber(((high as i64) << 32) | low as i64)
     }
+    /// The high half on the wire.
     pub fn high(self) -> i32 {
         (self.0 >> 32) as i32
     }
+    /// The low half on the wire.
     pub fn low(self) -> u32 {
         self.0 as u32
     }
+    /// The following sequence number (saturating).
     pub fn next(self) -> Self {
         SequenceNumber(self.0.saturating_add(1))
     }
@@ -244,17 +310,24 @@ impl std::ops::Add<i64> for SequenceNumber {
 /// Bitmap set over a window of 256 numbers starting at `base` (§9.4.2.6). Used for sequence and fragment numbers.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub struct NumberSet<T> {
+    /// The first number of the window.
     pub base: T,
+    /// How many bits of the window are meaningful (≤ 256).
     pub num_bits: u32,
+    /// The bits, most significant first: bit `i` stands for `base + i`.
     pub bitmap: [u32; 8],
 }
 
+/// A set of sequence numbers (SequenceNumberSet).
 pub type SequenceNumberSet = NumberSet<SequenceNumber>;
+/// A set of fragment numbers (FragmentNumberSet).
 pub type FragmentNumberSet = NumberSet<u32>;
 
 impl<T: Copy> NumberSet<T> {
+    /// The largest window.
     pub const MAX_BITS: u32 = 256;
 
+    /// An empty set starting at `base`.
     pub fn empty(base: T) -> Self {
         NumberSet {
             base,
@@ -269,6 +342,7 @@ impl<T: Copy> NumberSet<T> {
             self.num_bits = self.num_bits.max(offset + 1);
         }
     }
+    /// Whether bit `offset` (0-based from base) is set.
     pub fn contains_offset(&self, offset: u32) -> bool {
         offset < self.num_bits
             && self.bitmap[(offset / 32) as usize] & (1 << (31 - offset % 32)) != 0
@@ -277,12 +351,14 @@ impl<T: Copy> NumberSet<T> {
     pub fn offsets(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.num_bits.min(Self::MAX_BITS)).filter(move |&o| self.contains_offset(o))
     }
+    /// The bitmap words the wire carries (`ceil(num_bits / 32)`).
     pub fn words(&self) -> &[u32] {
         &self.bitmap[..self.num_bits.div_ceil(32) as usize]
     }
 }
 
 impl SequenceNumberSet {
+    /// The sequence numbers in the set, ascending.
     pub fn iter(&self) -> impl Iterator<Item = SequenceNumber> + '_ {
         let base = self.base;
         self.offsets().map(move |o| base + o as i64)
@@ -300,10 +376,12 @@ impl SequenceNumberSet {
 }
 
 impl FragmentNumberSet {
+    /// The fragment numbers in the set, ascending.
     pub fn iter(&self) -> impl Iterator<Item = u32> + '_ {
         let base = self.base;
         self.offsets().map(move |o| base.wrapping_add(o))
     }
+    /// Adds fragment `n` if it lies in the window; returns whether it did.
     pub fn insert(&mut self, n: u32) -> bool {
         let off = n.wrapping_sub(self.base);
         if off < 256 {
@@ -318,19 +396,24 @@ impl FragmentNumberSet {
 /// RTPS wire time: seconds and 2^-32 fractions since the Unix epoch.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug, Default)]
 pub struct Time {
+    /// Seconds since the Unix epoch.
     pub seconds: i32,
+    /// Fractions of a second, in units of 2^-32 s.
     pub fraction: u32,
 }
 
 impl Time {
+    /// TIME_ZERO.
     pub const ZERO: Time = Time {
         seconds: 0,
         fraction: 0,
     };
+    /// TIME_INVALID.
     pub const INVALID: Time = Time {
         seconds: -1,
         fraction: 0xffff_ffff,
     };
+    /// TIME_INFINITE.
     pub const INFINITE: Time = Time {
         seconds: 0x7fff_ffff,
         fraction: 0xffff_ffff,
@@ -346,6 +429,7 @@ impl Time {
             fraction: fraction as u32,
         }
     }
+    /// The duration since the Unix epoch; `None` for negative, invalid or infinite times.
     pub fn to_unix(self) -> Option<Duration> {
         if self.seconds < 0 || self == Time::INFINITE {
             return None;

@@ -10,13 +10,13 @@ use dds_runtime::rtps::*;
 
 /// xorshift64*: small, seeded, deterministic.
 #[derive(Debug, Clone)]
-pub struct Rng(u64);
+pub(crate) struct Rng(u64);
 
 impl Rng {
-    pub fn new(seed: u64) -> Self {
+    pub(crate) fn new(seed: u64) -> Self {
         Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
     }
-    pub fn next_u64(&mut self) -> u64 {
+    pub(crate) fn next_u64(&mut self) -> u64 {
         let mut x = self.0;
         x ^= x >> 12;
         x ^= x << 25;
@@ -25,31 +25,31 @@ impl Rng {
         x.wrapping_mul(0x2545_f491_4f6c_dd1d)
     }
     /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
+    pub(crate) fn unit(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
-    pub fn below(&mut self, n: u64) -> u64 {
+    pub(crate) fn below(&mut self, n: u64) -> u64 {
         self.next_u64() % n.max(1)
     }
 }
 
 #[derive(Debug, Clone, Copy)]
-pub struct Faults {
-    pub loss: f64,
-    pub duplicate: f64,
+pub(crate) struct Faults {
+    pub(crate) loss: f64,
+    pub(crate) duplicate: f64,
     /// Each datagram gets a delay uniform in [latency, latency + jitter]: jitter reorders.
-    pub latency: Duration,
-    pub jitter: Duration,
+    pub(crate) latency: Duration,
+    pub(crate) jitter: Duration,
 }
 
 impl Faults {
-    pub const NONE: Faults = Faults {
+    pub(crate) const NONE: Faults = Faults {
         loss: 0.0,
         duplicate: 0.0,
         latency: Duration::from_micros(100),
         jitter: Duration::ZERO,
     };
-    pub fn lossy(loss: f64) -> Faults {
+    pub(crate) fn lossy(loss: f64) -> Faults {
         Faults {
             loss,
             duplicate: 0.1,
@@ -59,11 +59,11 @@ impl Faults {
     }
 }
 
-pub struct Node {
-    pub p: Participant,
-    pub events: Vec<Event>,
+pub(crate) struct Node {
+    pub(crate) p: Participant,
+    pub(crate) events: Vec<Event>,
     /// Whether this node is connected: false = it neither receives nor gets anything out (crashed or cut off).
-    pub up: bool,
+    pub(crate) up: bool,
 }
 
 #[derive(PartialEq, Eq, PartialOrd, Ord)]
@@ -74,35 +74,35 @@ struct InFlight {
     payload: Vec<u8>,
 }
 
-pub struct Sim {
-    pub start: Instant,
-    pub now: Instant,
-    pub nodes: Vec<Node>,
-    pub rng: Rng,
-    pub faults: Faults,
+pub(crate) struct Sim {
+    pub(crate) start: Instant,
+    pub(crate) now: Instant,
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) rng: Rng,
+    pub(crate) faults: Faults,
     queue: BinaryHeap<Reverse<InFlight>>,
     seq: u64,
-    pub datagrams_sent: u64,
+    pub(crate) datagrams_sent: u64,
     /// Faults apply only to user traffic when set (discovery then completes quickly).
-    pub faults_on_discovery: bool,
+    pub(crate) faults_on_discovery: bool,
 }
 
-pub fn prefix(i: usize) -> GuidPrefix {
+pub(crate) fn prefix(i: usize) -> GuidPrefix {
     let mut p = [0u8; 12];
     p[0] = 0xaa;
     p[11] = i as u8 + 1;
     GuidPrefix(p)
 }
 
-pub fn config(i: usize) -> ParticipantConfig {
-    let mut c = ParticipantConfig::new(0, 0, prefix(i), [10, 0, 0, i as u8 + 1]).unwrap();
-    c.spdp_interval = Duration::from_millis(500);
-    c.lease_duration = Duration::from_secs(3);
-    c
+pub(crate) fn config(i: usize) -> ParticipantConfigBuilder {
+    ParticipantConfig::builder(0, 0, prefix(i), [10, 0, 0, i as u8 + 1])
+        .unwrap()
+        .spdp_interval(Duration::from_millis(500))
+        .lease_duration(Duration::from_secs(3))
 }
 
 impl Sim {
-    pub fn new(seed: u64, faults: Faults) -> Self {
+    pub(crate) fn new(seed: u64, faults: Faults) -> Self {
         let start = Instant::now();
         Sim {
             start,
@@ -117,8 +117,8 @@ impl Sim {
         }
     }
 
-    pub fn add(&mut self, config: ParticipantConfig) -> usize {
-        let p = Participant::new(config, self.now);
+    pub(crate) fn add(&mut self, config: impl Into<ParticipantConfig>) -> usize {
+        let p = Participant::new(config.into(), self.now);
         self.nodes.push(Node {
             p,
             events: Vec::new(),
@@ -127,7 +127,7 @@ impl Sim {
         self.nodes.len() - 1
     }
 
-    pub fn with_participants(seed: u64, faults: Faults, n: usize) -> Self {
+    pub(crate) fn with_participants(seed: u64, faults: Faults, n: usize) -> Self {
         let mut s = Sim::new(seed, faults);
         for i in 0..n {
             s.add(config(i));
@@ -142,9 +142,9 @@ impl Sim {
             .filter(|(_, n)| {
                 let c = n.p.config();
                 if l.is_multicast() {
-                    c.metatraffic_multicast.contains(l) || c.default_multicast.contains(l)
+                    c.metatraffic_multicast().contains(l) || c.default_multicast().contains(l)
                 } else {
-                    c.metatraffic_unicast.contains(l) || c.default_unicast.contains(l)
+                    c.metatraffic_unicast().contains(l) || c.default_unicast().contains(l)
                 }
             })
             .map(|(i, _)| i)
@@ -152,7 +152,7 @@ impl Sim {
     }
 
     /// Moves every pending transmit into the network and every event into the nodes' logs.
-    pub fn pump(&mut self) {
+    pub(crate) fn pump(&mut self) {
         for i in 0..self.nodes.len() {
             while let Some(t) = self.nodes[i].p.poll_transmit(self.now) {
                 self.datagrams_sent += 1;
@@ -202,12 +202,12 @@ impl Sim {
     }
 
     /// Advances to the next datagram or timeout; returns false when nothing is scheduled.
-    pub fn step(&mut self) -> bool {
+    pub(crate) fn step(&mut self) -> bool {
         self.step_until(None)
     }
 
     /// Like `step`, but never moves the clock past `cap`.
-    pub fn step_until(&mut self, cap: Option<Instant>) -> bool {
+    pub(crate) fn step_until(&mut self, cap: Option<Instant>) -> bool {
         self.pump();
         let next_dgram = self.queue.peek().map(|r| r.0.at);
         let next_timer = self.nodes.iter().filter_map(|n| n.p.poll_timeout()).min();
@@ -241,7 +241,11 @@ impl Sim {
     }
 
     /// Runs until `cond` holds or `limit` of simulated time passes; returns whether `cond` held.
-    pub fn run_until(&mut self, limit: Duration, mut cond: impl FnMut(&mut Sim) -> bool) -> bool {
+    pub(crate) fn run_until(
+        &mut self,
+        limit: Duration,
+        mut cond: impl FnMut(&mut Sim) -> bool,
+    ) -> bool {
         let end = self.now + limit;
         loop {
             self.pump();
@@ -254,21 +258,21 @@ impl Sim {
         }
     }
 
-    pub fn run_for(&mut self, d: Duration) {
+    pub(crate) fn run_for(&mut self, d: Duration) {
         let end = self.now + d;
         self.run_until(d, |s| s.now >= end);
     }
 
-    pub fn elapsed(&self) -> Duration {
+    pub(crate) fn elapsed(&self) -> Duration {
         self.now - self.start
     }
 
-    pub fn guid(&self, node: usize, id: EntityId) -> Guid {
+    pub(crate) fn guid(&self, node: usize, id: EntityId) -> Guid {
         Guid::new(self.nodes[node].p.guid_prefix(), id)
     }
 
     /// Takes the samples delivered to `reader` at `node` so far.
-    pub fn take_samples(&mut self, node: usize, reader: EntityId) -> Vec<ReceivedSample> {
+    pub(crate) fn take_samples(&mut self, node: usize, reader: EntityId) -> Vec<ReceivedSample> {
         let mut out = Vec::new();
         self.nodes[node].events.retain(|e| match e {
             Event::Sample(s) if s.reader == reader => {
@@ -280,7 +284,7 @@ impl Sim {
         out
     }
 
-    pub fn has_event(&self, node: usize, f: impl Fn(&Event) -> bool) -> bool {
+    pub(crate) fn has_event(&self, node: usize, f: impl Fn(&Event) -> bool) -> bool {
         self.nodes[node].events.iter().any(f)
     }
 }

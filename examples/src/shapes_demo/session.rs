@@ -370,7 +370,7 @@ fn writer_qos(xcdr2: bool) -> DataWriterQos {
 /// Reliable, keep-last-8, accepting XCDR1 and XCDR2.
 fn reader_qos() -> DataReaderQos {
     let both =
-        DataRepresentation([DataRepresentation::xcdr1().0, DataRepresentation::xcdr2().0].concat());
+        DataRepresentation::accept_both();
     DataReaderQos::builder()
         .reliability(Reliability::RELIABLE)
         .history(History::KeepLast(8))

@@ -2,15 +2,25 @@
 
 use crate::rtps::types::{EntityId, GuidPrefix};
 
+/// The SPDP writer.
 pub const PARTICIPANT_ANNOUNCER: u32 = 1 << 0;
+/// The SPDP reader.
 pub const PARTICIPANT_DETECTOR: u32 = 1 << 1;
+/// The SEDP publications writer.
 pub const PUBLICATIONS_ANNOUNCER: u32 = 1 << 2;
+/// The SEDP publications reader.
 pub const PUBLICATIONS_DETECTOR: u32 = 1 << 3;
+/// The SEDP subscriptions writer.
 pub const SUBSCRIPTIONS_ANNOUNCER: u32 = 1 << 4;
+/// The SEDP subscriptions reader.
 pub const SUBSCRIPTIONS_DETECTOR: u32 = 1 << 5;
+/// The participant message writer.
 pub const PARTICIPANT_MESSAGE_WRITER: u32 = 1 << 10;
+/// The participant message reader.
 pub const PARTICIPANT_MESSAGE_READER: u32 = 1 << 11;
+/// The SEDP topics writer.
 pub const TOPICS_ANNOUNCER: u32 = 1 << 28;
+/// The SEDP topics reader.
 pub const TOPICS_DETECTOR: u32 = 1 << 29;
 
 /// What we announce.
@@ -63,6 +73,7 @@ pub const READER_PAIRS: [(EntityId, EntityId, u32); 3] = [
 
 /// ParticipantMessageData kinds (§9.6.2.1).
 pub const PMD_KIND_AUTOMATIC: [u8; 4] = [0, 0, 0, 1];
+/// ParticipantMessageData kind: manual liveliness by participant.
 pub const PMD_KIND_MANUAL: [u8; 4] = [0, 0, 0, 2];
 
 /// Serializes ParticipantMessageData (CDR little-endian with encapsulation header).

@@ -1,9 +1,12 @@
 //! Writer/reader matching: topic and type names, partitions, then requested/offered QoS.
 
-use crate::qos::{check_compatible, partitions_match, QosPolicyId, ReaderQos, WriterQos};
+use super::{ReaderData, WriterData};
+use crate::qos::{check_compatible, partitions_match, QosPolicyId};
 
+/// The outcome of matching a publication with a subscription.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MatchResult {
+    /// Same topic, type and partition, and compatible QoS: the endpoints communicate.
     Match,
     /// Different topic, type or partition: not related at all, nothing to report.
     Unrelated,
@@ -11,22 +14,8 @@ pub enum MatchResult {
     Incompatible(QosPolicyId),
 }
 
-/// A writer endpoint's matching-relevant description.
-#[derive(Debug, Clone, Copy)]
-pub struct WriterView<'a> {
-    pub topic_name: &'a str,
-    pub type_name: &'a str,
-    pub qos: &'a WriterQos,
-}
-
-#[derive(Debug, Clone, Copy)]
-pub struct ReaderView<'a> {
-    pub topic_name: &'a str,
-    pub type_name: &'a str,
-    pub qos: &'a ReaderQos,
-}
-
-pub fn match_endpoints(w: WriterView<'_>, r: ReaderView<'_>) -> MatchResult {
+/// Matches a publication with a subscription (DDS 1.4 §2.2.3, RTPS 2.5 §8.5.5.1).
+pub fn match_endpoints(w: &WriterData, r: &ReaderData) -> MatchResult {
     if w.topic_name != r.topic_name {
         return MatchResult::Unrelated;
     }
@@ -37,7 +26,7 @@ pub fn match_endpoints(w: WriterView<'_>, r: ReaderView<'_>) -> MatchResult {
     if !partitions_match(&w.qos.partition, &r.qos.partition) {
         return MatchResult::Unrelated;
     }
-    match check_compatible(w.qos, r.qos) {
+    match check_compatible(&w.qos, &r.qos) {
         Ok(()) => MatchResult::Match,
         Err(p) => MatchResult::Incompatible(p),
     }

@@ -3,11 +3,12 @@
 pub mod builtin;
 pub mod matching;
 pub mod ports;
+mod qos_params;
 mod sedp;
 mod spdp;
 
 pub(crate) use sedp::{encode_endpoint_key, endpoint_guid as endpoint_guid_of};
-pub use sedp::{ReaderData, WriterData};
+pub use sedp::{EndpointData, EndpointQos, ReaderData, WriterData};
 pub use spdp::ParticipantData;
 
 /// Encapsulation of discovery payloads: PL_CDR little-endian (0x0003) and big-endian (0x0002).

@@ -1,7 +1,6 @@
 //! DiscoveredWriterData / DiscoveredReaderData (§8.5.4, §9.6.2.2) and their parameter-list form.
 
 use super::{pl_payload, PL_CDR_LE};
-use crate::qos::wire::{read_reader_qos, read_writer_qos, write_reader_qos, write_writer_qos};
 use crate::qos::{ReaderQos, WriterQos};
 use crate::rtps::messages::parameter::{pid, ParameterWriter};
 use crate::rtps::messages::{ParameterList, WireError};
@@ -10,127 +9,160 @@ use crate::xtypes::TypeInformation;
 
 const MAX_LOCATORS: usize = 64;
 
-/// A publication as announced in SEDP.
+/// An endpoint as announced in SEDP (§8.5.4): a publication (`Q` = [`WriterQos`], see [`WriterData`]) or a
+/// subscription (`Q` = [`ReaderQos`], see [`ReaderData`]). The two directions differ only in their QoS.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct WriterData {
+pub struct EndpointData<Q> {
+    /// The endpoint's GUID (PID_ENDPOINT_GUID), also the key of the SEDP sample.
     pub guid: Guid,
+    /// The owning participant (PID_PARTICIPANT_GUID), if announced.
     pub participant_guid: Option<Guid>,
+    /// The topic name.
     pub topic_name: String,
+    /// The registered type name.
     pub type_name: String,
-    pub qos: WriterQos,
+    /// The QoS as announced: endpoint, group and topic parts.
+    pub qos: Q,
+    /// Unicast locators of the endpoint; empty means its participant's default unicast locators.
     pub unicast_locators: Vec<Locator>,
+    /// Multicast locators of the endpoint.
     pub multicast_locators: Vec<Locator>,
-    pub type_information: Option<TypeInformation>,
-    pub entity_name: Option<String>,
-}
-
-/// A subscription as announced in SEDP.
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct ReaderData {
-    pub guid: Guid,
-    pub participant_guid: Option<Guid>,
-    pub topic_name: String,
-    pub type_name: String,
-    pub qos: ReaderQos,
-    pub unicast_locators: Vec<Locator>,
-    pub multicast_locators: Vec<Locator>,
+    /// The endpoint wants inline QoS with every DATA (announced by readers only; always `false` for writers).
     pub expects_inline_qos: bool,
+    /// XTypes TYPE_INFORMATION, kept opaque.
     pub type_information: Option<TypeInformation>,
+    /// PID_ENTITY_NAME, if announced.
     pub entity_name: Option<String>,
 }
 
-/// Fields common to both kinds while decoding.
+/// A publication as announced in SEDP (DiscoveredWriterData).
+pub type WriterData = EndpointData<WriterQos>;
+
+/// A subscription as announced in SEDP (DiscoveredReaderData).
+pub type ReaderData = EndpointData<ReaderQos>;
+
+/// The QoS part of an SEDP announcement, the only part in which the two directions differ on the wire.
+pub trait EndpointQos: Default {
+    /// Appends the QoS parameters of this direction.
+    fn write_params(&self, w: &mut ParameterWriter<'_>);
+    /// Decodes one parameter into `self`; `Ok(false)` when it is not a QoS parameter of this direction.
+    fn read_param(&mut self, id: u16, value: &[u8], little_endian: bool)
+        -> Result<bool, WireError>;
+}
+
+impl<Q: EndpointQos> EndpointData<Q> {
+    /// The PL_CDR_LE payload of the SEDP sample announcing this endpoint.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(512);
+        out.extend_from_slice(&PL_CDR_LE);
+        let mut w = ParameterWriter::new(&mut out, true);
+        w.guid(pid::ENDPOINT_GUID, &self.guid);
+        w.guid(
+            pid::PARTICIPANT_GUID,
+            &Guid::new(self.guid.prefix, EntityId::PARTICIPANT),
+        );
+        w.string(pid::TOPIC_NAME, &self.topic_name);
+        w.string(pid::TYPE_NAME, &self.type_name);
+        for l in &self.unicast_locators {
+            w.locator(pid::UNICAST_LOCATOR, l);
+        }
+        for l in &self.multicast_locators {
+            w.locator(pid::MULTICAST_LOCATOR, l);
+        }
+        if let Some(ti) = &self.type_information {
+            w.raw(pid::TYPE_INFORMATION, &ti.0);
+        }
+        if let Some(n) = &self.entity_name {
+            w.string(pid::ENTITY_NAME, n);
+        }
+        if self.expects_inline_qos {
+            w.bool(pid::EXPECTS_INLINE_QOS, true);
+        }
+        self.qos.write_params(&mut w);
+        w.finish();
+        out
+    }
+
+    /// Decodes an SEDP payload. An unknown must-understand parameter rejects the whole announcement;
+    /// vendor-specific ones are skipped; the endpoint GUID, topic name and type name are required.
+    pub fn decode(payload: &[u8]) -> Result<Self, WireError> {
+        let pl = pl_payload(payload)?;
+        let mut d = Decoded::<Q>::default();
+        for p in pl.iter() {
+            if p.id & pid::VENDOR_SPECIFIC != 0 {
+                continue;
+            }
+            let known = d.read_common(&pl, p.id, p.value)?
+                || d.data.qos.read_param(p.id, p.value, pl.little_endian)?;
+            if !known && p.id & pid::MUST_UNDERSTAND != 0 {
+                return Err(WireError::MustUnderstand(p.id));
+            }
+        }
+        d.finish()
+    }
+}
+
+/// An announcement while it is decoded: the required parameters are tracked apart.
 #[derive(Default)]
-struct Common {
+struct Decoded<Q> {
+    data: EndpointData<Q>,
     guid: Option<Guid>,
-    participant_guid: Option<Guid>,
     topic_name: Option<String>,
     type_name: Option<String>,
-    unicast: Vec<Locator>,
-    multicast: Vec<Locator>,
-    expects_inline_qos: bool,
-    type_information: Option<TypeInformation>,
-    entity_name: Option<String>,
 }
 
-/// The parameters an endpoint announcement cannot do without.
-struct RequiredEndpointFields {
-    guid: Guid,
-    topic_name: String,
-    type_name: String,
-}
-
-/// Walks an endpoint announcement: common parameters go into `Common`, the rest to `read_qos`. An unknown
-/// must-understand parameter rejects the whole announcement; vendor-specific ones are skipped.
-fn decode_endpoint(
-    payload: &[u8],
-    mut read_qos: impl FnMut(u16, &[u8], bool) -> Result<bool, WireError>,
-) -> Result<(Common, RequiredEndpointFields), WireError> {
-    let pl = pl_payload(payload)?;
-    let mut c = Common::default();
-    for p in pl.iter() {
-        if p.id & pid::VENDOR_SPECIFIC != 0 {
-            continue;
+impl<Q> Decoded<Q> {
+    /// Decodes one parameter common to both directions; `Ok(false)` when `id` is not one of them.
+    fn read_common(
+        &mut self,
+        pl: &ParameterList<'_>,
+        id: u16,
+        value: &[u8],
+    ) -> Result<bool, WireError> {
+        let mut cur = pl.cursor(value);
+        let d = &mut self.data;
+        match id {
+            pid::ENDPOINT_GUID => self.guid = Some(cur.guid()?),
+            pid::PARTICIPANT_GUID => d.participant_guid = Some(cur.guid()?),
+            pid::TOPIC_NAME => self.topic_name = Some(cur.string()?.to_owned()),
+            pid::TYPE_NAME => self.type_name = Some(cur.string()?.to_owned()),
+            pid::UNICAST_LOCATOR => add_locator(&mut d.unicast_locators, cur.locator()?),
+            pid::MULTICAST_LOCATOR => add_locator(&mut d.multicast_locators, cur.locator()?),
+            pid::EXPECTS_INLINE_QOS => d.expects_inline_qos = cur.u8()? != 0,
+            pid::TYPE_INFORMATION => d.type_information = Some(TypeInformation(value.to_vec())),
+            pid::ENTITY_NAME => d.entity_name = Some(cur.string()?.to_owned()),
+            // Known and deliberately unused.
+            pid::KEY_HASH
+            | pid::GROUP_GUID
+            | pid::TYPE_MAX_SIZE_SERIALIZED
+            | pid::PROTOCOL_VERSION
+            | pid::VENDORID => {}
+            _ => return Ok(false),
         }
-        let known =
-            read_common(&pl, p.id, p.value, &mut c)? || read_qos(p.id, p.value, pl.little_endian)?;
-        if !known && p.id & pid::MUST_UNDERSTAND != 0 {
-            return Err(WireError::MustUnderstand(p.id));
-        }
+        Ok(true)
     }
-    let required = RequiredEndpointFields {
-        guid: c
-            .guid
-            .take()
-            .ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
-        topic_name: c
-            .topic_name
-            .take()
-            .ok_or(WireError::Invalid("SEDP without topic name"))?,
-        type_name: c
-            .type_name
-            .take()
-            .ok_or(WireError::Invalid("SEDP without type name"))?,
-    };
-    Ok((c, required))
+
+    fn finish(self) -> Result<EndpointData<Q>, WireError> {
+        Ok(EndpointData {
+            guid: self
+                .guid
+                .ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
+            topic_name: self
+                .topic_name
+                .ok_or(WireError::Invalid("SEDP without topic name"))?,
+            type_name: self
+                .type_name
+                .ok_or(WireError::Invalid("SEDP without type name"))?,
+            ..self.data
+        })
+    }
 }
 
-fn read_common(
-    pl: &ParameterList<'_>,
-    id: u16,
-    value: &[u8],
-    c: &mut Common,
-) -> Result<bool, WireError> {
-    let mut cur = pl.cursor(value);
-    match id {
-        pid::ENDPOINT_GUID => c.guid = Some(cur.guid()?),
-        pid::PARTICIPANT_GUID => c.participant_guid = Some(cur.guid()?),
-        pid::TOPIC_NAME => c.topic_name = Some(cur.string()?.to_owned()),
-        pid::TYPE_NAME => c.type_name = Some(cur.string()?.to_owned()),
-        pid::UNICAST_LOCATOR => {
-            let l = cur.locator()?;
-            if c.unicast.len() < MAX_LOCATORS && !c.unicast.contains(&l) {
-                c.unicast.push(l);
-            }
-        }
-        pid::MULTICAST_LOCATOR => {
-            let l = cur.locator()?;
-            if c.multicast.len() < MAX_LOCATORS && !c.multicast.contains(&l) {
-                c.multicast.push(l);
-            }
-        }
-        pid::EXPECTS_INLINE_QOS => c.expects_inline_qos = cur.u8()? != 0,
-        pid::TYPE_INFORMATION => c.type_information = Some(TypeInformation(value.to_vec())),
-        pid::ENTITY_NAME => c.entity_name = Some(cur.string()?.to_owned()),
-        // Known and deliberately unused.
-        pid::KEY_HASH
-        | pid::GROUP_GUID
-        | pid::TYPE_MAX_SIZE_SERIALIZED
-        | pid::PROTOCOL_VERSION
-        | pid::VENDORID => {}
-        _ => return Ok(false),
+/// Adds a decoded locator, ignoring duplicates and anything beyond [`MAX_LOCATORS`].
+fn add_locator(list: &mut Vec<Locator>, l: Locator) {
+    if list.len() < MAX_LOCATORS && !list.contains(&l) {
+        list.push(l);
     }
-    Ok(true)
 }
 
 /// The endpoint GUID of a SEDP sample, from the payload (also works for key-only payloads).
@@ -138,120 +170,6 @@ pub(crate) fn endpoint_guid(payload: &[u8]) -> Option<Guid> {
     let pl = pl_payload(payload).ok()?;
     let v = pl.get(pid::ENDPOINT_GUID)?;
     pl.cursor(v).guid().ok()
-}
-
-#[allow(clippy::too_many_arguments)]
-fn write_common(
-    w: &mut ParameterWriter<'_>,
-    guid: &Guid,
-    topic: &str,
-    type_name: &str,
-    uc: &[Locator],
-    mc: &[Locator],
-    ti: &Option<TypeInformation>,
-    name: &Option<String>,
-) {
-    w.guid(pid::ENDPOINT_GUID, guid);
-    w.guid(
-        pid::PARTICIPANT_GUID,
-        &Guid::new(guid.prefix, EntityId::PARTICIPANT),
-    );
-    w.string(pid::TOPIC_NAME, topic);
-    w.string(pid::TYPE_NAME, type_name);
-    for l in uc {
-        w.locator(pid::UNICAST_LOCATOR, l);
-    }
-    for l in mc {
-        w.locator(pid::MULTICAST_LOCATOR, l);
-    }
-    if let Some(ti) = ti {
-        w.raw(pid::TYPE_INFORMATION, &ti.0);
-    }
-    if let Some(n) = name {
-        w.string(pid::ENTITY_NAME, n);
-    }
-}
-
-impl WriterData {
-    pub fn encode(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(512);
-        out.extend_from_slice(&PL_CDR_LE);
-        let mut w = ParameterWriter::new(&mut out, true);
-        write_common(
-            &mut w,
-            &self.guid,
-            &self.topic_name,
-            &self.type_name,
-            &self.unicast_locators,
-            &self.multicast_locators,
-            &self.type_information,
-            &self.entity_name,
-        );
-        write_writer_qos(&mut w, &self.qos);
-        w.finish();
-        out
-    }
-
-    pub fn decode(payload: &[u8]) -> Result<WriterData, WireError> {
-        let mut qos = WriterQos::default();
-        let (c, required) = decode_endpoint(payload, |id, value, le| {
-            read_writer_qos(id, value, le, &mut qos)
-        })?;
-        Ok(WriterData {
-            guid: required.guid,
-            participant_guid: c.participant_guid,
-            topic_name: required.topic_name,
-            type_name: required.type_name,
-            qos,
-            unicast_locators: c.unicast,
-            multicast_locators: c.multicast,
-            type_information: c.type_information,
-            entity_name: c.entity_name,
-        })
-    }
-}
-
-impl ReaderData {
-    pub fn encode(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(512);
-        out.extend_from_slice(&PL_CDR_LE);
-        let mut w = ParameterWriter::new(&mut out, true);
-        write_common(
-            &mut w,
-            &self.guid,
-            &self.topic_name,
-            &self.type_name,
-            &self.unicast_locators,
-            &self.multicast_locators,
-            &self.type_information,
-            &self.entity_name,
-        );
-        if self.expects_inline_qos {
-            w.bool(pid::EXPECTS_INLINE_QOS, true);
-        }
-        write_reader_qos(&mut w, &self.qos);
-        w.finish();
-        out
-    }
-
-    pub fn decode(payload: &[u8]) -> Result<ReaderData, WireError> {
-        let mut qos = ReaderQos::default();
-        let (c, required) = decode_endpoint(payload, |id, value, le| {
-            read_reader_qos(id, value, le, &mut qos)
-        })?;
-        Ok(ReaderData {
-            guid: required.guid,
-            participant_guid: c.participant_guid,
-            topic_name: required.topic_name,
-            type_name: required.type_name,
-            qos,
-            unicast_locators: c.unicast,
-            multicast_locators: c.multicast,
-            expects_inline_qos: c.expects_inline_qos,
-            type_information: c.type_information,
-            entity_name: c.entity_name,
-        })
-    }
 }
 
 /// Key-only payload for an SEDP dispose/unregister: just the endpoint GUID.
@@ -316,6 +234,7 @@ mod tests {
             unicast_locators: vec![Locator::udpv4([10, 0, 0, 1], 7411)],
             multicast_locators: vec![],
             type_information: Some(TypeInformation(vec![1, 2, 3, 4])),
+            expects_inline_qos: false,
             entity_name: None,
         };
         let enc = w.encode();
@@ -356,7 +275,7 @@ mod tests {
             ..Default::default()
         };
         let back = ReaderData::decode(&r.encode()).unwrap();
-        assert_eq!(back.qos.reader.data_representation.0, vec![0, 2]);
+        assert_eq!(back.qos.reader.data_representation.ids(), [0, 2]);
         assert!(back.expects_inline_qos);
         assert!(back.qos.reader.reliability.is_reliable());
         assert_eq!(

@@ -10,21 +10,37 @@ use crate::rtps::types::*;
 /// What a participant announces about itself.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ParticipantData {
+    /// The participant's GUID prefix.
     pub guid_prefix: GuidPrefix,
+    /// The RTPS version it speaks.
     pub protocol_version: ProtocolVersion,
+    /// Its vendor.
     pub vendor_id: VendorId,
+    /// Its domain id, when announced (absent: the receiver's own).
     pub domain_id: Option<u32>,
+    /// Its domain tag; participants with a non-empty tag are ignored.
     pub domain_tag: String,
+    /// Whether its builtin readers want inline QoS.
     pub expects_inline_qos: bool,
+    /// Where to send it discovery traffic unicast.
     pub metatraffic_unicast: Vec<Locator>,
+    /// Where to send it discovery traffic by multicast.
     pub metatraffic_multicast: Vec<Locator>,
+    /// Where to send it user traffic unicast (unless an endpoint announces its own locators).
     pub default_unicast: Vec<Locator>,
+    /// Where to send it user traffic by multicast.
     pub default_multicast: Vec<Locator>,
+    /// How long it lives without announcing itself.
     pub lease_duration: Duration,
+    /// Its builtin endpoints (`builtin::*` bits).
     pub builtin_endpoints: u32,
+    /// Its manual liveliness count.
     pub manual_liveliness_count: i32,
+    /// USER_DATA.
     pub user_data: Vec<u8>,
+    /// Its property list (name, value).
     pub properties: Vec<(String, String)>,
+    /// Its entity name, if announced.
     pub entity_name: Option<String>,
 }
 
@@ -56,6 +72,7 @@ impl Default for ParticipantData {
 const MAX_LOCATORS: usize = 64;
 
 impl ParticipantData {
+    /// The GUID of the participant entity.
     pub fn guid(&self) -> Guid {
         Guid::new(self.guid_prefix, EntityId::PARTICIPANT)
     }
@@ -108,13 +125,13 @@ impl ParticipantData {
                 p.u32(self.properties.len() as u32);
                 for (k, v) in &self.properties {
                     for s in [k, v] {
-                        while !p.out.len().is_multiple_of(4) {
+                        while p.out.len() % 4 != 0 {
                             p.u8(0);
                         }
                         put_string(p, s);
                     }
                 }
-                while !p.out.len().is_multiple_of(4) {
+                while p.out.len() % 4 != 0 {
                     p.u8(0);
                 }
                 // No binary properties.

@@ -12,6 +12,7 @@ pub struct MessageIter<'a> {
 }
 
 impl<'a> MessageIter<'a> {
+    /// An iterator over the submessages that follow a header (see [`MessageIter::parse`]).
     pub fn new(submessages: &'a [u8]) -> Self {
         MessageIter {
             rest: submessages,
@@ -40,7 +41,7 @@ impl<'a> Iterator for MessageIter<'a> {
         let sid = self.rest[0];
         let flags = self.rest[1];
         let raw = [self.rest[2], self.rest[3]];
-        let len = if flags & 1 != 0 {
+        let len = if flags & super::FLAG_E != 0 {
             u16::from_le_bytes(raw)
         } else {
             u16::from_be_bytes(raw)
@@ -75,6 +76,7 @@ pub struct MessageBuilder {
 }
 
 impl MessageBuilder {
+    /// A builder holding `header` and no submessage yet.
     pub fn new(header: &Header) -> Self {
         Self::with_buffer(header, Vec::new())
     }
@@ -87,9 +89,11 @@ impl MessageBuilder {
             last_header: None,
         }
     }
+    /// Appends a submessage, aligning the previous one to 4 bytes.
     pub fn push(&mut self, sub: &Submessage<'_>) {
         super::append(&mut self.buf, &mut self.last_header, sub, true);
     }
+    /// The message length so far, header included.
     pub fn len(&self) -> usize {
         self.buf.len()
     }
@@ -97,6 +101,7 @@ impl MessageBuilder {
     pub fn is_empty(&self) -> bool {
         self.buf.len() <= HEADER_LEN
     }
+    /// The finished message.
     pub fn finish(self) -> Vec<u8> {
         self.buf
     }

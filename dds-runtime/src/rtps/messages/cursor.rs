@@ -118,7 +118,7 @@ impl<'a> Cursor<'a> {
             *w = self.u32()?;
         }
         // Bits beyond numBits are meaningless; clear them so sets compare equal.
-        if !num_bits.is_multiple_of(32) {
+        if num_bits % 32 != 0 {
             let last = (num_bits / 32) as usize;
             bitmap[last] &= !(u32::MAX >> (num_bits % 32));
         }
@@ -224,7 +224,7 @@ impl Put<'_> {
     }
     /// Pads with zeros to a multiple of `n` measured from `origin`.
     pub fn align_from(&mut self, origin: usize, n: usize) {
-        while !(self.out.len() - origin).is_multiple_of(n) {
+        while (self.out.len() - origin) % n != 0 {
             self.out.push(0);
         }
     }

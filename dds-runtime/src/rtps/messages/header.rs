@@ -3,12 +3,16 @@
 use super::{Cursor, WireError};
 use crate::rtps::types::{GuidPrefix, ProtocolVersion, VendorId};
 
-pub const HEADER_LEN: usize = 20;
+pub(crate) const HEADER_LEN: usize = 20;
 
+/// The RTPS message header (§9.4.4): protocol version, vendor and the sender's GUID prefix.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Header {
+    /// The sender's protocol version.
     pub version: ProtocolVersion,
+    /// The sender's vendor.
     pub vendor_id: VendorId,
+    /// The sender's GUID prefix, the source of every submessage until an INFO_SRC.
     pub guid_prefix: GuidPrefix,
 }
 
@@ -38,6 +42,7 @@ impl Header {
         ))
     }
 
+    /// Appends the 20-byte header.
     pub fn write(&self, out: &mut Vec<u8>) {
         out.extend_from_slice(b"RTPS");
         out.push(self.version.major);

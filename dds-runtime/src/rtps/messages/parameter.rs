@@ -6,54 +6,103 @@ use crate::rtps::types::*;
 
 /// Parameter ids used by this implementation (§9.6.2.2, XTypes §7.6.3).
 pub mod pid {
+    /// Padding, skipped by readers.
     pub const PAD: u16 = 0x0000;
+    /// Ends a parameter list.
     pub const SENTINEL: u16 = 0x0001;
+    /// SPDP: how long the participant stays alive without announcements (Duration_t).
     pub const PARTICIPANT_LEASE_DURATION: u16 = 0x0002;
+    /// Reader QoS: TIME_BASED_FILTER minimum separation.
     pub const TIME_BASED_FILTER: u16 = 0x0004;
+    /// SEDP: the topic name (string).
     pub const TOPIC_NAME: u16 = 0x0005;
+    /// Writer QoS: OWNERSHIP_STRENGTH value.
     pub const OWNERSHIP_STRENGTH: u16 = 0x0006;
+    /// SEDP: the registered type name (string).
     pub const TYPE_NAME: u16 = 0x0007;
+    /// SPDP: the domain id.
     pub const DOMAIN_ID: u16 = 0x000f;
+    /// SPDP: the RTPS protocol version.
     pub const PROTOCOL_VERSION: u16 = 0x0015;
+    /// SPDP: the vendor id.
     pub const VENDORID: u16 = 0x0016;
+    /// QoS: RELIABILITY kind and max_blocking_time.
     pub const RELIABILITY: u16 = 0x001a;
+    /// QoS: LIVELINESS kind and lease duration.
     pub const LIVELINESS: u16 = 0x001b;
+    /// QoS: DURABILITY kind.
     pub const DURABILITY: u16 = 0x001d;
+    /// Writer QoS: DURABILITY_SERVICE.
     pub const DURABILITY_SERVICE: u16 = 0x001e;
+    /// QoS: OWNERSHIP kind.
     pub const OWNERSHIP: u16 = 0x001f;
+    /// Group QoS: PRESENTATION.
     pub const PRESENTATION: u16 = 0x0021;
+    /// QoS: DEADLINE period.
     pub const DEADLINE: u16 = 0x0023;
+    /// QoS: DESTINATION_ORDER kind.
     pub const DESTINATION_ORDER: u16 = 0x0025;
+    /// QoS: LATENCY_BUDGET duration.
     pub const LATENCY_BUDGET: u16 = 0x0027;
+    /// Group QoS: PARTITION names.
     pub const PARTITION: u16 = 0x0029;
+    /// Writer QoS: LIFESPAN duration.
     pub const LIFESPAN: u16 = 0x002b;
+    /// QoS: USER_DATA octets.
     pub const USER_DATA: u16 = 0x002c;
+    /// Group QoS: GROUP_DATA octets.
     pub const GROUP_DATA: u16 = 0x002d;
+    /// Topic QoS: TOPIC_DATA octets.
     pub const TOPIC_DATA: u16 = 0x002e;
+    /// SEDP: an endpoint's unicast locator.
     pub const UNICAST_LOCATOR: u16 = 0x002f;
+    /// SEDP: an endpoint's multicast locator.
     pub const MULTICAST_LOCATOR: u16 = 0x0030;
+    /// SPDP: a default (user traffic) unicast locator.
     pub const DEFAULT_UNICAST_LOCATOR: u16 = 0x0031;
+    /// SPDP: a metatraffic unicast locator.
     pub const METATRAFFIC_UNICAST_LOCATOR: u16 = 0x0032;
+    /// SPDP: a metatraffic multicast locator.
     pub const METATRAFFIC_MULTICAST_LOCATOR: u16 = 0x0033;
+    /// The endpoint wants inline QoS with every DATA.
     pub const EXPECTS_INLINE_QOS: u16 = 0x0043;
+    /// SPDP: the manual liveliness count.
     pub const PARTICIPANT_MANUAL_LIVELINESS_COUNT: u16 = 0x0034;
+    /// QoS: HISTORY kind and depth.
     pub const HISTORY: u16 = 0x0040;
+    /// QoS: RESOURCE_LIMITS.
     pub const RESOURCE_LIMITS: u16 = 0x0041;
+    /// SPDP: a default (user traffic) multicast locator.
     pub const DEFAULT_MULTICAST_LOCATOR: u16 = 0x0048;
+    /// Writer QoS: TRANSPORT_PRIORITY value.
     pub const TRANSPORT_PRIORITY: u16 = 0x0049;
+    /// The participant's GUID.
     pub const PARTICIPANT_GUID: u16 = 0x0050;
+    /// The publisher's or subscriber's GUID.
     pub const GROUP_GUID: u16 = 0x0052;
+    /// SPDP: the builtin endpoint set bits.
     pub const BUILTIN_ENDPOINT_SET: u16 = 0x0058;
+    /// SPDP: the property list (name, value pairs).
     pub const PROPERTY_LIST: u16 = 0x0059;
+    /// SEDP: the endpoint's GUID.
     pub const ENDPOINT_GUID: u16 = 0x005a;
+    /// SEDP: the largest serialized size of the type.
     pub const TYPE_MAX_SIZE_SERIALIZED: u16 = 0x0060;
+    /// The entity's name.
     pub const ENTITY_NAME: u16 = 0x0062;
+    /// Inline QoS: the instance's key hash.
     pub const KEY_HASH: u16 = 0x0070;
+    /// Inline QoS: dispose/unregister flags (see `messages::flags::StatusInfo`).
     pub const STATUS_INFO: u16 = 0x0071;
+    /// QoS: DATA_REPRESENTATION ids.
     pub const DATA_REPRESENTATION: u16 = 0x0073;
+    /// Reader QoS: TYPE_CONSISTENCY_ENFORCEMENT.
     pub const TYPE_CONSISTENCY: u16 = 0x0074;
+    /// XTypes TYPE_INFORMATION.
     pub const TYPE_INFORMATION: u16 = 0x0075;
+    /// SPDP: builtin endpoint QoS bits.
     pub const BUILTIN_ENDPOINT_QOS: u16 = 0x0077;
+    /// SPDP: the domain tag (string).
     pub const DOMAIN_TAG: u16 = 0x4014;
 
     /// Bit marking a vendor-specific parameter.
@@ -65,7 +114,9 @@ pub mod pid {
 /// One parameter, borrowed from the message.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Parameter<'a> {
+    /// The parameter id (PID), flag bits included.
     pub id: u16,
+    /// The value, padding included.
     pub value: &'a [u8],
 }
 
@@ -74,6 +125,7 @@ pub struct Parameter<'a> {
 pub struct ParameterList<'a> {
     /// The entries, without the sentinel.
     pub data: &'a [u8],
+    /// Whether the entries are little-endian.
     pub little_endian: bool,
 }
 
@@ -116,6 +168,7 @@ impl<'a> ParameterList<'a> {
         })
     }
 
+    /// The value of the first parameter with id `id`.
     pub fn get(&self, id: u16) -> Option<&'a [u8]> {
         self.iter().find(|p| p.id == id).map(|p| p.value)
     }
@@ -159,6 +212,7 @@ pub struct ParameterWriter<'a> {
 }
 
 impl<'a> ParameterWriter<'a> {
+    /// A writer appending to `out` in the given byte order.
     pub fn new(out: &'a mut Vec<u8>, little_endian: bool) -> Self {
         ParameterWriter {
             put: Put { out, little_endian },
@@ -182,30 +236,39 @@ impl<'a> ParameterWriter<'a> {
         self.put.out[len_at..len_at + 2].copy_from_slice(&b);
     }
 
+    /// A parameter holding `value` as is.
     pub fn raw(&mut self, id: u16, value: &[u8]) {
         self.param(id, |p| p.bytes(value));
     }
+    /// A `u32` parameter.
     pub fn u32(&mut self, id: u16, v: u32) {
         self.param(id, |p| p.u32(v));
     }
+    /// An `i32` parameter.
     pub fn i32(&mut self, id: u16, v: i32) {
         self.param(id, |p| p.i32(v));
     }
+    /// A boolean parameter (one octet, padded).
     pub fn bool(&mut self, id: u16, v: bool) {
         self.param(id, |p| p.u8(v as u8));
     }
+    /// A Duration_t parameter.
     pub fn duration(&mut self, id: u16, d: std::time::Duration) {
         self.param(id, |p| p.duration(d));
     }
+    /// A GUID parameter.
     pub fn guid(&mut self, id: u16, g: &Guid) {
         self.param(id, |p| p.bytes(&g.to_bytes()));
     }
+    /// A locator parameter.
     pub fn locator(&mut self, id: u16, l: &Locator) {
         self.param(id, |p| p.locator(l));
     }
+    /// A CDR string parameter.
     pub fn string(&mut self, id: u16, s: &str) {
         self.param(id, |p| put_string(p, s));
     }
+    /// A sequence-of-octets parameter (length, then bytes).
     pub fn octets(&mut self, id: u16, b: &[u8]) {
         self.param(id, |p| {
             p.u32(b.len() as u32);
@@ -215,6 +278,7 @@ impl<'a> ParameterWriter<'a> {
     /// Ends the list without a sentinel: the form [`ParameterList::data`] holds (encoders add the sentinel).
     pub fn without_sentinel(self) {}
 
+    /// Ends the list with the sentinel.
     pub fn finish(mut self) {
         self.put.u16(pid::SENTINEL);
         self.put.u16(0);

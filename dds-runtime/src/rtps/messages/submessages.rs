@@ -1,37 +1,57 @@
 //! Submessage structures (§9.4.5), decoded by borrowing from the datagram, and their encoders.
 
 use super::cursor::Put;
+use super::flags::*;
 use super::{id, Cursor, ParameterList, WireError};
 use crate::rtps::types::*;
 
 /// Submessage flag bits shared by all: E (endianness).
 pub const FLAG_E: u8 = 0x01;
 
+/// ACKNACK (§9.4.5.2): a reader's positive and negative acknowledgements.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct AckNack {
+    /// The reader acknowledging (may be ENTITYID_UNKNOWN).
     pub reader_id: EntityId,
+    /// The writer acknowledged.
     pub writer_id: EntityId,
+    /// Everything below the base is acknowledged; set bits are missing.
     pub reader_sn_state: SequenceNumberSet,
+    /// Counts ACKNACKs from this reader to this writer, to drop duplicates.
     pub count: i32,
+    /// F: no answer is required.
     pub final_flag: bool,
 }
 
+/// HEARTBEAT (§9.4.5.6): the range of sequence numbers a writer has available.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Heartbeat {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer announcing.
     pub writer_id: EntityId,
+    /// The first sequence number still available.
     pub first_sn: SequenceNumber,
+    /// The last sequence number written.
     pub last_sn: SequenceNumber,
+    /// Counts HEARTBEATs from this writer, to drop duplicates.
     pub count: i32,
+    /// F: the readers need not answer.
     pub final_flag: bool,
+    /// L: the heartbeat asserts liveliness.
     pub liveliness_flag: bool,
 }
 
+/// GAP (§9.4.5.5): sequence numbers that will never be sent to the reader.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Gap {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer.
     pub writer_id: EntityId,
+    /// The first irrelevant sequence number of the contiguous range.
     pub gap_start: SequenceNumber,
+    /// The range ends before the base; set bits are irrelevant too.
     pub gap_list: SequenceNumberSet,
 }
 
@@ -46,10 +66,14 @@ impl Gap {
     }
 }
 
+/// INFO_SRC (§9.4.5.8): the source of the following submessages.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct InfoSource {
+    /// The source's protocol version.
     pub version: ProtocolVersion,
+    /// The source's vendor.
     pub vendor_id: VendorId,
+    /// The source's GUID prefix.
     pub guid_prefix: GuidPrefix,
 }
 
@@ -71,9 +95,11 @@ impl PartialEq for InfoReply<'_> {
 impl Eq for InfoReply<'_> {}
 
 impl<'a> InfoReply<'a> {
+    /// The unicast locators to reply to.
     pub fn unicast(&self) -> impl Iterator<Item = Locator> + 'a {
         locators(self.unicast, self.little_endian)
     }
+    /// The multicast locators to reply to (none without the M flag).
     pub fn multicast(&self) -> impl Iterator<Item = Locator> + 'a {
         locators(self.multicast.unwrap_or(&[]), self.little_endian)
     }
@@ -84,39 +110,58 @@ fn locators(b: &[u8], le: bool) -> impl Iterator<Item = Locator> + '_ {
         .filter_map(move |c| Cursor::new(c, le).locator().ok())
 }
 
+/// INFO_REPLY_IP4 (§9.4.5.11): where to reply, IPv4 form.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct InfoReplyIp4 {
+    /// The unicast locator to reply to.
     pub unicast: Locator,
+    /// The multicast locator to reply to (M flag).
     pub multicast: Option<Locator>,
 }
 
 /// DATA (§9.4.5.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Data<'a> {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer.
     pub writer_id: EntityId,
+    /// The change's sequence number.
     pub writer_sn: SequenceNumber,
+    /// Inline QoS (Q flag): key hash, status info and the like.
     pub inline_qos: Option<ParameterList<'a>>,
     /// The serialized payload (D flag) or serialized key (K flag).
     pub payload: Option<&'a [u8]>,
+    /// K: the payload is a serialized key.
     pub key_flag: bool,
+    /// N: the payload is not serialized by standard means.
     pub non_standard_flag: bool,
 }
 
 /// DATA_FRAG (§9.4.5.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DataFrag<'a> {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer.
     pub writer_id: EntityId,
+    /// The change's sequence number.
     pub writer_sn: SequenceNumber,
     /// 1-based number of the first fragment in this submessage.
     pub fragment_starting_num: u32,
+    /// How many fragments this submessage carries.
     pub fragments_in_submessage: u16,
+    /// The size of every fragment but the last.
     pub fragment_size: u16,
+    /// The size of the whole serialized sample.
     pub sample_size: u32,
+    /// Inline QoS (Q flag), in the submessage with the first fragment.
     pub inline_qos: Option<ParameterList<'a>>,
+    /// The fragments' bytes, cut at the end of the sample.
     pub payload: &'a [u8],
+    /// K: the fragments are of a serialized key.
     pub key_flag: bool,
+    /// N: the payload is not serialized by standard means.
     pub non_standard_flag: bool,
 }
 
@@ -127,45 +172,72 @@ impl DataFrag<'_> {
     }
 }
 
+/// HEARTBEAT_FRAG (§9.4.5.7): the fragments available of one sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct HeartbeatFrag {
+    /// The reader addressed (ENTITYID_UNKNOWN: all matched readers).
     pub reader_id: EntityId,
+    /// The writer.
     pub writer_id: EntityId,
+    /// The sample's sequence number.
     pub writer_sn: SequenceNumber,
+    /// The last fragment available.
     pub last_fragment_num: u32,
+    /// Counts HEARTBEAT_FRAGs from this writer, to drop duplicates.
     pub count: i32,
 }
 
+/// NACK_FRAG (§9.4.5.12): the fragments a reader is missing from one sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct NackFrag {
+    /// The reader asking.
     pub reader_id: EntityId,
+    /// The writer asked.
     pub writer_id: EntityId,
+    /// The sample's sequence number.
     pub writer_sn: SequenceNumber,
+    /// The missing fragments.
     pub fragment_number_state: FragmentNumberSet,
+    /// Counts NACK_FRAGs from this reader to this writer, to drop duplicates.
     pub count: i32,
 }
 
 /// One decoded submessage.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Submessage<'a> {
+    /// PAD: nothing.
     Pad,
+    /// ACKNACK.
     AckNack(AckNack),
+    /// HEARTBEAT.
     Heartbeat(Heartbeat),
+    /// GAP.
     Gap(Gap),
     /// INFO_TS; `None` when the I flag invalidates the timestamp.
     InfoTs(Option<Time>),
+    /// INFO_SRC.
     InfoSrc(InfoSource),
+    /// INFO_DST: the GUID prefix of the participant the following submessages are for.
     InfoDst(GuidPrefix),
+    /// INFO_REPLY.
     InfoReply(InfoReply<'a>),
+    /// INFO_REPLY_IP4.
     InfoReplyIp4(InfoReplyIp4),
+    /// DATA.
     Data(Data<'a>),
+    /// DATA_FRAG.
     DataFrag(DataFrag<'a>),
+    /// HEARTBEAT_FRAG.
     HeartbeatFrag(HeartbeatFrag),
+    /// NACK_FRAG.
     NackFrag(NackFrag),
     /// Unknown or vendor-specific (id >= 0x80) submessages, skipped by the receiver.
     Unknown {
+        /// The submessage id.
         id: u8,
+        /// The flag bits as received.
         flags: u8,
+        /// The body, undecoded.
         body: &'a [u8],
     },
 }
@@ -187,7 +259,7 @@ impl<'a> Submessage<'a> {
                     writer_id,
                     reader_sn_state,
                     count,
-                    final_flag: flags & 0x02 != 0,
+                    final_flag: AckNackFlags::from_bits_retain(flags).contains(AckNackFlags::FINAL),
                 })
             }
             id::HEARTBEAT => {
@@ -200,14 +272,15 @@ impl<'a> Submessage<'a> {
                 if first_sn.0 < 1 || last_sn.0 < first_sn.0 - 1 {
                     return Err(WireError::Invalid("HEARTBEAT sequence numbers"));
                 }
+                let f = HeartbeatFlags::from_bits_retain(flags);
                 Submessage::Heartbeat(Heartbeat {
                     reader_id,
                     writer_id,
                     first_sn,
                     last_sn,
                     count,
-                    final_flag: flags & 0x02 != 0,
-                    liveliness_flag: flags & 0x04 != 0,
+                    final_flag: f.contains(HeartbeatFlags::FINAL),
+                    liveliness_flag: f.contains(HeartbeatFlags::LIVELINESS),
                 })
             }
             id::GAP => {
@@ -226,7 +299,7 @@ impl<'a> Submessage<'a> {
                 })
             }
             id::INFO_TS => {
-                if flags & 0x02 != 0 {
+                if InfoTsFlags::from_bits_retain(flags).contains(InfoTsFlags::INVALIDATE) {
                     Submessage::InfoTs(None)
                 } else {
                     Submessage::InfoTs(Some(c.time()?))
@@ -247,7 +320,9 @@ impl<'a> Submessage<'a> {
             id::INFO_DST => Submessage::InfoDst(c.guid_prefix()?),
             id::INFO_REPLY => {
                 let unicast = locator_list(&mut c)?;
-                let multicast = if flags & 0x02 != 0 {
+                let multicast = if InfoReplyFlags::from_bits_retain(flags)
+                    .contains(InfoReplyFlags::MULTICAST)
+                {
                     Some(locator_list(&mut c)?)
                 } else {
                     None
@@ -260,7 +335,9 @@ impl<'a> Submessage<'a> {
             }
             id::INFO_REPLY_IP4 => {
                 let unicast = ip4_locator(&mut c)?;
-                let multicast = if flags & 0x02 != 0 {
+                let multicast = if InfoReplyFlags::from_bits_retain(flags)
+                    .contains(InfoReplyFlags::MULTICAST)
+                {
                     Some(ip4_locator(&mut c)?)
                 } else {
                     None
@@ -311,53 +388,68 @@ impl<'a> Submessage<'a> {
         })
     }
 
+    /// The submessage id and the flag bits this submessage is encoded with.
+    fn kind_and_flags(&self, little_endian: bool) -> (u8, u8) {
+        let e = if little_endian { FLAG_E } else { 0 };
+        let (sid, flags) = match self {
+            Submessage::Pad => (id::PAD, 0),
+            Submessage::AckNack(a) => (
+                id::ACKNACK,
+                AckNackFlags::FINAL.bits() * u8::from(a.final_flag),
+            ),
+            Submessage::Heartbeat(h) => {
+                let mut f = HeartbeatFlags::empty();
+                f.set(HeartbeatFlags::FINAL, h.final_flag);
+                f.set(HeartbeatFlags::LIVELINESS, h.liveliness_flag);
+                (id::HEARTBEAT, f.bits())
+            }
+            Submessage::Gap(_) => (id::GAP, 0),
+            Submessage::InfoTs(t) => (
+                id::INFO_TS,
+                InfoTsFlags::INVALIDATE.bits() * u8::from(t.is_none()),
+            ),
+            Submessage::InfoSrc(_) => (id::INFO_SRC, 0),
+            Submessage::InfoDst(_) => (id::INFO_DST, 0),
+            Submessage::InfoReply(r) => (
+                id::INFO_REPLY,
+                InfoReplyFlags::MULTICAST.bits() * u8::from(r.multicast.is_some()),
+            ),
+            Submessage::InfoReplyIp4(r) => (
+                id::INFO_REPLY_IP4,
+                InfoReplyFlags::MULTICAST.bits() * u8::from(r.multicast.is_some()),
+            ),
+            Submessage::Data(d) => {
+                let mut f = DataFlags::empty();
+                f.set(DataFlags::INLINE_QOS, d.inline_qos.is_some());
+                if d.payload.is_some() {
+                    f |= if d.key_flag {
+                        DataFlags::KEY
+                    } else {
+                        DataFlags::DATA
+                    };
+                }
+                f.set(DataFlags::NON_STANDARD, d.non_standard_flag);
+                (id::DATA, f.bits())
+            }
+            Submessage::DataFrag(d) => {
+                let mut f = DataFragFlags::empty();
+                f.set(DataFragFlags::INLINE_QOS, d.inline_qos.is_some());
+                f.set(DataFragFlags::KEY, d.key_flag);
+                f.set(DataFragFlags::NON_STANDARD, d.non_standard_flag);
+                (id::DATA_FRAG, f.bits())
+            }
+            Submessage::HeartbeatFrag(_) => (id::HEARTBEAT_FRAG, 0),
+            Submessage::NackFrag(_) => (id::NACK_FRAG, 0),
+            Submessage::Unknown { id, flags, .. } => (*id, *flags & !FLAG_E),
+        };
+        (sid, flags | e)
+    }
+
     /// Appends this submessage (header included) in the given byte order, unpadded. Use [`append`] to add it
     /// to a message that may already hold submessages.
     pub fn encode(&self, out: &mut Vec<u8>, little_endian: bool) {
         let start = out.len();
-        let e = if little_endian { FLAG_E } else { 0 };
-        let (sid, flags) = match self {
-            Submessage::Pad => (id::PAD, e),
-            Submessage::AckNack(a) => (id::ACKNACK, e | if a.final_flag { 0x02 } else { 0 }),
-            Submessage::Heartbeat(h) => (
-                id::HEARTBEAT,
-                e | if h.final_flag { 0x02 } else { 0 } | if h.liveliness_flag { 0x04 } else { 0 },
-            ),
-            Submessage::Gap(_) => (id::GAP, e),
-            Submessage::InfoTs(t) => (id::INFO_TS, e | if t.is_none() { 0x02 } else { 0 }),
-            Submessage::InfoSrc(_) => (id::INFO_SRC, e),
-            Submessage::InfoDst(_) => (id::INFO_DST, e),
-            Submessage::InfoReply(r) => (
-                id::INFO_REPLY,
-                e | if r.multicast.is_some() { 0x02 } else { 0 },
-            ),
-            Submessage::InfoReplyIp4(r) => (
-                id::INFO_REPLY_IP4,
-                e | if r.multicast.is_some() { 0x02 } else { 0 },
-            ),
-            Submessage::Data(d) => {
-                let mut f = e;
-                if d.inline_qos.is_some() {
-                    f |= 0x02;
-                }
-                if d.payload.is_some() {
-                    f |= if d.key_flag { 0x08 } else { 0x04 };
-                }
-                if d.non_standard_flag {
-                    f |= 0x10;
-                }
-                (id::DATA, f)
-            }
-            Submessage::DataFrag(d) => (
-                id::DATA_FRAG,
-                e | if d.inline_qos.is_some() { 0x02 } else { 0 }
-                    | if d.key_flag { 0x04 } else { 0 }
-                    | if d.non_standard_flag { 0x08 } else { 0 },
-            ),
-            Submessage::HeartbeatFrag(_) => (id::HEARTBEAT_FRAG, e),
-            Submessage::NackFrag(_) => (id::NACK_FRAG, e),
-            Submessage::Unknown { id, flags, .. } => (*id, (*flags & !FLAG_E) | e),
-        };
+        let (sid, flags) = self.kind_and_flags(little_endian);
         out.push(sid);
         out.push(flags);
         out.extend_from_slice(&[0, 0]);
@@ -479,8 +571,8 @@ pub fn append(
     sub: &Submessage<'_>,
     little_endian: bool,
 ) {
-    if !out.len().is_multiple_of(4) {
-        while !out.len().is_multiple_of(4) {
+    if out.len() % 4 != 0 {
+        while out.len() % 4 != 0 {
             out.push(0);
         }
         if let Some(h) = *last_header {
@@ -553,11 +645,12 @@ fn data_prefix<'a>(
 fn decode_data<'a>(flags: u8, mut c: Cursor<'a>) -> Result<Data<'a>, WireError> {
     let le = c.little_endian;
     let (reader_id, writer_id, writer_sn) = data_prefix(&mut c, 20)?;
+    let f = DataFlags::from_bits_retain(flags);
     let (q, d, k, n) = (
-        flags & 0x02 != 0,
-        flags & 0x04 != 0,
-        flags & 0x08 != 0,
-        flags & 0x10 != 0,
+        f.contains(DataFlags::INLINE_QOS),
+        f.contains(DataFlags::DATA),
+        f.contains(DataFlags::KEY),
+        f.contains(DataFlags::NON_STANDARD),
     );
     if d && k {
         return Err(WireError::Invalid("DATA with both D and K"));
@@ -604,8 +697,9 @@ fn decode_data_frag<'a>(flags: u8, mut c: Cursor<'a>) -> Result<DataFrag<'a>, Wi
     if first_byte >= sample_size as u64 {
         return Err(WireError::Invalid("DATA_FRAG beyond sample"));
     }
+    let flags = DataFragFlags::from_bits_retain(flags);
     let mut rest = c.rest();
-    let inline_qos = if flags & 0x02 != 0 {
+    let inline_qos = if flags.contains(DataFragFlags::INLINE_QOS) {
         let (pl, r) = ParameterList::parse(rest, le)?;
         rest = r;
         Some(pl)
@@ -628,7 +722,7 @@ fn decode_data_frag<'a>(flags: u8, mut c: Cursor<'a>) -> Result<DataFrag<'a>, Wi
         sample_size,
         inline_qos,
         payload: &rest[..want],
-        key_flag: flags & 0x04 != 0,
-        non_standard_flag: flags & 0x08 != 0,
+        key_flag: flags.contains(DataFragFlags::KEY),
+        non_standard_flag: flags.contains(DataFragFlags::NON_STANDARD),
     })
 }

@@ -2,13 +2,14 @@
 
 use std::time::Instant;
 
+use foldhash::HashMap;
 use tracing::{debug, trace};
 
 use super::{Participant, ProxyParticipant};
-use crate::qos::Durability;
+use crate::qos::{Durability, QosPolicyId, ReaderQos, WriterQos};
 use crate::rtps::api::{ChangeKind, Event, ReceivedSample, WriteChange};
-use crate::rtps::discovery::matching::{match_endpoints, MatchResult, ReaderView, WriterView};
-use crate::rtps::discovery::{builtin, ParticipantData, ReaderData, WriterData};
+use crate::rtps::discovery::matching::{match_endpoints, MatchResult};
+use crate::rtps::discovery::{builtin, EndpointData, EndpointQos, ParticipantData};
 use crate::rtps::messages::parameter::pid;
 use crate::rtps::messages::Data;
 use crate::rtps::reader::WriterProxy;
@@ -53,7 +54,7 @@ impl Participant {
 
     pub(super) fn on_spdp(&mut self, now: Instant, src: GuidPrefix, d: &Data<'_>) {
         let status = d.inline_qos.and_then(|q| q.status_info()).unwrap_or(0);
-        if status & 0x03 != 0 {
+        if ChangeKind::from_status_info(status) != ChangeKind::Alive {
             let guid = d
                 .inline_qos
                 .and_then(|q| q.key_hash())
@@ -170,7 +171,7 @@ impl Participant {
                     });
                 }
             }
-            self.forget_writer(g);
+            self.forget_endpoint::<WriterQos>(g);
             self.events.push_back(Event::PublicationRemoved { guid: g });
         }
         let readers: Vec<Guid> = self
@@ -180,7 +181,7 @@ impl Participant {
             .copied()
             .collect();
         for g in readers {
-            self.forget_reader(g);
+            self.forget_endpoint::<ReaderQos>(g);
             self.events
                 .push_back(Event::SubscriptionRemoved { guid: g });
         }
@@ -192,63 +193,8 @@ impl Participant {
 
     pub(super) fn on_builtin_sample(&mut self, now: Instant, s: ReceivedSample) {
         match s.reader {
-            EntityId::SEDP_PUBLICATIONS_READER => {
-                if s.kind == ChangeKind::Alive {
-                    match WriterData::decode(&s.payload) {
-                        Ok(d) if d.guid.prefix == s.writer.prefix => {
-                            if self.known_writers.len() < MAX_ENDPOINTS
-                                || self.known_writers.contains_key(&d.guid)
-                            {
-                                let new = !self.known_writers.contains_key(&d.guid);
-                                if new {
-                                    self.events.push_back(Event::PublicationDiscovered(Box::new(
-                                        d.clone(),
-                                    )));
-                                }
-                                self.on_writer_known(now, d);
-                            }
-                        }
-                        Ok(_) => {
-                            debug!("SEDP publication for another participant's endpoint ignored")
-                        }
-                        Err(e) => debug!(error = %e, "dropping SEDP publication"),
-                    }
-                } else if let Some(g) = endpoint_of(&s) {
-                    if g.prefix == s.writer.prefix && self.known_writers.contains_key(&g) {
-                        self.forget_writer(g);
-                        self.events.push_back(Event::PublicationRemoved { guid: g });
-                    }
-                }
-            }
-            EntityId::SEDP_SUBSCRIPTIONS_READER => {
-                if s.kind == ChangeKind::Alive {
-                    match ReaderData::decode(&s.payload) {
-                        Ok(d) if d.guid.prefix == s.writer.prefix => {
-                            if self.known_readers.len() < MAX_ENDPOINTS
-                                || self.known_readers.contains_key(&d.guid)
-                            {
-                                if !self.known_readers.contains_key(&d.guid) {
-                                    self.events
-                                        .push_back(Event::SubscriptionDiscovered(Box::new(
-                                            d.clone(),
-                                        )));
-                                }
-                                self.on_reader_known(now, d);
-                            }
-                        }
-                        Ok(_) => {
-                            debug!("SEDP subscription for another participant's endpoint ignored")
-                        }
-                        Err(e) => debug!(error = %e, "dropping SEDP subscription"),
-                    }
-                } else if let Some(g) = endpoint_of(&s) {
-                    if g.prefix == s.writer.prefix && self.known_readers.contains_key(&g) {
-                        self.forget_reader(g);
-                        self.events
-                            .push_back(Event::SubscriptionRemoved { guid: g });
-                    }
-                }
-            }
+            EntityId::SEDP_PUBLICATIONS_READER => self.on_sedp::<WriterQos>(now, &s),
+            EntityId::SEDP_SUBSCRIPTIONS_READER => self.on_sedp::<ReaderQos>(now, &s),
             EntityId::P2P_MESSAGE_READER => {
                 if let Some((prefix, _kind)) = builtin::decode_participant_message(&s.payload) {
                     if prefix == s.writer.prefix {
@@ -260,13 +206,39 @@ impl Participant {
         }
     }
 
+    /// An SEDP sample of direction `Q`: a new or changed announcement, or a dispose.
+    fn on_sedp<Q: Direction>(&mut self, now: Instant, s: &ReceivedSample) {
+        if s.kind != ChangeKind::Alive {
+            if let Some(g) = endpoint_of(s) {
+                if g.prefix == s.writer.prefix && Q::known(self).contains_key(&g) {
+                    self.forget_endpoint::<Q>(g);
+                    self.events.push_back(Q::removed(g));
+                }
+            }
+            return;
+        }
+        match EndpointData::<Q>::decode(&s.payload) {
+            Ok(d) if d.guid.prefix == s.writer.prefix => {
+                let known = Q::known(self);
+                let new = !known.contains_key(&d.guid);
+                if !new || known.len() < MAX_ENDPOINTS {
+                    if new {
+                        self.events.push_back(Q::discovered(d.clone()));
+                    }
+                    self.on_endpoint_known(now, d);
+                }
+            }
+            Ok(_) => debug!(
+                direction = Q::NAME,
+                "SEDP announcement for another participant's endpoint ignored"
+            ),
+            Err(e) => debug!(direction = Q::NAME, error = %e, "dropping SEDP announcement"),
+        }
+    }
+
     /// Where to reach a known endpoint: its own unicast locators, else its participant's defaults.
-    fn endpoint_locators(
-        &self,
-        prefix: GuidPrefix,
-        uc: &[Locator],
-        mc: &[Locator],
-    ) -> Vec<Locator> {
+    fn endpoint_locators<Q>(&self, d: &EndpointData<Q>) -> Vec<Locator> {
+        let (prefix, uc, mc) = (d.guid.prefix, &d.unicast_locators, &d.multicast_locators);
         if !uc.is_empty() {
             return uc.to_vec();
         }
@@ -285,202 +257,135 @@ impl Participant {
         mc.to_vec()
     }
 
-    /// A publication appeared or changed: (re)match it with every local reader.
-    pub(super) fn on_writer_known(&mut self, now: Instant, d: WriterData) {
+    /// Announces a new local endpoint in SEDP and matches it.
+    pub(super) fn publish_endpoint<Q: Direction>(&mut self, now: Instant, d: EndpointData<Q>) {
+        self.announce(now, Q::ANNOUNCER, d.guid, ChangeKind::Alive, d.encode());
+        self.on_endpoint_known(now, d);
+        self.service(now);
+    }
+
+    /// An endpoint appeared or changed: (re)match it with every local endpoint of the other direction, and
+    /// a local one also with every known endpoint of the other direction.
+    fn on_endpoint_known<Q: Direction>(&mut self, now: Instant, d: EndpointData<Q>) {
         let guid = d.guid;
-        self.known_writers.insert(guid, d);
-        let readers: Vec<EntityId> = self.user_readers.iter().copied().collect();
-        for r in readers {
-            self.match_reader_with(now, r, guid);
+        Q::known_mut(self).insert(guid, d);
+        for local in Q::local_peers(self) {
+            self.rematch(now, local, guid);
         }
         if guid.prefix == self.config.guid_prefix {
-            let readers: Vec<Guid> = self.known_readers.keys().copied().collect();
-            for r in readers {
-                self.match_writer_with(now, guid.entity_id, r);
+            for remote in Q::known_peers(self) {
+                self.rematch(now, Q::local(guid.entity_id), remote);
             }
         }
     }
 
-    /// A subscription appeared or changed: (re)match it with every local writer.
-    pub(super) fn on_reader_known(&mut self, now: Instant, d: ReaderData) {
-        let guid = d.guid;
-        self.known_readers.insert(guid, d);
-        let writers: Vec<EntityId> = self.user_writers.iter().copied().collect();
-        for w in writers {
-            self.match_writer_with(now, w, guid);
-        }
-        if guid.prefix == self.config.guid_prefix {
-            let writers: Vec<Guid> = self.known_writers.keys().copied().collect();
-            for w in writers {
-                self.match_reader_with(now, guid.entity_id, w);
-            }
-        }
-    }
-
-    fn match_writer_with(&mut self, now: Instant, wid: EntityId, reader: Guid) {
-        let wguid = Guid::new(self.config.guid_prefix, wid);
+    /// Matches (or unmatches) one local endpoint with one known endpoint of the other direction, and reports
+    /// what changed.
+    fn rematch(&mut self, now: Instant, local: Local, remote: Guid) {
+        let ours = |id| Guid::new(self.config.guid_prefix, id);
+        let (wguid, rguid) = match local {
+            Local::Writer(id) => (ours(id), remote),
+            Local::Reader(id) => (remote, ours(id)),
+        };
         let (Some(wd), Some(rd)) = (
             self.known_writers.get(&wguid),
-            self.known_readers.get(&reader),
-        ) else {
-            return;
-        };
-        let res = match_endpoints(
-            WriterView {
-                topic_name: &wd.topic_name,
-                type_name: &wd.type_name,
-                qos: &wd.qos,
-            },
-            ReaderView {
-                topic_name: &rd.topic_name,
-                type_name: &rd.type_name,
-                qos: &rd.qos,
-            },
-        );
-        let reliable = rd.qos.reader.reliability.is_reliable();
-        let durable = rd.qos.reader.durability >= Durability::TransientLocal;
-        let locators =
-            self.endpoint_locators(reader.prefix, &rd.unicast_locators, &rd.multicast_locators);
-        // The reader's implementation decides some wire forms (see `ReaderProxy::for_vendor`); our own
-        // readers are not in `participants`.
-        let vendor = self
-            .participants
-            .get(&reader.prefix)
-            .map_or(VendorId::THIS, |p| p.data.vendor_id);
-        let Some(w) = self.writers.get_mut(&wid) else {
-            return;
-        };
-        if w.linger_until.is_some() {
-            return;
-        }
-        let has = w.has_proxy(&reader);
-        match res {
-            MatchResult::Match => {
-                if !has {
-                    w.add_proxy(
-                        now,
-                        ReaderProxy::new(reader, locators, reliable).for_vendor(vendor),
-                        durable,
-                        &mut self.events,
-                    );
-                    self.events.push_back(Event::PublicationMatched {
-                        writer: wid,
-                        reader,
-                        matched: true,
-                    });
-                }
-                self.incompatible.remove(&(wid, reader));
-            }
-            other => {
-                if has {
-                    w.remove_proxy(&reader, &mut self.events);
-                    self.events.push_back(Event::PublicationMatched {
-                        writer: wid,
-                        reader,
-                        matched: false,
-                    });
-                }
-                if let MatchResult::Incompatible(policy) = other {
-                    if self.incompatible.insert((wid, reader)) {
-                        self.events.push_back(Event::OfferedIncompatibleQos {
-                            writer: wid,
-                            reader,
-                            policy,
-                        });
-                    }
-                }
-            }
-        }
-    }
-
-    fn match_reader_with(&mut self, now: Instant, rid: EntityId, writer: Guid) {
-        let rguid = Guid::new(self.config.guid_prefix, rid);
-        let (Some(rd), Some(wd)) = (
             self.known_readers.get(&rguid),
-            self.known_writers.get(&writer),
         ) else {
             return;
         };
-        let res = match_endpoints(
-            WriterView {
-                topic_name: &wd.topic_name,
-                type_name: &wd.type_name,
-                qos: &wd.qos,
-            },
-            ReaderView {
-                topic_name: &rd.topic_name,
-                type_name: &rd.type_name,
-                qos: &rd.qos,
-            },
-        );
-        let reliable = wd.qos.writer.reliability.is_reliable();
-        let locators =
-            self.endpoint_locators(writer.prefix, &wd.unicast_locators, &wd.multicast_locators);
-        let Some(r) = self.readers.get_mut(&rid) else {
+        let res = match_endpoints(wd, rd);
+        let Some(has) = self.has_proxy(local, remote) else {
             return;
         };
-        let has = r.has_proxy(&writer);
         match res {
             MatchResult::Match => {
                 if !has {
-                    r.add_proxy(now, WriterProxy::new(writer, locators, reliable));
-                    self.readers_by_writer.clear();
-                    self.events.push_back(Event::SubscriptionMatched {
-                        reader: rid,
-                        writer,
-                        matched: true,
-                    });
+                    self.add_proxy(now, local, remote);
+                    self.events.push_back(local.matched(remote, true));
                 }
-                self.incompatible.remove(&(rid, writer));
+                self.incompatible.remove(&(local.id(), remote));
             }
             other => {
-                if has {
-                    r.remove_proxy(&writer);
-                    self.events.push_back(Event::SubscriptionMatched {
-                        reader: rid,
-                        writer,
-                        matched: false,
-                    });
+                if has && self.remove_proxy(local, remote) {
+                    self.events.push_back(local.matched(remote, false));
                 }
                 if let MatchResult::Incompatible(policy) = other {
-                    if self.incompatible.insert((rid, writer)) {
-                        self.events.push_back(Event::RequestedIncompatibleQos {
-                            reader: rid,
-                            writer,
-                            policy,
-                        });
+                    if self.incompatible.insert((local.id(), remote)) {
+                        self.events.push_back(local.incompatible(remote, policy));
                     }
                 }
             }
         }
     }
 
-    /// A publication is gone: unmatch it from local readers.
-    pub(super) fn forget_writer(&mut self, g: Guid) {
-        self.known_writers.remove(&g);
-        self.readers_by_writer.remove(&g);
-        for (id, r) in self.readers.iter_mut() {
-            if self.user_readers.contains(id) && r.remove_proxy(&g) {
-                self.events.push_back(Event::SubscriptionMatched {
-                    reader: *id,
-                    writer: g,
-                    matched: false,
-                });
-            }
+    /// Whether `local` already has a proxy for `remote`; `None` when it cannot match (gone or lingering).
+    fn has_proxy(&self, local: Local, remote: Guid) -> Option<bool> {
+        match local {
+            Local::Writer(id) => self
+                .writers
+                .get(&id)
+                .filter(|w| w.linger_until.is_none())
+                .map(|w| w.has_proxy(&remote)),
+            Local::Reader(id) => self.readers.get(&id).map(|r| r.has_proxy(&remote)),
         }
-        self.incompatible.retain(|(_, x)| *x != g);
     }
 
-    /// A subscription is gone: unmatch it from local writers.
-    pub(super) fn forget_reader(&mut self, g: Guid) {
-        self.known_readers.remove(&g);
-        for (id, w) in self.writers.iter_mut() {
-            if self.user_writers.contains(id) && w.remove_proxy(&g, &mut self.events) {
-                self.events.push_back(Event::PublicationMatched {
-                    writer: *id,
-                    reader: g,
-                    matched: false,
-                });
+    /// Gives `local` a proxy for the known endpoint `remote`.
+    fn add_proxy(&mut self, now: Instant, local: Local, remote: Guid) {
+        match local {
+            Local::Writer(id) => {
+                let Some(rd) = self.known_readers.get(&remote) else {
+                    return;
+                };
+                let reliable = rd.qos.reader.reliability.is_reliable();
+                let durable = rd.qos.reader.durability >= Durability::TransientLocal;
+                let locators = self.endpoint_locators(rd);
+                // The reader's implementation decides some wire forms (see `ReaderProxy::for_vendor`); our
+                // own readers are not in `participants`.
+                let vendor = self
+                    .participants
+                    .get(&remote.prefix)
+                    .map_or(VendorId::THIS, |p| p.data.vendor_id);
+                if let Some(w) = self.writers.get_mut(&id) {
+                    let proxy = ReaderProxy::new(remote, locators, reliable).for_vendor(vendor);
+                    w.add_proxy(now, proxy, durable, &mut self.events);
+                }
+            }
+            Local::Reader(id) => {
+                let Some(wd) = self.known_writers.get(&remote) else {
+                    return;
+                };
+                let reliable = wd.qos.writer.reliability.is_reliable();
+                let locators = self.endpoint_locators(wd);
+                if let Some(r) = self.readers.get_mut(&id) {
+                    r.add_proxy(now, WriterProxy::new(remote, locators, reliable));
+                    self.readers_by_writer.clear();
+                }
+            }
+        }
+    }
+
+    /// Removes `local`'s proxy for `remote`; whether it had one.
+    fn remove_proxy(&mut self, local: Local, remote: Guid) -> bool {
+        match local {
+            Local::Writer(id) => self
+                .writers
+                .get_mut(&id)
+                .is_some_and(|w| w.remove_proxy(&remote, &mut self.events)),
+            Local::Reader(id) => self
+                .readers
+                .get_mut(&id)
+                .is_some_and(|r| r.remove_proxy(&remote)),
+        }
+    }
+
+    /// A known endpoint of direction `Q` is gone: unmatch it from every local endpoint of the other direction.
+    pub(super) fn forget_endpoint<Q: Direction>(&mut self, g: Guid) {
+        Q::known_mut(self).remove(&g);
+        self.readers_by_writer.remove(&g);
+        for local in Q::local_peers(self) {
+            if self.remove_proxy(local, g) {
+                self.events.push_back(local.matched(g, false));
             }
         }
         self.incompatible.retain(|(_, x)| *x != g);
@@ -499,4 +404,125 @@ fn spdp_key_prefix(payload: &[u8]) -> Option<GuidPrefix> {
     let pl = crate::rtps::discovery::pl_payload(payload).ok()?;
     let v = pl.get(pid::PARTICIPANT_GUID)?;
     pl.cursor(v).guid().ok().map(|g| g.prefix)
+}
+
+/// A local user endpoint, seen from matching.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Local {
+    Writer(EntityId),
+    Reader(EntityId),
+}
+
+impl Local {
+    fn id(self) -> EntityId {
+        match self {
+            Local::Writer(id) | Local::Reader(id) => id,
+        }
+    }
+
+    /// The matched-status event for this endpoint and `remote`.
+    fn matched(self, remote: Guid, matched: bool) -> Event {
+        match self {
+            Local::Writer(writer) => Event::PublicationMatched {
+                writer,
+                reader: remote,
+                matched,
+            },
+            Local::Reader(reader) => Event::SubscriptionMatched {
+                reader,
+                writer: remote,
+                matched,
+            },
+        }
+    }
+
+    /// The incompatible-QoS event (offered for writers, requested for readers).
+    fn incompatible(self, remote: Guid, policy: QosPolicyId) -> Event {
+        match self {
+            Local::Writer(writer) => Event::OfferedIncompatibleQos {
+                writer,
+                reader: remote,
+                policy,
+            },
+            Local::Reader(reader) => Event::RequestedIncompatibleQos {
+                reader,
+                writer: remote,
+                policy,
+            },
+        }
+    }
+}
+
+/// What the participant keeps apart for each SEDP direction (publications, subscriptions).
+pub(super) trait Direction: EndpointQos + Clone {
+    /// For logs.
+    const NAME: &'static str;
+    /// Our SEDP writer that announces local endpoints of this direction.
+    const ANNOUNCER: EntityId;
+    /// Known endpoints of this direction, remote and local.
+    fn known(p: &Participant) -> &HashMap<Guid, EndpointData<Self>>;
+    /// Known endpoints of this direction, for changes.
+    fn known_mut(p: &mut Participant) -> &mut HashMap<Guid, EndpointData<Self>>;
+    /// A local endpoint of this direction.
+    fn local(id: EntityId) -> Local;
+    /// Local endpoints of the other direction.
+    fn local_peers(p: &Participant) -> Vec<Local>;
+    /// Known endpoints of the other direction.
+    fn known_peers(p: &Participant) -> Vec<Guid>;
+    /// The discovery event for a new endpoint.
+    fn discovered(d: EndpointData<Self>) -> Event;
+    /// The event for an endpoint that is gone.
+    fn removed(guid: Guid) -> Event;
+}
+
+impl Direction for WriterQos {
+    const NAME: &'static str = "publication";
+    const ANNOUNCER: EntityId = EntityId::SEDP_PUBLICATIONS_WRITER;
+    fn known(p: &Participant) -> &HashMap<Guid, EndpointData<Self>> {
+        &p.known_writers
+    }
+    fn known_mut(p: &mut Participant) -> &mut HashMap<Guid, EndpointData<Self>> {
+        &mut p.known_writers
+    }
+    fn local(id: EntityId) -> Local {
+        Local::Writer(id)
+    }
+    fn local_peers(p: &Participant) -> Vec<Local> {
+        p.user_readers.iter().map(|&id| Local::Reader(id)).collect()
+    }
+    fn known_peers(p: &Participant) -> Vec<Guid> {
+        p.known_readers.keys().copied().collect()
+    }
+    fn discovered(d: EndpointData<Self>) -> Event {
+        Event::PublicationDiscovered(Box::new(d))
+    }
+    fn removed(guid: Guid) -> Event {
+        Event::PublicationRemoved { guid }
+    }
+}
+
+impl Direction for ReaderQos {
+    const NAME: &'static str = "subscription";
+    const ANNOUNCER: EntityId = EntityId::SEDP_SUBSCRIPTIONS_WRITER;
+    fn known(p: &Participant) -> &HashMap<Guid, EndpointData<Self>> {
+        &p.known_readers
+    }
+    fn known_mut(p: &mut Participant) -> &mut HashMap<Guid, EndpointData<Self>> {
+        &mut p.known_readers
+    }
+    fn local(id: EntityId) -> Local {
+        Local::Reader(id)
+    }
+    fn local_peers(p: &Participant) -> Vec<Local> {
+        p.user_writers.iter().map(|&id| Local::Writer(id)).collect()
+    }
+    fn known_peers(p: &Participant) -> Vec<Guid> {
+        p.known_writers.keys().copied().collect()
+    }
+    fn discovered(d: EndpointData<Self>) -> Event {
+        Event::SubscriptionDiscovered(Box::new(d))
+    }
+    fn removed(guid: Guid) -> Event {
+        Event::SubscriptionRemoved { guid }
+    }
 }

@@ -6,11 +6,11 @@ use crate::rtps::api::Payload;
 
 /// What one stored fragment costs beyond its bytes (map node, vector header), charged against the limits so
 /// that tiny fragments cannot make us hold far more memory than their payload suggests.
-pub const FRAGMENT_OVERHEAD: usize = 64;
+pub(super) const FRAGMENT_OVERHEAD: usize = 64;
 
 /// One sample being reassembled.
 #[derive(Debug)]
-pub struct Defrag {
+pub(crate) struct Defrag {
     pub sample_size: u32,
     pub fragment_size: u16,
     /// Fragments received, by 1-based number.
@@ -25,7 +25,7 @@ pub struct Defrag {
 }
 
 impl Defrag {
-    pub fn new(sample_size: u32, fragment_size: u16) -> Self {
+    pub(crate) fn new(sample_size: u32, fragment_size: u16) -> Self {
         Defrag {
             sample_size,
             fragment_size,
@@ -38,13 +38,13 @@ impl Defrag {
         }
     }
 
-    pub fn total(&self) -> u32 {
+    pub(crate) fn total(&self) -> u32 {
         self.sample_size.div_ceil(self.fragment_size as u32)
     }
 
     /// Adds fragment `num` (its bytes); returns the memory newly held (bytes plus overhead). Inconsistent
     /// fragments are ignored.
-    pub fn add(&mut self, num: u32, data: &[u8]) -> usize {
+    pub(crate) fn add(&mut self, num: u32, data: &[u8]) -> usize {
         if num == 0 || num > self.total() || self.frags.contains_key(&num) {
             return 0;
         }
@@ -59,12 +59,12 @@ impl Defrag {
         cost
     }
 
-    pub fn is_complete(&self) -> bool {
+    pub(crate) fn is_complete(&self) -> bool {
         self.frags.len() as u64 == self.total() as u64
     }
 
     /// The missing fragment numbers up to `last` (at most 256, from the first missing one).
-    pub fn missing(&self, last: u32) -> Vec<u32> {
+    pub(crate) fn missing(&self, last: u32) -> Vec<u32> {
         let last = last.min(self.total());
         let mut v = Vec::new();
         let mut n = 1;
@@ -83,7 +83,7 @@ impl Defrag {
     }
 
     /// Concatenates the fragments (only call when complete).
-    pub fn assemble(self) -> Payload {
+    pub(crate) fn assemble(self) -> Payload {
         let mut v = Vec::with_capacity(self.sample_size as usize);
         for f in self.frags.into_values() {
             v.extend_from_slice(&f);

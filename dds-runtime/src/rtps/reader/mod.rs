@@ -4,7 +4,7 @@
 mod defrag;
 mod writer_proxy;
 
-pub use writer_proxy::{PendingChange, Slot, WriterProxy};
+pub(crate) use writer_proxy::{PendingChange, Slot, WriterProxy};
 
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
@@ -27,7 +27,7 @@ fn slot_size(s: &Slot) -> usize {
 /// Whether every must-understand inline QoS parameter is one we know.
 fn inline_qos_understood(q: Option<&crate::rtps::messages::ParameterList<'_>>) -> bool {
     use crate::rtps::messages::parameter::pid;
-    q.is_none_or(|q| {
+    q.map_or(true, |q| {
         q.check_must_understand(|id| {
             matches!(
                 id & !pid::MUST_UNDERSTAND,
@@ -40,7 +40,7 @@ fn inline_qos_understood(q: Option<&crate::rtps::messages::ParameterList<'_>>) -
 
 /// Protocol parameters of one reader.
 #[derive(Debug, Clone, Copy)]
-pub struct ReaderParams {
+pub(crate) struct ReaderParams {
     pub reliable: bool,
     pub heartbeat_response_delay: Duration,
     pub max_sample_size: usize,
@@ -52,7 +52,7 @@ pub struct ReaderParams {
 
 /// A local reader's protocol state.
 #[derive(Debug)]
-pub struct Reader {
+pub(crate) struct Reader {
     pub guid: Guid,
     params: ReaderParams,
     proxies: BTreeMap<Guid, WriterProxy>,
@@ -62,7 +62,7 @@ pub struct Reader {
 }
 
 impl Reader {
-    pub fn new(guid: Guid, params: ReaderParams) -> Self {
+    pub(crate) fn new(guid: Guid, params: ReaderParams) -> Self {
         Reader {
             guid,
             params,
@@ -72,7 +72,7 @@ impl Reader {
     }
 
     /// Sets the delivery credit and delivers what reliable proxies hold in order within it.
-    pub fn set_credit(&mut self, credit: Option<usize>, out: &mut Vec<Event>) {
+    pub(crate) fn set_credit(&mut self, credit: Option<usize>, out: &mut Vec<Event>) {
         self.credit.set(credit);
         let rid = self.guid.entity_id;
         for p in self.proxies.values_mut() {
@@ -94,20 +94,14 @@ impl Reader {
         }
     }
 
-    pub fn params(&self) -> &ReaderParams {
-        &self.params
-    }
-    pub fn matched(&self) -> impl Iterator<Item = &Guid> {
+    pub(crate) fn matched(&self) -> impl Iterator<Item = &Guid> {
         self.proxies.keys()
     }
-    pub fn has_proxy(&self, g: &Guid) -> bool {
+    pub(crate) fn has_proxy(&self, g: &Guid) -> bool {
         self.proxies.contains_key(g)
     }
-    pub fn proxy(&self, g: &Guid) -> Option<&WriterProxy> {
-        self.proxies.get(g)
-    }
 
-    pub fn add_proxy(&mut self, now: Instant, mut proxy: WriterProxy) {
+    pub(crate) fn add_proxy(&mut self, now: Instant, mut proxy: WriterProxy) {
         proxy.reliable &= self.params.reliable;
         if proxy.reliable {
             // Pre-emptive ACKNACK: prompts the writer to tell us what it has.
@@ -116,7 +110,7 @@ impl Reader {
         self.proxies.insert(proxy.guid, proxy);
     }
 
-    pub fn remove_proxy(&mut self, g: &Guid) -> bool {
+    pub(crate) fn remove_proxy(&mut self, g: &Guid) -> bool {
         self.proxies.remove(g).is_some()
     }
 
@@ -218,7 +212,7 @@ impl Reader {
 
     /// A DATA from `writer`. `datagram`, when given, is the shared buffer `d` was parsed from: the sample's
     /// payload then shares it instead of being copied.
-    pub fn on_data(
+    pub(crate) fn on_data(
         &mut self,
         writer: Guid,
         d: &Data<'_>,
@@ -275,7 +269,7 @@ impl Reader {
         self.accept(p, d.writer_sn, slot, out);
     }
 
-    pub fn on_data_frag(
+    pub(crate) fn on_data_frag(
         &mut self,
         writer: Guid,
         d: &DataFrag<'_>,
@@ -374,7 +368,7 @@ impl Reader {
         }
     }
 
-    pub fn on_gap(&mut self, writer: Guid, g: &Gap, out: &mut Vec<Event>) {
+    pub(crate) fn on_gap(&mut self, writer: Guid, g: &Gap, out: &mut Vec<Event>) {
         let rid = self.guid.entity_id;
         let cap = self.params.reorder_max_samples;
         let Some(p) = self.proxies.get_mut(&writer) else {
@@ -410,7 +404,7 @@ impl Reader {
         p.drop_stale_defrag();
     }
 
-    pub fn on_heartbeat(
+    pub(crate) fn on_heartbeat(
         &mut self,
         now: Instant,
         writer: Guid,
@@ -472,7 +466,7 @@ impl Reader {
     /// nothing; one we hold no fragment of is left to the HEARTBEAT/ACKNACK exchange, which asks for whole
     /// samples. It says nothing about other sequence numbers, so it neither moves `hb_last` nor prompts an
     /// ACKNACK; its count is its own, apart from HEARTBEAT's.
-    pub fn on_heartbeat_frag(&mut self, now: Instant, writer: Guid, hf: &HeartbeatFrag) {
+    pub(crate) fn on_heartbeat_frag(&mut self, now: Instant, writer: Guid, hf: &HeartbeatFrag) {
         let delay = self.params.heartbeat_response_delay;
         let Some(p) = self.proxies.get_mut(&writer) else {
             return;
@@ -502,7 +496,7 @@ impl Reader {
         p.nackfrag_due.get_or_insert(now + delay);
     }
 
-    pub fn next_timeout(&self) -> Option<Instant> {
+    pub(crate) fn next_timeout(&self) -> Option<Instant> {
         self.proxies
             .values()
             .flat_map(|p| [p.acknack_due, p.nackfrag_due])

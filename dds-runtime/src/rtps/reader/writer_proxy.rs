@@ -9,13 +9,13 @@ use crate::rtps::types::*;
 
 /// A received change waiting for its turn (or an irrelevant sequence number from a GAP).
 #[derive(Debug, Clone)]
-pub enum Slot {
+pub(crate) enum Slot {
     Change(PendingChange),
     Irrelevant,
 }
 
 #[derive(Debug, Clone)]
-pub struct PendingChange {
+pub(crate) struct PendingChange {
     pub kind: ChangeKind,
     pub payload: Payload,
     pub key_hash: Option<[u8; 16]>,
@@ -23,7 +23,7 @@ pub struct PendingChange {
 }
 
 #[derive(Debug)]
-pub struct WriterProxy {
+pub(crate) struct WriterProxy {
     pub guid: Guid,
     pub locators: Vec<Locator>,
     /// Reliable protocol with this writer (both sides reliable).
@@ -51,7 +51,7 @@ pub struct WriterProxy {
 }
 
 impl WriterProxy {
-    pub fn new(guid: Guid, locators: Vec<Locator>, reliable: bool) -> Self {
+    pub(crate) fn new(guid: Guid, locators: Vec<Locator>, reliable: bool) -> Self {
         WriterProxy {
             guid,
             locators,
@@ -73,12 +73,12 @@ impl WriterProxy {
         }
     }
 
-    pub fn destination(&self) -> &[Locator] {
+    pub(crate) fn destination(&self) -> &[Locator] {
         &self.locators[..self.locators.len().min(1)]
     }
 
     /// Drops defragmentation state below `next_expected`.
-    pub fn drop_stale_defrag(&mut self) {
+    pub(crate) fn drop_stale_defrag(&mut self) {
         let keep = self.defrag.split_off(&self.next_expected);
         for d in self.defrag.values() {
             self.defrag_bytes -= d.bytes;
@@ -86,7 +86,7 @@ impl WriterProxy {
         self.defrag = keep;
     }
 
-    pub fn has(&self, sn: SequenceNumber) -> bool {
+    pub(crate) fn has(&self, sn: SequenceNumber) -> bool {
         sn < self.next_expected || self.reorder.contains_key(&sn)
     }
 }

@@ -10,7 +10,7 @@ use crate::rtps::types::*;
 
 /// One change in the history.
 #[derive(Debug, Clone)]
-pub struct CacheChange {
+pub(crate) struct CacheChange {
     pub sn: SequenceNumber,
     pub kind: ChangeKind,
     pub payload: Payload,
@@ -20,13 +20,13 @@ pub struct CacheChange {
 
 /// Why a change cannot be added now.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum HistoryFull {
+pub(crate) enum HistoryFull {
     /// KEEP_ALL (or max_samples) limit reached by changes that may not be dropped yet.
     Full,
 }
 
 #[derive(Debug)]
-pub struct HistoryCache {
+pub(crate) struct HistoryCache {
     changes: BTreeMap<SequenceNumber, CacheChange>,
     instances: HashMap<[u8; 16], VecDeque<SequenceNumber>>,
     history: History,
@@ -35,7 +35,7 @@ pub struct HistoryCache {
 }
 
 impl HistoryCache {
-    pub fn new(history: History, limits: ResourceLimits) -> Self {
+    pub(crate) fn new(history: History, limits: ResourceLimits) -> Self {
         HistoryCache {
             changes: BTreeMap::new(),
             instances: HashMap::new(),
@@ -45,28 +45,34 @@ impl HistoryCache {
         }
     }
 
-    pub fn len(&self) -> usize {
+    #[cfg(test)]
+    pub(crate) fn len(&self) -> usize {
         self.changes.len()
     }
-    pub fn is_empty(&self) -> bool {
+    pub(crate) fn is_empty(&self) -> bool {
         self.changes.is_empty()
     }
-    pub fn bytes(&self) -> usize {
+    #[cfg(test)]
+    pub(crate) fn bytes(&self) -> usize {
         self.bytes
     }
-    pub fn get(&self, sn: SequenceNumber) -> Option<&CacheChange> {
+    pub(crate) fn get(&self, sn: SequenceNumber) -> Option<&CacheChange> {
         self.changes.get(&sn)
     }
-    pub fn first_sn(&self) -> Option<SequenceNumber> {
+    pub(crate) fn first_sn(&self) -> Option<SequenceNumber> {
         self.changes.keys().next().copied()
     }
-    pub fn range(&self, from: SequenceNumber) -> impl Iterator<Item = &CacheChange> {
+    pub(crate) fn range(&self, from: SequenceNumber) -> impl Iterator<Item = &CacheChange> {
         self.changes.range(from..).map(|(_, c)| c)
     }
 
     /// Whether adding a change for `key` needs room that only acknowledged changes below `acked` could give.
     /// Returns the sequence numbers that must be dropped to make room, or Full.
-    pub fn make_room(&mut self, key: &[u8; 16], acked: SequenceNumber) -> Result<(), HistoryFull> {
+    pub(crate) fn make_room(
+        &mut self,
+        key: &[u8; 16],
+        acked: SequenceNumber,
+    ) -> Result<(), HistoryFull> {
         let max_total = self.limits.max_samples.map(|m| m.max(1) as usize);
         let per_instance = match self.history {
             History::KeepLast(d) => Some(d.max(1) as usize),
@@ -104,14 +110,14 @@ impl HistoryCache {
     }
 
     /// Adds a change (call [`make_room`](Self::make_room) first).
-    pub fn add(&mut self, change: CacheChange) {
+    pub(crate) fn add(&mut self, change: CacheChange) {
         let key = change.key_hash.unwrap_or_default();
         self.bytes += change.payload.len();
         self.instances.entry(key).or_default().push_back(change.sn);
         self.changes.insert(change.sn, change);
     }
 
-    pub fn remove(&mut self, sn: SequenceNumber) -> Option<CacheChange> {
+    pub(crate) fn remove(&mut self, sn: SequenceNumber) -> Option<CacheChange> {
         let c = self.changes.remove(&sn)?;
         self.bytes -= c.payload.len();
         let key = c.key_hash.unwrap_or_default();
@@ -127,7 +133,7 @@ impl HistoryCache {
     }
 
     /// Drops every change below `sn` (volatile writers, once acknowledged by all).
-    pub fn remove_below(&mut self, sn: SequenceNumber) {
+    pub(crate) fn remove_below(&mut self, sn: SequenceNumber) {
         while let Some(first) = self.first_sn() {
             if first >= sn {
                 break;
@@ -139,7 +145,7 @@ impl HistoryCache {
     /// Bytes of the changes at or above `sn`.
     /// Called after every acknowledgement: walks only the smaller side of `sn` (the total is kept), so a
     /// volatile writer, whose history starts at the acknowledged floor, pays nothing.
-    pub fn bytes_from(&self, sn: SequenceNumber) -> usize {
+    pub(crate) fn bytes_from(&self, sn: SequenceNumber) -> usize {
         let (Some((first, _)), Some((last, _))) = (
             self.changes.first_key_value(),
             self.changes.last_key_value(),
@@ -162,7 +168,7 @@ impl HistoryCache {
 
     /// Drops disposed+unregistered instances' history beyond their last change (keeps memory bounded for
     /// transient-local writers whose instances come and go).
-    pub fn prune_unregistered(&mut self, acked: SequenceNumber) {
+    pub(crate) fn prune_unregistered(&mut self, acked: SequenceNumber) {
         let dead: Vec<SequenceNumber> = self
             .instances
             .values()

@@ -3,8 +3,8 @@
 mod history;
 mod reader_proxy;
 
-pub use history::{CacheChange, HistoryCache};
-pub use reader_proxy::ReaderProxy;
+pub(crate) use history::{CacheChange, HistoryCache};
+pub(crate) use reader_proxy::ReaderProxy;
 
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::time::{Duration, Instant};
@@ -21,7 +21,7 @@ use reader_proxy::{MAX_REQUESTED, MAX_REQUESTED_FRAG_SAMPLES};
 
 /// Protocol parameters of one writer.
 #[derive(Debug, Clone, Copy)]
-pub struct WriterParams {
+pub(crate) struct WriterParams {
     pub reliable: bool,
     pub durability: Durability,
     pub history: History,
@@ -39,7 +39,7 @@ pub struct WriterParams {
 
 /// A local writer's protocol state.
 #[derive(Debug)]
-pub struct Writer {
+pub(crate) struct Writer {
     pub guid: Guid,
     params: WriterParams,
     history: HistoryCache,
@@ -64,7 +64,7 @@ pub struct Writer {
 }
 
 impl Writer {
-    pub fn new(guid: Guid, params: WriterParams) -> Self {
+    pub(crate) fn new(guid: Guid, params: WriterParams) -> Self {
         Writer {
             guid,
             history: HistoryCache::new(params.history, params.limits),
@@ -85,33 +85,24 @@ impl Writer {
         }
     }
 
-    pub fn params(&self) -> &WriterParams {
-        &self.params
-    }
     fn durable(&self) -> bool {
         self.params.durability >= Durability::TransientLocal
     }
-    pub fn last_sn(&self) -> SequenceNumber {
+    pub(crate) fn last_sn(&self) -> SequenceNumber {
         SequenceNumber(self.next_sn.0 - 1)
     }
-    pub fn history(&self) -> &HistoryCache {
-        &self.history
-    }
-    pub fn unacked_bytes(&self) -> usize {
+    pub(crate) fn unacked_bytes(&self) -> usize {
         self.unacked_bytes
     }
-    pub fn matched(&self) -> impl Iterator<Item = &Guid> {
+    pub(crate) fn matched(&self) -> impl Iterator<Item = &Guid> {
         self.proxies.keys()
     }
-    pub fn has_proxy(&self, g: &Guid) -> bool {
+    pub(crate) fn has_proxy(&self, g: &Guid) -> bool {
         self.proxies.contains_key(g)
-    }
-    pub fn proxy(&self, g: &Guid) -> Option<&ReaderProxy> {
-        self.proxies.get(g)
     }
 
     /// Every change acknowledged by every reliable reader.
-    pub fn is_acknowledged(&self) -> bool {
+    pub(crate) fn is_acknowledged(&self) -> bool {
         self.proxies
             .values()
             .filter(|p| p.reliable)
@@ -136,7 +127,7 @@ impl Writer {
             let mut d: Vec<Locator> = self
                 .proxies
                 .values()
-                .filter(|p| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
+                .filter(|p| key_hash_only.map_or(true, |k| p.key_hash_only_disposes == k))
                 .filter_map(|p| p.destination().first().copied())
                 .collect();
             d.sort();
@@ -302,7 +293,7 @@ impl Writer {
     }
 
     /// Matches a reader. Durable writers serve their history to it; volatile ones answer older requests with GAP.
-    pub fn add_proxy(
+    pub(crate) fn add_proxy(
         &mut self,
         now: Instant,
         mut proxy: ReaderProxy,
@@ -339,7 +330,7 @@ impl Writer {
         }
     }
 
-    pub fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
+    pub(crate) fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
         let had = self.proxies.remove(guid).is_some();
         if had {
             self.rebuild_dest();
@@ -348,7 +339,7 @@ impl Writer {
         had
     }
 
-    pub fn on_acknack(
+    pub(crate) fn on_acknack(
         &mut self,
         now: Instant,
         reader: Guid,
@@ -400,7 +391,7 @@ impl Writer {
         }
     }
 
-    pub fn on_nack_frag(
+    pub(crate) fn on_nack_frag(
         &mut self,
         now: Instant,
         reader: Guid,
@@ -435,7 +426,7 @@ impl Writer {
         p.repair_due.get_or_insert(now + delay);
     }
 
-    pub fn next_timeout(&self) -> Option<Instant> {
+    pub(crate) fn next_timeout(&self) -> Option<Instant> {
         let r = self.proxies.values().filter_map(|p| p.repair_due).min();
         match (r, self.hb_due) {
             (Some(a), Some(b)) => Some(a.min(b)),

@@ -10,7 +10,7 @@ pub(crate) const MAX_REQUESTED: usize = 4096;
 pub(crate) const MAX_REQUESTED_FRAG_SAMPLES: usize = 64;
 
 #[derive(Debug, Clone)]
-pub struct ReaderProxy {
+pub(crate) struct ReaderProxy {
     pub guid: Guid,
     /// Where to send; the first is used.
     pub locators: Vec<Locator>,
@@ -33,7 +33,7 @@ pub struct ReaderProxy {
 }
 
 impl ReaderProxy {
-    pub fn new(guid: Guid, locators: Vec<Locator>, reliable: bool) -> Self {
+    pub(crate) fn new(guid: Guid, locators: Vec<Locator>, reliable: bool) -> Self {
         ReaderProxy {
             guid,
             locators,
@@ -50,12 +50,12 @@ impl ReaderProxy {
     }
 
     /// Adapts the wire form to what the reader's implementation (its participant's vendor) understands.
-    pub fn for_vendor(mut self, vendor: VendorId) -> Self {
+    pub(crate) fn for_vendor(mut self, vendor: VendorId) -> Self {
         self.key_hash_only_disposes = vendor == VendorId::FASTDDS;
         self
     }
 
-    pub fn destination(&self) -> &[Locator] {
+    pub(crate) fn destination(&self) -> &[Locator] {
         &self.locators[..self.locators.len().min(1)]
     }
 }
