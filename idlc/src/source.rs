@@ -1,20 +1,26 @@
 //! Source files and locations. Every location points into the file the text came from, never into the
 //! preprocessed buffer, so diagnostics show the file the user wrote.
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// Index of a file in its [`SourceDb`]; stable for the life of the database (one [`crate::driver::Session`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 pub struct FileId(pub u32);
 
 /// A byte range in one source file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub struct Loc {
+    /// The file the text is in.
     pub file: FileId,
+    /// Byte offset of the first byte.
     pub start: u32,
+    /// Byte offset one past the last byte (`>= start`).
     pub end: u32,
 }
 
 impl Loc {
+    /// The range `start..end` of `file`; an `end` before `start` is taken as `start`.
     pub fn new(file: FileId, start: usize, end: usize) -> Self {
         Loc {
             file,
@@ -22,19 +28,24 @@ impl Loc {
             end: end.max(start) as u32,
         }
     }
+    /// Length in bytes.
     pub fn len(&self) -> usize {
         (self.end - self.start) as usize
     }
+    /// The range is empty (a position rather than a span).
     pub fn is_empty(&self) -> bool {
         self.end == self.start
     }
 }
 
+/// One file as read, with its line index.
 #[derive(Debug)]
 pub struct SourceFile {
     /// Name shown in diagnostics (the path as given or found on the include path).
     pub name: String,
+    /// Normalised path, the key under which the file is found again.
     pub path: PathBuf,
+    /// The whole text.
     pub text: Arc<str>,
     line_starts: Vec<u32>,
 }
@@ -57,17 +68,21 @@ impl SourceFile {
     }
 }
 
-/// All files read during one compilation.
-#[derive(Debug, Default)]
+/// All files read during one compilation, or during a whole [`crate::driver::Session`]: a file read once keeps
+/// its [`FileId`]. Cloning is cheap (the files are shared).
+#[derive(Debug, Default, Clone)]
 pub struct SourceDb {
-    files: Vec<SourceFile>,
+    files: Vec<Arc<SourceFile>>,
+    by_path: HashMap<PathBuf, FileId>,
 }
 
 impl SourceDb {
+    /// An empty database.
     pub fn new() -> Self {
         Self::default()
     }
 
+    /// Adds a file and returns its id. A later [`SourceDb::find_path`] of the same path finds the newest one.
     pub fn add(
         &mut self,
         name: impl Into<String>,
@@ -82,31 +97,34 @@ impl SourceDb {
                 .filter(|(_, b)| *b == b'\n')
                 .map(|(i, _)| i as u32 + 1),
         );
-        self.files.push(SourceFile {
+        let path: PathBuf = path.into();
+        let id = FileId(self.files.len() as u32);
+        self.by_path.insert(path.clone(), id);
+        self.files.push(Arc::new(SourceFile {
             name: name.into(),
-            path: path.into(),
+            path,
             text,
             line_starts,
-        });
-        FileId(self.files.len() as u32 - 1)
+        }));
+        id
     }
 
+    /// The file with this id. Panics on an id from another database.
     pub fn get(&self, id: FileId) -> &SourceFile {
         &self.files[id.0 as usize]
     }
 
+    /// Every file, in the order read.
     pub fn files(&self) -> impl Iterator<Item = (FileId, &SourceFile)> {
         self.files
             .iter()
             .enumerate()
-            .map(|(i, f)| (FileId(i as u32), f))
+            .map(|(i, f)| (FileId(i as u32), &**f))
     }
 
+    /// The file read from `path`, if any.
     pub fn find_path(&self, path: &Path) -> Option<FileId> {
-        self.files
-            .iter()
-            .position(|f| f.path == path)
-            .map(|i| FileId(i as u32))
+        self.by_path.get(path).copied()
     }
 
     /// `file:line:col` of a location.
@@ -116,6 +134,7 @@ impl SourceDb {
         format!("{}:{}:{}", f.name, l, c)
     }
 
+    /// The source text of a location (empty when out of range).
     pub fn snippet(&self, loc: Loc) -> &str {
         let f = self.get(loc.file);
         f.text

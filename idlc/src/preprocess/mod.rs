@@ -32,8 +32,8 @@ pub struct Options {
     pub undefines: Vec<String>,
 }
 
-#[derive(Clone, Copy, Debug)]
-struct Seg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct Seg {
     out: u32,
     file: FileId,
     src: u32,
@@ -43,12 +43,35 @@ struct Seg {
 }
 
 /// Maps output offsets to source locations.
-#[derive(Debug, Default, Clone)]
+#[derive(Debug, Default, Clone, PartialEq, Eq, Hash)]
 pub struct SourceMap {
     segs: Vec<Seg>,
 }
 
 impl SourceMap {
+    /// The map of the output range `start..end`, with offsets relative to `start`: `slice(a, b).loc(x, y)` is
+    /// `loc(a + x, a + y)` for every range inside `a..b`.
+    pub(crate) fn slice(&self, start: usize, end: usize) -> SourceMap {
+        let i = self.segs.partition_point(|s| s.out as usize <= start);
+        let mut segs = Vec::new();
+        if i > 0 {
+            let s = self.segs[i - 1];
+            let skip = start as u32 - s.out;
+            segs.push(Seg {
+                out: 0,
+                src: if s.linear { s.src + skip } else { s.src },
+                ..s
+            });
+        }
+        for s in self.segs[i..].iter().take_while(|s| (s.out as usize) < end) {
+            segs.push(Seg {
+                out: s.out - start as u32,
+                ..*s
+            });
+        }
+        SourceMap { segs }
+    }
+
     fn seg_at(&self, off: usize) -> Option<&Seg> {
         let i = self.segs.partition_point(|s| s.out as usize <= off);
         if i == 0 {
@@ -111,20 +134,29 @@ impl SourceMap {
     }
 }
 
-#[derive(Clone, Debug)]
+/// A comment in the output.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Comment {
-    /// Output range, including the delimiters.
+    /// Output offset of the first delimiter.
     pub start: usize,
+    /// Output offset one past the closing delimiter (or the end of the line for `//`).
     pub end: usize,
 }
 
+/// The preprocessed translation unit.
 #[derive(Debug, Default)]
 pub struct Output {
+    /// The text, with directives blanked and macros expanded.
     pub text: String,
+    /// Where each output byte came from.
     pub map: SourceMap,
+    /// Every comment in the kept text, in order.
     pub comments: Vec<Comment>,
     /// Every file read, the main file first.
     pub files: Vec<FileId>,
+    /// Output offsets where an included file's text begins or ends, in order. The parser splits the text there
+    /// (when the split falls between definitions) and reuses the syntax tree of a piece seen before.
+    pub boundaries: Vec<usize>,
 }
 
 impl Output {
@@ -180,9 +212,20 @@ pub fn preprocess(
     diags: &mut Diagnostics,
 ) -> Output {
     let mut pp = Preprocessor::new(db, vfs, opts, diags);
+    let name = path.display().to_string();
+    // Read before (as an include of an earlier input of the session) under the same name: keep its id, so that
+    // the parse cache knows its text.
+    if let Some(id) = pp
+        .db
+        .find_path(path)
+        .filter(|id| pp.db.get(*id).name == name)
+    {
+        pp.run(id);
+        return pp.out;
+    }
     match vfs.read(path) {
         Ok(text) => {
-            let id = pp.db.add(path.display().to_string(), path, text);
+            let id = pp.db.add(name, path, text);
             pp.run(id);
         }
         Err(e) => pp.diags.push(Diagnostic::error(
@@ -838,8 +881,10 @@ impl<'a> Preprocessor<'a> {
         let saved = self.in_comment.take();
         // Keep tokens of the includer and the included file apart.
         self.out.text.push('\n');
+        self.out.boundaries.push(self.out.text.len());
         self.process(id, depth + 1);
         self.out.text.push('\n');
+        self.out.boundaries.push(self.out.text.len());
         self.in_comment = saved;
     }
 }

@@ -38,7 +38,11 @@ pub struct Resolver<'a> {
 }
 
 /// Resolves one or more specifications (e.g. several files of one build) into a single model.
-pub fn resolve(specs: &[ast::Spec], opts: &Options, diags: &mut Diagnostics) -> Model {
+pub fn resolve<'s>(
+    specs: impl IntoIterator<Item = &'s ast::Spec>,
+    opts: &Options,
+    diags: &mut Diagnostics,
+) -> Model {
     let mut r = Resolver {
         model: Model::default(),
         diags,
