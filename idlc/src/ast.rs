@@ -274,6 +274,8 @@ pub struct UnionDef {
 pub struct Enumerator {
     pub annotations: Vec<Annotation>,
     pub name: Ident,
+    /// `= value` after the name (C style, not IDL 4.2; enums only).
+    pub value: Option<ConstExpr>,
     pub doc: Vec<String>,
 }
 

@@ -368,3 +368,104 @@ fn json_model_output() {
     assert_eq!(v["decls"][0]["name"], "S");
     assert_eq!(v["decls"][0]["kind"]["decl"], "struct");
 }
+
+fn warning_codes(c: &Compilation) -> Vec<&'static str> {
+    c.diags
+        .iter()
+        .filter(|d| !d.is_error())
+        .map(|d| d.code.as_str())
+        .collect()
+}
+
+#[test]
+fn vendor_extensions_are_accepted_with_a_warning_each() {
+    let c = ok("enum E { A = 2, B, C = 7 };\n\
+         struct S { map<E, long> m; };\n\
+         union U switch (char) { case 65: long a; case 'b': short b; };\n");
+    match decl(&c, "E") {
+        DeclKind::Enum(e) => {
+            let v: Vec<i64> = e.enumerators.iter().map(|e| e.value).collect();
+            assert_eq!(v, [2, 3, 7]);
+        }
+        other => panic!("{other:?}"),
+    }
+    match decl(&c, "U") {
+        DeclKind::Union(u) => assert_eq!(u.cases[0].labels, [Value::Char('A')]),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(warning_codes(&c), ["idlc::W0107"; 4]);
+    // Both forms of a value on one enumerator, and a char label that does not fit, stay errors.
+    assert!(codes("enum E { @value(1) A = 2 };").contains(&"idlc::W0107"));
+    assert!(compile_str(
+        "m.idl",
+        "enum E { @value(1) A = 2 };",
+        &Options::default(),
+        &MemVfs::new()
+    )
+    .has_errors());
+    assert_eq!(
+        codes("union U switch (char) { case 300: long a; };"),
+        ["idlc::E0403"]
+    );
+}
+
+#[test]
+fn function_like_macro_call_spans_lines() {
+    let c = ok("#define MEMBER(t, n) t n;\n\
+         struct S {\n\
+             MEMBER(long,\n\
+                    x)\n\
+             MEMBER\n\
+               (short, y) long z;\n\
+         };\n");
+    match decl(&c, "S") {
+        DeclKind::Struct(s) => {
+            let names: Vec<&str> = s.fields.iter().map(|f| f.name.as_str()).collect();
+            assert_eq!(names, ["x", "y", "z"]);
+        }
+        other => panic!("{other:?}"),
+    }
+    // Positions after a multi-line call stay exact.
+    let mut c = compile_str(
+        "main.idl",
+        "#define P(a, b) a b\nstruct S {\n  P(long,\n    w); nope q;\n};\n",
+        &Options::default(),
+        &MemVfs::new(),
+    );
+    let text = c.render_diagnostics(Default::default());
+    assert!(text.contains("main.idl:4:9"), "{text}");
+}
+
+#[test]
+fn a_session_parses_a_shared_include_once_and_keeps_results_exact() {
+    use idlc::driver::Session;
+    // `t.idl` means something else depending on a macro the includer sets: the cache must not mix them up.
+    let files = MemVfs::new()
+        .with(
+            "t.idl",
+            "#ifdef WIDE\nstruct T { long long v; };\n#else\nstruct T { short v; };\n#endif\n",
+        )
+        .with("bad.idl", "struct B { nope x; };\n");
+    let mut s = Session::with_vfs(Options::default(), Box::new(files.clone()));
+    let narrow = s.compile_str("a.idl", "#include \"t.idl\"\nstruct A { T t; };\n");
+    let wide = s.compile_str(
+        "b.idl",
+        "#define WIDE\n#include \"t.idl\"\nstruct B2 { T t; };\n",
+    );
+    let again = s.compile_str("c.idl", "#include \"t.idl\"\nstruct C { T t; };\n");
+    let ty = |c: &Compilation| match decl(c, "T") {
+        DeclKind::Struct(st) => format!("{:?}", st.fields[0].ty),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(ty(&narrow), ty(&again));
+    assert_ne!(ty(&narrow), ty(&wide));
+    // A diagnostic in a shared include renders the same from a session as from a fresh compilation.
+    let main = "#include \"bad.idl\"\nstruct M { long y; };\n";
+    let mut fresh = compile_str("m.idl", main, &Options::default(), &files);
+    let _ = s.compile_str("n.idl", main);
+    let mut cached = s.compile_str("m.idl", main);
+    assert_eq!(
+        fresh.render_diagnostics(Default::default()),
+        cached.render_diagnostics(Default::default())
+    );
+}

@@ -435,15 +435,18 @@ impl<'a> Builder<'a> {
                 let doc = self.doc_before(e.as_span().start());
                 let mut annotations = Vec::new();
                 let mut name = None;
+                let mut value = None;
                 for c in e.into_inner() {
                     match c.as_rule() {
                         Rule::annotation_appl => annotations.push(self.annotation(c)),
+                        Rule::const_expr => value = Some(self.const_expr(c)),
                         _ => name = Some(self.ident(c)),
                     }
                 }
                 Enumerator {
                     annotations,
                     name: name.expect("enumerator name"),
+                    value,
                     doc,
                 }
             })

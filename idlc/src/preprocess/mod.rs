@@ -349,7 +349,7 @@ impl<'a> Preprocessor<'a> {
         self.in_comment = None;
         while pos < bytes.len() && !self.too_big {
             let line_end = memchr_nl(bytes, pos);
-            let active = conds.last().is_none_or(|c| c.active);
+            let active = conds.last().map_or(true, |c| c.active);
             let trimmed = text[pos..line_end].trim_start();
             if self.in_comment.is_none() && trimmed.starts_with('#') {
                 // Directive: join continuation lines.
@@ -374,11 +374,12 @@ impl<'a> Preprocessor<'a> {
                 continue;
             }
             if active {
-                self.scan_line(file, &text, pos, line_end);
+                // A macro invocation may continue on the following lines.
+                pos = self.scan_line(file, &text, pos, line_end);
             } else {
                 self.skip_line(&text, pos, line_end);
+                pos = line_end;
             }
-            pos = line_end;
         }
         if let Some(start) = self.in_comment.take() {
             let end = self.out.text.len();
@@ -431,8 +432,9 @@ impl<'a> Preprocessor<'a> {
         }
     }
 
-    /// Copies an active line, expanding macros and recording comments.
-    fn scan_line(&mut self, file: FileId, text: &str, from: usize, to: usize) {
+    /// Copies an active line, expanding macros and recording comments. Returns where the line ended: further
+    /// on than `to` when a function-like macro's arguments continue on the next lines.
+    fn scan_line(&mut self, file: FileId, text: &str, from: usize, mut to: usize) -> usize {
         let b = text.as_bytes();
         let mut i = from;
         let mut copy_from = from;
@@ -479,7 +481,10 @@ impl<'a> Preprocessor<'a> {
                 i += 2;
             } else if c == b'"' || c == b'\'' {
                 match lex::literal_len(&b[i..to]) {
-                    Some(n) if n > MAX_TOKEN => return self.token_too_long(file, i, n),
+                    Some(n) if n > MAX_TOKEN => {
+                        self.token_too_long(file, i, n);
+                        return to;
+                    }
                     Some(n) => i += n,
                     None => {
                         let what = if c == b'"' {
@@ -499,7 +504,8 @@ impl<'a> Preprocessor<'a> {
             } else if c.is_ascii_digit() {
                 let n = lex::number_len(&b[i..to]);
                 if n > MAX_TOKEN {
-                    return self.token_too_long(file, i, n);
+                    self.token_too_long(file, i, n);
+                    return to;
                 }
                 i += n;
             } else if is_ident_start(c) {
@@ -508,24 +514,23 @@ impl<'a> Preprocessor<'a> {
                     j += 1;
                 }
                 if j - i > MAX_TOKEN {
-                    return self.token_too_long(file, i, j - i);
+                    self.token_too_long(file, i, j - i);
+                    return to;
                 }
                 let name = &text[i..j];
                 if self.macros.is_defined(name) {
-                    // Find the invocation's extent on this line, then expand just that.
-                    let rest = lex::lex(&text[i..to]);
-                    let m = &self.macros.defs[name];
+                    // Find the invocation's extent, then expand just that.
                     let mut inv_len = name.len();
-                    if m.params.is_some() {
-                        let k = rest
-                            .iter()
-                            .skip(1)
-                            .position(|t| t.kind != Kind::Ws)
-                            .map(|p| p + 1);
+                    if self.macros.defs[name].params.is_some() {
+                        let (rest, k, line_to) = invocation_tokens(text, i, to);
                         match k {
                             Some(k) if rest[k].is("(") => match macros::collect_args(&rest, k) {
                                 Ok((_, end)) => {
-                                    inv_len = rest[..end].iter().map(|t| t.text.len()).sum()
+                                    inv_len = rest[..end].iter().map(|t| t.text.len()).sum();
+                                    if i + inv_len > to {
+                                        // Scanning goes on after the invocation, to the end of its line.
+                                        to = memchr_nl(b, i + inv_len - 1).min(line_to);
+                                    }
                                 }
                                 Err(e) => {
                                     self.err(
@@ -564,6 +569,7 @@ impl<'a> Preprocessor<'a> {
             }
         }
         self.emit_copy(file, text, copy_from, to);
+        to
     }
 
     fn token_too_long(&mut self, file: FileId, at: usize, len: usize) {
@@ -887,6 +893,40 @@ impl<'a> Preprocessor<'a> {
         self.out.boundaries.push(self.out.text.len());
         self.in_comment = saved;
     }
+}
+
+/// Most lines a function-like macro's arguments may span.
+const MAX_INVOCATION_LINES: usize = 64;
+
+/// Tokens of a function-like macro invocation starting at `at` (the macro name) on the line ending at `to`: the
+/// tokens up to the end of the line, extended line by line (at most [`MAX_INVOCATION_LINES`]) while the `(` or the
+/// closing `)` is still missing. Returns the tokens, the index of the first token after the name that is not
+/// whitespace, and the end of the last line lexed.
+fn invocation_tokens(text: &str, at: usize, to: usize) -> (Vec<Tok>, Option<usize>, usize) {
+    let mut line_to = to;
+    for _ in 0..MAX_INVOCATION_LINES {
+        let rest = lex::lex(&text[at..line_to]);
+        let k = rest
+            .iter()
+            .skip(1)
+            .position(|t| t.kind != Kind::Ws)
+            .map(|p| p + 1);
+        let complete = match k {
+            None => false,
+            Some(k) => !rest[k].is("(") || macros::collect_args(&rest, k).is_ok(),
+        };
+        if complete || line_to >= text.len() {
+            return (rest, k, line_to);
+        }
+        line_to = memchr_nl(text.as_bytes(), line_to);
+    }
+    let rest = lex::lex(&text[at..line_to]);
+    let k = rest
+        .iter()
+        .skip(1)
+        .position(|t| t.kind != Kind::Ws)
+        .map(|p| p + 1);
+    (rest, k, line_to)
 }
 
 fn memchr_nl(b: &[u8], from: usize) -> usize {

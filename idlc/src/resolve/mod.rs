@@ -375,7 +375,19 @@ impl<'a> Resolver<'a> {
                 let kr = self.model.resolve_alias(&k);
                 let key_ok = matches!(kr, Type::Prim { prim } if prim.is_integer() || *prim == Prim::Octet)
                     || matches!(kr, Type::String { .. } | Type::Error);
-                if !key_ok {
+                let enum_key = matches!(kr, Type::Named { decl, .. }
+                    if matches!(self.model.decls[*decl].kind, DeclKind::Enum(_)));
+                if enum_key {
+                    let msg = format!(
+                        "map key type `{}` is an enum, which IDL 4.2 does not allow",
+                        self.type_name(&k)
+                    );
+                    self.diags.push(
+                        Diagnostic::warning(Code::Extension, msg)
+                            .at(key.loc(), "accepted as a vendor extension")
+                            .help("IDL 4.2 map keys are integers or strings"),
+                    );
+                } else if !key_ok {
                     let msg = format!("map key type `{}` is not allowed", self.type_name(&k));
                     self.diags.push(
                         Diagnostic::error(Code::BadMemberType, msg)
@@ -462,7 +474,7 @@ impl<'a> Resolver<'a> {
         if dims
             .iter()
             .try_fold(1u64, |a, d| a.checked_mul(*d))
-            .is_none_or(|n| n > 1 << 32)
+            .map_or(true, |n| n > 1 << 32)
         {
             let msg = "array has more than 2^32 elements".to_string();
             self.diags
@@ -744,6 +756,16 @@ impl<'a> Resolver<'a> {
         let ok = match (resolved, &v) {
             (Type::Prim { prim: Prim::Bool }, Value::Bool(_)) => true,
             (Type::Prim { prim: Prim::Char }, Value::Char(_)) => true,
+            (Type::Prim { prim: Prim::Char }, Value::Int(i)) if (0..=255).contains(i) => {
+                let msg =
+                    format!("integer case label {i} on a `char` discriminator is not IDL 4.2");
+                self.diags.push(
+                    Diagnostic::warning(Code::Extension, msg)
+                        .at(e.loc, format!("taken as {:?}", char::from(*i as u8)))
+                        .help("write a character literal"),
+                );
+                return Some(Value::Char(char::from(*i as u8)));
+            }
             (Type::Prim { prim: Prim::WChar }, Value::Char(_) | Value::WChar(_)) => true,
             (Type::Prim { prim }, Value::Int(i)) => match prim.int_range() {
                 Some((lo, hi)) => {
@@ -807,7 +829,14 @@ impl<'a> Resolver<'a> {
         let int32 = Type::Prim { prim: Prim::I32 };
         for (i, en) in e.enumerators.iter().enumerate() {
             let ea = self.annotations(&en.annotations, Place::Enumerator);
-            let value = match ea.value.and_then(|v| self.eval_as(v, &int32)) {
+            if let Some(v) = &en.value {
+                self.c_style_value(en, v, ea.value.is_some());
+            }
+            let value = match ea
+                .value
+                .or(en.value.as_ref())
+                .and_then(|v| self.eval_as(v, &int32))
+            {
                 Some(Value::Int(v)) => v as i64,
                 _ => next,
             };
@@ -839,6 +868,32 @@ impl<'a> Resolver<'a> {
             x.default_index = default_index;
         }
         self.model.decls[id].verbatim = anns.verbatim;
+    }
+
+    /// Reports a C-style `NAME = value` enumerator: accepted with a warning, an error next to `@value`.
+    fn c_style_value(&mut self, en: &ast::Enumerator, v: &ast::ConstExpr, annotated: bool) {
+        let d = if annotated {
+            Diagnostic::error(
+                Code::Extension,
+                format!(
+                    "enumerator `{}` has both `@value` and `= value`",
+                    en.name.name
+                ),
+            )
+            .at(v.loc, "second value")
+            .help("keep only `@value(...)`")
+        } else {
+            Diagnostic::warning(
+                Code::Extension,
+                format!(
+                    "C-style enumerator value `{} = ...` is not IDL 4.2",
+                    en.name.name
+                ),
+            )
+            .at(v.loc, "accepted as `@value`")
+            .help("write `@value(...)` before the enumerator instead")
+        };
+        self.diags.push(d);
     }
 
     fn bitmask_def(&mut self, b: &ast::BitmaskDef, d: &Definition) {
