@@ -469,3 +469,14 @@ fn a_session_parses_a_shared_include_once_and_keeps_results_exact() {
         cached.render_diagnostics(Default::default())
     );
 }
+
+#[test]
+fn fixed_members_map_to_the_runtime_decimal() {
+    let mut c = ok("struct A { fixed<5,2> price; sequence<fixed<31,0>> big; };\n");
+    let code = c.rust().expect("rust");
+    assert!(
+        code.contains("price: ::dds_runtime::cdr::Fixed<5, 2>"),
+        "{code}"
+    );
+    assert!(code.contains("::dds_runtime::cdr::Fixed<31, 0>"), "{code}");
+}

@@ -537,14 +537,6 @@ impl<'a> Emitter<'a> {
 
     fn check_mappable(&mut self, t: &Type, loc: crate::source::Loc) {
         match t {
-            Type::Fixed { digits, scale } => self.diags.push(
-                Diagnostic::error(
-                    Code::BadMemberType,
-                    format!("`fixed<{digits},{scale}>` has no Rust mapping yet"),
-                )
-                .at(loc, "fixed-point type used here")
-                .help("use a `double`, or an integer holding a scaled value"),
-            ),
             Type::Sequence { elem, .. } | Type::Array { elem, .. } => {
                 self.check_mappable(elem, loc)
             }
