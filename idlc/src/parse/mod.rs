@@ -15,10 +15,15 @@ use pest::error::InputLocation;
 use pest::Parser as _;
 use std::sync::Arc;
 
-/// The pest parser generated from `idl.pest`.
-#[derive(pest_derive::Parser)]
-#[grammar = "parse/idl.pest"]
-pub(crate) struct IdlParser;
+mod grammar {
+    // pest_derive generates `Rule` without docs.
+    #![allow(missing_docs, unreachable_pub)]
+    /// The pest parser generated from `idl.pest`.
+    #[derive(pest_derive::Parser)]
+    #[grammar = "parse/idl.pest"]
+    pub(crate) struct IdlParser;
+}
+pub(crate) use grammar::{IdlParser, Rule};
 
 /// Deepest bracket nesting accepted; deeper input is refused before pest recurses into it.
 pub const MAX_NESTING: usize = 100;

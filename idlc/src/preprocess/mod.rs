@@ -23,8 +23,10 @@ const MAX_OUTPUT: usize = 256 << 20;
 /// byte is high, so longer tokens are refused up front.
 const MAX_TOKEN: usize = 1 << 20;
 
+/// What the preprocessor needs besides the input.
 #[derive(Clone, Debug, Default)]
 pub struct Options {
+    /// Directories searched for `#include`, in order.
     pub include_dirs: Vec<PathBuf>,
     /// `-D NAME` or `-D NAME=VALUE`, in order.
     pub defines: Vec<String>,
@@ -191,7 +193,7 @@ struct Cond {
     loc: Loc,
 }
 
-pub struct Preprocessor<'a> {
+struct Preprocessor<'a> {
     db: &'a mut SourceDb,
     vfs: &'a dyn Vfs,
     diags: &'a mut Diagnostics,

@@ -2,7 +2,7 @@
 //! requires declaration before use (forward declarations excepted).
 mod annotations;
 mod consts;
-pub mod scope;
+mod scope;
 
 use crate::ast::{self, DefKind, Definition, ForwardKind, Prim, ScopedName, TypeSpec};
 use crate::diag::{suggest, Code, Diagnostic, Diagnostics};
@@ -12,8 +12,10 @@ use annotations::Place;
 use scope::{Lookup, Scopes, Sym};
 use std::collections::HashSet;
 
+/// What resolution needs besides the syntax trees.
 #[derive(Clone, Debug)]
 pub struct Options {
+    /// Extensibility of types without an annotation.
     pub default_extensibility: Extensibility,
 }
 
@@ -25,7 +27,7 @@ impl Default for Options {
     }
 }
 
-pub struct Resolver<'a> {
+pub(crate) struct Resolver<'a> {
     pub model: Model,
     pub diags: &'a mut Diagnostics,
     opts: Options,
@@ -236,7 +238,7 @@ impl<'a> Resolver<'a> {
     // ---- names ---------------------------------------------------------------------------------------------
 
     /// Looks a name up from the current scope, reporting failures (with suggestions).
-    pub fn resolve_name(&mut self, n: &ScopedName, what: &str) -> Option<Sym> {
+    pub(crate) fn resolve_name(&mut self, n: &ScopedName, what: &str) -> Option<Sym> {
         let decls = &self.model.decls;
         let enum_members = |d: DeclId, part: &str| -> Option<usize> {
             match &decls[d].kind {
@@ -245,7 +247,7 @@ impl<'a> Resolver<'a> {
             }
         };
         match self.scopes.lookup(n, &self.cur, &enum_members) {
-            Lookup::Found(sym, _) => Some(sym),
+            Lookup::Found(sym) => Some(sym),
             Lookup::CaseMismatch { found, sym, loc } => {
                 self.diags.push(
                     Diagnostic::error(
@@ -313,7 +315,7 @@ impl<'a> Resolver<'a> {
             .map(|d| d.scoped_name())
     }
 
-    pub fn type_name(&self, t: &Type) -> String {
+    pub(crate) fn type_name(&self, t: &Type) -> String {
         match t {
             Type::Prim { prim } => prim.idl_name().to_string(),
             Type::String { wide, bound } => {
@@ -340,7 +342,7 @@ impl<'a> Resolver<'a> {
 
     // ---- types ---------------------------------------------------------------------------------------------
 
-    pub fn lower_type(&mut self, t: &TypeSpec) -> Type {
+    pub(crate) fn lower_type(&mut self, t: &TypeSpec) -> Type {
         match t {
             TypeSpec::Prim(p, loc) => {
                 if matches!(p, Prim::Any | Prim::Object) {
