@@ -74,6 +74,17 @@ impl SourceFile {
 pub struct SourceDb {
     files: Vec<Arc<SourceFile>>,
     by_path: HashMap<PathBuf, FileId>,
+    /// `#line` directives seen, per file, by the physical line they take effect on.
+    line_marks: HashMap<FileId, Vec<LineMark>>,
+}
+
+/// A `#line N ["name"]` directive: from physical line `from` on, lines are numbered from `line` and (when given)
+/// reported under `name`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct LineMark {
+    from: usize,
+    line: usize,
+    name: Option<Arc<str>>,
 }
 
 impl SourceDb {
@@ -127,11 +138,44 @@ impl SourceDb {
         self.by_path.get(path).copied()
     }
 
-    /// `file:line:col` of a location.
+    /// Records `#line line ["name"]` taking effect on physical line `from` (1-based) of `file`. Recording the same
+    /// directive again (the file included twice) changes nothing.
+    pub fn add_line_mark(&mut self, file: FileId, from: usize, line: usize, name: Option<&str>) {
+        let mark = LineMark {
+            from,
+            line,
+            name: name.map(Arc::from),
+        };
+        let marks = self.line_marks.entry(file).or_default();
+        match marks.binary_search_by_key(&from, |m| m.from) {
+            Ok(i) => marks[i] = mark,
+            Err(i) => marks.insert(i, mark),
+        }
+    }
+
+    /// The position of a byte offset as `#line` directives present it: file name, 1-based line and column.
+    /// Without directives, the file's own name and line.
+    pub fn presumed(&self, file: FileId, offset: u32) -> (&str, usize, usize) {
+        let f = self.get(file);
+        let (l, c) = f.line_col(offset);
+        let marks = self.line_marks.get(&file).map_or(&[][..], Vec::as_slice);
+        let i = marks.partition_point(|m| m.from <= l);
+        if i == 0 {
+            return (&f.name, l, c);
+        }
+        let m = &marks[i - 1];
+        let name = marks[..i]
+            .iter()
+            .rev()
+            .find_map(|m| m.name.as_deref())
+            .unwrap_or(&f.name);
+        (name, m.line + (l - m.from), c)
+    }
+
+    /// `file:line:col` of a location, as `#line` directives present it.
     pub fn describe(&self, loc: Loc) -> String {
-        let f = self.get(loc.file);
-        let (l, c) = f.line_col(loc.start);
-        format!("{}:{}:{}", f.name, l, c)
+        let (name, l, c) = self.presumed(loc.file, loc.start);
+        format!("{name}:{l}:{c}")
     }
 
     /// The source text of a location (empty when out of range).

@@ -480,3 +480,18 @@ fn fixed_members_map_to_the_runtime_decimal() {
     );
     assert!(code.contains("::dds_runtime::cdr::Fixed<31, 0>"), "{code}");
 }
+
+#[test]
+fn line_directive_moves_reported_positions() {
+    let src = "struct A { long a; };\n#line 100 \"gen.idl\"\nstruct B { nope b; };\n#line 7\nstruct C { nope c; };\n";
+    let c = compile_str("main.idl", src, &Options::default(), &MemVfs::new());
+    let at: Vec<String> = c
+        .diags
+        .iter()
+        .filter_map(|d| d.primary_loc())
+        .map(|l| c.db.describe(l))
+        .collect();
+    assert_eq!(at, ["gen.idl:100:12", "gen.idl:7:12"]);
+    assert!(codes("#line x\n").contains(&"idlc::E0005"));
+    assert!(codes("#line 3 gen.idl\n").contains(&"idlc::E0005"));
+}

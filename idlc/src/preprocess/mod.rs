@@ -170,9 +170,9 @@ impl Output {
         for line in self.text.split_inclusive('\n') {
             if let Some(seg) = self.map.seg_at(line_start) {
                 if cur != Some(seg.file) && !line.trim().is_empty() {
-                    let f = db.get(seg.file);
-                    let (l, _) = f.line_col(self.map.loc(line_start, line_start + 1).start);
-                    s.push_str(&format!("# {} \"{}\"\n", l, f.name));
+                    let at = self.map.loc(line_start, line_start + 1).start;
+                    let (name, l, _) = db.presumed(seg.file, at);
+                    s.push_str(&format!("# {l} \"{name}\"\n"));
                     cur = Some(seg.file);
                 }
             }
@@ -700,15 +700,7 @@ impl<'a> Preprocessor<'a> {
                 Diagnostic::warning(Code::WarningDirective, format!("#warning {rest}"))
                     .at(loc, "here"),
             ),
-            "line" => {
-                let ok = rest
-                    .split_whitespace()
-                    .next()
-                    .is_some_and(|n| n.bytes().all(|c| c.is_ascii_digit()));
-                if !ok {
-                    self.err(Code::BadDirective, loc, "#line needs a line number", "here");
-                }
-            }
+            "line" => self.line_directive(file, rest, loc),
             "pragma" => self.pragma(file, text, hash, rest, loc),
             _ => self.err(
                 Code::BadDirective,
@@ -717,6 +709,36 @@ impl<'a> Preprocessor<'a> {
                 "not a directive",
             ),
         }
+    }
+
+    /// `#line N ["name"]`: the next line is line `N` (of `name`) in reported positions.
+    fn line_directive(&mut self, file: FileId, rest: &str, loc: Loc) {
+        let mut words = rest.splitn(2, char::is_whitespace);
+        let number = words
+            .next()
+            .filter(|n| !n.is_empty() && n.bytes().all(|c| c.is_ascii_digit()))
+            .and_then(|n| n.parse::<usize>().ok());
+        let Some(number) = number else {
+            return self.err(Code::BadDirective, loc, "#line needs a line number", "here");
+        };
+        let name = words.next().map(str::trim).filter(|s| !s.is_empty());
+        let name = match name {
+            None => None,
+            Some(n) => match n.strip_prefix('"').and_then(|n| n.strip_suffix('"')) {
+                Some(n) => Some(n),
+                None => {
+                    return self.err(
+                        Code::BadDirective,
+                        loc,
+                        "#line expects a file name in double quotes",
+                        "here",
+                    )
+                }
+            },
+        };
+        // The directive may span lines (continuations): the mark applies after its last one.
+        let (last, _) = self.db.get(file).line_col(loc.end.saturating_sub(1));
+        self.db.add_line_mark(file, last + 1, number, name);
     }
 
     fn pragma(&mut self, file: FileId, text: &str, hash: usize, rest: &str, loc: Loc) {
