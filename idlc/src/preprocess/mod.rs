@@ -928,7 +928,8 @@ const MAX_INVOCATION_LINES: usize = 64;
 /// whitespace, and the end of the last line lexed.
 fn invocation_tokens(text: &str, at: usize, to: usize) -> (Vec<Tok>, Option<usize>, usize) {
     let mut line_to = to;
-    for _ in 0..MAX_INVOCATION_LINES {
+    let mut extra_lines = 0;
+    loop {
         let rest = lex::lex(&text[at..line_to]);
         let k = rest
             .iter()
@@ -939,18 +940,12 @@ fn invocation_tokens(text: &str, at: usize, to: usize) -> (Vec<Tok>, Option<usiz
             None => false,
             Some(k) => !rest[k].is("(") || macros::collect_args(&rest, k).is_ok(),
         };
-        if complete || line_to >= text.len() {
+        if complete || line_to >= text.len() || extra_lines == MAX_INVOCATION_LINES {
             return (rest, k, line_to);
         }
         line_to = memchr_nl(text.as_bytes(), line_to);
+        extra_lines += 1;
     }
-    let rest = lex::lex(&text[at..line_to]);
-    let k = rest
-        .iter()
-        .skip(1)
-        .position(|t| t.kind != Kind::Ws)
-        .map(|p| p + 1);
-    (rest, k, line_to)
 }
 
 fn memchr_nl(b: &[u8], from: usize) -> usize {
