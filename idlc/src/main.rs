@@ -1,7 +1,7 @@
 //! `idlc`: command-line front end. Exit status: 0 success, 1 errors in the input, 2 usage errors.
 use clap::{Parser, ValueEnum};
 use idlc::diag::RenderOptions;
-use idlc::driver::{compile_file, Options};
+use idlc::driver::{Options, Session};
 use idlc::model::Extensibility;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -102,8 +102,9 @@ fn main() -> ExitCode {
     let render = RenderOptions { color, width: 100 };
     let mut failed = false;
     let stdout = std::io::stdout();
+    let mut session = Session::new(opts);
     for file in &cli.files {
-        let mut c = compile_file(file, &opts);
+        let mut c = session.compile_file(file);
         let ext = if cli.emit == Emit::Json { "json" } else { "rs" };
         let stem = file
             .file_stem()

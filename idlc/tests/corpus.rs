@@ -53,6 +53,7 @@ fn expected_failures() -> BTreeMap<String, (String, String)> {
         .collect()
 }
 
+/// A Rust module name for a corpus file path (relative to the corpus).
 fn module_name(rel: &str) -> String {
     let s: String = rel
         .trim_end_matches(".idl")

@@ -213,9 +213,14 @@ diag_test!(
     "struct A { map<double, long> m; };\n"
 );
 diag_test!(
-    fixed_has_no_rust_mapping,
-    "E0414",
-    "struct A { fixed<5,2> price; };\n"
+    fixed_digits_out_of_range,
+    "E0304",
+    "struct A { fixed<32,2> price; };\n"
+);
+diag_test!(
+    vendor_enumerator_value,
+    "W0107",
+    "enum E {\n  A = 1,\n  B\n};\n"
 );
 diag_test!(any_is_not_data, "E0414", "struct A { any value; };\n");
 // ---- preprocessor ----

@@ -368,3 +368,130 @@ fn json_model_output() {
     assert_eq!(v["decls"][0]["name"], "S");
     assert_eq!(v["decls"][0]["kind"]["decl"], "struct");
 }
+
+fn warning_codes(c: &Compilation) -> Vec<&'static str> {
+    c.diags
+        .iter()
+        .filter(|d| !d.is_error())
+        .map(|d| d.code.as_str())
+        .collect()
+}
+
+#[test]
+fn vendor_extensions_are_accepted_with_a_warning_each() {
+    let c = ok("enum E { A = 2, B, C = 7 };\n\
+         struct S { map<E, long> m; };\n\
+         union U switch (char) { case 65: long a; case 'b': short b; };\n");
+    match decl(&c, "E") {
+        DeclKind::Enum(e) => {
+            let v: Vec<i64> = e.enumerators.iter().map(|e| e.value).collect();
+            assert_eq!(v, [2, 3, 7]);
+        }
+        other => panic!("{other:?}"),
+    }
+    match decl(&c, "U") {
+        DeclKind::Union(u) => assert_eq!(u.cases[0].labels, [Value::Char('A')]),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(warning_codes(&c), ["idlc::W0107"; 4]);
+    // Both forms of a value on one enumerator, and a char label that does not fit, stay errors.
+    assert!(codes("enum E { @value(1) A = 2 };").contains(&"idlc::W0107"));
+    assert!(compile_str(
+        "m.idl",
+        "enum E { @value(1) A = 2 };",
+        &Options::default(),
+        &MemVfs::new()
+    )
+    .has_errors());
+    assert_eq!(
+        codes("union U switch (char) { case 300: long a; };"),
+        ["idlc::E0403"]
+    );
+}
+
+#[test]
+fn function_like_macro_call_spans_lines() {
+    let c = ok("#define MEMBER(t, n) t n;\n\
+         struct S {\n\
+             MEMBER(long,\n\
+                    x)\n\
+             MEMBER\n\
+               (short, y) long z;\n\
+         };\n");
+    match decl(&c, "S") {
+        DeclKind::Struct(s) => {
+            let names: Vec<&str> = s.fields.iter().map(|f| f.name.as_str()).collect();
+            assert_eq!(names, ["x", "y", "z"]);
+        }
+        other => panic!("{other:?}"),
+    }
+    // Positions after a multi-line call stay exact.
+    let mut c = compile_str(
+        "main.idl",
+        "#define P(a, b) a b\nstruct S {\n  P(long,\n    w); nope q;\n};\n",
+        &Options::default(),
+        &MemVfs::new(),
+    );
+    let text = c.render_diagnostics(Default::default());
+    assert!(text.contains("main.idl:4:9"), "{text}");
+}
+
+#[test]
+fn a_session_parses_a_shared_include_once_and_keeps_results_exact() {
+    use idlc::driver::Session;
+    // `t.idl` means something else depending on a macro the includer sets: the cache must not mix them up.
+    let files = MemVfs::new()
+        .with(
+            "t.idl",
+            "#ifdef WIDE\nstruct T { long long v; };\n#else\nstruct T { short v; };\n#endif\n",
+        )
+        .with("bad.idl", "struct B { nope x; };\n");
+    let mut s = Session::with_vfs(Options::default(), Box::new(files.clone()));
+    let narrow = s.compile_str("a.idl", "#include \"t.idl\"\nstruct A { T t; };\n");
+    let wide = s.compile_str(
+        "b.idl",
+        "#define WIDE\n#include \"t.idl\"\nstruct B2 { T t; };\n",
+    );
+    let again = s.compile_str("c.idl", "#include \"t.idl\"\nstruct C { T t; };\n");
+    let ty = |c: &Compilation| match decl(c, "T") {
+        DeclKind::Struct(st) => format!("{:?}", st.fields[0].ty),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(ty(&narrow), ty(&again));
+    assert_ne!(ty(&narrow), ty(&wide));
+    // A diagnostic in a shared include renders the same from a session as from a fresh compilation.
+    let main = "#include \"bad.idl\"\nstruct M { long y; };\n";
+    let mut fresh = compile_str("m.idl", main, &Options::default(), &files);
+    let _ = s.compile_str("n.idl", main);
+    let mut cached = s.compile_str("m.idl", main);
+    assert_eq!(
+        fresh.render_diagnostics(Default::default()),
+        cached.render_diagnostics(Default::default())
+    );
+}
+
+#[test]
+fn fixed_members_map_to_the_runtime_decimal() {
+    let mut c = ok("struct A { fixed<5,2> price; sequence<fixed<31,0>> big; };\n");
+    let code = c.rust().expect("rust");
+    assert!(
+        code.contains("price: ::dds_runtime::cdr::Fixed<5, 2>"),
+        "{code}"
+    );
+    assert!(code.contains("::dds_runtime::cdr::Fixed<31, 0>"), "{code}");
+}
+
+#[test]
+fn line_directive_moves_reported_positions() {
+    let src = "struct A { long a; };\n#line 100 \"gen.idl\"\nstruct B { nope b; };\n#line 7\nstruct C { nope c; };\n";
+    let c = compile_str("main.idl", src, &Options::default(), &MemVfs::new());
+    let at: Vec<String> = c
+        .diags
+        .iter()
+        .filter_map(|d| d.primary_loc())
+        .map(|l| c.db.describe(l))
+        .collect();
+    assert_eq!(at, ["gen.idl:100:12", "gen.idl:7:12"]);
+    assert!(codes("#line x\n").contains(&"idlc::E0005"));
+    assert!(codes("#line 3 gen.idl\n").contains(&"idlc::E0005"));
+}

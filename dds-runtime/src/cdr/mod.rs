@@ -6,6 +6,7 @@
 
 mod collections;
 mod error;
+mod fixed;
 mod header;
 mod key;
 pub mod members;
@@ -17,6 +18,7 @@ mod wrappers;
 mod writer;
 
 pub use error::{DecodeError, DecodeErrorKind, EncodeError};
+pub use fixed::{Fixed, FixedError};
 pub use header::{ByteOrder, EncapsulationHeader, Extensibility, Representation, XcdrVersion};
 pub use key::{deserialize_key, instance_key, key_hash, serialize_key};
 pub use members::{DefaultSearch, Discriminator, StructMembers};

@@ -150,10 +150,23 @@ fn core_config(
     .map_err(crate::config::ConfigError::from)?
     .metatraffic_unicast(vec![locator(transport.metatraffic_unicast())])
     .default_unicast(vec![locator(transport.user_unicast())])
-    .metatraffic_multicast(transport.spdp_multicast().map(locator).into_iter().collect::<Vec<_>>())
+    .metatraffic_multicast(
+        transport
+            .spdp_multicast()
+            .map(locator)
+            .into_iter()
+            .collect::<Vec<_>>(),
+    )
     // We do not listen on the user multicast port: peers send user data unicast.
     .default_multicast(Vec::new())
-    .initial_peers(transport.spdp_peers().iter().copied().map(locator).collect::<Vec<_>>())
+    .initial_peers(
+        transport
+            .spdp_peers()
+            .iter()
+            .copied()
+            .map(locator)
+            .collect::<Vec<_>>(),
+    )
     .spdp_interval(config.spdp_interval)
     .lease_duration(config.lease_duration)
     .max_message_size(config.max_message_size)

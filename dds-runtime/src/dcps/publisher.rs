@@ -8,7 +8,7 @@ use foldhash::HashMap;
 use crate::cdr::{self, ByteOrder, DdsType, XcdrVersion};
 use crate::qos::{
     DataRepresentation, DataWriterQos, PublisherQos, Reliability, WriterQos,
-    XCDR2_DATA_REPRESENTATION, XCDR_DATA_REPRESENTATION,
+    XCDR2_DATA_REPRESENTATION,
 };
 use crate::rtps::{
     ChangeKind, EntityId, Event, Guid, Payload, Time, WriteChange, WriteError, WriterSpec,

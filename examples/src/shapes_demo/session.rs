@@ -369,8 +369,7 @@ fn writer_qos(xcdr2: bool) -> DataWriterQos {
 
 /// Reliable, keep-last-8, accepting XCDR1 and XCDR2.
 fn reader_qos() -> DataReaderQos {
-    let both =
-        DataRepresentation::accept_both();
+    let both = DataRepresentation::accept_both();
     DataReaderQos::builder()
         .reliability(Reliability::RELIABLE)
         .history(History::KeepLast(8))

@@ -75,4 +75,5 @@ codes! {
     IgnoredAnnotation = "W0104": "annotation has no effect here",
     Renamed = "W0105": "Rust name changed to avoid a collision",
     AnnotationCase = "W0106": "built-in annotation name not in lower case",
+    Extension = "W0107": "vendor extension to IDL 4.2 accepted",
 }

@@ -7,7 +7,7 @@ use crate::preprocess::Output;
 use crate::source::Loc;
 use pest::iterators::Pair;
 
-pub struct Builder<'a> {
+pub(crate) struct Builder<'a> {
     pp: &'a Output,
     diags: &'a mut Diagnostics,
 }
@@ -15,7 +15,7 @@ pub struct Builder<'a> {
 type P<'i> = Pair<'i, Rule>;
 
 impl<'a> Builder<'a> {
-    pub fn new(pp: &'a Output, diags: &'a mut Diagnostics) -> Self {
+    pub(crate) fn new(pp: &'a Output, diags: &'a mut Diagnostics) -> Self {
         Builder { pp, diags }
     }
 
@@ -28,7 +28,7 @@ impl<'a> Builder<'a> {
         self.diags.push(Diagnostic::error(code, msg).at(loc, label));
     }
 
-    pub fn specification(&mut self, p: P) -> Spec {
+    pub(crate) fn specification(&mut self, p: P) -> Spec {
         let defs = p
             .into_inner()
             .filter(|p| p.as_rule() == Rule::definition)
@@ -195,7 +195,7 @@ impl<'a> Builder<'a> {
         DefKind::Keylist { ty, keys }
     }
 
-    pub fn ident(&mut self, p: P) -> Ident {
+    pub(crate) fn ident(&mut self, p: P) -> Ident {
         let loc = self.loc(&p);
         let text = p.as_str();
         if let Some(esc) = text.strip_prefix('_') {
@@ -435,15 +435,18 @@ impl<'a> Builder<'a> {
                 let doc = self.doc_before(e.as_span().start());
                 let mut annotations = Vec::new();
                 let mut name = None;
+                let mut value = None;
                 for c in e.into_inner() {
                     match c.as_rule() {
                         Rule::annotation_appl => annotations.push(self.annotation(c)),
+                        Rule::const_expr => value = Some(self.const_expr(c)),
                         _ => name = Some(self.ident(c)),
                     }
                 }
                 Enumerator {
                     annotations,
                     name: name.expect("enumerator name"),
+                    value,
                     doc,
                 }
             })
@@ -668,7 +671,7 @@ impl<'a> Builder<'a> {
         }
     }
 
-    pub fn const_expr(&mut self, p: P) -> ConstExpr {
+    pub(crate) fn const_expr(&mut self, p: P) -> ConstExpr {
         let loc = self.loc(&p);
         match p.as_rule() {
             Rule::const_expr

@@ -1,22 +1,37 @@
 //! Parsing: the pest grammar in `idl.pest`, syntax-error reporting, and AST construction (`build.rs`).
+//!
+//! [`parse`] splits the translation unit where an included file begins or ends (see [`pieces`]) and looks each
+//! piece up in a [`ParseCache`] before parsing it, so a run that includes one file from many inputs parses it once.
 mod build;
 pub mod literal;
+mod pieces;
+
+pub use pieces::ParseCache;
 
 use crate::ast::Spec;
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::preprocess::Output;
 use pest::error::InputLocation;
 use pest::Parser as _;
+use std::sync::Arc;
 
-#[derive(pest_derive::Parser)]
-#[grammar = "parse/idl.pest"]
-pub struct IdlParser;
+mod grammar {
+    // pest_derive generates `Rule` without docs.
+    #![allow(missing_docs, unreachable_pub)]
+    /// The pest parser generated from `idl.pest`.
+    #[derive(pest_derive::Parser)]
+    #[grammar = "parse/idl.pest"]
+    pub(crate) struct IdlParser;
+}
+pub(crate) use grammar::{IdlParser, Rule};
 
 /// Deepest bracket nesting accepted; deeper input is refused before pest recurses into it.
 pub const MAX_NESTING: usize = 100;
 
-/// Parses preprocessed text into an AST. Syntax errors are reported into `diags`; the result is then empty.
-pub fn parse(pp: &Output, diags: &mut Diagnostics) -> Spec {
+/// Parses preprocessed text into syntax trees, one per piece of the translation unit, in order; together they
+/// are the whole specification. Pieces already in `cache` are not parsed again. Syntax errors are reported
+/// into `diags`; the result is then empty.
+pub fn parse(pp: &Output, cache: &mut ParseCache, diags: &mut Diagnostics) -> Vec<Arc<Spec>> {
     if let Some(off) = too_deep(&pp.text) {
         diags.push(
             Diagnostic::error(
@@ -25,8 +40,16 @@ pub fn parse(pp: &Output, diags: &mut Diagnostics) -> Spec {
             )
             .at(pp.map.loc(off, off + 1), "nesting limit reached here"),
         );
-        return Spec::default();
+        return vec![];
     }
+    if let Some(specs) = cache.parse_pieces(pp, diags) {
+        return specs;
+    }
+    vec![Arc::new(parse_whole(pp, diags))]
+}
+
+/// Parses the whole text in one go; on a syntax error, reports the furthest failure.
+fn parse_whole(pp: &Output, diags: &mut Diagnostics) -> Spec {
     match IdlParser::parse(Rule::specification, &pp.text) {
         Ok(mut pairs) => {
             let spec = pairs

@@ -2,7 +2,7 @@
 //! identifiers that remain are 0, as in C.
 use super::lex::{Kind, Tok};
 
-pub fn eval(toks: &[Tok]) -> Result<i64, String> {
+pub(crate) fn eval(toks: &[Tok]) -> Result<i64, String> {
     let toks: Vec<&Tok> = toks.iter().filter(|t| t.kind != Kind::Ws).collect();
     let mut p = Parser {
         toks,

@@ -1,7 +1,7 @@
 //! Preprocessing tokens: just enough lexing to find identifiers, literals and punctuation.
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
+pub(crate) enum Kind {
     Ident,
     Number,
     Str,
@@ -11,32 +11,32 @@ pub enum Kind {
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Tok {
+pub(crate) struct Tok {
     pub kind: Kind,
     pub text: String,
 }
 
 impl Tok {
-    pub fn new(kind: Kind, text: impl Into<String>) -> Self {
+    pub(crate) fn new(kind: Kind, text: impl Into<String>) -> Self {
         Tok {
             kind,
             text: text.into(),
         }
     }
-    pub fn is(&self, s: &str) -> bool {
+    pub(crate) fn is(&self, s: &str) -> bool {
         self.kind != Kind::Ws && self.text == s
     }
 }
 
-pub fn is_ident_start(b: u8) -> bool {
+pub(crate) fn is_ident_start(b: u8) -> bool {
     b.is_ascii_alphabetic() || b == b'_'
 }
-pub fn is_ident_char(b: u8) -> bool {
+pub(crate) fn is_ident_char(b: u8) -> bool {
     b.is_ascii_alphanumeric() || b == b'_'
 }
 
 /// Length of the literal starting with the quote at `s[0]`; `None` when it does not end on this line.
-pub fn literal_len(s: &[u8]) -> Option<usize> {
+pub(crate) fn literal_len(s: &[u8]) -> Option<usize> {
     let q = s[0];
     let mut i = 1;
     while i < s.len() {
@@ -51,7 +51,7 @@ pub fn literal_len(s: &[u8]) -> Option<usize> {
 }
 
 /// Length of a pp-number starting at `s[0]` (a digit, or '.' followed by a digit).
-pub fn number_len(s: &[u8]) -> usize {
+pub(crate) fn number_len(s: &[u8]) -> usize {
     let mut i = 1;
     while i < s.len() {
         let c = s[i];
@@ -68,7 +68,7 @@ pub fn number_len(s: &[u8]) -> usize {
 }
 
 /// Splits text (comments already removed) into tokens. Unterminated literals become punctuation.
-pub fn lex(text: &str) -> Vec<Tok> {
+pub(crate) fn lex(text: &str) -> Vec<Tok> {
     let b = text.as_bytes();
     let mut out = Vec::new();
     let mut i = 0;
@@ -119,7 +119,7 @@ pub fn lex(text: &str) -> Vec<Tok> {
 }
 
 /// Removes comments from one logical directive line (a `/*` that does not close ends the line).
-pub fn strip_comments(s: &str) -> String {
+pub(crate) fn strip_comments(s: &str) -> String {
     let b = s.as_bytes();
     let mut out = String::with_capacity(s.len());
     let mut i = 0;

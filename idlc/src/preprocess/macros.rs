@@ -8,24 +8,24 @@ const MAX_DEPTH: usize = 64;
 const MAX_TOKENS: usize = 1 << 20;
 
 #[derive(Clone, Debug)]
-pub struct Macro {
+pub(crate) struct Macro {
     pub params: Option<Vec<String>>,
     pub variadic: bool,
     pub body: Vec<Tok>,
 }
 
 #[derive(Default, Debug)]
-pub struct MacroTable {
+pub(crate) struct MacroTable {
     pub defs: HashMap<String, Macro>,
 }
 
 impl MacroTable {
-    pub fn is_defined(&self, name: &str) -> bool {
+    pub(crate) fn is_defined(&self, name: &str) -> bool {
         self.defs.contains_key(name)
     }
 
     /// Parses the text after `#define`.
-    pub fn define(&mut self, text: &str) -> Result<(), String> {
+    pub(crate) fn define(&mut self, text: &str) -> Result<(), String> {
         let text = text.trim_start();
         let name_len = text
             .bytes()
@@ -72,7 +72,7 @@ impl MacroTable {
     }
 
     /// Expands a token list fully.
-    pub fn expand(&self, toks: &[Tok]) -> Result<Vec<Tok>, String> {
+    pub(crate) fn expand(&self, toks: &[Tok]) -> Result<Vec<Tok>, String> {
         let mut hide = Vec::new();
         let mut budget = MAX_TOKENS;
         self.expand_in(toks, &mut hide, &mut budget)
@@ -223,7 +223,7 @@ impl MacroTable {
 }
 
 /// Collects the arguments of a call whose `(` is at `open`; returns them and the index after `)`.
-pub fn collect_args(toks: &[Tok], open: usize) -> Result<(Vec<Vec<Tok>>, usize), String> {
+pub(crate) fn collect_args(toks: &[Tok], open: usize) -> Result<(Vec<Vec<Tok>>, usize), String> {
     let mut args = vec![Vec::new()];
     let mut depth = 0usize;
     let mut i = open + 1;

@@ -23,8 +23,10 @@ const MAX_OUTPUT: usize = 256 << 20;
 /// byte is high, so longer tokens are refused up front.
 const MAX_TOKEN: usize = 1 << 20;
 
+/// What the preprocessor needs besides the input.
 #[derive(Clone, Debug, Default)]
 pub struct Options {
+    /// Directories searched for `#include`, in order.
     pub include_dirs: Vec<PathBuf>,
     /// `-D NAME` or `-D NAME=VALUE`, in order.
     pub defines: Vec<String>,
@@ -32,8 +34,8 @@ pub struct Options {
     pub undefines: Vec<String>,
 }
 
-#[derive(Clone, Copy, Debug)]
-struct Seg {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct Seg {
     out: u32,
     file: FileId,
     src: u32,
@@ -43,12 +45,35 @@ struct Seg {
 }
 
 /// Maps output offsets to source locations.
-#[derive(Debug, Default, Clone)]
+#[derive(Debug, Default, Clone, PartialEq, Eq, Hash)]
 pub struct SourceMap {
     segs: Vec<Seg>,
 }
 
 impl SourceMap {
+    /// The map of the output range `start..end`, with offsets relative to `start`: `slice(a, b).loc(x, y)` is
+    /// `loc(a + x, a + y)` for every range inside `a..b`.
+    pub(crate) fn slice(&self, start: usize, end: usize) -> SourceMap {
+        let i = self.segs.partition_point(|s| s.out as usize <= start);
+        let mut segs = Vec::new();
+        if i > 0 {
+            let s = self.segs[i - 1];
+            let skip = start as u32 - s.out;
+            segs.push(Seg {
+                out: 0,
+                src: if s.linear { s.src + skip } else { s.src },
+                ..s
+            });
+        }
+        for s in self.segs[i..].iter().take_while(|s| (s.out as usize) < end) {
+            segs.push(Seg {
+                out: s.out - start as u32,
+                ..*s
+            });
+        }
+        SourceMap { segs }
+    }
+
     fn seg_at(&self, off: usize) -> Option<&Seg> {
         let i = self.segs.partition_point(|s| s.out as usize <= off);
         if i == 0 {
@@ -111,20 +136,29 @@ impl SourceMap {
     }
 }
 
-#[derive(Clone, Debug)]
+/// A comment in the output.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Comment {
-    /// Output range, including the delimiters.
+    /// Output offset of the first delimiter.
     pub start: usize,
+    /// Output offset one past the closing delimiter (or the end of the line for `//`).
     pub end: usize,
 }
 
+/// The preprocessed translation unit.
 #[derive(Debug, Default)]
 pub struct Output {
+    /// The text, with directives blanked and macros expanded.
     pub text: String,
+    /// Where each output byte came from.
     pub map: SourceMap,
+    /// Every comment in the kept text, in order.
     pub comments: Vec<Comment>,
     /// Every file read, the main file first.
     pub files: Vec<FileId>,
+    /// Output offsets where an included file's text begins or ends, in order. The parser splits the text there
+    /// (when the split falls between definitions) and reuses the syntax tree of a piece seen before.
+    pub boundaries: Vec<usize>,
 }
 
 impl Output {
@@ -136,9 +170,9 @@ impl Output {
         for line in self.text.split_inclusive('\n') {
             if let Some(seg) = self.map.seg_at(line_start) {
                 if cur != Some(seg.file) && !line.trim().is_empty() {
-                    let f = db.get(seg.file);
-                    let (l, _) = f.line_col(self.map.loc(line_start, line_start + 1).start);
-                    s.push_str(&format!("# {} \"{}\"\n", l, f.name));
+                    let at = self.map.loc(line_start, line_start + 1).start;
+                    let (name, l, _) = db.presumed(seg.file, at);
+                    s.push_str(&format!("# {l} \"{name}\"\n"));
                     cur = Some(seg.file);
                 }
             }
@@ -159,7 +193,7 @@ struct Cond {
     loc: Loc,
 }
 
-pub struct Preprocessor<'a> {
+struct Preprocessor<'a> {
     db: &'a mut SourceDb,
     vfs: &'a dyn Vfs,
     diags: &'a mut Diagnostics,
@@ -180,9 +214,20 @@ pub fn preprocess(
     diags: &mut Diagnostics,
 ) -> Output {
     let mut pp = Preprocessor::new(db, vfs, opts, diags);
+    let name = path.display().to_string();
+    // Read before (as an include of an earlier input of the session) under the same name: keep its id, so that
+    // the parse cache knows its text.
+    if let Some(id) = pp
+        .db
+        .find_path(path)
+        .filter(|id| pp.db.get(*id).name == name)
+    {
+        pp.run(id);
+        return pp.out;
+    }
     match vfs.read(path) {
         Ok(text) => {
-            let id = pp.db.add(path.display().to_string(), path, text);
+            let id = pp.db.add(name, path, text);
             pp.run(id);
         }
         Err(e) => pp.diags.push(Diagnostic::error(
@@ -306,7 +351,7 @@ impl<'a> Preprocessor<'a> {
         self.in_comment = None;
         while pos < bytes.len() && !self.too_big {
             let line_end = memchr_nl(bytes, pos);
-            let active = conds.last().is_none_or(|c| c.active);
+            let active = conds.last().map_or(true, |c| c.active);
             let trimmed = text[pos..line_end].trim_start();
             if self.in_comment.is_none() && trimmed.starts_with('#') {
                 // Directive: join continuation lines.
@@ -331,11 +376,12 @@ impl<'a> Preprocessor<'a> {
                 continue;
             }
             if active {
-                self.scan_line(file, &text, pos, line_end);
+                // A macro invocation may continue on the following lines.
+                pos = self.scan_line(file, &text, pos, line_end);
             } else {
                 self.skip_line(&text, pos, line_end);
+                pos = line_end;
             }
-            pos = line_end;
         }
         if let Some(start) = self.in_comment.take() {
             let end = self.out.text.len();
@@ -388,8 +434,9 @@ impl<'a> Preprocessor<'a> {
         }
     }
 
-    /// Copies an active line, expanding macros and recording comments.
-    fn scan_line(&mut self, file: FileId, text: &str, from: usize, to: usize) {
+    /// Copies an active line, expanding macros and recording comments. Returns where the line ended: further
+    /// on than `to` when a function-like macro's arguments continue on the next lines.
+    fn scan_line(&mut self, file: FileId, text: &str, from: usize, mut to: usize) -> usize {
         let b = text.as_bytes();
         let mut i = from;
         let mut copy_from = from;
@@ -436,7 +483,10 @@ impl<'a> Preprocessor<'a> {
                 i += 2;
             } else if c == b'"' || c == b'\'' {
                 match lex::literal_len(&b[i..to]) {
-                    Some(n) if n > MAX_TOKEN => return self.token_too_long(file, i, n),
+                    Some(n) if n > MAX_TOKEN => {
+                        self.token_too_long(file, i, n);
+                        return to;
+                    }
                     Some(n) => i += n,
                     None => {
                         let what = if c == b'"' {
@@ -456,7 +506,8 @@ impl<'a> Preprocessor<'a> {
             } else if c.is_ascii_digit() {
                 let n = lex::number_len(&b[i..to]);
                 if n > MAX_TOKEN {
-                    return self.token_too_long(file, i, n);
+                    self.token_too_long(file, i, n);
+                    return to;
                 }
                 i += n;
             } else if is_ident_start(c) {
@@ -465,24 +516,23 @@ impl<'a> Preprocessor<'a> {
                     j += 1;
                 }
                 if j - i > MAX_TOKEN {
-                    return self.token_too_long(file, i, j - i);
+                    self.token_too_long(file, i, j - i);
+                    return to;
                 }
                 let name = &text[i..j];
                 if self.macros.is_defined(name) {
-                    // Find the invocation's extent on this line, then expand just that.
-                    let rest = lex::lex(&text[i..to]);
-                    let m = &self.macros.defs[name];
+                    // Find the invocation's extent, then expand just that.
                     let mut inv_len = name.len();
-                    if m.params.is_some() {
-                        let k = rest
-                            .iter()
-                            .skip(1)
-                            .position(|t| t.kind != Kind::Ws)
-                            .map(|p| p + 1);
+                    if self.macros.defs[name].params.is_some() {
+                        let (rest, k, line_to) = invocation_tokens(text, i, to);
                         match k {
                             Some(k) if rest[k].is("(") => match macros::collect_args(&rest, k) {
                                 Ok((_, end)) => {
-                                    inv_len = rest[..end].iter().map(|t| t.text.len()).sum()
+                                    inv_len = rest[..end].iter().map(|t| t.text.len()).sum();
+                                    if i + inv_len > to {
+                                        // Scanning goes on after the invocation, to the end of its line.
+                                        to = memchr_nl(b, i + inv_len - 1).min(line_to);
+                                    }
                                 }
                                 Err(e) => {
                                     self.err(
@@ -521,6 +571,7 @@ impl<'a> Preprocessor<'a> {
             }
         }
         self.emit_copy(file, text, copy_from, to);
+        to
     }
 
     fn token_too_long(&mut self, file: FileId, at: usize, len: usize) {
@@ -649,15 +700,7 @@ impl<'a> Preprocessor<'a> {
                 Diagnostic::warning(Code::WarningDirective, format!("#warning {rest}"))
                     .at(loc, "here"),
             ),
-            "line" => {
-                let ok = rest
-                    .split_whitespace()
-                    .next()
-                    .is_some_and(|n| n.bytes().all(|c| c.is_ascii_digit()));
-                if !ok {
-                    self.err(Code::BadDirective, loc, "#line needs a line number", "here");
-                }
-            }
+            "line" => self.line_directive(file, rest, loc),
             "pragma" => self.pragma(file, text, hash, rest, loc),
             _ => self.err(
                 Code::BadDirective,
@@ -666,6 +709,36 @@ impl<'a> Preprocessor<'a> {
                 "not a directive",
             ),
         }
+    }
+
+    /// `#line N ["name"]`: the next line is line `N` (of `name`) in reported positions.
+    fn line_directive(&mut self, file: FileId, rest: &str, loc: Loc) {
+        let mut words = rest.splitn(2, char::is_whitespace);
+        let number = words
+            .next()
+            .filter(|n| !n.is_empty() && n.bytes().all(|c| c.is_ascii_digit()))
+            .and_then(|n| n.parse::<usize>().ok());
+        let Some(number) = number else {
+            return self.err(Code::BadDirective, loc, "#line needs a line number", "here");
+        };
+        let name = words.next().map(str::trim).filter(|s| !s.is_empty());
+        let name = match name {
+            None => None,
+            Some(n) => match n.strip_prefix('"').and_then(|n| n.strip_suffix('"')) {
+                Some(n) => Some(n),
+                None => {
+                    return self.err(
+                        Code::BadDirective,
+                        loc,
+                        "#line expects a file name in double quotes",
+                        "here",
+                    )
+                }
+            },
+        };
+        // The directive may span lines (continuations): the mark applies after its last one.
+        let (last, _) = self.db.get(file).line_col(loc.end.saturating_sub(1));
+        self.db.add_line_mark(file, last + 1, number, name);
     }
 
     fn pragma(&mut self, file: FileId, text: &str, hash: usize, rest: &str, loc: Loc) {
@@ -838,9 +911,40 @@ impl<'a> Preprocessor<'a> {
         let saved = self.in_comment.take();
         // Keep tokens of the includer and the included file apart.
         self.out.text.push('\n');
+        self.out.boundaries.push(self.out.text.len());
         self.process(id, depth + 1);
         self.out.text.push('\n');
+        self.out.boundaries.push(self.out.text.len());
         self.in_comment = saved;
+    }
+}
+
+/// Most lines a function-like macro's arguments may span.
+const MAX_INVOCATION_LINES: usize = 64;
+
+/// Tokens of a function-like macro invocation starting at `at` (the macro name) on the line ending at `to`: the
+/// tokens up to the end of the line, extended line by line (at most [`MAX_INVOCATION_LINES`]) while the `(` or the
+/// closing `)` is still missing. Returns the tokens, the index of the first token after the name that is not
+/// whitespace, and the end of the last line lexed.
+fn invocation_tokens(text: &str, at: usize, to: usize) -> (Vec<Tok>, Option<usize>, usize) {
+    let mut line_to = to;
+    let mut extra_lines = 0;
+    loop {
+        let rest = lex::lex(&text[at..line_to]);
+        let k = rest
+            .iter()
+            .skip(1)
+            .position(|t| t.kind != Kind::Ws)
+            .map(|p| p + 1);
+        let complete = match k {
+            None => false,
+            Some(k) => !rest[k].is("(") || macros::collect_args(&rest, k).is_ok(),
+        };
+        if complete || line_to >= text.len() || extra_lines == MAX_INVOCATION_LINES {
+            return (rest, k, line_to);
+        }
+        line_to = memchr_nl(text.as_bytes(), line_to);
+        extra_lines += 1;
     }
 }
 

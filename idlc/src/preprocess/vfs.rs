@@ -3,8 +3,11 @@ use std::collections::HashMap;
 use std::io;
 use std::path::{Path, PathBuf};
 
+/// A source of files for `#include`.
 pub trait Vfs {
+    /// The text of the file at `path`.
     fn read(&self, path: &Path) -> io::Result<String>;
+    /// A file exists at `path` (include lookup tries candidates in order).
     fn exists(&self, path: &Path) -> bool;
 }
 
@@ -32,13 +35,16 @@ impl Vfs for FsVfs {
 /// An in-memory file set.
 #[derive(Default, Clone)]
 pub struct MemVfs {
+    /// The files, by path.
     pub files: HashMap<PathBuf, String>,
 }
 
 impl MemVfs {
+    /// No files.
     pub fn new() -> Self {
         Self::default()
     }
+    /// Adds a file (builder style).
     pub fn with(mut self, path: &str, text: &str) -> Self {
         self.files.insert(PathBuf::from(path), text.to_string());
         self

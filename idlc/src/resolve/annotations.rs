@@ -7,7 +7,7 @@ use crate::source::Loc;
 
 /// Where an annotation is applied.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Place {
+pub(crate) enum Place {
     Module,
     Struct,
     Union,
@@ -85,7 +85,7 @@ const BUILTIN: &[(&str, &[Place])] = {
 
 /// The interpreted annotations of one element.
 #[derive(Default, Debug)]
-pub struct Anns<'a> {
+pub(crate) struct Anns<'a> {
     pub id: Option<u32>,
     pub autoid: Option<AutoId>,
     pub hashid: Option<String>,
@@ -182,7 +182,7 @@ impl Resolver<'_> {
         }
     }
 
-    pub fn annotations<'a>(&mut self, list: &'a [Annotation], place: Place) -> Anns<'a> {
+    pub(crate) fn annotations<'a>(&mut self, list: &'a [Annotation], place: Place) -> Anns<'a> {
         let mut r = Anns::default();
         for a in list {
             let name = a

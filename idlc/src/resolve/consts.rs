@@ -15,7 +15,7 @@ impl Resolver<'_> {
     }
 
     /// Evaluates `e` and converts it to `ty`, reporting range and type errors.
-    pub fn eval_as(&mut self, e: &ConstExpr, ty: &Type) -> Option<Value> {
+    pub(crate) fn eval_as(&mut self, e: &ConstExpr, ty: &Type) -> Option<Value> {
         let target = self.model.resolve_alias(ty).clone();
         let unsigned_max = match &target {
             Type::Prim { prim } => prim.int_range().filter(|r| r.0 == 0).map(|r| r.1),
@@ -26,7 +26,7 @@ impl Resolver<'_> {
     }
 
     /// Evaluates an expression that must be a non-negative integer (bounds, sizes, ids).
-    pub fn eval_u64(&mut self, e: &ConstExpr, what: &str, min: u64) -> Option<u64> {
+    pub(crate) fn eval_u64(&mut self, e: &ConstExpr, what: &str, min: u64) -> Option<u64> {
         match self.eval(e, None)? {
             Value::Int(v) if v >= min as i128 && v <= u64::MAX as i128 => Some(v as u64),
             Value::Int(v) => {
@@ -42,7 +42,7 @@ impl Resolver<'_> {
         }
     }
 
-    pub fn coerce(&mut self, v: Value, target: &Type, loc: Loc) -> Option<Value> {
+    pub(crate) fn coerce(&mut self, v: Value, target: &Type, loc: Loc) -> Option<Value> {
         let tname = self.type_name(target);
         match (target, v) {
             (Type::Prim { prim }, Value::Int(i)) if prim.int_range().is_some() => {
@@ -102,7 +102,7 @@ impl Resolver<'_> {
     }
 
     /// Untyped evaluation. `unsigned_max` gives `~` its meaning for unsigned targets.
-    pub fn eval(&mut self, e: &ConstExpr, unsigned_max: Option<i128>) -> Option<Value> {
+    pub(crate) fn eval(&mut self, e: &ConstExpr, unsigned_max: Option<i128>) -> Option<Value> {
         match &e.kind {
             ExprKind::Literal(l) => Some(match l {
                 Literal::Int(v) => Value::Int(*v as i128),
@@ -266,7 +266,7 @@ fn as_f64(v: &Value) -> f64 {
     }
 }
 
-pub fn describe(v: &Value) -> String {
+pub(crate) fn describe(v: &Value) -> String {
     match v {
         Value::Int(i) => format!("integer {i}"),
         Value::Float(f) => format!("floating-point {f}"),

@@ -2,7 +2,7 @@
 //! requires declaration before use (forward declarations excepted).
 mod annotations;
 mod consts;
-pub mod scope;
+mod scope;
 
 use crate::ast::{self, DefKind, Definition, ForwardKind, Prim, ScopedName, TypeSpec};
 use crate::diag::{suggest, Code, Diagnostic, Diagnostics};
@@ -12,8 +12,10 @@ use annotations::Place;
 use scope::{Lookup, Scopes, Sym};
 use std::collections::HashSet;
 
+/// What resolution needs besides the syntax trees.
 #[derive(Clone, Debug)]
 pub struct Options {
+    /// Extensibility of types without an annotation.
     pub default_extensibility: Extensibility,
 }
 
@@ -25,7 +27,7 @@ impl Default for Options {
     }
 }
 
-pub struct Resolver<'a> {
+pub(crate) struct Resolver<'a> {
     pub model: Model,
     pub diags: &'a mut Diagnostics,
     opts: Options,
@@ -38,7 +40,11 @@ pub struct Resolver<'a> {
 }
 
 /// Resolves one or more specifications (e.g. several files of one build) into a single model.
-pub fn resolve(specs: &[ast::Spec], opts: &Options, diags: &mut Diagnostics) -> Model {
+pub fn resolve<'s>(
+    specs: impl IntoIterator<Item = &'s ast::Spec>,
+    opts: &Options,
+    diags: &mut Diagnostics,
+) -> Model {
     let mut r = Resolver {
         model: Model::default(),
         diags,
@@ -232,7 +238,7 @@ impl<'a> Resolver<'a> {
     // ---- names ---------------------------------------------------------------------------------------------
 
     /// Looks a name up from the current scope, reporting failures (with suggestions).
-    pub fn resolve_name(&mut self, n: &ScopedName, what: &str) -> Option<Sym> {
+    pub(crate) fn resolve_name(&mut self, n: &ScopedName, what: &str) -> Option<Sym> {
         let decls = &self.model.decls;
         let enum_members = |d: DeclId, part: &str| -> Option<usize> {
             match &decls[d].kind {
@@ -241,7 +247,7 @@ impl<'a> Resolver<'a> {
             }
         };
         match self.scopes.lookup(n, &self.cur, &enum_members) {
-            Lookup::Found(sym, _) => Some(sym),
+            Lookup::Found(sym) => Some(sym),
             Lookup::CaseMismatch { found, sym, loc } => {
                 self.diags.push(
                     Diagnostic::error(
@@ -309,7 +315,7 @@ impl<'a> Resolver<'a> {
             .map(|d| d.scoped_name())
     }
 
-    pub fn type_name(&self, t: &Type) -> String {
+    pub(crate) fn type_name(&self, t: &Type) -> String {
         match t {
             Type::Prim { prim } => prim.idl_name().to_string(),
             Type::String { wide, bound } => {
@@ -336,7 +342,7 @@ impl<'a> Resolver<'a> {
 
     // ---- types ---------------------------------------------------------------------------------------------
 
-    pub fn lower_type(&mut self, t: &TypeSpec) -> Type {
+    pub(crate) fn lower_type(&mut self, t: &TypeSpec) -> Type {
         match t {
             TypeSpec::Prim(p, loc) => {
                 if matches!(p, Prim::Any | Prim::Object) {
@@ -371,7 +377,19 @@ impl<'a> Resolver<'a> {
                 let kr = self.model.resolve_alias(&k);
                 let key_ok = matches!(kr, Type::Prim { prim } if prim.is_integer() || *prim == Prim::Octet)
                     || matches!(kr, Type::String { .. } | Type::Error);
-                if !key_ok {
+                let enum_key = matches!(kr, Type::Named { decl, .. }
+                    if matches!(self.model.decls[*decl].kind, DeclKind::Enum(_)));
+                if enum_key {
+                    let msg = format!(
+                        "map key type `{}` is an enum, which IDL 4.2 does not allow",
+                        self.type_name(&k)
+                    );
+                    self.diags.push(
+                        Diagnostic::warning(Code::Extension, msg)
+                            .at(key.loc(), "accepted as a vendor extension")
+                            .help("IDL 4.2 map keys are integers or strings"),
+                    );
+                } else if !key_ok {
                     let msg = format!("map key type `{}` is not allowed", self.type_name(&k));
                     self.diags.push(
                         Diagnostic::error(Code::BadMemberType, msg)
@@ -458,7 +476,7 @@ impl<'a> Resolver<'a> {
         if dims
             .iter()
             .try_fold(1u64, |a, d| a.checked_mul(*d))
-            .is_none_or(|n| n > 1 << 32)
+            .map_or(true, |n| n > 1 << 32)
         {
             let msg = "array has more than 2^32 elements".to_string();
             self.diags
@@ -740,6 +758,16 @@ impl<'a> Resolver<'a> {
         let ok = match (resolved, &v) {
             (Type::Prim { prim: Prim::Bool }, Value::Bool(_)) => true,
             (Type::Prim { prim: Prim::Char }, Value::Char(_)) => true,
+            (Type::Prim { prim: Prim::Char }, Value::Int(i)) if (0..=255).contains(i) => {
+                let msg =
+                    format!("integer case label {i} on a `char` discriminator is not IDL 4.2");
+                self.diags.push(
+                    Diagnostic::warning(Code::Extension, msg)
+                        .at(e.loc, format!("taken as {:?}", char::from(*i as u8)))
+                        .help("write a character literal"),
+                );
+                return Some(Value::Char(char::from(*i as u8)));
+            }
             (Type::Prim { prim: Prim::WChar }, Value::Char(_) | Value::WChar(_)) => true,
             (Type::Prim { prim }, Value::Int(i)) => match prim.int_range() {
                 Some((lo, hi)) => {
@@ -803,7 +831,14 @@ impl<'a> Resolver<'a> {
         let int32 = Type::Prim { prim: Prim::I32 };
         for (i, en) in e.enumerators.iter().enumerate() {
             let ea = self.annotations(&en.annotations, Place::Enumerator);
-            let value = match ea.value.and_then(|v| self.eval_as(v, &int32)) {
+            if let Some(v) = &en.value {
+                self.c_style_value(en, v, ea.value.is_some());
+            }
+            let value = match ea
+                .value
+                .or(en.value.as_ref())
+                .and_then(|v| self.eval_as(v, &int32))
+            {
                 Some(Value::Int(v)) => v as i64,
                 _ => next,
             };
@@ -835,6 +870,32 @@ impl<'a> Resolver<'a> {
             x.default_index = default_index;
         }
         self.model.decls[id].verbatim = anns.verbatim;
+    }
+
+    /// Reports a C-style `NAME = value` enumerator: accepted with a warning, an error next to `@value`.
+    fn c_style_value(&mut self, en: &ast::Enumerator, v: &ast::ConstExpr, annotated: bool) {
+        let d = if annotated {
+            Diagnostic::error(
+                Code::Extension,
+                format!(
+                    "enumerator `{}` has both `@value` and `= value`",
+                    en.name.name
+                ),
+            )
+            .at(v.loc, "second value")
+            .help("keep only `@value(...)`")
+        } else {
+            Diagnostic::warning(
+                Code::Extension,
+                format!(
+                    "C-style enumerator value `{} = ...` is not IDL 4.2",
+                    en.name.name
+                ),
+            )
+            .at(v.loc, "accepted as `@value`")
+            .help("write `@value(...)` before the enumerator instead")
+        };
+        self.diags.push(d);
     }
 
     fn bitmask_def(&mut self, b: &ast::BitmaskDef, d: &Definition) {

@@ -5,7 +5,7 @@ use crate::source::Loc;
 use std::collections::HashMap;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Sym {
+pub(crate) enum Sym {
     Module,
     Decl(DeclId),
     Enumerator(DeclId, usize),
@@ -13,7 +13,7 @@ pub enum Sym {
 }
 
 #[derive(Clone, Debug)]
-pub struct Entry {
+pub(crate) struct Entry {
     pub name: String,
     pub sym: Sym,
     pub loc: Loc,
@@ -21,12 +21,12 @@ pub struct Entry {
 
 /// All scopes, keyed by their path joined with `::` (the root is "").
 #[derive(Default, Debug)]
-pub struct Scopes {
+pub(crate) struct Scopes {
     scopes: HashMap<String, HashMap<String, Entry>>,
 }
 
-pub enum Lookup {
-    Found(Sym, Loc),
+pub(crate) enum Lookup {
+    Found(Sym),
     /// Found, but spelled with different case.
     CaseMismatch {
         found: String,
@@ -45,17 +45,23 @@ pub enum Lookup {
     },
 }
 
-pub fn key(path: &[String]) -> String {
+pub(crate) fn key(path: &[String]) -> String {
     path.join("::")
 }
 
 impl Scopes {
-    pub fn get(&self, scope: &str, name: &str) -> Option<&Entry> {
+    pub(crate) fn get(&self, scope: &str, name: &str) -> Option<&Entry> {
         self.scopes.get(scope)?.get(&name.to_ascii_lowercase())
     }
 
     /// Inserts, returning the existing entry that collides (same name ignoring case).
-    pub fn insert(&mut self, scope: &str, name: &str, sym: Sym, loc: Loc) -> Result<(), Entry> {
+    pub(crate) fn insert(
+        &mut self,
+        scope: &str,
+        name: &str,
+        sym: Sym,
+        loc: Loc,
+    ) -> Result<(), Entry> {
         let s = self.scopes.entry(scope.to_string()).or_default();
         let k = name.to_ascii_lowercase();
         if let Some(e) = s.get(&k) {
@@ -72,20 +78,8 @@ impl Scopes {
         Ok(())
     }
 
-    pub fn replace(&mut self, scope: &str, name: &str, sym: Sym, loc: Loc) {
-        let s = self.scopes.entry(scope.to_string()).or_default();
-        s.insert(
-            name.to_ascii_lowercase(),
-            Entry {
-                name: name.to_string(),
-                sym,
-                loc,
-            },
-        );
-    }
-
     /// Names visible from `from` (for suggestions).
-    pub fn visible_names(&self, from: &[String]) -> Vec<String> {
+    pub(crate) fn visible_names(&self, from: &[String]) -> Vec<String> {
         let mut out = Vec::new();
         for i in (0..=from.len()).rev() {
             if let Some(s) = self.scopes.get(&key(&from[..i])) {
@@ -96,7 +90,7 @@ impl Scopes {
     }
 
     /// Names declared directly in a scope.
-    pub fn names_in(&self, scope: &str) -> Vec<String> {
+    pub(crate) fn names_in(&self, scope: &str) -> Vec<String> {
         self.scopes
             .get(scope)
             .map(|s| s.values().map(|e| e.name.clone()).collect())
@@ -138,7 +132,7 @@ impl Scopes {
         Ok((cur.sym, cur.loc, case_ok))
     }
 
-    pub fn lookup(
+    pub(crate) fn lookup(
         &self,
         name: &ScopedName,
         from: &[String],
@@ -172,7 +166,7 @@ impl Scopes {
                             .unwrap_or_else(|| parts.join("::"));
                         return Lookup::CaseMismatch { found, sym, loc };
                     }
-                    return Lookup::Found(sym, loc);
+                    return Lookup::Found(sym);
                 }
                 Err((missing, sc)) => {
                     if first_failure.is_none() {

@@ -3,6 +3,7 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::model::*;
 use std::collections::HashMap;
 
+/// Checks the model as a whole (union labels, keys, member ids, ...), reporting into `diags`.
 pub fn validate(model: &Model, diags: &mut Diagnostics) {
     for (id, d) in model.decls.iter().enumerate() {
         match &d.kind {

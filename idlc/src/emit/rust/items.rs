@@ -95,7 +95,6 @@ impl Emitter<'_> {
                 .push((name, format!("{}::default()", self.std("Default"))));
         }
         for f in &s.fields {
-            self.check_mappable(&f.ty, f.loc);
             let name = used.take(ident(&snake(&f.name)));
             let (member, default, manual) = self.field(f, name);
             body.manual_default |= manual;
@@ -222,7 +221,6 @@ impl Emitter<'_> {
         let mut used = Dedup::new();
         let mut variants = Vec::new();
         for c in &u.cases {
-            self.check_mappable(&c.ty, c.loc);
             let name = used.take(ident(&upper_camel(&c.name)));
             let mut a: Vec<String> = c
                 .labels
@@ -307,7 +305,6 @@ impl Emitter<'_> {
 
     pub(super) fn alias_item(&mut self, id: DeclId, ty: &Type, w: &mut Writer) {
         let d = &self.model.decls[id];
-        self.check_mappable(ty, d.loc);
         let mut doc = d.doc.clone();
         if bare(&self.names[id]) != upper_camel(&d.name) {
             doc.push(format!(

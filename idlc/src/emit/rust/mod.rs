@@ -16,8 +16,8 @@ mod types;
 mod values;
 mod writer;
 
-use crate::diag::{Code, Diagnostic, Diagnostics};
-use crate::model::{DeclId, DeclKind, Model, Module, Type};
+use crate::diag::{Diagnostic, Diagnostics};
+use crate::model::{DeclId, DeclKind, Model, Module};
 use names::{bare, ident, lit_str, screaming, snake, upper_camel};
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
@@ -249,26 +249,5 @@ impl Emitter<'_> {
             w.verbatim(&v.text);
         }
         w.docs(doc);
-    }
-
-    fn check_mappable(&mut self, t: &Type, loc: crate::source::Loc) {
-        match t {
-            Type::Fixed { digits, scale } => self.diags.push(
-                Diagnostic::error(
-                    Code::BadMemberType,
-                    format!("`fixed<{digits},{scale}>` has no Rust mapping yet"),
-                )
-                .at(loc, "fixed-point type used here")
-                .help("use a `double`, or an integer holding a scaled value"),
-            ),
-            Type::Sequence { elem, .. } | Type::Array { elem, .. } => {
-                self.check_mappable(elem, loc)
-            }
-            Type::Map { key, value, .. } => {
-                self.check_mappable(key, loc);
-                self.check_mappable(value, loc);
-            }
-            _ => {}
-        }
     }
 }

@@ -80,7 +80,8 @@ impl Emitter<'_> {
                 }
                 s
             }
-            Type::Fixed { .. } | Type::Error => "()".into(),
+            Type::Fixed { digits, scale } => format!("{rt}::cdr::Fixed<{digits}, {scale}>"),
+            Type::Error => "()".into(),
             Type::Named { decl, .. } => {
                 // An alias that hides a bound cannot carry it into a nested position: spell the bounded type.
                 if pos == Pos::Nested {
