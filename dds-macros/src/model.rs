@@ -160,7 +160,7 @@ impl<'a> Union<'a> {
     pub(crate) fn default_value_case(&self) -> Option<&Case<'a>> {
         self.cases
             .iter()
-            .find(|c| c.payload.as_ref().map_or(true, |p| !p.self_ref))
+            .find(|c| c.payload.as_ref().is_none_or(|p| !p.self_ref))
     }
 }
 

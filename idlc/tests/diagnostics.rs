@@ -329,3 +329,25 @@ fn codes_are_unique() {
         assert!(seen.insert(c.as_str()), "duplicate code {}", c.as_str());
     }
 }
+
+#[test]
+fn line_directive_renames_and_renumbers_the_snippet() {
+    // The error is at `}` on physical line 4, which `#line` presents as line 42 of `gen.idl`.
+    let out = render("#line 40 \"gen.idl\"\nstruct A {\n  long x\n};\n");
+    assert!(
+        out.contains("gen.idl:42:1"),
+        "expected the presumed position in:\n{out}"
+    );
+    assert!(
+        out.contains(" 42 │ };"),
+        "expected the presumed line number in the gutter:\n{out}"
+    );
+    assert!(
+        out.contains(" 41 │   long x"),
+        "expected the context line renumbered too:\n{out}"
+    );
+    assert!(
+        !out.contains("main.idl"),
+        "the physical file name leaked:\n{out}"
+    );
+}

@@ -582,8 +582,7 @@ impl<T> ReaderCache<T> {
         let mut removed = 0;
         for (h, inst) in self.instances.iter_mut() {
             let before = inst.samples.len();
-            inst.samples
-                .retain(|s| !s.expires.is_some_and(|e| e <= now));
+            inst.samples.retain(|s| s.expires.is_none_or(|e| e > now));
             removed += before - inst.samples.len();
             if let Some(since) = inst.not_alive_since {
                 let delay = match inst.state {

@@ -395,7 +395,7 @@ impl Participant {
     pub fn is_acknowledged(&self, writer: EntityId) -> bool {
         self.writers
             .get(&writer)
-            .map_or(true, |w| w.is_acknowledged())
+            .is_none_or(|w| w.is_acknowledged())
     }
 
     /// Bytes written but not yet acknowledged by every reliable reader (what flow control looks at).

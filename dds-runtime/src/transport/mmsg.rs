@@ -4,8 +4,7 @@ use std::io;
 use std::net::{Ipv4Addr, SocketAddr, SocketAddrV4, UdpSocket};
 use std::os::fd::AsRawFd;
 
-use super::recv::{RecvBatch, RECV_BUFFER};
-use super::udp::Datagram;
+use super::datagram::{Datagram, RecvBatch, RECV_BUFFER};
 
 /// Datagrams received per `recvmmsg` call.
 const RECV_BATCH: usize = 8;

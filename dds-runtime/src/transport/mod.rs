@@ -19,6 +19,7 @@
 //! they read one datagram per `recv_from`. Sends are one `sendto` per datagram. Options that only Linux has
 //! (`SO_RCVBUFFORCE`, `IP_MULTICAST_ALL`) are set only there.
 
+mod datagram;
 pub mod iface;
 #[cfg(target_os = "linux")]
 mod mmsg;
@@ -26,6 +27,7 @@ mod recv;
 mod socket;
 mod udp;
 
+pub use datagram::{Channel, Datagram, Receiver, TransportStats};
 pub use iface::Interface;
 pub use recv::ReceivePath;
-pub use udp::{Channel, Datagram, Receiver, TransportStats, UdpTransport};
+pub use udp::UdpTransport;

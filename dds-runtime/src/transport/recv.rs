@@ -5,10 +5,7 @@ use std::io;
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::udp::{Channel, Datagram, Receiver, TransportStats};
-
-/// Largest UDP payload we can receive.
-pub(super) const RECV_BUFFER: usize = 65536;
+use super::datagram::{Channel, Datagram, Receiver, RecvBatch, TransportStats, RECV_BUFFER};
 
 /// How the receive threads read their sockets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -31,14 +28,6 @@ impl ReceivePath {
             ReceivePath::OneByOne
         }
     }
-}
-
-/// Buffers for reading one batch of datagrams from a socket.
-pub(super) trait RecvBatch {
-    /// Blocks for the first datagram, then takes what else the implementation can; returns how many arrived.
-    fn recv(&mut self, sock: &UdpSocket) -> io::Result<usize>;
-    /// The `i`th datagram of the last batch; `None` when its sender is not IPv4.
-    fn datagram(&self, i: usize) -> Option<Datagram<'_>>;
 }
 
 /// One datagram per call through `recv_from`.

@@ -1,53 +1,20 @@
 //! UDPv4 sockets of one participant and the threads that receive on them.
 
 use std::io;
-use std::net::{SocketAddr, SocketAddrV4, UdpSocket};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::net::{SocketAddrV4, UdpSocket};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
 use socket2::{SockRef, Socket};
 
+use super::datagram::{Channel, Receiver, TransportStats};
 use super::iface::{self, Interface};
 use super::recv::{self, ReceivePath};
 use super::socket::{multicast_socket, unicast_socket};
 use crate::config::{Config, ParticipantIndex, Peer};
 use crate::rtps::discovery::ports::{self, PortError};
-
-/// Which socket a datagram arrived on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Channel {
-    /// SPDP multicast (239.255.0.1 on the domain's discovery port).
-    SpdpMulticast,
-    /// Metatraffic unicast (SPDP to peers, SEDP).
-    MetaUnicast,
-    /// User-traffic unicast.
-    UserUnicast,
-}
-
-/// One received datagram.
-#[derive(Debug, Clone, Copy)]
-pub struct Datagram<'a> {
-    /// The payload.
-    pub data: &'a [u8],
-    /// The sender.
-    pub from: SocketAddr,
-}
-
-/// Called by the receive threads with each batch of datagrams (at least one; see [`ReceivePath`]).
-pub type Receiver = Arc<dyn Fn(Channel, &[Datagram<'_>]) + Send + Sync>;
-
-/// Counters for diagnostics and tests.
-#[derive(Debug, Default)]
-pub struct TransportStats {
-    /// Datagrams received.
-    pub received: AtomicU64,
-    /// Datagrams sent.
-    pub sent: AtomicU64,
-    /// Send failures (logged, not returned: UDP is lossy anyway).
-    pub send_errors: AtomicU64,
-}
 
 /// The sockets of one participant: metatraffic and user unicast (the index's ports, or ephemeral ones),
 /// and optionally the shared SPDP multicast socket.

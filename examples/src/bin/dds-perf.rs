@@ -440,7 +440,7 @@ fn ping_timer<T: PerfSample>(ctx: &Ctx<T>, now: Instant) -> Instant {
     let expected = ctx.pongs_expected();
     if st.sent_at.is_some() && st.seen < expected {
         st.timeouts += 1;
-        if st.warn_after.map_or(true, |w| now > w) {
+        if st.warn_after.is_none_or(|w| now > w) {
             println!(
                 "[{}] ping timed out (total {} times) ... sending new ping",
                 ctx.pid, st.timeouts

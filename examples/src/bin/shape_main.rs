@@ -442,7 +442,7 @@ fn run_subscriber(o: &ShapeOptions, readers: &[DataReader<ShapeType>]) -> DdsRes
                     let handle = s.info.instance_handle;
                     if let Some(d) = &s.data {
                         colors.insert((i, handle), d.color.clone());
-                        if o.color.as_ref().map_or(true, |c| *c == d.color) {
+                        if o.color.as_ref().is_none_or(|c| *c == d.color) {
                             println!(
                                 "{}",
                                 shape_output::sample_line(
@@ -462,7 +462,7 @@ fn run_subscriber(o: &ShapeOptions, readers: &[DataReader<ShapeType>]) -> DdsRes
                         InstanceState::NotAliveNoWriters => NotAlive::NoWriters,
                     };
                     let color = colors.get(&(i, handle)).cloned().unwrap_or_default();
-                    if o.color.as_ref().map_or(true, |c| *c == color) {
+                    if o.color.as_ref().is_none_or(|c| *c == color) {
                         println!(
                             "{}",
                             shape_output::instance_state_line(&topic, &color, state)

@@ -35,7 +35,7 @@ pub fn run(session: &mut Session, a: &ShapesArgs) -> DdsResult<u8> {
     let mut got = Tally::default();
     while !shutdown::requested()
         && start.elapsed() < duration
-        && a.count.map_or(true, |n| got.samples < n)
+        && a.count.is_none_or(|n| got.samples < n)
     {
         for p in session.tick(Instant::now())? {
             if !a.subscribes() && !a.quiet {

@@ -169,8 +169,7 @@ pub fn suggest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) ->
             strsim::jaro_winkler(name, c)
         };
         let lev = strsim::levenshtein(&name.to_ascii_lowercase(), &c.to_ascii_lowercase());
-        if (score >= 0.85 || lev <= (name.len().max(3) / 3))
-            && best.map_or(true, |(_, s)| score > s)
+        if (score >= 0.85 || lev <= (name.len().max(3) / 3)) && best.is_none_or(|(_, s)| score > s)
         {
             best = Some((c, score));
         }

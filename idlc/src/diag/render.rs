@@ -1,8 +1,8 @@
 //! Rendering through miette. With the `fancy` feature (on for the command line): a snippet of the right
 //! file, carets, labels, help and the code. Without it (`build.rs` use): the same facts as plain sentences.
 use super::{Diagnostic, Severity};
-use crate::source::SourceDb;
-use miette::{LabeledSpan, NamedSource};
+use crate::source::{FileId, SourceDb};
+use miette::{LabeledSpan, MietteError, MietteSpanContents, SourceCode, SourceSpan, SpanContents};
 use std::fmt;
 
 /// How diagnostics are drawn.
@@ -25,9 +25,38 @@ impl Default for RenderOptions {
 
 struct Report<'a> {
     diag: &'a Diagnostic,
-    source: Option<NamedSource<String>>,
-    file: Option<crate::source::FileId>,
+    source: Option<PresumedSource<'a>>,
+    file: Option<FileId>,
     help: Option<String>,
+}
+
+/// A file's text as `#line` directives present it: each snippet carries the presumed file name, and its
+/// line numbers are shifted to the presumed line of the snippet's first line.
+struct PresumedSource<'a> {
+    db: &'a SourceDb,
+    file: FileId,
+}
+
+impl SourceCode for PresumedSource<'_> {
+    fn read_span<'b>(
+        &'b self,
+        span: &SourceSpan,
+        before: usize,
+        after: usize,
+    ) -> Result<Box<dyn SpanContents<'b> + 'b>, MietteError> {
+        let text: &'b str = &self.db.get(self.file).text;
+        let inner = text.read_span(span, before, after)?;
+        let start = u32::try_from(inner.span().offset()).unwrap_or(u32::MAX);
+        let (name, line, _) = self.db.presumed(self.file, start);
+        Ok(Box::new(MietteSpanContents::new_named(
+            name.to_string(),
+            inner.data(),
+            *inner.span(),
+            line.saturating_sub(1),
+            inner.column(),
+            inner.line_count(),
+        )))
+    }
 }
 
 impl fmt::Debug for Report<'_> {
@@ -58,7 +87,7 @@ impl miette::Diagnostic for Report<'_> {
             .map(|h| Box::new(h) as Box<dyn fmt::Display>)
     }
     fn source_code(&self) -> Option<&dyn miette::SourceCode> {
-        self.source.as_ref().map(|s| s as &dyn miette::SourceCode)
+        self.source.as_ref().map(|s| s as &dyn SourceCode)
     }
     fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
         let file = self.file?;
@@ -82,10 +111,7 @@ impl miette::Diagnostic for Report<'_> {
 /// Renders one diagnostic as text.
 pub fn render(db: &SourceDb, diag: &Diagnostic, opts: RenderOptions) -> String {
     let file = diag.primary_loc().map(|l| l.file);
-    let source = file.map(|f| {
-        let sf = db.get(f);
-        NamedSource::new(sf.name.clone(), sf.text.to_string())
-    });
+    let source = file.map(|file| PresumedSource { db, file });
     // Labels in other files cannot share a snippet: say where they are instead.
     let mut extra: Vec<String> = diag
         .labels

@@ -154,7 +154,7 @@ fn cut_points(pp: &Output) -> Vec<usize> {
             (body.starts_with("/**") || body.starts_with("///"))
                 && pp.text[c.end..at].trim().is_empty()
         };
-        if depth == 0 && !after_doc && cuts.last().map_or(true, |&c| c < at) {
+        if depth == 0 && !after_doc && cuts.last().is_none_or(|&c| c < at) {
             cuts.push(at);
         }
     }

@@ -351,7 +351,7 @@ impl<'a> Preprocessor<'a> {
         self.in_comment = None;
         while pos < bytes.len() && !self.too_big {
             let line_end = memchr_nl(bytes, pos);
-            let active = conds.last().map_or(true, |c| c.active);
+            let active = conds.last().is_none_or(|c| c.active);
             let trimmed = text[pos..line_end].trim_start();
             if self.in_comment.is_none() && trimmed.starts_with('#') {
                 // Directive: join continuation lines.

@@ -476,7 +476,7 @@ impl<'a> Resolver<'a> {
         if dims
             .iter()
             .try_fold(1u64, |a, d| a.checked_mul(*d))
-            .map_or(true, |n| n > 1 << 32)
+            .is_none_or(|n| n > 1 << 32)
         {
             let msg = "array has more than 2^32 elements".to_string();
             self.diags

@@ -224,7 +224,7 @@ impl Put<'_> {
     }
     /// Pads with zeros to a multiple of `n` measured from `origin`.
     pub fn align_from(&mut self, origin: usize, n: usize) {
-        while (self.out.len() - origin) % n != 0 {
+        while !(self.out.len() - origin).is_multiple_of(n) {
             self.out.push(0);
         }
     }

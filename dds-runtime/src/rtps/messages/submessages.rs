@@ -571,8 +571,8 @@ pub fn append(
     sub: &Submessage<'_>,
     little_endian: bool,
 ) {
-    if out.len() % 4 != 0 {
-        while out.len() % 4 != 0 {
+    if !out.len().is_multiple_of(4) {
+        while !out.len().is_multiple_of(4) {
             out.push(0);
         }
         if let Some(h) = *last_header {

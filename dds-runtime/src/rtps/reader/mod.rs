@@ -27,7 +27,7 @@ fn slot_size(s: &Slot) -> usize {
 /// Whether every must-understand inline QoS parameter is one we know.
 fn inline_qos_understood(q: Option<&crate::rtps::messages::ParameterList<'_>>) -> bool {
     use crate::rtps::messages::parameter::pid;
-    q.map_or(true, |q| {
+    q.is_none_or(|q| {
         q.check_must_understand(|id| {
             matches!(
                 id & !pid::MUST_UNDERSTAND,

@@ -127,7 +127,7 @@ impl Writer {
             let mut d: Vec<Locator> = self
                 .proxies
                 .values()
-                .filter(|p| key_hash_only.map_or(true, |k| p.key_hash_only_disposes == k))
+                .filter(|p| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
                 .filter_map(|p| p.destination().first().copied())
                 .collect();
             d.sort();

@@ -137,7 +137,7 @@ impl Emitter<'_> {
         visiting.push(id);
         let r = match &self.model.decls[id].kind {
             DeclKind::Struct(s) => {
-                s.base.map_or(true, |b| self.decl_eq_hash(b, visiting))
+                s.base.is_none_or(|b| self.decl_eq_hash(b, visiting))
                     && s.fields.iter().all(|f| self.eq_hash_in(&f.ty, visiting))
             }
             DeclKind::Union(u) => {
