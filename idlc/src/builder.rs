@@ -7,7 +7,7 @@
 //! writes `$OUT_DIR/shapes.rs` and prints `cargo:rerun-if-changed` for every file read, includes too.
 //! Include the result with `include!(concat!(env!("OUT_DIR"), "/shapes.rs"));`.
 use crate::diag::{RenderOptions, Severity};
-use crate::driver::{compile_file, Options};
+use crate::driver::{Options, Session};
 use crate::model::Extensibility;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -101,7 +101,8 @@ impl Builder {
         self
     }
 
-    /// Compiles each file to `<out_dir>/<stem>.rs`. Every file is attempted; the first failure is returned.
+    /// Compiles each file to `<out_dir>/<stem>.rs`, in one [`Session`] so that files they share through
+    /// `#include` are read and parsed once. Every file is attempted; the first failure is returned.
     pub fn compile(&self, files: &[impl AsRef<Path>]) -> Result<(), Error> {
         let out_dir = match &self.out_dir {
             Some(d) => d.clone(),
@@ -109,18 +110,19 @@ impl Builder {
                 .map(PathBuf::from)
                 .ok_or(Error::NoOutDir)?,
         };
+        let mut session = Session::new(self.opts.clone());
         let mut first_err = None;
         for file in files {
             let file = file.as_ref();
-            if let Err(e) = self.compile_one(file, &out_dir) {
+            if let Err(e) = self.compile_one(&mut session, file, &out_dir) {
                 first_err.get_or_insert(e);
             }
         }
         first_err.map_or(Ok(()), Err)
     }
 
-    fn compile_one(&self, file: &Path, out_dir: &Path) -> Result<(), Error> {
-        let mut c = compile_file(file, &self.opts);
+    fn compile_one(&self, session: &mut Session, file: &Path, out_dir: &Path) -> Result<(), Error> {
+        let mut c = session.compile_file(file);
         if !self.quiet {
             println!("cargo:rerun-if-changed={}", file.display());
             for f in &c.files {
