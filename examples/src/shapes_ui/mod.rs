@@ -9,6 +9,8 @@ pub mod draw;
 pub mod input;
 
 use std::fmt;
+use std::io::{self, Write};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
 use dds_runtime::prelude::DdsError;
@@ -62,7 +64,8 @@ pub fn run(session: Session, a: &ShapesArgs) -> Result<u8, UiError> {
     let mut app = App::new(session, &a.topic, a.domain);
     let start = Instant::now();
     let mut terminal = ratatui::try_init()?;
-    let result = event_loop(&mut terminal, &mut app, a, start);
+    let result =
+        spawn_input().and_then(|events| event_loop(&mut terminal, &mut app, &events, a, start));
     ratatui::restore();
     result?;
     app.session.flush();
@@ -72,15 +75,34 @@ pub fn run(session: Session, a: &ShapesArgs) -> Result<u8, UiError> {
         rate_hz: app.session.rate_hz(),
     });
     let subscribed = !app.session.subscribed_topics().is_empty();
+    // The terminal may be gone (hung up): the summary is then lost, not a reason to fail.
+    let mut out = io::stdout().lock();
     for line in app.tally.summary(start.elapsed(), written, subscribed) {
-        println!("{line}");
+        let _ = writeln!(out, "{line}");
     }
     Ok(u8::from(subscribed && app.tally.samples == 0))
+}
+
+/// Reads terminal events on a thread of their own. When the terminal hangs up, crossterm's poll can spin
+/// without returning; the frame loop then still runs, sees SIGHUP/SIGTERM through [`shutdown`], and leaves.
+fn spawn_input() -> Result<Receiver<io::Result<Event>>, UiError> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::Builder::new()
+        .name("shapes-input".into())
+        .spawn(move || loop {
+            let ev = event::read();
+            let failed = ev.is_err();
+            if tx.send(ev).is_err() || failed {
+                break;
+            }
+        })?;
+    Ok(rx)
 }
 
 fn event_loop(
     terminal: &mut DefaultTerminal,
     app: &mut App,
+    events: &Receiver<io::Result<Event>>,
     a: &ShapesArgs,
     start: Instant,
 ) -> Result<(), UiError> {
@@ -95,10 +117,12 @@ fn event_loop(
         }
         let frame_end = Instant::now() + FRAME;
         while let Some(wait) = frame_end.checked_duration_since(Instant::now()) {
-            if !event::poll(wait)? {
-                break;
-            }
-            if let Event::Key(key) = event::read()? {
+            let ev = match events.recv_timeout(wait) {
+                Ok(ev) => ev?,
+                Err(RecvTimeoutError::Timeout) => break,
+                Err(RecvTimeoutError::Disconnected) => return Ok(()),
+            };
+            if let Event::Key(key) = ev {
                 if let Some(action) = input::action(key) {
                     app.apply(action)?;
                 }

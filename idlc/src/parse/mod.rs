@@ -1,7 +1,7 @@
 //! Parsing: the pest grammar in `idl.pest`, syntax-error reporting, and AST construction (`build.rs`).
 //!
-//! [`parse`] splits the translation unit where an included file begins or ends (see [`pieces`]) and looks each
-//! piece up in a [`ParseCache`] before parsing it, so a run that includes one file from many inputs parses it once.
+//! [`parse`] splits the translation unit where an included file begins or ends and looks each piece up in a
+//! [`ParseCache`] before parsing it, so a run that includes one file from many inputs parses it once.
 mod build;
 pub mod literal;
 mod pieces;
