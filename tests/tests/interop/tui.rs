@@ -149,6 +149,59 @@ fn window() -> Result<(), Skip> {
     Ok(())
 }
 
+#[test]
+fn shapes_window_leaves_when_its_terminal_hangs_up() {
+    let _ = hangup();
+}
+
+/// The terminal goes away under the window (the tmux server is killed): the process gets SIGHUP and must leave
+/// within a few seconds instead of lingering (crossterm's input poll can spin on a hung-up terminal).
+fn hangup() -> Result<(), Skip> {
+    require_netns()?;
+    let tmux_bin = tmux()?;
+    let shapes = our_bin("shapes")?;
+    let t = Tmux::start(
+        tmux_bin,
+        &format!("exec {} --domain 143 --rate 20", shell_word(&shapes)),
+    );
+    t.wait_for("squares", |s| s.world_has('■'));
+    let pid = String::from_utf8_lossy(
+        &t.run(&["list-panes", "-t", "ui", "-F", "#{pane_pid}"])
+            .stdout,
+    )
+    .trim()
+    .to_string();
+    assert!(pid.parse::<u32>().is_ok(), "pane pid {pid:?}");
+    let _ = t.run(&["kill-server"]);
+    let proc_dir = PathBuf::from(format!("/proc/{pid}"));
+    let deadline = Instant::now() + Duration::from_secs(5);
+    while alive(&proc_dir) && Instant::now() < deadline {
+        thread::sleep(Duration::from_millis(100));
+    }
+    let lingering = alive(&proc_dir);
+    if lingering {
+        let _ = Command::new("kill").args(["-9", &pid]).status();
+    }
+    assert!(
+        !lingering,
+        "shapes (pid {pid}) still ran 5 s after its terminal hung up"
+    );
+    Ok(())
+}
+
+/// Whether the process of `/proc/<pid>` exists and is not a zombie.
+fn alive(proc_dir: &Path) -> bool {
+    std::fs::read_to_string(proc_dir.join("stat"))
+        .map(|st| {
+            !st.rsplit(')')
+                .next()
+                .unwrap_or("")
+                .trim_start()
+                .starts_with('Z')
+        })
+        .unwrap_or(false)
+}
+
 /// `p` quoted for the shell tmux runs the command with.
 fn shell_word(p: &Path) -> String {
     format!("'{}'", p.display().to_string().replace('\'', r"'\''"))
