@@ -67,8 +67,8 @@ build_fastdds() {
 build_dust() {
   local d=$peers/dust
   mkdir -p "$d"
-  rsync -a --delete --exclude target "$suite/srcRs/DustDDS/" "$d/src-copy/"
-  (cd "$d/src-copy" && CARGO_TARGET_DIR=$d/target cargo build --release)
+  # Its build script reads the suite's IDL by a relative path: build in place, with the target dir outside.
+  (cd "$suite/srcRs/DustDDS" && CARGO_TARGET_DIR=$d/target cargo build --release)
   cp "$d/target/release/dust_dds_shape_main_linux" "$d/shape_main"
   echo "built $d/shape_main"
 }
