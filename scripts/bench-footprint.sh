@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# Footprint probe: resident memory a bare participant spends per discovered remote entity, ours against Cyclone 11.
+#
+#   scripts/bench-footprint.sh [writers|readers|participants] [N]     (default: writers 2000)
+#
+# A Cyclone DDS 11 process (PyPI binding, scripts/footprint/load.py) makes N remote writers, readers (each on its own
+# topic, so nothing matches) or participants appear. The bare participant is ours (`dds-idle`) or Cyclone's
+# (scripts/footprint/bare.py: the binding's libddsc). Its VmRSS is sampled from /proc every 100 ms: before the load
+# (settled), the peak while the load is discovered, and the settled figure after. Reported: KB per entity
+# ((settled after - before) / N) and the peak above the settled figure. A benchmark, not a test; it runs inside
+# scripts/isolated (loopback only).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [[ -z ${DDS_ISOLATED:-} ]]; then
+  cargo build -q --release -p dds-examples --bin dds-idle
+  exec env DDS_ISOLATED=1 scripts/isolated "$0" "$@"
+fi
+kind=${1:-writers} n=${2:-2000}
+export CYCLONEDDS_URI='<CycloneDDS><Domain><General><Interfaces><NetworkInterface name="lo"/></Interfaces></General></Domain></CycloneDDS>'
+export PYTHONDONTWRITEBYTECODE=1
+
+rss_kb() { awk '/^VmRSS/ {print $2}' "/proc/$1/status" 2>/dev/null || echo 0; }
+
+# Start a program that prints "ready pid N"; echo N.
+start_bare() {
+  local log=$1; shift
+  "$@" >"$log" 2>&1 &
+  for _ in $(seq 100); do
+    grep -q '^ready pid' "$log" 2>/dev/null && { awk '/^ready pid/ {print $3; exit}' "$log"; return; }
+    sleep 0.1
+  done
+  echo "bench-footprint: $* did not start" >&2; cat "$log" >&2; exit 1
+}
+
+# Sample $1's RSS until it has not changed by more than 1% for 3 s (or 60 s pass); echo "settled peak".
+settle() {
+  local pid=$1 peak=0 last=0 stable=0 r
+  for _ in $(seq 600); do
+    r=$(rss_kb "$pid"); ((r > peak)) && peak=$r
+    if ((last > 0)) && ((r * 100 <= last * 101)) && ((r * 100 >= last * 99)); then
+      stable=$((stable + 1)); ((stable >= 30)) && break
+    else
+      stable=0; last=$r
+    fi
+    sleep 0.1
+  done
+  echo "$r $peak"
+}
+
+probe() {
+  local name=$1 domain=$2; shift 2
+  local tmp pid load before after peak
+  tmp=$(mktemp -d)
+  pid=$(start_bare "$tmp/bare.log" "$@")
+  read -r before _ < <(settle "$pid")
+  python3 scripts/footprint/load.py "$domain" "$kind" "$n" 120 >"$tmp/load.log" 2>&1 &
+  load=$!
+  for _ in $(seq 600); do grep -q loaded "$tmp/load.log" && break; sleep 0.1; done
+  read -r after peak < <(settle "$pid")
+  kill "$load" "$pid" 2>/dev/null; wait "$load" "$pid" 2>/dev/null || true
+  awk -v name="$name" -v b="$before" -v a="$after" -v p="$peak" -v n="$n" -v k="$kind" 'BEGIN {
+    printf "%-12s %6d %-12s  before %7d KB  after %7d KB  %6.2f KB per %s  peak %+6d KB above settled\n",
+      name, n, k, b, a, (a - b) / n, substr(k, 1, length(k) - 1), p - a }'
+  rm -rf "$tmp"
+}
+
+probe ours 41 target/release/dds-idle -d 41
+probe cyclone-11 42 python3 scripts/footprint/bare.py 42
