@@ -13,6 +13,7 @@ use crate::rtps::api::{ChangeKind, Event, Payload, ReceivedSample};
 use crate::rtps::messages::{
     AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, NackFrag, Submessage,
 };
+use crate::rtps::due::DueFloor;
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
 use defrag::Defrag;
@@ -56,6 +57,8 @@ pub(crate) struct Reader {
     pub guid: Guid,
     params: ReaderParams,
     proxies: BTreeMap<Guid, WriterProxy>,
+    /// Lower bound of the proxies' `acknack_due` and `nackfrag_due`.
+    proxy_floor: DueFloor,
     /// Back-pressure: how many more changes reliable proxies may deliver (`None`: no limit). A change
     /// refused for lack of credit is not stored, so it stays missing and is NACKed, never acknowledged.
     credit: std::cell::Cell<Option<usize>>,
@@ -67,6 +70,7 @@ impl Reader {
             guid,
             params,
             proxies: BTreeMap::new(),
+            proxy_floor: DueFloor::default(),
             credit: std::cell::Cell::new(None),
         }
     }
@@ -107,6 +111,7 @@ impl Reader {
             // Pre-emptive ACKNACK: prompts the writer to tell us what it has.
             proxy.acknack_due = Some(now);
         }
+        self.proxy_floor.lower(proxy.acknack_due);
         self.proxies.insert(proxy.guid, proxy);
     }
 
@@ -459,6 +464,7 @@ impl Reader {
         if !hb.final_flag || missing {
             p.acknack_due.get_or_insert(now + delay);
         }
+        self.proxy_floor.lower(p.acknack_due);
     }
 
     /// HEARTBEAT_FRAG (§8.3.7.6): the writer has fragments 1..=last of one sample. Answered with a NACK_FRAG
@@ -494,20 +500,21 @@ impl Reader {
         let last = p.nackfrag_req.entry(sn).or_insert(0);
         *last = (*last).max(hf.last_fragment_num);
         p.nackfrag_due.get_or_insert(now + delay);
+        self.proxy_floor.lower(p.nackfrag_due);
     }
 
     pub(crate) fn next_timeout(&self) -> Option<Instant> {
-        self.proxies
-            .values()
-            .flat_map(|p| [p.acknack_due, p.nackfrag_due])
-            .flatten()
-            .min()
+        self.proxy_floor.get()
     }
 
     /// Sends due ACKNACKs (and NACK_FRAGs for partly received samples), and NACK_FRAGs answering
     /// HEARTBEAT_FRAGs.
     pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
+        if !self.proxy_floor.reached(now) {
+            return;
+        }
         let rid = self.guid.entity_id;
+        let mut exact: Option<Instant> = None;
         for p in self.proxies.values_mut() {
             if p.acknack_due.is_some_and(|t| t <= now) {
                 Self::send_acknack(rid, p, out);
@@ -515,7 +522,11 @@ impl Reader {
             if p.nackfrag_due.is_some_and(|t| t <= now) {
                 Self::send_requested_nackfrags(rid, p, out);
             }
+            for t in [p.acknack_due, p.nackfrag_due].into_iter().flatten() {
+                exact = Some(exact.map_or(t, |e| e.min(t)));
+            }
         }
+        self.proxy_floor.set_exact(exact);
     }
 
     /// An ACKNACK for what is missing up to the last heartbeat, and a NACK_FRAG per partly received sample.

@@ -15,6 +15,7 @@ use crate::rtps::messages::parameter::pid;
 use crate::rtps::messages::{
     Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, ParameterList, Submessage,
 };
+use crate::rtps::due::DueFloor;
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
 use reader_proxy::{MAX_REQUESTED, MAX_REQUESTED_FRAG_SAMPLES};
@@ -55,6 +56,8 @@ pub(crate) struct Writer {
     /// HEARTBEAT_FRAG count: its own sequence, separate from HEARTBEAT's (§8.3.7.6).
     hbfrag_count: i32,
     hb_due: Option<Instant>,
+    /// Lower bound of the proxies' `repair_due`.
+    repair_floor: DueFloor,
     bytes_since_nonfinal_hb: usize,
     bytes_since_hb: usize,
     unacked_bytes: usize,
@@ -77,6 +80,7 @@ impl Writer {
             hb_count: 0,
             hbfrag_count: 0,
             hb_due: None,
+            repair_floor: DueFloor::default(),
             bytes_since_nonfinal_hb: 0,
             bytes_since_hb: 0,
             unacked_bytes: 0,
@@ -320,6 +324,7 @@ impl Writer {
             }
         }
         let behind = proxy.reliable && proxy.acked < self.next_sn;
+        self.repair_floor.lower(proxy.repair_due);
         self.proxies.insert(proxy.guid, proxy);
         self.rebuild_dest();
         self.update_acked(ev);
@@ -379,6 +384,7 @@ impl Writer {
         {
             p.repair_due.get_or_insert(now + delay);
         }
+        self.repair_floor.lower(p.repair_due);
         if progressed {
             self.update_acked(ev);
             if self.is_acknowledged() {
@@ -424,25 +430,29 @@ impl Writer {
             p.requested.insert(nf.writer_sn);
         }
         p.repair_due.get_or_insert(now + delay);
+        self.repair_floor.lower(p.repair_due);
     }
 
     pub(crate) fn next_timeout(&self) -> Option<Instant> {
-        let r = self.proxies.values().filter_map(|p| p.repair_due).min();
-        match (r, self.hb_due) {
+        match (self.repair_floor.get(), self.hb_due) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         }
     }
 
     pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
-        let due: Vec<Guid> = self
-            .proxies
-            .values()
-            .filter(|p| p.repair_due.is_some_and(|t| t <= now))
-            .map(|p| p.guid)
-            .collect();
-        for g in due {
-            self.repair(now, g, out);
+        if self.repair_floor.reached(now) {
+            let due: Vec<Guid> = self
+                .proxies
+                .values()
+                .filter(|p| p.repair_due.is_some_and(|t| t <= now))
+                .map(|p| p.guid)
+                .collect();
+            for g in due {
+                self.repair(now, g, out);
+            }
+            let exact = self.proxies.values().filter_map(|p| p.repair_due).min();
+            self.repair_floor.set_exact(exact);
         }
         if self.hb_due.is_some_and(|t| t <= now) {
             if self.has_reliable_proxy() && !self.is_acknowledged() {
