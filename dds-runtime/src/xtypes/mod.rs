@@ -19,3 +19,15 @@ impl TypeInformation {
         typeobject::from_bytes(&self.0)
     }
 }
+
+mod build;
+mod describe;
+mod error;
+mod objects;
+
+pub use build::TypeSupport;
+pub use describe::{
+    bounded_desc, BitmaskDef, CaseDef, EnumDef, MemberDef, NamedRef, StructDef, TypeDef, TypeDesc,
+    TypeRef, UnionDef, XTypesType,
+};
+pub use error::BuildError;
