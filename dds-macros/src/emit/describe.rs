@@ -18,6 +18,7 @@ pub(super) fn dds_type(
     members: TokenStream,
 ) -> TokenStream {
     let cdr = c.cdr();
+    let rt = c.runtime();
     let name = c.ident();
     let type_name = &c.type_name;
     let ext_t = ext_tokens(c, ext);
@@ -36,6 +37,10 @@ pub(super) fn dds_type(
                     extensibility: #ext_t,
                     members: #members,
                 }
+            }
+
+            fn type_information() -> ::core::option::Option<&'static [u8]> {
+                <Self as #rt::xtypes::XTypesType>::type_support().map(|s| s.information_bytes.as_slice())
             }
         }
     }

@@ -9,6 +9,7 @@ mod encode;
 mod key;
 mod layout;
 mod newtype;
+mod xtypes;
 
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -20,13 +21,15 @@ use crate::types::mentions;
 
 /// Every impl (and the decoder's partial struct) for `c`.
 pub(crate) fn container(c: &Container) -> TokenStream {
-    match &c.data {
+    let mut out = match &c.data {
         Data::Struct(s) => struct_impls(c, s),
         Data::Enum(e) => enum_impls(c, e),
         Data::Union(u) => union_impls(c, u),
         Data::Transparent(t) => newtype::transparent(c, t),
         Data::Bitmask(b) => newtype::bitmask(c, b),
-    }
+    };
+    out.extend(xtypes::xtypes_impl(c));
+    out
 }
 
 fn struct_impls(c: &Container, s: &Struct) -> TokenStream {

@@ -202,4 +202,10 @@ pub trait DdsType: CdrType + Send + Sync + 'static {
 
     /// Metadata for TypeObject generation.
     fn type_descriptor() -> TypeDescriptor;
+
+    /// The XCDR2 `TypeInformation` SEDP announces for this type (`PID_TYPE_INFORMATION`), built once; `None`
+    /// when the type has none. The derive implements it from `xtypes::XTypesType::type_support`.
+    fn type_information() -> Option<&'static [u8]> {
+        None
+    }
 }

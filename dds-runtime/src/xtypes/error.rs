@@ -1,0 +1,21 @@
+//! Why a type has no type information.
+
+use thiserror::Error;
+
+/// Why a type has no type information.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum BuildError {
+    /// A topic type must be a named struct or union.
+    #[error("a topic type must be a named struct or union")]
+    NotNamed,
+    /// The type uses something XTypes 1.3 cannot describe.
+    #[error("{0}")]
+    Unsupported(&'static str),
+    /// Mutually recursive types (strongly connected components) are not built yet.
+    #[error("recursive type {0}: strongly connected components are not supported yet")]
+    Recursive(String),
+    /// Encoding a type object failed (a name with a NUL, ...).
+    #[error("encoding a type object: {0}")]
+    Encode(#[from] crate::cdr::EncodeError),
+}
