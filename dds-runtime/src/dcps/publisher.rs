@@ -325,9 +325,9 @@ impl<T: DdsType> DataWriter<T> {
         let payload = self.serialize(sample)?;
         // Keyed writes register the instance, so that deleting the writer can unregister it.
         let key_hash = if T::IS_KEYED {
-            self.instance_of(sample, true, false)?
-                .and_then(|(_, kh)| kh)
+            self.instance_of(sample, true, true)?.and_then(|(_, kh)| kh)
         } else {
+            lock(&self.inner.instances).keyless_last_write = Some(Instant::now());
             None
         };
         let change = WriteChange {
@@ -613,7 +613,7 @@ impl<T: DdsType> Endpoint for WriterInner<T> {
         if missed.is_empty() {
             return;
         }
-        self.state.signal(
+        self.state.signal_consumed(
             StatusMask::OFFERED_DEADLINE_MISSED,
             |st| {
                 st.offered_deadline_missed.record(&missed);

@@ -788,7 +788,7 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
         if missed.is_empty() {
             return;
         }
-        self.state.signal(
+        self.state.signal_consumed(
             StatusMask::REQUESTED_DEADLINE_MISSED,
             |st| {
                 st.requested_deadline_missed.record(&missed);

@@ -133,6 +133,17 @@ impl DataWriterListener<ShapeType> for Printer {
             )
         );
     }
+    fn on_offered_deadline_missed(&self, w: &DataWriter<ShapeType>, st: DeadlineMissedStatus) {
+        println!(
+            "{}",
+            shape_output::offered_deadline_missed_line(
+                &self.topic,
+                w.topic().type_name(),
+                st.total_count,
+                st.total_count_change
+            )
+        );
+    }
 }
 
 impl DataReaderListener<ShapeType> for Printer {
@@ -154,6 +165,17 @@ impl DataReaderListener<ShapeType> for Printer {
                 &self.topic,
                 r.topic().type_name(),
                 st.last_policy_id
+            )
+        );
+    }
+    fn on_requested_deadline_missed(&self, r: &DataReader<ShapeType>, st: DeadlineMissedStatus) {
+        println!(
+            "{}",
+            shape_output::requested_deadline_missed_line(
+                &self.topic,
+                r.topic().type_name(),
+                st.total_count,
+                st.total_count_change
             )
         );
     }
