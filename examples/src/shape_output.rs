@@ -111,6 +111,26 @@ pub fn requested_incompatible_line(
     )
 }
 
+/// The writer listener's `on_offered_deadline_missed` line: the status' total count and its change.
+pub fn offered_deadline_missed_line(
+    topic: &str,
+    type_name: &str,
+    total: u32,
+    change: u32,
+) -> String {
+    format!("on_offered_deadline_missed() topic: '{topic}'  type: '{type_name}' : (total = {total}, change = {change})")
+}
+
+/// The reader listener's `on_requested_deadline_missed` line: the status' total count and its change.
+pub fn requested_deadline_missed_line(
+    topic: &str,
+    type_name: &str,
+    total: u32,
+    change: u32,
+) -> String {
+    format!("on_requested_deadline_missed() topic: '{topic}'  type: '{type_name}' : (total = {total}, change = {change})")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -192,9 +192,19 @@ def status_listener(topic_name):
         pid = status.last_policy_id
         out("on_requested_incompatible_qos() %s : %d (%s)" % (prefix, pid, POLICY_NAMES.get(pid, "Unknown")))
 
+    def offered_deadline(_writer, status):
+        out("on_offered_deadline_missed() %s : (total = %d, change = %d)"
+            % (prefix, status.total_count, status.total_count_change))
+
+    def requested_deadline(_reader, status):
+        out("on_requested_deadline_missed() %s : (total = %d, change = %d)"
+            % (prefix, status.total_count, status.total_count_change))
+
     return Listener(on_publication_matched=pub_matched, on_subscription_matched=sub_matched,
                     on_offered_incompatible_qos=offered_incompat,
-                    on_requested_incompatible_qos=requested_incompat)
+                    on_requested_incompatible_qos=requested_incompat,
+                    on_offered_deadline_missed=offered_deadline,
+                    on_requested_deadline_missed=requested_deadline)
 
 
 def shape_line(topic, s):

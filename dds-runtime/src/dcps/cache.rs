@@ -96,6 +96,8 @@ pub(crate) struct ReaderCache<T> {
     next_seq: u64,
     total: usize,
     filter: Option<Filter<T>>,
+    /// Reads return samples grouped by instance (ordered access, INSTANCE scope) instead of in reception order.
+    instance_order: bool,
 }
 
 /// The sample a read (copying the data with `copy`, if any) or a take (moving it out) returns for `slot`.
@@ -129,11 +131,16 @@ impl<T> ReaderCache<T> {
             next_seq: 0,
             total: 0,
             filter: None,
+            instance_order: false,
         }
     }
 
     pub(crate) fn set_filter(&mut self, f: Option<Filter<T>>) {
         self.filter = f;
+    }
+
+    pub(crate) fn set_instance_order(&mut self, on: bool) {
+        self.instance_order = on;
     }
 
     pub(crate) fn lookup(&self, key: &[u8]) -> Option<InstanceHandle> {
@@ -492,7 +499,10 @@ impl<T> ReaderCache<T> {
             }
             None => self.instances.iter().for_each(|(h, inst)| gather(*h, inst)),
         }
-        picked.sort_unstable_by_key(|p| p.0);
+        // Gathered instance by instance, each in reception order: grouped by instance as it is.
+        if !self.instance_order {
+            picked.sort_unstable_by_key(|p| p.0);
+        }
         picked.truncate(limit);
         // Ranks count the samples of the same instance later in the collection; the last one (in reception
         // order) is the instance's most recent sample in the collection.

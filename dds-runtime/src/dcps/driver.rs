@@ -27,6 +27,8 @@ use super::sync::{lock, read, recover, write};
 pub(crate) enum Pending {
     /// A change from a matched writer.
     Sample(ReceivedSample),
+    /// A whole coherent set from one writer: stored at once, so that no read sees part of it.
+    CoherentSet(Vec<ReceivedSample>),
     /// The writer unmatched (deleted, lost, or QoS changed).
     WriterGone(Guid),
 }
@@ -292,6 +294,9 @@ impl Driver {
     ) {
         let (reader, item) = match ev {
             Event::Sample(s) => (s.reader, Pending::Sample(s)),
+            Event::CoherentSet {
+                reader, samples, ..
+            } => (reader, Pending::CoherentSet(samples)),
             Event::SubscriptionMatched {
                 reader,
                 writer,

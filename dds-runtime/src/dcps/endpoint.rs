@@ -120,6 +120,19 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         self.deliver(mask, target, status, entity, call);
     }
 
+    /// [`EndpointState::signal`] for a status whose listener consumes the change counts (DDS 1.4 §2.2.4.2.1),
+    /// as the deadline statuses do: each callback reports only what happened since the previous one.
+    pub(crate) fn signal_consumed<T: Status, E>(
+        &self,
+        mask: StatusMask,
+        update: impl FnOnce(&mut S) -> &mut T,
+        entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
+        call: impl FnOnce(&L, &E, T),
+    ) {
+        let (target, status) = self.update(update, true);
+        self.deliver(mask, target, status, entity, call);
+    }
+
     /// Records that `remote` matched or unmatched (see [`EndpointState::signal`]); a listener consumes the
     /// change counts.
     pub(crate) fn record_match<T: MatchedStatus, E>(

@@ -19,6 +19,7 @@ use super::driver::{Endpoint, EndpointHandle};
 use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
 use super::participant::DomainParticipant;
+use super::presentation::CoherentGroup;
 use super::sample::InstanceHandle;
 use super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, PublicationMatchedStatus, StatusMask,
@@ -43,6 +44,7 @@ pub trait DataWriterListener<T: DdsType>: Send + Sync {
 pub struct Publisher {
     participant: DomainParticipant,
     qos: Arc<PublisherQos>,
+    group: Arc<CoherentGroup>,
 }
 
 impl std::fmt::Debug for Publisher {
@@ -72,6 +74,7 @@ impl DomainParticipant {
         Ok(Publisher {
             participant: self.clone(),
             qos: Arc::new(qos.clone()),
+            group: Arc::default(),
         })
     }
 }
@@ -85,6 +88,24 @@ impl Publisher {
     /// The participant.
     pub fn participant(&self) -> &DomainParticipant {
         &self.participant
+    }
+
+    /// Starts a coherent set (DDS 1.4 §2.2.2.4.1.10): what every writer of this publisher writes until
+    /// [`Publisher::end_coherent_changes`] reaches each matched reader as one whole, or not at all (a set
+    /// cut short by the writer's deletion or loss is discarded). Calls nest; only the outermost pair
+    /// counts. On the wire: `PID_COHERENT_SET` on every change and an end-of-set marker per writer.
+    /// Readers whose subscriber requests coherent access hold each writer's part until it is whole;
+    /// the guarantee is per writer (a set spanning several writers is not made atomic across them).
+    pub fn begin_coherent_changes(&self) -> DdsResult<()> {
+        self.group.begin(self.participant.driver())
+    }
+
+    /// Ends the coherent set started by [`Publisher::begin_coherent_changes`]: every writer sends its
+    /// end-of-set marker, waiting for flow control up to 1 s each (`Timeout` past it).
+    /// `PreconditionNotMet` without a matching begin.
+    pub fn end_coherent_changes(&self) -> DdsResult<()> {
+        self.group
+            .end(self.participant.driver(), Duration::from_secs(1))
     }
 
     /// Creates a writer. An empty `data_representation` means the type's default (XCDR1 for @final types
@@ -122,6 +143,7 @@ impl Publisher {
             .state
             .create(sink, owner, |c, now| c.create_writer(now, spec))?;
         let id = handle.id();
+        self.group.add_writer(&driver, id);
         tracing::info!(
             topic = topic.name(),
             type_name = T::TYPE_NAME,
@@ -325,9 +347,9 @@ impl<T: DdsType> DataWriter<T> {
         let payload = self.serialize(sample)?;
         // Keyed writes register the instance, so that deleting the writer can unregister it.
         let key_hash = if T::IS_KEYED {
-            self.instance_of(sample, true, false)?
-                .and_then(|(_, kh)| kh)
+            self.instance_of(sample, true, true)?.and_then(|(_, kh)| kh)
         } else {
+            lock(&self.inner.instances).keyless_last_write = Some(Instant::now());
             None
         };
         let change = WriteChange {
@@ -613,7 +635,7 @@ impl<T: DdsType> Endpoint for WriterInner<T> {
         if missed.is_empty() {
             return;
         }
-        self.state.signal(
+        self.state.signal_consumed(
             StatusMask::OFFERED_DEADLINE_MISSED,
             |st| {
                 st.offered_deadline_missed.record(&missed);

@@ -11,7 +11,7 @@ use foldhash::{HashMap, HashMapExt};
 
 use crate::cdr::{self, DdsType};
 use crate::qos::{DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos};
-use crate::rtps::{Event, Guid, ReaderSpec};
+use crate::rtps::{Event, Guid, ReaderSpec, ReceivedSample};
 
 use super::cache::{to_sample, Outcome, ReaderCache, Selection};
 use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition};
@@ -20,6 +20,7 @@ use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
 use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
 use super::participant::DomainParticipant;
+use super::presentation::{instance_ordered, AccessScope};
 use super::sample::{
     InstanceHandle, InstanceStateMask, Sample, SampleInfo, SampleStateMask, ViewStateMask,
 };
@@ -55,6 +56,7 @@ pub trait DataReaderListener<T: DdsType>: Send + Sync {
 pub struct Subscriber {
     participant: DomainParticipant,
     qos: Arc<SubscriberQos>,
+    access: Arc<AccessScope>,
 }
 
 impl std::fmt::Debug for Subscriber {
@@ -72,6 +74,7 @@ impl DomainParticipant {
         Ok(Subscriber {
             participant: self.clone(),
             qos: Arc::new(qos.clone()),
+            access: Arc::default(),
         })
     }
 }
@@ -85,6 +88,25 @@ impl Subscriber {
     /// The participant.
     pub fn participant(&self) -> &DomainParticipant {
         &self.participant
+    }
+
+    /// Starts an access scope (DDS 1.4 §2.2.2.5.2.8) for reading coherent or ordered data across this
+    /// subscriber's readers. Calls nest. Coherent sets become visible only whole (each writer's part of a
+    /// set is stored at once), so reads inside and outside a scope never see part of a set.
+    pub fn begin_access(&self) -> DdsResult<()> {
+        self.participant.driver().check_alive()?;
+        self.access.begin();
+        Ok(())
+    }
+
+    /// Ends the access scope started by [`Subscriber::begin_access`]; `PreconditionNotMet` without one.
+    pub fn end_access(&self) -> DdsResult<()> {
+        self.access.end()
+    }
+
+    /// Whether an access scope is open.
+    pub fn in_access(&self) -> bool {
+        self.access.is_open()
     }
 
     /// Creates a reader on a topic or content-filtered topic. An empty `data_representation` accepts XCDR1
@@ -117,6 +139,7 @@ impl Subscriber {
         };
         let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
         cache.set_filter(topic.sample_filter());
+        cache.set_instance_order(instance_ordered(&self.qos.presentation));
         let inner = Arc::new(ReaderInner::<T> {
             state: EndpointState::new(driver.clone()),
             pending: Mutex::new(VecDeque::new()),
@@ -160,6 +183,17 @@ struct CacheState<T> {
     by_hash: HashMap<[u8; 16], Vec<u8>>,
     /// The queue being processed, swapped with `pending` (one lock round per batch, buffers reused).
     batch: VecDeque<Pending>,
+}
+
+/// One pass of `process` over a reader's queue.
+struct Pass {
+    now: Instant,
+    rx_time: SystemTime,
+    /// Consecutive samples mostly come from one writer: its QoS is looked up once per run.
+    writer_info: Option<(Guid, RemoteWriterInfo)>,
+    /// Something was stored or changed state.
+    any: bool,
+    rejected: Vec<(super::status::SampleRejectedReason, InstanceHandle)>,
 }
 
 /// What a reader's handle keeps alive.
@@ -641,6 +675,28 @@ impl<T: DdsType> ReaderInner<T> {
         });
     }
 
+    /// Decodes one received change and stores it in the cache.
+    fn store(&self, st: &mut CacheState<T>, s: ReceivedSample, pass: &mut Pass) {
+        let info = match pass.writer_info {
+            Some((g, info)) if g == s.writer => info,
+            _ => {
+                let info = self.state.driver.remote_writer(&s.writer);
+                pass.writer_info = Some((s.writer, info));
+                info
+            }
+        };
+        let key = st.cache.take_key_buffer();
+        let Some(inc) = decode_change::<T>(s, info, &mut st.by_hash, key, pass.now, pass.rx_time)
+        else {
+            return;
+        };
+        match st.cache.insert(inc, pass.now) {
+            Outcome::Accepted { .. } => pass.any = true,
+            Outcome::Filtered => {}
+            Outcome::Rejected { reason, handle } => pass.rejected.push((reason, handle)),
+        }
+    }
+
     fn notify_data(self: &Arc<Self>) {
         if self.data_waiters.load(AtomicOrdering::SeqCst) > 0 {
             self.data_cv.notify_all();
@@ -662,46 +718,34 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
     }
 
     fn process(self: Arc<Self>) {
-        let now = Instant::now();
-        let rx_time = SystemTime::now();
-        let mut any = false;
-        let mut rejected = Vec::new();
+        let mut pass = Pass {
+            now: Instant::now(),
+            rx_time: SystemTime::now(),
+            writer_info: None,
+            any: false,
+            rejected: Vec::new(),
+        };
         {
             let mut guard = lock(&self.cache);
             let st = &mut *guard;
             // Taking the queue under the cache lock keeps the core's order even with several receive threads.
             let mut batch = std::mem::take(&mut st.batch);
             std::mem::swap(&mut batch, &mut *lock(&self.pending));
-            // Consecutive samples mostly come from one writer: look its QoS up once per run.
-            let mut writer_info: Option<(Guid, RemoteWriterInfo)> = None;
             for item in batch.drain(..) {
                 match item {
-                    Pending::Sample(s) => {
-                        let info = match writer_info {
-                            Some((g, info)) if g == s.writer => info,
-                            _ => {
-                                let info = self.state.driver.remote_writer(&s.writer);
-                                writer_info = Some((s.writer, info));
-                                info
-                            }
-                        };
-                        let key = st.cache.take_key_buffer();
-                        let Some(inc) =
-                            decode_change::<T>(s, info, &mut st.by_hash, key, now, rx_time)
-                        else {
-                            continue;
-                        };
-                        match st.cache.insert(inc, now) {
-                            Outcome::Accepted { .. } => any = true,
-                            Outcome::Filtered => {}
-                            Outcome::Rejected { reason, handle } => rejected.push((reason, handle)),
+                    Pending::Sample(s) => self.store(st, s, &mut pass),
+                    // Under one lock hold: a read sees all of the set or none of it.
+                    Pending::CoherentSet(set) => {
+                        for s in set {
+                            self.store(st, s, &mut pass);
                         }
                     }
-                    Pending::WriterGone(g) => any |= st.cache.writer_gone(g, now),
+                    Pending::WriterGone(g) => pass.any |= st.cache.writer_gone(g, pass.now),
                 }
             }
             st.batch = batch;
         }
+        let Pass { any, rejected, .. } = pass;
         if !rejected.is_empty() {
             tracing::debug!(
                 count = rejected.len(),
@@ -788,7 +832,7 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
         if missed.is_empty() {
             return;
         }
-        self.state.signal(
+        self.state.signal_consumed(
             StatusMask::REQUESTED_DEADLINE_MISSED,
             |st| {
                 st.requested_deadline_missed.record(&missed);

@@ -478,6 +478,17 @@ pub struct ReceivedSample {
 pub enum Event {
     /// A change for a local reader.
     Sample(ReceivedSample),
+    /// A whole coherent set from one writer (RTPS 2.5 §8.7.6), in the writer's order: every change the
+    /// writer made between `begin_coherent_set` and `end_coherent_set`. Delivered only once every change
+    /// of the set arrived; a set with a missing change is reported as [`Event::SampleLost`] instead.
+    CoherentSet {
+        /// The local reader.
+        reader: EntityId,
+        /// The writer of the set.
+        writer: Guid,
+        /// The changes of the set (never empty).
+        samples: Vec<ReceivedSample>,
+    },
     /// A local writer matched or unmatched a reader.
     PublicationMatched {
         /// The local writer.

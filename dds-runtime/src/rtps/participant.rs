@@ -2,6 +2,7 @@
 //!
 //! `receive` dispatches incoming submessages, `discovery` runs SPDP/SEDP/matching, `timers` the periodic work.
 
+mod coherent;
 mod discovery;
 mod receive;
 mod timers;

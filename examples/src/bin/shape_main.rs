@@ -54,8 +54,8 @@ fn main() -> ExitCode {
         }
     };
     let result = match &app.role {
-        Role::Publisher(writers) => run_publisher(&options, writers),
-        Role::Subscriber(readers) => run_subscriber(&options, readers),
+        Role::Publisher(p, writers) => run_publisher(&options, p, writers),
+        Role::Subscriber(s, readers) => run_subscriber(&options, s, readers),
     };
     match result {
         Ok(()) => {
@@ -71,18 +71,6 @@ fn main() -> ExitCode {
 
 /// The first option this implementation cannot honour, as shape_main's `... = not supported` line.
 fn unsupported(o: &ShapeOptions) -> Option<String> {
-    if o.coherent {
-        return Some("    Presentation Coherent Access = not supported".into());
-    }
-    if o.ordered {
-        return Some("    Presentation Ordered Access = not supported".into());
-    }
-    if matches!(
-        o.access_scope,
-        Some(AccessScope::Topic | AccessScope::Group)
-    ) {
-        return Some("    Presentation Access Scope = not supported".into());
-    }
     if o.cft_expression.is_some() {
         return Some("    ContentFilteredTopic expression (--cft) = not supported".into());
     }
@@ -96,8 +84,8 @@ fn unsupported(o: &ShapeOptions) -> Option<String> {
 }
 
 enum Role {
-    Publisher(Vec<DataWriter<ShapeType>>),
-    Subscriber(Vec<DataReader<ShapeType>>),
+    Publisher(Publisher, Vec<DataWriter<ShapeType>>),
+    Subscriber(Subscriber, Vec<DataReader<ShapeType>>),
 }
 
 struct App {
@@ -133,6 +121,17 @@ impl DataWriterListener<ShapeType> for Printer {
             )
         );
     }
+    fn on_offered_deadline_missed(&self, w: &DataWriter<ShapeType>, st: DeadlineMissedStatus) {
+        println!(
+            "{}",
+            shape_output::offered_deadline_missed_line(
+                &self.topic,
+                w.topic().type_name(),
+                st.total_count,
+                st.total_count_change
+            )
+        );
+    }
 }
 
 impl DataReaderListener<ShapeType> for Printer {
@@ -154,6 +153,17 @@ impl DataReaderListener<ShapeType> for Printer {
                 &self.topic,
                 r.topic().type_name(),
                 st.last_policy_id
+            )
+        );
+    }
+    fn on_requested_deadline_missed(&self, r: &DataReader<ShapeType>, st: DeadlineMissedStatus) {
+        println!(
+            "{}",
+            shape_output::requested_deadline_missed_line(
+                &self.topic,
+                r.topic().type_name(),
+                st.total_count,
+                st.total_count_change
             )
         );
     }
@@ -206,6 +216,20 @@ fn history(o: &ShapeOptions) -> Option<History> {
     }
 }
 
+/// PRESENTATION from `--access-scope`, `--coherent` and `--ordered` (shape_main sets it on the publisher or
+/// subscriber whatever the flags; INSTANCE scope by default).
+fn presentation(o: &ShapeOptions) -> Presentation {
+    Presentation {
+        access_scope: match o.access_scope {
+            None | Some(AccessScope::Instance) => PresentationAccessScope::Instance,
+            Some(AccessScope::Topic) => PresentationAccessScope::Topic,
+            Some(AccessScope::Group) => PresentationAccessScope::Group,
+        },
+        coherent_access: o.coherent,
+        ordered_access: o.ordered,
+    }
+}
+
 fn partition(p: &Option<String>) -> Partition {
     match p {
         Some(p) => Partition::new([p.as_str()]),
@@ -232,6 +256,7 @@ impl App {
             let publisher = participant.create_publisher(
                 &PublisherQos::builder()
                     .partition(partition(&o.partition))
+                    .presentation(presentation(o))
                     .build(),
             )?;
             let mut qos = DataWriterQos::builder()
@@ -271,11 +296,12 @@ impl App {
                 }));
                 writers.push(w);
             }
-            Role::Publisher(writers)
+            Role::Publisher(publisher, writers)
         } else {
             let subscriber = participant.create_subscriber(
                 &SubscriberQos::builder()
                     .partition(partition(&o.partition))
+                    .presentation(presentation(o))
                     .build(),
             )?;
             let mut qos = DataReaderQos::builder()
@@ -313,7 +339,7 @@ impl App {
                 }));
                 readers.push(r);
             }
-            Role::Subscriber(readers)
+            Role::Subscriber(subscriber, readers)
         };
         Ok(App {
             _participant: participant,
@@ -350,7 +376,24 @@ fn instance_colors(o: &ShapeOptions) -> Vec<String> {
         .collect()
 }
 
-fn run_publisher(o: &ShapeOptions, writers: &[DataWriter<ShapeType>]) -> DdsResult<()> {
+/// Whether iteration `n` starts (`Some(true)`) or ends (`Some(false)`) a coherent set, as shape_main does
+/// with `--coherent-sample-count` (only with coherent or ordered access).
+fn coherent_step(o: &ShapeOptions, n: u32, start: bool) -> bool {
+    let count = o.coherent_sample_count;
+    (o.coherent || o.ordered)
+        && count != 0
+        && if start {
+            n % count == 0
+        } else {
+            n % count == count - 1
+        }
+}
+
+fn run_publisher(
+    o: &ShapeOptions,
+    publisher: &Publisher,
+    writers: &[DataWriter<ShapeType>],
+) -> DdsResult<()> {
     let mut rng = seed_rng();
     let mut shape = ShapeType {
         color: o.color.clone().unwrap_or_else(|| "BLUE".into()),
@@ -376,6 +419,10 @@ fn run_publisher(o: &ShapeOptions, writers: &[DataWriter<ShapeType>]) -> DdsResu
                 shape.shapesize + 1
             };
         }
+        if coherent_step(o, n, true) {
+            println!("Started Coherent Set");
+            publisher.begin_coherent_changes()?;
+        }
         for w in writers {
             for c in &colors {
                 shape.color.clone_from(c);
@@ -397,6 +444,10 @@ fn run_publisher(o: &ShapeOptions, writers: &[DataWriter<ShapeType>]) -> DdsResu
                     );
                 }
             }
+        }
+        if coherent_step(o, n, false) {
+            println!("Finished Coherent Set");
+            publisher.end_coherent_changes()?;
         }
         shutdown::sleep(o.write_period);
         n += 1;
@@ -421,11 +472,25 @@ fn run_publisher(o: &ShapeOptions, writers: &[DataWriter<ShapeType>]) -> DdsResu
     Ok(())
 }
 
-fn run_subscriber(o: &ShapeOptions, readers: &[DataReader<ShapeType>]) -> DdsResult<()> {
+fn run_subscriber(
+    o: &ShapeOptions,
+    subscriber: &Subscriber,
+    readers: &[DataReader<ShapeType>],
+) -> DdsResult<()> {
     // Key of each instance seen with data, to name instances in NOT_ALIVE lines.
     let mut colors: HashMap<(usize, InstanceHandle), String> = HashMap::new();
     let mut n = 0u32;
     while !shutdown::requested() {
+        if o.coherent {
+            println!("Reading coherent sets, iteration {n}");
+        }
+        if o.ordered {
+            println!("Reading with ordered access, iteration {n}");
+        }
+        let access = o.coherent || o.ordered;
+        if access {
+            subscriber.begin_access()?;
+        }
         for (i, r) in readers.iter().enumerate() {
             let topic = r.topic().name().to_string();
             let mut previous = InstanceHandle::NIL;
@@ -473,6 +538,9 @@ fn run_subscriber(o: &ShapeOptions, readers: &[DataReader<ShapeType>]) -> DdsRes
                     break;
                 }
             }
+        }
+        if access {
+            subscriber.end_access()?;
         }
         n += 1;
         if o.num_iterations != 0 && n >= o.num_iterations {

@@ -82,6 +82,14 @@ pub mod pid {
     pub const GROUP_GUID: u16 = 0x0052;
     /// SPDP: the builtin endpoint set bits.
     pub const BUILTIN_ENDPOINT_SET: u16 = 0x0058;
+    /// PID_COHERENT_SET (inline QoS): the sequence number of the first change of the coherent set.
+    pub const COHERENT_SET: u16 = 0x0056;
+    /// PID_GROUP_COHERENT_SET (inline QoS): the group sequence number of the first change of a group set.
+    pub const GROUP_COHERENT_SET: u16 = 0x0063;
+    /// PID_GROUP_SEQ_NUM (inline QoS): the change's sequence number within its publisher.
+    pub const GROUP_SEQ_NUM: u16 = 0x0064;
+    /// PID_WRITER_GROUP_INFO (inline QoS): the writers of a group coherent set.
+    pub const WRITER_GROUP_INFO: u16 = 0x0065;
     /// SPDP: the property list (name, value pairs).
     pub const PROPERTY_LIST: u16 = 0x0059;
     /// SEDP: the endpoint's GUID.
@@ -198,6 +206,15 @@ impl<'a> ParameterList<'a> {
             k.copy_from_slice(v);
             k
         })
+    }
+
+    /// Inline QoS: PID_COHERENT_SET, the first sequence number of the change's coherent set.
+    pub fn coherent_set(&self) -> Option<SequenceNumber> {
+        let v = self.get(pid::COHERENT_SET)?;
+        let mut c = self.cursor(v);
+        let high = c.i32().ok()?;
+        let low = c.u32().ok()?;
+        Some(SequenceNumber::from_parts(high, low))
     }
 
     /// Inline QoS: the status-info flags (last byte; 0x01 disposed, 0x02 unregistered).

@@ -3,6 +3,7 @@
 use std::collections::BTreeMap;
 
 use crate::rtps::api::Payload;
+use crate::rtps::types::SequenceNumber;
 
 /// What one stored fragment costs beyond its bytes (map node, vector header), charged against the limits so
 /// that tiny fragments cannot make us hold far more memory than their payload suggests.
@@ -20,6 +21,8 @@ pub(crate) struct Defrag {
     pub status_info: Option<u8>,
     pub key_hash: Option<[u8; 16]>,
     pub key_flag: bool,
+    /// `PID_COHERENT_SET` of the sample, if it is in a coherent set.
+    pub coherent_set: Option<SequenceNumber>,
     /// Source timestamp in force for the first fragment that carried one.
     pub source_timestamp: Option<crate::rtps::types::Time>,
 }
@@ -34,6 +37,7 @@ impl Defrag {
             status_info: None,
             key_hash: None,
             key_flag: false,
+            coherent_set: None,
             source_timestamp: None,
         }
     }

@@ -1,6 +1,7 @@
 //! Readers: per-writer proxies, reordering, duplicate suppression, defragmentation and acknowledgement
 //! (§8.4.10, §8.4.12).
 
+mod coherent;
 mod defrag;
 mod writer_proxy;
 
@@ -16,6 +17,7 @@ use crate::rtps::messages::{
 use crate::rtps::due::DueFloor;
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
+use coherent::{Assembler, SetLimits, SetMark};
 use defrag::Defrag;
 
 fn slot_size(s: &Slot) -> usize {
@@ -107,6 +109,10 @@ impl Reader {
 
     pub(crate) fn add_proxy(&mut self, now: Instant, mut proxy: WriterProxy) {
         proxy.reliable &= self.params.reliable;
+        proxy.coherent = Assembler::new(SetLimits {
+            max_samples: self.params.reorder_max_samples,
+            max_bytes: self.params.reorder_max_bytes,
+        });
         if proxy.reliable {
             // Pre-emptive ACKNACK: prompts the writer to tell us what it has.
             proxy.acknack_due = Some(now);
@@ -127,7 +133,7 @@ impl Reader {
         out: &mut Vec<Event>,
     ) {
         if let Slot::Change(c) = slot {
-            out.push(Event::Sample(ReceivedSample {
+            let s = ReceivedSample {
                 reader,
                 writer: p.guid,
                 sequence: sn,
@@ -135,7 +141,12 @@ impl Reader {
                 payload: c.payload,
                 key_hash: c.key_hash,
                 source_timestamp: c.source_timestamp,
-            }));
+            };
+            if c.coherent.is_none() && !p.coherent.is_open() {
+                out.push(Event::Sample(s));
+            } else {
+                p.coherent.offer(sn, c.coherent, s, out);
+            }
         }
     }
 
@@ -251,6 +262,14 @@ impl Reader {
         let status = d.inline_qos.and_then(|q| q.status_info());
         let kind = status.map_or(ChangeKind::Alive, ChangeKind::from_status_info);
         let key_hash = d.inline_qos.and_then(|q| q.key_hash());
+        let coherent = d
+            .inline_qos
+            .and_then(|q| q.coherent_set())
+            .map(|set| SetMark {
+                set,
+                // The end-of-set marker: no data, no key, no status.
+                end: d.payload.is_none() && status.is_none(),
+            });
         let slot = match d.payload {
             Some(b) if b.len() > self.params.max_sample_size => {
                 out.push(Event::SampleLost {
@@ -261,7 +280,9 @@ impl Reader {
                 Slot::Irrelevant
             }
             // Alive data needs a payload; a dispose/unregister may come with only inline QoS.
-            None if kind == ChangeKind::Alive => Slot::Irrelevant,
+            None if kind == ChangeKind::Alive && !coherent.is_some_and(|c| c.end) => {
+                Slot::Irrelevant
+            }
             b => Slot::Change(PendingChange {
                 kind,
                 payload: b
@@ -269,6 +290,7 @@ impl Reader {
                     .unwrap_or_default(),
                 key_hash,
                 source_timestamp: ts,
+                coherent,
             }),
         };
         self.accept(p, d.writer_sn, slot, out);
@@ -332,6 +354,7 @@ impl Reader {
             df.status_info = d.inline_qos.and_then(|q| q.status_info());
             df.key_hash = d.inline_qos.and_then(|q| q.key_hash());
             df.key_flag = d.key_flag;
+            df.coherent_set = d.inline_qos.and_then(|q| q.coherent_set());
             p.defrag.insert(sn, df);
         }
         let Some(df) = p.defrag.get_mut(&sn) else {
@@ -362,12 +385,14 @@ impl Reader {
                 .map_or(ChangeKind::Alive, ChangeKind::from_status_info);
             let key_hash = df.key_hash;
             let source_timestamp = df.source_timestamp;
+            let coherent = df.coherent_set.map(|set| SetMark { set, end: false });
             let payload = df.assemble();
             let slot = Slot::Change(PendingChange {
                 kind,
                 payload,
                 key_hash,
                 source_timestamp,
+                coherent,
             });
             self.accept(p, sn, slot, out);
         }

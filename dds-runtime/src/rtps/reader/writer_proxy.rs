@@ -3,6 +3,7 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
+use super::coherent::{Assembler, SetMark};
 use super::defrag::Defrag;
 use crate::rtps::api::{ChangeKind, Payload};
 use crate::rtps::types::*;
@@ -20,6 +21,8 @@ pub(crate) struct PendingChange {
     pub payload: Payload,
     pub key_hash: Option<[u8; 16]>,
     pub source_timestamp: Option<Time>,
+    /// Membership in a coherent set (`PID_COHERENT_SET`).
+    pub coherent: Option<SetMark>,
 }
 
 #[derive(Debug)]
@@ -48,6 +51,8 @@ pub(crate) struct WriterProxy {
     pub nackfrag_count: i32,
     pub defrag: BTreeMap<SequenceNumber, Defrag>,
     pub defrag_bytes: usize,
+    /// The writer's coherent set being assembled.
+    pub coherent: Assembler,
 }
 
 impl WriterProxy {
@@ -70,6 +75,7 @@ impl WriterProxy {
             nackfrag_count: 0,
             defrag: BTreeMap::new(),
             defrag_bytes: 0,
+            coherent: Assembler::default(),
         }
     }
 

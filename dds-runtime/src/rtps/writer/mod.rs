@@ -1,8 +1,11 @@
 //! Writers: history cache, per-reader state and the reliable/best-effort protocol (§8.4.7, §8.4.9).
 
+mod coherent;
 mod history;
 mod reader_proxy;
 
+pub(crate) use coherent::CoherentMark;
+use coherent::CoherentState;
 pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use reader_proxy::ReaderProxy;
 
@@ -64,6 +67,8 @@ pub(crate) struct Writer {
     blocked: bool,
     /// Set when deleted: lingers until acknowledged or this deadline.
     pub linger_until: Option<Instant>,
+    /// The open coherent set, if any (see `coherent.rs`).
+    coherent: CoherentState,
 }
 
 impl Writer {
@@ -86,6 +91,7 @@ impl Writer {
             unacked_bytes: 0,
             blocked: false,
             linger_until: None,
+            coherent: CoherentState::Off,
         }
     }
 
@@ -225,6 +231,7 @@ impl Writer {
             payload: change.payload,
             key_hash: change.key_hash,
             source_timestamp: change.source_timestamp,
+            coherent: self.coherent.mark(sn),
         };
         self.history.add(cc);
         if !self.data_dest.is_empty() {
@@ -557,6 +564,9 @@ impl Writer {
     }
 }
 
+/// Room for the inline QoS of one change: coherent set (12), key hash (20), status info (8).
+const INLINE_QOS_MAX: usize = 40;
+
 /// Runs of consecutive sequence numbers as GAP submessages.
 fn send_gaps(
     out: &mut Outbox,
@@ -585,14 +595,21 @@ fn send_gaps(
     }
 }
 
-/// Inline QoS for a change: key hash when keyed, status info when not alive. Built on the stack.
-fn inline_qos(c: &CacheChange, buf: &mut [u8; 28]) -> usize {
+/// Inline QoS for a change: key hash when keyed, status info when not alive, the coherent set when in one
+/// (an end-of-set marker carries only that). Built on the stack.
+fn inline_qos(c: &CacheChange, buf: &mut [u8; INLINE_QOS_MAX]) -> usize {
     let mut n = 0;
+    if let Some(m) = &c.coherent {
+        n = coherent::put_coherent_set(m, buf);
+        if m.end {
+            return n;
+        }
+    }
     if let Some(k) = &c.key_hash {
-        buf[0..2].copy_from_slice(&pid::KEY_HASH.to_le_bytes());
-        buf[2..4].copy_from_slice(&16u16.to_le_bytes());
-        buf[4..20].copy_from_slice(k);
-        n = 20;
+        buf[n..n + 2].copy_from_slice(&pid::KEY_HASH.to_le_bytes());
+        buf[n + 2..n + 4].copy_from_slice(&16u16.to_le_bytes());
+        buf[n + 4..n + 20].copy_from_slice(k);
+        n += 20;
     }
     if c.kind != ChangeKind::Alive {
         buf[n..n + 2].copy_from_slice(&pid::STATUS_INFO.to_le_bytes());
@@ -622,7 +639,7 @@ pub(crate) fn send_change(
     if dest.is_empty() {
         return 0;
     }
-    let mut qbuf = [0u8; 28];
+    let mut qbuf = [0u8; INLINE_QOS_MAX];
     let qn = inline_qos(c, &mut qbuf);
     let inline_qos = (qn > 0).then_some(ParameterList {
         data: &qbuf[..qn],
@@ -632,7 +649,8 @@ pub(crate) fn send_change(
     let len = c.payload.len();
     let alive = c.kind == ChangeKind::Alive;
     if len <= frag || frag == 0 || (key_hash_only && !alive) {
-        let payload = (alive || (len > 0 && !key_hash_only)).then_some(&c.payload[..]);
+        let marker = c.coherent.is_some_and(|m| m.end);
+        let payload = (!marker && (alive || (len > 0 && !key_hash_only))).then_some(&c.payload[..]);
         let d = Submessage::Data(Data {
             reader_id: rid,
             writer_id: wid,

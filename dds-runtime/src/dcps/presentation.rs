@@ -1,0 +1,141 @@
+//! PRESENTATION (DDS 1.4 §2.2.3.6): the state behind `Publisher::begin_coherent_changes` /
+//! `end_coherent_changes` and `Subscriber::begin_access` / `end_access`.
+//!
+//! A publisher's coherent set spans all its writers: while one is open, each writer (also one created
+//! meanwhile) has a coherent set open in the RTPS core, and ending it sends every writer's end-of-set
+//! marker. Readers deliver each writer's part of the set whole or not at all (see `rtps::reader::coherent`).
+
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use crate::qos::{Presentation, PresentationAccessScope};
+use crate::rtps::{EntityId, WriteError};
+
+use super::driver::Driver;
+use super::error::{DdsError, DdsResult};
+use super::sync::lock;
+
+#[derive(Debug, Default)]
+struct GroupState {
+    writers: Vec<EntityId>,
+    /// Nesting depth of begin_coherent_changes.
+    depth: u32,
+}
+
+/// A publisher's writers and its open coherent set.
+#[derive(Debug, Default)]
+pub(crate) struct CoherentGroup {
+    state: Mutex<GroupState>,
+}
+
+impl CoherentGroup {
+    /// Records a new writer of the publisher; it joins the open set, if any. (No lock of this group is
+    /// held while the core is called: listeners run from there and may call back.)
+    pub(crate) fn add_writer(&self, driver: &Driver, id: EntityId) {
+        let open = {
+            let mut st = lock(&self.state);
+            st.writers.push(id);
+            st.depth > 0
+        };
+        if open {
+            let _ = driver.with_core(|c, _| c.begin_coherent_set(id));
+        }
+    }
+
+    /// Opens a coherent set on every writer (nested calls only count).
+    pub(crate) fn begin(&self, driver: &Driver) -> DdsResult<()> {
+        driver.check_alive()?;
+        let writers = {
+            let mut st = lock(&self.state);
+            st.depth += 1;
+            if st.depth > 1 {
+                return Ok(());
+            }
+            st.writers.clone()
+        };
+        let gone = driver.with_core(|c, _| {
+            writers
+                .into_iter()
+                .filter(|w| c.begin_coherent_set(*w).is_err())
+                .collect::<Vec<_>>()
+        });
+        lock(&self.state).writers.retain(|w| !gone.contains(w));
+        Ok(())
+    }
+
+    /// Closes the outermost set: every writer sends its end-of-set marker, each waiting up to
+    /// `max_blocking` while flow control refuses it.
+    pub(crate) fn end(&self, driver: &Driver, max_blocking: Duration) -> DdsResult<()> {
+        driver.check_alive()?;
+        let writers = {
+            let mut st = lock(&self.state);
+            if st.depth == 0 {
+                return Err(DdsError::PreconditionNotMet(
+                    "end_coherent_changes without begin_coherent_changes",
+                ));
+            }
+            st.depth -= 1;
+            if st.depth > 0 {
+                return Ok(());
+            }
+            st.writers.clone()
+        };
+        let deadline = Instant::now().checked_add(max_blocking);
+        for w in writers {
+            end_one(driver, w, deadline)?;
+        }
+        Ok(())
+    }
+}
+
+/// Ends writer `w`'s set, waiting for flow control until `deadline`.
+fn end_one(driver: &Driver, w: EntityId, deadline: Option<Instant>) -> DdsResult<()> {
+    loop {
+        let seen = driver.progress_generation();
+        match driver.with_core(|c, now| c.end_coherent_set(now, w)) {
+            Ok(_) | Err(WriteError::UnknownWriter(_)) | Err(WriteError::Deleted) => return Ok(()),
+            Err(WriteError::WouldBlock) => match deadline {
+                Some(d) if Instant::now() >= d => return Err(DdsError::Timeout),
+                Some(d) => driver.wait_progress_change(seen, d),
+                None => {
+                    driver.wait_progress_change(seen, Instant::now() + Duration::from_millis(20))
+                }
+            },
+            Err(e) => return Err(DdsError::Write(e)),
+        }
+        driver.check_alive()?;
+    }
+}
+
+/// A subscriber's access scope: `begin_access` / `end_access` nesting.
+#[derive(Debug, Default)]
+pub(crate) struct AccessScope {
+    depth: Mutex<u32>,
+}
+
+impl AccessScope {
+    pub(crate) fn begin(&self) {
+        *lock(&self.depth) += 1;
+    }
+
+    pub(crate) fn end(&self) -> DdsResult<()> {
+        let mut d = lock(&self.depth);
+        if *d == 0 {
+            return Err(DdsError::PreconditionNotMet(
+                "end_access without begin_access",
+            ));
+        }
+        *d -= 1;
+        Ok(())
+    }
+
+    pub(crate) fn is_open(&self) -> bool {
+        *lock(&self.depth) > 0
+    }
+}
+
+/// Whether reads return each instance's samples together (ordered access with INSTANCE scope) rather than
+/// in reception order across instances (the default, and what TOPIC and GROUP scope ask for).
+pub(crate) fn instance_ordered(p: &Presentation) -> bool {
+    p.ordered_access && p.access_scope == PresentationAccessScope::Instance
+}

@@ -1,0 +1,233 @@
+//! PRESENTATION between two of our participants: coherent sets through `begin_coherent_changes` /
+//! `end_coherent_changes` are seen whole or not at all, a set cut short by the writer's deletion is never
+//! seen, ordered access with INSTANCE scope groups each instance's samples, and the access scope nests.
+mod dcps_util;
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use dcps_util::*;
+use dds_runtime::prelude::*;
+
+fn presentation(scope: PresentationAccessScope, coherent: bool, ordered: bool) -> Presentation {
+    Presentation {
+        access_scope: scope,
+        coherent_access: coherent,
+        ordered_access: ordered,
+    }
+}
+
+/// A writer under a publisher and a reader under a subscriber, both with `p`, matched.
+fn pair(
+    domain: u32,
+    p: Presentation,
+) -> (
+    (DomainParticipant, DomainParticipant),
+    Publisher,
+    DataWriter<ShapeType>,
+    Subscriber,
+    DataReader<ShapeType>,
+) {
+    let (p1, p2) = (participant(domain), participant(domain));
+    let (wq, rq) = reliable_keep_all();
+    let publ = p1
+        .create_publisher(&PublisherQos::builder().presentation(p).build())
+        .unwrap();
+    let sub = p2
+        .create_subscriber(&SubscriberQos::builder().presentation(p).build())
+        .unwrap();
+    let t1 = p1
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let t2 = p2
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let w = publ.create_datawriter(&t1, &wq).unwrap();
+    let r = sub.create_datareader(&t2, &rq).unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1
+        && r.subscription_matched_status().current_count == 1));
+    ((p1, p2), publ, w, sub, r)
+}
+
+/// Watches the reader's sample count from another thread and records every value it saw.
+fn watch(r: &DataReader<ShapeType>) -> (Arc<Mutex<Vec<usize>>>, Arc<AtomicBool>) {
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let stop = Arc::new(AtomicBool::new(false));
+    let (r, s, st) = (r.clone(), seen.clone(), stop.clone());
+    std::thread::spawn(move || {
+        while !st.load(Ordering::Relaxed) {
+            let n = r.sample_count();
+            let mut v = s.lock().unwrap();
+            if v.last() != Some(&n) {
+                v.push(n);
+            }
+            drop(v);
+            std::thread::sleep(Duration::from_micros(200));
+        }
+    });
+    (seen, stop)
+}
+
+#[test]
+fn coherent_set_is_seen_whole_or_not_at_all() {
+    let (_ps, publ, w, _sub, r) = pair(
+        135,
+        presentation(PresentationAccessScope::Topic, true, false),
+    );
+    let (seen, stop) = watch(&r);
+    for round in 0..3 {
+        publ.begin_coherent_changes().unwrap();
+        for i in 0..5 {
+            w.write(&shape(["RED", "BLUE"][i % 2], round * 10 + i as i32))
+                .unwrap();
+            std::thread::sleep(Duration::from_millis(15));
+        }
+        // Everything sent and acknowledged, but the set is open: nothing is visible.
+        w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+        std::thread::sleep(Duration::from_millis(50));
+        assert_eq!(r.sample_count(), 5 * round as usize, "round {round}");
+        publ.end_coherent_changes().unwrap();
+        assert!(wait_until(Duration::from_secs(5), || r.sample_count()
+            == 5 * (round as usize + 1)));
+    }
+    stop.store(true, Ordering::Relaxed);
+    let seen = seen.lock().unwrap().clone();
+    assert!(
+        seen.iter().all(|n| n % 5 == 0),
+        "a partial set was visible: {seen:?}"
+    );
+    let xs: Vec<i32> = r
+        .take()
+        .unwrap()
+        .iter()
+        .map(|s| s.data.as_ref().unwrap().x)
+        .collect();
+    assert_eq!(xs.len(), 15);
+    assert!(matches!(
+        publ.end_coherent_changes(),
+        Err(DdsError::PreconditionNotMet(_))
+    ));
+}
+
+#[test]
+fn nested_coherent_changes_end_with_the_outermost() {
+    let (_ps, publ, w, _sub, r) = pair(
+        136,
+        presentation(PresentationAccessScope::Topic, true, false),
+    );
+    publ.begin_coherent_changes().unwrap();
+    w.write(&shape("RED", 1)).unwrap();
+    publ.begin_coherent_changes().unwrap();
+    w.write(&shape("RED", 2)).unwrap();
+    publ.end_coherent_changes().unwrap();
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    std::thread::sleep(Duration::from_millis(100));
+    assert_eq!(r.sample_count(), 0, "the outer set is still open");
+    publ.end_coherent_changes().unwrap();
+    assert!(wait_until(Duration::from_secs(5), || r.sample_count() == 2));
+}
+
+#[test]
+fn set_cut_short_by_deleting_the_writer_is_never_seen() {
+    let (_ps, publ, w, _sub, r) = pair(
+        137,
+        presentation(PresentationAccessScope::Topic, true, false),
+    );
+    w.write(&shape("GREEN", 0)).unwrap();
+    publ.begin_coherent_changes().unwrap();
+    for i in 1..4 {
+        w.write(&shape("RED", i)).unwrap();
+    }
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    drop(w);
+    assert!(wait_until(Duration::from_secs(5), || r
+        .subscription_matched_status()
+        .current_count
+        == 0));
+    std::thread::sleep(Duration::from_millis(100));
+    let got: Vec<Sample<ShapeType>> = r.take().unwrap();
+    let colors: Vec<&str> = got
+        .iter()
+        .filter_map(|s| s.data.as_ref().map(|d| d.color.as_str()))
+        .collect();
+    assert_eq!(colors, vec!["GREEN"], "{got:?}");
+}
+
+#[test]
+fn ordered_access_instance_scope_groups_instances() {
+    let (_ps, _publ, w, _sub, r) = pair(
+        138,
+        presentation(PresentationAccessScope::Instance, false, true),
+    );
+    for i in 0..3 {
+        w.write(&shape("RED", i)).unwrap();
+        w.write(&shape("BLUE", i)).unwrap();
+    }
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    assert!(wait_until(Duration::from_secs(5), || r.sample_count() == 6));
+    let got: Vec<(String, i32)> = r
+        .take()
+        .unwrap()
+        .into_iter()
+        .map(|s| s.data.map(|d| (d.color, d.x)).unwrap())
+        .collect();
+    let colors: Vec<&str> = got.iter().map(|(c, _)| c.as_str()).collect();
+    assert!(
+        colors == ["RED", "RED", "RED", "BLUE", "BLUE", "BLUE"]
+            || colors == ["BLUE", "BLUE", "BLUE", "RED", "RED", "RED"],
+        "{got:?}"
+    );
+    // Each instance in write order.
+    let red: Vec<i32> = got
+        .iter()
+        .filter(|(c, _)| c == "RED")
+        .map(|(_, x)| *x)
+        .collect();
+    assert_eq!(red, vec![0, 1, 2]);
+}
+
+#[test]
+fn topic_scope_reads_in_write_order_across_instances() {
+    let (_ps, _publ, w, _sub, r) = pair(
+        139,
+        presentation(PresentationAccessScope::Topic, false, true),
+    );
+    for i in 0..3 {
+        w.write(&shape("RED", i)).unwrap();
+        w.write(&shape("BLUE", i)).unwrap();
+    }
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    assert!(wait_until(Duration::from_secs(5), || r.sample_count() == 6));
+    let colors: Vec<String> = r
+        .take()
+        .unwrap()
+        .into_iter()
+        .map(|s| s.data.unwrap().color)
+        .collect();
+    assert_eq!(colors, ["RED", "BLUE", "RED", "BLUE", "RED", "BLUE"]);
+}
+
+#[test]
+fn access_scope_nests() {
+    let p = participant(135);
+    let sub = p
+        .create_subscriber(
+            &SubscriberQos::builder()
+                .presentation(presentation(PresentationAccessScope::Group, true, true))
+                .build(),
+        )
+        .unwrap();
+    assert!(sub.end_access().is_err());
+    sub.begin_access().unwrap();
+    sub.begin_access().unwrap();
+    assert!(sub.in_access());
+    sub.end_access().unwrap();
+    assert!(sub.in_access());
+    sub.end_access().unwrap();
+    assert!(!sub.in_access());
+    assert!(sub.end_access().is_err());
+}
