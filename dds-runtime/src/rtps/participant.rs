@@ -3,6 +3,7 @@
 //! `receive` dispatches incoming submessages, `discovery` runs SPDP/SEDP/matching, `timers` the periodic work.
 
 mod discovery;
+mod historical;
 mod receive;
 mod timers;
 

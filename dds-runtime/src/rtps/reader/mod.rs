@@ -2,6 +2,7 @@
 //! (§8.4.10, §8.4.12).
 
 mod defrag;
+mod historical;
 mod writer_proxy;
 
 pub(crate) use writer_proxy::{PendingChange, Slot, WriterProxy};
