@@ -8,6 +8,7 @@
 
 mod interop {
     pub mod ddsperf;
+    pub mod durability;
     pub mod harness;
     pub mod main_job;
     pub mod shapes;
