@@ -9,6 +9,7 @@
 mod interop {
     pub mod ddsperf;
     pub mod deadline;
+    pub mod durability;
     pub mod harness;
     pub mod main_job;
     pub mod shapes;

@@ -50,6 +50,20 @@ pub(crate) trait Endpoint: Send + Sync {
     }
 }
 
+/// Watches the core for a service that lives beside the endpoints (the durability service and its
+/// duplicate filter, `dcps::durability`): the driver knows no service type.
+pub(crate) trait CoreObserver: Send + Sync {
+    /// Under the core lock: whether `s` may reach its reader. Must be cheap and must not call the driver.
+    fn admit(&self, _s: &ReceivedSample) -> bool {
+        true
+    }
+    /// Under the core lock, before samples that follow it are admitted: an event other than a sample.
+    /// Must be cheap and must not call the driver.
+    fn observe_locked(&self, _ev: &Event) {}
+    /// Without the core lock: an event of the core, after the endpoints had theirs.
+    fn on_event(&self, _ev: &Event) {}
+}
+
 /// What we learnt about a remote writer in SEDP that the reader-side QoS needs.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct RemoteWriterInfo {
@@ -85,6 +99,10 @@ pub(crate) struct Driver {
     pub(crate) status: Arc<StatusCore>,
     /// Payload buffers of sent datagrams, handed back to the core at the next `with_core`.
     spare_buffers: Mutex<Vec<Vec<u8>>>,
+    /// Services watching the core (see [`CoreObserver`]); `has_observers` keeps the sample path free of
+    /// the lock while there are none.
+    observers: RwLock<Vec<Arc<dyn CoreObserver>>>,
+    has_observers: AtomicBool,
 }
 
 /// Most sent buffers kept for recycling.
@@ -208,6 +226,8 @@ impl Driver {
             timer_thread: Mutex::new(None),
             status: Arc::new(StatusCore::default()),
             spare_buffers: Mutex::new(Vec::new()),
+            observers: RwLock::new(Vec::new()),
+            has_observers: AtomicBool::new(false),
         });
         let weak: Weak<Driver> = Arc::downgrade(&driver);
         let rx = Arc::new(move |_ch: Channel, batch: &[Datagram<'_>]| {
@@ -293,6 +313,7 @@ impl Driver {
         touched: &mut Vec<(EntityId, Arc<dyn Endpoint>)>,
     ) {
         let (reader, item) = match ev {
+            Event::Sample(s) if !self.admit(&s) => return,
             Event::Sample(s) => (s.reader, Pending::Sample(s)),
             Event::CoherentSet {
                 reader, samples, ..
@@ -310,6 +331,11 @@ impl Driver {
                 (reader, Pending::WriterGone(writer))
             }
             other => {
+                if self.has_observers.load(Ordering::Acquire) {
+                    read(&self.observers)
+                        .iter()
+                        .for_each(|o| o.observe_locked(&other));
+                }
                 deferred.push(other);
                 return;
             }
@@ -373,7 +399,34 @@ impl Driver {
 
     fn dispatch_event(&self, ev: Event) {
         tracing::debug!(event = ?ev, "core event");
-        match &ev {
+        self.dispatch_endpoint_event(&ev);
+        if self.has_observers.load(Ordering::Acquire) {
+            let observers = read(&self.observers).clone();
+            for o in observers {
+                o.on_event(&ev);
+            }
+        }
+    }
+
+    /// Whether every observer lets `s` reach its reader.
+    fn admit(&self, s: &ReceivedSample) -> bool {
+        !self.has_observers.load(Ordering::Acquire)
+            || read(&self.observers).iter().all(|o| o.admit(s))
+    }
+
+    /// Registers a service that watches the core (until shutdown).
+    pub(crate) fn add_observer(&self, o: Arc<dyn CoreObserver>) {
+        write(&self.observers).push(o);
+        self.has_observers.store(true, Ordering::Release);
+    }
+
+    /// Runs `f` on the core for a query: no event is polled and no datagram sent.
+    pub(crate) fn query_core<R>(&self, f: impl FnOnce(&Participant) -> R) -> R {
+        f(&lock(&self.core))
+    }
+
+    fn dispatch_endpoint_event(&self, ev: &Event) {
+        match ev {
             Event::PublicationMatched { writer: id, .. }
             | Event::OfferedIncompatibleQos { writer: id, .. }
             | Event::SubscriptionMatched { reader: id, .. }
@@ -381,7 +434,7 @@ impl Driver {
             | Event::LivelinessChanged { reader: id, .. }
             | Event::SampleLost { reader: id, .. } => {
                 if let Some(e) = self.endpoint(*id) {
-                    e.on_event(&ev);
+                    e.on_event(ev);
                 }
             }
             Event::ParticipantDiscovered(p) => {
@@ -584,8 +637,10 @@ impl Driver {
             }
         }
         self.transport.shutdown();
-        // Readers and writers point back at us: forget them to break the cycle.
+        // Readers, writers and observers point back at us: forget them to break the cycle.
         write(&self.endpoints).clear();
+        self.has_observers.store(false, Ordering::Release);
+        write(&self.observers).clear();
     }
 }
 

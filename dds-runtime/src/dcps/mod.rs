@@ -31,6 +31,7 @@ mod cache;
 pub mod condition;
 mod decode;
 mod driver;
+pub mod durability;
 mod endpoint;
 mod error;
 pub mod filter;
@@ -47,6 +48,7 @@ mod topic;
 /// GUIDs name entities in the DCPS API ([`DataWriter::guid`], [`SampleInfo::publication_guid`], ...).
 pub use crate::rtps::{Guid, GuidPrefix};
 pub use condition::{Condition, GuardCondition, ReadCondition, StatusCondition, WaitSet};
+pub use durability::{DurabilityServiceConfig, DurabilityServiceMode};
 pub use error::{DdsError, DdsResult};
 pub use filter::{ContentFilter, FieldValue, FilterFields};
 pub use listener::{DataReaderListener, DataWriterListener};

@@ -12,6 +12,7 @@ use crate::transport::UdpTransport;
 
 use super::condition::StatusCondition;
 use super::driver::Driver;
+use super::durability::DurabilityServiceConfig;
 use super::error::DdsResult;
 use super::sample::InstanceHandle;
 
@@ -99,6 +100,7 @@ pub struct DomainParticipantBuilder {
     ignore_env: bool,
     user_data: Vec<u8>,
     name: Option<String>,
+    durability_service: Option<DurabilityServiceConfig>,
 }
 
 impl DomainParticipantBuilder {
@@ -223,13 +225,28 @@ impl DomainParticipantBuilder {
         Ok(c)
     }
 
+    /// The durability service this participant runs (default: `DDS_DURABILITY_SERVICE` and
+    /// `DDS_DURABILITY_STORE`, else one for its own TRANSIENT and PERSISTENT writers; see
+    /// [`super::durability`]).
+    pub fn durability_service(mut self, c: DurabilityServiceConfig) -> Self {
+        self.durability_service = Some(c);
+        self
+    }
+
     /// Binds the sockets, starts the receive and timer threads and begins SPDP.
     pub fn build(self) -> DdsResult<DomainParticipant> {
         let config = self.resolve_config()?;
+        let durability = match self.durability_service {
+            Some(c) => c,
+            None if self.ignore_env => DurabilityServiceConfig::default(),
+            None => DurabilityServiceConfig::from_env()?,
+        };
         let driver = Driver::start(config, self.user_data, self.name)?;
+        let guard = Arc::new(Guard(driver.clone()));
+        super::durability::install(&driver, &durability)?;
         Ok(DomainParticipant {
-            driver: driver.clone(),
-            _guard: Arc::new(Guard(driver)),
+            driver,
+            _guard: guard,
         })
     }
 }

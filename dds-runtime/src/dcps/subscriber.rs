@@ -527,6 +527,17 @@ impl<T: DdsType> DataReader<T> {
         }
     }
 
+    /// Blocks until every matched reliable writer's announced data (the history of TRANSIENT_LOCAL writers
+    /// and of durability services' stand-ins included) has arrived (`Ok(true)`), or `timeout` passes
+    /// (`Ok(false)`). Returns at once when no writer is matched yet. See docs/durability.md.
+    pub fn wait_for_historical_data(&self, timeout: Duration) -> DdsResult<bool> {
+        super::durability::wait_for_historical_data(
+            &self.inner.state.driver,
+            self.handle.id(),
+            timeout,
+        )
+    }
+
     /// An async stream of samples (each taken, oldest first). Runtime-agnostic: it registers the task's
     /// waker and is woken by the receive thread. Ends when the participant shuts down.
     pub fn stream(&self) -> SampleStream<T> {

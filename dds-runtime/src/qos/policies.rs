@@ -93,9 +93,10 @@ pub enum Durability {
     Volatile,
     /// The writer keeps its history for late-joining readers.
     TransientLocal,
-    /// As TransientLocal here (no durability service).
+    /// The data outlives its writer: a durability service keeps it for late joiners (see
+    /// `dcps::durability`; as TransientLocal when no service runs).
     Transient,
-    /// As TransientLocal here (no durability service).
+    /// As Transient, and the data also survives a restart of the service when it has a persistent store.
     Persistent,
 }
 

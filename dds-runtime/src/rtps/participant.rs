@@ -4,6 +4,7 @@
 
 mod coherent;
 mod discovery;
+mod historical;
 mod receive;
 mod timers;
 

@@ -74,12 +74,6 @@ fn unsupported(o: &ShapeOptions) -> Option<String> {
     if o.cft_expression.is_some() {
         return Some("    ContentFilteredTopic expression (--cft) = not supported".into());
     }
-    if matches!(
-        o.durability,
-        DurabilityArg::Transient | DurabilityArg::Persistent
-    ) {
-        return Some("    Durability TRANSIENT/PERSISTENT = not supported".into());
-    }
     None
 }
 
@@ -264,7 +258,11 @@ impl App {
                 .durability(durability(o))
                 .data_representation(representation(o));
             if let Some(h) = history(o) {
-                qos = qos.history(h);
+                // -D t / -D p: the durability service keeps what the writer keeps.
+                qos = qos.history(h).durability_service(DurabilityService {
+                    history: h,
+                    ..Default::default()
+                });
             }
             if let Some(s) = o.ownership_strength {
                 qos = qos

@@ -260,6 +260,8 @@ impl Participant {
     /// Announces a new local endpoint in SEDP and matches it.
     pub(super) fn publish_endpoint<Q: Direction>(&mut self, now: Instant, d: EndpointData<Q>) {
         self.announce(now, Q::ANNOUNCER, d.guid, ChangeKind::Alive, d.encode());
+        // Local endpoints are reported as remote ones are (the DCPS services watch both).
+        self.events.push_back(Q::discovered(d.clone()));
         self.on_endpoint_known(now, d);
         self.service(now);
     }

@@ -3,6 +3,7 @@
 
 mod coherent;
 mod defrag;
+mod historical;
 mod writer_proxy;
 
 pub(crate) use writer_proxy::{PendingChange, Slot, WriterProxy};

@@ -1,0 +1,435 @@
+//! The durability service: a DDS application inside the participant. It watches discovery for TRANSIENT
+//! and PERSISTENT writers, subscribes to their topics with a reader of its own (untyped: it keeps the
+//! serialized payloads), keeps each writer's changes within its DURABILITY_SERVICE QoS, and republishes
+//! them through a stand-in writer, one per original writer, which keeps its history for late joiners as a
+//! TRANSIENT_LOCAL writer does. The stand-in outlives the original writer.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, Weak};
+use std::time::{Duration, Instant};
+
+use super::history::{instance_of, Limits, StoredChange, WriterHistory};
+use super::marker;
+#[cfg(feature = "persistence")]
+use super::store::{Batch, PersistentStore};
+use crate::dcps::driver::{CoreObserver, Driver, Endpoint, Pending};
+use crate::dcps::sync::lock;
+use crate::qos::{
+    DataReaderQos, DataRepresentation, Durability, History, ReaderQos, Reliability, ResourceLimits,
+    UserData, WriterQos,
+};
+use crate::rtps::discovery::WriterData;
+use crate::rtps::{
+    ChangeKind, EntityId, Event, Guid, GuidPrefix, ReaderSpec, ReceivedSample, WriteChange,
+    WriteError, WriterSpec,
+};
+
+/// Which writers a service keeps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Scope {
+    /// Only the participant's own writers (the service every participant runs).
+    Local(GuidPrefix),
+    /// Every writer of the domain (the standalone `dds-durability`).
+    Domain,
+}
+
+/// A channel: one reader of the service per topic, type and partition list.
+type ChannelKey = (String, String, Vec<String>);
+
+/// What the service keeps of one original writer.
+struct Kept {
+    /// The original writer's announcement.
+    data: WriterData,
+    history: WriterHistory,
+    /// The stand-in writer, once created.
+    stand_in: Option<EntityId>,
+    /// When the original writer was seen to go (or, after a restart, when the service loaded it).
+    gone_since: Option<Instant>,
+}
+
+impl Kept {
+    fn keyed(&self) -> bool {
+        self.data.guid.entity_id.is_keyed()
+    }
+    #[cfg_attr(not(feature = "persistence"), allow(dead_code))]
+    fn persistent(&self) -> bool {
+        self.data.qos.writer.durability == Durability::Persistent
+    }
+}
+
+#[derive(Default)]
+struct State {
+    channels: HashMap<ChannelKey, Option<EntityId>>,
+    kept: HashMap<Guid, Kept>,
+}
+
+/// The running service.
+pub(crate) struct Service {
+    driver: Weak<Driver>,
+    scope: Scope,
+    /// Most changes kept per original writer, whatever its QoS says.
+    cap: usize,
+    #[cfg(feature = "persistence")]
+    store: Option<PersistentStore>,
+    state: Mutex<State>,
+    me: Weak<Service>,
+}
+
+/// The stand-in QoS: the original writer's, with the service's history, limits and marker.
+fn stand_in_qos(w: &WriterData, cap: usize) -> WriterQos {
+    let mut q = w.qos.clone();
+    let ds = q.writer.durability_service;
+    q.writer.history = ds.history;
+    q.writer.resource_limits = ResourceLimits {
+        max_samples: Some(ds.max_samples.unwrap_or(u32::MAX).min(cap as u32)),
+        max_instances: ds.max_instances,
+        max_samples_per_instance: ds.max_samples_per_instance,
+    };
+    q.writer.reliability = Reliability::Reliable {
+        max_blocking_time: Duration::from_millis(100),
+    };
+    q.writer.user_data = UserData(marker::user_data(&w.guid));
+    q
+}
+
+/// The service reader's QoS for a channel of `w`: reliable, TRANSIENT_LOCAL (so that writers send their
+/// history), KEEP_ALL, both representations, in `w`'s partitions.
+fn channel_qos(w: &WriterData) -> ReaderQos {
+    ReaderQos {
+        reader: DataReaderQos::builder()
+            .reliability(Reliability::RELIABLE)
+            .durability(Durability::TransientLocal)
+            .history(History::KeepAll)
+            .data_representation(DataRepresentation::accept_both())
+            .build(),
+        partition: w.qos.partition.clone(),
+        topic_data: w.qos.topic_data.clone(),
+        ..ReaderQos::default()
+    }
+}
+
+impl Service {
+    /// A service on `driver` (registered as its observer by the caller).
+    pub(crate) fn new(
+        driver: &Arc<Driver>,
+        scope: Scope,
+        cap: usize,
+        #[cfg(feature = "persistence")] store: Option<PersistentStore>,
+    ) -> Arc<Self> {
+        Arc::new_cyclic(|me| Service {
+            driver: Arc::downgrade(driver),
+            scope,
+            cap,
+            #[cfg(feature = "persistence")]
+            store,
+            state: Mutex::new(State::default()),
+            me: me.clone(),
+        })
+    }
+
+    fn in_scope(&self, w: &WriterData) -> bool {
+        w.qos.writer.durability >= Durability::Transient
+            && marker::stand_in_for(&w.qos.writer.user_data.0).is_none()
+            && match self.scope {
+                Scope::Local(p) => w.guid.prefix == p,
+                Scope::Domain => true,
+            }
+    }
+
+    /// Keeps `w` from now on: its channel reader and its stand-in.
+    fn adopt(&self, w: &WriterData, changes: Vec<StoredChange>, gone: bool) {
+        let Some(driver) = self.driver.upgrade() else {
+            return;
+        };
+        {
+            let mut st = lock(&self.state);
+            if let Some(k) = st.kept.get_mut(&w.guid) {
+                k.gone_since = None;
+                return;
+            }
+            let mut history =
+                WriterHistory::new(Limits::new(&w.qos.writer.durability_service, self.cap));
+            for c in changes {
+                history.insert(c);
+            }
+            st.kept.insert(
+                w.guid,
+                Kept {
+                    data: w.clone(),
+                    history,
+                    stand_in: None,
+                    gone_since: gone.then(Instant::now),
+                },
+            );
+        }
+        #[cfg(feature = "persistence")]
+        if let Some(store) = &self.store {
+            if w.qos.writer.durability == Durability::Persistent {
+                if let Err(e) = store.save_writer(w) {
+                    tracing::warn!(error = %e, writer = ?w.guid, "durability: writer not stored");
+                }
+            }
+        }
+        if !gone {
+            self.open_channel(&driver, w);
+        }
+        self.create_stand_in(&driver, w);
+    }
+
+    fn open_channel(&self, driver: &Arc<Driver>, w: &WriterData) {
+        let key = (
+            w.topic_name.clone(),
+            w.type_name.clone(),
+            w.qos.partition.0.clone(),
+        );
+        {
+            let mut st = lock(&self.state);
+            if st.channels.contains_key(&key) {
+                return;
+            }
+            st.channels.insert(key.clone(), None);
+        }
+        let sink = Arc::new(ChannelSink {
+            service: self.me.clone(),
+            queue: Mutex::new(Vec::new()),
+        });
+        let spec = ReaderSpec::new(
+            w.topic_name.clone(),
+            w.type_name.clone(),
+            w.guid.entity_id.is_keyed(),
+            channel_qos(w),
+        );
+        match driver.create_endpoint(sink, |c, now| c.create_reader(now, spec)) {
+            Ok(id) => {
+                lock(&self.state).channels.insert(key, Some(id));
+                tracing::info!(topic = %w.topic_name, "durability: subscribed");
+            }
+            Err(e) => tracing::warn!(error = %e, topic = %w.topic_name, "durability: no reader"),
+        }
+    }
+
+    fn create_stand_in(&self, driver: &Arc<Driver>, w: &WriterData) {
+        let sink = Arc::new(StandInSink {
+            service: self.me.clone(),
+            original: w.guid,
+        });
+        let mut spec = WriterSpec::new(
+            w.topic_name.clone(),
+            w.type_name.clone(),
+            w.guid.entity_id.is_keyed(),
+            stand_in_qos(w, self.cap),
+        );
+        spec.type_information = w.type_information.clone();
+        spec.entity_name = Some(format!("durability stand-in for {}", w.topic_name));
+        let id = match driver.create_endpoint(sink, |c, now| c.create_writer(now, spec)) {
+            Ok(id) => id,
+            Err(e) => {
+                tracing::warn!(error = %e, topic = %w.topic_name, "durability: no stand-in");
+                return;
+            }
+        };
+        let backlog: Vec<WriteChange> = {
+            let mut st = lock(&self.state);
+            let Some(k) = st.kept.get_mut(&w.guid) else {
+                return;
+            };
+            k.stand_in = Some(id);
+            let keyed = k.keyed();
+            k.history.changes().map(|c| c.to_write(keyed)).collect()
+        };
+        for ch in backlog {
+            write_change(driver, id, ch);
+        }
+    }
+
+    /// Keeps and republishes what a channel reader received.
+    fn ingest(&self, samples: Vec<ReceivedSample>) {
+        let Some(driver) = self.driver.upgrade() else {
+            return;
+        };
+        let mut out: Vec<(EntityId, WriteChange)> = Vec::new();
+        #[cfg(feature = "persistence")]
+        let mut batch = Batch::default();
+        {
+            let mut st = lock(&self.state);
+            for s in samples {
+                // Unregistrations are not kept: the service keeps the instance for late joiners.
+                if s.kind == ChangeKind::Unregister {
+                    continue;
+                }
+                let Some(k) = st.kept.get_mut(&s.writer) else {
+                    continue;
+                };
+                let keyed = k.keyed();
+                let c = StoredChange {
+                    seq: s.sequence.0,
+                    kind: s.kind,
+                    key_hash: instance_of(keyed, s.key_hash, &s.payload),
+                    timestamp: s.source_timestamp,
+                    payload: s.payload.compact(),
+                };
+                let ins = k.history.insert(c.clone());
+                if !ins.kept {
+                    continue;
+                }
+                if let Some(id) = k.stand_in {
+                    out.push((id, c.to_write(keyed)));
+                }
+                #[cfg(feature = "persistence")]
+                if k.persistent() {
+                    batch
+                        .evicted
+                        .extend(ins.evicted.iter().map(|seq| (s.writer, *seq)));
+                    batch.put.push((s.writer, c));
+                }
+            }
+        }
+        #[cfg(feature = "persistence")]
+        if let Some(store) = &self.store {
+            if !batch.is_empty() {
+                if let Err(e) = store.apply(&batch) {
+                    tracing::warn!(error = %e, "durability: changes not stored");
+                }
+            }
+        }
+        for (id, ch) in out {
+            write_change(&driver, id, ch);
+        }
+    }
+
+    /// The original writer left: its data stays; `service_cleanup_delay` starts.
+    fn writer_gone(&self, g: &Guid) {
+        tracing::debug!(writer = ?g, "durability: original writer gone");
+        if let Some(k) = lock(&self.state).kept.get_mut(g) {
+            k.gone_since.get_or_insert_with(Instant::now);
+        }
+    }
+
+    /// Forgets `original` once it has been gone for its `service_cleanup_delay` and each of its instances is
+    /// disposed (DDS 1.4 §2.2.3.5).
+    fn cleanup(&self, original: &Guid, now: Instant) {
+        let stand_in = {
+            let mut st = lock(&self.state);
+            let Some(k) = st.kept.get(original) else {
+                return;
+            };
+            let delay = k.data.qos.writer.durability_service.service_cleanup_delay;
+            let due = k.gone_since.is_some_and(|t| now >= t + delay);
+            if !due || !k.history.all_disposed() {
+                return;
+            }
+            st.kept.remove(original).and_then(|k| k.stand_in)
+        };
+        tracing::info!(writer = ?original, "durability: cleaned up");
+        #[cfg(feature = "persistence")]
+        if let Some(store) = &self.store {
+            if let Err(e) = store.remove_writer(original) {
+                tracing::warn!(error = %e, "durability: writer not removed from the store");
+            }
+        }
+        if let (Some(id), Some(driver)) = (stand_in, self.driver.upgrade()) {
+            driver.delete_endpoint(id);
+        }
+    }
+
+    /// Adopts the writers discovery already knows (for a service started after its participant).
+    pub(crate) fn adopt_known(&self) {
+        let Some(driver) = self.driver.upgrade() else {
+            return;
+        };
+        let known: Vec<WriterData> = driver.query_core(|c| {
+            c.publications()
+                .filter(|w| self.in_scope(w))
+                .cloned()
+                .collect()
+        });
+        for w in known {
+            self.adopt(&w, Vec::new(), false);
+        }
+    }
+
+    /// Re-adopts what the persistent store holds (at start).
+    #[cfg(feature = "persistence")]
+    pub(crate) fn restore(&self) -> Result<usize, super::store::StoreError> {
+        let Some(store) = &self.store else {
+            return Ok(0);
+        };
+        let writers = store.load()?;
+        let n = writers.len();
+        for w in writers {
+            tracing::info!(writer = ?w.data.guid, changes = w.changes.len(), "durability: restored");
+            self.adopt(&w.data, w.changes, true);
+        }
+        Ok(n)
+    }
+}
+
+/// Writes a change to a stand-in, waiting (at most 2 s) while flow control holds it back.
+fn write_change(driver: &Driver, id: EntityId, ch: WriteChange) {
+    let deadline = Instant::now() + Duration::from_secs(2);
+    loop {
+        match driver.with_core(|core, now| core.write(now, id, ch.clone())) {
+            Err(WriteError::WouldBlock) if Instant::now() < deadline => {
+                let seen = driver.progress_generation();
+                driver.wait_progress_change(seen, Instant::now() + Duration::from_millis(20));
+            }
+            Err(e) => {
+                tracing::warn!(error = %e, "durability: change not republished");
+                return;
+            }
+            Ok(_) => return,
+        }
+    }
+}
+
+impl CoreObserver for Service {
+    fn on_event(&self, ev: &Event) {
+        match ev {
+            Event::PublicationDiscovered(w) if self.in_scope(w) => self.adopt(w, Vec::new(), false),
+            Event::PublicationRemoved { guid } => self.writer_gone(guid),
+            Event::WriterDeleted { writer } => {
+                if let Some(d) = self.driver.upgrade() {
+                    self.writer_gone(&Guid::new(d.guid_prefix, *writer));
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// The driver-facing side of a channel reader.
+struct ChannelSink {
+    service: Weak<Service>,
+    queue: Mutex<Vec<ReceivedSample>>,
+}
+
+impl Endpoint for ChannelSink {
+    fn enqueue(&self, item: Pending) {
+        if let Pending::Sample(s) = item {
+            lock(&self.queue).push(s);
+        }
+    }
+    fn process(self: Arc<Self>) {
+        let samples = std::mem::take(&mut *lock(&self.queue));
+        if let (Some(svc), false) = (self.service.upgrade(), samples.is_empty()) {
+            svc.ingest(samples);
+        }
+    }
+    fn on_event(self: Arc<Self>, _ev: &Event) {}
+    fn tick(self: Arc<Self>, _now: Instant) {}
+}
+
+/// The driver-facing side of a stand-in writer: runs the cleanup check of its original writer.
+struct StandInSink {
+    service: Weak<Service>,
+    original: Guid,
+}
+
+impl Endpoint for StandInSink {
+    fn on_event(self: Arc<Self>, _ev: &Event) {}
+    fn tick(self: Arc<Self>, now: Instant) {
+        if let Some(svc) = self.service.upgrade() {
+            svc.cleanup(&self.original, now);
+        }
+    }
+}

@@ -1,0 +1,233 @@
+//! TRANSIENT and PERSISTENT durability end to end: the durability service keeps data past its writer,
+//! serves late joiners once each, honours DURABILITY_SERVICE history, survives a restart with its
+//! persistent store, and durability kinds match in the order VOLATILE < TRANSIENT_LOCAL < TRANSIENT <
+//! PERSISTENT.
+mod dcps_util;
+
+use std::time::Duration;
+
+use dcps_util::*;
+use dds_runtime::prelude::*;
+
+const HISTORY_TIMEOUT: Duration = Duration::from_secs(10);
+
+fn durable_writer_qos(kind: Durability, depth: u32) -> DataWriterQos {
+    DataWriterQos::builder()
+        .reliability(reliable())
+        .durability(kind)
+        .history(History::KeepLast(depth))
+        .durability_service(DurabilityService {
+            history: History::KeepLast(depth),
+            ..DurabilityService::default()
+        })
+        // Deleting the writer must not dispose its instances, or the service forgets them (see
+        // `disposed_data_is_cleaned_up`).
+        .writer_data_lifecycle(WriterDataLifecycle {
+            autodispose_unregistered_instances: false,
+        })
+        .build()
+}
+
+fn durable_reader_qos(kind: Durability) -> DataReaderQos {
+    DataReaderQos::builder()
+        .reliability(reliable())
+        .durability(kind)
+        .history(History::KeepAll)
+        .build()
+}
+
+/// Takes until `n` samples arrived (or the timeout passed), then a little longer to catch repeats.
+fn take_all(r: &DataReader<ShapeType>, n: usize) -> Vec<(String, i32)> {
+    let mut got = Vec::new();
+    wait_until(HISTORY_TIMEOUT, || {
+        got.extend(
+            r.take()
+                .unwrap()
+                .into_iter()
+                .filter_map(|s| s.data.map(|d| (d.color, d.x))),
+        );
+        got.len() >= n
+    });
+    std::thread::sleep(Duration::from_millis(500));
+    got.extend(
+        r.take()
+            .unwrap()
+            .into_iter()
+            .filter_map(|s| s.data.map(|d| (d.color, d.x))),
+    );
+    got.sort();
+    got
+}
+
+fn write_rounds(w: &DataWriter<ShapeType>, rounds: i32) {
+    for x in 1..=rounds {
+        for color in ["BLUE", "RED"] {
+            w.write(&shape(color, x)).unwrap();
+        }
+    }
+}
+
+fn expected(from: i32, to: i32) -> Vec<(String, i32)> {
+    let mut v: Vec<(String, i32)> = (from..=to)
+        .flat_map(|x| [("BLUE".to_string(), x), ("RED".to_string(), x)])
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn transient_data_outlives_its_writer() {
+    let pw = participant(141);
+    let w = writer::<ShapeType>(
+        &pw,
+        "Transient",
+        &durable_writer_qos(Durability::Transient, 2),
+    );
+    write_rounds(&w, 3);
+    drop(w);
+    std::thread::sleep(Duration::from_millis(300));
+    let pr = participant(141);
+    let r = reader::<ShapeType>(&pr, "Transient", &durable_reader_qos(Durability::Transient));
+    assert!(wait_until(HISTORY_TIMEOUT, || r
+        .subscription_matched_status()
+        .current_count
+        >= 1));
+    assert!(r.wait_for_historical_data(HISTORY_TIMEOUT).unwrap());
+    // DURABILITY_SERVICE keeps the last 2 per instance.
+    assert_eq!(take_all(&r, 4), expected(2, 3));
+}
+
+#[test]
+fn disposed_data_is_cleaned_up() {
+    let pw = participant(146);
+    let mut wq = durable_writer_qos(Durability::Transient, 2);
+    wq.writer_data_lifecycle = WriterDataLifecycle::default();
+    let w = writer::<ShapeType>(&pw, "Disposed", &wq);
+    write_rounds(&w, 2);
+    // Autodispose: deleting the writer disposes both instances; service_cleanup_delay 0 lets them go.
+    drop(w);
+    std::thread::sleep(Duration::from_millis(500));
+    let pr = participant(146);
+    let r = reader::<ShapeType>(&pr, "Disposed", &durable_reader_qos(Durability::Transient));
+    std::thread::sleep(Duration::from_secs(1));
+    assert_eq!(r.subscription_matched_status().current_count, 0);
+    assert!(r.take().unwrap().is_empty());
+}
+
+#[test]
+fn late_joiner_gets_each_sample_once_while_the_writer_lives() {
+    let pw = participant(142);
+    let w = writer::<ShapeType>(&pw, "Both", &durable_writer_qos(Durability::Transient, 3));
+    write_rounds(&w, 3);
+    let pr = participant(142);
+    let r = reader::<ShapeType>(&pr, "Both", &durable_reader_qos(Durability::Transient));
+    assert!(wait_until(HISTORY_TIMEOUT, || r
+        .subscription_matched_status()
+        .current_count
+        == 2));
+    assert_eq!(
+        take_all(&r, 6),
+        expected(1, 3),
+        "writer and stand-in: once each"
+    );
+    write_rounds(&w, 3);
+    let mut live = take_all(&r, 6);
+    live.dedup();
+    assert_eq!(live.len(), 2 * 3, "live samples once each");
+}
+
+#[test]
+fn without_a_service_transient_is_transient_local() {
+    let pw = DomainParticipant::builder()
+        .domain_id(143)
+        .interface("lo")
+        .spdp_interval(Duration::from_millis(200))
+        .durability_service(DurabilityServiceConfig::off())
+        .build()
+        .unwrap();
+    let w = writer::<ShapeType>(&pw, "Off", &durable_writer_qos(Durability::Transient, 2));
+    write_rounds(&w, 2);
+    drop(w);
+    let pr = participant(143);
+    let r = reader::<ShapeType>(&pr, "Off", &durable_reader_qos(Durability::Transient));
+    std::thread::sleep(Duration::from_secs(1));
+    assert_eq!(r.subscription_matched_status().current_count, 0);
+    assert!(r.take().unwrap().is_empty());
+}
+
+#[test]
+fn persistent_data_survives_a_restart_of_the_service() {
+    let dir = std::env::temp_dir().join(format!("dds-durability-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let db = dir.join("store.redb");
+    let _ = std::fs::remove_file(&db);
+    let service = |db: &std::path::Path| {
+        require_netns();
+        DomainParticipant::builder()
+            .domain_id(144)
+            .interface("lo")
+            .spdp_interval(Duration::from_millis(200))
+            .durability_service(DurabilityServiceConfig::domain().persistent_store(db))
+            .build()
+            .unwrap()
+    };
+    let svc = service(&db);
+    let pw = DomainParticipant::builder()
+        .domain_id(144)
+        .interface("lo")
+        .spdp_interval(Duration::from_millis(200))
+        .durability_service(DurabilityServiceConfig::off())
+        .build()
+        .unwrap();
+    let w = writer::<ShapeType>(
+        &pw,
+        "Persist",
+        &durable_writer_qos(Durability::Persistent, 5),
+    );
+    assert!(wait_until(HISTORY_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    write_rounds(&w, 4);
+    w.wait_for_acknowledgments(HISTORY_TIMEOUT).unwrap();
+    drop(w);
+    drop(pw);
+    drop(svc);
+    std::thread::sleep(Duration::from_millis(300));
+    let _svc = service(&db);
+    let pr = participant(144);
+    let r = reader::<ShapeType>(&pr, "Persist", &durable_reader_qos(Durability::Persistent));
+    assert_eq!(take_all(&r, 8), expected(1, 4));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn durability_kinds_match_in_order() {
+    let p1 = participant(145);
+    let p2 = participant(145);
+    let kinds = [
+        Durability::Volatile,
+        Durability::TransientLocal,
+        Durability::Transient,
+        Durability::Persistent,
+    ];
+    // Offered TRANSIENT: readers up to TRANSIENT match, PERSISTENT is incompatible.
+    let w = writer::<ShapeType>(&p1, "Order", &durable_writer_qos(Durability::Transient, 1));
+    let readers: Vec<DataReader<ShapeType>> = kinds
+        .iter()
+        .map(|k| reader::<ShapeType>(&p2, "Order", &durable_reader_qos(*k)))
+        .collect();
+    assert!(wait_until(HISTORY_TIMEOUT, || {
+        readers[..3]
+            .iter()
+            .all(|r| r.subscription_matched_status().current_count >= 1)
+            && readers[3].requested_incompatible_qos_status().total_count >= 1
+    }));
+    let st = readers[3].requested_incompatible_qos_status();
+    assert_eq!(st.last_policy_id, Some(QosPolicyId::Durability));
+    assert!(w.offered_incompatible_qos_status().total_count >= 1);
+    assert_eq!(
+        w.offered_incompatible_qos_status().last_policy_id,
+        Some(QosPolicyId::Durability)
+    );
+}

@@ -1,0 +1,172 @@
+//! TRANSIENT and PERSISTENT durability across processes: the durability order against Cyclone DDS (both
+//! directions), and a test that kills things: persistent samples survive `kill -9` of their writer and of
+//! the `dds-durability` service, and a reader that joins after the service restarted gets each sample
+//! written before the kill exactly once.
+
+use std::collections::BTreeMap;
+use std::process::Command;
+use std::time::Duration;
+
+use super::harness::{our_bin, require_netns, Proc, Skip};
+use super::shapes::Prog;
+use crate::check;
+
+const WAIT: Duration = Duration::from_secs(20);
+
+/// A sample line of `shape_main` (`Square     RED        012 034 [30]`), as printed by a writer with `-w`
+/// and by a reader.
+fn samples(p: &Proc, color: &str) -> Vec<String> {
+    let prefix = format!("{:<10} {color:<10} ", "Square");
+    p.grep(|l| l.starts_with(&prefix) && l.contains(" [") && !l.contains("NOT_ALIVE"))
+}
+
+/// A writer offering `offered` and a reader requesting `requested`, with the durability order deciding:
+/// incompatible pairs print the DURABILITY lines and exchange nothing, compatible pairs exchange data.
+fn durability_pair(
+    publ: Prog,
+    sub: Prog,
+    domain: u32,
+    offered: char,
+    requested: char,
+) -> Result<(), Skip> {
+    require_netns()?;
+    let mut s = sub.spawn(
+        "sub",
+        &format!("-S -t Square -d {domain} -r -D {requested}"),
+    )?;
+    let mut p = publ.spawn(
+        "pub",
+        &format!("-P -t Square -d {domain} -r -c ORANGE -D {offered}"),
+    )?;
+    let compatible = "vltp".find(offered) >= "vltp".find(requested);
+    if compatible {
+        let got = s.wait_line(WAIT, |l| l.starts_with("Square     ORANGE"));
+        check!(
+            got.is_some(),
+            &[&p, &s],
+            "-D {offered} to -D {requested}: no data"
+        );
+    } else {
+        let sl = s.wait_line(WAIT, |l| l.starts_with("on_requested_incompatible_qos()"));
+        let pl = p.wait_line(WAIT, |l| l.starts_with("on_offered_incompatible_qos()"));
+        check!(
+            sl.as_deref().is_some_and(|l| l.ends_with("(DURABILITY)")),
+            &[&p, &s],
+            "reader incompatible line"
+        );
+        check!(
+            pl.as_deref().is_some_and(|l| l.ends_with("(DURABILITY)")),
+            &[&p, &s],
+            "writer incompatible line"
+        );
+        check!(
+            samples(&s, "ORANGE").is_empty(),
+            &[&p, &s],
+            "incompatible pair exchanged data"
+        );
+    }
+    let _ = p.interrupt(WAIT);
+    let _ = s.interrupt(WAIT);
+    Ok(())
+}
+
+#[test]
+fn transient_writer_persistent_reader_incompatible_us_to_cyclone() {
+    let _ = durability_pair(Prog::Ours, Prog::Cyclone, 190, 't', 'p');
+}
+
+#[test]
+fn transient_writer_persistent_reader_incompatible_cyclone_to_us() {
+    let _ = durability_pair(Prog::Cyclone, Prog::Ours, 191, 't', 'p');
+}
+
+#[test]
+fn persistent_writer_transient_reader_match_us_to_cyclone() {
+    let _ = durability_pair(Prog::Ours, Prog::Cyclone, 192, 'p', 't');
+}
+
+#[test]
+fn persistent_writer_transient_local_reader_match_cyclone_to_us() {
+    let _ = durability_pair(Prog::Cyclone, Prog::Ours, 193, 'p', 'l');
+}
+
+fn service(domain: u32, store: &std::path::Path) -> Result<Proc, Skip> {
+    let mut c = Command::new(our_bin("dds-durability")?);
+    c.args(["--domain", &domain.to_string(), "--store"])
+        .arg(store);
+    let p = Proc::spawn("dds-durability", c);
+    check!(
+        p.wait_line(WAIT, |l| l.ends_with("ready")).is_some(),
+        &[&p],
+        "service not ready"
+    );
+    Ok(p)
+}
+
+#[test]
+fn persistent_samples_survive_kill_9_of_writer_and_service() {
+    let _ = kill_test(194);
+}
+
+fn kill_test(domain: u32) -> Result<(), Skip> {
+    require_netns()?;
+    let dir = std::env::temp_dir().join(format!("dds-durability-kill-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let store = dir.join("domain.redb");
+    let _ = std::fs::remove_file(&store);
+    let svc = service(domain, &store)?;
+    // The writer runs without its own in-process service: only dds-durability keeps its data.
+    let mut c = Command::new(our_bin("shape_main")?);
+    c.args([
+        "-P", "-t", "Square", "-c", "GREEN", "-r", "-D", "p", "-k", "0", "-w", "-z", "0",
+    ])
+    .args(["-d", &domain.to_string()])
+    .env("DDS_DURABILITY_SERVICE", "off");
+    let writer = Proc::spawn("writer", c);
+    let enough = writer
+        .wait_lines(WAIT, 30, |l| l.starts_with("Square     GREEN"))
+        .is_some();
+    check!(enough, &[&svc, &writer], "writer did not write 30 samples");
+    // kill -9 the writer (Proc's drop sends SIGKILL), keeping what it printed before.
+    let written = samples(&writer, "GREEN");
+    drop(writer);
+    // The service stores each batch with an fsync'ed commit; give it a moment to receive the last ones.
+    std::thread::sleep(Duration::from_secs(1));
+    drop(svc);
+    let svc = service(domain, &store)?;
+    let mut r = Prog::Ours.spawn("reader", &format!("-S -t Square -d {domain} -r -D p -k 0"))?;
+    let all = r
+        .wait_lines(WAIT, written.len(), |l| l.starts_with("Square     GREEN"))
+        .is_some();
+    std::thread::sleep(Duration::from_secs(1));
+    let got = samples(&r, "GREEN");
+    eprintln!(
+        "kill test: {} samples written before kill -9, {} received after the restart",
+        written.len(),
+        got.len()
+    );
+    let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+    for l in &got {
+        *counts.entry(l.as_str()).or_default() += 1;
+    }
+    let missing: Vec<&String> = written
+        .iter()
+        .filter(|l| !counts.contains_key(l.as_str()))
+        .collect();
+    let repeated: Vec<(&&str, &usize)> = counts.iter().filter(|(_, n)| **n > 1).collect();
+    check!(
+        all && missing.is_empty(),
+        &[&svc, &r],
+        "{} written, missing {missing:?}",
+        written.len()
+    );
+    check!(
+        repeated.is_empty(),
+        &[&svc, &r],
+        "received more than once: {repeated:?}"
+    );
+    let _ = r.interrupt(WAIT);
+    drop(svc);
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(())
+}
