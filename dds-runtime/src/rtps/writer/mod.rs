@@ -370,6 +370,7 @@ impl Writer {
                 p.requested.insert(sn);
             }
         }
+        request_past_bitmap(p, &ack.reader_sn_state, next_sn);
         let acked = p.acked;
         p.requested = p.requested.split_off(&acked);
         p.requested_frags = p.requested_frags.split_off(&acked);
@@ -544,6 +545,26 @@ impl Writer {
             let hb = self.heartbeat(g.entity_id, false);
             out.push(&dest, dst, Ts::Any, &hb);
         }
+    }
+}
+
+/// SEQUENCE_NUMBER_SET bits: what one ACKNACK can ask for.
+const BITMAP_BITS: u32 = 256;
+
+/// A reader that lacks the last sequence number its bitmap can name is further behind than one ACKNACK
+/// says: it lacks at least a full bitmap in a row. Waiting for its next ACKNACK after every 256 repairs
+/// (each round a NACK response delay apart) makes a reader that fell 10 000 small samples behind trail
+/// forever at 256 samples per round while new data overflows its reorder window. So the request is read
+/// as running on past the bitmap, up to the writer's last change and `MAX_REQUESTED`; the repair budget
+/// per round still bounds what goes out, and a sample the reader does hold comes twice at worst.
+fn request_past_bitmap(p: &mut ReaderProxy, set: &SequenceNumberSet, next_sn: SequenceNumber) {
+    if set.num_bits < BITMAP_BITS || !set.contains_offset(BITMAP_BITS - 1) {
+        return;
+    }
+    let mut sn = set.base + i64::from(BITMAP_BITS);
+    while sn < next_sn && p.requested.len() < MAX_REQUESTED {
+        p.requested.insert(sn);
+        sn = sn.next();
     }
 }
 
