@@ -56,6 +56,9 @@ pub(crate) struct Writer {
     hbfrag_count: i32,
     hb_due: Option<Instant>,
     bytes_since_nonfinal_hb: usize,
+    /// Changes written since the last non-final heartbeat: with a sample limit on the history, small
+    /// samples fill it long before the bytes reach the watermark.
+    changes_since_nonfinal_hb: usize,
     bytes_since_hb: usize,
     unacked_bytes: usize,
     blocked: bool,
@@ -78,6 +81,7 @@ impl Writer {
             hbfrag_count: 0,
             hb_due: None,
             bytes_since_nonfinal_hb: 0,
+            changes_since_nonfinal_hb: 0,
             bytes_since_hb: 0,
             unacked_bytes: 0,
             blocked: false,
@@ -228,14 +232,20 @@ impl Writer {
             self.send_new(sn, &dest, out);
             if self.has_reliable_proxy() {
                 self.bytes_since_nonfinal_hb += len;
+                self.changes_since_nonfinal_hb += 1;
                 self.bytes_since_hb += len;
-                // Ask for acknowledgements every quarter of the high watermark, so that flow control keeps
-                // moving without waiting for the periodic heartbeat (and without an ACKNACK per datagram);
-                // otherwise the piggy-backed heartbeat only announces.
-                let final_flag = self.bytes_since_nonfinal_hb < self.params.high_watermark / 4;
+                // Ask for acknowledgements every quarter of the high watermark (or of the history's sample
+                // limit), so that flow control keeps moving without waiting for the periodic heartbeat (and
+                // without an ACKNACK per datagram); otherwise the piggy-backed heartbeat only announces.
+                let final_flag =
+                    self.bytes_since_nonfinal_hb < self.params.high_watermark / 4
+                        && self.params.limits.max_samples.is_none_or(|m| {
+                            self.changes_since_nonfinal_hb < (m as usize / 4).max(1)
+                        });
                 if !final_flag || self.bytes_since_hb >= self.params.piggyback_heartbeat_bytes {
                     if !final_flag {
                         self.bytes_since_nonfinal_hb = 0;
+                        self.changes_since_nonfinal_hb = 0;
                     }
                     self.bytes_since_hb = 0;
                     let hb = self.heartbeat(EntityId::UNKNOWN, final_flag);
@@ -460,6 +470,7 @@ impl Writer {
                 };
                 let hb = self.heartbeat(EntityId::UNKNOWN, false);
                 self.bytes_since_nonfinal_hb = 0;
+                self.changes_since_nonfinal_hb = 0;
                 out.push(&dest, None, Ts::Any, &hb);
                 self.hb_due = Some(now + self.params.heartbeat_period);
             } else {
