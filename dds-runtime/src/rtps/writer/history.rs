@@ -45,7 +45,6 @@ impl HistoryCache {
         }
     }
 
-    #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
         self.changes.len()
     }

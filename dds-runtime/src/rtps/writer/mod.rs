@@ -205,16 +205,19 @@ impl Writer {
             if self.blocked {
                 self.update_acked(ev);
                 if self.blocked {
+                    self.solicit_acks(now);
                     return Err(WriteError::WouldBlock);
                 }
             }
             if self.unacked_bytes > 0 && self.unacked_bytes + len > self.params.high_watermark {
                 self.blocked = true;
+                self.solicit_acks(now);
                 return Err(WriteError::WouldBlock);
             }
         }
         let key = change.key_hash.unwrap_or_default();
         if self.history.make_room(&key, self.acked_floor()).is_err() {
+            self.solicit_acks(now);
             return Err(WriteError::WouldBlock);
         }
         let sn = self.next_sn;
@@ -286,6 +289,39 @@ impl Writer {
             let full = full.to_vec();
             let hf = self.heartbeat_frag(rid, sn, fragments);
             out.push(&full, None, Ts::Any, &hf);
+        }
+    }
+
+    /// Whether flow control holds (or is about to hold) the application back: the unacknowledged bytes
+    /// are past half the high watermark, or the history is past half its sample limit.
+    fn under_pressure(&self) -> bool {
+        self.blocked
+            || self.unacked_bytes >= self.params.high_watermark / 2
+            || self
+                .params
+                .limits
+                .max_samples
+                .is_some_and(|m| self.history.len() >= (m as usize / 2).max(1))
+    }
+
+    /// The periodic heartbeat's interval: the configured period, but a twentieth of it (at least 1 ms)
+    /// while flow control holds the writer back. A blocked writer writes nothing, so no piggy-backed
+    /// heartbeat asks for the acknowledgements that would release it; on a lossy link, where a heartbeat
+    /// or its ACKNACK is lost every other round trip at 30% loss each way, waiting a whole period per lost
+    /// round trip is what made the stream collapse.
+    fn heartbeat_interval(&self) -> Duration {
+        if self.under_pressure() {
+            (self.params.heartbeat_period / 20).max(Duration::from_millis(1))
+        } else {
+            self.params.heartbeat_period
+        }
+    }
+
+    /// A write was refused by flow control: make sure a heartbeat asks for acknowledgements soon.
+    fn solicit_acks(&mut self, now: Instant) {
+        let soon = now + self.heartbeat_interval();
+        if self.hb_due.is_none_or(|t| t > soon) {
+            self.hb_due = Some(soon);
         }
     }
 
@@ -472,7 +508,7 @@ impl Writer {
                 self.bytes_since_nonfinal_hb = 0;
                 self.changes_since_nonfinal_hb = 0;
                 out.push(&dest, None, Ts::Any, &hb);
-                self.hb_due = Some(now + self.params.heartbeat_period);
+                self.hb_due = Some(now + self.heartbeat_interval());
             } else {
                 self.hb_due = None;
             }
