@@ -499,8 +499,13 @@ impl<T> ReaderCache<T> {
             }
             None => self.instances.iter().for_each(|(h, inst)| gather(*h, inst)),
         }
-        // Gathered instance by instance, each in reception order: grouped by instance as it is.
+        // Gathered instance by instance, each in reception order: grouped by instance as it is. Otherwise only
+        // the first `limit` in reception order are wanted: select them, then sort just those.
         if !self.instance_order {
+            if picked.len() > limit && limit > 0 {
+                picked.select_nth_unstable_by_key(limit - 1, |p| p.0);
+            }
+            picked.truncate(limit);
             picked.sort_unstable_by_key(|p| p.0);
         }
         picked.truncate(limit);
@@ -555,11 +560,11 @@ impl<T> ReaderCache<T> {
             }
         }
         if take {
-            // Per instance, highest index first, so that earlier indices stay valid.
-            picked.sort_unstable_by(|a, b| (a.1, b.2).cmp(&(b.1, a.2)));
-            for &(_, t, idx) in &picked {
-                if let Some(inst) = self.instances.get_mut(&touched[t].handle) {
-                    inst.samples.remove(idx);
+            // Per instance, ascending index, each instance's samples removed in one pass.
+            picked.sort_unstable_by_key(|p| (p.1, p.2));
+            for group in picked.chunk_by(|a, b| a.1 == b.1) {
+                if let Some(inst) = self.instances.get_mut(&touched[group[0].1].handle) {
+                    remove_indices(&mut inst.samples, group.iter().map(|p| p.2));
                 }
             }
             self.total -= picked.len();
@@ -634,6 +639,23 @@ struct Touched {
     emitted: usize,
     /// Index (in the instance) of its last sample in the collection.
     last_index: usize,
+}
+
+/// Removes the samples at `indices` (ascending, distinct) from `q`: a prefix (the usual take of the oldest)
+/// with one drain, anything else in one pass over the queue; never an element shift per removed sample.
+fn remove_indices<S>(q: &mut VecDeque<S>, indices: impl ExactSizeIterator<Item = usize> + Clone) {
+    let n = indices.len();
+    if indices.clone().enumerate().all(|(k, i)| k == i) {
+        q.drain(..n);
+        return;
+    }
+    let mut next = indices.peekable();
+    let mut i = 0usize;
+    q.retain(|_| {
+        let drop_it = next.next_if_eq(&i).is_some();
+        i += 1;
+        !drop_it
+    });
 }
 
 #[cfg(test)]
@@ -842,5 +864,16 @@ mod tests {
         ));
         assert_eq!(c.tick(t0 + Duration::from_millis(160)).len(), 0);
         assert_eq!(c.tick(t0 + Duration::from_millis(210)).len(), 1);
+    }
+
+    #[test]
+    fn remove_indices_prefix_and_scattered() {
+        let mut q: VecDeque<u32> = (0..10).collect();
+        remove_indices(&mut q, [0usize, 1, 2].into_iter());
+        assert_eq!(q, (3..10).collect::<VecDeque<_>>());
+        remove_indices(&mut q, [1usize, 4, 6].into_iter());
+        assert_eq!(q, VecDeque::from([3, 5, 6, 8]));
+        remove_indices(&mut q, std::iter::empty());
+        assert_eq!(q.len(), 4);
     }
 }

@@ -638,10 +638,25 @@ fn receive_pongs<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
 
 /// `sub` mode: sequence checking per writer and key, optional latency, and pongs for pinged data.
 fn receive_data<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
-    let Ok(samples) = reader.select().max_samples(1000).take() else {
+    // A take gives credit back to the core, which may deliver more and call the data-available listener
+    // again on this thread, inside the take: that nested call returns at once (the loop below takes what
+    // it would have), and the statistics lock, held across each take, keeps the batches of different
+    // threads counted in the order they were taken.
+    thread_local!(static INSIDE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) });
+    if INSIDE.with(|i| i.replace(true)) {
         return;
-    };
+    }
+    while receive_batch(ctx, reader) {}
+    INSIDE.with(|i| i.set(false));
+}
+
+/// Takes and accounts up to 1000 samples; false when there were none.
+fn receive_batch<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) -> bool {
     let mut stats = ctx.sub_stats.lock().expect("sub stats");
+    let samples = match reader.select().max_samples(1000).take() {
+        Ok(s) if !s.is_empty() => s,
+        _ => return false,
+    };
     for s in &samples {
         let Some(d) = &s.data else { continue };
         if ctx.is_local(&s.info.publication_guid.to_bytes()) && !ctx.o.match_local {
@@ -677,6 +692,7 @@ fn receive_data<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
             }
         }
     }
+    true
 }
 
 /// `pub` mode: bursts at the requested rate, key values round robin, write durations in a histogram.

@@ -47,7 +47,6 @@ impl HistoryCache {
         }
     }
 
-    #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
         self.changes.len()
     }

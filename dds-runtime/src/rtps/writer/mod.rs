@@ -62,6 +62,9 @@ pub(crate) struct Writer {
     /// Lower bound of the proxies' `repair_due`.
     repair_floor: DueFloor,
     bytes_since_nonfinal_hb: usize,
+    /// Changes written since the last non-final heartbeat: with a sample limit on the history, small
+    /// samples fill it long before the bytes reach the watermark.
+    changes_since_nonfinal_hb: usize,
     bytes_since_hb: usize,
     unacked_bytes: usize,
     blocked: bool,
@@ -87,6 +90,7 @@ impl Writer {
             hb_due: None,
             repair_floor: DueFloor::default(),
             bytes_since_nonfinal_hb: 0,
+            changes_since_nonfinal_hb: 0,
             bytes_since_hb: 0,
             unacked_bytes: 0,
             blocked: false,
@@ -211,16 +215,19 @@ impl Writer {
             if self.blocked {
                 self.update_acked(ev);
                 if self.blocked {
+                    self.solicit_acks(now);
                     return Err(WriteError::WouldBlock);
                 }
             }
             if self.unacked_bytes > 0 && self.unacked_bytes + len > self.params.high_watermark {
                 self.blocked = true;
+                self.solicit_acks(now);
                 return Err(WriteError::WouldBlock);
             }
         }
         let key = change.key_hash.unwrap_or_default();
         if self.history.make_room(&key, self.acked_floor()).is_err() {
+            self.solicit_acks(now);
             return Err(WriteError::WouldBlock);
         }
         let sn = self.next_sn;
@@ -239,14 +246,20 @@ impl Writer {
             self.send_new(sn, &dest, out);
             if self.has_reliable_proxy() {
                 self.bytes_since_nonfinal_hb += len;
+                self.changes_since_nonfinal_hb += 1;
                 self.bytes_since_hb += len;
-                // Ask for acknowledgements every quarter of the high watermark, so that flow control keeps
-                // moving without waiting for the periodic heartbeat (and without an ACKNACK per datagram);
-                // otherwise the piggy-backed heartbeat only announces.
-                let final_flag = self.bytes_since_nonfinal_hb < self.params.high_watermark / 4;
+                // Ask for acknowledgements every quarter of the high watermark (or of the history's sample
+                // limit), so that flow control keeps moving without waiting for the periodic heartbeat (and
+                // without an ACKNACK per datagram); otherwise the piggy-backed heartbeat only announces.
+                let final_flag =
+                    self.bytes_since_nonfinal_hb < self.params.high_watermark / 4
+                        && self.params.limits.max_samples.is_none_or(|m| {
+                            self.changes_since_nonfinal_hb < (m as usize / 4).max(1)
+                        });
                 if !final_flag || self.bytes_since_hb >= self.params.piggyback_heartbeat_bytes {
                     if !final_flag {
                         self.bytes_since_nonfinal_hb = 0;
+                        self.changes_since_nonfinal_hb = 0;
                     }
                     self.bytes_since_hb = 0;
                     let hb = self.heartbeat(EntityId::UNKNOWN, final_flag);
@@ -287,6 +300,39 @@ impl Writer {
             let full = full.to_vec();
             let hf = self.heartbeat_frag(rid, sn, fragments);
             out.push(&full, None, Ts::Any, &hf);
+        }
+    }
+
+    /// Whether flow control holds (or is about to hold) the application back: the unacknowledged bytes
+    /// are past half the high watermark, or the history is past half its sample limit.
+    fn under_pressure(&self) -> bool {
+        self.blocked
+            || self.unacked_bytes >= self.params.high_watermark / 2
+            || self
+                .params
+                .limits
+                .max_samples
+                .is_some_and(|m| self.history.len() >= (m as usize / 2).max(1))
+    }
+
+    /// The periodic heartbeat's interval: the configured period, but a twentieth of it (at least 1 ms)
+    /// while flow control holds the writer back. A blocked writer writes nothing, so no piggy-backed
+    /// heartbeat asks for the acknowledgements that would release it; on a lossy link, where a heartbeat
+    /// or its ACKNACK is lost every other round trip at 30% loss each way, waiting a whole period per lost
+    /// round trip is what made the stream collapse.
+    fn heartbeat_interval(&self) -> Duration {
+        if self.under_pressure() {
+            (self.params.heartbeat_period / 20).max(Duration::from_millis(1))
+        } else {
+            self.params.heartbeat_period
+        }
+    }
+
+    /// A write was refused by flow control: make sure a heartbeat asks for acknowledgements soon.
+    fn solicit_acks(&mut self, now: Instant) {
+        let soon = now + self.heartbeat_interval();
+        if self.hb_due.is_none_or(|t| t > soon) {
+            self.hb_due = Some(soon);
         }
     }
 
@@ -382,6 +428,7 @@ impl Writer {
                 p.requested.insert(sn);
             }
         }
+        request_past_bitmap(p, &ack.reader_sn_state, next_sn);
         let acked = p.acked;
         p.requested = p.requested.split_off(&acked);
         p.requested_frags = p.requested_frags.split_off(&acked);
@@ -476,8 +523,9 @@ impl Writer {
                 };
                 let hb = self.heartbeat(EntityId::UNKNOWN, false);
                 self.bytes_since_nonfinal_hb = 0;
+                self.changes_since_nonfinal_hb = 0;
                 out.push(&dest, None, Ts::Any, &hb);
-                self.hb_due = Some(now + self.params.heartbeat_period);
+                self.hb_due = Some(now + self.heartbeat_interval());
             } else {
                 self.hb_due = None;
             }
@@ -566,6 +614,26 @@ impl Writer {
 
 /// Room for the inline QoS of one change: coherent set (12), key hash (20), status info (8).
 const INLINE_QOS_MAX: usize = 40;
+
+/// SEQUENCE_NUMBER_SET bits: what one ACKNACK can ask for.
+const BITMAP_BITS: u32 = 256;
+
+/// A reader that lacks the last sequence number its bitmap can name is further behind than one ACKNACK
+/// says: it lacks at least a full bitmap in a row. Waiting for its next ACKNACK after every 256 repairs
+/// (each round a NACK response delay apart) makes a reader that fell 10 000 small samples behind trail
+/// forever at 256 samples per round while new data overflows its reorder window. So the request is read
+/// as running on past the bitmap, up to the writer's last change and `MAX_REQUESTED`; the repair budget
+/// per round still bounds what goes out, and a sample the reader does hold comes twice at worst.
+fn request_past_bitmap(p: &mut ReaderProxy, set: &SequenceNumberSet, next_sn: SequenceNumber) {
+    if set.num_bits < BITMAP_BITS || !set.contains_offset(BITMAP_BITS - 1) {
+        return;
+    }
+    let mut sn = set.base + i64::from(BITMAP_BITS);
+    while sn < next_sn && p.requested.len() < MAX_REQUESTED {
+        p.requested.insert(sn);
+        sn = sn.next();
+    }
+}
 
 /// Runs of consecutive sequence numbers as GAP submessages.
 fn send_gaps(
