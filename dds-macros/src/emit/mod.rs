@@ -1,11 +1,13 @@
 //! Code generation from the checked model. The emitters each own one concern and only read the model:
 //! [`encode`], [`decode`], [`key`] (key-only streams, the key hash's size scan), [`layout`] (compile-time
-//! constants) and [`describe`] (`DdsType` and its type descriptor); [`newtype`] covers typedefs and bitmasks.
+//! constants), [`describe`] (`DdsType` and its type descriptor) and [`fields`] (member access for content
+//! filters); [`newtype`] covers typedefs and bitmasks.
 //! This module puts their pieces together into the impls of one container.
 
 mod decode;
 mod describe;
 mod encode;
+mod fields;
 mod key;
 mod layout;
 mod newtype;
@@ -20,13 +22,21 @@ use crate::types::mentions;
 
 /// Every impl (and the decoder's partial struct) for `c`.
 pub(crate) fn container(c: &Container) -> TokenStream {
-    match &c.data {
+    let impls = match &c.data {
         Data::Struct(s) => struct_impls(c, s),
         Data::Enum(e) => enum_impls(c, e),
         Data::Union(u) => union_impls(c, u),
         Data::Transparent(t) => newtype::transparent(c, t),
         Data::Bitmask(b) => newtype::bitmask(c, b),
-    }
+    };
+    let filter_fields = match &c.data {
+        Data::Struct(s) => fields::struct_fields(c, s, &c.input.generics),
+        Data::Enum(e) => fields::enum_fields(c, e),
+        Data::Union(u) => fields::union_fields(c, u),
+        Data::Transparent(_) => fields::transparent_fields(c),
+        Data::Bitmask(_) => fields::bitmask_fields(c),
+    };
+    quote!(#impls #filter_fields)
 }
 
 fn struct_impls(c: &Container, s: &Struct) -> TokenStream {

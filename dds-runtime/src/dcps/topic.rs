@@ -113,7 +113,7 @@ impl<T: DdsType + FilterFields> ContentFilteredTopic<T> {
     /// Changes the parameters; readers created on this topic apply them to samples received from now on.
     pub fn set_expression_parameters<S: AsRef<str>>(&self, params: &[S]) -> DdsResult<()> {
         let params: Vec<String> = params.iter().map(|s| s.as_ref().to_string()).collect();
-        write(&self.filter).set_parameters(&params)
+        Ok(write(&self.filter).set_parameters(&params)?)
     }
 }
 
