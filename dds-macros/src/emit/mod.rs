@@ -100,14 +100,15 @@ fn struct_impls(c: &Container, s: &Struct) -> TokenStream {
     }
 }
 
-/// The struct's generics with `T: CdrType + Send + Sync + 'static` on every type parameter.
+/// The struct's generics with `T: CdrType + FilterFields + Send + Sync + 'static` on every type parameter.
 fn struct_generics(c: &Container) -> Generics {
     let cdr = c.cdr();
+    let rt = c.runtime();
     let mut generics = c.input.generics.clone();
     let params: Vec<syn::Ident> = generics.type_params().map(|t| t.ident.clone()).collect();
     let wc = generics.make_where_clause();
     for p in params {
-        wc.predicates.push(syn::parse_quote!(#p: #cdr::CdrType + ::core::marker::Send + ::core::marker::Sync + 'static));
+        wc.predicates.push(syn::parse_quote!(#p: #cdr::CdrType + #rt::filter::FilterFields + ::core::marker::Send + ::core::marker::Sync + 'static));
     }
     generics
 }
