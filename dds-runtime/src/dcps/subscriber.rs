@@ -112,6 +112,7 @@ impl Subscriber {
             qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
             type_information: None,
             entity_name: None,
+            content_filter: topic.content_filter_property(),
         };
         let credit_limit = match (&rq.reliability, &rq.history, rq.resource_limits.max_samples) {
             (crate::qos::Reliability::Reliable { .. }, crate::qos::History::KeepAll, Some(m)) => {

@@ -83,9 +83,6 @@ fn unsupported(o: &ShapeOptions) -> Option<String> {
     ) {
         return Some("    Presentation Access Scope = not supported".into());
     }
-    if o.cft_expression.is_some() {
-        return Some("    ContentFilteredTopic expression (--cft) = not supported".into());
-    }
     if matches!(
         o.durability,
         DurabilityArg::Transient | DurabilityArg::Persistent
@@ -299,15 +296,26 @@ impl App {
             let qos = qos.build();
             let mut readers = Vec::new();
             for t in &topics {
-                // shape_main reads a content-filtered topic "<topic>_filtered" on `color` when -c is
-                // given; the filter is applied when printing (same output).
-                let shown = if o.color.is_some() {
-                    format!("{}_filtered", t.name())
-                } else {
-                    t.name().to_string()
+                // shape_main reads a content-filtered topic "<topic>_filtered": `--cft EXPR`, else
+                // `color = %0` when -c is given.
+                let filter = match (&o.cft_expression, &o.color) {
+                    (Some(e), _) => Some((e.as_str(), Vec::new())),
+                    (None, Some(c)) => Some(("color = %0", vec![c.clone()])),
+                    (None, None) => None,
                 };
-                println!("Create reader for topic: {shown}");
-                let r = subscriber.create_datareader(t, &qos)?;
+                let r = match filter {
+                    Some((expr, params)) => {
+                        let name = format!("{}_filtered", t.name());
+                        println!("Create reader for topic: {name}");
+                        let cft =
+                            participant.create_content_filtered_topic(&name, t, expr, &params)?;
+                        subscriber.create_datareader(&cft, &qos)?
+                    }
+                    None => {
+                        println!("Create reader for topic: {}", t.name());
+                        subscriber.create_datareader(t, &qos)?
+                    }
+                };
                 r.set_listener(Box::new(Printer {
                     topic: t.name().to_string(),
                 }));
