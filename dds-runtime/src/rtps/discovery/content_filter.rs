@@ -164,7 +164,7 @@ mod tests {
     fn signature_is_md5_of_nul_terminated_fields() {
         let f = ContentFilterProperty::ddssql("a", "b", "x", vec!["1".into()]);
         let mut md5 = Md5::new();
-        md5.update(b"a\0b\0DDSSQL\0x\01\0");
+        md5.update(b"a\0b\0DDSSQL\0x\0\x31\0");
         let want: [u8; 16] = md5.finalize().into();
         assert_eq!(f.signature(), want);
         let g = ContentFilterProperty::ddssql("a", "b", "x", vec!["2".into()]);
