@@ -3,6 +3,7 @@
 //! The layers, bottom up:
 //! - [`cdr`]: XCDR1/XCDR2 serialization. Knows nothing of RTPS.
 //! - [`xtypes`]: type identifiers and type objects.
+//! - [`filter`]: the SQL subset of content filters and queries, and the member access the derive gives.
 //! - `qos`: the QoS policies, shared by discovery and the DCPS API (feature `rtps`).
 //! - `rtps`: the sans-I/O protocol core: messages, discovery, writers and readers (feature `rtps`).
 //! - `transport`: sockets and receive threads that drive the core (feature `net`).
@@ -60,6 +61,7 @@ pub mod cdr;
 pub mod config;
 #[cfg(feature = "net")]
 pub mod dcps;
+pub mod filter;
 #[cfg(feature = "net")]
 pub mod prelude;
 #[cfg(feature = "rtps")]

@@ -1,11 +1,13 @@
 //! Code generation from the checked model. The emitters each own one concern and only read the model:
 //! [`encode`], [`decode`], [`key`] (key-only streams, the key hash's size scan), [`layout`] (compile-time
-//! constants) and [`describe`] (`DdsType` and its type descriptor); [`newtype`] covers typedefs and bitmasks.
+//! constants), [`describe`] (`DdsType` and its type descriptor) and [`fields`] (member access for content
+//! filters); [`newtype`] covers typedefs and bitmasks.
 //! This module puts their pieces together into the impls of one container.
 
 mod decode;
 mod describe;
 mod encode;
+mod fields;
 mod key;
 mod layout;
 mod newtype;
@@ -29,6 +31,13 @@ pub(crate) fn container(c: &Container) -> TokenStream {
         Data::Bitmask(b) => newtype::bitmask(c, b),
     };
     out.extend(xtypes::xtypes_impl(c));
+    out.extend(match &c.data {
+        Data::Struct(s) => fields::struct_fields(c, s, &c.input.generics),
+        Data::Enum(e) => fields::enum_fields(c, e),
+        Data::Union(u) => fields::union_fields(c, u),
+        Data::Transparent(_) => fields::transparent_fields(c),
+        Data::Bitmask(_) => fields::bitmask_fields(c),
+    });
     out
 }
 
@@ -93,14 +102,15 @@ fn struct_impls(c: &Container, s: &Struct) -> TokenStream {
     }
 }
 
-/// The struct's generics with `T: CdrType + Send + Sync + 'static` on every type parameter.
+/// The struct's generics with `T: CdrType + FilterFields + Send + Sync + 'static` on every type parameter.
 fn struct_generics(c: &Container) -> Generics {
     let cdr = c.cdr();
+    let rt = c.runtime();
     let mut generics = c.input.generics.clone();
     let params: Vec<syn::Ident> = generics.type_params().map(|t| t.ident.clone()).collect();
     let wc = generics.make_where_clause();
     for p in params {
-        wc.predicates.push(syn::parse_quote!(#p: #cdr::CdrType + ::core::marker::Send + ::core::marker::Sync + 'static));
+        wc.predicates.push(syn::parse_quote!(#p: #cdr::CdrType + #rt::filter::FilterFields + ::core::marker::Send + ::core::marker::Sync + 'static));
     }
     generics
 }

@@ -186,7 +186,7 @@ pub struct MemberDescriptor {
 }
 
 /// A named IDL type that can be a topic type: what `#[derive(DdsType)]` implements.
-pub trait DdsType: CdrType + Send + Sync + 'static {
+pub trait DdsType: CdrType + crate::filter::FilterFields + Send + Sync + 'static {
     /// Scoped IDL name, `"Module::Type"`.
     const TYPE_NAME: &'static str;
     /// XTypes extensibility.

@@ -7,6 +7,7 @@ use std::time::{Duration, Instant, SystemTime};
 
 use foldhash::{HashMap, HashMapExt};
 
+use crate::filter::FilterFields;
 use crate::qos::{DataReaderQos, History, Ownership, INFINITE};
 use crate::rtps::{ChangeKind, Guid};
 
@@ -15,6 +16,10 @@ use super::sample::{
     SampleStateMask, ViewState, ViewStateMask,
 };
 use super::status::SampleRejectedReason;
+
+mod query;
+use query::read_query;
+pub(crate) use query::SharedFilter;
 
 /// One decoded change arriving from a writer.
 pub(crate) struct Incoming<T> {
@@ -74,13 +79,15 @@ struct Instance<T> {
 }
 
 /// Which samples a read/take returns.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Selection {
     pub(crate) max_samples: Option<usize>,
     pub(crate) sample_states: SampleStateMask,
     pub(crate) view_states: ViewStateMask,
     pub(crate) instance_states: InstanceStateMask,
     pub(crate) instance: Option<InstanceHandle>,
+    /// A query condition's expression: only samples with data that it accepts, in its ORDER BY order.
+    pub(crate) query: Option<SharedFilter>,
 }
 
 type Filter<T> = Box<dyn Fn(&T) -> bool + Send + Sync>;
@@ -119,7 +126,7 @@ fn finite(d: Duration) -> Option<Duration> {
     (d != INFINITE && d < Duration::from_secs(100 * 365 * 86400)).then_some(d)
 }
 
-impl<T> ReaderCache<T> {
+impl<T: FilterFields> ReaderCache<T> {
     pub(crate) fn new(qos: DataReaderQos, keyed: bool) -> Self {
         ReaderCache {
             qos,
@@ -430,9 +437,12 @@ impl<T> ReaderCache<T> {
 
     /// Whether some sample matches the masks (ReadCondition trigger, DATA_AVAILABLE).
     pub(crate) fn has_matching(&self, sel: &Selection) -> bool {
-        self.instances
-            .values()
-            .any(|i| i.samples.iter().any(|s| Self::matches(i, s, sel)))
+        let q = read_query(sel);
+        self.instances.values().any(|i| {
+            i.samples
+                .iter()
+                .any(|s| Self::selected(i, s, sel, q.as_deref()))
+        })
     }
 
     /// The smallest instance handle above `prev` that has a matching sample.
@@ -442,9 +452,14 @@ impl<T> ReaderCache<T> {
         sel: &Selection,
     ) -> Option<InstanceHandle> {
         use std::ops::Bound::{Excluded, Unbounded};
+        let q = read_query(sel);
         self.instances
             .range((Excluded(prev), Unbounded))
-            .find(|(_, i)| i.samples.iter().any(|s| Self::matches(i, s, sel)))
+            .find(|(_, i)| {
+                i.samples
+                    .iter()
+                    .any(|s| Self::selected(i, s, sel, q.as_deref()))
+            })
             .map(|(h, _)| *h)
     }
 
@@ -472,13 +487,15 @@ impl<T> ReaderCache<T> {
         mut emit: impl FnMut(&mut Option<T>, SampleInfo),
     ) {
         let limit = sel.max_samples.unwrap_or(usize::MAX);
+        let q = read_query(sel);
+        let q = q.as_deref();
         // Instances with a selected sample, and the selection as (seq, instance ordinal, index in instance).
         let mut touched: Vec<Touched> = Vec::new();
         let mut picked: Vec<(u64, usize, usize)> = Vec::new();
         let mut gather = |h: InstanceHandle, inst: &Instance<T>| {
             let before = picked.len();
             for (i, s) in inst.samples.iter().enumerate() {
-                if Self::matches(inst, s, sel) {
+                if Self::selected(inst, s, sel, q) {
                     picked.push((s.seq, touched.len(), i));
                 }
             }
@@ -499,15 +516,17 @@ impl<T> ReaderCache<T> {
             }
             None => self.instances.iter().for_each(|(h, inst)| gather(*h, inst)),
         }
-        // Gathered instance by instance, each in reception order: grouped by instance as it is. Otherwise only
-        // the first `limit` in reception order are wanted: select them, then sort just those.
+        // Gathered instance by instance, each in reception order: grouped by instance as it is. Otherwise, in
+        // reception order; without ORDER BY only the first `limit` are wanted: select them, then sort just those.
+        let ordered_by_query = q.is_some_and(|q| q.has_order_by());
         if !self.instance_order {
-            if picked.len() > limit && limit > 0 {
+            if !ordered_by_query && picked.len() > limit && limit > 0 {
                 picked.select_nth_unstable_by_key(limit - 1, |p| p.0);
+                picked.truncate(limit);
             }
-            picked.truncate(limit);
             picked.sort_unstable_by_key(|p| p.0);
         }
+        self.order_by(q, &mut picked, &touched);
         picked.truncate(limit);
         // Ranks count the samples of the same instance later in the collection; the last one (in reception
         // order) is the instance's most recent sample in the collection.

@@ -1,17 +1,20 @@
-//! WaitSet and its conditions: [`GuardCondition`], [`StatusCondition`], [`ReadCondition`].
+//! WaitSet and its conditions: [`GuardCondition`], [`StatusCondition`], [`ReadCondition`] and
+//! [`QueryCondition`] (a read condition with a query expression).
 //!
 //! Every condition owns a signal; whoever changes what a condition looks at calls `Signal::notify`,
 //! which wakes the waitsets the condition is attached to. `WaitSet::wait` re-evaluates the trigger values
 //! after each wakeup, so spurious notifications are harmless.
 
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
-use std::sync::{Arc, Condvar, Mutex, Weak};
+use std::sync::{Arc, Condvar, Mutex, RwLock, Weak};
 use std::time::{Duration, Instant};
 
+use super::cache::SharedFilter;
 use super::error::{DdsError, DdsResult};
 use super::sample::{InstanceStateMask, SampleStateMask, ViewStateMask};
 use super::status::StatusMask;
-use super::sync::{lock, recover};
+use super::sync::{lock, read, recover, write};
+use crate::filter::ContentFilter;
 
 /// One waitset's wakeup channel: a generation counter under a mutex, and a condvar.
 #[derive(Debug, Default)]
@@ -141,7 +144,14 @@ impl StatusCondition {
 
 /// What a [`ReadCondition`] asks its reader.
 pub(crate) trait ReadConditionSource: Send + Sync {
-    fn has_matching(&self, s: SampleStateMask, v: ViewStateMask, i: InstanceStateMask) -> bool;
+    /// Whether a sample is in the states and, with a query, carries data the query accepts.
+    fn has_matching(
+        &self,
+        s: SampleStateMask,
+        v: ViewStateMask,
+        i: InstanceStateMask,
+        query: Option<&SharedFilter>,
+    ) -> bool;
     fn data_signal(&self) -> &Signal;
 }
 
@@ -155,6 +165,8 @@ pub struct ReadCondition {
     pub view_states: ViewStateMask,
     /// Instance states selected.
     pub instance_states: InstanceStateMask,
+    /// The query of a [`QueryCondition`].
+    pub(crate) query: Option<SharedFilter>,
 }
 
 impl std::fmt::Debug for ReadCondition {
@@ -163,6 +175,13 @@ impl std::fmt::Debug for ReadCondition {
             .field("sample_states", &self.sample_states)
             .field("view_states", &self.view_states)
             .field("instance_states", &self.instance_states)
+            .field(
+                "query",
+                &self
+                    .query
+                    .as_ref()
+                    .map(|q| read(q).expression().to_string()),
+            )
             .finish()
     }
 }
@@ -170,8 +189,81 @@ impl std::fmt::Debug for ReadCondition {
 impl ReadCondition {
     /// Whether the reader holds a matching sample.
     pub fn trigger_value(&self) -> bool {
-        self.source
-            .has_matching(self.sample_states, self.view_states, self.instance_states)
+        self.source.has_matching(
+            self.sample_states,
+            self.view_states,
+            self.instance_states,
+            self.query.as_ref(),
+        )
+    }
+
+    /// Whether this is the read condition of a [`QueryCondition`].
+    pub fn is_query(&self) -> bool {
+        self.query.is_some()
+    }
+}
+
+/// A [`ReadCondition`] that also requires the sample's data to satisfy a query expression (DDS 1.4 Annex B:
+/// a condition, optionally followed by `ORDER BY`), made by `DataReader::create_querycondition`.
+/// `read_w_condition`/`take_w_condition` given a query condition return only the samples it accepts, sorted
+/// by its ORDER BY (equal keys in reception order). It dereferences to its read condition; in a [`WaitSet`]
+/// it appears as [`Condition::Read`] with [`ReadCondition::is_query`] true.
+#[derive(Debug, Clone)]
+pub struct QueryCondition {
+    read: ReadCondition,
+}
+
+impl QueryCondition {
+    pub(crate) fn new(read: ReadCondition, query: ContentFilter) -> Self {
+        QueryCondition {
+            read: ReadCondition {
+                query: Some(Arc::new(RwLock::new(query))),
+                ..read
+            },
+        }
+    }
+
+    fn query(&self) -> &SharedFilter {
+        self.read
+            .query
+            .as_ref()
+            .expect("a query condition always has a query")
+    }
+
+    /// The query expression.
+    pub fn query_expression(&self) -> String {
+        read(self.query()).expression().to_string()
+    }
+
+    /// The current query parameters.
+    pub fn query_parameters(&self) -> Vec<String> {
+        read(self.query()).parameters().to_vec()
+    }
+
+    /// Replaces the query parameters (`%n`); refused when the expression uses one beyond the new list. Attached
+    /// waitsets re-evaluate the condition.
+    pub fn set_query_parameters<S: AsRef<str>>(&self, params: &[S]) -> DdsResult<()> {
+        write(self.query()).set_parameters(params)?;
+        self.read.source.data_signal().notify();
+        Ok(())
+    }
+
+    /// Whether the reader holds a sample in the states that the query accepts.
+    pub fn trigger_value(&self) -> bool {
+        self.read.trigger_value()
+    }
+}
+
+impl std::ops::Deref for QueryCondition {
+    type Target = ReadCondition;
+    fn deref(&self) -> &ReadCondition {
+        &self.read
+    }
+}
+
+impl From<QueryCondition> for Condition {
+    fn from(c: QueryCondition) -> Self {
+        Condition::Read(c.read)
     }
 }
 
@@ -208,12 +300,20 @@ impl Condition {
             (Condition::Status(a), Condition::Status(b)) => Arc::ptr_eq(&a.core, &b.core),
             (Condition::Read(a), Condition::Read(b)) => {
                 Arc::ptr_eq(&a.source, &b.source)
+                    && same_query(a.query.as_ref(), b.query.as_ref())
                     && a.sample_states == b.sample_states
                     && a.view_states == b.view_states
                     && a.instance_states == b.instance_states
             }
             _ => false,
         }
+    }
+}
+
+fn same_query(a: Option<&SharedFilter>, b: Option<&SharedFilter>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+        (a, b) => a.is_none() && b.is_none(),
     }
 }
 

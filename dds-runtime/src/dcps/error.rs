@@ -2,6 +2,7 @@
 
 use crate::cdr::{DecodeError, EncodeError};
 use crate::config::ConfigError;
+use crate::filter::FilterError;
 use crate::rtps::{CoreError, WriteError};
 
 /// Errors returned by DCPS operations (DDS 1.4 §2.2.1.1 return codes, plus Rust-side causes).
@@ -41,6 +42,9 @@ pub enum DdsError {
     /// The protocol core refused to create an entity.
     #[error("rtps: {0}")]
     Core(#[from] CoreError),
+    /// A content filter or query expression, or its parameters, were refused.
+    #[error("filter: {0}")]
+    Filter(#[from] FilterError),
     /// The protocol core refused a write for a reason not covered by another variant.
     #[error("rtps write: {0}")]
     Write(#[source] WriteError),

@@ -47,10 +47,12 @@ mod topic;
 
 /// GUIDs name entities in the DCPS API ([`DataWriter::guid`], [`SampleInfo::publication_guid`], ...).
 pub use crate::rtps::{Guid, GuidPrefix};
-pub use condition::{Condition, GuardCondition, ReadCondition, StatusCondition, WaitSet};
+pub use condition::{
+    Condition, GuardCondition, QueryCondition, ReadCondition, StatusCondition, WaitSet,
+};
 pub use durability::{DurabilityServiceConfig, DurabilityServiceMode};
 pub use error::{DdsError, DdsResult};
-pub use filter::{ContentFilter, FieldValue, FilterFields};
+pub use filter::{ContentFilter, FieldValue, FilterError, FilterFields};
 pub use listener::{DataReaderListener, DataWriterListener};
 pub use participant::{
     DiscoveredParticipant, DomainParticipant, DomainParticipantBuilder, WriteBatching,

@@ -127,6 +127,7 @@ impl Publisher {
             qos: WriterQos::new(wq.clone(), &self.qos, topic.qos()),
             type_information: None,
             entity_name: None,
+            content_filter: None,
         };
         let inner = Arc::new(WriterInner::<T> {
             state: EndpointState::new(driver.clone()),

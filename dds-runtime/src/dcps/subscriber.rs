@@ -13,8 +13,11 @@ use crate::cdr::{self, DdsType};
 use crate::qos::{DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos};
 use crate::rtps::{Event, Guid, ReaderSpec, ReceivedSample};
 
+use super::cache::SharedFilter;
 use super::cache::{to_sample, Outcome, ReaderCache, Selection};
-use super::condition::{ReadCondition, ReadConditionSource, Signal, StatusCondition};
+use super::condition::{
+    QueryCondition, ReadCondition, ReadConditionSource, Signal, StatusCondition,
+};
 use super::decode::decode_change;
 use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
 use super::endpoint::{check_history, EndpointState};
@@ -30,6 +33,7 @@ use super::status::{
 };
 use super::sync::{lock, recover};
 use super::topic::{Topic, TopicDescription};
+use crate::filter::ContentFilter;
 
 /// Callbacks of a [`DataReader`] (see [`crate::dcps::listener`]). Every method has an empty default.
 #[allow(unused_variables)]
@@ -130,6 +134,7 @@ impl Subscriber {
             qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
             type_information: None,
             entity_name: None,
+            content_filter: topic.content_filter_property(),
         };
         let credit_limit = match (&rq.reliability, &rq.history, rq.resource_limits.max_samples) {
             (crate::qos::Reliability::Reliable { .. }, crate::qos::History::KeepAll, Some(m)) => {
@@ -455,25 +460,27 @@ impl<T: DdsType> DataReader<T> {
         self.select().next_instance(prev).take()
     }
 
-    /// Reads with a read condition's masks.
+    /// Reads with a read condition's masks (and a [`QueryCondition`]'s query and ORDER BY).
     pub fn read_w_condition(&self, c: &ReadCondition) -> DdsResult<Vec<Sample<T>>>
     where
         T: Clone,
     {
-        self.select()
-            .sample_state(c.sample_states)
-            .view_state(c.view_states)
-            .instance_state(c.instance_states)
-            .read()
+        self.select_w_condition(c).read()
     }
 
-    /// Takes with a read condition's masks.
+    /// Takes with a read condition's masks (and a [`QueryCondition`]'s query and ORDER BY).
     pub fn take_w_condition(&self, c: &ReadCondition) -> DdsResult<Vec<Sample<T>>> {
-        self.select()
+        self.select_w_condition(c).take()
+    }
+
+    fn select_w_condition(&self, c: &ReadCondition) -> Selector<'_, T> {
+        let mut s = self
+            .select()
             .sample_state(c.sample_states)
             .view_state(c.view_states)
-            .instance_state(c.instance_states)
-            .take()
+            .instance_state(c.instance_states);
+        s.sel.query = c.query.clone();
+        s
     }
 
     /// The handle of the instance whose key equals the key of `key_sample` (other members are ignored);
@@ -558,7 +565,23 @@ impl<T: DdsType> DataReader<T> {
             sample_states,
             view_states,
             instance_states,
+            query: None,
         }
+    }
+
+    /// A query condition on this reader: a read condition whose samples must also satisfy `expression` (the
+    /// Annex B subset, optionally ending in `ORDER BY`), with `%n` bound to `params[n]`.
+    pub fn create_querycondition<S: AsRef<str>>(
+        &self,
+        sample_states: SampleStateMask,
+        view_states: ViewStateMask,
+        instance_states: InstanceStateMask,
+        expression: &str,
+        params: &[S],
+    ) -> DdsResult<QueryCondition> {
+        let query = ContentFilter::query(expression, params)?;
+        let read = self.create_readcondition(sample_states, view_states, instance_states);
+        Ok(QueryCondition::new(read, query))
     }
 
     /// The reader's status condition.
@@ -856,11 +879,18 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
 }
 
 impl<T: DdsType> ReadConditionSource for ReaderInner<T> {
-    fn has_matching(&self, s: SampleStateMask, v: ViewStateMask, i: InstanceStateMask) -> bool {
+    fn has_matching(
+        &self,
+        s: SampleStateMask,
+        v: ViewStateMask,
+        i: InstanceStateMask,
+        query: Option<&SharedFilter>,
+    ) -> bool {
         let sel = Selection {
             sample_states: s,
             view_states: v,
             instance_states: i,
+            query: query.cloned(),
             ..Selection::default()
         };
         lock(&self.cache).cache.has_matching(&sel)

@@ -5,6 +5,7 @@ use std::sync::{Arc, RwLock};
 
 use crate::cdr::DdsType;
 use crate::qos::TopicQos;
+use crate::rtps::discovery::ContentFilterProperty;
 
 use super::error::{DdsError, DdsResult};
 use super::filter::{ContentFilter, FilterFields};
@@ -71,6 +72,11 @@ pub trait TopicDescription<T: DdsType> {
     fn sample_filter(&self) -> Option<SampleFilter<T>> {
         None
     }
+    /// The filter readers announce in SEDP (PID_CONTENT_FILTER_PROPERTY), if any.
+    #[doc(hidden)]
+    fn content_filter_property(&self) -> Option<ContentFilterProperty> {
+        None
+    }
 }
 
 impl<T: DdsType> TopicDescription<T> for Topic<T> {
@@ -80,7 +86,8 @@ impl<T: DdsType> TopicDescription<T> for Topic<T> {
 }
 
 /// A topic whose readers only see samples for which the filter expression holds. The filter runs in the
-/// reader (the writer still sends everything; no writer-side filtering is announced).
+/// reader on every sample that arrives; readers also announce it in SEDP (PID_CONTENT_FILTER_PROPERTY, class
+/// `DDSSQL`) with the parameters they were created with.
 pub struct ContentFilteredTopic<T> {
     topic: Topic<T>,
     name: String,
@@ -113,7 +120,7 @@ impl<T: DdsType + FilterFields> ContentFilteredTopic<T> {
     /// Changes the parameters; readers created on this topic apply them to samples received from now on.
     pub fn set_expression_parameters<S: AsRef<str>>(&self, params: &[S]) -> DdsResult<()> {
         let params: Vec<String> = params.iter().map(|s| s.as_ref().to_string()).collect();
-        write(&self.filter).set_parameters(&params)
+        Ok(write(&self.filter).set_parameters(&params)?)
     }
 }
 
@@ -124,6 +131,15 @@ impl<T: DdsType + FilterFields> TopicDescription<T> for ContentFilteredTopic<T> 
     fn sample_filter(&self) -> Option<SampleFilter<T>> {
         let f = self.filter.clone();
         Some(Box::new(move |s: &T| read(&f).matches(s)))
+    }
+    fn content_filter_property(&self) -> Option<ContentFilterProperty> {
+        let f = read(&self.filter);
+        Some(ContentFilterProperty::ddssql(
+            &self.name,
+            self.topic.name(),
+            f.expression(),
+            f.parameters().to_vec(),
+        ))
     }
 }
 

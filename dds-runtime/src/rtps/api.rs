@@ -5,7 +5,7 @@ use std::ops::Deref;
 use std::sync::Arc;
 use std::time::Duration;
 
-use super::discovery::{ports, ParticipantData, ReaderData, WriterData};
+use super::discovery::{ports, ContentFilterProperty, ParticipantData, ReaderData, WriterData};
 use super::messages::flags::StatusInfo;
 use super::types::*;
 use crate::qos::{QosPolicyId, ReaderQos, WriterQos};
@@ -426,6 +426,8 @@ pub struct EndpointSpec<Q> {
     pub type_information: Option<TypeInformation>,
     /// PID_ENTITY_NAME to announce.
     pub entity_name: Option<String>,
+    /// PID_CONTENT_FILTER_PROPERTY to announce (readers on a content-filtered topic).
+    pub content_filter: Option<ContentFilterProperty>,
 }
 
 /// A local writer to create.
@@ -449,6 +451,7 @@ impl<Q> EndpointSpec<Q> {
             qos: qos.into(),
             type_information: None,
             entity_name: None,
+            content_filter: None,
         }
     }
 }

@@ -263,6 +263,7 @@ impl Participant {
             expects_inline_qos: false,
             type_information: spec.type_information,
             entity_name: spec.entity_name,
+            content_filter: spec.content_filter,
         })
     }
 

@@ -16,18 +16,6 @@ pub(crate) struct ShapeType {
     pub shapesize: i32,
 }
 
-impl FilterFields for ShapeType {
-    fn field(&self, path: &str) -> Option<FieldValue> {
-        Some(match path {
-            "color" => self.color.clone().into(),
-            "x" => self.x.into(),
-            "y" => self.y.into(),
-            "shapesize" => self.shapesize.into(),
-            _ => return None,
-        })
-    }
-}
-
 pub(crate) fn shape(color: &str, x: i32) -> ShapeType {
     ShapeType {
         color: color.into(),

@@ -42,10 +42,6 @@ fn main() -> ExitCode {
         }
     };
     shutdown::install();
-    if let Some(line) = unsupported(&options) {
-        println!("{line}");
-        return ExitCode::from(ERROR_INITIALIZING);
-    }
     let app = match App::init(&options) {
         Ok(app) => app,
         Err(e) => {
@@ -67,14 +63,6 @@ fn main() -> ExitCode {
             ExitCode::from(ERROR_RUNNING)
         }
     }
-}
-
-/// The first option this implementation cannot honour, as shape_main's `... = not supported` line.
-fn unsupported(o: &ShapeOptions) -> Option<String> {
-    if o.cft_expression.is_some() {
-        return Some("    ContentFilteredTopic expression (--cft) = not supported".into());
-    }
-    None
 }
 
 enum Role {
@@ -323,15 +311,26 @@ impl App {
             let qos = qos.build();
             let mut readers = Vec::new();
             for t in &topics {
-                // shape_main reads a content-filtered topic "<topic>_filtered" on `color` when -c is
-                // given; the filter is applied when printing (same output).
-                let shown = if o.color.is_some() {
-                    format!("{}_filtered", t.name())
-                } else {
-                    t.name().to_string()
+                // shape_main reads a content-filtered topic "<topic>_filtered": `--cft EXPR`, else
+                // `color = %0` when -c is given.
+                let filter = match (&o.cft_expression, &o.color) {
+                    (Some(e), _) => Some((e.as_str(), Vec::new())),
+                    (None, Some(c)) => Some(("color = %0", vec![c.clone()])),
+                    (None, None) => None,
                 };
-                println!("Create reader for topic: {shown}");
-                let r = subscriber.create_datareader(t, &qos)?;
+                let r = match filter {
+                    Some((expr, params)) => {
+                        let name = format!("{}_filtered", t.name());
+                        println!("Create reader for topic: {name}");
+                        let cft =
+                            participant.create_content_filtered_topic(&name, t, expr, &params)?;
+                        subscriber.create_datareader(&cft, &qos)?
+                    }
+                    None => {
+                        println!("Create reader for topic: {}", t.name());
+                        subscriber.create_datareader(t, &qos)?
+                    }
+                };
                 r.set_listener(Box::new(Printer {
                     topic: t.name().to_string(),
                 }));

@@ -1,12 +1,14 @@
 //! Discovery: SPDP (participants), SEDP (endpoints), the builtin endpoints and matching.
 
 pub mod builtin;
+mod content_filter;
 pub mod matching;
 pub mod ports;
 mod qos_params;
 mod sedp;
 mod spdp;
 
+pub use content_filter::ContentFilterProperty;
 pub(crate) use sedp::{encode_endpoint_key, endpoint_guid as endpoint_guid_of};
 pub use sedp::{EndpointData, EndpointQos, ReaderData, WriterData};
 pub use spdp::ParticipantData;

@@ -1,6 +1,6 @@
 //! DiscoveredWriterData / DiscoveredReaderData (§8.5.4, §9.6.2.2) and their parameter-list form.
 
-use super::{pl_payload, PL_CDR_LE};
+use super::{pl_payload, ContentFilterProperty, PL_CDR_LE};
 use crate::qos::{ReaderQos, WriterQos};
 use crate::rtps::messages::parameter::{pid, ParameterWriter};
 use crate::rtps::messages::{ParameterList, WireError};
@@ -33,6 +33,8 @@ pub struct EndpointData<Q> {
     pub type_information: Option<TypeInformation>,
     /// PID_ENTITY_NAME, if announced.
     pub entity_name: Option<String>,
+    /// PID_CONTENT_FILTER_PROPERTY: the reader's content filter (readers only).
+    pub content_filter: Option<ContentFilterProperty>,
 }
 
 /// A publication as announced in SEDP (DiscoveredWriterData).
@@ -77,6 +79,9 @@ impl<Q: EndpointQos> EndpointData<Q> {
         }
         if self.expects_inline_qos {
             w.bool(pid::EXPECTS_INLINE_QOS, true);
+        }
+        if let Some(f) = &self.content_filter {
+            f.write(&mut w);
         }
         self.qos.write_params(&mut w);
         w.finish();
@@ -131,6 +136,9 @@ impl<Q> Decoded<Q> {
             pid::EXPECTS_INLINE_QOS => d.expects_inline_qos = cur.u8()? != 0,
             pid::TYPE_INFORMATION => d.type_information = Some(TypeInformation(value.to_vec())),
             pid::ENTITY_NAME => d.entity_name = Some(cur.string()?.to_owned()),
+            pid::CONTENT_FILTER_PROPERTY => {
+                d.content_filter = Some(ContentFilterProperty::read(&mut cur)?)
+            }
             // Known and deliberately unused.
             pid::KEY_HASH
             | pid::GROUP_GUID
@@ -236,6 +244,7 @@ mod tests {
             type_information: Some(TypeInformation(vec![1, 2, 3, 4])),
             expects_inline_qos: false,
             entity_name: None,
+            content_filter: None,
         };
         let enc = w.encode();
         let back = WriterData::decode(&enc).unwrap();
@@ -272,9 +281,16 @@ mod tests {
             type_name: "ShapeType".into(),
             qos: ReaderQos::from(rq),
             expects_inline_qos: true,
+            content_filter: Some(ContentFilterProperty::ddssql(
+                "Square_f",
+                "Square",
+                "x < %0",
+                vec!["5".into()],
+            )),
             ..Default::default()
         };
         let back = ReaderData::decode(&r.encode()).unwrap();
+        assert_eq!(back.content_filter, r.content_filter);
         assert_eq!(back.qos.reader.data_representation.ids(), [0, 2]);
         assert!(back.expects_inline_qos);
         assert!(back.qos.reader.reliability.is_reliable());

@@ -98,6 +98,10 @@ pub mod pid {
     pub const TYPE_MAX_SIZE_SERIALIZED: u16 = 0x0060;
     /// The entity's name.
     pub const ENTITY_NAME: u16 = 0x0062;
+    /// ContentFilterProperty_t: a reader's content filter (SEDP).
+    pub const CONTENT_FILTER_PROPERTY: u16 = 0x0035;
+    /// ContentFilterInfo_t: the filter results a writer computed for a change (inline QoS).
+    pub const CONTENT_FILTER_INFO: u16 = 0x0055;
     /// Inline QoS: the instance's key hash.
     pub const KEY_HASH: u16 = 0x0070;
     /// Inline QoS: dispose/unregister flags (see `messages::flags::StatusInfo`).
