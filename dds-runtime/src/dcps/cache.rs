@@ -626,6 +626,25 @@ struct Touched {
     last_index: usize,
 }
 
+/// What `DataReader::get_qos`/`set_qos` and `get_key_value` need.
+impl<T> ReaderCache<T> {
+    /// The QoS the cache applies.
+    pub(crate) fn qos(&self) -> &DataReaderQos {
+        &self.qos
+    }
+
+    /// Replaces the QoS (`set_qos` checked that only changeable policies differ: deadline, time-based
+    /// filter, reader data lifecycle, ...); applies from the next sample or tick.
+    pub(crate) fn set_qos(&mut self, qos: DataReaderQos) {
+        self.qos = qos;
+    }
+
+    /// A sample holding the key of instance `h`, if one was received.
+    pub(crate) fn key_holder(&self, h: InstanceHandle) -> Option<&T> {
+        self.instances.get(&h)?.key_holder.as_ref()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,7 +6,7 @@
 use std::hash::{BuildHasher, Hasher};
 use std::net::{IpAddr, SocketAddr, SocketAddrV4};
 use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU64, AtomicUsize, Ordering};
-use std::sync::{Arc, Condvar, Mutex, RwLock, Weak};
+use std::sync::{Arc, Condvar, Mutex, OnceLock, RwLock, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
@@ -83,7 +83,12 @@ pub(crate) struct Driver {
     pub(crate) status: Arc<StatusCore>,
     /// Payload buffers of sent datagrams, handed back to the core at the next `with_core`.
     spare_buffers: Mutex<Vec<Vec<u8>>>,
+    /// Told of every remote publication and subscription discovered (topics, INCONSISTENT_TOPIC).
+    discovery_hook: OnceLock<DiscoveryHook>,
 }
+
+/// See [`Driver::set_discovery_hook`].
+type DiscoveryHook = Box<dyn Fn(&Event) + Send + Sync>;
 
 /// Most sent buffers kept for recycling.
 const MAX_SPARE_BUFFERS: usize = 32;
@@ -206,6 +211,7 @@ impl Driver {
             timer_thread: Mutex::new(None),
             status: Arc::new(StatusCore::default()),
             spare_buffers: Mutex::new(Vec::new()),
+            discovery_hook: OnceLock::new(),
         });
         let weak: Weak<Driver> = Arc::downgrade(&driver);
         let rx = Arc::new(move |_ch: Channel, batch: &[Datagram<'_>]| {
@@ -394,11 +400,24 @@ impl Driver {
             Event::PublicationDiscovered(w) => {
                 let (guid, info) = remote_writer_info(w);
                 lock(&self.remote_writers).insert(guid, info);
+                self.discovered(&ev);
             }
+            Event::SubscriptionDiscovered(_) => self.discovered(&ev),
             Event::PublicationRemoved { guid } => {
                 lock(&self.remote_writers).remove(guid);
             }
             _ => {}
+        }
+    }
+
+    /// Installs the function told of every remote publication and subscription discovered (once).
+    pub(crate) fn set_discovery_hook(&self, hook: DiscoveryHook) {
+        let _ = self.discovery_hook.set(hook);
+    }
+
+    fn discovered(&self, ev: &Event) {
+        if let Some(h) = self.discovery_hook.get() {
+            h(ev);
         }
     }
 

@@ -75,7 +75,9 @@ impl Participant {
                 return;
             }
         };
-        if data.guid_prefix == self.config.guid_prefix {
+        if data.guid_prefix == self.config.guid_prefix
+            || self.ignored.participant(&data.guid_prefix)
+        {
             return;
         }
         if data.domain_id.is_some_and(|d| d != self.config.domain_id) || !data.domain_tag.is_empty()
@@ -218,6 +220,9 @@ impl Participant {
             return;
         }
         match EndpointData::<Q>::decode(&s.payload) {
+            Ok(d) if self.ignored.endpoint(&d.guid, &d.topic_name) => {
+                trace!(endpoint = ?d.guid, "ignored SEDP announcement dropped");
+            }
             Ok(d) if d.guid.prefix == s.writer.prefix => {
                 let known = Q::known(self);
                 let new = !known.contains_key(&d.guid);
