@@ -96,6 +96,8 @@ pub(crate) struct ReaderCache<T> {
     next_seq: u64,
     total: usize,
     filter: Option<Filter<T>>,
+    /// Makes the key holder of a new instance from its first data (`get_key_value`).
+    key_of: Option<fn(&T) -> Option<T>>,
 }
 
 /// The sample a read (copying the data with `copy`, if any) or a take (moving it out) returns for `slot`.
@@ -129,6 +131,7 @@ impl<T> ReaderCache<T> {
             next_seq: 0,
             total: 0,
             filter: None,
+            key_of: None,
         }
     }
 
@@ -216,7 +219,10 @@ impl<T> ReaderCache<T> {
             }
             None if !alive && inc.kind == ChangeKind::Unregister => return Outcome::Filtered,
             None => {
-                let holder = inc.key_holder.take();
+                let holder = inc
+                    .key_holder
+                    .take()
+                    .or_else(|| self.key_of.and_then(|f| inc.data.as_ref().and_then(f)));
                 match self.new_instance(key, holder, now) {
                     Some(h) => h,
                     None => {
@@ -637,6 +643,11 @@ impl<T> ReaderCache<T> {
     /// filter, reader data lifecycle, ...); applies from the next sample or tick.
     pub(crate) fn set_qos(&mut self, qos: DataReaderQos) {
         self.qos = qos;
+    }
+
+    /// Gives new instances of received data a key holder made with `f` (once per instance).
+    pub(crate) fn set_key_holder_fn(&mut self, f: fn(&T) -> Option<T>) {
+        self.key_of = Some(f);
     }
 
     /// A sample holding the key of instance `h`, if one was received.

@@ -10,6 +10,7 @@ use std::time::SystemTime;
 use crate::qos::{ChangeableQos, DomainParticipantQos, PublisherQos, SubscriberQos, TopicQos};
 use crate::rtps::{EntityId, Guid, GuidPrefix};
 
+use super::super::builtin::ParticipantBuiltinTopicData;
 use super::super::chain::{ParentListener, StatusChange};
 use super::super::driver::Driver;
 use super::super::error::{DdsError, DdsResult};
@@ -288,6 +289,35 @@ impl DomainParticipant {
     /// The default topic QoS (`get_default_topic_qos`), to pass to `create_topic`.
     pub fn default_topic_qos(&self) -> TopicQos {
         self.registry.with(|e| e.default_topic_qos.clone())
+    }
+
+    /// What SPDP announced about the discovered participant `handle` (`get_discovered_participant_data`);
+    /// `BadParameter` for an unknown handle.
+    pub fn get_discovered_participant_data(
+        &self,
+        handle: InstanceHandle,
+    ) -> DdsResult<ParticipantBuiltinTopicData> {
+        self.driver.check_alive()?;
+        self.driver
+            .with_core(|c, _| {
+                c.discovered_participants()
+                    .find(|p| participant_handle(p.guid_prefix) == handle)
+                    .map(ParticipantBuiltinTopicData::from)
+            })
+            .ok_or_else(|| DdsError::BadParameter(format!("no discovered participant {handle:?}")))
+    }
+
+    /// The remote topics discovered through their readers and writers, as (name, type name)
+    /// (`get_discovered_topics` and `get_discovered_topic_data`; SEDP topic announcements are not used).
+    pub fn discovered_topics(&self) -> Vec<(String, String)> {
+        let mut v: Vec<(String, String)> = self.registry.with(|e| {
+            e.remote_topics
+                .iter()
+                .map(|(n, t)| (n.clone(), t.clone()))
+                .collect()
+        });
+        v.sort();
+        v
     }
 
     /// The handles of the remote participants discovered (`get_discovered_participants`).

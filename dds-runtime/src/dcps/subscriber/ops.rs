@@ -7,7 +7,7 @@ use std::any::Any;
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, Weak};
 
-use crate::cdr::DdsType;
+use crate::cdr::{self, DdsType};
 use crate::qos::{ChangeableQos, DataReaderQos, ReaderQos, SubscriberQos, TopicQos};
 use crate::rtps::EntityId;
 
@@ -98,6 +98,9 @@ pub(super) fn register_reader<T: DdsType>(
     let Ok(group) = s.with_group(|g| g.node.handle) else {
         return;
     };
+    if T::IS_KEYED {
+        lock(&inner.cache).cache.set_key_holder_fn(key_holder::<T>);
+    }
     let entity: Weak<dyn Registered> = Arc::downgrade(inner) as Weak<ReaderInner<T>>;
     s.participant.registry().add_endpoint(
         false,
@@ -112,6 +115,19 @@ pub(super) fn register_reader<T: DdsType>(
             entity,
         },
     );
+}
+
+/// A sample holding only the key of `data` (its other members defaulted), for `get_key_value`.
+fn key_holder<T: DdsType>(data: &T) -> Option<T> {
+    let mut buf = Vec::new();
+    cdr::serialize_key(
+        data,
+        cdr::XcdrVersion::Xcdr2,
+        cdr::ByteOrder::NATIVE,
+        &mut buf,
+    )
+    .ok()?;
+    cdr::deserialize_key(&buf).ok()
 }
 
 impl<T: DdsType> Registered for ReaderInner<T> {
@@ -418,17 +434,14 @@ impl<T: DdsType> DataReader<T> {
         self.inner.state.check_alive()
     }
 
-    /// The key of the instance `handle` (`get_key_value`): a received sample of it whose key members are
-    /// the instance's. `BadParameter` for an unknown handle.
-    pub fn get_key_value(&self, handle: InstanceHandle) -> DdsResult<T>
-    where
-        T: Clone,
-    {
+    /// The key of the instance `handle` (`get_key_value`): a sample whose key members are the instance's
+    /// and whose other members are defaulted. `BadParameter` for an unknown handle.
+    pub fn get_key_value(&self, handle: InstanceHandle) -> DdsResult<T> {
         self.inner.state.check_alive()?;
         lock(&self.inner.cache)
             .cache
             .key_holder(handle)
-            .cloned()
+            .and_then(key_holder)
             .ok_or_else(|| DdsError::BadParameter(format!("unknown instance handle {handle:?}")))
     }
 
@@ -451,11 +464,17 @@ impl<T: DdsType> DataReader<T> {
             .ok_or_else(|| DdsError::BadParameter(format!("no matched writer {handle:?}")))
     }
 
+    /// `delete_contained_entities` of a reader: its read conditions hold no resources here, so there is
+    /// nothing to delete; `AlreadyDeleted` once the reader was deleted.
+    pub fn delete_contained_entities(&self) -> DdsResult<()> {
+        self.inner.state.check_alive()
+    }
+
     /// Deletes a read condition of this reader (`delete_readcondition`): conditions hold no resources
     /// here, so this only checks that `condition` is this reader's (`PreconditionNotMet` otherwise).
     pub fn delete_readcondition(&self, condition: &ReadCondition) -> DdsResult<()> {
-        let ours: Arc<dyn ReadConditionSource> = self.inner.clone();
-        if Arc::ptr_eq(&condition.source, &ours) {
+        let ours = Arc::as_ptr(&self.inner) as *const ();
+        if Arc::as_ptr(&condition.source) as *const () == ours {
             Ok(())
         } else {
             Err(DdsError::PreconditionNotMet(
