@@ -250,6 +250,7 @@ fn participant_set_qos_announces_user_data() {
 #[test]
 fn participant_enable_and_current_time() {
     let p = participant(156);
+    assert_eq!(p.domain_id(), 156);
     p.enable().unwrap();
     let t = p.get_current_time().unwrap();
     let d = SystemTime::now().duration_since(t).unwrap_or_default();
@@ -516,6 +517,7 @@ fn participant_delete_topic() {
         p.delete_topic(&t),
         Err(DdsError::PreconditionNotMet(_))
     ));
+    assert_eq!(w.topic().name(), "DT");
     w.publisher().delete_datawriter(&w).unwrap();
     p.delete_topic(&t).unwrap();
     assert!(
@@ -547,6 +549,11 @@ fn participant_find_topic() {
     let _w = writer::<ShapeType>(&p2, "Remote", &DataWriterQos::default());
     let t = p1.find_topic::<ShapeType>("Remote", MATCH_TIMEOUT).unwrap();
     assert_eq!(t.name(), "Remote");
+    assert_eq!(t.type_name(), "ShapeType");
+    assert_eq!(t.participant().guid_prefix(), p1.guid_prefix());
+    assert!(p1
+        .discovered_topics()
+        .contains(&("Remote".to_string(), "ShapeType".to_string())));
     assert!(p1.contains_entity(t.instance_handle().unwrap()));
     assert!(matches!(
         p1.find_topic::<ShapeType>("Absent", Duration::from_millis(200)),
@@ -745,6 +752,7 @@ fn publisher_status_condition() {
 fn publisher_default_datawriter_qos_and_copy_from_topic_qos() {
     let p = participant(178);
     let publ = p.create_publisher(&PublisherQos::default()).unwrap();
+    assert_eq!(publ.participant().guid_prefix(), p.guid_prefix());
     let q = DataWriterQos::builder()
         .history(History::KeepLast(7))
         .build();
@@ -1023,6 +1031,7 @@ fn subscriber_status_condition_data_on_readers() {
     let p = participant(191);
     let (wq, rq) = reliable_qos();
     let (w, r) = matched::<ShapeType>(&p, &p, "SDOR", &wq, &rq);
+    assert_eq!(r.topic().name(), "SDOR");
     let cond = r.subscriber().status_condition().unwrap();
     cond.set_enabled_statuses(StatusMask::DATA_ON_READERS);
     assert!(!cond.trigger_value());
@@ -1038,6 +1047,7 @@ fn subscriber_get_datareaders() {
     let (wq, rq) = reliable_qos();
     let (w, r) = matched::<ShapeType>(&p, &p, "GDR", &wq, &rq);
     let sub = r.subscriber().clone();
+    assert_eq!(sub.participant().guid_prefix(), p.guid_prefix());
     let any = (
         SampleStateMask::NOT_READ,
         ViewStateMask::ANY,
@@ -1249,4 +1259,58 @@ fn reader_delete_readcondition() {
         Err(DdsError::PreconditionNotMet(_))
     ));
     r1.delete_readcondition(&c).unwrap();
+    r1.delete_contained_entities().unwrap();
+}
+
+#[test]
+fn reader_read_and_take_w_condition() {
+    let p = participant(202);
+    let (wq, rq) = reliable_qos();
+    let (w, r) = matched::<ShapeType>(&p, &p, "RWC", &wq, &rq);
+    w.write(&shape("RED", 1)).unwrap();
+    w.write(&shape("BLUE", 2)).unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || r.sample_count() == 2));
+    let unread = r.create_readcondition(
+        SampleStateMask::NOT_READ,
+        ViewStateMask::ANY,
+        InstanceStateMask::ANY,
+    );
+    let read = r.create_readcondition(
+        SampleStateMask::READ,
+        ViewStateMask::ANY,
+        InstanceStateMask::ANY,
+    );
+    assert!(unread.trigger_value() && !read.trigger_value());
+    assert_eq!(r.read_w_condition(&unread).unwrap().len(), 2);
+    assert!(!unread.trigger_value() && read.trigger_value());
+    assert_eq!(r.take_w_condition(&read).unwrap().len(), 2);
+    assert_eq!(r.sample_count(), 0);
+}
+
+#[test]
+fn reader_next_instance_and_next_sample() {
+    let p = participant(203);
+    let (wq, rq) = reliable_qos();
+    let (w, r) = matched::<ShapeType>(&p, &p, "RNI", &wq, &rq);
+    for (c, x) in [("RED", 1), ("BLUE", 2), ("RED", 3)] {
+        w.write(&shape(c, x)).unwrap();
+    }
+    assert!(wait_until(MATCH_TIMEOUT, || r.sample_count() == 3));
+    let one = r.read_next_sample().unwrap().expect("an unread sample");
+    assert_eq!(one.info.sample_state, SampleState::NotRead);
+    let first = r.read_next_instance(InstanceHandle::NIL).unwrap();
+    assert!(!first.is_empty());
+    let h = first[0].info.instance_handle;
+    assert!(first.iter().all(|s| s.info.instance_handle == h));
+    // read/take_next_instance_w_condition: the selector with a state filter.
+    let next = r
+        .select()
+        .next_instance(h)
+        .sample_state(SampleStateMask::NOT_READ)
+        .take()
+        .unwrap();
+    assert!(!next.is_empty() && next.iter().all(|s| s.info.instance_handle != h));
+    assert_eq!(r.take_instance(h).unwrap().len(), first.len());
+    assert_eq!(first.len() + next.len(), 3);
+    assert!(r.take_next_sample().unwrap().is_none());
 }

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Condvar, Mutex, Weak};
 use std::time::Instant;
 
-use foldhash::HashMap;
+use foldhash::{HashMap, HashSet};
 
 use crate::qos::{
     DataReaderQos, DataWriterQos, DomainParticipantQos, PublisherQos, SubscriberQos, TopicQos,
@@ -22,7 +22,7 @@ use super::chain::ListenerNode;
 use super::condition::StatusCore;
 use super::error::{DdsError, DdsResult};
 use super::sample::{InstanceHandle, InstanceStateMask, SampleStateMask, ViewStateMask};
-use super::status::InconsistentTopicStatus;
+use super::status::{InconsistentTopicStatus, StatusMask};
 use super::sync::{lock, recover};
 
 /// Most remote topic names remembered for `find_topic`.
@@ -103,6 +103,8 @@ pub(crate) struct Entities {
     pub(crate) readers: Vec<EndpointEntry>,
     /// Topic name → type name of remote endpoints (for `find_topic` and INCONSISTENT_TOPIC).
     pub(crate) remote_topics: HashMap<String, String>,
+    /// Remote endpoints already counted in an INCONSISTENT_TOPIC status (announced again on QoS changes).
+    inconsistent_seen: HashSet<Guid>,
     pub(crate) participant_qos: DomainParticipantQos,
     pub(crate) default_publisher_qos: PublisherQos,
     pub(crate) default_subscriber_qos: SubscriberQos,
@@ -227,17 +229,27 @@ impl Registry {
     ) -> InstanceHandle {
         let node = self.group_node(KIND_TOPIC);
         let handle = node.handle;
-        self.with(|e| {
+        let clash = self.with(|e| {
+            let mut inconsistent = InconsistentTopicStatus::default();
+            let clash = e.remote_topics.get(name).is_some_and(|t| t != type_name);
+            if clash {
+                inconsistent.record();
+            }
             e.topics.push(TopicEntry {
                 identity,
                 name: name.to_string(),
                 type_name: type_name.to_string(),
-                node,
+                node: node.clone(),
                 qos,
-                inconsistent: InconsistentTopicStatus::default(),
+                inconsistent,
                 deleted: false,
-            })
+            });
+            clash
         });
+        if clash {
+            // Known before the topic existed: the status is set, no listener can have been installed yet.
+            node.raise_up(StatusMask::INCONSISTENT_TOPIC);
+        }
         handle
     }
 
@@ -259,14 +271,24 @@ impl Registry {
         &self,
         ev: &Event,
     ) -> Vec<(Arc<ListenerNode>, InconsistentTopicStatus)> {
-        let (topic, type_name) = match ev {
-            Event::PublicationDiscovered(w) => (&w.topic_name, &w.type_name),
-            Event::SubscriptionDiscovered(r) => (&r.topic_name, &r.type_name),
+        let (guid, topic, type_name) = match ev {
+            Event::PublicationDiscovered(w) => (w.guid, &w.topic_name, &w.type_name),
+            Event::SubscriptionDiscovered(r) => (r.guid, &r.topic_name, &r.type_name),
             _ => return Vec::new(),
         };
         let out = self.with(|e| {
             if e.remote_topics.len() < MAX_REMOTE_TOPICS || e.remote_topics.contains_key(topic) {
                 e.remote_topics.insert(topic.clone(), type_name.clone());
+            }
+            let inconsistent = e
+                .topics
+                .iter()
+                .any(|t| !t.deleted && t.name == *topic && t.type_name != *type_name);
+            if !inconsistent || e.inconsistent_seen.len() >= MAX_REMOTE_TOPICS {
+                return Vec::new();
+            }
+            if !e.inconsistent_seen.insert(guid) {
+                return Vec::new();
             }
             e.topics
                 .iter_mut()

@@ -227,7 +227,8 @@ impl Participant {
                 let known = Q::known(self);
                 let new = !known.contains_key(&d.guid);
                 if !new || known.len() < MAX_ENDPOINTS {
-                    if new {
+                    // New, or announced again with another QoS (`set_qos`): reported either way.
+                    if known.get(&d.guid) != Some(&d) {
                         self.events.push_back(Q::discovered(d.clone()));
                     }
                     self.on_endpoint_known(now, d);
@@ -459,7 +460,7 @@ impl Local {
 }
 
 /// What the participant keeps apart for each SEDP direction (publications, subscriptions).
-pub(super) trait Direction: EndpointQos + Clone {
+pub(super) trait Direction: EndpointQos + Clone + PartialEq {
     /// For logs.
     const NAME: &'static str;
     /// Our SEDP writer that announces local endpoints of this direction.
