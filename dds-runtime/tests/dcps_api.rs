@@ -601,8 +601,14 @@ fn topic_inconsistent_topic() {
         "the topic's listener is more specific"
     );
     let s = t.inconsistent_topic_status().unwrap();
-    assert!(s.total_count >= 1);
+    assert_eq!(s.total_count, 1, "counted once per remote endpoint");
     assert!(!cond.trigger_value());
+    // A topic created after the remote endpoint was discovered starts inconsistent.
+    let late = p1
+        .create_topic::<ShapeType>("Clash", &TopicQos::default())
+        .unwrap();
+    assert!(late.status_condition().unwrap().trigger_value());
+    assert_eq!(late.inconsistent_topic_status().unwrap().total_count, 1);
 }
 
 #[test]

@@ -119,6 +119,17 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         &self.deleted
     }
 
+    /// An explicit `delete_*`: the entity refuses operations from then on and leaves the core (a writer
+    /// unregisters its instances first). `AlreadyDeleted` when it was deleted before.
+    pub(crate) fn delete(&self) -> DdsResult<()> {
+        self.check_alive()?;
+        if self.deleted.swap(true, Ordering::AcqRel) {
+            return Err(DdsError::AlreadyDeleted);
+        }
+        self.driver.delete_endpoint(self.id());
+        Ok(())
+    }
+
     /// `Err(AlreadyDeleted)` once the entity or its participant was deleted.
     pub(crate) fn check_alive(&self) -> DdsResult<()> {
         if self.deleted.load(Ordering::Acquire) {

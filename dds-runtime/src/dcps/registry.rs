@@ -14,7 +14,8 @@ use std::time::Instant;
 use foldhash::{HashMap, HashSet};
 
 use crate::qos::{
-    DataReaderQos, DataWriterQos, DomainParticipantQos, PublisherQos, SubscriberQos, TopicQos,
+    ChangeableQos, DataReaderQos, DataWriterQos, DomainParticipantQos, PublisherQos, SubscriberQos,
+    TopicQos,
 };
 use crate::rtps::{EntityId, Event, Guid, GuidPrefix};
 
@@ -171,39 +172,19 @@ impl Registry {
         InstanceHandle::from_guid(Guid::new(self.prefix, EntityId([k[1], k[2], k[3], kind])))
     }
 
-    /// Registers a publisher with QoS `qos`; returns its level of the listener chain.
-    pub(crate) fn add_publisher(
+    /// Registers a publisher or subscriber with QoS `qos`; returns its level of the listener chain.
+    pub(crate) fn add_group<Q: GroupQos>(
         &self,
         identity: Weak<dyn Any + Send + Sync>,
-        qos: PublisherQos,
+        qos: Q,
     ) -> Arc<ListenerNode> {
-        let node = self.group_node(KIND_WRITER_GROUP);
+        let node = self.group_node(Q::KIND);
         self.with(|e| {
-            e.publishers.push(Group {
+            Q::groups(e).push(Group {
                 identity,
                 node: node.clone(),
                 qos,
-                child_default: DataWriterQos::default(),
-                suspended: 0,
-                deleted: false,
-            })
-        });
-        node
-    }
-
-    /// Registers a subscriber with QoS `qos`; returns its level of the listener chain.
-    pub(crate) fn add_subscriber(
-        &self,
-        identity: Weak<dyn Any + Send + Sync>,
-        qos: SubscriberQos,
-    ) -> Arc<ListenerNode> {
-        let node = self.group_node(KIND_READER_GROUP);
-        self.with(|e| {
-            e.subscribers.push(Group {
-                identity,
-                node: node.clone(),
-                qos,
-                child_default: DataReaderQos::default(),
+                child_default: Q::Child::default(),
                 suspended: 0,
                 deleted: false,
             })
@@ -325,9 +306,15 @@ impl Registry {
 }
 
 /// Publishers and subscribers, told apart by their QoS type.
-pub(crate) trait GroupQos: Sized + Clone {
+pub(crate) trait GroupQos: ChangeableQos + Sized + Clone {
     /// The QoS of their readers or writers.
-    type Child: Clone;
+    type Child: Clone + Default;
+    /// The RTPS entity kind used for their handles.
+    const KIND: u8;
+    /// Whether `new` changes what their readers or writers announce (partition, group data).
+    fn announced_change(&self, new: &Self) -> bool;
+    /// ENTITY_FACTORY.autoenable_created_entities.
+    fn autoenable(&self) -> bool;
     /// The registered groups of this kind.
     fn groups(e: &mut Entities) -> &mut Vec<Group<Self, Self::Child>>;
     /// The readers or writers.
@@ -336,6 +323,13 @@ pub(crate) trait GroupQos: Sized + Clone {
 
 impl GroupQos for PublisherQos {
     type Child = DataWriterQos;
+    const KIND: u8 = KIND_WRITER_GROUP;
+    fn announced_change(&self, new: &Self) -> bool {
+        self.partition != new.partition || self.group_data != new.group_data
+    }
+    fn autoenable(&self) -> bool {
+        self.autoenable_created_entities
+    }
     fn groups(e: &mut Entities) -> &mut Vec<Group<Self, Self::Child>> {
         &mut e.publishers
     }
@@ -346,6 +340,13 @@ impl GroupQos for PublisherQos {
 
 impl GroupQos for SubscriberQos {
     type Child = DataReaderQos;
+    const KIND: u8 = KIND_READER_GROUP;
+    fn announced_change(&self, new: &Self) -> bool {
+        self.partition != new.partition || self.group_data != new.group_data
+    }
+    fn autoenable(&self) -> bool {
+        self.autoenable_created_entities
+    }
     fn groups(e: &mut Entities) -> &mut Vec<Group<Self, Self::Child>> {
         &mut e.subscribers
     }
@@ -416,6 +417,59 @@ impl Registry {
             }
             Ok(())
         })
+    }
+
+    /// Changes the QoS of the group at `ptr` (`set_qos`); returns its readers or writers when what they
+    /// announce changed (they must announce again).
+    pub(crate) fn set_group_qos<Q: GroupQos>(
+        &self,
+        ptr: *const (),
+        qos: &Q,
+    ) -> DdsResult<Vec<Weak<dyn Registered>>> {
+        if !qos.autoenable() {
+            return Err(DdsError::Unsupported(
+                "disabled entities: every entity is enabled when created",
+            ));
+        }
+        let (handle, changed) = self.with_group::<Q, _>(ptr, |g| {
+            if let Some(p) = g.qos.immutable_change(qos) {
+                return Err(DdsError::ImmutablePolicy(p));
+            }
+            let changed = g.qos.announced_change(qos);
+            g.qos = qos.clone();
+            Ok((g.node.handle, changed))
+        })??;
+        if !changed {
+            return Ok(Vec::new());
+        }
+        Ok(self
+            .children::<Q>(handle)
+            .into_iter()
+            .map(|c| c.entity)
+            .collect())
+    }
+
+    /// The reader or writer of the group `handle` on `topic` whose inner state is an `E`.
+    pub(crate) fn find_child<Q: GroupQos, E: Any + Send + Sync>(
+        &self,
+        handle: InstanceHandle,
+        topic: &str,
+    ) -> Option<Arc<E>> {
+        self.children::<Q>(handle)
+            .into_iter()
+            .filter(|c| c.topic == topic)
+            .find_map(|c| c.entity.upgrade()?.as_any().downcast::<E>().ok())
+    }
+
+    /// Marks every reader or writer of the group `handle` deleted; returns their ids (to delete in the
+    /// core).
+    pub(crate) fn delete_children<Q: GroupQos>(&self, handle: InstanceHandle) -> Vec<EntityId> {
+        let ids: Vec<EntityId> = self
+            .children::<Q>(handle)
+            .into_iter()
+            .map(|c| c.id)
+            .collect();
+        self.mark_deleted(&ids)
     }
 
     /// Marks the readers and writers `ids` deleted; returns those that were not yet (to delete in the core).

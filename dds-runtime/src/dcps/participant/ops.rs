@@ -3,7 +3,6 @@
 //! `get_current_time`. The entity-specific ones (`delete_publisher`, `find_topic`, ...) live with their
 //! entity.
 
-use std::sync::atomic::Ordering;
 use std::sync::{Arc, Weak};
 use std::time::SystemTime;
 
@@ -234,21 +233,17 @@ impl DomainParticipant {
     /// SEDP; handles still held return `AlreadyDeleted` from then on.
     pub fn delete_contained_entities(&self) -> DdsResult<()> {
         self.driver.check_alive()?;
-        let endpoints: Vec<EntityId> = self.registry.with(|e| {
-            let ids = e
-                .writers
-                .iter()
-                .chain(e.readers.iter())
-                .filter_map(|w| {
-                    let d = w.deleted.upgrade()?;
-                    (!d.swap(true, Ordering::AcqRel)).then_some(w.guid.entity_id)
-                })
-                .collect();
+        let ids: Vec<EntityId> = self.registry.with(|e| {
             e.publishers.iter_mut().for_each(|g| g.deleted = true);
             e.subscribers.iter_mut().for_each(|g| g.deleted = true);
             e.topics.iter_mut().for_each(|t| t.deleted = true);
-            ids
+            e.writers
+                .iter()
+                .chain(e.readers.iter())
+                .map(|w| w.guid.entity_id)
+                .collect()
         });
+        let endpoints = self.registry.mark_deleted(&ids);
         for id in endpoints {
             self.driver.delete_endpoint(id);
         }

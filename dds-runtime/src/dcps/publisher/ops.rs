@@ -3,7 +3,6 @@
 //! and the matched subscription data; and how publishers and writers enter the participant's registry.
 
 use std::any::Any;
-use std::sync::atomic::Ordering;
 use std::sync::{Arc, Weak};
 use std::time::{Duration, Instant, SystemTime};
 
@@ -55,7 +54,7 @@ pub(super) fn register_publisher(p: &Publisher) {
     let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&p.qos) as Weak<PublisherQos>;
     p.participant
         .registry()
-        .add_publisher(identity, (*p.qos).clone());
+        .add_group(identity, (*p.qos).clone());
 }
 
 /// The publisher level of a new writer's listener chain; `AlreadyDeleted` for a deleted publisher.
@@ -143,24 +142,11 @@ impl Publisher {
     /// Changes the QoS (`set_qos`): PARTITION and GROUP_DATA may change, and every writer announces
     /// them again (matches follow the new partitions); PRESENTATION cannot (`ImmutablePolicy`).
     pub fn set_qos(&self, qos: &PublisherQos) -> DdsResult<()> {
-        if !qos.autoenable_created_entities {
-            return Err(DdsError::Unsupported(
-                "disabled entities: every entity is enabled when created",
-            ));
-        }
-        let changed = self.with_group(|g| {
-            if let Some(p) = g.qos.immutable_change(qos) {
-                return Err(DdsError::ImmutablePolicy(p));
-            }
-            let changed = g.qos.partition != qos.partition || g.qos.group_data != qos.group_data;
-            g.qos = qos.clone();
-            Ok(changed)
-        })??;
-        if changed {
-            for w in self.writers()? {
-                if let Some(w) = w.entity.upgrade() {
-                    w.group_changed();
-                }
+        self.participant.driver().check_alive()?;
+        let ptr = Arc::as_ptr(&self.qos) as *const ();
+        for e in self.participant.registry().set_group_qos(ptr, qos)? {
+            if let Some(e) = e.upgrade() {
+                e.group_changed();
             }
         }
         Ok(())
@@ -224,22 +210,12 @@ impl Publisher {
     /// autodispose), leaves SEDP, and its handles return `AlreadyDeleted` from then on.
     /// `PreconditionNotMet` for a writer of another publisher.
     pub fn delete_datawriter<T: DdsType>(&self, writer: &DataWriter<T>) -> DdsResult<()> {
-        let ptr = Arc::as_ptr(&self.qos);
-        if !std::ptr::eq(Arc::as_ptr(&writer.publisher().qos), ptr) {
+        if !Arc::ptr_eq(&writer.publisher().qos, &self.qos) {
             return Err(DdsError::PreconditionNotMet(
                 "the writer belongs to another publisher",
             ));
         }
-        writer.inner.state.check_alive()?;
-        writer
-            .inner
-            .state
-            .deleted_flag()
-            .store(true, Ordering::Release);
-        self.participant
-            .driver()
-            .delete_endpoint(writer.handle.id());
-        Ok(())
+        writer.inner.state.delete()
     }
 
     /// A writer of this publisher on the topic `topic_name` (`lookup_datawriter`), `None` when there is
@@ -248,16 +224,12 @@ impl Publisher {
         &self,
         topic_name: &str,
     ) -> DdsResult<Option<DataWriter<T>>> {
-        Ok(self.writers()?.into_iter().find_map(|w| {
-            if w.topic != topic_name {
-                return None;
-            }
-            let inner = w
-                .entity
-                .upgrade()?
-                .as_any()
-                .downcast::<WriterInner<T>>()
-                .ok()?;
+        let handle = self.instance_handle()?;
+        let inner = self
+            .participant
+            .registry()
+            .find_child::<PublisherQos, WriterInner<T>>(handle, topic_name);
+        Ok(inner.and_then(|inner| {
             let handle = inner.state.handle()?;
             Some(DataWriter { inner, handle })
         }))
@@ -265,8 +237,12 @@ impl Publisher {
 
     /// Deletes every writer of this publisher (`delete_contained_entities`).
     pub fn delete_contained_entities(&self) -> DdsResult<()> {
-        let ids: Vec<EntityId> = self.writers()?.into_iter().map(|w| w.id).collect();
-        for id in self.participant.registry().mark_deleted(&ids) {
+        let handle = self.instance_handle()?;
+        for id in self
+            .participant
+            .registry()
+            .delete_children::<PublisherQos>(handle)
+        {
             self.participant.driver().delete_endpoint(id);
         }
         Ok(())

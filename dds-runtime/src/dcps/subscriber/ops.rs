@@ -4,12 +4,10 @@
 //! enter the participant's registry.
 
 use std::any::Any;
-use std::sync::atomic::Ordering;
 use std::sync::{Arc, Weak};
 
 use crate::cdr::{self, DdsType};
 use crate::qos::{ChangeableQos, DataReaderQos, ReaderQos, SubscriberQos, TopicQos};
-use crate::rtps::EntityId;
 
 use super::super::builtin::PublicationBuiltinTopicData;
 use super::super::chain::{ListenerNode, ParentListener, StatusChange};
@@ -81,7 +79,7 @@ pub(super) fn register_subscriber(s: &Subscriber) {
     let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&s.qos) as Weak<SubscriberQos>;
     s.participant
         .registry()
-        .add_subscriber(identity, (*s.qos).clone());
+        .add_group(identity, (*s.qos).clone());
 }
 
 /// The subscriber level of a new reader's listener chain; `AlreadyDeleted` for a deleted subscriber.
@@ -207,24 +205,11 @@ impl Subscriber {
     /// Changes the QoS (`set_qos`): PARTITION and GROUP_DATA may change, and every reader announces them
     /// again (matches follow the new partitions); PRESENTATION cannot (`ImmutablePolicy`).
     pub fn set_qos(&self, qos: &SubscriberQos) -> DdsResult<()> {
-        if !qos.autoenable_created_entities {
-            return Err(DdsError::Unsupported(
-                "disabled entities: every entity is enabled when created",
-            ));
-        }
-        let changed = self.with_group(|g| {
-            if let Some(p) = g.qos.immutable_change(qos) {
-                return Err(DdsError::ImmutablePolicy(p));
-            }
-            let changed = g.qos.partition != qos.partition || g.qos.group_data != qos.group_data;
-            g.qos = qos.clone();
-            Ok(changed)
-        })??;
-        if changed {
-            for r in self.readers()? {
-                if let Some(r) = r.entity.upgrade() {
-                    r.group_changed();
-                }
+        self.participant.driver().check_alive()?;
+        let ptr = Arc::as_ptr(&self.qos) as *const ();
+        for e in self.participant.registry().set_group_qos(ptr, qos)? {
+            if let Some(e) = e.upgrade() {
+                e.group_changed();
             }
         }
         Ok(())
@@ -295,16 +280,7 @@ impl Subscriber {
                 "the reader belongs to another subscriber",
             ));
         }
-        reader.inner.state.check_alive()?;
-        reader
-            .inner
-            .state
-            .deleted_flag()
-            .store(true, Ordering::Release);
-        self.participant
-            .driver()
-            .delete_endpoint(reader.handle.id());
-        Ok(())
+        reader.inner.state.delete()
     }
 
     /// A reader of this subscriber on the topic `topic_name` (`lookup_datareader`), `None` when there is
@@ -313,16 +289,12 @@ impl Subscriber {
         &self,
         topic_name: &str,
     ) -> DdsResult<Option<DataReader<T>>> {
-        Ok(self.readers()?.into_iter().find_map(|r| {
-            if r.topic != topic_name {
-                return None;
-            }
-            let inner = r
-                .entity
-                .upgrade()?
-                .as_any()
-                .downcast::<ReaderInner<T>>()
-                .ok()?;
+        let handle = self.instance_handle()?;
+        let inner = self
+            .participant
+            .registry()
+            .find_child::<SubscriberQos, ReaderInner<T>>(handle, topic_name);
+        Ok(inner.and_then(|inner| {
             let handle = inner.state.handle()?;
             Some(DataReader { inner, handle })
         }))
@@ -330,8 +302,12 @@ impl Subscriber {
 
     /// Deletes every reader of this subscriber (`delete_contained_entities`).
     pub fn delete_contained_entities(&self) -> DdsResult<()> {
-        let ids: Vec<EntityId> = self.readers()?.into_iter().map(|r| r.id).collect();
-        for id in self.participant.registry().mark_deleted(&ids) {
+        let handle = self.instance_handle()?;
+        for id in self
+            .participant
+            .registry()
+            .delete_children::<SubscriberQos>(handle)
+        {
             self.participant.driver().delete_endpoint(id);
         }
         Ok(())

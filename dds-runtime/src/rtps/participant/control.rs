@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use foldhash::{HashSet, HashSetExt};
 
+use super::discovery::Direction;
 use super::Participant;
 use crate::qos::{ReaderQos, WriterQos};
 use crate::rtps::api::CoreError;
@@ -127,15 +128,7 @@ impl Participant {
         writer: EntityId,
         qos: WriterQos,
     ) -> Result<(), CoreError> {
-        let guid = Guid::new(self.config.guid_prefix, writer);
-        let mut d = match self.known_writers.get(&guid) {
-            Some(d) if self.user_writers.contains(&writer) => d.clone(),
-            _ => return Err(CoreError::UnknownEntity(writer)),
-        };
-        self.timers_changed();
-        d.qos = qos;
-        self.publish_endpoint(now, d);
-        Ok(())
+        self.update_endpoint_qos(now, writer, qos)
     }
 
     /// Replaces the QoS a local reader announces, like [`Participant::update_writer_qos`].
@@ -145,10 +138,18 @@ impl Participant {
         reader: EntityId,
         qos: ReaderQos,
     ) -> Result<(), CoreError> {
-        let guid = Guid::new(self.config.guid_prefix, reader);
-        let mut d = match self.known_readers.get(&guid) {
-            Some(d) if self.user_readers.contains(&reader) => d.clone(),
-            _ => return Err(CoreError::UnknownEntity(reader)),
+        self.update_endpoint_qos(now, reader, qos)
+    }
+
+    fn update_endpoint_qos<Q: Direction>(
+        &mut self,
+        now: Instant,
+        id: EntityId,
+        qos: Q,
+    ) -> Result<(), CoreError> {
+        let guid = Guid::new(self.config.guid_prefix, id);
+        let Some(mut d) = Q::known(self).get(&guid).cloned() else {
+            return Err(CoreError::UnknownEntity(id));
         };
         self.timers_changed();
         d.qos = qos;
