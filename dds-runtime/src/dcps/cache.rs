@@ -105,6 +105,8 @@ pub(crate) struct ReaderCache<T> {
     filter: Option<Filter<T>>,
     /// Reads return samples grouped by instance (ordered access, INSTANCE scope) instead of in reception order.
     instance_order: bool,
+    /// Makes the key holder of a new instance from its first data (`get_key_value`).
+    key_of: Option<fn(&T) -> Option<T>>,
 }
 
 /// The sample a read (copying the data with `copy`, if any) or a take (moving it out) returns for `slot`.
@@ -139,6 +141,7 @@ impl<T: FilterFields> ReaderCache<T> {
             total: 0,
             filter: None,
             instance_order: false,
+            key_of: None,
         }
     }
 
@@ -230,7 +233,10 @@ impl<T: FilterFields> ReaderCache<T> {
             }
             None if !alive && inc.kind == ChangeKind::Unregister => return Outcome::Filtered,
             None => {
-                let holder = inc.key_holder.take();
+                let holder = inc
+                    .key_holder
+                    .take()
+                    .or_else(|| self.key_of.and_then(|f| inc.data.as_ref().and_then(f)));
                 match self.new_instance(key, holder, now) {
                     Some(h) => h,
                     None => {
@@ -675,6 +681,30 @@ fn remove_indices<S>(q: &mut VecDeque<S>, indices: impl ExactSizeIterator<Item =
         i += 1;
         !drop_it
     });
+}
+
+/// What `DataReader::get_qos`/`set_qos` and `get_key_value` need.
+impl<T> ReaderCache<T> {
+    /// The QoS the cache applies.
+    pub(crate) fn qos(&self) -> &DataReaderQos {
+        &self.qos
+    }
+
+    /// Replaces the QoS (`set_qos` checked that only changeable policies differ: deadline, time-based
+    /// filter, reader data lifecycle, ...); applies from the next sample or tick.
+    pub(crate) fn set_qos(&mut self, qos: DataReaderQos) {
+        self.qos = qos;
+    }
+
+    /// Gives new instances of received data a key holder made with `f` (once per instance).
+    pub(crate) fn set_key_holder_fn(&mut self, f: fn(&T) -> Option<T>) {
+        self.key_of = Some(f);
+    }
+
+    /// A sample holding the key of instance `h`, if one was received.
+    pub(crate) fn key_holder(&self, h: InstanceHandle) -> Option<&T> {
+        self.instances.get(&h)?.key_holder.as_ref()
+    }
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 use std::hash::{BuildHasher, Hasher};
 use std::net::{IpAddr, SocketAddr, SocketAddrV4};
 use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU64, AtomicUsize, Ordering};
-use std::sync::{Arc, Condvar, Mutex, RwLock, Weak};
+use std::sync::{Arc, Condvar, Mutex, OnceLock, RwLock, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
@@ -103,7 +103,12 @@ pub(crate) struct Driver {
     /// the lock while there are none.
     observers: RwLock<Vec<Arc<dyn CoreObserver>>>,
     has_observers: AtomicBool,
+    /// Told of every remote publication and subscription discovered (topics, INCONSISTENT_TOPIC).
+    discovery_hook: OnceLock<DiscoveryHook>,
 }
+
+/// See [`Driver::set_discovery_hook`].
+type DiscoveryHook = Box<dyn Fn(&Event) + Send + Sync>;
 
 /// Most sent buffers kept for recycling.
 const MAX_SPARE_BUFFERS: usize = 32;
@@ -228,6 +233,7 @@ impl Driver {
             spare_buffers: Mutex::new(Vec::new()),
             observers: RwLock::new(Vec::new()),
             has_observers: AtomicBool::new(false),
+            discovery_hook: OnceLock::new(),
         });
         let weak: Weak<Driver> = Arc::downgrade(&driver);
         let rx = Arc::new(move |_ch: Channel, batch: &[Datagram<'_>]| {
@@ -452,11 +458,24 @@ impl Driver {
             Event::PublicationDiscovered(w) => {
                 let (guid, info) = remote_writer_info(w);
                 lock(&self.remote_writers).insert(guid, info);
+                self.discovered(ev);
             }
+            Event::SubscriptionDiscovered(_) => self.discovered(ev),
             Event::PublicationRemoved { guid } => {
                 lock(&self.remote_writers).remove(guid);
             }
             _ => {}
+        }
+    }
+
+    /// Installs the function told of every remote publication and subscription discovered (once).
+    pub(crate) fn set_discovery_hook(&self, hook: DiscoveryHook) {
+        let _ = self.discovery_hook.set(hook);
+    }
+
+    fn discovered(&self, ev: &Event) {
+        if let Some(h) = self.discovery_hook.get() {
+            h(ev);
         }
     }
 

@@ -1,15 +1,18 @@
 //! What a typed writer and a typed reader share: their driver and entity id, their statuses and status
 //! condition, their listener, the list of matched remote endpoints and the way back to a public handle.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock, Weak};
 use std::time::Instant;
 
 use crate::qos::History;
 use crate::rtps::{CoreError, EntityId, Guid, Participant};
 
+use super::chain::{ErasedStatus, ListenerNode, MaskedListener, ParentListener, StatusChange};
 use super::condition::StatusCore;
 use super::driver::{Driver, Endpoint, EndpointHandle};
 use super::error::{DdsError, DdsResult};
+use super::sample::InstanceHandle;
 use super::status::{MatchedStatus, Status, StatusMask};
 use super::sync::lock;
 
@@ -28,9 +31,19 @@ pub(crate) struct EndpointState<S, L: ?Sized, O> {
     id: OnceLock<EntityId>,
     statuses: Mutex<S>,
     status_core: Arc<StatusCore>,
-    listener: Mutex<Option<Arc<L>>>,
+    listener: Mutex<Option<MaskedListener<L>>>,
+    /// The publisher or subscriber level of the listener chain (set once, when registered).
+    parent: OnceLock<Arc<ListenerNode>>,
+    /// Set by an explicit `delete_*`: the entity refuses operations from then on.
+    deleted: Arc<AtomicBool>,
     matched: Mutex<Vec<Guid>>,
     handle: Mutex<Weak<EndpointHandle<O>>>,
+}
+
+/// Where a status goes: the entity's own listener, or one of the levels above.
+enum Target<L: ?Sized, H> {
+    Own(Arc<L>, H),
+    Parent(Arc<dyn ParentListener>),
 }
 
 impl<S: Default, L: ?Sized, O> EndpointState<S, L, O> {
@@ -42,6 +55,8 @@ impl<S: Default, L: ?Sized, O> EndpointState<S, L, O> {
             statuses: Mutex::new(S::default()),
             status_core: Arc::new(StatusCore::default()),
             listener: Mutex::new(None),
+            parent: OnceLock::new(),
+            deleted: Arc::new(AtomicBool::new(false)),
             matched: Mutex::new(Vec::new()),
             handle: Mutex::new(Weak::new()),
         }
@@ -83,9 +98,73 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         &self.status_core
     }
 
-    /// Installs (or with `None` removes) the listener.
+    /// Installs (or with `None` removes) the listener, enabled for every status.
     pub(crate) fn set_listener(&self, l: Option<Arc<L>>) {
-        *lock(&self.listener) = l;
+        self.set_listener_with_mask(l, StatusMask::all());
+    }
+
+    /// Installs (or with `None` removes) the listener, enabled for the statuses in `mask` only; the
+    /// others go to the levels above (DDS 1.4 §2.2.4.1).
+    pub(crate) fn set_listener_with_mask(&self, l: Option<Arc<L>>, mask: StatusMask) {
+        *lock(&self.listener) = l.map(|listener| MaskedListener { listener, mask });
+    }
+
+    /// Links the entity to its publisher or subscriber level of the listener chain (once).
+    pub(crate) fn set_parent(&self, node: Arc<ListenerNode>) {
+        let _ = self.parent.set(node);
+    }
+
+    /// The flag an explicit delete sets (shared with the participant's entity registry).
+    pub(crate) fn deleted_flag(&self) -> &Arc<AtomicBool> {
+        &self.deleted
+    }
+
+    /// An explicit `delete_*`: the entity refuses operations from then on and leaves the core (a writer
+    /// unregisters its instances first). `AlreadyDeleted` when it was deleted before.
+    pub(crate) fn delete(&self) -> DdsResult<()> {
+        self.check_alive()?;
+        if self.deleted.swap(true, Ordering::AcqRel) {
+            return Err(DdsError::AlreadyDeleted);
+        }
+        self.driver.delete_endpoint(self.id());
+        Ok(())
+    }
+
+    /// `Err(AlreadyDeleted)` once the entity or its participant was deleted.
+    pub(crate) fn check_alive(&self) -> DdsResult<()> {
+        if self.deleted.load(Ordering::Acquire) {
+            return Err(DdsError::AlreadyDeleted);
+        }
+        self.driver.check_alive()
+    }
+
+    /// The entity's own listener if it is enabled for `kind`.
+    fn own_listener(&self, kind: StatusMask) -> Option<Arc<L>> {
+        match &*lock(&self.listener) {
+            Some(m) if m.mask.contains(kind) => Some(m.listener.clone()),
+            _ => None,
+        }
+    }
+
+    /// The most specific listener enabled for `kind` (DDS 1.4 §2.2.4.1), with the public handle when it is
+    /// the entity's own.
+    fn target(&self, kind: StatusMask) -> Option<Target<L, Arc<EndpointHandle<O>>>> {
+        if let Some(l) = self.own_listener(kind) {
+            return Some(Target::Own(l, self.handle()?));
+        }
+        self.parent.get()?.find(kind).map(Target::Parent)
+    }
+
+    /// A read or take: the subscriber's DATA_ON_READERS is reset (DDS 1.4 §2.2.4.1).
+    pub(crate) fn data_read(&self) {
+        if let Some(parent) = self.parent.get() {
+            parent.clear_up(StatusMask::DATA_ON_READERS | StatusMask::DATA_AVAILABLE);
+        }
+    }
+
+    /// The GUID of the endpoint.
+    fn guid(&self) -> Guid {
+        Guid::new(self.driver.guid_prefix, self.id())
     }
 
     /// The GUIDs of the matched remote endpoints.
@@ -104,38 +183,41 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         let out = s.clone();
         s.reset_changes();
         self.status_core.clear(mask);
+        if let Some(parent) = self.parent.get() {
+            parent.clear_up(mask);
+        }
         out
     }
 
     /// Records a status change with `update`, raises `mask` and calls the listener, if any, with the entity
     /// (built from the handle by `entity`) and the status.
-    pub(crate) fn signal<T: Status, E>(
+    pub(crate) fn signal<T: ErasedStatus, E>(
         &self,
         mask: StatusMask,
         update: impl FnOnce(&mut S) -> &mut T,
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E, T),
     ) {
-        let (target, status) = self.update(update, false);
+        let (target, status) = self.update(mask, update, false);
         self.deliver(mask, target, status, entity, call);
     }
 
     /// [`EndpointState::signal`] for a status whose listener consumes the change counts (DDS 1.4 §2.2.4.2.1),
     /// as the deadline statuses do: each callback reports only what happened since the previous one.
-    pub(crate) fn signal_consumed<T: Status, E>(
+    pub(crate) fn signal_consumed<T: ErasedStatus, E>(
         &self,
         mask: StatusMask,
         update: impl FnOnce(&mut S) -> &mut T,
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E, T),
     ) {
-        let (target, status) = self.update(update, true);
+        let (target, status) = self.update(mask, update, true);
         self.deliver(mask, target, status, entity, call);
     }
 
     /// Records that `remote` matched or unmatched (see [`EndpointState::signal`]); a listener consumes the
     /// change counts.
-    pub(crate) fn record_match<T: MatchedStatus, E>(
+    pub(crate) fn record_match<T: MatchedStatus + ErasedStatus, E>(
         &self,
         mask: StatusMask,
         field: impl FnOnce(&mut S) -> &mut T,
@@ -146,6 +228,7 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         let (target, status) = {
             let mut list = lock(&self.matched);
             self.update(
+                mask,
                 |st| {
                     let s = field(st);
                     s.record_match(&mut list, remote, matched);
@@ -160,14 +243,13 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
     /// Applies `update` to a status. With `consume`, a listener consumes the change counts (DDS 2.2.4.2.1):
     /// the next callback reports only what happened since this one.
     #[allow(clippy::type_complexity)]
-    fn update<T: Status>(
+    fn update<T: ErasedStatus>(
         &self,
+        mask: StatusMask,
         update: impl FnOnce(&mut S) -> &mut T,
         consume: bool,
-    ) -> (Option<(Arc<L>, Arc<EndpointHandle<O>>)>, T) {
-        let target = lock(&self.listener)
-            .clone()
-            .and_then(|l| Some((l, self.handle()?)));
+    ) -> (Option<Target<L, Arc<EndpointHandle<O>>>>, T) {
+        let target = self.target(mask);
         let mut st = lock(&self.statuses);
         let s = update(&mut st);
         let out = s.clone();
@@ -177,30 +259,65 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         (target, out)
     }
 
-    /// Raises `mask`, then (no lock held) calls the listener.
-    fn deliver<T, E>(
+    /// Raises `mask`, then (no lock held) calls the listener chosen by [`EndpointState::target`].
+    fn deliver<T: ErasedStatus, E>(
         &self,
         mask: StatusMask,
-        target: Option<(Arc<L>, Arc<EndpointHandle<O>>)>,
+        target: Option<Target<L, Arc<EndpointHandle<O>>>>,
         status: T,
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E, T),
     ) {
         self.status_core.raise(mask);
-        if let Some((l, h)) = target {
-            call(&l, &entity(h), status);
+        if let Some(parent) = self.parent.get() {
+            parent.raise_up(mask);
+        }
+        match target {
+            Some(Target::Own(l, h)) => call(&l, &entity(h), status),
+            Some(Target::Parent(l)) => {
+                if let Some(change) = status.erase(mask) {
+                    l.on_status(InstanceHandle::from_guid(self.guid()), change);
+                }
+            }
+            None => {}
         }
     }
 
-    /// Calls the listener, if any, with the entity, without a status (DATA_AVAILABLE).
+    /// Calls the entity's own listener, if any (`notify_datareaders`), regardless of the levels above.
+    pub(crate) fn call_own_listener<E>(
+        &self,
+        entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
+        call: impl FnOnce(&L, &E),
+    ) {
+        let l = lock(&self.listener).as_ref().map(|m| m.listener.clone());
+        if let (Some(l), Some(h)) = (l, self.handle()) {
+            call(&l, &entity(h));
+        }
+    }
+
+    /// New data arrived (DATA_AVAILABLE): raises DATA_ON_READERS on the subscriber and calls, by DDS 1.4
+    /// §2.2.4.1 precedence, the nearest `on_data_on_readers` (subscriber, participant), else the reader's
+    /// own `on_data_available` (`call`), else the nearest level's.
     pub(crate) fn call_listener<E>(
         &self,
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E),
     ) {
-        let l = lock(&self.listener).clone();
-        if let (Some(l), Some(h)) = (l, self.handle()) {
-            call(&l, &entity(h));
+        if let Some(parent) = self.parent.get() {
+            parent.raise_up(StatusMask::DATA_ON_READERS | StatusMask::DATA_AVAILABLE);
+            if let Some(l) = parent.find(StatusMask::DATA_ON_READERS) {
+                parent.clear_up(StatusMask::DATA_ON_READERS);
+                l.on_data_on_readers(parent.handle);
+                return;
+            }
+        }
+        match self.target(StatusMask::DATA_AVAILABLE) {
+            Some(Target::Own(l, h)) => call(&l, &entity(h)),
+            Some(Target::Parent(l)) => l.on_status(
+                InstanceHandle::from_guid(self.guid()),
+                StatusChange::DataAvailable,
+            ),
+            None => {}
         }
     }
 }

@@ -3,6 +3,7 @@
 use crate::cdr::{DecodeError, EncodeError};
 use crate::config::ConfigError;
 use crate::filter::FilterError;
+use crate::qos::QosPolicyId;
 use crate::rtps::{CoreError, WriteError};
 
 /// Errors returned by DCPS operations (DDS 1.4 §2.2.1.1 return codes, plus Rust-side causes).
@@ -36,6 +37,13 @@ pub enum DdsError {
     /// The entity (or its participant) has been deleted.
     #[error("entity already deleted")]
     AlreadyDeleted,
+    /// `set_qos` tried to change a policy that cannot change once the entity is enabled (DDS
+    /// IMMUTABLE_POLICY).
+    #[error("immutable policy: {0:?}")]
+    ImmutablePolicy(QosPolicyId),
+    /// The QoS values contradict each other (DDS INCONSISTENT_POLICY).
+    #[error("inconsistent policy: {0}")]
+    InconsistentPolicy(&'static str),
     /// The feature is not implemented.
     #[error("unsupported: {0}")]
     Unsupported(&'static str),

@@ -27,7 +27,9 @@
 //! alone; a key-only dispose/unregister is mapped to its instance through its key payload, or through its
 //! key hash when a sample of that instance carrying the same hash was seen before.
 
+pub mod builtin;
 mod cache;
+mod chain;
 pub mod condition;
 mod decode;
 mod driver;
@@ -39,6 +41,7 @@ pub mod listener;
 mod participant;
 mod presentation;
 mod publisher;
+mod registry;
 pub mod sample;
 pub mod status;
 mod subscriber;
@@ -47,15 +50,23 @@ mod topic;
 
 /// GUIDs name entities in the DCPS API ([`DataWriter::guid`], [`SampleInfo::publication_guid`], ...).
 pub use crate::rtps::{Guid, GuidPrefix};
+pub use builtin::{
+    ParticipantBuiltinTopicData, PublicationBuiltinTopicData, SubscriptionBuiltinTopicData,
+};
+pub use chain::StatusChange;
 pub use condition::{
     Condition, GuardCondition, QueryCondition, ReadCondition, StatusCondition, WaitSet,
 };
 pub use durability::{DurabilityServiceConfig, DurabilityServiceMode};
 pub use error::{DdsError, DdsResult};
 pub use filter::{ContentFilter, FieldValue, FilterError, FilterFields};
-pub use listener::{DataReaderListener, DataWriterListener};
+pub use listener::{
+    DataReaderListener, DataWriterListener, DomainParticipantListener, PublisherListener,
+    SubscriberListener, TopicListener,
+};
 pub use participant::{
-    DiscoveredParticipant, DomainParticipant, DomainParticipantBuilder, WriteBatching,
+    DiscoveredParticipant, DomainParticipant, DomainParticipantBuilder, DomainParticipantFactory,
+    WriteBatching,
 };
 pub use publisher::{DataWriter, Publisher};
 pub use sample::{

@@ -3,17 +3,25 @@
 //! entities (`create_topic`, `create_publisher`, ...) live with the entity they create, so that this module
 //! depends on none of them.
 
-use std::sync::Arc;
+mod factory;
+mod ops;
+
+pub use factory::DomainParticipantFactory;
+pub use ops::DomainParticipantListener;
+
+use std::sync::{Arc, Weak};
 use std::time::Duration;
 
 use crate::config::{Config, InterfaceSelection, ParticipantIndex, Peer};
+use crate::qos::DomainParticipantQos;
 use crate::rtps::{EntityId, Guid, GuidPrefix};
 use crate::transport::UdpTransport;
 
 use super::condition::StatusCondition;
 use super::driver::Driver;
 use super::durability::DurabilityServiceConfig;
-use super::error::DdsResult;
+use super::error::{DdsError, DdsResult};
+use super::registry::Registry;
 use super::sample::InstanceHandle;
 
 /// A participant discovered through SPDP.
@@ -70,6 +78,26 @@ impl Drop for Guard {
 pub struct DomainParticipant {
     driver: Arc<Driver>,
     _guard: Arc<Guard>,
+    registry: Arc<Registry>,
+}
+
+/// A reference to a participant that does not keep it alive (held by listeners of its entities).
+#[derive(Clone)]
+pub(crate) struct WeakParticipant {
+    driver: Weak<Driver>,
+    guard: Weak<Guard>,
+    registry: Weak<Registry>,
+}
+
+impl WeakParticipant {
+    /// The participant, while some handle of it exists.
+    pub(crate) fn upgrade(&self) -> Option<DomainParticipant> {
+        Some(DomainParticipant {
+            driver: self.driver.upgrade()?,
+            _guard: self.guard.upgrade()?,
+            registry: self.registry.upgrade()?,
+        })
+    }
 }
 
 impl std::fmt::Debug for DomainParticipant {
@@ -101,6 +129,7 @@ pub struct DomainParticipantBuilder {
     user_data: Vec<u8>,
     name: Option<String>,
     durability_service: Option<DurabilityServiceConfig>,
+    qos: Option<DomainParticipantQos>,
 }
 
 impl DomainParticipantBuilder {
@@ -178,6 +207,12 @@ impl DomainParticipantBuilder {
         self.user_data = d;
         self
     }
+    /// The participant QoS (USER_DATA, ENTITY_FACTORY); its USER_DATA replaces [`user_data`](Self::user_data)
+    /// when not empty. Without it, the participant factory's default participant QoS applies.
+    pub fn qos(mut self, q: DomainParticipantQos) -> Self {
+        self.qos = Some(q);
+        self
+    }
     /// Entity name announced in SPDP.
     pub fn name(mut self, n: impl Into<String>) -> Self {
         self.name = Some(n.into());
@@ -241,13 +276,41 @@ impl DomainParticipantBuilder {
             None if self.ignore_env => DurabilityServiceConfig::default(),
             None => DurabilityServiceConfig::from_env()?,
         };
-        let driver = Driver::start(config, self.user_data, self.name)?;
+        let qos = self.qos.clone().unwrap_or_else(|| {
+            factory::DomainParticipantFactory::get_instance().default_participant_qos()
+        });
+        if !qos.autoenable_created_entities
+            || !factory::DomainParticipantFactory::get_instance()
+                .qos()
+                .autoenable_created_entities
+        {
+            return Err(DdsError::Unsupported(
+                "disabled entities: every entity is enabled when created",
+            ));
+        }
+        let user_data = if qos.user_data.0.is_empty() {
+            self.user_data
+        } else {
+            qos.user_data.0.clone()
+        };
+        let mut qos = qos;
+        qos.user_data = user_data.clone().into();
+        let driver = Driver::start(config, user_data, self.name)?;
         let guard = Arc::new(Guard(driver.clone()));
+        let registry = Arc::new(Registry::new(
+            driver.guid_prefix,
+            driver.status.clone(),
+            qos,
+        ));
+        ops::install_discovery_hook(&driver, &registry);
         super::durability::install(&driver, &durability)?;
-        Ok(DomainParticipant {
+        let p = DomainParticipant {
             driver,
             _guard: guard,
-        })
+            registry,
+        };
+        factory::DomainParticipantFactory::get_instance().register(&p);
+        Ok(p)
     }
 }
 
@@ -312,5 +375,19 @@ impl DomainParticipant {
     /// The driver the participant's entities run on.
     pub(crate) fn driver(&self) -> &Arc<Driver> {
         &self.driver
+    }
+
+    /// The registry of the entities the participant contains.
+    pub(crate) fn registry(&self) -> &Arc<Registry> {
+        &self.registry
+    }
+
+    /// A reference that does not keep the participant alive.
+    pub(crate) fn downgrade(&self) -> WeakParticipant {
+        WeakParticipant {
+            driver: Arc::downgrade(&self.driver),
+            guard: Arc::downgrade(&self._guard),
+            registry: Arc::downgrade(&self.registry),
+        }
     }
 }

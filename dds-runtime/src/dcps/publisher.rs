@@ -1,6 +1,8 @@
 //! `Publisher` and `DataWriter<T>`.
 
-use std::sync::{Arc, Mutex};
+mod ops;
+
+use std::sync::{Arc, Mutex, RwLock};
 use std::time::{Duration, Instant, SystemTime};
 
 use foldhash::HashMap;
@@ -25,8 +27,10 @@ use super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, PublicationMatchedStatus, StatusMask,
     WriterStatuses,
 };
-use super::sync::lock;
+use super::sync::{lock, read};
 use super::topic::Topic;
+
+pub use ops::PublisherListener;
 
 /// Callbacks of a [`DataWriter`] (see [`crate::dcps::listener`]). Every method has an empty default.
 #[allow(unused_variables)]
@@ -71,11 +75,13 @@ impl DomainParticipant {
     /// Creates a publisher.
     pub fn create_publisher(&self, qos: &PublisherQos) -> DdsResult<Publisher> {
         self.driver().check_alive()?;
-        Ok(Publisher {
+        let p = Publisher {
             participant: self.clone(),
             qos: Arc::new(qos.clone()),
             group: Arc::default(),
-        })
+        };
+        ops::register_publisher(&p);
+        Ok(p)
     }
 }
 
@@ -116,6 +122,7 @@ impl Publisher {
         qos: &DataWriterQos,
     ) -> DdsResult<DataWriter<T>> {
         let driver = self.participant.driver().clone();
+        let parent = ops::writer_parent(self)?;
         let (version, rep) = writer_version::<T>(&qos.data_representation);
         let mut wq = qos.clone();
         wq.data_representation = rep;
@@ -131,6 +138,7 @@ impl Publisher {
         };
         let inner = Arc::new(WriterInner::<T> {
             state: EndpointState::new(driver.clone()),
+            current: RwLock::new(wq.clone()),
             qos: wq,
             version,
             instances: Mutex::new(WriterInstances::default()),
@@ -139,10 +147,12 @@ impl Publisher {
             topic: topic.clone(),
             publisher: self.clone(),
         };
+        inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
         let handle = inner
             .state
             .create(sink, owner, |c, now| c.create_writer(now, spec))?;
+        ops::register_writer(self, &inner, topic.name());
         let id = handle.id();
         self.group.add_writer(&driver, id);
         tracing::info!(
@@ -183,7 +193,10 @@ struct WriterOwner<T> {
 
 struct WriterInner<T: DdsType> {
     state: EndpointState<WriterStatuses, dyn DataWriterListener<T>, WriterOwner<T>>,
+    /// The QoS it was created with.
     qos: DataWriterQos,
+    /// The QoS in effect (changed by `set_qos`).
+    current: RwLock<DataWriterQos>,
     version: XcdrVersion,
     instances: Mutex<WriterInstances>,
 }
@@ -267,7 +280,8 @@ impl<T: DdsType> DataWriter<T> {
         &self.handle.owner().publisher
     }
 
-    /// The QoS in effect (with the data representation resolved).
+    /// The QoS the writer was created with (with the data representation resolved); `get_qos` returns
+    /// the one in effect after `set_qos`.
     pub fn qos(&self) -> &DataWriterQos {
         &self.inner.qos
     }
@@ -591,8 +605,7 @@ impl<T: DdsType> DataWriter<T> {
 
 impl<T: DdsType> WriterInner<T> {
     fn unregister_kind(&self) -> ChangeKind {
-        if self
-            .qos
+        if read(&self.current)
             .writer_data_lifecycle
             .autodispose_unregistered_instances
         {
@@ -613,7 +626,7 @@ impl<T: DdsType> WriterInner<T> {
 
 impl<T: DdsType> Endpoint for WriterInner<T> {
     fn tick(self: Arc<Self>, now: Instant) {
-        let period = self.qos.deadline.0;
+        let period = read(&self.current).deadline.0;
         if period == crate::qos::INFINITE || period.is_zero() {
             return;
         }

@@ -319,3 +319,27 @@ pub(crate) struct ReaderStatuses {
     pub(crate) sample_rejected: SampleRejectedStatus,
     pub(crate) liveliness_changed: LivelinessChangedStatus,
 }
+
+/// INCONSISTENT_TOPIC: a remote topic of the same name with another type was discovered.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct InconsistentTopicStatus {
+    /// Inconsistent remote endpoints seen.
+    pub total_count: u32,
+    /// Change since the last get.
+    pub total_count_change: u32,
+}
+
+impl Status for InconsistentTopicStatus {
+    fn reset_changes(&mut self) {
+        self.total_count_change = 0;
+    }
+}
+
+impl InconsistentTopicStatus {
+    /// Records one inconsistent remote endpoint.
+    pub(crate) fn record(&mut self) {
+        self.total_count = self.total_count.saturating_add(1);
+        self.total_count_change = self.total_count_change.saturating_add(1);
+    }
+}

@@ -1,5 +1,7 @@
 //! `Subscriber` and `DataReader<T>`.
 
+mod ops;
+
 use std::collections::VecDeque;
 use std::pin::Pin;
 use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
@@ -34,6 +36,8 @@ use super::status::{
 use super::sync::{lock, recover};
 use super::topic::{Topic, TopicDescription};
 use crate::filter::ContentFilter;
+
+pub use ops::SubscriberListener;
 
 /// Callbacks of a [`DataReader`] (see [`crate::dcps::listener`]). Every method has an empty default.
 #[allow(unused_variables)]
@@ -75,11 +79,13 @@ impl DomainParticipant {
     /// Creates a subscriber.
     pub fn create_subscriber(&self, qos: &SubscriberQos) -> DdsResult<Subscriber> {
         self.driver().check_alive()?;
-        Ok(Subscriber {
+        let s = Subscriber {
             participant: self.clone(),
             qos: Arc::new(qos.clone()),
             access: Arc::default(),
-        })
+        };
+        ops::register_subscriber(&s);
+        Ok(s)
     }
 }
 
@@ -121,6 +127,7 @@ impl Subscriber {
         qos: &DataReaderQos,
     ) -> DdsResult<DataReader<T>> {
         let driver = self.participant.driver().clone();
+        let parent = ops::reader_parent(self)?;
         let mut rq = qos.clone();
         if rq.data_representation.ids().is_empty() {
             rq.data_representation = DataRepresentation::accept_both();
@@ -163,6 +170,7 @@ impl Subscriber {
             topic: t.clone(),
             subscriber: self.clone(),
         };
+        inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
         let handle = inner.state.create(sink, owner, |c, now| {
             let id = c.create_reader(now, spec)?;
@@ -171,6 +179,7 @@ impl Subscriber {
             }
             Ok(id)
         })?;
+        ops::register_reader(self, &inner, t.name());
         let id = handle.id();
         tracing::info!(
             topic = t.name(),
@@ -326,7 +335,8 @@ impl<T: DdsType> DataReader<T> {
         take: bool,
         mut emit: impl FnMut(&mut Option<T>, SampleInfo),
     ) -> DdsResult<usize> {
-        self.inner.state.driver.check_alive()?;
+        self.inner.state.check_alive()?;
+        self.inner.state.data_read();
         let mut n = 0;
         {
             let mut st = lock(&self.inner.cache);

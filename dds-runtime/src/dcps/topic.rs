@@ -1,5 +1,7 @@
 //! `Topic<T>` and `ContentFilteredTopic<T>`.
 
+mod ops;
+
 use std::marker::PhantomData;
 use std::sync::{Arc, RwLock};
 
@@ -11,6 +13,8 @@ use super::error::{DdsError, DdsResult};
 use super::filter::{ContentFilter, FilterFields};
 use super::participant::DomainParticipant;
 use super::sync::{read, write};
+
+pub use ops::TopicListener;
 
 struct TopicInner {
     participant: DomainParticipant,
@@ -51,7 +55,7 @@ impl<T: DdsType> Topic<T> {
     pub fn type_name(&self) -> &'static str {
         T::TYPE_NAME
     }
-    /// The topic QoS.
+    /// The QoS the topic was created with; `get_qos` returns the one in effect after `set_qos`.
     pub fn qos(&self) -> &TopicQos {
         &self.inner.qos
     }
@@ -150,14 +154,16 @@ impl DomainParticipant {
         if name.is_empty() || name.len() > 256 {
             return Err(DdsError::BadParameter(format!("topic name {name:?}")));
         }
-        Ok(Topic {
+        let topic = Topic {
             inner: Arc::new(TopicInner {
                 participant: self.clone(),
                 name: name.to_string(),
                 qos: qos.clone(),
             }),
             _t: PhantomData,
-        })
+        };
+        ops::register_topic(&topic);
+        Ok(topic)
     }
 
     /// A content-filtered view of `topic` (SQL subset, see [`crate::dcps::filter`]); `%N` in the expression

@@ -233,3 +233,16 @@ impl From<Vec<i16>> for DataRepresentation {
         DataRepresentation::any_of(v)
     }
 }
+
+qos_set!(
+    /// DomainParticipantQos: USER_DATA announced in SPDP and ENTITY_FACTORY.
+    DomainParticipantQos, DomainParticipantQosBuilder {
+    user_data: UserData = UserData::default(),
+    autoenable_created_entities: bool = true,
+});
+
+qos_set!(
+    /// The QoS of the participant factory itself (DDS `DomainParticipantFactoryQos`): ENTITY_FACTORY.
+    DomainParticipantFactoryQos, DomainParticipantFactoryQosBuilder {
+    autoenable_created_entities: bool = true,
+});

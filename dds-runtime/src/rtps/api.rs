@@ -535,14 +535,14 @@ pub enum Event {
         /// Its GUID prefix.
         guid_prefix: GuidPrefix,
     },
-    /// A publication (remote or local) appeared.
+    /// A publication (remote) appeared, or was announced again with other data (its QoS changed).
     PublicationDiscovered(Box<WriterData>),
     /// A known publication is gone.
     PublicationRemoved {
         /// Its GUID.
         guid: Guid,
     },
-    /// A subscription (remote or local) appeared.
+    /// A subscription (remote) appeared, or was announced again with other data (its QoS changed).
     SubscriptionDiscovered(Box<ReaderData>),
     /// A known subscription is gone.
     SubscriptionRemoved {

@@ -3,6 +3,7 @@
 //! `receive` dispatches incoming submessages, `discovery` runs SPDP/SEDP/matching, `timers` the periodic work.
 
 mod coherent;
+mod control;
 mod discovery;
 mod historical;
 mod receive;
@@ -60,6 +61,8 @@ pub struct Participant {
     /// A lower bound on every timer (`None`: unknown), so that traffic does not rescan every endpoint.
     timer_floor: Cell<Option<Instant>>,
     last_full_scan: Instant,
+    /// What the application ignores (`ignore_participant`, `ignore_endpoint`, `ignore_topic`).
+    ignored: control::Ignored,
 }
 
 fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
@@ -144,6 +147,7 @@ impl Participant {
             readers_by_writer: HashMap::new(),
             timer_floor: Cell::new(None),
             last_full_scan: now,
+            ignored: control::Ignored::new(),
             config,
         };
         let prefix = p.config.guid_prefix;

@@ -75,7 +75,9 @@ impl Participant {
                 return;
             }
         };
-        if data.guid_prefix == self.config.guid_prefix {
+        if data.guid_prefix == self.config.guid_prefix
+            || self.ignored.participant(&data.guid_prefix)
+        {
             return;
         }
         if data.domain_id.is_some_and(|d| d != self.config.domain_id) || !data.domain_tag.is_empty()
@@ -218,11 +220,15 @@ impl Participant {
             return;
         }
         match EndpointData::<Q>::decode(&s.payload) {
+            Ok(d) if self.ignored.endpoint(&d.guid, &d.topic_name) => {
+                trace!(endpoint = ?d.guid, "ignored SEDP announcement dropped");
+            }
             Ok(d) if d.guid.prefix == s.writer.prefix => {
                 let known = Q::known(self);
                 let new = !known.contains_key(&d.guid);
                 if !new || known.len() < MAX_ENDPOINTS {
-                    if new {
+                    // New, or announced again with another QoS (`set_qos`): reported either way.
+                    if known.get(&d.guid) != Some(&d) {
                         self.events.push_back(Q::discovered(d.clone()));
                     }
                     self.on_endpoint_known(now, d);
@@ -456,7 +462,7 @@ impl Local {
 }
 
 /// What the participant keeps apart for each SEDP direction (publications, subscriptions).
-pub(super) trait Direction: EndpointQos + Clone {
+pub(super) trait Direction: EndpointQos + Clone + PartialEq {
     /// For logs.
     const NAME: &'static str;
     /// Our SEDP writer that announces local endpoints of this direction.

@@ -1,7 +1,6 @@
 //! Queries for the durability service and `wait_for_historical_data`.
 
 use super::Participant;
-use crate::rtps::discovery::WriterData;
 use crate::rtps::types::EntityId;
 
 impl Participant {
@@ -10,10 +9,5 @@ impl Participant {
     /// `false` for an unknown reader.
     pub fn reader_caught_up(&self, reader: EntityId) -> bool {
         self.readers.get(&reader).is_some_and(|r| r.caught_up())
-    }
-
-    /// Every known publication (remote and local).
-    pub fn publications(&self) -> impl Iterator<Item = &WriterData> {
-        self.known_writers.values()
     }
 }

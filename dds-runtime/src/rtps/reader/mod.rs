@@ -12,10 +12,10 @@ use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use crate::rtps::api::{ChangeKind, Event, Payload, ReceivedSample};
+use crate::rtps::due::DueFloor;
 use crate::rtps::messages::{
     AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, NackFrag, Submessage,
 };
-use crate::rtps::due::DueFloor;
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
 use coherent::{Assembler, SetLimits, SetMark};

@@ -14,11 +14,11 @@ use std::time::{Duration, Instant};
 
 use crate::qos::{Durability, History, ResourceLimits};
 use crate::rtps::api::{ChangeKind, Event, WriteChange, WriteError};
+use crate::rtps::due::DueFloor;
 use crate::rtps::messages::parameter::pid;
 use crate::rtps::messages::{
     Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, ParameterList, Submessage,
 };
-use crate::rtps::due::DueFloor;
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
 use reader_proxy::{MAX_REQUESTED, MAX_REQUESTED_FRAG_SAMPLES};
