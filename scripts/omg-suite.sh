@@ -96,7 +96,7 @@ case $cmd in
     ;;
   run)
     [[ $# -ge 2 ]] || usage
-    pub=$(peer "$1") sub=$(peer "$2") name="$1-$2"; shift 2
+    pub=$(peer "$1") sub=$(peer "$2") name="$(basename "$1")-$(basename "$2")"; shift 2
     for p in "$pub" "$sub"; do [[ -x $p ]] || { echo "omg-suite: $p missing (run build first)" >&2; exit 2; }; done
     mkdir -p "$out/run-$name"
     # The harness writes its report relative to the working directory and imports its suite from SUITE_DIR.
