@@ -65,6 +65,7 @@ while time.time() < end and not (seen_x and seen_s):
             last = st
         seen_s = seen_s or st == 42
     time.sleep(0.02)
+time.sleep(2)  # stay to acknowledge what was received
 "#;
 
 /// Writes x = 0, 1, ... every 20 ms for 15 s.
