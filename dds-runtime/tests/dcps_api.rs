@@ -525,6 +525,11 @@ fn participant_delete_topic() {
         "the writer's own topic remains"
     );
     assert!(matches!(t.get_qos(), Err(DdsError::AlreadyDeleted)));
+    let publ = p.create_publisher(&PublisherQos::default()).unwrap();
+    assert!(matches!(
+        publ.create_datawriter(&t, &DataWriterQos::default()),
+        Err(DdsError::AlreadyDeleted)
+    ));
 }
 
 #[test]

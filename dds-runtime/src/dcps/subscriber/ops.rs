@@ -18,6 +18,7 @@ use super::super::registry::{Child, EndpointEntry, Group, Registered};
 use super::super::sample::{InstanceHandle, InstanceStateMask, SampleStateMask, ViewStateMask};
 use super::super::status::*;
 use super::super::sync::lock;
+use super::super::topic::Topic;
 use super::{DataReader, DataReaderListener, ReaderInner, Subscriber};
 
 /// Callbacks of a [`Subscriber`] for its readers' statuses that have no listener of their own enabled for
@@ -83,7 +84,12 @@ pub(super) fn register_subscriber(s: &Subscriber) {
 }
 
 /// The subscriber level of a new reader's listener chain; `AlreadyDeleted` for a deleted subscriber.
-pub(super) fn reader_parent(s: &Subscriber) -> DdsResult<Arc<ListenerNode>> {
+/// Also `AlreadyDeleted` for a deleted topic.
+pub(super) fn reader_parent<T: DdsType>(
+    s: &Subscriber,
+    topic: &Topic<T>,
+) -> DdsResult<Arc<ListenerNode>> {
+    topic.check_alive()?;
     s.with_group(|g| g.node.clone())
 }
 
