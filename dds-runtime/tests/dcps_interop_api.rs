@@ -19,25 +19,14 @@ const CYCLONE_URI: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><
 /// The shape type and a participant, shared by the scripts.
 const PRELUDE: &str = r#"
 import os, sys, time
-from dataclasses import dataclass
+sys.path.insert(0, os.environ["DCPS_UTIL"])
+from cyclone_shapes import ShapeType  # the shapes type, as the other Cyclone interop test declares it
 from cyclonedds.core import Policy, Qos
 from cyclonedds.domain import DomainParticipant
-from cyclonedds.idl import IdlStruct
-from cyclonedds.idl.annotations import appendable, key
-from cyclonedds.idl.types import int32
 from cyclonedds.pub import DataWriter
 from cyclonedds.sub import DataReader, Subscriber
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
-
-@dataclass
-@appendable
-class ShapeType(IdlStruct, typename="ShapeType"):
-    color: str
-    key("color")
-    x: int32
-    y: int32
-    shapesize: int32
 
 dp = DomainParticipant(int(os.environ["DDS_DOMAIN_ID"]))
 tp = Topic(dp, sys.argv[1], ShapeType)
@@ -97,6 +86,10 @@ fn cyclone(domain: u32, topic: &str, body: &str) -> (Peer, mpsc::Receiver<String
         .arg(topic)
         .env("CYCLONEDDS_URI", CYCLONE_URI)
         .env("DDS_DOMAIN_ID", domain.to_string())
+        .env(
+            "DCPS_UTIL",
+            concat!(env!("CARGO_MANIFEST_DIR"), "/tests/dcps_util"),
+        )
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
         .spawn()
