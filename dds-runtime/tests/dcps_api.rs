@@ -1218,6 +1218,14 @@ fn reader_set_qos() {
             .last_policy_id,
         Some(QosPolicyId::Deadline)
     );
+    let mut slow = q.clone();
+    slow.time_based_filter = TimeBasedFilter {
+        minimum_separation: Duration::from_secs(1),
+    };
+    assert!(matches!(
+        pair.reader.set_qos(&slow),
+        Err(DdsError::InconsistentPolicy(_))
+    ));
     q.reliability = Reliability::BestEffort;
     assert!(matches!(
         pair.reader.set_qos(&q),

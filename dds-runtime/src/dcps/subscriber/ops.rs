@@ -367,8 +367,8 @@ impl<T: DdsType> DataReader<T> {
 
     /// Changes the QoS (`set_qos`). DEADLINE, LATENCY_BUDGET, USER_DATA, TIME_BASED_FILTER and
     /// READER_DATA_LIFECYCLE may change: the reader applies them from the next sample or check, and
-    /// announces them again in SEDP. The others cannot (`ImmutablePolicy`). An empty
-    /// `data_representation` keeps the current one.
+    /// announces them again in SEDP. The others cannot (`ImmutablePolicy`); a time-based filter longer than
+    /// the deadline is `InconsistentPolicy`. An empty `data_representation` keeps the current one.
     pub fn set_qos(&self, qos: &DataReaderQos) -> DdsResult<()> {
         self.inner.state.check_alive()?;
         let mut new = qos.clone();
@@ -380,6 +380,11 @@ impl<T: DdsType> DataReader<T> {
             }
             if let Some(p) = current.immutable_change(&new) {
                 return Err(DdsError::ImmutablePolicy(p));
+            }
+            if new.time_based_filter.minimum_separation > new.deadline.0 {
+                return Err(DdsError::InconsistentPolicy(
+                    "time-based filter separation longer than the deadline",
+                ));
             }
             st.cache.set_qos(new.clone());
         }
