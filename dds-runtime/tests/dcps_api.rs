@@ -525,6 +525,11 @@ fn participant_delete_topic() {
         "the writer's own topic remains"
     );
     assert!(matches!(t.get_qos(), Err(DdsError::AlreadyDeleted)));
+    let publ = p.create_publisher(&PublisherQos::default()).unwrap();
+    assert!(matches!(
+        publ.create_datawriter(&t, &DataWriterQos::default()),
+        Err(DdsError::AlreadyDeleted)
+    ));
 }
 
 #[test]
@@ -1213,6 +1218,14 @@ fn reader_set_qos() {
             .last_policy_id,
         Some(QosPolicyId::Deadline)
     );
+    let mut slow = q.clone();
+    slow.time_based_filter = TimeBasedFilter {
+        minimum_separation: Duration::from_secs(1),
+    };
+    assert!(matches!(
+        pair.reader.set_qos(&slow),
+        Err(DdsError::InconsistentPolicy(_))
+    ));
     q.reliability = Reliability::BestEffort;
     assert!(matches!(
         pair.reader.set_qos(&q),

@@ -167,7 +167,7 @@ impl ListenerNode {
     pub(crate) fn raise_up(&self, kind: StatusMask) {
         let mut node = Some(self);
         while let Some(n) = node {
-            n.status.raise(kind);
+            n.status.raise_new(kind);
             node = n.parent.as_deref();
         }
     }

@@ -108,6 +108,14 @@ impl StatusCore {
         self.changed.fetch_or(m.bits(), Ordering::SeqCst);
         self.signal.notify();
     }
+    /// Raises `m`, waking the attached waitsets only when some bit of `m` was not raised yet (a waitset
+    /// never sleeps on a raised, enabled status).
+    pub(crate) fn raise_new(&self, m: StatusMask) {
+        let prev = self.changed.fetch_or(m.bits(), Ordering::SeqCst);
+        if prev & m.bits() != m.bits() {
+            self.signal.notify();
+        }
+    }
     pub(crate) fn clear(&self, m: StatusMask) {
         self.changed.fetch_and(!m.bits(), Ordering::SeqCst);
     }

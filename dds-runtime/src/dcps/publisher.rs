@@ -122,7 +122,7 @@ impl Publisher {
         qos: &DataWriterQos,
     ) -> DdsResult<DataWriter<T>> {
         let driver = self.participant.driver().clone();
-        let parent = ops::writer_parent(self)?;
+        let parent = ops::writer_parent(self, topic)?;
         let (version, rep) = writer_version::<T>(&qos.data_representation);
         let mut wq = qos.clone();
         wq.data_representation = rep;

@@ -127,7 +127,7 @@ impl Subscriber {
         qos: &DataReaderQos,
     ) -> DdsResult<DataReader<T>> {
         let driver = self.participant.driver().clone();
-        let parent = ops::reader_parent(self)?;
+        let parent = ops::reader_parent(self, topic.topic())?;
         let mut rq = qos.clone();
         if rq.data_representation.ids().is_empty() {
             rq.data_representation = DataRepresentation::accept_both();

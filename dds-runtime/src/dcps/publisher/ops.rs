@@ -19,6 +19,7 @@ use super::super::registry::{Child, EndpointEntry, Group, Registered};
 use super::super::sample::InstanceHandle;
 use super::super::status::*;
 use super::super::sync::{lock, read, write};
+use super::super::topic::Topic;
 use super::{DataWriter, DataWriterListener, Publisher, WriterInner};
 
 /// Callbacks of a [`Publisher`] for the statuses of its writers that have no listener of their own
@@ -58,7 +59,12 @@ pub(super) fn register_publisher(p: &Publisher) {
 }
 
 /// The publisher level of a new writer's listener chain; `AlreadyDeleted` for a deleted publisher.
-pub(super) fn writer_parent(p: &Publisher) -> DdsResult<Arc<ListenerNode>> {
+/// Also `AlreadyDeleted` for a deleted topic.
+pub(super) fn writer_parent<T: DdsType>(
+    p: &Publisher,
+    topic: &Topic<T>,
+) -> DdsResult<Arc<ListenerNode>> {
+    topic.check_alive()?;
     p.with_group(|g| g.node.clone())
 }
 

@@ -18,6 +18,7 @@ use super::super::registry::{Child, EndpointEntry, Group, Registered};
 use super::super::sample::{InstanceHandle, InstanceStateMask, SampleStateMask, ViewStateMask};
 use super::super::status::*;
 use super::super::sync::lock;
+use super::super::topic::Topic;
 use super::{DataReader, DataReaderListener, ReaderInner, Subscriber};
 
 /// Callbacks of a [`Subscriber`] for its readers' statuses that have no listener of their own enabled for
@@ -91,7 +92,12 @@ pub(super) fn register_subscriber(s: &Subscriber) {
 }
 
 /// The subscriber level of a new reader's listener chain; `AlreadyDeleted` for a deleted subscriber.
-pub(super) fn reader_parent(s: &Subscriber) -> DdsResult<Arc<ListenerNode>> {
+/// Also `AlreadyDeleted` for a deleted topic.
+pub(super) fn reader_parent<T: DdsType>(
+    s: &Subscriber,
+    topic: &Topic<T>,
+) -> DdsResult<Arc<ListenerNode>> {
+    topic.check_alive()?;
     s.with_group(|g| g.node.clone())
 }
 
@@ -370,8 +376,8 @@ impl<T: DdsType> DataReader<T> {
 
     /// Changes the QoS (`set_qos`). DEADLINE, LATENCY_BUDGET, USER_DATA, TIME_BASED_FILTER and
     /// READER_DATA_LIFECYCLE may change: the reader applies them from the next sample or check, and
-    /// announces them again in SEDP. The others cannot (`ImmutablePolicy`). An empty
-    /// `data_representation` keeps the current one.
+    /// announces them again in SEDP. The others cannot (`ImmutablePolicy`); a time-based filter longer than
+    /// the deadline is `InconsistentPolicy`. An empty `data_representation` keeps the current one.
     pub fn set_qos(&self, qos: &DataReaderQos) -> DdsResult<()> {
         self.inner.state.check_alive()?;
         let mut new = qos.clone();
@@ -383,6 +389,11 @@ impl<T: DdsType> DataReader<T> {
             }
             if let Some(p) = current.immutable_change(&new) {
                 return Err(DdsError::ImmutablePolicy(p));
+            }
+            if new.time_based_filter.minimum_separation > new.deadline.0 {
+                return Err(DdsError::InconsistentPolicy(
+                    "time-based filter separation longer than the deadline",
+                ));
             }
             st.cache.set_qos(new.clone());
         }

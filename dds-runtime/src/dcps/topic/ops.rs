@@ -60,6 +60,11 @@ impl<T: DdsType> Topic<T> {
         })
     }
 
+    /// `AlreadyDeleted` once the topic (or its participant) was deleted.
+    pub(crate) fn check_alive(&self) -> DdsResult<()> {
+        self.with_entry(|_| ())
+    }
+
     /// The topic's handle (`get_instance_handle`).
     pub fn instance_handle(&self) -> DdsResult<InstanceHandle> {
         self.with_entry(|t| t.node.handle)
@@ -133,7 +138,7 @@ impl<T: DdsType> Topic<T> {
 
     /// Enables the topic (`enable`): topics are enabled when created.
     pub fn enable(&self) -> DdsResult<()> {
-        self.with_entry(|_| ())
+        self.check_alive()
     }
 }
 
@@ -184,13 +189,17 @@ impl DomainParticipant {
         }
         let deadline = Instant::now().checked_add(timeout);
         let found = self.registry().wait_for(deadline, |e| {
+            if self.driver().check_alive().is_err() {
+                return Some(Err(DdsError::AlreadyDeleted));
+            }
             e.topics
                 .iter()
                 .find(|t| !t.deleted && t.name == name)
                 .map(|t| t.type_name.clone())
                 .or_else(|| e.remote_topics.get(name).cloned())
+                .map(Ok)
         });
-        match found {
+        match found.transpose()? {
             None => Err(DdsError::Timeout),
             Some(ty) if ty != T::TYPE_NAME => {
                 Err(DdsError::PreconditionNotMet("the topic has another type"))
