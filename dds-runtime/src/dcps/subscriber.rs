@@ -149,6 +149,7 @@ impl Subscriber {
             Ok(id)
         })?;
         let id = handle.id();
+        topic.reader_created(id);
         tracing::info!(
             topic = t.name(),
             type_name = T::TYPE_NAME,

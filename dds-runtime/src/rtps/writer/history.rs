@@ -16,6 +16,8 @@ pub(crate) struct CacheChange {
     pub payload: Payload,
     pub key_hash: Option<[u8; 16]>,
     pub source_timestamp: Option<Time>,
+    /// Readers whose content filter rejected this change (sorted; empty for most changes).
+    pub rejected: Vec<Guid>,
 }
 
 /// Why a change cannot be added now.
@@ -200,6 +202,7 @@ mod tests {
             payload: vec![0u8; 10].into(),
             key_hash: Some([key; 16]),
             source_timestamp: None,
+            rejected: Vec::new(),
         }
     }
 

@@ -1,8 +1,10 @@
 //! Writers: history cache, per-reader state and the reliable/best-effort protocol (§8.4.7, §8.4.9).
 
+mod content_filter;
 mod history;
 mod reader_proxy;
 
+pub(crate) use content_filter::ReaderFilters;
 pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use reader_proxy::ReaderProxy;
 
@@ -61,6 +63,8 @@ pub(crate) struct Writer {
     blocked: bool,
     /// Set when deleted: lingers until acknowledged or this deadline.
     pub linger_until: Option<Instant>,
+    /// The content filters of the matched readers that announced one.
+    pub filters: ReaderFilters,
 }
 
 impl Writer {
@@ -82,6 +86,7 @@ impl Writer {
             unacked_bytes: 0,
             blocked: false,
             linger_until: None,
+            filters: ReaderFilters::default(),
         }
     }
 
@@ -190,6 +195,20 @@ impl Writer {
         out: &mut Outbox,
         ev: &mut VecDeque<Event>,
     ) -> Result<SequenceNumber, WriteError> {
+        self.write_filtered(now, change, Vec::new(), out, ev)
+    }
+
+    /// [`Writer::write`] of a change that the content filters of the `rejected` readers refused: they get a
+    /// GAP for it (reliable ones), the others the DATA.
+    pub(crate) fn write_filtered(
+        &mut self,
+        now: Instant,
+        change: WriteChange,
+        mut rejected: Vec<Guid>,
+        out: &mut Outbox,
+        ev: &mut VecDeque<Event>,
+    ) -> Result<SequenceNumber, WriteError> {
+        rejected.sort_unstable();
         if self.linger_until.is_some() {
             return Err(WriteError::Deleted);
         }
@@ -221,10 +240,16 @@ impl Writer {
             payload: change.payload,
             key_hash: change.key_hash,
             source_timestamp: change.source_timestamp,
+            rejected,
         };
+        let filtered = !cc.rejected.is_empty();
         self.history.add(cc);
         if !self.data_dest.is_empty() {
-            let dest = std::mem::take(&mut self.data_dest);
+            let dest = if filtered {
+                self.send_rejections(sn, out)
+            } else {
+                std::mem::take(&mut self.data_dest)
+            };
             self.send_new(sn, &dest, out);
             if self.has_reliable_proxy() {
                 self.bytes_since_nonfinal_hb += len;
@@ -242,7 +267,9 @@ impl Writer {
                     out.push(&dest, None, Ts::Any, &hb);
                 }
             }
-            self.data_dest = dest;
+            if !filtered {
+                self.data_dest = dest;
+            }
         }
         if self.has_reliable_proxy() {
             self.unacked_bytes += len;
@@ -331,6 +358,7 @@ impl Writer {
     }
 
     pub(crate) fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
+        self.filters.set(*guid, None);
         let had = self.proxies.remove(guid).is_some();
         if had {
             self.rebuild_dest();
@@ -505,7 +533,7 @@ impl Writer {
             };
             p.requested_frags.remove(&sn);
             match self.history.get(sn) {
-                Some(c) if sn >= p.floor => {
+                Some(c) if sn >= p.floor && c.rejected.binary_search(&g).is_err() => {
                     resend(c, None);
                     budget -= c.payload.len() as isize + 64;
                 }
