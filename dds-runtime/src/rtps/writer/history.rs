@@ -18,6 +18,8 @@ pub(crate) struct CacheChange {
     pub source_timestamp: Option<Time>,
     /// Readers whose content filter rejected this change (sorted; empty for most changes).
     pub rejected: Vec<Guid>,
+    /// PID_CONTENT_FILTER_INFO to send with it, when matched readers filter.
+    pub filter_info: Option<Box<[u8]>>,
 }
 
 /// Why a change cannot be added now.
@@ -203,6 +205,7 @@ mod tests {
             key_hash: Some([key; 16]),
             source_timestamp: None,
             rejected: Vec::new(),
+            filter_info: None,
         }
     }
 

@@ -240,6 +240,11 @@ impl Writer {
             payload: change.payload,
             key_hash: change.key_hash,
             source_timestamp: change.source_timestamp,
+            filter_info: if change.kind == ChangeKind::Alive {
+                self.filters.info(&rejected)
+            } else {
+                None
+            },
             rejected,
         };
         let filtered = !cc.rejected.is_empty();
@@ -642,8 +647,17 @@ pub(crate) fn send_change(
     }
     let mut qbuf = [0u8; 28];
     let qn = inline_qos(c, &mut qbuf);
-    let inline_qos = (qn > 0).then_some(ParameterList {
-        data: &qbuf[..qn],
+    // Only changes evaluated by content filters carry more: the filter info, after the fixed part.
+    let with_info: Vec<u8>;
+    let qos: &[u8] = match &c.filter_info {
+        Some(info) => {
+            with_info = [&qbuf[..qn], info].concat();
+            &with_info
+        }
+        None => &qbuf[..qn],
+    };
+    let inline_qos = (!qos.is_empty()).then_some(ParameterList {
+        data: qos,
         little_endian: true,
     });
     let ts = Ts::Set(c.source_timestamp);
