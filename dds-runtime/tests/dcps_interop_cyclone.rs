@@ -1,4 +1,5 @@
-//! Scratch interop check against a real Cyclone DDS 11 peer (python `cyclonedds`), both directions.
+//! Scratch interop check against a real Cyclone DDS 11 peer (python `cyclonedds`), both directions, and
+//! content filtering with Cyclone (which has no SQL filters) as a plain writer and as a plain reader.
 //! Ignored by default (needs python3 + cyclonedds): run with
 //! `scripts/isolated cargo test -p dds-runtime --test dcps_interop_cyclone -- --ignored`.
 mod dcps_util;
@@ -119,4 +120,121 @@ fn cyclone_writer_to_rust_reader() {
         disposed,
         "dispose from Cyclone not seen as NOT_ALIVE_DISPOSED"
     );
+}
+
+fn tl_reliable_reader() -> DataReaderQos {
+    DataReaderQos::builder()
+        .reliability(reliable())
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast(100))
+        .build()
+}
+
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn cyclone_writer_to_rust_content_filtered_reader() {
+    let p = participant(63);
+    let t = p
+        .create_topic::<ShapeType>("Triangle", &TopicQos::default())
+        .unwrap();
+    let cft = p
+        .create_content_filtered_topic(
+            "Triangle_filtered",
+            &t,
+            "x >= %0 AND color = 'BLUE'",
+            &["5"],
+        )
+        .unwrap();
+    let r = p
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&cft, &tl_reliable_reader())
+        .unwrap();
+    let mut child = python(63, &["pub", "Triangle", "BLUE", "10"]);
+    let mut xs = Vec::new();
+    let mut disposed = false;
+    wait_until(Duration::from_secs(25), || {
+        for s in r.take().unwrap() {
+            match s.data {
+                Some(d) => xs.push(d.x),
+                None => disposed |= s.info.instance_state == InstanceState::NotAliveDisposed,
+            }
+        }
+        xs.len() >= 5 && disposed
+    });
+    let status = child.wait().unwrap();
+    assert!(
+        status.success(),
+        "Cyclone writer did not match our filtering reader"
+    );
+    assert_eq!(xs, (5..10).collect::<Vec<_>>());
+    assert!(disposed, "the dispose passes the filter's instance");
+}
+
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn rust_writer_filters_for_our_reader_while_cyclone_gets_everything() {
+    let p = participant(64);
+    let t = p
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let w = p
+        .create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(&t, &tl_reliable_writer())
+        .unwrap();
+    // Our filtering reader in another participant, so that the writer filters for it on the wire.
+    let p2 = participant(64);
+    let t2 = p2
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let cft = p2
+        .create_content_filtered_topic("Square_low", &t2, "x < %0", &["3"])
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&cft, &tl_reliable_reader())
+        .unwrap();
+    let mut child = python(64, &["sub", "Square", "10", "dispose"]);
+    assert!(
+        wait_until(Duration::from_secs(20), || w
+            .publication_matched_status()
+            .current_count
+            == 2),
+        "the writer did not match both readers"
+    );
+    for i in 0..10 {
+        w.write(&shape("RED", i)).unwrap();
+    }
+    w.dispose(&shape("RED", 0)).unwrap();
+    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
+    let out = BufReader::new(child.stdout.take().unwrap());
+    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "cyclone sub failed: {lines:?}");
+    let cyclone_xs: Vec<i64> = lines
+        .iter()
+        .filter(|l| l.contains("\"RED\""))
+        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
+        .collect();
+    assert_eq!(cyclone_xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
+    let mut ours = Vec::new();
+    wait_until(Duration::from_secs(5), || {
+        ours.extend(
+            r.take()
+                .unwrap()
+                .into_iter()
+                .filter_map(|s| s.data.map(|d| d.x)),
+        );
+        ours.len() >= 3
+    });
+    std::thread::sleep(Duration::from_millis(200));
+    ours.extend(
+        r.take()
+            .unwrap()
+            .into_iter()
+            .filter_map(|s| s.data.map(|d| d.x)),
+    );
+    assert_eq!(ours, [0, 1, 2]);
 }
