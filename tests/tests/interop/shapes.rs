@@ -194,7 +194,7 @@ pub fn content_filter(publ: Prog, sub: Prog, domain: u32) -> Result<(), Skip> {
         &[&p, &s],
         "subscriber printed no filtered samples"
     );
-    let _ = p.wait_line(WAIT, |l| {
+    let _ = p.wait_line(Duration::from_secs(3), |l| {
         is_sample(l, "Square", "BLUE") && x_of(l).is_some_and(|x| x > 100)
     });
     stop(&mut p);
