@@ -29,6 +29,37 @@ fn python(domain: u32, args: &[&str]) -> Child {
         .expect("python3 with cyclonedds")
 }
 
+/// A transient-local reliable writer of "Square" on `p`.
+fn square_writer(p: &DomainParticipant) -> DataWriter<ShapeType> {
+    let t = p
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    p.create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(&t, &tl_reliable_writer())
+        .unwrap()
+}
+
+/// Writes RED x = 0..10 and disposes it; returns the x values the Cyclone subscriber `child` printed, and
+/// all its lines.
+fn write_red_to_cyclone(w: &DataWriter<ShapeType>, mut child: Child) -> (Vec<i64>, Vec<String>) {
+    for i in 0..10 {
+        w.write(&shape("RED", i)).unwrap();
+    }
+    w.dispose(&shape("RED", 0)).unwrap();
+    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
+    let out = BufReader::new(child.stdout.take().unwrap());
+    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "cyclone sub failed: {lines:?}");
+    let xs = lines
+        .iter()
+        .filter(|l| l.contains("\"RED\""))
+        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
+        .collect();
+    (xs, lines)
+}
+
 fn tl_reliable_writer() -> DataWriterQos {
     DataWriterQos::builder()
         .reliability(reliable())
@@ -41,15 +72,8 @@ fn tl_reliable_writer() -> DataWriterQos {
 #[ignore = "needs python3 with cyclonedds; run explicitly"]
 fn rust_writer_to_cyclone_reader() {
     let p = participant(61);
-    let t = p
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let w = p
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t, &tl_reliable_writer())
-        .unwrap();
-    let mut child = python(61, &["sub", "Square", "10", "dispose"]);
+    let w = square_writer(&p);
+    let child = python(61, &["sub", "Square", "10", "dispose"]);
     assert!(
         wait_until(Duration::from_secs(20), || w
             .publication_matched_status()
@@ -57,20 +81,7 @@ fn rust_writer_to_cyclone_reader() {
             == 1),
         "no match with Cyclone"
     );
-    for i in 0..10 {
-        w.write(&shape("RED", i)).unwrap();
-    }
-    w.dispose(&shape("RED", 0)).unwrap();
-    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
-    let out = BufReader::new(child.stdout.take().unwrap());
-    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
-    let status = child.wait().unwrap();
-    assert!(status.success(), "cyclone sub failed: {lines:?}");
-    let xs: Vec<i64> = lines
-        .iter()
-        .filter(|l| l.contains("\"RED\""))
-        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
-        .collect();
+    let (xs, lines) = write_red_to_cyclone(&w, child);
     assert_eq!(xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
     assert!(
         lines.iter().any(|l| l.contains("\"disposed\": true")),
@@ -175,14 +186,7 @@ fn cyclone_writer_to_rust_content_filtered_reader() {
 #[ignore = "needs python3 with cyclonedds; run explicitly"]
 fn rust_writer_filters_for_our_reader_while_cyclone_gets_everything() {
     let p = participant(64);
-    let t = p
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let w = p
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t, &tl_reliable_writer())
-        .unwrap();
+    let w = square_writer(&p);
     // Our filtering reader in another participant, so that the writer filters for it on the wire.
     let p2 = participant(64);
     let t2 = p2
@@ -196,7 +200,7 @@ fn rust_writer_filters_for_our_reader_while_cyclone_gets_everything() {
         .unwrap()
         .create_datareader(&cft, &tl_reliable_reader())
         .unwrap();
-    let mut child = python(64, &["sub", "Square", "10", "dispose"]);
+    let child = python(64, &["sub", "Square", "10", "dispose"]);
     assert!(
         wait_until(Duration::from_secs(20), || w
             .publication_matched_status()
@@ -204,20 +208,7 @@ fn rust_writer_filters_for_our_reader_while_cyclone_gets_everything() {
             == 2),
         "the writer did not match both readers"
     );
-    for i in 0..10 {
-        w.write(&shape("RED", i)).unwrap();
-    }
-    w.dispose(&shape("RED", 0)).unwrap();
-    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
-    let out = BufReader::new(child.stdout.take().unwrap());
-    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
-    let status = child.wait().unwrap();
-    assert!(status.success(), "cyclone sub failed: {lines:?}");
-    let cyclone_xs: Vec<i64> = lines
-        .iter()
-        .filter(|l| l.contains("\"RED\""))
-        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
-        .collect();
+    let (cyclone_xs, lines) = write_red_to_cyclone(&w, child);
     assert_eq!(cyclone_xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
     let mut ours = Vec::new();
     wait_until(Duration::from_secs(5), || {
