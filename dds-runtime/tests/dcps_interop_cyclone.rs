@@ -1,4 +1,5 @@
-//! Scratch interop check against a real Cyclone DDS 11 peer (python `cyclonedds`), both directions.
+//! Scratch interop check against a real Cyclone DDS 11 peer (python `cyclonedds`), both directions, and
+//! content filtering with Cyclone (which has no SQL filters) as a plain writer and as a plain reader.
 //! Ignored by default (needs python3 + cyclonedds): run with
 //! `scripts/isolated cargo test -p dds-runtime --test dcps_interop_cyclone -- --ignored`.
 mod dcps_util;
@@ -28,6 +29,37 @@ fn python(domain: u32, args: &[&str]) -> Child {
         .expect("python3 with cyclonedds")
 }
 
+/// A transient-local reliable writer of "Square" on `p`.
+fn square_writer(p: &DomainParticipant) -> DataWriter<ShapeType> {
+    let t = p
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    p.create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(&t, &tl_reliable_writer())
+        .unwrap()
+}
+
+/// Writes RED x = 0..10 and disposes it; returns the x values the Cyclone subscriber `child` printed, and
+/// all its lines.
+fn write_red_to_cyclone(w: &DataWriter<ShapeType>, mut child: Child) -> (Vec<i64>, Vec<String>) {
+    for i in 0..10 {
+        w.write(&shape("RED", i)).unwrap();
+    }
+    w.dispose(&shape("RED", 0)).unwrap();
+    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
+    let out = BufReader::new(child.stdout.take().unwrap());
+    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "cyclone sub failed: {lines:?}");
+    let xs = lines
+        .iter()
+        .filter(|l| l.contains("\"RED\""))
+        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
+        .collect();
+    (xs, lines)
+}
+
 fn tl_reliable_writer() -> DataWriterQos {
     DataWriterQos::builder()
         .reliability(reliable())
@@ -40,15 +72,8 @@ fn tl_reliable_writer() -> DataWriterQos {
 #[ignore = "needs python3 with cyclonedds; run explicitly"]
 fn rust_writer_to_cyclone_reader() {
     let p = participant(61);
-    let t = p
-        .create_topic::<ShapeType>("Square", &TopicQos::default())
-        .unwrap();
-    let w = p
-        .create_publisher(&PublisherQos::default())
-        .unwrap()
-        .create_datawriter(&t, &tl_reliable_writer())
-        .unwrap();
-    let mut child = python(61, &["sub", "Square", "10", "dispose"]);
+    let w = square_writer(&p);
+    let child = python(61, &["sub", "Square", "10", "dispose"]);
     assert!(
         wait_until(Duration::from_secs(20), || w
             .publication_matched_status()
@@ -56,20 +81,7 @@ fn rust_writer_to_cyclone_reader() {
             == 1),
         "no match with Cyclone"
     );
-    for i in 0..10 {
-        w.write(&shape("RED", i)).unwrap();
-    }
-    w.dispose(&shape("RED", 0)).unwrap();
-    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
-    let out = BufReader::new(child.stdout.take().unwrap());
-    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
-    let status = child.wait().unwrap();
-    assert!(status.success(), "cyclone sub failed: {lines:?}");
-    let xs: Vec<i64> = lines
-        .iter()
-        .filter(|l| l.contains("\"RED\""))
-        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
-        .collect();
+    let (xs, lines) = write_red_to_cyclone(&w, child);
     assert_eq!(xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
     assert!(
         lines.iter().any(|l| l.contains("\"disposed\": true")),
@@ -119,4 +131,101 @@ fn cyclone_writer_to_rust_reader() {
         disposed,
         "dispose from Cyclone not seen as NOT_ALIVE_DISPOSED"
     );
+}
+
+fn tl_reliable_reader() -> DataReaderQos {
+    DataReaderQos::builder()
+        .reliability(reliable())
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast(100))
+        .build()
+}
+
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn cyclone_writer_to_rust_content_filtered_reader() {
+    let p = participant(63);
+    let t = p
+        .create_topic::<ShapeType>("Triangle", &TopicQos::default())
+        .unwrap();
+    let cft = p
+        .create_content_filtered_topic(
+            "Triangle_filtered",
+            &t,
+            "x >= %0 AND color = 'BLUE'",
+            &["5"],
+        )
+        .unwrap();
+    let r = p
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&cft, &tl_reliable_reader())
+        .unwrap();
+    let mut child = python(63, &["pub", "Triangle", "BLUE", "10"]);
+    let mut xs = Vec::new();
+    let mut disposed = false;
+    wait_until(Duration::from_secs(25), || {
+        for s in r.take().unwrap() {
+            match s.data {
+                Some(d) => xs.push(d.x),
+                None => disposed |= s.info.instance_state == InstanceState::NotAliveDisposed,
+            }
+        }
+        xs.len() >= 5 && disposed
+    });
+    let status = child.wait().unwrap();
+    assert!(
+        status.success(),
+        "Cyclone writer did not match our filtering reader"
+    );
+    assert_eq!(xs, (5..10).collect::<Vec<_>>());
+    assert!(disposed, "the dispose passes the filter's instance");
+}
+
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn rust_writer_filters_for_our_reader_while_cyclone_gets_everything() {
+    let p = participant(64);
+    let w = square_writer(&p);
+    // Our filtering reader in another participant, so that the writer filters for it on the wire.
+    let p2 = participant(64);
+    let t2 = p2
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let cft = p2
+        .create_content_filtered_topic("Square_low", &t2, "x < %0", &["3"])
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&cft, &tl_reliable_reader())
+        .unwrap();
+    let child = python(64, &["sub", "Square", "10", "dispose"]);
+    assert!(
+        wait_until(Duration::from_secs(20), || w
+            .publication_matched_status()
+            .current_count
+            == 2),
+        "the writer did not match both readers"
+    );
+    let (cyclone_xs, lines) = write_red_to_cyclone(&w, child);
+    assert_eq!(cyclone_xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
+    let mut ours = Vec::new();
+    wait_until(Duration::from_secs(5), || {
+        ours.extend(
+            r.take()
+                .unwrap()
+                .into_iter()
+                .filter_map(|s| s.data.map(|d| d.x)),
+        );
+        ours.len() >= 3
+    });
+    std::thread::sleep(Duration::from_millis(200));
+    ours.extend(
+        r.take()
+            .unwrap()
+            .into_iter()
+            .filter_map(|s| s.data.map(|d| d.x)),
+    );
+    assert_eq!(ours, [0, 1, 2]);
 }

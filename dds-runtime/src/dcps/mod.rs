@@ -47,6 +47,7 @@ pub mod status;
 mod subscriber;
 mod sync;
 mod topic;
+mod writer_filter;
 
 /// GUIDs name entities in the DCPS API ([`DataWriter::guid`], [`SampleInfo::publication_guid`], ...).
 pub use crate::rtps::{Guid, GuidPrefix};

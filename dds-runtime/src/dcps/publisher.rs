@@ -29,6 +29,7 @@ use super::status::{
 };
 use super::sync::{lock, read};
 use super::topic::Topic;
+use super::writer_filter::WriterFilters;
 
 pub use ops::PublisherListener;
 
@@ -142,6 +143,7 @@ impl Publisher {
             qos: wq,
             version,
             instances: Mutex::new(WriterInstances::default()),
+            filters: Mutex::new(WriterFilters::default()),
         });
         let owner = WriterOwner {
             topic: topic.clone(),
@@ -199,6 +201,8 @@ struct WriterInner<T: DdsType> {
     current: RwLock<DataWriterQos>,
     version: XcdrVersion,
     instances: Mutex<WriterInstances>,
+    /// Matched readers' content filters, for writer-side filtering.
+    filters: Mutex<WriterFilters>,
 }
 
 /// Writes samples of type `T`. Cheap to clone; the writer is deleted when the last clone is dropped (a
@@ -308,8 +312,9 @@ impl<T: DdsType> DataWriter<T> {
         }
     }
 
-    /// Hands one change to the core, waiting up to max_blocking_time while flow control refuses it.
-    fn submit(&self, change: WriteChange) -> DdsResult<()> {
+    /// Hands one change to the core, waiting up to max_blocking_time while flow control refuses it. With the
+    /// `sample`, the matched readers' content filters are evaluated on it (writer-side filtering).
+    fn submit(&self, change: WriteChange, sample: Option<&T>) -> DdsResult<()> {
         let driver = &self.inner.state.driver;
         driver.check_alive()?;
         let max_block = match self.inner.qos.reliability {
@@ -321,7 +326,13 @@ impl<T: DdsType> DataWriter<T> {
         let id = self.id();
         loop {
             let seen = driver.progress_generation();
-            match driver.with_core(|c, now| c.write(now, id, change.clone())) {
+            let write = |c: &mut crate::rtps::Participant, now| {
+                let rejected = sample
+                    .map(|s| lock(&self.inner.filters).rejected(c, id, s))
+                    .unwrap_or_default();
+                c.write_filtered(now, id, change.clone(), rejected)
+            };
+            match driver.with_core(write) {
                 Ok(_) => return Ok(()),
                 Err(WriteError::WouldBlock) => {
                     let now = Instant::now();
@@ -374,7 +385,7 @@ impl<T: DdsType> DataWriter<T> {
             source_timestamp: Some(wire_time(timestamp)),
         };
         tracing::trace!(writer = ?self.id(), "write");
-        self.submit(change)
+        self.submit(change, Some(sample))
     }
 
     /// The instance of `sample` (by serialized key) and its key hash; registers it when `create`, and
@@ -478,7 +489,7 @@ impl<T: DdsType> DataWriter<T> {
             key_hash,
             source_timestamp: Some(wire_time(ts)),
         };
-        self.submit(change)?;
+        self.submit(change, None)?;
         if matches!(kind, ChangeKind::Unregister | ChangeKind::DisposeUnregister) {
             let mut inst = lock(&self.inner.instances);
             if let Some(i) = inst.by_handle.remove(&h) {

@@ -181,6 +181,7 @@ impl Subscriber {
         })?;
         ops::register_reader(self, &inner, t.name());
         let id = handle.id();
+        topic.reader_created(id);
         tracing::info!(
             topic = t.name(),
             type_name = T::TYPE_NAME,

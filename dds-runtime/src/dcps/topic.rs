@@ -3,16 +3,17 @@
 mod ops;
 
 use std::marker::PhantomData;
-use std::sync::{Arc, RwLock};
+use std::sync::{Arc, Mutex, RwLock};
 
 use crate::cdr::DdsType;
 use crate::qos::TopicQos;
 use crate::rtps::discovery::ContentFilterProperty;
+use crate::rtps::EntityId;
 
 use super::error::{DdsError, DdsResult};
 use super::filter::{ContentFilter, FilterFields};
 use super::participant::DomainParticipant;
-use super::sync::{read, write};
+use super::sync::{lock, read, write};
 
 pub use ops::TopicListener;
 
@@ -81,6 +82,10 @@ pub trait TopicDescription<T: DdsType> {
     fn content_filter_property(&self) -> Option<ContentFilterProperty> {
         None
     }
+    /// A reader was created on this description (a content-filtered topic re-announces it when its
+    /// parameters change).
+    #[doc(hidden)]
+    fn reader_created(&self, _reader: EntityId) {}
 }
 
 impl<T: DdsType> TopicDescription<T> for Topic<T> {
@@ -96,6 +101,8 @@ pub struct ContentFilteredTopic<T> {
     topic: Topic<T>,
     name: String,
     filter: Arc<RwLock<ContentFilter>>,
+    /// The readers created on it, to re-announce when the parameters change.
+    readers: Arc<Mutex<Vec<EntityId>>>,
 }
 
 impl<T> Clone for ContentFilteredTopic<T> {
@@ -104,6 +111,7 @@ impl<T> Clone for ContentFilteredTopic<T> {
             topic: self.topic.clone(),
             name: self.name.clone(),
             filter: self.filter.clone(),
+            readers: self.readers.clone(),
         }
     }
 }
@@ -121,10 +129,19 @@ impl<T: DdsType + FilterFields> ContentFilteredTopic<T> {
     pub fn expression_parameters(&self) -> Vec<String> {
         read(&self.filter).parameters().to_vec()
     }
-    /// Changes the parameters; readers created on this topic apply them to samples received from now on.
+    /// Changes the parameters; readers created on this topic apply them to samples received from now on,
+    /// and announce them again in SEDP so that writers filtering for them use them too (a writer that has
+    /// not yet seen the new announcement may still skip a sample that the new parameters accept).
     pub fn set_expression_parameters<S: AsRef<str>>(&self, params: &[S]) -> DdsResult<()> {
-        let params: Vec<String> = params.iter().map(|s| s.as_ref().to_string()).collect();
-        Ok(write(&self.filter).set_parameters(&params)?)
+        write(&self.filter).set_parameters(params)?;
+        let property = self.content_filter_property();
+        let readers = lock(&self.readers).clone();
+        self.topic.participant().driver().with_core(|c, now| {
+            for r in readers {
+                c.set_reader_content_filter(now, r, property.clone());
+            }
+        });
+        Ok(())
     }
 }
 
@@ -135,6 +152,9 @@ impl<T: DdsType + FilterFields> TopicDescription<T> for ContentFilteredTopic<T> 
     fn sample_filter(&self) -> Option<SampleFilter<T>> {
         let f = self.filter.clone();
         Some(Box::new(move |s: &T| read(&f).matches(s)))
+    }
+    fn reader_created(&self, reader: EntityId) {
+        lock(&self.readers).push(reader);
     }
     fn content_filter_property(&self) -> Option<ContentFilterProperty> {
         let f = read(&self.filter);
@@ -186,6 +206,7 @@ impl DomainParticipant {
             topic: topic.clone(),
             name: name.to_string(),
             filter: Arc::new(RwLock::new(filter)),
+            readers: Arc::new(Mutex::new(Vec::new())),
         })
     }
 }

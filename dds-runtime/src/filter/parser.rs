@@ -144,26 +144,28 @@ impl Parser {
     }
 
     fn or(&mut self) -> Result<Expr, FilterError> {
-        let mut terms = vec![self.and()?];
-        while self.eat_keyword("OR") {
-            terms.push(self.and()?);
-        }
-        Ok(if terms.len() == 1 {
-            terms.remove(0)
-        } else {
-            Expr::Or(terms)
-        })
+        self.chain("OR", Self::and, Expr::Or)
     }
 
     fn and(&mut self) -> Result<Expr, FilterError> {
-        let mut terms = vec![self.not()?];
-        while self.eat_keyword("AND") {
-            terms.push(self.not()?);
+        self.chain("AND", Self::not, Expr::And)
+    }
+
+    /// `term {kw term}` as one flat list (a single term stands alone).
+    fn chain(
+        &mut self,
+        kw: &str,
+        term: fn(&mut Self) -> Result<Expr, FilterError>,
+        list: fn(Vec<Expr>) -> Expr,
+    ) -> Result<Expr, FilterError> {
+        let mut terms = vec![term(self)?];
+        while self.eat_keyword(kw) {
+            terms.push(term(self)?);
         }
         Ok(if terms.len() == 1 {
             terms.remove(0)
         } else {
-            Expr::And(terms)
+            list(terms)
         })
     }
 

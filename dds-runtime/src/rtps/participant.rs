@@ -6,6 +6,7 @@ mod coherent;
 mod control;
 mod discovery;
 mod historical;
+mod filtering;
 mod receive;
 mod timers;
 
@@ -382,20 +383,7 @@ impl Participant {
         writer: EntityId,
         change: WriteChange,
     ) -> Result<SequenceNumber, WriteError> {
-        if !self.user_writers.contains(&writer) {
-            return Err(WriteError::UnknownWriter(writer));
-        }
-        let Some(w) = self.writers.get_mut(&writer) else {
-            return Err(WriteError::UnknownWriter(writer));
-        };
-        let events = &mut self.events;
-        let r = if self.config.write_batch_delay.is_some() {
-            self.out.hold(now, |out| w.write(now, change, out, events))
-        } else {
-            w.write(now, change, &mut self.out, events)
-        };
-        timers::lower_floor(&self.timer_floor, w.next_timeout());
-        r
+        self.write_filtered(now, writer, change, Vec::new())
     }
 
     /// Whether every matched reliable reader acknowledged everything the writer wrote (true for unknown ids).

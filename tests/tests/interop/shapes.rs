@@ -174,6 +174,51 @@ pub fn large(publ: Prog, sub: Prog, domain: u32, xcdr: u8) -> Result<(), Skip> {
     Ok(())
 }
 
+/// `--cft`: the subscriber reads a content-filtered topic and prints only samples with `x <= 100`, while the
+/// publisher's shapes range further.
+pub fn content_filter(publ: Prog, sub: Prog, domain: u32) -> Result<(), Skip> {
+    require_netns()?;
+    let x_of = |l: &str| {
+        l.split_whitespace()
+            .nth(2)
+            .and_then(|x| x.parse::<i32>().ok())
+    };
+    let mut s = sub.spawn("sub", &format!("-S -t Square -d {domain} -r --cft x<=100"))?;
+    let mut p = publ.spawn(
+        "pub",
+        &format!("-P -t Square -d {domain} -c BLUE -r --write-period 10"),
+    )?;
+    let got = s.wait_lines(WAIT, 10, |l| is_sample(l, "Square", "BLUE"));
+    check!(
+        got.is_some(),
+        &[&p, &s],
+        "subscriber printed no filtered samples"
+    );
+    let _ = p.wait_line(Duration::from_secs(3), |l| {
+        is_sample(l, "Square", "BLUE") && x_of(l).is_some_and(|x| x > 100)
+    });
+    stop(&mut p);
+    stop(&mut s);
+    let printed = s.grep(|l| is_sample(l, "Square", "BLUE"));
+    let outside: Vec<&String> = printed
+        .iter()
+        .filter(|l| x_of(l).is_none_or(|x| x > 100))
+        .collect();
+    check!(
+        outside.is_empty(),
+        &[&p, &s],
+        "samples outside the filter printed: {outside:?}"
+    );
+    check!(
+        s.grep(|l| l.contains("Create reader for topic: Square_filtered"))
+            .len()
+            == 1,
+        &[&s],
+        "the reader is not on the content-filtered topic"
+    );
+    Ok(())
+}
+
 /// Partition "A" matches "A" but not "B".
 pub fn partitions(publ: Prog, sub: Prog, domain: u32) -> Result<(), Skip> {
     require_netns()?;
@@ -369,6 +414,20 @@ mod cyclone_xcdr2 {
     #[test]
     fn xcdr2_dispose_peer_to_us() {
         let _ = final_state(Prog::Cyclone, Prog::Ours, 75, 'd', 2);
+    }
+}
+
+/// `shape_main --cft`: Cyclone as a plain writer to our filtering subscriber, and ours to ours (where the
+/// writer filters on the wire).
+mod content_filters {
+    use super::*;
+    #[test]
+    fn cft_peer_to_us() {
+        let _ = content_filter(Prog::Cyclone, Prog::Ours, 78);
+    }
+    #[test]
+    fn cft_us_to_us() {
+        let _ = content_filter(Prog::Ours, Prog::Ours, 79);
     }
 }
 

@@ -310,6 +310,8 @@ impl Participant {
                 if !has {
                     self.add_proxy(now, local, remote);
                     self.events.push_back(local.matched(remote, true));
+                } else if let Local::Writer(id) = local {
+                    self.refresh_reader_filter(id, remote);
                 }
                 self.incompatible.remove(&(local.id(), remote));
             }
@@ -358,6 +360,7 @@ impl Participant {
                     let proxy = ReaderProxy::new(remote, locators, reliable).for_vendor(vendor);
                     w.add_proxy(now, proxy, durable, &mut self.events);
                 }
+                self.refresh_reader_filter(id, remote);
             }
             Local::Reader(id) => {
                 let Some(wd) = self.known_writers.get(&remote) else {

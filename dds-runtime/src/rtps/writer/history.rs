@@ -18,6 +18,10 @@ pub(crate) struct CacheChange {
     pub source_timestamp: Option<Time>,
     /// Membership in a coherent set, sent again with every repair.
     pub coherent: Option<super::CoherentMark>,
+    /// Readers whose content filter rejected this change (sorted; empty for most changes).
+    pub rejected: Vec<Guid>,
+    /// PID_CONTENT_FILTER_INFO to send with it, when matched readers filter.
+    pub filter_info: Option<Box<[u8]>>,
 }
 
 /// Why a change cannot be added now.
@@ -202,6 +206,8 @@ mod tests {
             key_hash: Some([key; 16]),
             source_timestamp: None,
             coherent: None,
+            rejected: Vec::new(),
+            filter_info: None,
         }
     }
 

@@ -1,11 +1,13 @@
 //! Writers: history cache, per-reader state and the reliable/best-effort protocol (§8.4.7, §8.4.9).
 
 mod coherent;
+mod content_filter;
 mod history;
 mod reader_proxy;
 
 pub(crate) use coherent::CoherentMark;
 use coherent::CoherentState;
+pub(crate) use content_filter::ReaderFilters;
 pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use reader_proxy::ReaderProxy;
 
@@ -72,6 +74,8 @@ pub(crate) struct Writer {
     pub linger_until: Option<Instant>,
     /// The open coherent set, if any (see `coherent.rs`).
     coherent: CoherentState,
+    /// The content filters of the matched readers that announced one.
+    pub filters: ReaderFilters,
 }
 
 impl Writer {
@@ -96,6 +100,7 @@ impl Writer {
             blocked: false,
             linger_until: None,
             coherent: CoherentState::Off,
+            filters: ReaderFilters::default(),
         }
     }
 
@@ -204,6 +209,20 @@ impl Writer {
         out: &mut Outbox,
         ev: &mut VecDeque<Event>,
     ) -> Result<SequenceNumber, WriteError> {
+        self.write_filtered(now, change, Vec::new(), out, ev)
+    }
+
+    /// [`Writer::write`] of a change that the content filters of the `rejected` readers refused: they get a
+    /// GAP for it (reliable ones), the others the DATA.
+    pub(crate) fn write_filtered(
+        &mut self,
+        now: Instant,
+        change: WriteChange,
+        mut rejected: Vec<Guid>,
+        out: &mut Outbox,
+        ev: &mut VecDeque<Event>,
+    ) -> Result<SequenceNumber, WriteError> {
+        rejected.sort_unstable();
         if self.linger_until.is_some() {
             return Err(WriteError::Deleted);
         }
@@ -239,10 +258,21 @@ impl Writer {
             key_hash: change.key_hash,
             source_timestamp: change.source_timestamp,
             coherent: self.coherent.mark(sn),
+            filter_info: if change.kind == ChangeKind::Alive {
+                self.filters.info(&rejected)
+            } else {
+                None
+            },
+            rejected,
         };
+        let filtered = !cc.rejected.is_empty();
         self.history.add(cc);
         if !self.data_dest.is_empty() {
-            let dest = std::mem::take(&mut self.data_dest);
+            let dest = if filtered {
+                self.send_rejections(sn, out)
+            } else {
+                std::mem::take(&mut self.data_dest)
+            };
             self.send_new(sn, &dest, out);
             if self.has_reliable_proxy() {
                 self.bytes_since_nonfinal_hb += len;
@@ -266,7 +296,9 @@ impl Writer {
                     out.push(&dest, None, Ts::Any, &hb);
                 }
             }
-            self.data_dest = dest;
+            if !filtered {
+                self.data_dest = dest;
+            }
         }
         if self.has_reliable_proxy() {
             self.unacked_bytes += len;
@@ -389,6 +421,7 @@ impl Writer {
     }
 
     pub(crate) fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
+        self.filters.set(*guid, None);
         let had = self.proxies.remove(guid).is_some();
         if had {
             self.rebuild_dest();
@@ -570,7 +603,7 @@ impl Writer {
             };
             p.requested_frags.remove(&sn);
             match self.history.get(sn) {
-                Some(c) if sn >= p.floor => {
+                Some(c) if sn >= p.floor && c.rejected.binary_search(&g).is_err() => {
                     resend(c, None);
                     budget -= c.payload.len() as isize + 64;
                 }
@@ -709,8 +742,17 @@ pub(crate) fn send_change(
     }
     let mut qbuf = [0u8; INLINE_QOS_MAX];
     let qn = inline_qos(c, &mut qbuf);
-    let inline_qos = (qn > 0).then_some(ParameterList {
-        data: &qbuf[..qn],
+    // Only changes evaluated by content filters carry more: the filter info, after the fixed part.
+    let with_info: Vec<u8>;
+    let qos: &[u8] = match &c.filter_info {
+        Some(info) => {
+            with_info = [&qbuf[..qn], info].concat();
+            &with_info
+        }
+        None => &qbuf[..qn],
+    };
+    let inline_qos = (!qos.is_empty()).then_some(ParameterList {
+        data: qos,
         little_endian: true,
     });
     let ts = Ts::Set(c.source_timestamp);
