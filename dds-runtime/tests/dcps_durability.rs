@@ -222,6 +222,7 @@ fn durability_kinds_match_in_order() {
             .iter()
             .all(|r| r.subscription_matched_status().current_count >= 1)
             && readers[3].requested_incompatible_qos_status().total_count >= 1
+            && w.offered_incompatible_qos_status().total_count >= 1
     }));
     let st = readers[3].requested_incompatible_qos_status();
     assert_eq!(st.last_policy_id, Some(QosPolicyId::Durability));

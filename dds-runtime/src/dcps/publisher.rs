@@ -492,6 +492,16 @@ impl<T: DdsType> DataWriter<T> {
         self.key_change(ChangeKind::Dispose, Some(sample), InstanceHandle::NIL, ts)
     }
 
+    /// Asserts this writer's liveliness (MANUAL_BY_TOPIC or MANUAL_BY_PARTICIPANT): a HEARTBEAT with the
+    /// liveliness flag to its matched readers. Writing a sample asserts it too.
+    pub fn assert_liveliness(&self) -> DdsResult<()> {
+        let driver = &self.inner.state.driver;
+        driver.check_alive()?;
+        let id = self.id();
+        driver.with_core(|c, now| c.assert_writer_liveliness(now, id));
+        Ok(())
+    }
+
     /// Blocks until every matched reliable reader acknowledged everything written, or `Timeout`.
     pub fn wait_for_acknowledgments(&self, timeout: Duration) -> DdsResult<()> {
         let driver = &self.inner.state.driver;

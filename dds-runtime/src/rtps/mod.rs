@@ -5,6 +5,7 @@
 //! deterministic and testable in simulation. See `docs/rtps-core.md`.
 
 pub mod discovery;
+mod liveliness;
 pub mod messages;
 mod outbox;
 mod participant;

@@ -4,6 +4,7 @@
 
 mod discovery;
 mod historical;
+mod liveliness;
 mod receive;
 mod timers;
 
@@ -35,6 +36,8 @@ pub struct Participant {
     config: ParticipantConfig,
     out: Outbox,
     events: VecDeque<Event>,
+    /// Leases of matched writers with manual liveliness.
+    leases: crate::rtps::liveliness::Leases,
     /// Reused buffer for what readers deliver while a datagram is processed.
     scratch: Vec<Event>,
     writers: BTreeMap<EntityId, Writer>,
@@ -126,6 +129,7 @@ impl Participant {
         let mut p = Participant {
             out: Outbox::new(header, config.max_message_size),
             events: VecDeque::new(),
+            leases: Default::default(),
             scratch: Vec::new(),
             writers: BTreeMap::new(),
             readers: BTreeMap::new(),

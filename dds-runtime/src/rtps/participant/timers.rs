@@ -54,6 +54,9 @@ impl Participant {
         for p in self.participants.values() {
             t = t.min(p.lease_deadline);
         }
+        if let Some(x) = self.leases.next_deadline() {
+            t = t.min(x);
+        }
         for w in self.writers.values() {
             if let Some(x) = w.next_timeout() {
                 t = t.min(x);
@@ -102,6 +105,7 @@ impl Participant {
             }
             self.pmd_due = now + self.config.spdp_interval;
         }
+        self.expire_leases(now);
         let expired: Vec<GuidPrefix> = self
             .participants
             .iter()

@@ -1,6 +1,7 @@
 //! Writers: history cache, per-reader state and the reliable/best-effort protocol (§8.4.7, §8.4.9).
 
 mod history;
+mod liveliness;
 mod reader_proxy;
 
 pub(crate) use history::{CacheChange, HistoryCache};
