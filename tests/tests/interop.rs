@@ -10,6 +10,7 @@ mod interop {
     pub mod ddsperf;
     pub mod durability;
     pub mod harness;
+    pub mod liveliness;
     pub mod main_job;
     pub mod shapes;
     pub mod tshark;
