@@ -171,7 +171,8 @@ struct WriterInner<T: DdsType> {
 /// QoS enforced on the writer side by the RTPS core: reliability, durability (volatile, transient-local),
 /// history, resource limits, partitions, ownership strength (announced). Here: writer data lifecycle
 /// (autodispose on unregister and on deletion), offered deadline missed (checked every 50 ms per instance).
-/// Lifespan is announced and applied by readers. Liveliness other than automatic is not implemented.
+/// Lifespan is announced and applied by readers. Manual liveliness: see `assert_liveliness`; LIVELINESS_LOST
+/// on the writer is not raised yet.
 pub struct DataWriter<T: DdsType> {
     inner: Arc<WriterInner<T>>,
     handle: Arc<EndpointHandle<WriterOwner<T>>>,
