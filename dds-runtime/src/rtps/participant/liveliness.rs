@@ -52,16 +52,14 @@ impl Participant {
     /// Asserts the liveliness of this participant's MANUAL_BY_PARTICIPANT writers (DDS
     /// `DomainParticipant::assert_liveliness`): a ParticipantMessageData of kind MANUAL to every participant.
     pub fn assert_liveliness(&mut self, now: Instant) {
+        self.send_participant_message(now, builtin::PMD_KIND_MANUAL);
+    }
+
+    /// Writes a ParticipantMessageData of `kind` (no data) on the builtin participant-message writer.
+    pub(super) fn send_participant_message(&mut self, now: Instant, kind: [u8; 4]) {
         let prefix = self.config.guid_prefix;
-        let change = WriteChange::alive(builtin::encode_participant_message(
-            &prefix,
-            builtin::PMD_KIND_MANUAL,
-            &[],
-        ))
-        .with_key_hash(builtin::participant_message_key(
-            &prefix,
-            builtin::PMD_KIND_MANUAL,
-        ));
+        let change = WriteChange::alive(builtin::encode_participant_message(&prefix, kind, &[]))
+            .with_key_hash(builtin::participant_message_key(&prefix, kind));
         if let Some(w) = self.writers.get_mut(&EntityId::P2P_MESSAGE_WRITER) {
             let _ = w.write(now, change, &mut self.out, &mut self.events);
         }
