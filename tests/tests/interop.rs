@@ -11,6 +11,7 @@ mod interop {
     pub mod deadline;
     pub mod durability;
     pub mod harness;
+    pub mod liveliness;
     pub mod main_job;
     pub mod shapes;
     pub mod tshark;

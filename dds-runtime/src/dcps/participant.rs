@@ -365,6 +365,14 @@ impl DomainParticipant {
             .collect()
     }
 
+    /// Asserts the liveliness of this participant's MANUAL_BY_PARTICIPANT writers: a ParticipantMessageData of
+    /// kind MANUAL goes to every participant (see the liveliness section of docs/dcps-api.md).
+    pub fn assert_liveliness(&self) -> DdsResult<()> {
+        self.driver.check_alive()?;
+        self.driver.with_core(|c, now| c.assert_liveliness(now));
+        Ok(())
+    }
+
     /// The participant's status condition.
     pub fn status_condition(&self) -> StatusCondition {
         StatusCondition {

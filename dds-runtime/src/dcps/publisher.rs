@@ -211,7 +211,8 @@ struct WriterInner<T: DdsType> {
 /// QoS enforced on the writer side by the RTPS core: reliability, durability (volatile, transient-local),
 /// history, resource limits, partitions, ownership strength (announced). Here: writer data lifecycle
 /// (autodispose on unregister and on deletion), offered deadline missed (checked every 50 ms per instance).
-/// Lifespan is announced and applied by readers. Liveliness other than automatic is not implemented.
+/// Lifespan is announced and applied by readers. Manual liveliness: see `assert_liveliness`; LIVELINESS_LOST
+/// on the writer is not raised yet.
 pub struct DataWriter<T: DdsType> {
     inner: Arc<WriterInner<T>>,
     handle: Arc<EndpointHandle<WriterOwner<T>>>,
@@ -538,6 +539,16 @@ impl<T: DdsType> DataWriter<T> {
     /// Disposes with an explicit source timestamp.
     pub fn dispose_w_timestamp(&self, sample: &T, ts: SystemTime) -> DdsResult<()> {
         self.key_change(ChangeKind::Dispose, Some(sample), InstanceHandle::NIL, ts)
+    }
+
+    /// Asserts this writer's liveliness (MANUAL_BY_TOPIC or MANUAL_BY_PARTICIPANT): a HEARTBEAT with the
+    /// liveliness flag to its matched readers. Writing a sample asserts it too.
+    pub fn assert_liveliness(&self) -> DdsResult<()> {
+        let driver = &self.inner.state.driver;
+        driver.check_alive()?;
+        let id = self.id();
+        driver.with_core(|c, now| c.assert_writer_liveliness(now, id));
+        Ok(())
     }
 
     /// Blocks until every matched reliable reader acknowledged everything written, or `Timeout`.

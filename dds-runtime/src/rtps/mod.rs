@@ -6,6 +6,7 @@
 
 pub mod discovery;
 mod due;
+mod liveliness;
 pub mod messages;
 mod outbox;
 mod participant;

@@ -7,6 +7,7 @@ mod control;
 mod discovery;
 mod historical;
 mod filtering;
+mod liveliness;
 mod receive;
 mod timers;
 
@@ -38,6 +39,8 @@ pub struct Participant {
     config: ParticipantConfig,
     out: Outbox,
     events: VecDeque<Event>,
+    /// Leases of matched writers with manual liveliness.
+    leases: crate::rtps::liveliness::Leases,
     /// Reused buffer for what readers deliver while a datagram is processed.
     scratch: Vec<Event>,
     writers: BTreeMap<EntityId, Writer>,
@@ -131,6 +134,7 @@ impl Participant {
         let mut p = Participant {
             out: Outbox::new(header, config.max_message_size),
             events: VecDeque::new(),
+            leases: Default::default(),
             scratch: Vec::new(),
             writers: BTreeMap::new(),
             readers: BTreeMap::new(),

@@ -198,9 +198,10 @@ impl Participant {
             EntityId::SEDP_PUBLICATIONS_READER => self.on_sedp::<WriterQos>(now, &s),
             EntityId::SEDP_SUBSCRIPTIONS_READER => self.on_sedp::<ReaderQos>(now, &s),
             EntityId::P2P_MESSAGE_READER => {
-                if let Some((prefix, _kind)) = builtin::decode_participant_message(&s.payload) {
+                if let Some((prefix, kind)) = builtin::decode_participant_message(&s.payload) {
                     if prefix == s.writer.prefix {
                         self.refresh_lease(now, prefix);
+                        self.participant_message(now, s.writer, kind);
                     }
                 }
             }
@@ -367,10 +368,12 @@ impl Participant {
                     return;
                 };
                 let reliable = wd.qos.writer.reliability.is_reliable();
+                let liveliness = wd.qos.writer.liveliness;
                 let locators = self.endpoint_locators(wd);
                 if let Some(r) = self.readers.get_mut(&id) {
                     r.add_proxy(now, WriterProxy::new(remote, locators, reliable));
                     self.readers_by_writer.clear();
+                    self.track_liveliness(now, remote, id, &liveliness);
                 }
             }
         }
@@ -383,10 +386,12 @@ impl Participant {
                 .writers
                 .get_mut(&id)
                 .is_some_and(|w| w.remove_proxy(&remote, &mut self.events)),
-            Local::Reader(id) => self
-                .readers
-                .get_mut(&id)
-                .is_some_and(|r| r.remove_proxy(&remote)),
+            Local::Reader(id) => {
+                self.untrack_liveliness(&remote, id);
+                self.readers
+                    .get_mut(&id)
+                    .is_some_and(|r| r.remove_proxy(&remote))
+            }
         }
     }
 

@@ -70,6 +70,7 @@ impl Participant {
                             wguid,
                             |r| r.on_data(wguid, &d, ts, shared, scratch),
                         );
+                        self.writer_asserted(now, wguid);
                     }
                 }
                 Submessage::DataFrag(d) => {
@@ -82,12 +83,16 @@ impl Participant {
                         wguid,
                         |r| r.on_data_frag(wguid, &d, ts, scratch),
                     );
+                    self.writer_asserted(now, wguid);
                 }
                 Submessage::Heartbeat(h) => {
                     let wguid = Guid::new(src, h.writer_id);
                     self.for_readers_arming(h.reader_id, wguid, |r, scratch| {
                         r.on_heartbeat(now, wguid, &h, scratch)
                     });
+                    if h.liveliness_flag {
+                        self.writer_asserted(now, wguid);
+                    }
                 }
                 Submessage::Gap(g) => {
                     let wguid = Guid::new(src, g.writer_id);

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use tracing::debug;
 
 use super::Participant;
-use crate::rtps::api::{ChangeKind, WriteChange};
+use crate::rtps::api::ChangeKind;
 use crate::rtps::discovery::builtin;
 use crate::rtps::messages::parameter::{pid, ParameterWriter};
 use crate::rtps::messages::{Data, ParameterList, Submessage};
@@ -54,6 +54,9 @@ impl Participant {
         for p in self.participants.values() {
             t = t.min(p.lease_deadline);
         }
+        if let Some(x) = self.leases.next_deadline() {
+            t = t.min(x);
+        }
         for w in self.writers.values() {
             if let Some(x) = w.next_timeout() {
                 t = t.min(x);
@@ -87,21 +90,10 @@ impl Participant {
         if now >= self.pmd_due {
             // Automatic liveliness: one ParticipantMessageData per interval keeps our lease alive at peers that
             // only count builtin liveliness traffic.
-            let prefix = self.config.guid_prefix;
-            let change = WriteChange::alive(builtin::encode_participant_message(
-                &prefix,
-                builtin::PMD_KIND_AUTOMATIC,
-                &[],
-            ))
-            .with_key_hash(builtin::participant_message_key(
-                &prefix,
-                builtin::PMD_KIND_AUTOMATIC,
-            ));
-            if let Some(w) = self.writers.get_mut(&EntityId::P2P_MESSAGE_WRITER) {
-                let _ = w.write(now, change, &mut self.out, &mut self.events);
-            }
+            self.send_participant_message(now, builtin::PMD_KIND_AUTOMATIC);
             self.pmd_due = now + self.config.spdp_interval;
         }
+        self.expire_leases(now);
         let expired: Vec<GuidPrefix> = self
             .participants
             .iter()

@@ -3,6 +3,7 @@
 mod coherent;
 mod content_filter;
 mod history;
+mod liveliness;
 mod reader_proxy;
 
 pub(crate) use coherent::CoherentMark;
