@@ -81,8 +81,14 @@ pub(crate) struct Driver {
     timer_thread: Mutex<Option<JoinHandle<()>>>,
     /// The participant's status condition.
     pub(crate) status: Arc<StatusCore>,
-    /// Payload buffers of sent datagrams, handed back to the core at the next `with_core`.
-    spare_buffers: Mutex<Vec<Vec<u8>>>,
+    /// Sent datagrams (payload buffers and destination lists), handed back to the core at the next
+    /// `with_core`.
+    spare_buffers: Mutex<Vec<Transmit>>,
+}
+
+thread_local! {
+    /// Each thread's reusable vector of datagrams to send, for `Driver::with_core`.
+    static BATCH: std::cell::RefCell<Vec<Transmit>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Most sent buffers kept for recycling.
@@ -252,14 +258,15 @@ impl Driver {
     /// Runs `f` on the core, then (lock released) sends what it queued and dispatches its events.
     pub(crate) fn with_core<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R) -> R {
         let now = Instant::now();
-        let mut batch: Vec<Transmit> = Vec::new();
+        // The batch vector is kept per thread (a nested call, from a listener, gets a fresh one).
+        let mut batch: Vec<Transmit> = BATCH.with(|b| std::mem::take(&mut *b.borrow_mut()));
         let mut deferred: Vec<Event> = Vec::new();
         let mut touched: Vec<(EntityId, Arc<dyn Endpoint>)> = Vec::new();
         let (r, next_timeout) = {
             let mut core = lock(&self.core);
-            // Sent datagram buffers go back to the core for reuse (saves an allocation per datagram).
-            for buf in std::mem::take(&mut *lock(&self.spare_buffers)) {
-                core.recycle(buf);
+            // Sent datagrams go back to the core for reuse (saves allocations per datagram).
+            for t in lock(&self.spare_buffers).drain(..) {
+                core.recycle_transmit(t);
             }
             let r = f(&mut core, now);
             while let Some(t) = core.poll_transmit(now) {
@@ -273,12 +280,13 @@ impl Driver {
         self.send_batch(&batch);
         {
             let mut spare = lock(&self.spare_buffers);
-            for t in batch {
+            for t in batch.drain(..) {
                 if spare.len() < MAX_SPARE_BUFFERS {
-                    spare.push(t.payload);
+                    spare.push(t);
                 }
             }
         }
+        BATCH.with(|b| *b.borrow_mut() = batch);
         self.after_unlock(deferred, touched, next_timeout);
         r
     }
