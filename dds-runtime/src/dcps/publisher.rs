@@ -284,7 +284,7 @@ impl<T: DdsType> DataWriter<T> {
         let id = self.id();
         loop {
             let seen = driver.progress_generation();
-            match driver.with_core(|c, now| c.write(now, id, change.clone())) {
+            match driver.with_core_writing(|c, now| c.write(now, id, change.clone())) {
                 Ok(_) => return Ok(()),
                 Err(WriteError::WouldBlock) => {
                     let now = Instant::now();
