@@ -47,26 +47,14 @@ for ns in "$a" "$b"; do
   ip netns exec "$ns" iptables -A INPUT -p udp -m statistic --mode random --probability "$loss" -j DROP
 done
 
-# Cyclone's shared/ copy carries its library links as small text files naming their targets: make real links.
-cy11_cmd() {
-  local lib=$tmp/cyclib
-  mkdir -p "$lib"
-  for f in "$cy11_root"/lib/*.so*; do
-    local target=$f
-    while [[ $(stat -c %s "$target") -lt 64 ]]; do target=$cy11_root/lib/$(cat "$target"); done
-    ln -sf "$(realpath "$target")" "$lib/$(basename "$f")"
-  done
-  printf '#!/bin/sh\nLD_LIBRARY_PATH=%s exec %s "$@"\n' "$lib" "$(realpath "$cy11_root/bin/ddsperf")" >"$tmp/cy11"
-  chmod +x "$tmp/cy11"
-  echo "$tmp/cy11"
-}
+source scripts/cyclone11.sh
 
 # run STACK -> prints "received lost-reported write-timeouts"
 run() {
   local prog iface_a=${tag}va iface_b=${tag}vb
   case $1 in
     ours) prog=$ours ;;
-    cy11) prog=$(cy11_cmd) ;;
+    cy11) prog=$(cyclone11_ddsperf "$cy11_root" "$tmp") ;;
     *) echo "bench-loss: unknown stack $1" >&2; return 2 ;;
   esac
   local uri='<General><Interfaces><NetworkInterface name="IF"/></Interfaces></General>'
