@@ -32,24 +32,11 @@ ours=target/release/dds-perf
 out=$(mktemp -d)
 trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$out"' EXIT
 
-# Cyclone's shared/ copy carries its library links as small text files naming their targets: make real links.
-cyclone_lib() {
-  local root=$1 lib=$out/cyclib
-  mkdir -p "$lib"
-  for f in "$root"/lib/*.so*; do
-    local target=$f
-    while [[ $(stat -c %s "$target") -lt 64 ]]; do target=$root/lib/$(cat "$target"); done
-    ln -sf "$(realpath "$target")" "$lib/$(basename "$f")"
-  done
-  echo "$lib"
-}
+source scripts/cyclone11.sh
 
 declare -A cmd=([ours]=$ours [cy010]=/usr/bin/ddsperf)
 if [[ -x $cy11_root/bin/ddsperf ]]; then
-  cy11_lib=$(cyclone_lib "$cy11_root")
-  printf '#!/bin/sh\nLD_LIBRARY_PATH=%s exec %s "$@"\n' "$cy11_lib" "$(realpath "$cy11_root/bin/ddsperf")" >"$out/cy11"
-  chmod +x "$out/cy11"
-  cmd[cy11]=$out/cy11
+  cmd[cy11]=$(cyclone11_ddsperf "$cy11_root" "$out")
 fi
 read -r -a stacks <<<"$stacks"
 for s in "${stacks[@]}"; do

@@ -26,9 +26,6 @@ fn offered_stream(seed: u64, loss: f64, rate_hz: u32, secs: u32) -> Outcome {
         latency: Duration::from_micros(50),
         jitter: Duration::ZERO,
     };
-    let mut sim = Sim::with_participants(seed, faults, 2);
-    sim.faults_on_discovery = false;
-    let now = sim.now;
     let wq = DataWriterQos::builder()
         .history(History::KeepAll)
         .resource_limits(ResourceLimits {
@@ -40,19 +37,7 @@ fn offered_stream(seed: u64, loss: f64, rate_hz: u32, secs: u32) -> Outcome {
         .reliability(Reliability::RELIABLE)
         .history(History::KeepAll)
         .build();
-    let w = sim.nodes[0]
-        .p
-        .create_writer(now, WriterSpec::new("T", "M::T", false, wq))
-        .unwrap();
-    let r = sim.nodes[1]
-        .p
-        .create_reader(now, ReaderSpec::new("T", "M::T", false, rq))
-        .unwrap();
-    assert!(sim.run_until(Duration::from_secs(5), |s| !s.nodes[0]
-        .p
-        .writer_matches(w)
-        .is_empty()
-        && !s.nodes[1].p.reader_matches(r).is_empty()));
+    let (mut sim, w, r) = Sim::writer_and_reader(seed, faults, wq, rq);
     let tick = Duration::from_secs(1) / rate_hz;
     let offered = u64::from(rate_hz) * u64::from(secs);
     let (mut written, mut delivered) = (0u64, 0u64);

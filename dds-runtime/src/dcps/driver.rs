@@ -97,14 +97,20 @@ pub(crate) struct Driver {
     timer_thread: Mutex<Option<JoinHandle<()>>>,
     /// The participant's status condition.
     pub(crate) status: Arc<StatusCore>,
-    /// Payload buffers of sent datagrams, handed back to the core at the next `with_core`.
-    spare_buffers: Mutex<Vec<Vec<u8>>>,
+    /// Sent datagrams (payload buffers and destination lists), handed back to the core at the next
+    /// `with_core`.
+    spare_buffers: Mutex<Vec<Transmit>>,
     /// Services watching the core (see [`CoreObserver`]); `has_observers` keeps the sample path free of
     /// the lock while there are none.
     observers: RwLock<Vec<Arc<dyn CoreObserver>>>,
     has_observers: AtomicBool,
     /// Told of every remote publication and subscription discovered (topics, INCONSISTENT_TOPIC).
     discovery_hook: OnceLock<DiscoveryHook>,
+}
+
+thread_local! {
+    /// Each thread's reusable vector of datagrams to send, for `Driver::with_core`.
+    static BATCH: std::cell::RefCell<Vec<Transmit>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// See [`Driver::set_discovery_hook`].
@@ -279,15 +285,28 @@ impl Driver {
 
     /// Runs `f` on the core, then (lock released) sends what it queued and dispatches its events.
     pub(crate) fn with_core<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R) -> R {
+        self.run_core(f, true)
+    }
+
+    /// [`with_core`](Self::with_core) for a write: it does not count as progress. A write never gives room
+    /// to another, and a writer refused by flow control waits for progress made after its attempt: were
+    /// its own attempt progress, it would retry at once, spinning (at 64 KiB this was a fifth of the
+    /// publisher's CPU, taken from the subscriber on a two-core machine).
+    pub(crate) fn with_core_writing<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R) -> R {
+        self.run_core(f, false)
+    }
+
+    fn run_core<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R, progress: bool) -> R {
         let now = Instant::now();
-        let mut batch: Vec<Transmit> = Vec::new();
+        // The batch vector is kept per thread (a nested call, from a listener, gets a fresh one).
+        let mut batch: Vec<Transmit> = BATCH.with(|b| std::mem::take(&mut *b.borrow_mut()));
         let mut deferred: Vec<Event> = Vec::new();
         let mut touched: Vec<(EntityId, Arc<dyn Endpoint>)> = Vec::new();
         let (r, next_timeout) = {
             let mut core = lock(&self.core);
-            // Sent datagram buffers go back to the core for reuse (saves an allocation per datagram).
-            for buf in std::mem::take(&mut *lock(&self.spare_buffers)) {
-                core.recycle(buf);
+            // Sent datagrams go back to the core for reuse (saves allocations per datagram).
+            for t in lock(&self.spare_buffers).drain(..) {
+                core.recycle_transmit(t);
             }
             let r = f(&mut core, now);
             while let Some(t) = core.poll_transmit(now) {
@@ -301,13 +320,14 @@ impl Driver {
         self.send_batch(&batch);
         {
             let mut spare = lock(&self.spare_buffers);
-            for t in batch {
+            for t in batch.drain(..) {
                 if spare.len() < MAX_SPARE_BUFFERS {
-                    spare.push(t.payload);
+                    spare.push(t);
                 }
             }
         }
-        self.after_unlock(deferred, touched, next_timeout);
+        BATCH.with(|b| *b.borrow_mut() = batch);
+        self.after_unlock(deferred, touched, next_timeout, progress);
         r
     }
 
@@ -376,8 +396,11 @@ impl Driver {
         deferred: Vec<Event>,
         touched: Vec<(EntityId, Arc<dyn Endpoint>)>,
         next_timeout: Option<Instant>,
+        progress: bool,
     ) {
-        self.bump_progress();
+        if progress {
+            self.bump_progress();
+        }
         {
             // Wake the timer thread only when it sleeps past the core's new deadline; when it is busy, the
             // generation bump makes it re-read the deadline before sleeping.

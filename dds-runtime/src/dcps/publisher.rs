@@ -333,7 +333,7 @@ impl<T: DdsType> DataWriter<T> {
                     .unwrap_or_default();
                 c.write_filtered(now, id, change.clone(), rejected)
             };
-            match driver.with_core(write) {
+            match driver.with_core_writing(write) {
                 Ok(_) => return Ok(()),
                 Err(WriteError::WouldBlock) => {
                     let now = Instant::now();

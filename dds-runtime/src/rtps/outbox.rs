@@ -41,6 +41,8 @@ pub(crate) struct Outbox {
     pending: Vec<Pending>,
     ready: VecDeque<Transmit>,
     pool: Vec<Vec<u8>>,
+    /// Destination lists of sent datagrams, for reuse.
+    dest_pool: Vec<Vec<Locator>>,
     /// While set, pushes do not ask for the open messages to close at the next drain.
     holding: bool,
     /// The open messages must close at the next drain.
@@ -57,6 +59,7 @@ impl Outbox {
             pending: Vec::new(),
             ready: VecDeque::new(),
             pool: Vec::new(),
+            dest_pool: Vec::new(),
             holding: false,
             flush_due: false,
             held_since: None,
@@ -101,8 +104,11 @@ impl Outbox {
             append(&mut buf, &mut last_header, &Submessage::InfoDst(d), true);
         }
         let preamble = buf.len();
+        let mut dests = self.dest_pool.pop().unwrap_or_default();
+        dests.clear();
+        dests.extend_from_slice(destinations);
         self.pending.push(Pending {
-            destinations: destinations.to_vec(),
+            destinations: dests,
             dst,
             buf,
             ts: None,
@@ -185,6 +191,13 @@ impl Outbox {
     pub(crate) fn recycle(&mut self, buf: Vec<u8>) {
         if self.pool.len() < 64 {
             self.pool.push(buf);
+        }
+    }
+
+    /// Takes back a sent datagram's destination list for reuse.
+    pub(crate) fn recycle_destinations(&mut self, dests: Vec<Locator>) {
+        if self.dest_pool.len() < 64 && dests.capacity() <= 64 {
+            self.dest_pool.push(dests);
         }
     }
 }

@@ -221,6 +221,13 @@ impl Participant {
         self.out.recycle(buf);
     }
 
+    /// Hands a sent [`Transmit`] back whole: its payload buffer and its destination list are reused for
+    /// later datagrams (no allocation per datagram in the steady state).
+    pub fn recycle_transmit(&mut self, t: Transmit) {
+        self.out.recycle(t.payload);
+        self.out.recycle_destinations(t.destinations);
+    }
+
     /// The next event for the DCPS layer, in order.
     pub fn poll_event(&mut self) -> Option<Event> {
         loop {

@@ -263,6 +263,33 @@ impl Sim {
         self.run_until(d, |s| s.now >= end);
     }
 
+    /// Two participants (without faults on discovery) with an unkeyed writer of "T" on node 0 and a reader on
+    /// node 1, once each has matched the other (panics after 5 simulated seconds).
+    pub(crate) fn writer_and_reader(
+        seed: u64,
+        faults: Faults,
+        wq: dds_runtime::qos::DataWriterQos,
+        rq: dds_runtime::qos::DataReaderQos,
+    ) -> (Sim, EntityId, EntityId) {
+        let mut sim = Sim::with_participants(seed, faults, 2);
+        sim.faults_on_discovery = false;
+        let now = sim.now;
+        let w = sim.nodes[0]
+            .p
+            .create_writer(now, WriterSpec::new("T", "M::T", false, wq))
+            .unwrap();
+        let r = sim.nodes[1]
+            .p
+            .create_reader(now, ReaderSpec::new("T", "M::T", false, rq))
+            .unwrap();
+        assert!(sim.run_until(Duration::from_secs(5), |s| !s.nodes[0]
+            .p
+            .writer_matches(w)
+            .is_empty()
+            && !s.nodes[1].p.reader_matches(r).is_empty()));
+        (sim, w, r)
+    }
+
     pub(crate) fn elapsed(&self) -> Duration {
         self.now - self.start
     }

@@ -38,6 +38,9 @@ pub(crate) struct HistoryCache {
     history: History,
     limits: ResourceLimits,
     bytes: usize,
+    /// The queue of the last instance that emptied, kept for the next new instance (a writer whose
+    /// history drains after every acknowledgement would otherwise allocate one per sample).
+    spare_queue: Option<VecDeque<SequenceNumber>>,
 }
 
 impl HistoryCache {
@@ -48,6 +51,7 @@ impl HistoryCache {
             history,
             limits,
             bytes: 0,
+            spare_queue: None,
         }
     }
 
@@ -118,7 +122,11 @@ impl HistoryCache {
     pub(crate) fn add(&mut self, change: CacheChange) {
         let key = change.key_hash.unwrap_or_default();
         self.bytes += change.payload.len();
-        self.instances.entry(key).or_default().push_back(change.sn);
+        let spare = &mut self.spare_queue;
+        self.instances
+            .entry(key)
+            .or_insert_with(|| spare.take().unwrap_or_default())
+            .push_back(change.sn);
         self.changes.insert(change.sn, change);
     }
 
@@ -131,7 +139,11 @@ impl HistoryCache {
                 q.remove(pos);
             }
             if q.is_empty() {
-                self.instances.remove(&key);
+                if let Some(q) = self.instances.remove(&key) {
+                    if q.capacity() <= 64 {
+                        self.spare_queue = Some(q);
+                    }
+                }
             }
         }
         Some(c)
