@@ -13,4 +13,5 @@ mod interop {
     pub mod shapes;
     pub mod tshark;
     pub mod tui;
+    pub mod xtypes;
 }

@@ -36,6 +36,7 @@ mod error;
 pub mod filter;
 pub mod listener;
 mod participant;
+mod process_info;
 mod publisher;
 pub mod sample;
 pub mod status;

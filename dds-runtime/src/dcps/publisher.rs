@@ -104,7 +104,8 @@ impl Publisher {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: WriterQos::new(wq.clone(), &self.qos, topic.qos()),
-            type_information: None,
+            type_information: T::type_information()
+                .map(|b| crate::xtypes::TypeInformation(b.to_vec())),
             entity_name: None,
         };
         let inner = Arc::new(WriterInner::<T> {

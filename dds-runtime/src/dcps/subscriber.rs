@@ -106,7 +106,8 @@ impl Subscriber {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
-            type_information: None,
+            type_information: T::type_information()
+                .map(|b| crate::xtypes::TypeInformation(b.to_vec())),
             entity_name: None,
         };
         let credit_limit = match (&rq.reliability, &rq.history, rq.resource_limits.max_samples) {
