@@ -104,8 +104,7 @@ impl Publisher {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: WriterQos::new(wq.clone(), &self.qos, topic.qos()),
-            type_information: T::type_information()
-                .map(|b| crate::xtypes::TypeInformation(b.to_vec())),
+            type_information: crate::xtypes::announced_type_information(T::type_information()),
             entity_name: None,
         };
         let inner = Arc::new(WriterInner::<T> {

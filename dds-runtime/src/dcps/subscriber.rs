@@ -106,8 +106,7 @@ impl Subscriber {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
-            type_information: T::type_information()
-                .map(|b| crate::xtypes::TypeInformation(b.to_vec())),
+            type_information: crate::xtypes::announced_type_information(T::type_information()),
             entity_name: None,
         };
         let credit_limit = match (&rq.reliability, &rq.history, rq.resource_limits.max_samples) {

@@ -78,6 +78,8 @@ fn hex(b: &[u8]) -> String {
 fn cyclone_sees_our_type_information_and_process() -> Result<(), Skip> {
     require_netns()?;
     cyclone_peer()?;
+    // Announcing type information is opt-in (docs/xtypes.md); nextest runs each test in its own process.
+    std::env::set_var(dds_runtime::xtypes::ANNOUNCE_ENV, "on");
     let domain = 141;
     let p = DomainParticipant::builder()
         .domain_id(domain)
