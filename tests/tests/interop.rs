@@ -16,4 +16,5 @@ mod interop {
     pub mod shapes;
     pub mod tshark;
     pub mod tui;
+    pub mod xtypes;
 }

@@ -204,6 +204,7 @@ fn core_config(
     .fragment_size(config.fragment_size)
     .write_batch_delay(config.write_batch_delay)
     .user_data(user_data)
+    .properties(super::process_info::properties())
     .entity_name(name)
     .build();
     Ok(pc)

@@ -40,6 +40,7 @@ pub mod filter;
 pub mod listener;
 mod participant;
 mod presentation;
+mod process_info;
 mod publisher;
 mod registry;
 pub mod sample;

@@ -133,7 +133,7 @@ impl Publisher {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: WriterQos::new(wq.clone(), &self.qos, topic.qos()),
-            type_information: None,
+            type_information: crate::xtypes::announced_type_information(T::type_information()),
             entity_name: None,
             content_filter: None,
         };

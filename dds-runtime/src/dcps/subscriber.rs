@@ -139,7 +139,7 @@ impl Subscriber {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
-            type_information: None,
+            type_information: crate::xtypes::announced_type_information(T::type_information()),
             entity_name: None,
             content_filter: topic.content_filter_property(),
         };
