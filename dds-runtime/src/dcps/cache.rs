@@ -8,7 +8,7 @@ use std::time::{Duration, Instant, SystemTime};
 use foldhash::{HashMap, HashMapExt};
 
 use crate::filter::FilterFields;
-use crate::qos::{DataReaderQos, History, Ownership, INFINITE};
+use crate::qos::{DataReaderQos, DestinationOrder, History, Ownership, INFINITE};
 use crate::rtps::{ChangeKind, Guid};
 
 use super::sample::{
@@ -17,6 +17,7 @@ use super::sample::{
 };
 use super::status::SampleRejectedReason;
 
+mod order;
 mod query;
 use query::read_query;
 pub(crate) use query::SharedFilter;
@@ -73,6 +74,8 @@ struct Instance<T> {
     writers: HashMap<Guid, i32>,
     owner: Option<(Guid, i32)>,
     samples: VecDeque<Stored<T>>,
+    /// The newest source timestamp accepted (DESTINATION_ORDER BY_SOURCE_TIMESTAMP).
+    newest_source: Option<SystemTime>,
     last_accepted: Option<Instant>,
     last_data: Instant,
     not_alive_since: Option<Instant>,
@@ -195,6 +198,7 @@ impl<T: FilterFields> ReaderCache<T> {
                 writers: HashMap::new(),
                 owner: None,
                 samples: VecDeque::new(),
+                newest_source: None,
                 last_accepted: None,
                 last_data: now,
                 not_alive_since: None,
@@ -249,6 +253,8 @@ impl<T: FilterFields> ReaderCache<T> {
             }
         };
         let exclusive = self.qos.ownership == Ownership::Exclusive;
+        let by_source = self.qos.destination_order == DestinationOrder::BySourceTimestamp;
+        let deadline = finite(self.qos.deadline.0);
         let min_sep = self.qos.time_based_filter.minimum_separation;
         let history = self.qos.history;
         let limits = self.qos.resource_limits;
@@ -260,19 +266,13 @@ impl<T: FilterFields> ReaderCache<T> {
             inst.key_holder = inc.key_holder.take();
         }
 
-        // Exclusive ownership: only the strongest alive writer's changes count (ties: lowest GUID).
+        // Exclusive ownership: only the strongest alive writer's changes count (ties: lowest GUID); an
+        // owner that missed the requested deadline of the instance hands it over.
         if exclusive {
             inst.writers.insert(inc.writer, inc.strength);
-            let owner_ok = match inst.owner {
-                None => true,
-                Some((g, _)) if g == inc.writer => true,
-                Some((g, s)) => {
-                    !inst.writers.contains_key(&g)
-                        || inc.strength > s
-                        || (inc.strength == s && inc.writer < g)
-                }
-            };
-            if !owner_ok {
+            let stale =
+                deadline.is_some_and(|d| now.saturating_duration_since(inst.last_data) >= d);
+            if !order::owner_accepts(inst.owner, &inst.writers, inc.writer, inc.strength, stale) {
                 if matches!(
                     inc.kind,
                     ChangeKind::Unregister | ChangeKind::DisposeUnregister
@@ -282,6 +282,17 @@ impl<T: FilterFields> ReaderCache<T> {
                 return Outcome::Filtered;
             }
             inst.owner = Some((inc.writer, inc.strength));
+        }
+
+        // Destination order by source timestamp: a value or dispose older than the newest accepted one
+        // of the instance is dropped (DDS 1.4 §2.2.3.17); unregisters always count.
+        let ordered = matches!(inc.kind, ChangeKind::Alive | ChangeKind::Dispose);
+        if by_source && ordered && !order::in_source_order(inst.newest_source, inc.source_timestamp)
+        {
+            return Outcome::Filtered;
+        }
+        if ordered {
+            inst.newest_source = Some(inc.source_timestamp);
         }
 
         if alive {
@@ -641,6 +652,8 @@ impl<T: FilterFields> ReaderCache<T> {
                     && now.saturating_duration_since(inst.last_data) >= d
                 {
                     inst.last_data = now;
+                    // The owner missed its deadline: the next strongest writer may take over.
+                    inst.owner = None;
                     missed.push(*h);
                 }
             }

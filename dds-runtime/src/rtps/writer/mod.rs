@@ -39,6 +39,8 @@ pub(crate) struct WriterParams {
     pub max_repair_bytes: usize,
     /// Bytes written between piggy-backed heartbeats (0: one after every write).
     pub piggyback_heartbeat_bytes: usize,
+    /// LIFESPAN: changes leave the history this long after they were written; `None`: never.
+    pub lifespan: Option<Duration>,
 }
 
 /// A local writer's protocol state.
@@ -225,6 +227,7 @@ impl Writer {
                 return Err(WriteError::WouldBlock);
             }
         }
+        self.expire(now);
         let key = change.key_hash.unwrap_or_default();
         if self.history.make_room(&key, self.acked_floor()).is_err() {
             self.solicit_acks(now);
@@ -239,6 +242,7 @@ impl Writer {
             key_hash: change.key_hash,
             source_timestamp: change.source_timestamp,
             coherent: self.coherent.mark(sn),
+            expires: self.params.lifespan.map(|l| now + l),
         };
         self.history.add(cc);
         if !self.data_dest.is_empty() {
@@ -358,6 +362,7 @@ impl Writer {
         ev: &mut VecDeque<Event>,
     ) {
         proxy.reliable &= self.params.reliable;
+        self.expire(now);
         if !(self.durable() && reader_durable) {
             proxy.floor = self.next_sn;
             proxy.acked = self.next_sn;
@@ -494,7 +499,16 @@ impl Writer {
         }
     }
 
+    /// Drops expired changes (LIFESPAN): they are never served to a late joiner nor repaired (a GAP
+    /// answers requests for them).
+    fn expire(&mut self, now: Instant) {
+        if self.params.lifespan.is_some() {
+            self.history.expire(now);
+        }
+    }
+
     pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
+        self.expire(now);
         if self.repair_floor.reached(now) {
             let due: Vec<Guid> = self
                 .proxies
@@ -537,6 +551,7 @@ impl Writer {
         let frag = self.params.fragment_size;
         let wid = self.guid.entity_id;
         let reliable_writer = self.params.reliable;
+        self.expire(now);
         let Some(p) = self.proxies.get_mut(&g) else {
             return;
         };
