@@ -291,9 +291,6 @@ impl<T: FilterFields> ReaderCache<T> {
         {
             return Outcome::Filtered;
         }
-        if ordered {
-            inst.newest_source = Some(inc.source_timestamp);
-        }
 
         if alive {
             if !min_sep.is_zero() {
@@ -339,6 +336,7 @@ impl<T: FilterFields> ReaderCache<T> {
             inst.writers.insert(inc.writer, inc.strength);
             inst.last_accepted = Some(now);
             inst.last_data = now;
+            inst.newest_source = Some(inc.source_timestamp);
             if evict {
                 if let Some(old) = inst.samples.pop_front() {
                     drop(old);
@@ -373,6 +371,7 @@ impl<T: FilterFields> ReaderCache<T> {
                 inst.no_writers_gen += 1;
             }
             inst.state = InstanceState::NotAliveDisposed;
+            inst.newest_source = Some(inc.source_timestamp);
         }
         if matches!(
             inc.kind,
@@ -847,6 +846,46 @@ mod tests {
             .filter_map(|s| s.data)
             .collect();
         assert_eq!(r, vec![1, 3, 5]);
+    }
+
+    #[test]
+    fn exclusive_owner_missing_its_deadline_hands_over() {
+        let qos = DataReaderQos {
+            ownership: Ownership::Exclusive,
+            deadline: crate::qos::Deadline(Duration::from_millis(100)),
+            history: History::KeepLast(10),
+            ..Default::default()
+        };
+        let mut c = ReaderCache::new(qos, true);
+        let t0 = Instant::now();
+        let ms = |n| t0 + Duration::from_millis(n);
+        assert!(matches!(
+            c.insert(inc(9, ChangeKind::Alive, 1, 1), t0),
+            Outcome::Accepted { .. }
+        ));
+        assert_eq!(
+            c.insert(inc(2, ChangeKind::Alive, 1, 2), ms(50)),
+            Outcome::Filtered
+        );
+        // The owner is silent for a deadline: the weaker writer takes over, then 9 takes back.
+        assert!(matches!(
+            c.insert(inc(2, ChangeKind::Alive, 1, 3), ms(120)),
+            Outcome::Accepted { .. }
+        ));
+        assert!(matches!(
+            c.insert(inc(9, ChangeKind::Alive, 1, 4), ms(130)),
+            Outcome::Accepted { .. }
+        ));
+        assert_eq!(
+            c.insert(inc(2, ChangeKind::Alive, 1, 5), ms(140)),
+            Outcome::Filtered
+        );
+        // The same through the deadline tick.
+        assert_eq!(c.tick(ms(240)).len(), 1);
+        assert!(matches!(
+            c.insert(inc(2, ChangeKind::Alive, 1, 6), ms(245)),
+            Outcome::Accepted { .. }
+        ));
     }
 
     #[test]
