@@ -8,7 +8,7 @@ use std::time::{Duration, Instant, SystemTime};
 use foldhash::{HashMap, HashMapExt};
 
 use crate::filter::FilterFields;
-use crate::qos::{DataReaderQos, History, Ownership, INFINITE};
+use crate::qos::{DataReaderQos, DestinationOrder, History, Ownership, INFINITE};
 use crate::rtps::{ChangeKind, Guid};
 
 use super::sample::{
@@ -17,6 +17,7 @@ use super::sample::{
 };
 use super::status::SampleRejectedReason;
 
+mod order;
 mod query;
 use query::read_query;
 pub(crate) use query::SharedFilter;
@@ -73,6 +74,8 @@ struct Instance<T> {
     writers: HashMap<Guid, i32>,
     owner: Option<(Guid, i32)>,
     samples: VecDeque<Stored<T>>,
+    /// The newest source timestamp accepted (DESTINATION_ORDER BY_SOURCE_TIMESTAMP).
+    newest_source: Option<SystemTime>,
     last_accepted: Option<Instant>,
     last_data: Instant,
     not_alive_since: Option<Instant>,
@@ -195,6 +198,7 @@ impl<T: FilterFields> ReaderCache<T> {
                 writers: HashMap::new(),
                 owner: None,
                 samples: VecDeque::new(),
+                newest_source: None,
                 last_accepted: None,
                 last_data: now,
                 not_alive_since: None,
@@ -249,6 +253,8 @@ impl<T: FilterFields> ReaderCache<T> {
             }
         };
         let exclusive = self.qos.ownership == Ownership::Exclusive;
+        let by_source = self.qos.destination_order == DestinationOrder::BySourceTimestamp;
+        let deadline = finite(self.qos.deadline.0);
         let min_sep = self.qos.time_based_filter.minimum_separation;
         let history = self.qos.history;
         let limits = self.qos.resource_limits;
@@ -260,19 +266,13 @@ impl<T: FilterFields> ReaderCache<T> {
             inst.key_holder = inc.key_holder.take();
         }
 
-        // Exclusive ownership: only the strongest alive writer's changes count (ties: lowest GUID).
+        // Exclusive ownership: only the strongest alive writer's changes count (ties: lowest GUID); an
+        // owner that missed the requested deadline of the instance hands it over.
         if exclusive {
             inst.writers.insert(inc.writer, inc.strength);
-            let owner_ok = match inst.owner {
-                None => true,
-                Some((g, _)) if g == inc.writer => true,
-                Some((g, s)) => {
-                    !inst.writers.contains_key(&g)
-                        || inc.strength > s
-                        || (inc.strength == s && inc.writer < g)
-                }
-            };
-            if !owner_ok {
+            let stale =
+                deadline.is_some_and(|d| now.saturating_duration_since(inst.last_data) >= d);
+            if !order::owner_accepts(inst.owner, &inst.writers, inc.writer, inc.strength, stale) {
                 if matches!(
                     inc.kind,
                     ChangeKind::Unregister | ChangeKind::DisposeUnregister
@@ -282,6 +282,14 @@ impl<T: FilterFields> ReaderCache<T> {
                 return Outcome::Filtered;
             }
             inst.owner = Some((inc.writer, inc.strength));
+        }
+
+        // Destination order by source timestamp: a value or dispose older than the newest accepted one
+        // of the instance is dropped (DDS 1.4 §2.2.3.17); unregisters always count.
+        let ordered = matches!(inc.kind, ChangeKind::Alive | ChangeKind::Dispose);
+        if by_source && ordered && !order::in_source_order(inst.newest_source, inc.source_timestamp)
+        {
+            return Outcome::Filtered;
         }
 
         if alive {
@@ -328,6 +336,7 @@ impl<T: FilterFields> ReaderCache<T> {
             inst.writers.insert(inc.writer, inc.strength);
             inst.last_accepted = Some(now);
             inst.last_data = now;
+            inst.newest_source = Some(inc.source_timestamp);
             if evict {
                 if let Some(old) = inst.samples.pop_front() {
                     drop(old);
@@ -362,6 +371,7 @@ impl<T: FilterFields> ReaderCache<T> {
                 inst.no_writers_gen += 1;
             }
             inst.state = InstanceState::NotAliveDisposed;
+            inst.newest_source = Some(inc.source_timestamp);
         }
         if matches!(
             inc.kind,
@@ -641,6 +651,8 @@ impl<T: FilterFields> ReaderCache<T> {
                     && now.saturating_duration_since(inst.last_data) >= d
                 {
                     inst.last_data = now;
+                    // The owner missed its deadline: the next strongest writer may take over.
+                    inst.owner = None;
                     missed.push(*h);
                 }
             }
@@ -834,6 +846,46 @@ mod tests {
             .filter_map(|s| s.data)
             .collect();
         assert_eq!(r, vec![1, 3, 5]);
+    }
+
+    #[test]
+    fn exclusive_owner_missing_its_deadline_hands_over() {
+        let qos = DataReaderQos {
+            ownership: Ownership::Exclusive,
+            deadline: crate::qos::Deadline(Duration::from_millis(100)),
+            history: History::KeepLast(10),
+            ..Default::default()
+        };
+        let mut c = ReaderCache::new(qos, true);
+        let t0 = Instant::now();
+        let ms = |n| t0 + Duration::from_millis(n);
+        assert!(matches!(
+            c.insert(inc(9, ChangeKind::Alive, 1, 1), t0),
+            Outcome::Accepted { .. }
+        ));
+        assert_eq!(
+            c.insert(inc(2, ChangeKind::Alive, 1, 2), ms(50)),
+            Outcome::Filtered
+        );
+        // The owner is silent for a deadline: the weaker writer takes over, then 9 takes back.
+        assert!(matches!(
+            c.insert(inc(2, ChangeKind::Alive, 1, 3), ms(120)),
+            Outcome::Accepted { .. }
+        ));
+        assert!(matches!(
+            c.insert(inc(9, ChangeKind::Alive, 1, 4), ms(130)),
+            Outcome::Accepted { .. }
+        ));
+        assert_eq!(
+            c.insert(inc(2, ChangeKind::Alive, 1, 5), ms(140)),
+            Outcome::Filtered
+        );
+        // The same through the deadline tick.
+        assert_eq!(c.tick(ms(240)).len(), 1);
+        assert!(matches!(
+            c.insert(inc(2, ChangeKind::Alive, 1, 6), ms(245)),
+            Outcome::Accepted { .. }
+        ));
     }
 
     #[test]

@@ -84,6 +84,7 @@ fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
         low_watermark: usize::MAX,
         max_repair_bytes: c.max_repair_bytes,
         piggyback_heartbeat_bytes: 0,
+        lifespan: None,
     }
 }
 
@@ -106,6 +107,7 @@ fn user_writer_params(c: &ParticipantConfig, q: &DataWriterQos, keyed: bool) -> 
         } else {
             0
         },
+        lifespan: (q.lifespan.0 < crate::qos::INFINITE).then_some(q.lifespan.0),
     }
 }
 

@@ -1,6 +1,7 @@
 //! The writer history cache: changes by sequence number, with KEEP_LAST per instance and resource limits.
 
 use std::collections::{BTreeMap, VecDeque};
+use std::time::Instant;
 
 use foldhash::{HashMap, HashMapExt};
 
@@ -22,6 +23,8 @@ pub(crate) struct CacheChange {
     pub rejected: Vec<Guid>,
     /// PID_CONTENT_FILTER_INFO to send with it, when matched readers filter.
     pub filter_info: Option<Box<[u8]>>,
+    /// When the change expires (the writer's LIFESPAN); `None`: never.
+    pub expires: Option<Instant>,
 }
 
 /// Why a change cannot be added now.
@@ -149,6 +152,20 @@ impl HistoryCache {
         Some(c)
     }
 
+    /// Drops the changes whose lifespan ended at `now`; returns how many. Changes expire in the order they
+    /// were written (one lifespan per writer), so only the expired front of the history is visited.
+    pub(crate) fn expire(&mut self, now: Instant) -> usize {
+        let mut n = 0;
+        while let Some((&sn, c)) = self.changes.first_key_value() {
+            if c.expires.is_none_or(|e| e > now) {
+                break;
+            }
+            self.remove(sn);
+            n += 1;
+        }
+        n
+    }
+
     /// Drops every change below `sn` (volatile writers, once acknowledged by all).
     pub(crate) fn remove_below(&mut self, sn: SequenceNumber) {
         while let Some(first) = self.first_sn() {
@@ -220,7 +237,23 @@ mod tests {
             coherent: None,
             rejected: Vec::new(),
             filter_info: None,
+            expires: None,
         }
+    }
+
+    #[test]
+    fn expire_drops_the_expired_front() {
+        let t0 = Instant::now();
+        let mut h = HistoryCache::new(History::KeepAll, ResourceLimits::default());
+        for sn in 1..=4 {
+            let mut c = ch(sn, 0);
+            c.expires = Some(t0 + std::time::Duration::from_millis(sn as u64 * 10));
+            h.add(c);
+        }
+        assert_eq!(h.expire(t0), 0);
+        assert_eq!(h.expire(t0 + std::time::Duration::from_millis(20)), 2);
+        assert_eq!(h.first_sn(), Some(SequenceNumber(3)));
+        assert_eq!(h.bytes(), 20);
     }
 
     #[test]

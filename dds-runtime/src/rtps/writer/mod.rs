@@ -42,6 +42,8 @@ pub(crate) struct WriterParams {
     pub max_repair_bytes: usize,
     /// Bytes written between piggy-backed heartbeats (0: one after every write).
     pub piggyback_heartbeat_bytes: usize,
+    /// LIFESPAN: changes leave the history this long after they were written; `None`: never.
+    pub lifespan: Option<Duration>,
 }
 
 /// A local writer's protocol state.
@@ -245,6 +247,7 @@ impl Writer {
                 return Err(WriteError::WouldBlock);
             }
         }
+        self.expire(now);
         let key = change.key_hash.unwrap_or_default();
         if self.history.make_room(&key, self.acked_floor()).is_err() {
             self.solicit_acks(now);
@@ -265,6 +268,7 @@ impl Writer {
                 None
             },
             rejected,
+            expires: self.params.lifespan.map(|l| now + l),
         };
         let filtered = !cc.rejected.is_empty();
         self.history.add(cc);
@@ -391,6 +395,7 @@ impl Writer {
         ev: &mut VecDeque<Event>,
     ) {
         proxy.reliable &= self.params.reliable;
+        self.expire(now);
         if !(self.durable() && reader_durable) {
             proxy.floor = self.next_sn;
             proxy.acked = self.next_sn;
@@ -528,7 +533,16 @@ impl Writer {
         }
     }
 
+    /// Drops expired changes (LIFESPAN): they are never served to a late joiner nor repaired (a GAP
+    /// answers requests for them).
+    fn expire(&mut self, now: Instant) {
+        if self.params.lifespan.is_some() {
+            self.history.expire(now);
+        }
+    }
+
     pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
+        self.expire(now);
         if self.repair_floor.reached(now) {
             let due: Vec<Guid> = self
                 .proxies
@@ -571,6 +585,7 @@ impl Writer {
         let frag = self.params.fragment_size;
         let wid = self.guid.entity_id;
         let reliable_writer = self.params.reliable;
+        self.expire(now);
         let Some(p) = self.proxies.get_mut(&g) else {
             return;
         };
