@@ -25,9 +25,9 @@ use crate::snapshot::Snapshot;
     about = "Look at a DDS domain: participants, topics, writers, readers"
 )]
 struct Cli {
-    /// Domain id.
-    #[arg(short = 'd', long, global = true, default_value_t = 0)]
-    domain: u32,
+    /// Domain id (default: `DDS_DOMAIN_ID`, else 0).
+    #[arg(short = 'd', long, global = true)]
+    domain: Option<u32>,
     #[command(subcommand)]
     command: Command,
 }
@@ -100,11 +100,11 @@ fn main() -> ExitCode {
 }
 
 /// Joins the domain, waits for discovery, prints once, or again every interval with `--watch`.
-fn watch(domain: u32, v: &View, show: impl Fn(&Snapshot, Style) -> String) -> ExitCode {
+fn watch(domain: Option<u32>, v: &View, show: impl Fn(&Snapshot, Style) -> String) -> ExitCode {
     let observer = match Observer::join(domain) {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("dds: cannot join domain {domain}: {e}");
+            eprintln!("dds: cannot join the domain: {e}");
             return ExitCode::FAILURE;
         }
     };

@@ -35,11 +35,14 @@ pub(crate) struct Observer {
 }
 
 impl Observer {
-    /// Joins `domain` (the usual `DDS_*` environment applies) and starts SPDP.
-    pub(crate) fn join(domain: u32) -> Result<Self, JoinError> {
-        let config = DomainParticipant::builder()
-            .domain_id(domain)
-            .resolve_config()?;
+    /// Joins `domain` (else `DDS_DOMAIN_ID`, else 0; the other `DDS_*` variables apply too) and starts SPDP.
+    pub(crate) fn join(domain: Option<u32>) -> Result<Self, JoinError> {
+        let mut builder = DomainParticipant::builder();
+        if let Some(d) = domain {
+            builder = builder.domain_id(d);
+        }
+        let config = builder.resolve_config()?;
+        let domain = config.domain_id;
         let transport = UdpTransport::bind(&config)?;
         let prefix = guid_prefix();
         let loc = |a: std::net::SocketAddrV4| Locator::udpv4(a.ip().octets(), a.port());
@@ -69,6 +72,7 @@ impl Observer {
         )
         .spdp_interval(config.spdp_interval)
         .lease_duration(config.lease_duration)
+        .max_message_size(config.max_message_size)
         .entity_name(Some("dds".to_string()))
         .build();
         let core = Arc::new(Mutex::new(Participant::new(pc, Instant::now())));
