@@ -11,6 +11,7 @@ mod interop {
     pub mod deadline;
     pub mod harness;
     pub mod main_job;
+    pub mod presentation;
     pub mod shapes;
     pub mod tshark;
     pub mod tui;

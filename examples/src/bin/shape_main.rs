@@ -383,7 +383,7 @@ fn coherent_step(o: &ShapeOptions, n: u32, start: bool) -> bool {
     (o.coherent || o.ordered)
         && count != 0
         && if start {
-            n % count == 0
+            n.is_multiple_of(count)
         } else {
             n % count == count - 1
         }
