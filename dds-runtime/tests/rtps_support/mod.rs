@@ -6,6 +6,7 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::time::{Duration, Instant};
 
+use dds_runtime::qos::{DataReaderQos, DataWriterQos};
 use dds_runtime::rtps::*;
 
 /// xorshift64*: small, seeded, deterministic.
@@ -92,6 +93,33 @@ pub(crate) fn prefix(i: usize) -> GuidPrefix {
     p[0] = 0xaa;
     p[11] = i as u8 + 1;
     GuidPrefix(p)
+}
+
+/// Two participants (faults on user traffic only) with a keyless writer on node 0 and a reader on node 1 of
+/// topic "T", run until matched. Returns the simulator, the writer and the reader.
+pub(crate) fn matched_pair(
+    seed: u64,
+    faults: Faults,
+    wq: DataWriterQos,
+    rq: DataReaderQos,
+) -> (Sim, EntityId, EntityId) {
+    let mut sim = Sim::with_participants(seed, faults, 2);
+    sim.faults_on_discovery = false;
+    let now = sim.now;
+    let w = sim.nodes[0]
+        .p
+        .create_writer(now, WriterSpec::new("T", "M::T", false, wq))
+        .unwrap();
+    let r = sim.nodes[1]
+        .p
+        .create_reader(now, ReaderSpec::new("T", "M::T", false, rq))
+        .unwrap();
+    assert!(sim.run_until(Duration::from_secs(5), |s| !s.nodes[0]
+        .p
+        .writer_matches(w)
+        .is_empty()
+        && !s.nodes[1].p.reader_matches(r).is_empty()));
+    (sim, w, r)
 }
 
 pub(crate) fn config(i: usize) -> ParticipantConfigBuilder {
