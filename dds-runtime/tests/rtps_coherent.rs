@@ -34,9 +34,6 @@ struct Setup {
 }
 
 fn setup(seed: u64, faults: Faults, reliable: bool) -> Setup {
-    let mut sim = Sim::with_participants(seed, faults, 2);
-    sim.faults_on_discovery = false;
-    let now = sim.now;
     let wq = DataWriterQos::builder().history(History::KeepAll).build();
     let rel = if reliable {
         Reliability::RELIABLE
@@ -47,19 +44,7 @@ fn setup(seed: u64, faults: Faults, reliable: bool) -> Setup {
         .reliability(rel)
         .history(History::KeepAll)
         .build();
-    let w = sim.nodes[0]
-        .p
-        .create_writer(now, WriterSpec::new("T", "M::T", false, wq))
-        .unwrap();
-    let r = sim.nodes[1]
-        .p
-        .create_reader(now, ReaderSpec::new("T", "M::T", false, rq))
-        .unwrap();
-    assert!(sim.run_until(Duration::from_secs(5), |s| !s.nodes[0]
-        .p
-        .writer_matches(w)
-        .is_empty()
-        && !s.nodes[1].p.reader_matches(r).is_empty()));
+    let (sim, w, r) = Sim::writer_and_reader(seed, faults, wq, rq);
     Setup { sim, w, r }
 }
 

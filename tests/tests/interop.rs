@@ -14,6 +14,7 @@ mod interop {
     pub mod harness;
     pub mod liveliness;
     pub mod main_job;
+    pub mod presentation;
     pub mod shapes;
     pub mod tshark;
     pub mod tui;

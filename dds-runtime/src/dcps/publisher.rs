@@ -101,8 +101,8 @@ impl Publisher {
     /// [`Publisher::end_coherent_changes`] reaches each matched reader as one whole, or not at all (a set
     /// cut short by the writer's deletion or loss is discarded). Calls nest; only the outermost pair
     /// counts. On the wire: `PID_COHERENT_SET` on every change and an end-of-set marker per writer.
-    /// Readers whose subscriber requests coherent access hold each writer's part until it is whole;
-    /// the guarantee is per writer (a set spanning several writers is not made atomic across them).
+    /// Readers hold each writer's part of the set until it is whole; the guarantee is per writer (a set
+    /// spanning several writers is not made atomic across them).
     pub fn begin_coherent_changes(&self) -> DdsResult<()> {
         self.group.begin(self.participant.driver())
     }

@@ -239,8 +239,9 @@ struct ReaderInner<T: DdsType> {
 /// the lowest GUID), time-based filter (per instance, no delayed delivery of the last filtered sample),
 /// reader data lifecycle (both autopurge delays), lifespan (from the writer's announced lifespan, counted
 /// from the source timestamp), requested deadline missed (checked every 50 ms).
-/// Not enforced: destination order by source timestamp (reception order is used), presentation
-/// (coherent/ordered access), liveliness kinds other than what the core reports.
+/// Coherent sets are stored whole or not at all; ordered access with INSTANCE scope groups reads by
+/// instance. Not enforced: destination order by source timestamp (reception order is used), GROUP-scope
+/// presentation across writers, liveliness kinds other than what the core reports.
 pub struct DataReader<T: DdsType> {
     inner: Arc<ReaderInner<T>>,
     handle: Arc<EndpointHandle<ReaderOwner<T>>>,

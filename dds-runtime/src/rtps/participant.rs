@@ -5,8 +5,8 @@
 mod coherent;
 mod control;
 mod discovery;
-mod historical;
 mod filtering;
+mod historical;
 mod liveliness;
 mod receive;
 mod timers;

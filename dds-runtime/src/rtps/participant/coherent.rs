@@ -7,20 +7,14 @@ use std::time::Instant;
 use super::{timers, Participant};
 use crate::rtps::api::WriteError;
 use crate::rtps::types::{EntityId, SequenceNumber};
+use crate::rtps::writer::Writer;
 
 impl Participant {
     /// Starts a coherent set on a user writer: every change it writes until
     /// [`Participant::end_coherent_set`] carries `PID_COHERENT_SET`, and readers deliver them all at once
     /// ([`crate::rtps::Event::CoherentSet`]) or not at all. Starting a set that is open does nothing.
     pub fn begin_coherent_set(&mut self, writer: EntityId) -> Result<(), WriteError> {
-        if !self.user_writers.contains(&writer) {
-            return Err(WriteError::UnknownWriter(writer));
-        }
-        let w = self
-            .writers
-            .get_mut(&writer)
-            .ok_or(WriteError::UnknownWriter(writer))?;
-        w.begin_coherent();
+        self.user_writer(writer)?.begin_coherent();
         Ok(())
     }
 
@@ -33,16 +27,23 @@ impl Participant {
         now: Instant,
         writer: EntityId,
     ) -> Result<Option<SequenceNumber>, WriteError> {
-        if !self.user_writers.contains(&writer) {
+        self.user_writer(writer)?;
+        // Found above; looked up again so that the outbox and the event queue can be borrowed beside it.
+        let Some(w) = self.writers.get_mut(&writer) else {
             return Err(WriteError::UnknownWriter(writer));
-        }
-        let w = self
-            .writers
-            .get_mut(&writer)
-            .ok_or(WriteError::UnknownWriter(writer))?;
+        };
         let r = w.end_coherent(now, &mut self.out, &mut self.events);
         timers::lower_floor(&self.timer_floor, w.next_timeout());
         r
+    }
+
+    fn user_writer(&mut self, id: EntityId) -> Result<&mut Writer, WriteError> {
+        if !self.user_writers.contains(&id) {
+            return Err(WriteError::UnknownWriter(id));
+        }
+        self.writers
+            .get_mut(&id)
+            .ok_or(WriteError::UnknownWriter(id))
     }
 
     /// Whether the writer has a coherent set open.

@@ -1,0 +1,208 @@
+//! PRESENTATION against Cyclone DDS 11 (python `cyclonedds`) and ours against ours, with shape_main's
+//! command line.
+//!
+//! Cyclone 11.0.1 refuses `begin_coherent` (`dds_begin_coherent` returns UNSUPPORTED), so it cannot write
+//! coherent sets; what it can do is announce and match the PRESENTATION QoS and read what our coherent
+//! writers send. These tests check that, and the all-or-nothing delivery of sets ours against ours.
+
+use std::process::Command;
+use std::time::Duration;
+
+use super::harness::{cyclone_peer, require_netns, root, Proc, Skip};
+use super::shapes::Prog;
+use crate::check;
+
+const WAIT: Duration = Duration::from_secs(20);
+
+fn is_sample(l: &str) -> bool {
+    l.starts_with("Square ") && l.ends_with(']') && !l.contains("NOT_ALIVE")
+}
+
+/// The `[size]` of a sample line.
+fn size(l: &str) -> Option<u32> {
+    l.rsplit_once('[')?.1.trim_end_matches(']').parse().ok()
+}
+
+/// Our coherent writer (topic scope, sets of 3) to a plain Cyclone reader: Cyclone reads every sample, in
+/// order, and nothing else (the end-of-set markers are not samples to it).
+#[test]
+fn coherent_writer_ours_to_cyclone_reader() -> Result<(), Skip> {
+    require_netns()?;
+    let mut s = Prog::Cyclone.spawn("sub", "-S -t Square -d 183 -r -k 0")?;
+    let mut p = Prog::Ours.spawn(
+        "pub",
+        "-P -t Square -d 183 -r -k 0 -c RED --coherent --access-scope t --coherent-sample-count 3 \
+         --write-period 50 -z 0",
+    )?;
+    let got = s.wait_lines(WAIT, 30, is_sample);
+    check!(got.is_some(), &[&p, &s], "Cyclone read 30 samples");
+    let _ = p.interrupt(Duration::from_secs(10));
+    let _ = s.interrupt(Duration::from_secs(10));
+    let sizes: Vec<u32> = s.grep(is_sample).iter().filter_map(|l| size(l)).collect();
+    check!(
+        sizes.windows(2).all(|w| w[1] == w[0] + 1),
+        &[&p, &s],
+        "consecutive sizes (nothing lost, nothing extra): {sizes:?}"
+    );
+    check!(
+        s.grep(|l| l.contains("NOT_ALIVE")).is_empty() || sizes.len() >= 30,
+        &[&p, &s],
+        "no spurious instance states"
+    );
+    Ok(())
+}
+
+/// A Cyclone publisher with the given PRESENTATION writing RED samples of increasing size.
+fn cyclone_presentation_writer(domain: u32, scope: &str, coherent: bool) -> Result<Proc, Skip> {
+    let peers = root().join("tests/peers");
+    cyclone_peer()?;
+    let script = format!(
+        r#"
+import sys, time
+sys.path.insert(0, {peers:?})
+from cyclone_shape import ShapeType
+from cyclonedds.core import Qos, Policy, Listener
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.pub import Publisher, DataWriter
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+scope = Policy.PresentationAccessScope.{scope}(coherent_access={coherent}, ordered_access=True)
+dp = DomainParticipant({domain})
+pub = Publisher(dp, qos=Qos(scope))
+def incompat(_w, st):
+    print("on_offered_incompatible_qos() policy %d" % st.last_policy_id, flush=True)
+w = DataWriter(pub, Topic(dp, "Square", ShapeType),
+               qos=Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepAll),
+               listener=Listener(on_offered_incompatible_qos=incompat))
+for i in range(400):
+    w.write(ShapeType(color="RED", x=i, y=i, shapesize=i + 1))
+    time.sleep(0.05)
+"#,
+        peers = peers.display().to_string(),
+        coherent = if coherent { "True" } else { "False" },
+    );
+    let mut c = Command::new("python3");
+    c.arg("-u").arg("-c").arg(script);
+    Ok(Proc::spawn(&format!("cyclone {scope} writer"), c))
+}
+
+/// Cyclone announces PRESENTATION (TOPIC, coherent, ordered) and our coherent, ordered TOPIC-scope reader
+/// matches it and reads its samples (Cyclone sends them outside any set) in order.
+#[test]
+fn presentation_cyclone_writer_to_ours_topic_scope() -> Result<(), Skip> {
+    require_netns()?;
+    let mut s = Prog::Ours.spawn(
+        "sub",
+        "-S -t Square -d 184 -r -k 0 -x 2 --coherent --ordered --access-scope t",
+    )?;
+    let mut p = cyclone_presentation_writer(184, "Topic", true)?;
+    let got = s.wait_lines(WAIT, 10, is_sample);
+    check!(
+        got.is_some(),
+        &[&p, &s],
+        "our coherent reader read Cyclone's samples"
+    );
+    let sizes: Vec<u32> = s.grep(is_sample).iter().filter_map(|l| size(l)).collect();
+    check!(
+        sizes.windows(2).all(|w| w[1] == w[0] + 1),
+        &[&p, &s],
+        "in order: {sizes:?}"
+    );
+    check!(
+        s.wait_line(Duration::from_secs(2), |l| l
+            .starts_with("Reading coherent sets"))
+            .is_some(),
+        &[&p, &s],
+        "coherent read loop"
+    );
+    let _ = s.interrupt(Duration::from_secs(10));
+    let _ = p.interrupt(Duration::from_secs(5));
+    Ok(())
+}
+
+/// Offered INSTANCE scope against requested TOPIC scope: both sides report PRESENTATION (id 3) incompatible.
+#[test]
+fn presentation_scope_mismatch_cyclone_to_ours_is_incompatible() -> Result<(), Skip> {
+    require_netns()?;
+    let mut s = Prog::Ours.spawn(
+        "sub",
+        "-S -t Square -d 185 -r -k 0 -x 2 --coherent --access-scope t",
+    )?;
+    let mut p = cyclone_presentation_writer(185, "Instance", true)?;
+    let ours = s.wait_line(WAIT, |l| {
+        l.starts_with("on_requested_incompatible_qos()") && l.contains("PRESENTATION")
+    });
+    let theirs = p.wait_line(WAIT, |l| l == "on_offered_incompatible_qos() policy 3");
+    check!(
+        ours.is_some() && theirs.is_some(),
+        &[&p, &s],
+        "both report PRESENTATION incompatible"
+    );
+    check!(
+        s.grep(is_sample).is_empty(),
+        &[&p, &s],
+        "no data across the mismatch"
+    );
+    let _ = s.interrupt(Duration::from_secs(10));
+    let _ = p.interrupt(Duration::from_secs(5));
+    Ok(())
+}
+
+/// The suite's coherent-set case (`Test_CoherentSets_*` with instances), ours against ours: 3 topics, 4
+/// instances, sets of 3 iterations; every read loop that sees data sees whole sets (36 samples).
+fn coherent_sets_ours(domain: u32, scope: char) -> Result<(), Skip> {
+    require_netns()?;
+    let mut s = Prog::Ours.spawn(
+        "sub",
+        &format!(
+            "-S -t Square -d {domain} -r -k 0 --coherent --access-scope {scope} --num-topics 3 \
+             --take-read --read-period 100"
+        ),
+    )?;
+    let mut p = Prog::Ours.spawn(
+        "pub",
+        &format!(
+            "-P -t Square -d {domain} -r -k 0 --coherent --access-scope {scope} --num-topics 3 \
+             --num-instances 4 --coherent-sample-count 3 --write-period 100 -z 0"
+        ),
+    )?;
+    let enough = s.wait_lines(WAIT, 36 * 4, |l| {
+        l.starts_with("Square") && l.ends_with(']')
+    });
+    let _ = p.interrupt(Duration::from_secs(10));
+    let _ = s.interrupt(Duration::from_secs(10));
+    check!(enough.is_some(), &[&p, &s], "four sets read");
+    let mut per_loop = Vec::new();
+    let mut n = 0;
+    for l in s.lines() {
+        if l.starts_with("Reading coherent sets") {
+            if n > 0 {
+                per_loop.push(n);
+            }
+            n = 0;
+        } else if l.starts_with("Square") && l.ends_with(']') {
+            n += 1;
+        }
+    }
+    check!(
+        per_loop.iter().all(|n| n % 36 == 0),
+        &[&p, &s],
+        "whole sets only: {per_loop:?}"
+    );
+    Ok(())
+}
+
+#[test]
+fn coherent_sets_topic_scope_ours_to_ours() -> Result<(), Skip> {
+    coherent_sets_ours(186, 't')
+}
+
+#[test]
+fn coherent_sets_group_scope_ours_to_ours() -> Result<(), Skip> {
+    coherent_sets_ours(187, 'g')
+}
+
+#[test]
+fn coherent_sets_instance_scope_ours_to_ours() -> Result<(), Skip> {
+    coherent_sets_ours(188, 'i')
+}
