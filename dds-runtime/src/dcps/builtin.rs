@@ -4,7 +4,8 @@
 
 use crate::qos::{ReaderQos, WriterQos};
 use crate::rtps::discovery::{EndpointData, ParticipantData};
-use crate::rtps::{Guid, GuidPrefix};
+use crate::rtps::{Guid, GuidPrefix, VendorId};
+use crate::xtypes::TypeInformation;
 
 /// DCPSPublication: a writer as SEDP announced it.
 #[derive(Debug, Clone, PartialEq)]
@@ -20,6 +21,8 @@ pub struct PublicationBuiltinTopicData {
     pub type_name: String,
     /// Its QoS: the writer's, its publisher's (presentation, partition, group data) and TOPIC_DATA.
     pub qos: WriterQos,
+    /// Its XTypes TypeInformation (PID_TYPE_INFORMATION), when announced.
+    pub type_information: Option<TypeInformation>,
 }
 
 /// DCPSSubscription: a reader as SEDP announced it.
@@ -36,6 +39,8 @@ pub struct SubscriptionBuiltinTopicData {
     pub type_name: String,
     /// Its QoS: the reader's, its subscriber's and TOPIC_DATA.
     pub qos: ReaderQos,
+    /// Its XTypes TypeInformation (PID_TYPE_INFORMATION), when announced.
+    pub type_information: Option<TypeInformation>,
 }
 
 /// DCPSParticipant: a participant as SPDP announced it.
@@ -46,6 +51,23 @@ pub struct ParticipantBuiltinTopicData {
     pub key: GuidPrefix,
     /// Its USER_DATA.
     pub user_data: Vec<u8>,
+    /// The vendor of its DDS implementation.
+    pub vendor_id: VendorId,
+    /// Its entity name (PID_ENTITY_NAME), when announced.
+    pub entity_name: Option<String>,
+    /// Its PROPERTY_LIST: among others the host name, process id and program name that Cyclone DDS and we
+    /// announce (`__Hostname`, `__Pid`, `__ProcessName`).
+    pub properties: Vec<(String, String)>,
+}
+
+impl ParticipantBuiltinTopicData {
+    /// The value of property `name`, if announced.
+    pub fn property(&self, name: &str) -> Option<&str> {
+        self.properties
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
+    }
 }
 
 impl From<&EndpointData<WriterQos>> for PublicationBuiltinTopicData {
@@ -56,6 +78,7 @@ impl From<&EndpointData<WriterQos>> for PublicationBuiltinTopicData {
             topic_name: d.topic_name.clone(),
             type_name: d.type_name.clone(),
             qos: d.qos.clone(),
+            type_information: d.type_information.clone(),
         }
     }
 }
@@ -68,6 +91,7 @@ impl From<&EndpointData<ReaderQos>> for SubscriptionBuiltinTopicData {
             topic_name: d.topic_name.clone(),
             type_name: d.type_name.clone(),
             qos: d.qos.clone(),
+            type_information: d.type_information.clone(),
         }
     }
 }
@@ -77,6 +101,9 @@ impl From<&ParticipantData> for ParticipantBuiltinTopicData {
         ParticipantBuiltinTopicData {
             key: d.guid_prefix,
             user_data: d.user_data.clone(),
+            vendor_id: d.vendor_id,
+            entity_name: d.entity_name.clone(),
+            properties: d.properties.clone(),
         }
     }
 }

@@ -9,7 +9,9 @@ use std::time::SystemTime;
 use crate::qos::{ChangeableQos, DomainParticipantQos, PublisherQos, SubscriberQos, TopicQos};
 use crate::rtps::{EntityId, Guid, GuidPrefix};
 
-use super::super::builtin::ParticipantBuiltinTopicData;
+use super::super::builtin::{
+    ParticipantBuiltinTopicData, PublicationBuiltinTopicData, SubscriptionBuiltinTopicData,
+};
 use super::super::chain::{ParentListener, StatusChange};
 use super::super::driver::Driver;
 use super::super::error::{DdsError, DdsResult};
@@ -313,6 +315,35 @@ impl DomainParticipant {
         });
         v.sort();
         v
+    }
+
+    /// What SPDP announced about every participant discovered so far.
+    pub fn discovered_participant_data(&self) -> Vec<ParticipantBuiltinTopicData> {
+        self.driver.with_core(|c, _| {
+            c.discovered_participants()
+                .map(ParticipantBuiltinTopicData::from)
+                .collect()
+        })
+    }
+
+    /// Every publication known, remote and local, matched or not (the DCPSPublication built-in topic's
+    /// content).
+    pub fn discovered_publications(&self) -> Vec<PublicationBuiltinTopicData> {
+        self.driver.with_core(|c, _| {
+            c.publications()
+                .map(PublicationBuiltinTopicData::from)
+                .collect()
+        })
+    }
+
+    /// Every subscription known, remote and local, matched or not (the DCPSSubscription built-in topic's
+    /// content).
+    pub fn discovered_subscriptions(&self) -> Vec<SubscriptionBuiltinTopicData> {
+        self.driver.with_core(|c, _| {
+            c.subscriptions()
+                .map(SubscriptionBuiltinTopicData::from)
+                .collect()
+        })
     }
 
     /// The handles of the remote participants discovered (`get_discovered_participants`).

@@ -3,8 +3,8 @@
 use std::collections::BTreeMap;
 
 use dds_runtime::prelude::*;
-use dds_runtime::rtps::discovery::{EndpointData, ParticipantData};
-use dds_runtime::rtps::{Guid, GuidPrefix, Participant, VendorId};
+use dds_runtime::qos::{ReaderQos, WriterQos};
+use dds_runtime::rtps::VendorId;
 use serde_json::{json, Value};
 
 /// A discovered participant.
@@ -58,30 +58,24 @@ pub(crate) struct Snapshot {
 }
 
 impl Snapshot {
-    /// Reads the core's discovery state.
-    pub(crate) fn of(core: &Participant) -> Self {
-        let mut participants: Vec<_> = core.discovered_participants().map(participant).collect();
+    /// Reads what the participant discovered (the content of the DCPSParticipant, DCPSPublication and
+    /// DCPSSubscription built-in topics).
+    pub(crate) fn of(p: &DomainParticipant) -> Self {
+        let mut participants: Vec<_> = p
+            .discovered_participant_data()
+            .iter()
+            .map(participant)
+            .collect();
         participants.sort_by(|a, b| a.guid_prefix.cmp(&b.guid_prefix));
-        let mut endpoints: Vec<_> = core
-            .publications()
-            .map(|w| {
-                let q = &w.qos.writer;
-                endpoint(
-                    Direction::Writer,
-                    w,
-                    (&q.reliability, &q.durability, &q.ownership),
-                    &w.qos.partition,
-                )
-            })
-            .chain(core.subscriptions().map(|r| {
-                let q = &r.qos.reader;
-                endpoint(
-                    Direction::Reader,
-                    r,
-                    (&q.reliability, &q.durability, &q.ownership),
-                    &r.qos.partition,
-                )
-            }))
+        let mut endpoints: Vec<_> = p
+            .discovered_publications()
+            .iter()
+            .map(|w| endpoint(Direction::Writer, &Announced::from(w)))
+            .chain(
+                p.discovered_subscriptions()
+                    .iter()
+                    .map(|r| endpoint(Direction::Reader, &Announced::from(r))),
+            )
             .filter(|e| !e.participant.is_empty())
             .collect();
         endpoints.sort_by(|a, b| {
@@ -146,16 +140,11 @@ impl EndpointInfo {
     }
 }
 
-fn participant(p: &ParticipantData) -> ParticipantInfo {
-    // The property names Cyclone DDS announces and its `cyclonedds ps` reads.
-    let prop = |name: &str| {
-        p.properties
-            .iter()
-            .find(|(k, _)| k == name)
-            .map(|(_, v)| v.clone())
-    };
+fn participant(p: &ParticipantBuiltinTopicData) -> ParticipantInfo {
+    // The property names Cyclone DDS and we announce, and `cyclonedds ps` reads.
+    let prop = |name: &str| p.property(name).map(str::to_string);
     ParticipantInfo {
-        guid_prefix: prefix_hex(&p.guid_prefix),
+        guid_prefix: prefix_hex(&p.key),
         vendor: vendor_name(p.vendor_id),
         name: p.entity_name.clone(),
         host: prop("__Hostname"),
@@ -165,39 +154,84 @@ fn participant(p: &ParticipantData) -> ParticipantInfo {
     }
 }
 
-type MainQos<'a> = (&'a Reliability, &'a Durability, &'a Ownership);
+/// What `dds ls` shows of a publication or a subscription: the two differ only in their QoS type.
+struct Announced<'a> {
+    key: Guid,
+    participant_key: Option<Guid>,
+    topic_name: &'a str,
+    type_name: &'a str,
+    reliability: &'a Reliability,
+    durability: &'a Durability,
+    ownership: &'a Ownership,
+    partition: &'a Partition,
+    type_information: bool,
+}
 
-fn endpoint<Q>(
-    direction: Direction,
-    d: &EndpointData<Q>,
-    (reliability, durability, ownership): MainQos<'_>,
-    partition: &Partition,
-) -> EndpointInfo {
+impl<'a> From<&'a PublicationBuiltinTopicData> for Announced<'a> {
+    fn from(d: &'a PublicationBuiltinTopicData) -> Self {
+        let WriterQos {
+            writer: q,
+            partition,
+            ..
+        } = &d.qos;
+        Announced {
+            key: d.key,
+            participant_key: d.participant_key,
+            topic_name: &d.topic_name,
+            type_name: &d.type_name,
+            reliability: &q.reliability,
+            durability: &q.durability,
+            ownership: &q.ownership,
+            partition,
+            type_information: d.type_information.is_some(),
+        }
+    }
+}
+
+impl<'a> From<&'a SubscriptionBuiltinTopicData> for Announced<'a> {
+    fn from(d: &'a SubscriptionBuiltinTopicData) -> Self {
+        let ReaderQos {
+            reader: q,
+            partition,
+            ..
+        } = &d.qos;
+        Announced {
+            key: d.key,
+            participant_key: d.participant_key,
+            topic_name: &d.topic_name,
+            type_name: &d.type_name,
+            reliability: &q.reliability,
+            durability: &q.durability,
+            ownership: &q.ownership,
+            partition,
+            type_information: d.type_information.is_some(),
+        }
+    }
+}
+
+fn endpoint(direction: Direction, d: &Announced<'_>) -> EndpointInfo {
     EndpointInfo {
         direction,
-        guid: guid_hex(&d.guid),
-        participant: d
-            .participant_guid
-            .map(|g| prefix_hex(&g.prefix))
-            .unwrap_or_else(|| prefix_hex(&d.guid.prefix)),
-        topic: d.topic_name.clone(),
-        type_name: d.type_name.clone(),
-        reliability: match reliability {
+        guid: guid_hex(&d.key),
+        participant: prefix_hex(&d.participant_key.map_or(d.key.prefix, |g| g.prefix)),
+        topic: d.topic_name.to_string(),
+        type_name: d.type_name.to_string(),
+        reliability: match d.reliability {
             Reliability::BestEffort => "best-effort",
             Reliability::Reliable { .. } => "reliable",
         },
-        durability: match durability {
+        durability: match d.durability {
             Durability::Volatile => "volatile",
             Durability::TransientLocal => "transient-local",
             Durability::Transient => "transient",
             Durability::Persistent => "persistent",
         },
-        ownership: match ownership {
+        ownership: match d.ownership {
             Ownership::Shared => "shared",
             Ownership::Exclusive => "exclusive",
         },
-        partitions: partition.0.clone(),
-        type_information: d.type_information.is_some(),
+        partitions: d.partition.0.clone(),
+        type_information: d.type_information,
     }
 }
 
