@@ -55,8 +55,14 @@ probe() {
   read -r before _ < <(settle "$pid")
   python3 scripts/footprint/load.py "$domain" "$kind" "$n" 120 >"$tmp/load.log" 2>&1 &
   load=$!
-  for _ in $(seq 600); do grep -q loaded "$tmp/load.log" && break; sleep 0.1; done
+  local early=0 r
+  for _ in $(seq 600); do
+    r=$(rss_kb "$pid"); ((r > early)) && early=$r
+    grep -q loaded "$tmp/load.log" && break
+    sleep 0.1
+  done
   read -r after peak < <(settle "$pid")
+  ((early > peak)) && peak=$early
   kill "$load" "$pid" 2>/dev/null; wait "$load" "$pid" 2>/dev/null || true
   awk -v name="$name" -v b="$before" -v a="$after" -v p="$peak" -v n="$n" -v k="$kind" 'BEGIN {
     printf "%-12s %6d %-12s  before %7d KB  after %7d KB  %6.2f KB per %s  peak %+6d KB above settled\n",
