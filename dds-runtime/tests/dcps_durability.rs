@@ -116,7 +116,10 @@ fn disposed_data_is_cleaned_up() {
     wq.writer_data_lifecycle = WriterDataLifecycle::default();
     let w = writer::<ShapeType>(&pw, "Disposed", &wq);
     write_rounds(&w, 2);
-    // Autodispose: deleting the writer disposes both instances; service_cleanup_delay 0 lets them go.
+    // Both instances disposed, then the writer deleted: service_cleanup_delay 0 lets them go.
+    for color in ["BLUE", "RED"] {
+        w.dispose(&shape(color, 0)).unwrap();
+    }
     drop(w);
     std::thread::sleep(Duration::from_millis(500));
     let pr = participant(146);

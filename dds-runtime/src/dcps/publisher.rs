@@ -210,7 +210,7 @@ struct WriterInner<T: DdsType> {
 ///
 /// QoS enforced on the writer side by the RTPS core: reliability, durability (volatile, transient-local),
 /// history, resource limits, partitions, ownership strength (announced). Here: writer data lifecycle
-/// (autodispose on unregister and on deletion), offered deadline missed (checked every 50 ms per instance).
+/// (autodispose on unregister; a deleted writer only unregisters), offered deadline missed (checked every 50 ms per instance).
 /// Lifespan is announced and applied by readers. Manual liveliness: see `assert_liveliness`; LIVELINESS_LOST
 /// on the writer is not raised yet.
 pub struct DataWriter<T: DdsType> {
@@ -713,10 +713,13 @@ impl<T: DdsType> Endpoint for WriterInner<T> {
         }
     }
 
-    /// Like Cyclone: a deleted writer unregisters its instances (disposing them too with
-    /// autodispose_unregistered_instances), so readers see the state change, not just the unmatch.
+    /// A deleted writer unregisters its instances, so readers see the state change, not just the unmatch. It
+    /// does not dispose them, whatever autodispose_unregistered_instances says: DDS 1.4 §2.2.2.4.1.6 allows
+    /// both, and Cyclone DDS (and the OMG suite's `Test_FinalInstanceState_2`, which expects
+    /// NOT_ALIVE_NO_WRITERS from a publisher that simply ends) only unregister, which also leaves TRANSIENT data
+    /// to the durability service.
     fn farewell(&self) -> Vec<WriteChange> {
-        let kind = self.unregister_kind();
+        let kind = ChangeKind::Unregister;
         let ts = Some(wire_time(SystemTime::now()));
         lock(&self.instances)
             .by_handle

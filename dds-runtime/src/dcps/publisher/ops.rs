@@ -212,8 +212,8 @@ impl Publisher {
         ) = own;
     }
 
-    /// Deletes `writer` (`delete_datawriter`): it unregisters its instances (disposing them with
-    /// autodispose), leaves SEDP, and its handles return `AlreadyDeleted` from then on.
+    /// Deletes `writer` (`delete_datawriter`): it unregisters its instances (without disposing
+    /// them, as Cyclone does), leaves SEDP, and its handles return `AlreadyDeleted` from then on.
     /// `PreconditionNotMet` for a writer of another publisher.
     pub fn delete_datawriter<T: DdsType>(&self, writer: &DataWriter<T>) -> DdsResult<()> {
         if !Arc::ptr_eq(&writer.publisher().qos, &self.qos) {
