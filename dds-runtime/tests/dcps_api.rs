@@ -1191,6 +1191,12 @@ fn reader_set_qos() {
     let mut wq = pair.writer.get_qos().unwrap();
     wq.deadline = Deadline(Duration::from_millis(50));
     pair.writer.set_qos(&wq).unwrap();
+    // Once the reader's side has seen the new offer (SEDP), a 100 ms request is compatible with it.
+    let wh = pair.writer.instance_handle();
+    assert!(wait_until(MATCH_TIMEOUT, || pair
+        .reader
+        .get_matched_publication_data(wh)
+        .is_ok_and(|d| d.qos.writer.deadline == wq.deadline)));
     q.deadline = Deadline(Duration::from_millis(100));
     pair.reader.set_qos(&q).unwrap();
     std::thread::sleep(SHORT);
