@@ -167,47 +167,33 @@ struct Announced<'a> {
     type_information: bool,
 }
 
-impl<'a> From<&'a PublicationBuiltinTopicData> for Announced<'a> {
-    fn from(d: &'a PublicationBuiltinTopicData) -> Self {
-        let WriterQos {
-            writer: q,
-            partition,
-            ..
-        } = &d.qos;
-        Announced {
-            key: d.key,
-            participant_key: d.participant_key,
-            topic_name: &d.topic_name,
-            type_name: &d.type_name,
-            reliability: &q.reliability,
-            durability: &q.durability,
-            ownership: &q.ownership,
-            partition,
-            type_information: d.type_information.is_some(),
+/// `From` for the built-in data of one direction: `$qos` is its QoS type, `$own` the field holding the
+/// endpoint's own policies; everything else is shared.
+macro_rules! announced_from {
+    ($data:ty, $qos:ident, $own:ident) => {
+        impl<'a> From<&'a $data> for Announced<'a> {
+            fn from(d: &'a $data) -> Self {
+                let $qos {
+                    $own: q, partition, ..
+                } = &d.qos;
+                Announced {
+                    key: d.key,
+                    participant_key: d.participant_key,
+                    topic_name: &d.topic_name,
+                    type_name: &d.type_name,
+                    reliability: &q.reliability,
+                    durability: &q.durability,
+                    ownership: &q.ownership,
+                    partition,
+                    type_information: d.type_information.is_some(),
+                }
+            }
         }
-    }
+    };
 }
 
-impl<'a> From<&'a SubscriptionBuiltinTopicData> for Announced<'a> {
-    fn from(d: &'a SubscriptionBuiltinTopicData) -> Self {
-        let ReaderQos {
-            reader: q,
-            partition,
-            ..
-        } = &d.qos;
-        Announced {
-            key: d.key,
-            participant_key: d.participant_key,
-            topic_name: &d.topic_name,
-            type_name: &d.type_name,
-            reliability: &q.reliability,
-            durability: &q.durability,
-            ownership: &q.ownership,
-            partition,
-            type_information: d.type_information.is_some(),
-        }
-    }
-}
+announced_from!(PublicationBuiltinTopicData, WriterQos, writer);
+announced_from!(SubscriptionBuiltinTopicData, ReaderQos, reader);
 
 fn endpoint(direction: Direction, d: &Announced<'_>) -> EndpointInfo {
     EndpointInfo {
