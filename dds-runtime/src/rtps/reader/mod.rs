@@ -540,7 +540,7 @@ impl Reader {
             return;
         }
         let rid = self.guid.entity_id;
-        let mut exact: Option<Instant> = None;
+        let mut exact = DueFloor::default();
         for p in self.proxies.values_mut() {
             if p.acknack_due.is_some_and(|t| t <= now) {
                 Self::send_acknack(rid, p, out);
@@ -548,11 +548,10 @@ impl Reader {
             if p.nackfrag_due.is_some_and(|t| t <= now) {
                 Self::send_requested_nackfrags(rid, p, out);
             }
-            for t in [p.acknack_due, p.nackfrag_due].into_iter().flatten() {
-                exact = Some(exact.map_or(t, |e| e.min(t)));
-            }
+            exact.lower(p.acknack_due);
+            exact.lower(p.nackfrag_due);
         }
-        self.proxy_floor.set_exact(exact);
+        self.proxy_floor = exact;
     }
 
     /// An ACKNACK for what is missing up to the last heartbeat, and a NACK_FRAG per partly received sample.
