@@ -7,7 +7,7 @@ use std::time::Duration;
 /// ddsperf's `-T` topics (the subset both stacks know).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TopicSel {
-    /// KeyedSeq: seq, keyval, sequence<octet> (default).
+    /// KeyedSeq: seq, keyval, `sequence<octet>` (default).
     Ks,
     /// Keyed32.
     K32,

@@ -1,6 +1,6 @@
 //! `dds-perf`: throughput and latency tool compatible with Cyclone DDS's `ddsperf` on the wire and on the
 //! terminal. Same topics ("DDSPerfRDataKS", "DDSPerfRPingKS", "DDSPerfRPongKS", ...), types, QoS,
-//! participant user data ("DDSPerf:<has_reader>:<pid>:<host>") and ping/pong protocol:
+//! participant user data (`DDSPerf:<has_reader>:<pid>:<host>`) and ping/pong protocol:
 //! - the least significant bit of the source timestamp marks a sample that wants an answer;
 //! - a pong goes out on a writer in the pinging participant's partition (its GUID as text), echoing the
 //!   sample with the ping's timestamp (lsb set for pings, cleared for pinged data samples);
