@@ -1,6 +1,6 @@
 //! `TypeInformation` (the `PID_TYPE_INFORMATION` payload of SEDP) and `TypeMapping` (identifier → object pairs).
 
-use crate::cdr::{CdrReader, CdrWriter, DecodeError, DecodeErrorKind, EncodeError};
+use crate::cdr::{members, CdrReader, CdrWriter, DecodeError, EncodeError, Extensibility};
 
 use super::codec::{appendable, seq, XtypesCodec};
 use super::decode;
@@ -141,36 +141,22 @@ impl XtypesCodec for TypeInformation {
     }
 
     fn decode(r: &mut CdrReader<'_>) -> Result<Self, DecodeError> {
-        decode::appendable(r, "TypeInformation", |r| {
-            let mut ti = TypeInformation::default();
-            while r.remaining() > 0 {
-                let h = r.read_u32("EMHEADER")?;
-                let (id, lc, must) = (h & 0x0fff_ffff, (h >> 28) & 7, h >> 31 == 1);
-                let len = match lc {
-                    0..=3 => 1usize << lc,
-                    4 => r.read_u32("NEXTINT")? as usize,
-                    _ => {
-                        let n = r.read_u32("NEXTINT")? as usize;
-                        r.rewind(4);
-                        4usize.saturating_add(n.saturating_mul([1, 4, 8][lc as usize - 5]))
-                    }
-                };
-                let saved = r.begin_limit(len, "TypeInformation member")?;
-                match id {
-                    ID_MINIMAL => ti.minimal = TypeIdentifierWithDependencies::decode(r)?,
-                    ID_COMPLETE => ti.complete = TypeIdentifierWithDependencies::decode(r)?,
-                    _ if must => {
-                        return Err(r.error(
-                            "TypeInformation member",
-                            DecodeErrorKind::UnknownMustUnderstand { id },
-                        ))
-                    }
-                    _ => {}
+        // A mutable type: DHEADER, then EMHEADER-framed members, read by the same code as generated types.
+        let mut st = members::begin_decode(r, Extensibility::Mutable)?;
+        let mut ti = TypeInformation::default();
+        while let Some(m) = st.next_member(r)? {
+            match m.id {
+                ID_MINIMAL => ti.minimal = TypeIdentifierWithDependencies::decode(r)?,
+                ID_COMPLETE => ti.complete = TypeIdentifierWithDependencies::decode(r)?,
+                _ => {
+                    members::skip_member(r, m)?;
+                    continue;
                 }
-                r.end_limit(saved);
             }
-            Ok(ti)
-        })
+            members::end_member(r, m);
+        }
+        st.end(r);
+        Ok(ti)
     }
 }
 
