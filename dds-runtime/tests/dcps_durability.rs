@@ -149,6 +149,49 @@ fn late_joiner_gets_each_sample_once_while_the_writer_lives() {
     assert_eq!(take_all(&r, 6), expected(1, 3), "live samples once each");
 }
 
+/// Alignment: a domain-wide service started after the original writer is gone learns the writer's data
+/// from the stand-in of the service that kept it, and keeps serving it after that service is gone too.
+#[test]
+fn a_late_domain_service_aligns_from_another_service() {
+    let pw = participant(148);
+    let w = writer::<ShapeType>(
+        &pw,
+        "Aligned",
+        &durable_writer_qos(Durability::Transient, 2),
+    );
+    write_rounds(&w, 3);
+    drop(w);
+    // Only pw's own service (and its stand-in) holds the data now.
+    let ps = participant_with(148, DurabilityServiceConfig::domain());
+    let pr = participant(148);
+    let stand_in_of = |p: &DomainParticipant| {
+        let prefix = p.guid_prefix();
+        pr.discovered_publications()
+            .iter()
+            .any(|d| d.topic_name == "Aligned" && d.key.prefix == prefix)
+    };
+    assert!(
+        wait_until(HISTORY_TIMEOUT, || stand_in_of(&ps)),
+        "no stand-in from the domain service"
+    );
+    // The stand-in exists once the service adopted the writer; give the history a moment to arrive.
+    std::thread::sleep(Duration::from_millis(1000));
+    drop(pw);
+    assert!(wait_until(HISTORY_TIMEOUT, || !pr
+        .discovered_publications()
+        .iter()
+        .any(
+            |d| d.topic_name == "Aligned" && d.key.prefix != ps.guid_prefix()
+        )));
+    let r = reader::<ShapeType>(&pr, "Aligned", &durable_reader_qos(Durability::Transient));
+    assert!(wait_until(HISTORY_TIMEOUT, || r
+        .subscription_matched_status()
+        .current_count
+        >= 1));
+    assert!(r.wait_for_historical_data(HISTORY_TIMEOUT).unwrap());
+    assert_eq!(take_all(&r, 4), expected(2, 3));
+}
+
 #[test]
 fn without_a_service_transient_is_transient_local() {
     let pw = participant_with(143, DurabilityServiceConfig::off());

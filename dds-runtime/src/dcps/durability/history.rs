@@ -91,6 +91,8 @@ pub(crate) struct WriterHistory {
     limits: Limits,
     changes: BTreeMap<i64, StoredChange>,
     instances: HashMap<[u8; 16], VecDeque<i64>>,
+    /// The highest sequence number ever kept.
+    last_seq: i64,
 }
 
 impl WriterHistory {
@@ -100,7 +102,14 @@ impl WriterHistory {
             limits,
             changes: BTreeMap::new(),
             instances: HashMap::new(),
+            last_seq: 0,
         }
+    }
+
+    /// A sequence number after every one kept so far (for changes learnt from another service, whose
+    /// stand-in numbers them its own way).
+    pub(crate) fn next_seq(&self) -> i64 {
+        self.last_seq + 1
     }
 
     /// Keeps `ch` (a duplicate sequence number is ignored), evicting the oldest change of its instance beyond
@@ -122,6 +131,7 @@ impl WriterHistory {
                 out.evicted.push(old);
             }
         }
+        self.last_seq = self.last_seq.max(ch.seq);
         self.changes.insert(ch.seq, ch);
         while self.changes.len() > self.limits.total {
             if let Some((old, c)) = self.changes.pop_first() {

@@ -61,6 +61,8 @@ impl Kept {
 struct State {
     channels: HashMap<ChannelKey, Option<EntityId>>,
     kept: HashMap<Guid, Kept>,
+    /// Stand-ins of other services this one aligns from -> the original writer each stands for.
+    sources: HashMap<Guid, Guid>,
 }
 
 /// The running service.
@@ -90,6 +92,18 @@ fn stand_in_qos(w: &WriterData, cap: usize) -> WriterQos {
     };
     q.writer.user_data = UserData(marker::user_data(&w.guid));
     q
+}
+
+/// What a service knows of `original` from its stand-in `w`: the stand-in's announcement under the original's
+/// GUID, without the stand-in's marker and name (the stand-in's QoS is the original's, with the service's
+/// history and limits).
+fn original_of(w: &WriterData, original: Guid) -> WriterData {
+    let mut d = w.clone();
+    d.guid = original;
+    d.participant_guid = Some(Guid::new(original.prefix, EntityId::PARTICIPANT));
+    d.qos.writer.user_data = UserData::default();
+    d.entity_name = None;
+    d
 }
 
 /// The service reader's QoS for a channel of `w`: reliable, TRANSIENT_LOCAL (so that writers send their
@@ -134,6 +148,35 @@ impl Service {
                 Scope::Local(p) => w.guid.prefix == p,
                 Scope::Domain => true,
             }
+    }
+
+    /// The original writer `w` stands for, when `w` is another participant's stand-in that this service
+    /// aligns from: a domain-wide service learns from other services what it did not see itself (it started
+    /// after the original writer was gone, or missed some of its changes).
+    fn aligns_from(&self, w: &WriterData) -> Option<Guid> {
+        let own = self.driver.upgrade()?.guid_prefix;
+        let original = marker::stand_in_for(&w.qos.writer.user_data.0)?;
+        (self.scope == Scope::Domain
+            && w.guid.prefix != own
+            && w.qos.writer.durability >= Durability::Transient)
+            .then_some(original)
+    }
+
+    /// Keeps `original` from the other service's stand-in `w` (unless already kept) and subscribes to it.
+    fn align(&self, w: &WriterData, original: Guid) {
+        let Some(driver) = self.driver.upgrade() else {
+            return;
+        };
+        let known = {
+            let mut st = lock(&self.state);
+            st.sources.insert(w.guid, original);
+            st.kept.contains_key(&original)
+        };
+        tracing::debug!(stand_in = ?w.guid, ?original, known, "durability: aligning");
+        if !known {
+            self.adopt(&original_of(w, original), Vec::new(), true);
+        }
+        self.open_channel(&driver, w);
     }
 
     /// Keeps `w` from now on: its channel reader and its stand-in.
@@ -257,12 +300,17 @@ impl Service {
                 if s.kind == ChangeKind::Unregister {
                     continue;
                 }
-                let Some(k) = st.kept.get_mut(&s.writer) else {
+                // A change from another service's stand-in is the original writer's, numbered here.
+                let original = st.sources.get(&s.writer).copied();
+                let Some(k) = st.kept.get_mut(&original.unwrap_or(s.writer)) else {
                     continue;
                 };
                 let keyed = k.keyed();
                 let c = StoredChange {
-                    seq: s.sequence.0,
+                    seq: match original {
+                        Some(_) => k.history.next_seq(),
+                        None => s.sequence.0,
+                    },
                     kind: s.kind,
                     key_hash: instance_of(keyed, s.key_hash, &s.payload),
                     timestamp: s.source_timestamp,
@@ -277,10 +325,11 @@ impl Service {
                 }
                 #[cfg(feature = "persistence")]
                 if k.persistent() {
+                    let g = k.data.guid;
                     batch
                         .evicted
-                        .extend(ins.evicted.iter().map(|seq| (s.writer, *seq)));
-                    batch.put.push((s.writer, c));
+                        .extend(ins.evicted.iter().map(|seq| (g, *seq)));
+                    batch.put.push((g, c));
                 }
             }
         }
@@ -386,6 +435,11 @@ impl CoreObserver for Service {
     fn on_event(&self, ev: &Event) {
         match ev {
             Event::PublicationDiscovered(w) if self.in_scope(w) => self.adopt(w, Vec::new(), false),
+            Event::PublicationDiscovered(w) => {
+                if let Some(original) = self.aligns_from(w) {
+                    self.align(w, original);
+                }
+            }
             Event::PublicationRemoved { guid } => self.writer_gone(guid),
             Event::WriterDeleted { writer } => {
                 if let Some(d) = self.driver.upgrade() {
