@@ -65,7 +65,7 @@ pub(crate) trait CoreObserver: Send + Sync {
 }
 
 /// What we learnt about a remote writer in SEDP that the reader-side QoS needs.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub(crate) struct RemoteWriterInfo {
     /// Its ownership strength.
     pub(crate) strength: i32,
@@ -480,8 +480,14 @@ impl Driver {
                 tracing::info!(peer = ?guid_prefix, "participant lost");
             }
             Event::PublicationDiscovered(w) => {
+                // Only what differs from the default is kept: most writers cost nothing here.
                 let (guid, info) = remote_writer_info(w);
-                lock(&self.remote_writers).insert(guid, info);
+                let mut known = lock(&self.remote_writers);
+                if info == RemoteWriterInfo::default() {
+                    known.remove(&guid);
+                } else {
+                    known.insert(guid, info);
+                }
                 self.discovered(ev);
             }
             Event::SubscriptionDiscovered(_) => self.discovered(ev),

@@ -50,8 +50,10 @@ pub struct Participant {
     user_readers: BTreeSet<EntityId>,
     participants: HashMap<GuidPrefix, ProxyParticipant>,
     /// Every known publication and subscription, remote and local (local ones match locally too).
-    known_writers: HashMap<Guid, WriterData>,
-    known_readers: HashMap<Guid, ReaderData>,
+    /// Every known endpoint, local and remote. Boxed: a table slot is then a pointer, not a whole
+    /// announcement, which halves the memory per remote endpoint (the table keeps spare slots).
+    known_writers: HashMap<Guid, Box<WriterData>>,
+    known_readers: HashMap<Guid, Box<ReaderData>>,
     /// (local endpoint, remote endpoint) pairs already reported incompatible.
     incompatible: HashSet<(EntityId, Guid)>,
     next_entity_key: u32,
@@ -452,11 +454,11 @@ impl Participant {
 
     /// A known publication (remote or local), e.g. for ownership strength or builtin topics.
     pub fn publication(&self, guid: &Guid) -> Option<&WriterData> {
-        self.known_writers.get(guid)
+        self.known_writers.get(guid).map(Box::as_ref)
     }
     /// A known subscription (remote or local).
     pub fn subscription(&self, guid: &Guid) -> Option<&ReaderData> {
-        self.known_readers.get(guid)
+        self.known_readers.get(guid).map(Box::as_ref)
     }
 
     /// Announces our departure: SPDP dispose to everyone, so peers drop us without waiting for the lease.

@@ -153,7 +153,7 @@ impl Participant {
         };
         self.timers_changed();
         d.qos = qos;
-        self.publish_endpoint(now, d);
+        self.publish_endpoint(now, *d);
         Ok(())
     }
 
@@ -169,11 +169,11 @@ impl Participant {
 impl Participant {
     /// Every known publication, remote and local (DCPSPublication).
     pub fn publications(&self) -> impl Iterator<Item = &crate::rtps::discovery::WriterData> {
-        self.known_writers.values()
+        self.known_writers.values().map(Box::as_ref)
     }
 
     /// Every known subscription, remote and local (DCPSSubscription).
     pub fn subscriptions(&self) -> impl Iterator<Item = &crate::rtps::discovery::ReaderData> {
-        self.known_readers.values()
+        self.known_readers.values().map(Box::as_ref)
     }
 }

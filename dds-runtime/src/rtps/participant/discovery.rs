@@ -229,7 +229,7 @@ impl Participant {
                 let new = !known.contains_key(&d.guid);
                 if !new || known.len() < MAX_ENDPOINTS {
                     // New, or announced again with another QoS (`set_qos`): reported either way.
-                    if known.get(&d.guid) != Some(&d) {
+                    if known.get(&d.guid).map(Box::as_ref) != Some(&d) {
                         self.events.push_back(Q::discovered(d.clone()));
                     }
                     self.on_endpoint_known(now, d);
@@ -277,7 +277,7 @@ impl Participant {
     /// a local one also with every known endpoint of the other direction.
     fn on_endpoint_known<Q: Direction>(&mut self, now: Instant, d: EndpointData<Q>) {
         let guid = d.guid;
-        Q::known_mut(self).insert(guid, d);
+        Q::known_mut(self).insert(guid, Box::new(d));
         for local in Q::local_peers(self) {
             self.rematch(now, local, guid);
         }
@@ -476,9 +476,9 @@ pub(super) trait Direction: EndpointQos + Clone + PartialEq {
     /// Our SEDP writer that announces local endpoints of this direction.
     const ANNOUNCER: EntityId;
     /// Known endpoints of this direction, remote and local.
-    fn known(p: &Participant) -> &HashMap<Guid, EndpointData<Self>>;
+    fn known(p: &Participant) -> &HashMap<Guid, Box<EndpointData<Self>>>;
     /// Known endpoints of this direction, for changes.
-    fn known_mut(p: &mut Participant) -> &mut HashMap<Guid, EndpointData<Self>>;
+    fn known_mut(p: &mut Participant) -> &mut HashMap<Guid, Box<EndpointData<Self>>>;
     /// A local endpoint of this direction.
     fn local(id: EntityId) -> Local;
     /// Local endpoints of the other direction.
@@ -494,10 +494,10 @@ pub(super) trait Direction: EndpointQos + Clone + PartialEq {
 impl Direction for WriterQos {
     const NAME: &'static str = "publication";
     const ANNOUNCER: EntityId = EntityId::SEDP_PUBLICATIONS_WRITER;
-    fn known(p: &Participant) -> &HashMap<Guid, EndpointData<Self>> {
+    fn known(p: &Participant) -> &HashMap<Guid, Box<EndpointData<Self>>> {
         &p.known_writers
     }
-    fn known_mut(p: &mut Participant) -> &mut HashMap<Guid, EndpointData<Self>> {
+    fn known_mut(p: &mut Participant) -> &mut HashMap<Guid, Box<EndpointData<Self>>> {
         &mut p.known_writers
     }
     fn local(id: EntityId) -> Local {
@@ -520,10 +520,10 @@ impl Direction for WriterQos {
 impl Direction for ReaderQos {
     const NAME: &'static str = "subscription";
     const ANNOUNCER: EntityId = EntityId::SEDP_SUBSCRIPTIONS_WRITER;
-    fn known(p: &Participant) -> &HashMap<Guid, EndpointData<Self>> {
+    fn known(p: &Participant) -> &HashMap<Guid, Box<EndpointData<Self>>> {
         &p.known_readers
     }
-    fn known_mut(p: &mut Participant) -> &mut HashMap<Guid, EndpointData<Self>> {
+    fn known_mut(p: &mut Participant) -> &mut HashMap<Guid, Box<EndpointData<Self>>> {
         &mut p.known_readers
     }
     fn local(id: EntityId) -> Local {

@@ -73,12 +73,12 @@ impl Participant {
             return;
         };
         d.content_filter = filter;
-        self.publish_endpoint(now, d);
+        self.publish_endpoint(now, *d);
     }
 
     /// A matched reader announced again: the writer takes its (possibly changed) filter.
     pub(super) fn refresh_reader_filter(&mut self, id: EntityId, remote: Guid) {
-        let filter = self.known_readers.get(&remote).and_then(usable_filter);
+        let filter = self.known_readers.get(&remote).and_then(|d| usable_filter(d));
         if let Some(w) = self.writers.get_mut(&id) {
             w.filters.set(remote, filter);
         }
