@@ -277,9 +277,16 @@ impl App {
                     o.color.as_deref().unwrap_or("BLUE")
                 );
                 let w = publisher.create_datawriter(t, &qos)?;
-                w.set_listener(Box::new(Printer {
+                let printer = Printer {
                     topic: t.name().to_string(),
-                }));
+                };
+                // A reader known before this writer existed is matched (or found incompatible) inside
+                // create_datawriter, before the listener is set: report what the listener missed.
+                let st = w.offered_incompatible_qos_status();
+                if st.total_count_change > 0 {
+                    printer.on_offered_incompatible_qos(&w, st);
+                }
+                w.set_listener(Box::new(printer));
                 writers.push(w);
             }
             Role::Publisher(publisher, writers)
@@ -331,9 +338,15 @@ impl App {
                         subscriber.create_datareader(t, &qos)?
                     }
                 };
-                r.set_listener(Box::new(Printer {
+                let printer = Printer {
                     topic: t.name().to_string(),
-                }));
+                };
+                // As for writers: an incompatible writer known before this reader existed.
+                let st = r.requested_incompatible_qos_status();
+                if st.total_count_change > 0 {
+                    printer.on_requested_incompatible_qos(&r, st);
+                }
+                r.set_listener(Box::new(printer));
                 readers.push(r);
             }
             Role::Subscriber(subscriber, readers)

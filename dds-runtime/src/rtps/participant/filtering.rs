@@ -78,7 +78,10 @@ impl Participant {
 
     /// A matched reader announced again: the writer takes its (possibly changed) filter.
     pub(super) fn refresh_reader_filter(&mut self, id: EntityId, remote: Guid) {
-        let filter = self.known_readers.get(&remote).and_then(|d| usable_filter(d));
+        let filter = self
+            .known_readers
+            .get(&remote)
+            .and_then(|d| usable_filter(d));
         if let Some(w) = self.writers.get_mut(&id) {
             w.filters.set(remote, filter);
         }
