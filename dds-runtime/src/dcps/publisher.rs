@@ -151,9 +151,10 @@ impl Publisher {
         };
         inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
-        let handle = inner
-            .state
-            .create(sink, owner, |c, now| c.create_writer(now, spec))?;
+        let handle = inner.state.create(sink, owner, |c, now| {
+            super::participant::register_local_types::<T>(c);
+            c.create_writer(now, spec)
+        })?;
         ops::register_writer(self, &inner, topic.name());
         let id = handle.id();
         self.group.add_writer(&driver, id);

@@ -173,6 +173,7 @@ impl Subscriber {
         inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
         let handle = inner.state.create(sink, owner, |c, now| {
+            super::participant::register_local_types::<T>(c);
             let id = c.create_reader(now, spec)?;
             if credit_limit.is_some() {
                 c.set_reader_credit(id, credit_limit);

@@ -5,17 +5,18 @@ pub mod store;
 pub mod typelookup;
 pub mod typeobject;
 
-/// Environment variable that turns on `PID_TYPE_INFORMATION` in SEDP (`on`, `1` or `true`).
+/// Environment variable that turns `PID_TYPE_INFORMATION` in SEDP off (`off`, `0` or `false`); it is on by
+/// default.
 pub const ANNOUNCE_ENV: &str = "DDS_TYPE_INFORMATION";
 
-/// Whether endpoints announce their type information: opt-in through [`ANNOUNCE_ENV`] until the TypeLookup
-/// service exists, because a peer that receives a type id it cannot resolve (Cyclone DDS 0.10's `ddsperf`, whose
-/// type hashes differ from Cyclone 11's) waits for the type and never matches. Read once per process.
+/// Whether endpoints announce their type information: yes, unless [`ANNOUNCE_ENV`] says `off` (for a peer
+/// that mishandles it). Peers that do not know our types ask for them through the TypeLookup service, which
+/// every participant serves. Read once per process.
 pub fn announce_type_information() -> bool {
     static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
     *ON.get_or_init(|| {
-        std::env::var(ANNOUNCE_ENV)
-            .is_ok_and(|v| matches!(v.to_ascii_lowercase().as_str(), "on" | "1" | "true"))
+        !std::env::var(ANNOUNCE_ENV)
+            .is_ok_and(|v| matches!(v.to_ascii_lowercase().as_str(), "off" | "0" | "false"))
     })
 }
 
