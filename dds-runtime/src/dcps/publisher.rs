@@ -133,7 +133,10 @@ impl Publisher {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: WriterQos::new(wq.clone(), &self.qos, topic.qos()),
-            type_information: crate::xtypes::announced_type_information(T::type_information()),
+            type_information: crate::xtypes::announced_type_information_for(
+                T::type_information(),
+                T::type_mapping(),
+            ),
             entity_name: None,
             content_filter: None,
         };

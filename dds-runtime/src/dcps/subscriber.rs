@@ -139,7 +139,10 @@ impl Subscriber {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
-            type_information: crate::xtypes::announced_type_information(T::type_information()),
+            type_information: crate::xtypes::announced_type_information_for(
+                T::type_information(),
+                T::type_mapping(),
+            ),
             entity_name: None,
             content_filter: topic.content_filter_property(),
         };

@@ -28,6 +28,19 @@ pub fn announced_type_information(bytes: Option<&[u8]>) -> Option<TypeInformatio
         .map(|b| TypeInformation(b.to_vec()))
 }
 
+/// What an endpoint of a type with these XCDR2 `TypeInformation` and `TypeMapping` bytes announces in SEDP:
+/// [`announced_type_information`], except for types that use `int8`/`uint8`, which Cyclone DDS 0.10 peers
+/// cannot resolve (see `compat`): they announce nothing and match by name.
+pub fn announced_type_information_for(
+    information: Option<&[u8]>,
+    mapping: Option<&[u8]>,
+) -> Option<TypeInformation> {
+    if mapping.is_none_or(compat::uses_int8) {
+        return None;
+    }
+    announced_type_information(information)
+}
+
 /// The XCDR2-serialized `TypeInformation` (PID_TYPE_INFORMATION, 0x0075), kept verbatim: what SEDP carries.
 /// [`TypeInformation::decode`] gives the structured [`typeobject::TypeInformation`].
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -46,6 +59,7 @@ impl TypeInformation {
 }
 
 mod build;
+mod compat;
 mod describe;
 mod error;
 mod objects;

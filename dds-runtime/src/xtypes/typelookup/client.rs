@@ -196,9 +196,10 @@ impl Client {
     pub fn handle_reply(&mut self, store: &mut TypeStore, reply: &Reply) -> ReplyOutcome {
         let mut out = ReplyOutcome::default();
         let id = reply.related_request_id;
-        if id.writer_guid != self.writer_guid {
-            return out;
-        }
+        // Cyclone DDS 0.10 puts its own reply writer's GUID (in host byte order) into `relatedRequestId`,
+        // keeping only the sequence number: such a reply is matched by the number alone, and it can only
+        // deliver objects (hash-checked) that the request asked for; it never ends a request.
+        let exact = id.writer_guid == self.writer_guid;
         let Some(f) = self.in_flight.get_mut(&id.sequence_number) else {
             return out;
         };
@@ -208,18 +209,20 @@ impl Client {
                     let Some(i) = asked.iter().position(|a| a == &p.type_identifier) else {
                         continue;
                     };
-                    let id = asked.swap_remove(i);
-                    self.asked.remove(&id);
-                    match store.insert_verified(id.clone(), p.type_object.clone()) {
-                        Ok(_) => out.stored.push(id),
-                        Err(e) => out.rejected.push((id, e)),
+                    match store.insert_verified(p.type_identifier.clone(), p.type_object.clone()) {
+                        Ok(_) => {
+                            let id = asked.swap_remove(i);
+                            self.asked.remove(&id);
+                            out.stored.push(id);
+                        }
+                        Err(e) => out.rejected.push((p.type_identifier.clone(), e)),
                     }
                 }
                 if asked.is_empty() {
                     self.in_flight.remove(&id.sequence_number);
                 }
             }
-            (Asked::Dependencies { id: of, page }, Return::GetTypeDependencies(Ok(d))) => {
+            (Asked::Dependencies { id: of, page }, Return::GetTypeDependencies(Ok(d))) if exact => {
                 let (of, page) = (of.clone(), *page);
                 self.in_flight.remove(&id.sequence_number);
                 self.want(store, d.dependent_typeids.iter().map(|t| t.type_id.clone()));
@@ -231,7 +234,7 @@ impl Client {
                     });
                 }
             }
-            _ => {
+            _ if exact => {
                 // An error return, or an answer to another operation: the request is over.
                 if let Some(InFlight {
                     asked: Asked::Types(ids),
@@ -243,6 +246,7 @@ impl Client {
                     });
                 }
             }
+            _ => {}
         }
         out
     }
