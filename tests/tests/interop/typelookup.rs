@@ -124,15 +124,18 @@ fn cyclone_typeof_and_subscribe_resolve_our_type() -> Result<(), Skip> {
     let domain = 151;
     let (_p, run, h) = our_writer(domain, "TlSquare");
     let d = domain.to_string();
-    let typeof_out = cyclonedds_cli(&[
-        "typeof",
-        "-i",
-        &d,
-        "-r",
-        "5s",
-        "--suppress-progress-bar",
-        "TlSquare",
-    ])
+    let typeof_out = cyclonedds_cli(
+        30,
+        &[
+            "typeof",
+            "-i",
+            &d,
+            "-r",
+            "5s",
+            "--suppress-progress-bar",
+            "TlSquare",
+        ],
+    )
     .output()
     .expect("cyclonedds typeof");
     let text = String::from_utf8_lossy(&typeof_out.stdout);
