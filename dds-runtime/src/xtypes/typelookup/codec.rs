@@ -13,8 +13,8 @@ use crate::cdr::{
     XcdrVersion,
 };
 use crate::xtypes::typeobject::{
-    TypeIdentifier, TypeIdentifierPair, TypeIdentifierTypeObjectPair, TypeIdentifierWithSize,
-    XtypesCodec,
+    read_appendable, write_appendable as union, write_seq as seq, TypeIdentifier,
+    TypeIdentifierPair, TypeIdentifierTypeObjectPair, TypeIdentifierWithSize, XtypesCodec,
 };
 
 use super::messages::*;
@@ -237,18 +237,6 @@ fn string(w: W<'_, '_>, s: &str) -> Result<(), EncodeError> {
     Ok(())
 }
 
-/// An appendable body behind its DHEADER (the unions, the mutable structs).
-fn union(
-    w: W<'_, '_>,
-    f: impl FnOnce(W<'_, '_>) -> Result<(), EncodeError>,
-) -> Result<(), EncodeError> {
-    w.enter()?;
-    let slot = w.begin_length();
-    f(w)?;
-    w.leave();
-    w.end_length(slot)
-}
-
 /// A mutable struct: DHEADER, then its members each behind an EMHEADER written by `f`.
 fn mutable(
     w: W<'_, '_>,
@@ -272,18 +260,6 @@ fn result<T>(
             w.write_u32(*code as u32);
             Ok(())
         }
-    })
-}
-
-/// A sequence of non-primitive elements: DHEADER, count, elements.
-fn seq<T>(
-    w: W<'_, '_>,
-    items: &[T],
-    f: impl Fn(W<'_, '_>, &T) -> Result<(), EncodeError>,
-) -> Result<(), EncodeError> {
-    union(w, |w| {
-        w.write_len(items.len(), "sequence")?;
-        items.iter().try_for_each(|i| f(w, i))
     })
 }
 
@@ -356,21 +332,6 @@ fn read_string(r: R<'_, '_>) -> Result<String, DecodeError> {
     std::str::from_utf8(body)
         .map(str::to_owned)
         .map_err(|_| r.error("instanceName", DecodeErrorKind::MalformedString))
-}
-
-/// An appendable body behind its DHEADER; what `f` leaves unread is skipped.
-fn read_appendable<T>(
-    r: R<'_, '_>,
-    what: &'static str,
-    f: impl FnOnce(R<'_, '_>) -> Result<T, DecodeError>,
-) -> Result<T, DecodeError> {
-    r.enter(what)?;
-    let len = r.read_u32(what)? as usize;
-    let saved = r.begin_limit(len, what)?;
-    let v = f(r)?;
-    r.end_limit(saved);
-    r.leave();
-    Ok(v)
 }
 
 /// An appendable union: DHEADER, a `long` discriminator, the member `f` reads for it.
