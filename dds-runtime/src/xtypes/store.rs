@@ -13,6 +13,9 @@ use super::typeobject::{
     to_bytes, TypeIdentifier, TypeIdentifierWithSize, TypeInformation, TypeMapping, TypeObject,
 };
 
+/// Dependencies kept per type (a peer's list beyond it is cut: the store stays bounded).
+const MAX_DEPENDENCIES: usize = 256;
+
 /// How much a store may learn from peers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct StoreLimits {
@@ -146,8 +149,13 @@ impl TypeStore {
             if self.dependencies.len() >= self.limits.max_learnt {
                 return;
             }
-            self.dependencies
-                .insert(id.clone(), d.dependent_typeids.clone().into());
+            let deps: Vec<TypeIdentifierWithSize> = d
+                .dependent_typeids
+                .iter()
+                .take(MAX_DEPENDENCIES)
+                .cloned()
+                .collect();
+            self.dependencies.insert(id.clone(), deps.into());
         }
     }
 
