@@ -7,6 +7,7 @@ fn main() {
         "cdr_decode" => dds_fuzz::cdr_one,
         "rtps_decode" => dds_fuzz::rtps_one,
         "idl_parse" => dds_fuzz::idl_one,
+        "typelookup_decode" => dds_fuzz::typelookup_one,
         t => panic!("unknown target {t}"),
     };
     for f in args {

@@ -3,7 +3,9 @@
 pub mod cdr;
 mod idl;
 mod rtps;
+mod typelookup;
 
 pub use cdr::cdr_one;
 pub use idl::idl_one;
 pub use rtps::rtps_one;
+pub use typelookup::typelookup_one;

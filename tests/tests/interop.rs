@@ -18,5 +18,6 @@ mod interop {
     pub mod shapes;
     pub mod tshark;
     pub mod tui;
+    pub mod typelookup;
     pub mod xtypes;
 }

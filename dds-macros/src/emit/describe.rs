@@ -42,6 +42,10 @@ pub(super) fn dds_type(
             fn type_information() -> ::core::option::Option<&'static [u8]> {
                 <Self as #rt::xtypes::XTypesType>::type_support().map(|s| s.information_bytes.as_slice())
             }
+
+            fn type_mapping() -> ::core::option::Option<&'static [u8]> {
+                <Self as #rt::xtypes::XTypesType>::type_support().map(|s| s.mapping_bytes.as_slice())
+            }
         }
     }
 }

@@ -208,4 +208,10 @@ pub trait DdsType: CdrType + crate::filter::FilterFields + Send + Sync + 'static
     fn type_information() -> Option<&'static [u8]> {
         None
     }
+
+    /// The XCDR2 `TypeMapping` of this type (every type object its `TypeInformation` names), built once;
+    /// what the TypeLookup service answers with. The derive implements it next to `type_information`.
+    fn type_mapping() -> Option<&'static [u8]> {
+        None
+    }
 }

@@ -67,8 +67,8 @@ pub use listener::{
     SubscriberListener, TopicListener,
 };
 pub use participant::{
-    DiscoveredParticipant, DomainParticipant, DomainParticipantBuilder, DomainParticipantFactory,
-    WriteBatching,
+    DiscoveredParticipant, DiscoveredType, DomainParticipant, DomainParticipantBuilder,
+    DomainParticipantFactory, WriteBatching,
 };
 pub use publisher::{DataWriter, Publisher};
 pub use sample::{

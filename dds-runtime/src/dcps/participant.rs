@@ -5,9 +5,12 @@
 
 mod factory;
 mod ops;
+mod types;
 
 pub use factory::DomainParticipantFactory;
 pub use ops::DomainParticipantListener;
+pub(crate) use types::register_local_types;
+pub use types::DiscoveredType;
 
 use std::sync::{Arc, Weak};
 use std::time::Duration;

@@ -133,7 +133,10 @@ impl Publisher {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: WriterQos::new(wq.clone(), &self.qos, topic.qos()),
-            type_information: crate::xtypes::announced_type_information(T::type_information()),
+            type_information: crate::xtypes::announced_type_information_for(
+                T::type_information(),
+                T::type_mapping(),
+            ),
             entity_name: None,
             content_filter: None,
         };
@@ -151,9 +154,10 @@ impl Publisher {
         };
         inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
-        let handle = inner
-            .state
-            .create(sink, owner, |c, now| c.create_writer(now, spec))?;
+        let handle = inner.state.create(sink, owner, |c, now| {
+            super::participant::register_local_types::<T>(c);
+            c.create_writer(now, spec)
+        })?;
         ops::register_writer(self, &inner, topic.name());
         let id = handle.id();
         self.group.add_writer(&driver, id);

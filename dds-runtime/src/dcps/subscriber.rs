@@ -139,7 +139,10 @@ impl Subscriber {
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
             qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
-            type_information: crate::xtypes::announced_type_information(T::type_information()),
+            type_information: crate::xtypes::announced_type_information_for(
+                T::type_information(),
+                T::type_mapping(),
+            ),
             entity_name: None,
             content_filter: topic.content_filter_property(),
         };
@@ -173,6 +176,7 @@ impl Subscriber {
         inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
         let handle = inner.state.create(sink, owner, |c, now| {
+            super::participant::register_local_types::<T>(c);
             let id = c.create_reader(now, spec)?;
             if credit_limit.is_some() {
                 c.set_reader_credit(id, credit_limit);

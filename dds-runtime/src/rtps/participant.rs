@@ -10,6 +10,7 @@ mod historical;
 mod liveliness;
 mod receive;
 mod timers;
+mod type_lookup;
 
 use std::cell::Cell;
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
@@ -69,6 +70,8 @@ pub struct Participant {
     last_full_scan: Instant,
     /// What the application ignores (`ignore_participant`, `ignore_endpoint`, `ignore_topic`).
     ignored: control::Ignored,
+    /// The TypeLookup service: the type store, its server and client.
+    type_lookup: type_lookup::TypeLookupService,
 }
 
 fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
@@ -157,14 +160,17 @@ impl Participant {
             timer_floor: Cell::new(None),
             last_full_scan: now,
             ignored: control::Ignored::new(),
+            type_lookup: type_lookup::TypeLookupService::new(config.guid_prefix),
             config,
         };
         let prefix = p.config.guid_prefix;
         for (w, _, _) in super::discovery::builtin::WRITER_PAIRS {
-            p.writers.insert(
-                w,
-                Writer::new(Guid::new(prefix, w), builtin_writer_params(&p.config)),
-            );
+            let mut params = builtin_writer_params(&p.config);
+            if type_lookup::is_service_endpoint(w) {
+                params = type_lookup::writer_params(params);
+            }
+            p.writers
+                .insert(w, Writer::new(Guid::new(prefix, w), params));
         }
         for (r, _, _) in super::discovery::builtin::READER_PAIRS {
             p.readers.insert(

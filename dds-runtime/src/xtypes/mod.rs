@@ -1,19 +1,22 @@
 //! XTypes 1.3: the type system ([`typeobject`]), what a Rust type says about itself ([`XTypesType`], emitted by
 //! `#[derive(DdsType)]`), and the per-type [`TypeInformation`]/[`typeobject::TypeMapping`] built from it.
 
+pub mod store;
+pub mod typelookup;
 pub mod typeobject;
 
-/// Environment variable that turns on `PID_TYPE_INFORMATION` in SEDP (`on`, `1` or `true`).
+/// Environment variable that turns `PID_TYPE_INFORMATION` in SEDP off (`off`, `0` or `false`); it is on by
+/// default.
 pub const ANNOUNCE_ENV: &str = "DDS_TYPE_INFORMATION";
 
-/// Whether endpoints announce their type information: opt-in through [`ANNOUNCE_ENV`] until the TypeLookup
-/// service exists, because a peer that receives a type id it cannot resolve (Cyclone DDS 0.10's `ddsperf`, whose
-/// type hashes differ from Cyclone 11's) waits for the type and never matches. Read once per process.
+/// Whether endpoints announce their type information: yes, unless [`ANNOUNCE_ENV`] says `off` (for a peer
+/// that mishandles it). Peers that do not know our types ask for them through the TypeLookup service, which
+/// every participant serves. Read once per process.
 pub fn announce_type_information() -> bool {
     static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
     *ON.get_or_init(|| {
-        std::env::var(ANNOUNCE_ENV)
-            .is_ok_and(|v| matches!(v.to_ascii_lowercase().as_str(), "on" | "1" | "true"))
+        !std::env::var(ANNOUNCE_ENV)
+            .is_ok_and(|v| matches!(v.to_ascii_lowercase().as_str(), "off" | "0" | "false"))
     })
 }
 
@@ -23,6 +26,19 @@ pub fn announced_type_information(bytes: Option<&[u8]>) -> Option<TypeInformatio
     bytes
         .filter(|_| announce_type_information())
         .map(|b| TypeInformation(b.to_vec()))
+}
+
+/// What an endpoint of a type with these XCDR2 `TypeInformation` and `TypeMapping` bytes announces in SEDP:
+/// [`announced_type_information`], except for types that use `int8`/`uint8`, which Cyclone DDS 0.10 peers
+/// cannot resolve (see `compat`): they announce nothing and match by name.
+pub fn announced_type_information_for(
+    information: Option<&[u8]>,
+    mapping: Option<&[u8]>,
+) -> Option<TypeInformation> {
+    if mapping.is_none_or(compat::uses_int8) {
+        return None;
+    }
+    announced_type_information(information)
 }
 
 /// The XCDR2-serialized `TypeInformation` (PID_TYPE_INFORMATION, 0x0075), kept verbatim: what SEDP carries.
@@ -43,6 +59,7 @@ impl TypeInformation {
 }
 
 mod build;
+mod compat;
 mod describe;
 mod error;
 mod objects;

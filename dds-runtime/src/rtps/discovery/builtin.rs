@@ -18,6 +18,14 @@ pub const SUBSCRIPTIONS_DETECTOR: u32 = 1 << 5;
 pub const PARTICIPANT_MESSAGE_WRITER: u32 = 1 << 10;
 /// The participant message reader.
 pub const PARTICIPANT_MESSAGE_READER: u32 = 1 << 11;
+/// The TypeLookup service's request writer (XTypes 1.3 §7.6.3.3.4).
+pub const TYPELOOKUP_REQUEST_WRITER: u32 = 1 << 12;
+/// The TypeLookup service's request reader.
+pub const TYPELOOKUP_REQUEST_READER: u32 = 1 << 13;
+/// The TypeLookup service's reply writer.
+pub const TYPELOOKUP_REPLY_WRITER: u32 = 1 << 14;
+/// The TypeLookup service's reply reader.
+pub const TYPELOOKUP_REPLY_READER: u32 = 1 << 15;
 /// The SEDP topics writer.
 pub const TOPICS_ANNOUNCER: u32 = 1 << 28;
 /// The SEDP topics reader.
@@ -31,10 +39,14 @@ pub const OURS: u32 = PARTICIPANT_ANNOUNCER
     | SUBSCRIPTIONS_ANNOUNCER
     | SUBSCRIPTIONS_DETECTOR
     | PARTICIPANT_MESSAGE_WRITER
-    | PARTICIPANT_MESSAGE_READER;
+    | PARTICIPANT_MESSAGE_READER
+    | TYPELOOKUP_REQUEST_WRITER
+    | TYPELOOKUP_REQUEST_READER
+    | TYPELOOKUP_REPLY_WRITER
+    | TYPELOOKUP_REPLY_READER;
 
 /// (our writer, the remote reader it serves, the bit the remote must announce for that reader).
-pub const WRITER_PAIRS: [(EntityId, EntityId, u32); 3] = [
+pub const WRITER_PAIRS: [(EntityId, EntityId, u32); 5] = [
     (
         EntityId::SEDP_PUBLICATIONS_WRITER,
         EntityId::SEDP_PUBLICATIONS_READER,
@@ -50,10 +62,20 @@ pub const WRITER_PAIRS: [(EntityId, EntityId, u32); 3] = [
         EntityId::P2P_MESSAGE_READER,
         PARTICIPANT_MESSAGE_READER,
     ),
+    (
+        EntityId::TYPELOOKUP_REQUEST_WRITER,
+        EntityId::TYPELOOKUP_REQUEST_READER,
+        TYPELOOKUP_REQUEST_READER,
+    ),
+    (
+        EntityId::TYPELOOKUP_REPLY_WRITER,
+        EntityId::TYPELOOKUP_REPLY_READER,
+        TYPELOOKUP_REPLY_READER,
+    ),
 ];
 
 /// (our reader, the remote writer it listens to, the bit the remote must announce for that writer).
-pub const READER_PAIRS: [(EntityId, EntityId, u32); 3] = [
+pub const READER_PAIRS: [(EntityId, EntityId, u32); 5] = [
     (
         EntityId::SEDP_PUBLICATIONS_READER,
         EntityId::SEDP_PUBLICATIONS_WRITER,
@@ -68,6 +90,16 @@ pub const READER_PAIRS: [(EntityId, EntityId, u32); 3] = [
         EntityId::P2P_MESSAGE_READER,
         EntityId::P2P_MESSAGE_WRITER,
         PARTICIPANT_MESSAGE_WRITER,
+    ),
+    (
+        EntityId::TYPELOOKUP_REQUEST_READER,
+        EntityId::TYPELOOKUP_REQUEST_WRITER,
+        TYPELOOKUP_REQUEST_WRITER,
+    ),
+    (
+        EntityId::TYPELOOKUP_REPLY_READER,
+        EntityId::TYPELOOKUP_REPLY_WRITER,
+        TYPELOOKUP_REPLY_WRITER,
     ),
 ];
 

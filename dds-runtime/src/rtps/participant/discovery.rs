@@ -197,6 +197,8 @@ impl Participant {
         match s.reader {
             EntityId::SEDP_PUBLICATIONS_READER => self.on_sedp::<WriterQos>(now, &s),
             EntityId::SEDP_SUBSCRIPTIONS_READER => self.on_sedp::<ReaderQos>(now, &s),
+            EntityId::TYPELOOKUP_REQUEST_READER => self.on_type_lookup_request(now, &s),
+            EntityId::TYPELOOKUP_REPLY_READER => self.on_type_lookup_reply(now, &s),
             EntityId::P2P_MESSAGE_READER => {
                 if let Some((prefix, kind)) = builtin::decode_participant_message(&s.payload) {
                     if prefix == s.writer.prefix {
@@ -231,6 +233,7 @@ impl Participant {
                     // New, or announced again with another QoS (`set_qos`): reported either way.
                     if known.get(&d.guid).map(Box::as_ref) != Some(&d) {
                         self.events.push_back(Q::discovered(d.clone()));
+                        self.want_announced_types(now, d.type_information.as_ref());
                     }
                     self.on_endpoint_known(now, d);
                 }

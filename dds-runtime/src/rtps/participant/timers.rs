@@ -94,6 +94,7 @@ impl Participant {
             self.pmd_due = now + self.config.spdp_interval;
         }
         self.expire_leases(now);
+        self.type_lookup_timeout(now);
         let expired: Vec<GuidPrefix> = self
             .participants
             .iter()

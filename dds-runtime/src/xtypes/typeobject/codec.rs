@@ -47,7 +47,7 @@ pub fn from_bytes<T: XtypesCodec>(bytes: &[u8]) -> Result<T, DecodeError> {
 }
 
 /// Writes an `@appendable` body behind its DHEADER.
-pub(super) fn appendable(
+pub(crate) fn appendable(
     w: &mut CdrWriter<'_>,
     f: impl FnOnce(&mut CdrWriter<'_>) -> Result<(), EncodeError>,
 ) -> Result<(), EncodeError> {
@@ -90,7 +90,7 @@ fn optional<T>(
 }
 
 /// A sequence of non-primitive elements: DHEADER, count, elements.
-pub(super) fn seq<T>(
+pub(crate) fn seq<T>(
     w: &mut CdrWriter<'_>,
     items: &[T],
     f: impl Fn(&mut CdrWriter<'_>, &T) -> Result<(), EncodeError>,

@@ -17,7 +17,7 @@ fn invalid(r: &CdrReader<'_>, what: &'static str, found: u64) -> DecodeError {
 }
 
 /// Reads an `@appendable` body behind its DHEADER; members it does not know are skipped.
-pub(super) fn appendable<T>(
+pub(crate) fn appendable<T>(
     r: R<'_, '_>,
     what: &'static str,
     f: impl FnOnce(&mut CdrReader<'_>) -> Result<T, DecodeError>,

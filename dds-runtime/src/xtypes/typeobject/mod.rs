@@ -14,7 +14,10 @@ mod identifier;
 mod info;
 mod object;
 
+/// The DHEADER helpers, shared with the TypeLookup codec.
+pub(crate) use codec::{appendable as write_appendable, seq as write_seq};
 pub use codec::{from_bytes, to_bytes, XtypesCodec};
+pub(crate) use decode::appendable as read_appendable;
 pub use identifier::{
     EquivalenceHash, EquivalenceKind, PlainCollectionHeader, StronglyConnectedComponentId,
     TypeIdentifier,
