@@ -23,6 +23,8 @@ pub enum StatusChange {
     OfferedIncompatibleQos(IncompatibleQosStatus),
     /// OFFERED_DEADLINE_MISSED of a writer.
     OfferedDeadlineMissed(DeadlineMissedStatus),
+    /// LIVELINESS_LOST of a writer.
+    LivelinessLost(LivelinessLostStatus),
     /// SUBSCRIPTION_MATCHED of a reader.
     SubscriptionMatched(SubscriptionMatchedStatus),
     /// REQUESTED_INCOMPATIBLE_QOS of a reader.
@@ -48,6 +50,7 @@ impl StatusChange {
             StatusChange::PublicationMatched(_) => StatusMask::PUBLICATION_MATCHED,
             StatusChange::OfferedIncompatibleQos(_) => StatusMask::OFFERED_INCOMPATIBLE_QOS,
             StatusChange::OfferedDeadlineMissed(_) => StatusMask::OFFERED_DEADLINE_MISSED,
+            StatusChange::LivelinessLost(_) => StatusMask::LIVELINESS_LOST,
             StatusChange::SubscriptionMatched(_) => StatusMask::SUBSCRIPTION_MATCHED,
             StatusChange::RequestedIncompatibleQos(_) => StatusMask::REQUESTED_INCOMPATIBLE_QOS,
             StatusChange::RequestedDeadlineMissed(_) => StatusMask::REQUESTED_DEADLINE_MISSED,
@@ -92,6 +95,7 @@ erased!(DeadlineMissedStatus {
 erased!(SampleLostStatus { SAMPLE_LOST => SampleLost });
 erased!(SampleRejectedStatus { SAMPLE_REJECTED => SampleRejected });
 erased!(LivelinessChangedStatus { LIVELINESS_CHANGED => LivelinessChanged });
+erased!(LivelinessLostStatus { LIVELINESS_LOST => LivelinessLost });
 erased!(InconsistentTopicStatus { INCONSISTENT_TOPIC => InconsistentTopic });
 
 /// A listener of a level above a reader or writer (publisher, subscriber, participant), type-erased.

@@ -459,6 +459,7 @@ impl Driver {
         match ev {
             Event::PublicationMatched { writer: id, .. }
             | Event::OfferedIncompatibleQos { writer: id, .. }
+            | Event::LivelinessLost { writer: id }
             | Event::SubscriptionMatched { reader: id, .. }
             | Event::RequestedIncompatibleQos { reader: id, .. }
             | Event::LivelinessChanged { reader: id, .. }

@@ -198,8 +198,22 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E, T),
     ) {
-        let (target, status) = self.update(mask, update, false);
-        self.deliver(mask, target, status, entity, call);
+        if let Some((target, status)) = self.update(mask, |s| Some(update(s)), false) {
+            self.deliver(mask, target, status, entity, call);
+        }
+    }
+
+    /// [`EndpointState::signal`] when `update` changed the status (returns it), nothing otherwise.
+    pub(crate) fn signal_if<T: ErasedStatus, E>(
+        &self,
+        mask: StatusMask,
+        update: impl FnOnce(&mut S) -> Option<&mut T>,
+        entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
+        call: impl FnOnce(&L, &E, T),
+    ) {
+        if let Some((target, status)) = self.update(mask, update, false) {
+            self.deliver(mask, target, status, entity, call);
+        }
     }
 
     /// [`EndpointState::signal`] for a status whose listener consumes the change counts (DDS 1.4 §2.2.4.2.1),
@@ -211,8 +225,9 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E, T),
     ) {
-        let (target, status) = self.update(mask, update, true);
-        self.deliver(mask, target, status, entity, call);
+        if let Some((target, status)) = self.update(mask, |s| Some(update(s)), true) {
+            self.deliver(mask, target, status, entity, call);
+        }
     }
 
     /// Records that `remote` matched or unmatched (see [`EndpointState::signal`]); a listener consumes the
@@ -225,38 +240,40 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E, T),
     ) {
-        let (target, status) = {
+        let updated = {
             let mut list = lock(&self.matched);
             self.update(
                 mask,
                 |st| {
                     let s = field(st);
                     s.record_match(&mut list, remote, matched);
-                    s
+                    Some(s)
                 },
                 true,
             )
         };
-        self.deliver(mask, target, status, entity, call);
+        if let Some((target, status)) = updated {
+            self.deliver(mask, target, status, entity, call);
+        }
     }
 
-    /// Applies `update` to a status. With `consume`, a listener consumes the change counts (DDS 2.2.4.2.1):
-    /// the next callback reports only what happened since this one.
+    /// Applies `update` to a status (`None`: it did not change). With `consume`, a listener consumes the
+    /// change counts (DDS 2.2.4.2.1): the next callback reports only what happened since this one.
     #[allow(clippy::type_complexity)]
     fn update<T: ErasedStatus>(
         &self,
         mask: StatusMask,
-        update: impl FnOnce(&mut S) -> &mut T,
+        update: impl FnOnce(&mut S) -> Option<&mut T>,
         consume: bool,
-    ) -> (Option<Target<L, Arc<EndpointHandle<O>>>>, T) {
+    ) -> Option<(Option<Target<L, Arc<EndpointHandle<O>>>>, T)> {
         let target = self.target(mask);
         let mut st = lock(&self.statuses);
-        let s = update(&mut st);
+        let s = update(&mut st)?;
         let out = s.clone();
         if consume && target.is_some() {
             s.reset_changes();
         }
-        (target, out)
+        Some((target, out))
     }
 
     /// Raises `mask`, then (no lock held) calls the listener chosen by [`EndpointState::target`].

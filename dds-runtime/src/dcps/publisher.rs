@@ -24,8 +24,8 @@ use super::participant::DomainParticipant;
 use super::presentation::CoherentGroup;
 use super::sample::InstanceHandle;
 use super::status::{
-    DeadlineMissedStatus, IncompatibleQosStatus, PublicationMatchedStatus, StatusMask,
-    WriterStatuses,
+    DeadlineMissedStatus, IncompatibleQosStatus, LivelinessLostStatus, PublicationMatchedStatus,
+    StatusMask, WriterStatuses,
 };
 use super::sync::{lock, read};
 use super::topic::Topic;
@@ -42,6 +42,8 @@ pub trait DataWriterListener<T: DdsType>: Send + Sync {
     fn on_offered_incompatible_qos(&self, writer: &DataWriter<T>, status: IncompatibleQosStatus) {}
     /// The writer missed its offered deadline for an instance.
     fn on_offered_deadline_missed(&self, writer: &DataWriter<T>, status: DeadlineMissedStatus) {}
+    /// The writer did not assert its manual liveliness within its lease.
+    fn on_liveliness_lost(&self, writer: &DataWriter<T>, status: LivelinessLostStatus) {}
 }
 
 /// Groups writers; carries the partition and presentation QoS.
@@ -211,8 +213,8 @@ struct WriterInner<T: DdsType> {
 /// QoS enforced on the writer side by the RTPS core: reliability, durability (volatile, transient-local),
 /// history, resource limits, partitions, ownership strength (announced). Here: writer data lifecycle
 /// (autodispose on unregister; a deleted writer only unregisters), offered deadline missed (checked every 50 ms per instance).
-/// Lifespan is announced and applied by readers. Manual liveliness: see `assert_liveliness`; LIVELINESS_LOST
-/// on the writer is not raised yet.
+/// Lifespan is announced and applied by readers. Manual liveliness: see `assert_liveliness`; a writer that
+/// fails to assert within its lease raises LIVELINESS_LOST.
 pub struct DataWriter<T: DdsType> {
     inner: Arc<WriterInner<T>>,
     handle: Arc<EndpointHandle<WriterOwner<T>>>,
@@ -592,6 +594,14 @@ impl<T: DdsType> DataWriter<T> {
             })
     }
 
+    /// LIVELINESS_LOST (resets the change count): how often this writer failed to assert its manual
+    /// liveliness within its lease.
+    pub fn liveliness_lost_status(&self) -> LivelinessLostStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::LIVELINESS_LOST, |s| &mut s.liveliness_lost)
+    }
+
     /// Handles of the matched readers.
     pub fn matched_subscriptions(&self) -> Vec<InstanceHandle> {
         self.inner
@@ -707,6 +717,18 @@ impl<T: DdsType> Endpoint for WriterInner<T> {
                     },
                     self.writer(),
                     |l, w, s| l.on_offered_incompatible_qos(w, s),
+                );
+            }
+            Event::LivelinessLost { .. } => {
+                tracing::info!(writer = ?id, "liveliness lost");
+                self.state.signal_consumed(
+                    StatusMask::LIVELINESS_LOST,
+                    |st| {
+                        st.liveliness_lost.record();
+                        &mut st.liveliness_lost
+                    },
+                    self.writer(),
+                    |l, w, s| l.on_liveliness_lost(w, s),
                 );
             }
             _ => {}

@@ -708,6 +708,21 @@ impl<T: DdsType> ReaderInner<T> {
         move |handle| DataReader { inner, handle }
     }
 
+    /// `writer` became alive (`Some(true)`), not alive (`Some(false)`) or unmatched (`None`): LIVELINESS_CHANGED
+    /// when that changed the counts.
+    fn liveliness(self: &Arc<Self>, writer: Guid, to: Option<bool>) {
+        self.state.signal_if(
+            StatusMask::LIVELINESS_CHANGED,
+            |st| {
+                st.liveliness_changed
+                    .record(&mut st.writers_alive, writer, to)
+                    .then_some(&mut st.liveliness_changed)
+            },
+            self.reader(),
+            |l, r, s| l.on_liveliness_changed(r, s),
+        );
+    }
+
     /// Gives the core back the room freed by a take. Under the core lock every delivered sample is either
     /// queued in `pending` or in the cache, so the credit is exact.
     fn refresh_credit(&self) {
@@ -828,6 +843,9 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                     self.reader(),
                     |l, r, s| l.on_subscription_matched(r, s),
                 );
+                // A writer matched is alive until its lease says otherwise; an unmatched one is no longer
+                // counted.
+                self.liveliness(*writer, matched.then_some(true));
             }
             Event::RequestedIncompatibleQos { policy, writer, .. } => {
                 tracing::warn!(reader = ?id, ?writer, ?policy, "requested incompatible QoS");
@@ -848,15 +866,7 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                         self.notify_data();
                     }
                 }
-                self.state.signal(
-                    StatusMask::LIVELINESS_CHANGED,
-                    |st| {
-                        st.liveliness_changed.record(*writer, *alive);
-                        &mut st.liveliness_changed
-                    },
-                    self.reader(),
-                    |l, r, s| l.on_liveliness_changed(r, s),
-                );
+                self.liveliness(*writer, Some(*alive));
             }
             Event::SampleLost { count, .. } => {
                 self.state.signal(

@@ -558,6 +558,12 @@ pub enum Event {
         /// Whether the writer is alive now.
         alive: bool,
     },
+    /// A local writer with manual liveliness did not assert it within its lease (LIVELINESS_LOST; once per
+    /// lapse: the next write or assertion renews it).
+    LivelinessLost {
+        /// The local writer.
+        writer: EntityId,
+    },
     /// Samples from `writer` that `reader` will never get (writer no longer had them, or buffers overflowed).
     SampleLost {
         /// The local reader.

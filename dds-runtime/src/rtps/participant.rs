@@ -41,6 +41,8 @@ pub struct Participant {
     events: VecDeque<Event>,
     /// Leases of matched writers with manual liveliness.
     leases: crate::rtps::liveliness::Leases,
+    /// Leases of our own writers with manual liveliness (LIVELINESS_LOST).
+    own_leases: super::writer::OwnLeases,
     /// Reused buffer for what readers deliver while a datagram is processed.
     scratch: Vec<Event>,
     writers: BTreeMap<EntityId, Writer>,
@@ -137,6 +139,7 @@ impl Participant {
             out: Outbox::new(header, config.max_message_size),
             events: VecDeque::new(),
             leases: Default::default(),
+            own_leases: Default::default(),
             scratch: Vec::new(),
             writers: BTreeMap::new(),
             readers: BTreeMap::new(),
@@ -297,6 +300,7 @@ impl Participant {
         let params = user_writer_params(&self.config, &data.qos.writer, keyed);
         self.writers.insert(id, Writer::new(data.guid, params));
         self.user_writers.insert(id);
+        self.own_leases.track(now, id, &data.qos.writer.liveliness);
         self.publish_endpoint(now, data);
         Ok(id)
     }
@@ -330,6 +334,7 @@ impl Participant {
         if w.linger_until.is_some() {
             return;
         }
+        self.own_leases.untrack(id);
         if w.is_acknowledged() {
             self.finish_writer(now, id);
         } else {
@@ -367,6 +372,7 @@ impl Participant {
 
     fn finish_writer(&mut self, now: Instant, id: EntityId) {
         self.user_writers.remove(&id);
+        self.own_leases.untrack(id);
         let guid = Guid::new(self.config.guid_prefix, id);
         if let Some(w) = self.writers.remove(&id) {
             for r in w.matched() {

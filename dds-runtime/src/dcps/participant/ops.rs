@@ -33,6 +33,8 @@ pub trait DomainParticipantListener: Send + Sync {
     fn on_offered_incompatible_qos(&self, writer: InstanceHandle, status: IncompatibleQosStatus) {}
     /// A writer missed its offered deadline.
     fn on_offered_deadline_missed(&self, writer: InstanceHandle, status: DeadlineMissedStatus) {}
+    /// A writer did not assert its manual liveliness within its lease.
+    fn on_liveliness_lost(&self, writer: InstanceHandle, status: LivelinessLostStatus) {}
     /// A reader matched or unmatched a writer.
     fn on_subscription_matched(&self, reader: InstanceHandle, status: SubscriptionMatchedStatus) {}
     /// A reader found a writer with incompatible QoS.
@@ -63,6 +65,7 @@ impl ParentListener for ParticipantLevel {
             StatusChange::PublicationMatched(s) => l.on_publication_matched(e, s),
             StatusChange::OfferedIncompatibleQos(s) => l.on_offered_incompatible_qos(e, s),
             StatusChange::OfferedDeadlineMissed(s) => l.on_offered_deadline_missed(e, s),
+            StatusChange::LivelinessLost(s) => l.on_liveliness_lost(e, s),
             StatusChange::SubscriptionMatched(s) => l.on_subscription_matched(e, s),
             StatusChange::RequestedIncompatibleQos(s) => l.on_requested_incompatible_qos(e, s),
             StatusChange::RequestedDeadlineMissed(s) => l.on_requested_deadline_missed(e, s),

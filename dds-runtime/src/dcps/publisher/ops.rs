@@ -33,6 +33,8 @@ pub trait PublisherListener: Send + Sync {
     fn on_offered_incompatible_qos(&self, writer: InstanceHandle, status: IncompatibleQosStatus) {}
     /// A writer missed its offered deadline.
     fn on_offered_deadline_missed(&self, writer: InstanceHandle, status: DeadlineMissedStatus) {}
+    /// A writer did not assert its manual liveliness within its lease.
+    fn on_liveliness_lost(&self, writer: InstanceHandle, status: LivelinessLostStatus) {}
 }
 
 /// The publisher listener as a level of the chain.
@@ -44,6 +46,7 @@ impl ParentListener for PublisherLevel {
             StatusChange::PublicationMatched(s) => self.0.on_publication_matched(w, s),
             StatusChange::OfferedIncompatibleQos(s) => self.0.on_offered_incompatible_qos(w, s),
             StatusChange::OfferedDeadlineMissed(s) => self.0.on_offered_deadline_missed(w, s),
+            StatusChange::LivelinessLost(s) => self.0.on_liveliness_lost(w, s),
             _ => {}
         }
     }
