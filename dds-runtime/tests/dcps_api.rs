@@ -201,7 +201,7 @@ fn factory_delete_participant() {
 }
 
 #[test]
-fn factory_qos_autoenable_false_is_unsupported() {
+fn factory_qos_autoenable_false_creates_disabled_participants() {
     require_netns();
     let f = DomainParticipantFactory::get_instance();
     let off = DomainParticipantFactoryQos::builder()
@@ -209,10 +209,10 @@ fn factory_qos_autoenable_false_is_unsupported() {
         .build();
     f.set_qos(&off).unwrap();
     assert_eq!(f.qos(), off);
-    assert!(matches!(
-        f.create_participant(154, &DomainParticipantQos::default()),
-        Err(DdsError::Unsupported(_))
-    ));
+    let disabled = f
+        .create_participant(154, &DomainParticipantQos::default())
+        .unwrap();
+    assert!(!disabled.is_enabled());
     f.set_qos(&DomainParticipantFactoryQos::default()).unwrap();
     assert!(f
         .create_participant(154, &DomainParticipantQos::default())
@@ -244,7 +244,8 @@ fn participant_set_qos_announces_user_data() {
     let off = DomainParticipantQos::builder()
         .autoenable_created_entities(false)
         .build();
-    assert!(matches!(p1.set_qos(&off), Err(DdsError::Unsupported(_))));
+    p1.set_qos(&off).unwrap();
+    assert!(!p1.get_qos().autoenable_created_entities);
 }
 
 #[test]

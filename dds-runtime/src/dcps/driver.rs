@@ -216,12 +216,18 @@ impl Driver {
         config: Config,
         user_data: Vec<u8>,
         name: Option<String>,
+        enabled: bool,
     ) -> DdsResult<Arc<Driver>> {
         let transport = UdpTransport::bind(&config)?;
         let prefix = new_guid_prefix();
         let pc = core_config(&config, &transport, prefix, user_data, name)?;
+        let mut core = Participant::new(pc, Instant::now());
+        if !enabled {
+            // Created disabled: nothing is sent, not even the first SPDP announcement, until `enable`.
+            core.set_enabled(Instant::now(), false);
+        }
         let driver = Arc::new(Driver {
-            core: Mutex::new(Participant::new(pc, Instant::now())),
+            core: Mutex::new(core),
             transport,
             config,
             guid_prefix: prefix,

@@ -38,6 +38,8 @@ pub(crate) struct EndpointState<S, L: ?Sized, O> {
     deleted: Arc<AtomicBool>,
     matched: Mutex<Vec<Guid>>,
     handle: Mutex<Weak<EndpointHandle<O>>>,
+    /// Whether the endpoint is enabled (announced and matched); see `dcps::enable`.
+    enabled: AtomicBool,
 }
 
 /// Where a status goes: the entity's own listener, or one of the levels above.
@@ -59,6 +61,7 @@ impl<S: Default, L: ?Sized, O> EndpointState<S, L, O> {
             deleted: Arc::new(AtomicBool::new(false)),
             matched: Mutex::new(Vec::new()),
             handle: Mutex::new(Weak::new()),
+            enabled: AtomicBool::new(true),
         }
     }
 }
@@ -127,6 +130,30 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
             return Err(DdsError::AlreadyDeleted);
         }
         self.driver.delete_endpoint(self.id());
+        Ok(())
+    }
+
+    /// `Err(NotEnabled)` while the endpoint is disabled (after `check_alive`).
+    pub(crate) fn check_enabled(&self) -> DdsResult<()> {
+        self.check_alive()?;
+        if !self.enabled.load(Ordering::Acquire) {
+            return Err(DdsError::NotEnabled);
+        }
+        Ok(())
+    }
+
+    /// Records that the endpoint was created disabled (before it is visible to the application).
+    pub(crate) fn set_created_disabled(&self) {
+        self.enabled.store(false, Ordering::Release);
+    }
+
+    /// Enables an endpoint created disabled: the core announces and matches it. Nothing when enabled.
+    pub(crate) fn enable_in_core(&self) -> DdsResult<()> {
+        self.check_alive()?;
+        if !self.enabled.swap(true, Ordering::AcqRel) {
+            let id = self.id();
+            self.driver.with_core(|c, now| c.enable_endpoint(now, id));
+        }
         Ok(())
     }
 

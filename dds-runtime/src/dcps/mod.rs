@@ -34,6 +34,7 @@ pub mod condition;
 mod decode;
 mod driver;
 pub mod durability;
+mod enable;
 mod endpoint;
 mod error;
 pub mod filter;

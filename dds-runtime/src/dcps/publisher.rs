@@ -126,6 +126,10 @@ impl Publisher {
     ) -> DdsResult<DataWriter<T>> {
         let driver = self.participant.driver().clone();
         let parent = ops::writer_parent(self, topic)?;
+        let enabled = self
+            .participant
+            .registry()
+            .group_creates_enabled::<PublisherQos>(Arc::as_ptr(&self.qos) as *const ())?;
         let (version, rep) = writer_version::<T>(&qos.data_representation);
         let mut wq = qos.clone();
         wq.data_representation = rep;
@@ -153,9 +157,16 @@ impl Publisher {
         };
         inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
-        let handle = inner
-            .state
-            .create(sink, owner, |c, now| c.create_writer(now, spec))?;
+        if !enabled {
+            inner.state.set_created_disabled();
+        }
+        let handle = inner.state.create(sink, owner, |c, now| {
+            if enabled {
+                c.create_writer(now, spec)
+            } else {
+                c.create_writer_disabled(now, spec)
+            }
+        })?;
         ops::register_writer(self, &inner, topic.name());
         let id = handle.id();
         self.group.add_writer(&driver, id);
@@ -319,7 +330,7 @@ impl<T: DdsType> DataWriter<T> {
     /// `sample`, the matched readers' content filters are evaluated on it (writer-side filtering).
     fn submit(&self, change: WriteChange, sample: Option<&T>) -> DdsResult<()> {
         let driver = &self.inner.state.driver;
-        driver.check_alive()?;
+        self.inner.state.check_enabled()?;
         let max_block = match self.inner.qos.reliability {
             Reliability::Reliable { max_blocking_time } => max_blocking_time,
             Reliability::BestEffort => Duration::ZERO,
@@ -547,7 +558,7 @@ impl<T: DdsType> DataWriter<T> {
     /// liveliness flag to its matched readers. Writing a sample asserts it too.
     pub fn assert_liveliness(&self) -> DdsResult<()> {
         let driver = &self.inner.state.driver;
-        driver.check_alive()?;
+        self.inner.state.check_enabled()?;
         let id = self.id();
         driver.with_core(|c, now| c.assert_writer_liveliness(now, id));
         Ok(())
@@ -556,7 +567,7 @@ impl<T: DdsType> DataWriter<T> {
     /// Blocks until every matched reliable reader acknowledged everything written, or `Timeout`.
     pub fn wait_for_acknowledgments(&self, timeout: Duration) -> DdsResult<()> {
         let driver = &self.inner.state.driver;
-        driver.check_alive()?;
+        self.inner.state.check_enabled()?;
         let id = self.id();
         let deadline = Instant::now().checked_add(timeout);
         if driver.wait_progress(deadline, || driver.with_core(|c, _| c.is_acknowledged(id))) {

@@ -83,6 +83,9 @@ pub(crate) trait Registered: Send + Sync {
     }
     /// Calls the reader's `on_data_available` (`notify_datareaders`); nothing for writers.
     fn notify_data_available(self: Arc<Self>) {}
+    /// Enables the reader or writer (`enable`): `PreconditionNotMet` while its factory or topic is
+    /// disabled.
+    fn enable(self: Arc<Self>) -> DdsResult<()>;
 }
 
 impl EndpointEntry {
@@ -110,6 +113,8 @@ pub(crate) struct Entities {
     pub(crate) default_publisher_qos: PublisherQos,
     pub(crate) default_subscriber_qos: SubscriberQos,
     pub(crate) default_topic_qos: TopicQos,
+    /// The disabled participant, topics, publishers and subscribers (see `dcps::enable`).
+    pub(crate) disabled: HashSet<InstanceHandle>,
 }
 
 impl Entities {
@@ -426,11 +431,6 @@ impl Registry {
         ptr: *const (),
         qos: &Q,
     ) -> DdsResult<Vec<Weak<dyn Registered>>> {
-        if !qos.autoenable() {
-            return Err(DdsError::Unsupported(
-                "disabled entities: every entity is enabled when created",
-            ));
-        }
         let (handle, changed) = self.with_group::<Q, _>(ptr, |g| {
             if let Some(p) = g.qos.immutable_change(qos) {
                 return Err(DdsError::ImmutablePolicy(p));

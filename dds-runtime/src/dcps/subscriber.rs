@@ -128,6 +128,10 @@ impl Subscriber {
     ) -> DdsResult<DataReader<T>> {
         let driver = self.participant.driver().clone();
         let parent = ops::reader_parent(self, topic.topic())?;
+        let enabled = self
+            .participant
+            .registry()
+            .group_creates_enabled::<SubscriberQos>(Arc::as_ptr(&self.qos) as *const ())?;
         let mut rq = qos.clone();
         if rq.data_representation.ids().is_empty() {
             rq.data_representation = DataRepresentation::accept_both();
@@ -172,8 +176,15 @@ impl Subscriber {
         };
         inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
+        if !enabled {
+            inner.state.set_created_disabled();
+        }
         let handle = inner.state.create(sink, owner, |c, now| {
-            let id = c.create_reader(now, spec)?;
+            let id = if enabled {
+                c.create_reader(now, spec)?
+            } else {
+                c.create_reader_disabled(now, spec)?
+            };
             if credit_limit.is_some() {
                 c.set_reader_credit(id, credit_limit);
             }
@@ -337,7 +348,7 @@ impl<T: DdsType> DataReader<T> {
         take: bool,
         mut emit: impl FnMut(&mut Option<T>, SampleInfo),
     ) -> DdsResult<usize> {
-        self.inner.state.check_alive()?;
+        self.inner.state.check_enabled()?;
         self.inner.state.data_read();
         let mut n = 0;
         {
@@ -517,6 +528,7 @@ impl<T: DdsType> DataReader<T> {
 
     /// Blocks until a not-read sample is available (`Ok(true)`) or `timeout` passes (`Ok(false)`).
     pub fn wait_for_data(&self, timeout: Duration) -> DdsResult<bool> {
+        self.inner.state.check_enabled()?;
         let deadline = Instant::now().checked_add(timeout);
         let unread = Selection {
             sample_states: SampleStateMask::NOT_READ,

@@ -5,6 +5,7 @@
 mod coherent;
 mod control;
 mod discovery;
+mod enable;
 mod filtering;
 mod historical;
 mod liveliness;
@@ -43,6 +44,10 @@ pub struct Participant {
     leases: crate::rtps::liveliness::Leases,
     /// Leases of our own writers with manual liveliness (LIVELINESS_LOST).
     own_leases: super::writer::OwnLeases,
+    /// Whether the participant sends and receives (see `enable`).
+    enabled: bool,
+    /// Local endpoints created disabled, not announced yet.
+    deferred: enable::DeferredEndpoints,
     /// Reused buffer for what readers deliver while a datagram is processed.
     scratch: Vec<Event>,
     writers: BTreeMap<EntityId, Writer>,
@@ -140,6 +145,8 @@ impl Participant {
             events: VecDeque::new(),
             leases: Default::default(),
             own_leases: Default::default(),
+            enabled: true,
+            deferred: Default::default(),
             scratch: Vec::new(),
             writers: BTreeMap::new(),
             readers: BTreeMap::new(),
@@ -290,6 +297,15 @@ impl Participant {
 
     /// Creates a local writer and announces it in SEDP; it matches local and remote readers from then on.
     pub fn create_writer(&mut self, now: Instant, spec: WriterSpec) -> Result<EntityId, CoreError> {
+        let data = self.add_writer(spec)?;
+        let id = data.guid.entity_id;
+        self.own_leases.track(now, id, &data.qos.writer.liveliness);
+        self.publish_endpoint(now, data);
+        Ok(id)
+    }
+
+    /// Adds a local writer, not yet announced.
+    fn add_writer(&mut self, spec: WriterSpec) -> Result<WriterData, CoreError> {
         let keyed = spec.keyed;
         let kinds = [
             entity_kind::USER_WRITER_NO_KEY,
@@ -300,13 +316,19 @@ impl Participant {
         let params = user_writer_params(&self.config, &data.qos.writer, keyed);
         self.writers.insert(id, Writer::new(data.guid, params));
         self.user_writers.insert(id);
-        self.own_leases.track(now, id, &data.qos.writer.liveliness);
-        self.publish_endpoint(now, data);
-        Ok(id)
+        Ok(data)
     }
 
     /// Creates a local reader and announces it in SEDP; it matches local and remote writers from then on.
     pub fn create_reader(&mut self, now: Instant, spec: ReaderSpec) -> Result<EntityId, CoreError> {
+        let data = self.add_reader(spec)?;
+        let id = data.guid.entity_id;
+        self.publish_endpoint(now, data);
+        Ok(id)
+    }
+
+    /// Adds a local reader, not yet announced.
+    fn add_reader(&mut self, spec: ReaderSpec) -> Result<ReaderData, CoreError> {
         let kinds = [
             entity_kind::USER_READER_NO_KEY,
             entity_kind::USER_READER_WITH_KEY,
@@ -317,14 +339,16 @@ impl Participant {
         let params = reader_params(&self.config, reliable);
         self.readers.insert(id, Reader::new(data.guid, params));
         self.user_readers.insert(id);
-        self.publish_endpoint(now, data);
-        Ok(id)
+        Ok(data)
     }
 
     /// Deletes a writer. A reliable writer with unacknowledged data lingers (still repairing, refusing writes)
     /// until acknowledged or `writer_linger_duration` passes; then `Event::WriterDeleted`.
     pub fn delete_writer(&mut self, now: Instant, id: EntityId) {
         self.timers_changed();
+        if self.drop_deferred(id) {
+            return;
+        }
         if !self.user_writers.contains(&id) {
             return;
         }
@@ -346,6 +370,9 @@ impl Participant {
     /// Deletes a reader at once: unmatch events and an SEDP dispose.
     pub fn delete_reader(&mut self, now: Instant, id: EntityId) {
         self.timers_changed();
+        if self.drop_deferred(id) {
+            return;
+        }
         if !self.user_readers.remove(&id) {
             return;
         }

@@ -102,16 +102,10 @@ impl DomainParticipant {
         self.registry.with(|e| e.participant_qos.clone())
     }
 
-    /// Changes the participant QoS (`set_qos`): a new USER_DATA is announced in SPDP at once.
-    /// `autoenable_created_entities = false` is refused with `Unsupported` (entities are enabled when
-    /// created).
+    /// Changes the participant QoS (`set_qos`): a new USER_DATA is announced in SPDP at once;
+    /// `autoenable_created_entities` applies to the entities created from then on.
     pub fn set_qos(&self, qos: &DomainParticipantQos) -> DdsResult<()> {
         self.driver.check_alive()?;
-        if !qos.autoenable_created_entities {
-            return Err(DdsError::Unsupported(
-                "disabled entities: every entity is enabled when created",
-            ));
-        }
         let old = self.get_qos();
         if let Some(p) = old.immutable_change(qos) {
             return Err(DdsError::ImmutablePolicy(p));
@@ -136,10 +130,23 @@ impl DomainParticipant {
         self.registry.node.set_listener(None);
     }
 
-    /// Enables the participant (`enable`): entities are enabled when created, so this only checks that the
-    /// participant was not deleted.
+    /// Enables the participant (`enable`): it starts announcing itself (SPDP) and receiving. With
+    /// `autoenable_created_entities`, the topics, publishers and subscribers it created disabled are
+    /// enabled too (and their readers and writers as their own QoS says). Nothing when enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.driver.check_alive()
+        self.driver.check_alive()?;
+        if self.registry.enable(self.registry.node.handle, &[])? {
+            self.driver.with_core(|c, now| c.set_enabled(now, true));
+            if self.get_qos().autoenable_created_entities {
+                self.registry.enable_participant_contents();
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether the participant is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.registry.is_enabled(self.registry.node.handle)
     }
 
     /// The current time (`get_current_time`), as source timestamps use it.

@@ -56,9 +56,9 @@ impl ParentListener for PublisherLevel {
 /// Registers a new publisher in its participant.
 pub(super) fn register_publisher(p: &Publisher) {
     let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&p.qos) as Weak<PublisherQos>;
-    p.participant
-        .registry()
-        .add_group(identity, (*p.qos).clone());
+    let registry = p.participant.registry();
+    let node = registry.add_group(identity, (*p.qos).clone());
+    registry.created_by_participant(node.handle);
 }
 
 /// The publisher level of a new writer's listener chain; `AlreadyDeleted` for a deleted publisher.
@@ -107,6 +107,14 @@ impl<T: DdsType> Registered for WriterInner<T> {
                 tracing::debug!(error = %e, "writer QoS not announced again");
             }
         }
+    }
+    fn enable(self: Arc<Self>) -> DdsResult<()> {
+        let handle = self.state.handle().ok_or(DdsError::AlreadyDeleted)?;
+        DataWriter {
+            inner: self,
+            handle,
+        }
+        .enable()
     }
 }
 
@@ -184,9 +192,21 @@ impl Publisher {
         })
     }
 
-    /// Enables the publisher (`enable`): entities are enabled when created.
+    /// Enables the publisher (`enable`): `PreconditionNotMet` while its participant is disabled. With
+    /// `autoenable_created_entities`, the writers it created disabled are enabled too.
     pub fn enable(&self) -> DdsResult<()> {
-        self.with_group(|_| ())
+        let (h, auto) = self.with_group(|g| (g.node.handle, g.qos.autoenable_created_entities))?;
+        let registry = self.participant.registry();
+        if registry.enable(h, &[registry.node.handle])? && auto {
+            registry.enable_group_children::<PublisherQos>(h);
+        }
+        Ok(())
+    }
+
+    /// Whether the publisher is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.instance_handle()
+            .is_ok_and(|h| self.participant.registry().is_enabled(h))
     }
 
     /// Sets the QoS `create_datawriter` callers get from [`default_datawriter_qos`](Self::default_datawriter_qos)
@@ -348,9 +368,25 @@ impl<T: DdsType> DataWriter<T> {
             .set_listener_with_mask(Some(Arc::from(listener)), mask);
     }
 
-    /// Enables the writer (`enable`): writers are enabled when created.
+    /// Enables the writer (`enable`): it is announced in SEDP and matched from now on.
+    /// `PreconditionNotMet` while its publisher or topic is disabled; nothing when enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.inner.state.check_alive()
+        self.inner.state.check_alive()?;
+        let owner = self.handle.owner();
+        let parents = [
+            owner.publisher.instance_handle()?,
+            owner.topic.instance_handle()?,
+        ];
+        self.publisher()
+            .participant()
+            .registry()
+            .check_parents_enabled(&parents)?;
+        self.inner.state.enable_in_core()
+    }
+
+    /// Whether the writer is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.inner.state.check_enabled().is_ok()
     }
 
     /// Writes `sample` as an instance of `handle` (`write_w_handle`); `NIL` looks the instance up from the

@@ -86,9 +86,9 @@ impl ParentListener for SubscriberLevel {
 /// Registers a new subscriber in its participant.
 pub(super) fn register_subscriber(s: &Subscriber) {
     let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&s.qos) as Weak<SubscriberQos>;
-    s.participant
-        .registry()
-        .add_group(identity, (*s.qos).clone());
+    let registry = s.participant.registry();
+    let node = registry.add_group(identity, (*s.qos).clone());
+    registry.created_by_participant(node.handle);
 }
 
 /// The subscriber level of a new reader's listener chain; `AlreadyDeleted` for a deleted subscriber.
@@ -164,6 +164,14 @@ impl<T: DdsType> Registered for ReaderInner<T> {
     fn notify_data_available(self: Arc<Self>) {
         self.state
             .call_own_listener(self.reader(), |l, r| l.on_data_available(r));
+    }
+    fn enable(self: Arc<Self>) -> DdsResult<()> {
+        let handle = self.state.handle().ok_or(DdsError::AlreadyDeleted)?;
+        DataReader {
+            inner: self,
+            handle,
+        }
+        .enable()
     }
 }
 
@@ -257,9 +265,21 @@ impl Subscriber {
         })
     }
 
-    /// Enables the subscriber (`enable`): entities are enabled when created.
+    /// Enables the subscriber (`enable`): `PreconditionNotMet` while its participant is disabled. With
+    /// `autoenable_created_entities`, the readers it created disabled are enabled too.
     pub fn enable(&self) -> DdsResult<()> {
-        self.with_group(|_| ())
+        let (h, auto) = self.with_group(|g| (g.node.handle, g.qos.autoenable_created_entities))?;
+        let registry = self.participant.registry();
+        if registry.enable(h, &[registry.node.handle])? && auto {
+            registry.enable_group_children::<SubscriberQos>(h);
+        }
+        Ok(())
+    }
+
+    /// Whether the subscriber is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.instance_handle()
+            .is_ok_and(|h| self.participant.registry().is_enabled(h))
     }
 
     /// Sets the default reader QoS (`set_default_datareader_qos`).
@@ -425,9 +445,25 @@ impl<T: DdsType> DataReader<T> {
             .set_listener_with_mask(Some(Arc::from(listener)), mask);
     }
 
-    /// Enables the reader (`enable`): readers are enabled when created.
+    /// Enables the reader (`enable`): it is announced in SEDP and matched from now on.
+    /// `PreconditionNotMet` while its subscriber or topic is disabled; nothing when enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.inner.state.check_alive()
+        self.inner.state.check_alive()?;
+        let owner = self.handle.owner();
+        let parents = [
+            owner.subscriber.instance_handle()?,
+            owner.topic.instance_handle()?,
+        ];
+        self.subscriber()
+            .participant()
+            .registry()
+            .check_parents_enabled(&parents)?;
+        self.inner.state.enable_in_core()
+    }
+
+    /// Whether the reader is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.inner.state.check_enabled().is_ok()
     }
 
     /// The key of the instance `handle` (`get_key_value`): a sample whose key members are the instance's

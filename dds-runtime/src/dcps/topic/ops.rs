@@ -38,12 +38,9 @@ impl ParentListener for TopicLevel {
 /// Registers a new topic in its participant.
 pub(super) fn register_topic<T: DdsType>(t: &Topic<T>) {
     let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&t.inner) as Weak<TopicInner>;
-    t.inner.participant.registry().add_topic(
-        identity,
-        &t.inner.name,
-        T::TYPE_NAME,
-        t.inner.qos.clone(),
-    );
+    let registry = t.inner.participant.registry();
+    let handle = registry.add_topic(identity, &t.inner.name, T::TYPE_NAME, t.inner.qos.clone());
+    registry.created_by_participant(handle);
 }
 
 impl<T: DdsType> Topic<T> {
@@ -136,9 +133,18 @@ impl<T: DdsType> Topic<T> {
         })
     }
 
-    /// Enables the topic (`enable`): topics are enabled when created.
+    /// Enables the topic (`enable`): `PreconditionNotMet` while its participant is disabled; nothing when
+    /// enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.check_alive()
+        let h = self.instance_handle()?;
+        let registry = self.participant().registry();
+        registry.enable(h, &[registry.node.handle]).map(|_| ())
+    }
+
+    /// Whether the topic is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.instance_handle()
+            .is_ok_and(|h| self.participant().registry().is_enabled(h))
     }
 }
 

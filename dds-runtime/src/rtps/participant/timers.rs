@@ -29,6 +29,9 @@ pub(super) fn lower_floor(floor: &Cell<Option<Instant>>, t: Option<Instant>) {
 impl Participant {
     /// When `handle_timeout` must be called next.
     pub fn poll_timeout(&self) -> Option<Instant> {
+        if !self.enabled {
+            return None;
+        }
         let t = match self.timer_floor.get() {
             Some(t) => t,
             None => {
@@ -83,7 +86,7 @@ impl Participant {
 
     /// Runs everything due at `now`.
     pub(super) fn service(&mut self, now: Instant) {
-        if self.timer_floor.get().is_some_and(|floor| now < floor) {
+        if !self.enabled || self.timer_floor.get().is_some_and(|floor| now < floor) {
             return;
         }
         if now >= self.spdp_due {
