@@ -760,6 +760,79 @@ fn publisher_status_condition() {
     publ.enable().unwrap();
 }
 
+/// Reading one writer's (or reader's) status leaves its publisher's (subscriber's) condition raised while a
+/// sibling still has the same status unread; reading the sibling's clears it.
+#[test]
+fn group_status_condition_stays_raised_for_an_unread_sibling() {
+    let p = participant(228);
+    let t = p
+        .create_topic::<ShapeType>("Siblings", &TopicQos::default())
+        .unwrap();
+    let publ = p.create_publisher(&PublisherQos::default()).unwrap();
+    let sub = p.create_subscriber(&SubscriberQos::default()).unwrap();
+    let (pc, sc) = (
+        publ.status_condition().unwrap(),
+        sub.status_condition().unwrap(),
+    );
+    let wq = DataWriterQos::default();
+    let (a, b) = (
+        publ.create_datawriter(&t, &wq).unwrap(),
+        publ.create_datawriter(&t, &wq).unwrap(),
+    );
+    let rq = DataReaderQos::default();
+    let (ra, rb) = (
+        sub.create_datareader::<ShapeType, _>(&t, &rq).unwrap(),
+        sub.create_datareader::<ShapeType, _>(&t, &rq).unwrap(),
+    );
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        a.publication_matched_status().current_count == 2
+            && b.publication_matched_status().current_count == 2
+            && ra.subscription_matched_status().current_count == 2
+            && rb.subscription_matched_status().current_count == 2
+    }));
+    // Everything read once: now raise PUBLICATION_MATCHED on both writers again with a third reader.
+    let _ = (
+        ra.liveliness_changed_status(),
+        rb.liveliness_changed_status(),
+    );
+    assert!(!pc
+        .changed_statuses()
+        .contains(StatusMask::PUBLICATION_MATCHED));
+    let _rc = reader::<ShapeType>(&p, "Siblings", &rq);
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        pc.changed_statuses()
+            .contains(StatusMask::PUBLICATION_MATCHED)
+            && a.matched_subscriptions().len() == 3
+            && b.matched_subscriptions().len() == 3
+    }));
+    a.publication_matched_status();
+    assert!(
+        pc.changed_statuses()
+            .contains(StatusMask::PUBLICATION_MATCHED),
+        "b's change is unread"
+    );
+    b.publication_matched_status();
+    assert!(!pc
+        .changed_statuses()
+        .contains(StatusMask::PUBLICATION_MATCHED));
+    // The same on the subscriber, with a new writer matching both readers.
+    assert!(!sc
+        .changed_statuses()
+        .contains(StatusMask::SUBSCRIPTION_MATCHED));
+    let _wc = writer::<ShapeType>(&p, "Siblings", &wq);
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        ra.matched_publications().len() == 3 && rb.matched_publications().len() == 3
+    }));
+    ra.subscription_matched_status();
+    assert!(sc
+        .changed_statuses()
+        .contains(StatusMask::SUBSCRIPTION_MATCHED));
+    rb.subscription_matched_status();
+    assert!(!sc
+        .changed_statuses()
+        .contains(StatusMask::SUBSCRIPTION_MATCHED));
+}
+
 #[test]
 fn publisher_default_datawriter_qos_and_copy_from_topic_qos() {
     let p = participant(178);

@@ -129,6 +129,9 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         if self.deleted.swap(true, Ordering::AcqRel) {
             return Err(DdsError::AlreadyDeleted);
         }
+        if let Some(parent) = self.parent.get() {
+            parent.forget(self.instance());
+        }
         self.driver.delete_endpoint(self.id());
         Ok(())
     }
@@ -185,13 +188,19 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
     /// A read or take: the subscriber's DATA_ON_READERS is reset (DDS 1.4 §2.2.4.1).
     pub(crate) fn data_read(&self) {
         if let Some(parent) = self.parent.get() {
-            parent.clear_up(StatusMask::DATA_ON_READERS | StatusMask::DATA_AVAILABLE);
+            parent.clear_up(self.instance(), StatusMask::DATA_AVAILABLE);
+            parent.clear_up(parent.handle, StatusMask::DATA_ON_READERS);
         }
     }
 
     /// The GUID of the endpoint.
     fn guid(&self) -> Guid {
         Guid::new(self.driver.guid_prefix, self.id())
+    }
+
+    /// The endpoint's instance handle, as the levels above know it.
+    fn instance(&self) -> InstanceHandle {
+        InstanceHandle::from_guid(self.guid())
     }
 
     /// The GUIDs of the matched remote endpoints.
@@ -211,7 +220,7 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         s.reset_changes();
         self.status_core.clear(mask);
         if let Some(parent) = self.parent.get() {
-            parent.clear_up(mask);
+            parent.clear_up(self.instance(), mask);
         }
         out
     }
@@ -314,7 +323,7 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
     ) {
         self.status_core.raise(mask);
         if let Some(parent) = self.parent.get() {
-            parent.raise_up(mask);
+            parent.raise_up(self.instance(), mask);
         }
         match target {
             Some(Target::Own(l, h)) => call(&l, &entity(h), status),
@@ -348,9 +357,10 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         call: impl FnOnce(&L, &E),
     ) {
         if let Some(parent) = self.parent.get() {
-            parent.raise_up(StatusMask::DATA_ON_READERS | StatusMask::DATA_AVAILABLE);
+            parent.raise_up(self.instance(), StatusMask::DATA_AVAILABLE);
+            parent.raise_up(parent.handle, StatusMask::DATA_ON_READERS);
             if let Some(l) = parent.find(StatusMask::DATA_ON_READERS) {
-                parent.clear_up(StatusMask::DATA_ON_READERS);
+                parent.clear_up(parent.handle, StatusMask::DATA_ON_READERS);
                 l.on_data_on_readers(parent.handle);
                 return;
             }

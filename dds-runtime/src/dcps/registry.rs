@@ -234,7 +234,7 @@ impl Registry {
         });
         if clash {
             // Known before the topic existed: the status is set, no listener can have been installed yet.
-            node.raise_up(StatusMask::INCONSISTENT_TOPIC);
+            node.raise_up(node.handle, StatusMask::INCONSISTENT_TOPIC);
         }
         handle
     }

@@ -88,7 +88,7 @@ pub(super) fn install_discovery_hook(driver: &Driver, registry: &Arc<Registry>) 
         let Some(reg) = weak.upgrade() else { return };
         for (node, status) in reg.on_discovery(ev) {
             tracing::warn!(topic = ?node.handle, "inconsistent topic");
-            node.raise_up(StatusMask::INCONSISTENT_TOPIC);
+            node.raise_up(node.handle, StatusMask::INCONSISTENT_TOPIC);
             if let Some(l) = node.find(StatusMask::INCONSISTENT_TOPIC) {
                 l.on_status(node.handle, StatusChange::InconsistentTopic(status));
             }

@@ -128,7 +128,8 @@ impl<T: DdsType> Topic<T> {
         self.with_entry(|t| {
             let s = t.inconsistent.clone();
             t.inconsistent.total_count_change = 0;
-            t.node.clear_up(StatusMask::INCONSISTENT_TOPIC);
+            t.node
+                .clear_up(t.node.handle, StatusMask::INCONSISTENT_TOPIC);
             s
         })
     }
