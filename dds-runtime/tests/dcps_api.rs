@@ -572,14 +572,10 @@ fn participant_find_topic() {
 }
 
 #[test]
-fn participant_multitopic_and_builtin_subscriber_unsupported() {
+fn participant_multitopic_unsupported() {
     let p = participant(172);
     assert!(matches!(
         p.create_multitopic("M", "T", "SELECT * FROM T"),
-        Err(DdsError::Unsupported(_))
-    ));
-    assert!(matches!(
-        p.get_builtin_subscriber(),
         Err(DdsError::Unsupported(_))
     ));
 }

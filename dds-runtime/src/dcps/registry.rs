@@ -142,6 +142,8 @@ pub(crate) struct Registry {
     entities: Mutex<Entities>,
     /// Notified when a remote topic is discovered (`find_topic` waits on it).
     discovered: Condvar,
+    /// The built-in subscriber, created when first asked for.
+    pub(crate) builtin: std::sync::OnceLock<super::builtin_subscriber::BuiltinSubscriber>,
 }
 
 impl Registry {
@@ -161,6 +163,7 @@ impl Registry {
                 ..Entities::default()
             }),
             discovered: Condvar::new(),
+            builtin: std::sync::OnceLock::new(),
         }
     }
 

@@ -578,6 +578,11 @@ pub enum Event {
         /// The local writer.
         writer: EntityId,
     },
+    /// A local reader was deleted (after its unmatch events).
+    ReaderDeleted {
+        /// The local reader.
+        reader: EntityId,
+    },
     /// Flow control released a writer that returned WouldBlock: unacknowledged bytes fell below the low watermark.
     WriterUnblocked {
         /// The local writer.

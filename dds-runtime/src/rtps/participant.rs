@@ -394,6 +394,7 @@ impl Participant {
             Vec::new(),
         );
         self.forget_endpoint::<ReaderQos>(guid);
+        self.events.push_back(Event::ReaderDeleted { reader: id });
         self.service(now);
     }
 

@@ -10,6 +10,7 @@ use crate::cdr::{self, DdsType};
 use crate::qos::{ChangeableQos, DataReaderQos, ReaderQos, SubscriberQos, TopicQos};
 
 use super::super::builtin::PublicationBuiltinTopicData;
+use super::super::builtin_subscriber::BuiltinSubscriber;
 use super::super::chain::{ListenerNode, ParentListener, StatusChange};
 use super::super::condition::{ReadCondition, ReadConditionSource, StatusCondition};
 use super::super::error::{DdsError, DdsResult};
@@ -184,12 +185,17 @@ impl DomainParticipant {
             .delete_group::<SubscriberQos>(Arc::as_ptr(&subscriber.qos) as *const ())
     }
 
-    /// `get_builtin_subscriber`: not supported (built-in topics are not readable as topics; discovery
-    /// data is available through `discovered_participants`, `get_matched_*_data`).
-    pub fn get_builtin_subscriber(&self) -> DdsResult<Subscriber> {
-        Err(DdsError::Unsupported(
-            "built-in topic readers: use get_matched_publication_data and friends",
-        ))
+    /// The built-in subscriber (`get_builtin_subscriber`): readers of `DCPSParticipant`,
+    /// `DCPSPublication`, `DCPSSubscription` and `DCPSTopic`. Created on the first call with what
+    /// discovery knows by then; every call returns the same readers.
+    pub fn get_builtin_subscriber(&self) -> DdsResult<BuiltinSubscriber> {
+        self.driver().check_alive()?;
+        let driver = self.driver();
+        Ok(self
+            .registry()
+            .builtin
+            .get_or_init(|| BuiltinSubscriber::start(driver))
+            .clone())
     }
 }
 
