@@ -4,7 +4,7 @@
 
 use crate::qos::{ReaderQos, WriterQos};
 use crate::rtps::discovery::{EndpointData, ParticipantData};
-use crate::rtps::{Guid, GuidPrefix, VendorId};
+use crate::rtps::{EntityId, Guid, GuidPrefix, VendorId};
 use crate::xtypes::TypeInformation;
 
 use super::sample::InstanceHandle;
@@ -18,7 +18,7 @@ use super::sample::InstanceHandle;
 pub struct EndpointBuiltinTopicData<Q> {
     /// The endpoint's GUID.
     pub key: Guid,
-    /// Its participant's GUID, when announced.
+    /// Its participant's GUID: as announced, else the one its GUID prefix names.
     pub participant_key: Option<Guid>,
     /// The topic name.
     pub topic_name: String,
@@ -68,7 +68,10 @@ impl<Q: Clone> From<&EndpointData<Q>> for EndpointBuiltinTopicData<Q> {
     fn from(d: &EndpointData<Q>) -> Self {
         EndpointBuiltinTopicData {
             key: d.guid,
-            participant_key: d.participant_guid,
+            // Cyclone does not send PID_PARTICIPANT_GUID in SEDP: the GUID prefix names the participant.
+            participant_key: d
+                .participant_guid
+                .or(Some(Guid::new(d.guid.prefix, EntityId::PARTICIPANT))),
             topic_name: d.topic_name.clone(),
             type_name: d.type_name.clone(),
             qos: d.qos.clone(),
