@@ -161,3 +161,33 @@ fn builtin_subscriber_created_late_is_seeded_with_what_was_discovered() {
         })
     }));
 }
+
+#[test]
+fn ignore_topic_by_its_dcpstopic_handle() {
+    let p = participant(231);
+    let other = participant(231);
+    let r = reader::<ShapeType>(&p, "IgnoreMe", &DataReaderQos::default());
+    let w = writer::<ShapeType>(&other, "IgnoreMe", &DataWriterQos::default());
+    assert!(wait_until(MATCH_TIMEOUT, || r.matched_publications().len() == 1));
+    let topics = p.get_builtin_subscriber().unwrap().topic_reader();
+    let key = topics
+        .read()
+        .unwrap()
+        .into_iter()
+        .filter_map(|s| s.data)
+        .find(|t| t.name == "IgnoreMe")
+        .expect("DCPSTopic sample")
+        .key;
+    assert!(matches!(
+        p.ignore_topic_by_handle(InstanceHandle(7)),
+        Err(DdsError::BadParameter(_))
+    ));
+    p.ignore_topic_by_handle(key).unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || r
+        .matched_publications()
+        .is_empty()));
+    let w2 = writer::<ShapeType>(&other, "IgnoreMe", &DataWriterQos::default());
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    assert!(r.matched_publications().is_empty());
+    drop((w, w2));
+}

@@ -10,7 +10,8 @@ use crate::qos::{ChangeableQos, DomainParticipantQos, PublisherQos, SubscriberQo
 use crate::rtps::{EntityId, Guid, GuidPrefix};
 
 use super::super::builtin::{
-    ParticipantBuiltinTopicData, PublicationBuiltinTopicData, SubscriptionBuiltinTopicData,
+    topic_key, ParticipantBuiltinTopicData, PublicationBuiltinTopicData,
+    SubscriptionBuiltinTopicData,
 };
 use super::super::chain::{ParentListener, StatusChange};
 use super::super::driver::Driver;
@@ -172,12 +173,26 @@ impl DomainParticipant {
         Ok(())
     }
 
-    /// Ignores every remote endpoint on the topic `name` (`ignore_topic`, by name: topics have no
-    /// discovery handle here).
+    /// Ignores every remote endpoint on the topic `name` (`ignore_topic` by name).
     pub fn ignore_topic(&self, name: &str) -> DdsResult<()> {
         self.driver.check_alive()?;
         self.driver.with_core(|c, _| c.ignore_topic(name))?;
         Ok(())
+    }
+
+    /// Ignores a remote topic by its handle (`ignore_topic` as DDS defines it): the instance handle of its
+    /// `DCPSTopic` sample (`TopicBuiltinTopicData::key`). `BadParameter` for a topic not discovered.
+    pub fn ignore_topic_by_handle(&self, handle: InstanceHandle) -> DdsResult<()> {
+        let name = self
+            .registry
+            .with(|e| {
+                e.remote_topics
+                    .iter()
+                    .find(|(n, t)| topic_key(n, t) == handle)
+                    .map(|(n, _)| n.clone())
+            })
+            .ok_or_else(|| DdsError::BadParameter(format!("no discovered topic {handle:?}")))?;
+        self.ignore_topic(&name)
     }
 
     /// Ignores a remote writer (`ignore_publication`), by its handle (`SampleInfo::publication_handle`,
