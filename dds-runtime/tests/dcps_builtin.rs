@@ -191,3 +191,56 @@ fn ignore_topic_by_its_dcpstopic_handle() {
     assert!(r.matched_publications().is_empty());
     drop((w, w2));
 }
+
+/// Topics travel in SEDP (DCPSTopic, builtin endpoints 0x2c2/0x2c7): a topic with no reader or writer is
+/// seen by the other participant's DCPSTopic reader and `find_topic`, clashes as INCONSISTENT_TOPIC, and
+/// is disposed when deleted.
+#[test]
+fn topics_are_announced_in_sedp() {
+    let p = participant(232);
+    let other = participant(232);
+    let topics = p.get_builtin_subscriber().unwrap().topic_reader();
+    let qos = TopicQos::builder().topic_data(b"about".to_vec()).build();
+    let lonely = other.create_topic::<ShapeType>("Lonely", &qos).unwrap();
+    let mut seen = None;
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        seen = topics
+            .read()
+            .unwrap()
+            .into_iter()
+            .find(|s| s.data.as_ref().is_some_and(|t| t.name == "Lonely"));
+        seen.is_some()
+    }));
+    let seen = seen.unwrap();
+    let t = seen.data.unwrap();
+    assert_eq!(
+        (t.type_name.as_str(), t.topic_data.as_slice()),
+        ("ShapeType", &b"about"[..])
+    );
+    let found = p
+        .find_topic::<ShapeType>("Lonely", MATCH_TIMEOUT)
+        .expect("find_topic sees the remote topic");
+    assert_eq!(found.name(), "Lonely");
+    // Same name, another type, still no endpoint anywhere: INCONSISTENT_TOPIC on our topic.
+    let clash = p
+        .create_topic::<Blob>("Clashing", &TopicQos::default())
+        .unwrap();
+    let _theirs = other
+        .create_topic::<ShapeType>("Clashing", &TopicQos::default())
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        clash
+            .inconsistent_topic_status()
+            .is_ok_and(|s| s.total_count == 1)
+    }));
+    // Deleted: disposed in DCPSTopic.
+    other.delete_topic(&lonely).unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        topics
+            .read_instance(seen.info.instance_handle)
+            .is_ok_and(|s| {
+                s.iter()
+                    .any(|s| s.info.instance_state == InstanceState::NotAliveDisposed)
+            })
+    }));
+}

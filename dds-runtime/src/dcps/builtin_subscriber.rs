@@ -1,7 +1,8 @@
 //! The built-in subscriber (`get_builtin_subscriber`, DDS 1.4 §2.2.5): its four readers, seeded with what
 //! discovery knows when it is first asked for, then fed by the core's discovery events.
 
-use std::sync::Arc;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 
 use super::builtin::{
     topic_key, ParticipantBuiltinTopicData, PublicationBuiltinTopicData,
@@ -10,7 +11,8 @@ use super::builtin::{
 use super::builtin_reader::BuiltinDataReader;
 use super::driver::{CoreObserver, Driver};
 use super::sample::InstanceHandle;
-use crate::rtps::discovery::{EndpointData, ParticipantData};
+use super::sync::lock;
+use crate::rtps::discovery::{EndpointData, ParticipantData, TopicData};
 use crate::rtps::{EntityId, Event, Guid, GuidPrefix};
 
 /// The built-in subscriber of a participant: one reader per built-in topic. Cheap to clone; every call of
@@ -19,6 +21,8 @@ use crate::rtps::{EntityId, Event, Guid, GuidPrefix};
 pub struct BuiltinSubscriber {
     /// Our participant's prefix (local endpoints that are deleted leave as remote ones do).
     prefix: GuidPrefix,
+    /// The DCPSTopic instance of each topic announced in SEDP, by the announcement's GUID.
+    topic_guids: Arc<Mutex<HashMap<Guid, InstanceHandle>>>,
     participants: BuiltinDataReader<ParticipantBuiltinTopicData>,
     publications: BuiltinDataReader<PublicationBuiltinTopicData>,
     subscriptions: BuiltinDataReader<SubscriptionBuiltinTopicData>,
@@ -50,6 +54,7 @@ impl BuiltinSubscriber {
     pub(crate) fn start(driver: &Driver) -> Self {
         let s = BuiltinSubscriber {
             prefix: driver.guid_prefix,
+            topic_guids: Arc::default(),
             participants: BuiltinDataReader::new("DCPSParticipant"),
             publications: BuiltinDataReader::new("DCPSPublication"),
             subscriptions: BuiltinDataReader::new("DCPSSubscription"),
@@ -57,13 +62,17 @@ impl BuiltinSubscriber {
         };
         // Events from now on; what came before is seeded below (a repeat is only an update).
         driver.add_observer(Arc::new(s.clone()));
-        let (participants, writers, readers) = driver.query_core(|c| {
+        let (participants, writers, readers, topics) = driver.query_core(|c| {
             let mut ps: Vec<ParticipantData> = c.discovered_participants().cloned().collect();
             ps.push(c.participant_data());
             let ws: Vec<EndpointData<_>> = c.publications().cloned().collect();
             let rs: Vec<EndpointData<_>> = c.subscriptions().cloned().collect();
-            (ps, ws, rs)
+            let ts: Vec<TopicData> = c.discovered_topic_announcements().cloned().collect();
+            (ps, ws, rs, ts)
         });
+        for t in topics {
+            s.on_event(&Event::TopicDiscovered(Box::new(t)));
+        }
         for p in &participants {
             s.participant(p);
         }
@@ -127,6 +136,18 @@ impl CoreObserver for BuiltinSubscriber {
             Event::WriterDeleted { writer } => {
                 let g = Guid::new(self.prefix, *writer);
                 self.publications.dispose(InstanceHandle::from_guid(g));
+            }
+            Event::TopicDiscovered(t) => {
+                let key = topic_key(&t.topic_name, &t.type_name);
+                lock(&self.topic_guids).insert(t.guid, key);
+                let data =
+                    TopicBuiltinTopicData::new(&t.topic_name, &t.type_name, t.topic_data.clone());
+                self.topics.upsert(key, data);
+            }
+            Event::TopicRemoved { guid } => {
+                if let Some(key) = lock(&self.topic_guids).remove(guid) {
+                    self.topics.dispose(key);
+                }
             }
             Event::ReaderDeleted { reader } => {
                 let g = Guid::new(self.prefix, *reader);

@@ -491,7 +491,7 @@ impl Driver {
                 lock(&self.remote_writers).insert(guid, info);
                 self.discovered(ev);
             }
-            Event::SubscriptionDiscovered(_) => self.discovered(ev),
+            Event::SubscriptionDiscovered(_) | Event::TopicDiscovered(_) => self.discovered(ev),
             Event::PublicationRemoved { guid } => {
                 lock(&self.remote_writers).remove(guid);
             }

@@ -11,6 +11,7 @@
 //! The registry keeps the handles of the disabled participant, topics, publishers and subscribers;
 //! readers and writers keep their own flag (checked on their hot paths) in their endpoint state.
 
+use super::driver::Driver;
 use super::error::{DdsError, DdsResult};
 use super::registry::{Entities, GroupQos, Registry};
 use super::sample::InstanceHandle;
@@ -99,6 +100,30 @@ fn disabled_groups<Q: GroupQos, C>(
 }
 
 impl Registry {
+    /// Announces in SEDP (DCPSTopic) every enabled topic not announced yet.
+    pub(crate) fn announce_topics(&self, driver: &Driver) {
+        let todo: Vec<(InstanceHandle, String, String, Vec<u8>)> = self.with(|e| {
+            e.topics
+                .iter()
+                .filter(|t| !t.deleted && t.wire.is_none() && !e.disabled.contains(&t.node.handle))
+                .map(|t| {
+                    let data = t.qos.topic_data.0.clone();
+                    (t.node.handle, t.name.clone(), t.type_name.clone(), data)
+                })
+                .collect()
+        });
+        for (h, name, type_name, data) in todo {
+            match driver.with_core(|c, now| c.announce_topic(now, &name, &type_name, data)) {
+                Ok(g) => self.with(|e| {
+                    if let Some(t) = e.topics.iter_mut().find(|t| t.node.handle == h) {
+                        t.wire = Some(g);
+                    }
+                }),
+                Err(err) => tracing::debug!(error = %err, topic = %name, "topic not announced"),
+            }
+        }
+    }
+
     /// Records a topic, publisher or subscriber just created by the participant: disabled when the
     /// participant is, or its QoS does not autoenable.
     pub(crate) fn created_by_participant(&self, child: InstanceHandle) {

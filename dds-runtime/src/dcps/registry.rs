@@ -56,6 +56,8 @@ pub(crate) struct TopicEntry {
     pub(crate) qos: TopicQos,
     pub(crate) inconsistent: InconsistentTopicStatus,
     pub(crate) deleted: bool,
+    /// The GUID of its SEDP announcement (DCPSTopic), once announced.
+    pub(crate) wire: Option<Guid>,
 }
 
 /// A reader or writer.
@@ -107,8 +109,10 @@ pub(crate) struct Entities {
     pub(crate) readers: Vec<EndpointEntry>,
     /// Topic name → type name of remote endpoints (for `find_topic` and INCONSISTENT_TOPIC).
     pub(crate) remote_topics: HashMap<String, String>,
-    /// Remote endpoints already counted in an INCONSISTENT_TOPIC status (announced again on QoS changes).
-    inconsistent_seen: HashSet<Guid>,
+    /// Remote topics (participant, topic name) already counted in an INCONSISTENT_TOPIC status: a remote
+    /// participant's topic counts once, whether learnt from its SEDP topic announcement or from its readers
+    /// and writers (announced again on QoS changes).
+    inconsistent_seen: HashSet<(GuidPrefix, String)>,
     pub(crate) participant_qos: DomainParticipantQos,
     pub(crate) default_publisher_qos: PublisherQos,
     pub(crate) default_subscriber_qos: SubscriberQos,
@@ -232,6 +236,7 @@ impl Registry {
                 qos,
                 inconsistent,
                 deleted: false,
+                wire: None,
             });
             clash
         });
@@ -240,6 +245,16 @@ impl Registry {
             node.raise_up(node.handle, StatusMask::INCONSISTENT_TOPIC);
         }
         handle
+    }
+
+    /// Takes the GUID of the SEDP announcement of the topic at `ptr` (to withdraw it). Works while the topic
+    /// is being dropped: the entry is looked up before dead entries are pruned.
+    pub(crate) fn take_topic_wire(&self, ptr: *const ()) -> Option<Guid> {
+        lock(&self.entities)
+            .topics
+            .iter_mut()
+            .find(|t| same(&t.identity, ptr))
+            .and_then(|t| t.wire.take())
     }
 
     /// Registers a writer (`writer` true) or reader of the group `group` on `topic`.
@@ -263,6 +278,7 @@ impl Registry {
         let (guid, topic, type_name) = match ev {
             Event::PublicationDiscovered(w) => (w.guid, &w.topic_name, &w.type_name),
             Event::SubscriptionDiscovered(r) => (r.guid, &r.topic_name, &r.type_name),
+            Event::TopicDiscovered(t) => (t.guid, &t.topic_name, &t.type_name),
             _ => return Vec::new(),
         };
         let out = self.with(|e| {
@@ -276,7 +292,7 @@ impl Registry {
             if !inconsistent || e.inconsistent_seen.len() >= MAX_REMOTE_TOPICS {
                 return Vec::new();
             }
-            if !e.inconsistent_seen.insert(guid) {
+            if !e.inconsistent_seen.insert((guid.prefix, topic.clone())) {
                 return Vec::new();
             }
             e.topics

@@ -578,6 +578,13 @@ pub enum Event {
         /// The local writer.
         writer: EntityId,
     },
+    /// A remote topic was announced in SEDP (DCPSTopic), or announced again with other data.
+    TopicDiscovered(Box<crate::rtps::discovery::TopicData>),
+    /// A remote topic announced in SEDP was withdrawn (or its participant left).
+    TopicRemoved {
+        /// The topic's GUID.
+        guid: Guid,
+    },
     /// A local reader was deleted (after its unmatch events).
     ReaderDeleted {
         /// The local reader.

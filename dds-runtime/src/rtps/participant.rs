@@ -11,6 +11,7 @@ mod historical;
 mod liveliness;
 mod receive;
 mod timers;
+mod topics;
 
 use std::cell::Cell;
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
@@ -48,6 +49,8 @@ pub struct Participant {
     enabled: bool,
     /// Local endpoints created disabled, not announced yet.
     deferred: enable::DeferredEndpoints,
+    /// Remote topics announced in SEDP (DCPSTopic).
+    known_topics: HashMap<Guid, super::discovery::TopicData>,
     /// Reused buffer for what readers deliver while a datagram is processed.
     scratch: Vec<Event>,
     writers: BTreeMap<EntityId, Writer>,
@@ -147,6 +150,7 @@ impl Participant {
             own_leases: Default::default(),
             enabled: true,
             deferred: Default::default(),
+            known_topics: HashMap::new(),
             scratch: Vec::new(),
             writers: BTreeMap::new(),
             readers: BTreeMap::new(),
@@ -180,6 +184,7 @@ impl Participant {
                 Reader::new(Guid::new(prefix, r), reader_params(&p.config, true)),
             );
         }
+        p.add_topic_builtins();
         p.spdp_payload = p.participant_data().encode();
         p.service(now);
         p
@@ -209,7 +214,8 @@ impl Participant {
             default_unicast: c.default_unicast.clone(),
             default_multicast: c.default_multicast.clone(),
             lease_duration: c.lease_duration,
-            builtin_endpoints: super::discovery::builtin::OURS,
+            builtin_endpoints: super::discovery::builtin::OURS
+                | super::discovery::topics::TOPIC_BITS,
             manual_liveliness_count: 0,
             user_data: c.user_data.clone(),
             properties: c.properties.clone(),

@@ -140,6 +140,7 @@ impl DomainParticipant {
             self.driver.with_core(|c, now| c.set_enabled(now, true));
             if self.get_qos().autoenable_created_entities {
                 self.registry.enable_participant_contents();
+                self.registry.announce_topics(&self.driver);
             }
         }
         Ok(())

@@ -41,6 +41,7 @@ pub(super) fn register_topic<T: DdsType>(t: &Topic<T>) {
     let registry = t.inner.participant.registry();
     let handle = registry.add_topic(identity, &t.inner.name, T::TYPE_NAME, t.inner.qos.clone());
     registry.created_by_participant(handle);
+    registry.announce_topics(t.inner.participant.driver());
 }
 
 impl<T: DdsType> Topic<T> {
@@ -139,7 +140,10 @@ impl<T: DdsType> Topic<T> {
     pub fn enable(&self) -> DdsResult<()> {
         let h = self.instance_handle()?;
         let registry = self.participant().registry();
-        registry.enable(h, &[registry.node.handle]).map(|_| ())
+        if registry.enable(h, &[registry.node.handle])? {
+            registry.announce_topics(self.participant().driver());
+        }
+        Ok(())
     }
 
     /// Whether the topic is enabled.
@@ -175,7 +179,18 @@ impl DomainParticipant {
             }
             t.deleted = true;
             Ok(())
-        })
+        })?;
+        self.withdraw_topic(ptr);
+        Ok(())
+    }
+
+    /// Withdraws the SEDP announcement of the topic at `ptr`, if it was announced.
+    pub(super) fn withdraw_topic(&self, ptr: *const ()) {
+        if let Some(g) = self.registry().take_topic_wire(ptr) {
+            if self.driver().check_alive().is_ok() {
+                self.driver().with_core(|c, now| c.withdraw_topic(now, g));
+            }
+        }
     }
 
     /// The local topic named `name` (`lookup_topicdescription`); `None` when there is none, or it has
