@@ -323,13 +323,12 @@ impl<T: Clone + Send + Sync + 'static> BuiltinDataReader<T> {
         view_states: ViewStateMask,
         instance_states: InstanceStateMask,
     ) -> ReadCondition {
-        ReadCondition {
-            source: self.inner.clone(),
+        ReadCondition::on(
+            self.inner.clone(),
             sample_states,
             view_states,
             instance_states,
-            query: None,
-        }
+        )
     }
 
     /// The samples in `rc`'s states (`read_w_condition`).

@@ -150,6 +150,18 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         self.enabled.store(false, Ordering::Release);
     }
 
+    /// `enable()` of a reader or writer: `PreconditionNotMet` while one of its `parents` (group, topic) is
+    /// disabled in `registry`, else [`EndpointState::enable_in_core`].
+    pub(crate) fn enable_under(
+        &self,
+        registry: &super::registry::Registry,
+        parents: impl FnOnce() -> DdsResult<[InstanceHandle; 2]>,
+    ) -> DdsResult<()> {
+        self.check_alive()?;
+        registry.check_parents_enabled(&parents()?)?;
+        self.enable_in_core()
+    }
+
     /// Enables an endpoint created disabled: the core announces and matches it. Nothing when enabled.
     pub(crate) fn enable_in_core(&self) -> DdsResult<()> {
         self.check_alive()?;

@@ -584,13 +584,12 @@ impl<T: DdsType> DataReader<T> {
         view_states: ViewStateMask,
         instance_states: InstanceStateMask,
     ) -> ReadCondition {
-        ReadCondition {
-            source: self.inner.clone(),
+        ReadCondition::on(
+            self.inner.clone(),
             sample_states,
             view_states,
             instance_states,
-            query: None,
-        }
+        )
     }
 
     /// A query condition on this reader: a read condition whose samples must also satisfy `expression` (the

@@ -371,17 +371,11 @@ impl<T: DdsType> DataWriter<T> {
     /// Enables the writer (`enable`): it is announced in SEDP and matched from now on.
     /// `PreconditionNotMet` while its publisher or topic is disabled; nothing when enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.inner.state.check_alive()?;
-        let owner = self.handle.owner();
-        let parents = [
-            owner.publisher.instance_handle()?,
-            owner.topic.instance_handle()?,
-        ];
-        self.publisher()
-            .participant()
-            .registry()
-            .check_parents_enabled(&parents)?;
-        self.inner.state.enable_in_core()
+        let (group, topic) = (self.publisher(), self.topic());
+        let registry = group.participant().registry();
+        self.inner.state.enable_under(registry, || {
+            Ok([group.instance_handle()?, topic.instance_handle()?])
+        })
     }
 
     /// Whether the writer is enabled.

@@ -454,17 +454,11 @@ impl<T: DdsType> DataReader<T> {
     /// Enables the reader (`enable`): it is announced in SEDP and matched from now on.
     /// `PreconditionNotMet` while its subscriber or topic is disabled; nothing when enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.inner.state.check_alive()?;
-        let owner = self.handle.owner();
-        let parents = [
-            owner.subscriber.instance_handle()?,
-            owner.topic.instance_handle()?,
-        ];
-        self.subscriber()
-            .participant()
-            .registry()
-            .check_parents_enabled(&parents)?;
-        self.inner.state.enable_in_core()
+        let (group, topic) = (self.subscriber(), self.topic());
+        let registry = group.participant().registry();
+        self.inner.state.enable_under(registry, || {
+            Ok([group.instance_handle()?, topic.instance_handle()?])
+        })
     }
 
     /// Whether the reader is enabled.
