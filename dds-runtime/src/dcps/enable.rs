@@ -73,6 +73,16 @@ impl Registry {
         }
     }
 
+    /// Enables the publisher or subscriber at `ptr` (`enable`): `PreconditionNotMet` while the participant
+    /// is disabled; with `autoenable_created_entities`, its readers or writers created disabled too.
+    pub(crate) fn enable_group<Q: GroupQos>(&self, ptr: *const ()) -> DdsResult<()> {
+        let (g, auto) = self.with_group::<Q, _>(ptr, |g| (g.node.handle, g.qos.autoenable()))?;
+        if self.enable(g, &[self.node.handle])? && auto {
+            self.enable_group_children::<Q>(g);
+        }
+        Ok(())
+    }
+
     /// Enables the readers or writers of the group `g` that were created disabled (their topics
     /// permitting).
     pub(crate) fn enable_group_children<Q: GroupQos>(&self, g: InstanceHandle) {

@@ -195,18 +195,16 @@ impl Publisher {
     /// Enables the publisher (`enable`): `PreconditionNotMet` while its participant is disabled. With
     /// `autoenable_created_entities`, the writers it created disabled are enabled too.
     pub fn enable(&self) -> DdsResult<()> {
-        let (h, auto) = self.with_group(|g| (g.node.handle, g.qos.autoenable_created_entities))?;
-        let registry = self.participant.registry();
-        if registry.enable(h, &[registry.node.handle])? && auto {
-            registry.enable_group_children::<PublisherQos>(h);
-        }
-        Ok(())
+        self.participant.driver().check_alive()?;
+        self.participant
+            .registry()
+            .enable_group::<PublisherQos>(Arc::as_ptr(&self.qos) as *const ())
     }
 
     /// Whether the publisher is enabled.
     pub fn is_enabled(&self) -> bool {
-        self.instance_handle()
-            .is_ok_and(|h| self.participant.registry().is_enabled(h))
+        let registry = self.participant.registry();
+        self.instance_handle().is_ok_and(|h| registry.is_enabled(h))
     }
 
     /// Sets the QoS `create_datawriter` callers get from [`default_datawriter_qos`](Self::default_datawriter_qos)

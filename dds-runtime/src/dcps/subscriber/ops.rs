@@ -274,18 +274,16 @@ impl Subscriber {
     /// Enables the subscriber (`enable`): `PreconditionNotMet` while its participant is disabled. With
     /// `autoenable_created_entities`, the readers it created disabled are enabled too.
     pub fn enable(&self) -> DdsResult<()> {
-        let (h, auto) = self.with_group(|g| (g.node.handle, g.qos.autoenable_created_entities))?;
-        let registry = self.participant.registry();
-        if registry.enable(h, &[registry.node.handle])? && auto {
-            registry.enable_group_children::<SubscriberQos>(h);
-        }
-        Ok(())
+        self.participant.driver().check_alive()?;
+        self.participant
+            .registry()
+            .enable_group::<SubscriberQos>(Arc::as_ptr(&self.qos) as *const ())
     }
 
     /// Whether the subscriber is enabled.
     pub fn is_enabled(&self) -> bool {
-        self.instance_handle()
-            .is_ok_and(|h| self.participant.registry().is_enabled(h))
+        let registry = self.participant.registry();
+        self.instance_handle().is_ok_and(|h| registry.is_enabled(h))
     }
 
     /// Sets the default reader QoS (`set_default_datareader_qos`).
