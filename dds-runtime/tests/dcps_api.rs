@@ -201,7 +201,7 @@ fn factory_delete_participant() {
 }
 
 #[test]
-fn factory_qos_autoenable_false_is_unsupported() {
+fn factory_qos_autoenable_false_creates_disabled_participants() {
     require_netns();
     let f = DomainParticipantFactory::get_instance();
     let off = DomainParticipantFactoryQos::builder()
@@ -209,10 +209,10 @@ fn factory_qos_autoenable_false_is_unsupported() {
         .build();
     f.set_qos(&off).unwrap();
     assert_eq!(f.qos(), off);
-    assert!(matches!(
-        f.create_participant(154, &DomainParticipantQos::default()),
-        Err(DdsError::Unsupported(_))
-    ));
+    let disabled = f
+        .create_participant(154, &DomainParticipantQos::default())
+        .unwrap();
+    assert!(!disabled.is_enabled());
     f.set_qos(&DomainParticipantFactoryQos::default()).unwrap();
     assert!(f
         .create_participant(154, &DomainParticipantQos::default())
@@ -244,7 +244,8 @@ fn participant_set_qos_announces_user_data() {
     let off = DomainParticipantQos::builder()
         .autoenable_created_entities(false)
         .build();
-    assert!(matches!(p1.set_qos(&off), Err(DdsError::Unsupported(_))));
+    p1.set_qos(&off).unwrap();
+    assert!(!p1.get_qos().autoenable_created_entities);
 }
 
 #[test]
@@ -571,14 +572,10 @@ fn participant_find_topic() {
 }
 
 #[test]
-fn participant_multitopic_and_builtin_subscriber_unsupported() {
+fn participant_multitopic_unsupported() {
     let p = participant(172);
     assert!(matches!(
         p.create_multitopic("M", "T", "SELECT * FROM T"),
-        Err(DdsError::Unsupported(_))
-    ));
-    assert!(matches!(
-        p.get_builtin_subscriber(),
         Err(DdsError::Unsupported(_))
     ));
 }
@@ -757,6 +754,79 @@ fn publisher_status_condition() {
     w.publication_matched_status();
     assert!(!cond.trigger_value());
     publ.enable().unwrap();
+}
+
+/// Reading one writer's (or reader's) status leaves its publisher's (subscriber's) condition raised while a
+/// sibling still has the same status unread; reading the sibling's clears it.
+#[test]
+fn group_status_condition_stays_raised_for_an_unread_sibling() {
+    let p = participant(228);
+    let t = p
+        .create_topic::<ShapeType>("Siblings", &TopicQos::default())
+        .unwrap();
+    let publ = p.create_publisher(&PublisherQos::default()).unwrap();
+    let sub = p.create_subscriber(&SubscriberQos::default()).unwrap();
+    let (pc, sc) = (
+        publ.status_condition().unwrap(),
+        sub.status_condition().unwrap(),
+    );
+    let wq = DataWriterQos::default();
+    let (a, b) = (
+        publ.create_datawriter(&t, &wq).unwrap(),
+        publ.create_datawriter(&t, &wq).unwrap(),
+    );
+    let rq = DataReaderQos::default();
+    let (ra, rb) = (
+        sub.create_datareader::<ShapeType, _>(&t, &rq).unwrap(),
+        sub.create_datareader::<ShapeType, _>(&t, &rq).unwrap(),
+    );
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        a.publication_matched_status().current_count == 2
+            && b.publication_matched_status().current_count == 2
+            && ra.subscription_matched_status().current_count == 2
+            && rb.subscription_matched_status().current_count == 2
+    }));
+    // Everything read once: now raise PUBLICATION_MATCHED on both writers again with a third reader.
+    let _ = (
+        ra.liveliness_changed_status(),
+        rb.liveliness_changed_status(),
+    );
+    assert!(!pc
+        .changed_statuses()
+        .contains(StatusMask::PUBLICATION_MATCHED));
+    let _rc = reader::<ShapeType>(&p, "Siblings", &rq);
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        pc.changed_statuses()
+            .contains(StatusMask::PUBLICATION_MATCHED)
+            && a.matched_subscriptions().len() == 3
+            && b.matched_subscriptions().len() == 3
+    }));
+    a.publication_matched_status();
+    assert!(
+        pc.changed_statuses()
+            .contains(StatusMask::PUBLICATION_MATCHED),
+        "b's change is unread"
+    );
+    b.publication_matched_status();
+    assert!(!pc
+        .changed_statuses()
+        .contains(StatusMask::PUBLICATION_MATCHED));
+    // The same on the subscriber, with a new writer matching both readers.
+    assert!(!sc
+        .changed_statuses()
+        .contains(StatusMask::SUBSCRIPTION_MATCHED));
+    let _wc = writer::<ShapeType>(&p, "Siblings", &wq);
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        ra.matched_publications().len() == 3 && rb.matched_publications().len() == 3
+    }));
+    ra.subscription_matched_status();
+    assert!(sc
+        .changed_statuses()
+        .contains(StatusMask::SUBSCRIPTION_MATCHED));
+    rb.subscription_matched_status();
+    assert!(!sc
+        .changed_statuses()
+        .contains(StatusMask::SUBSCRIPTION_MATCHED));
 }
 
 #[test]

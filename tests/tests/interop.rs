@@ -7,6 +7,7 @@
 //! fails the test when `CI=true` and skips it otherwise.
 
 mod interop {
+    pub mod builtin;
     pub mod dds_cli;
     pub mod ddsperf;
     pub mod deadline;

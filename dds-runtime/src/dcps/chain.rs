@@ -23,6 +23,8 @@ pub enum StatusChange {
     OfferedIncompatibleQos(IncompatibleQosStatus),
     /// OFFERED_DEADLINE_MISSED of a writer.
     OfferedDeadlineMissed(DeadlineMissedStatus),
+    /// LIVELINESS_LOST of a writer.
+    LivelinessLost(LivelinessLostStatus),
     /// SUBSCRIPTION_MATCHED of a reader.
     SubscriptionMatched(SubscriptionMatchedStatus),
     /// REQUESTED_INCOMPATIBLE_QOS of a reader.
@@ -48,6 +50,7 @@ impl StatusChange {
             StatusChange::PublicationMatched(_) => StatusMask::PUBLICATION_MATCHED,
             StatusChange::OfferedIncompatibleQos(_) => StatusMask::OFFERED_INCOMPATIBLE_QOS,
             StatusChange::OfferedDeadlineMissed(_) => StatusMask::OFFERED_DEADLINE_MISSED,
+            StatusChange::LivelinessLost(_) => StatusMask::LIVELINESS_LOST,
             StatusChange::SubscriptionMatched(_) => StatusMask::SUBSCRIPTION_MATCHED,
             StatusChange::RequestedIncompatibleQos(_) => StatusMask::REQUESTED_INCOMPATIBLE_QOS,
             StatusChange::RequestedDeadlineMissed(_) => StatusMask::REQUESTED_DEADLINE_MISSED,
@@ -92,6 +95,7 @@ erased!(DeadlineMissedStatus {
 erased!(SampleLostStatus { SAMPLE_LOST => SampleLost });
 erased!(SampleRejectedStatus { SAMPLE_REJECTED => SampleRejected });
 erased!(LivelinessChangedStatus { LIVELINESS_CHANGED => LivelinessChanged });
+erased!(LivelinessLostStatus { LIVELINESS_LOST => LivelinessLost });
 erased!(InconsistentTopicStatus { INCONSISTENT_TOPIC => InconsistentTopic });
 
 /// A listener of a level above a reader or writer (publisher, subscriber, participant), type-erased.
@@ -113,6 +117,9 @@ pub(crate) struct ListenerNode {
     any: AtomicBool,
     /// The status condition of this level's entity.
     pub(crate) status: Arc<StatusCore>,
+    /// The statuses raised on this level and not read yet, by the entity they belong to (this level's
+    /// own, or one it contains): a bit of `status` is cleared only when no entity still has it pending.
+    pending: Mutex<Vec<(InstanceHandle, StatusMask)>>,
     parent: Option<Arc<ListenerNode>>,
 }
 
@@ -128,6 +135,7 @@ impl ListenerNode {
             slot: Mutex::new(None),
             any: AtomicBool::new(false),
             status,
+            pending: Mutex::new(Vec::new()),
             parent,
         }
     }
@@ -162,23 +170,48 @@ impl ListenerNode {
         None
     }
 
-    /// Raises `kind` on the status conditions of this level and every level above: a publisher's,
-    /// subscriber's or participant's condition triggers when a status of an entity it contains changes.
-    pub(crate) fn raise_up(&self, kind: StatusMask) {
+    /// Raises `kind`, a status of the entity `source` (this level's or one it contains), on the status
+    /// conditions of this level and every level above: a publisher's, subscriber's or participant's
+    /// condition triggers when a status of an entity it contains changes.
+    pub(crate) fn raise_up(&self, source: InstanceHandle, kind: StatusMask) {
         let mut node = Some(self);
         while let Some(n) = node {
+            {
+                let mut p = lock(&n.pending);
+                match p.iter_mut().find(|(h, _)| *h == source) {
+                    Some((_, m)) => *m |= kind,
+                    None => p.push((source, kind)),
+                }
+            }
             n.status.raise_new(kind);
             node = n.parent.as_deref();
         }
     }
 
-    /// Clears `kind` on this level and every level above (the application read the status).
-    pub(crate) fn clear_up(&self, kind: StatusMask) {
+    /// The application read `kind` of the entity `source`: clears it on this level and every level above,
+    /// except where another entity still has it pending (reading one writer's status leaves its
+    /// publisher's condition raised for a sibling's).
+    pub(crate) fn clear_up(&self, source: InstanceHandle, kind: StatusMask) {
         let mut node = Some(self);
         while let Some(n) = node {
-            n.status.clear(kind);
+            let still = {
+                let mut p = lock(&n.pending);
+                for (h, m) in p.iter_mut() {
+                    if *h == source {
+                        m.remove(kind);
+                    }
+                }
+                p.retain(|(_, m)| !m.is_empty());
+                p.iter().fold(StatusMask::empty(), |acc, (_, m)| acc | *m)
+            };
+            n.status.clear(kind - still);
             node = n.parent.as_deref();
         }
+    }
+
+    /// Forgets what the entity `source` (deleted) had pending, as if it had been read.
+    pub(crate) fn forget(&self, source: InstanceHandle) {
+        self.clear_up(source, StatusMask::all());
     }
 }
 

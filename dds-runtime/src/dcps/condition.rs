@@ -195,6 +195,22 @@ impl std::fmt::Debug for ReadCondition {
 }
 
 impl ReadCondition {
+    /// A read condition (no query) on `source` for samples in the given states.
+    pub(crate) fn on(
+        source: Arc<dyn ReadConditionSource>,
+        sample_states: SampleStateMask,
+        view_states: ViewStateMask,
+        instance_states: InstanceStateMask,
+    ) -> Self {
+        ReadCondition {
+            source,
+            sample_states,
+            view_states,
+            instance_states,
+            query: None,
+        }
+    }
+
     /// Whether the reader holds a matching sample.
     pub fn trigger_value(&self) -> bool {
         self.source.has_matching(

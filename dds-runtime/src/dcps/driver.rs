@@ -216,12 +216,18 @@ impl Driver {
         config: Config,
         user_data: Vec<u8>,
         name: Option<String>,
+        enabled: bool,
     ) -> DdsResult<Arc<Driver>> {
         let transport = UdpTransport::bind(&config)?;
         let prefix = new_guid_prefix();
         let pc = core_config(&config, &transport, prefix, user_data, name)?;
+        let mut core = Participant::new(pc, Instant::now());
+        if !enabled {
+            // Created disabled: nothing is sent, not even the first SPDP announcement, until `enable`.
+            core.set_enabled(Instant::now(), false);
+        }
         let driver = Arc::new(Driver {
-            core: Mutex::new(Participant::new(pc, Instant::now())),
+            core: Mutex::new(core),
             transport,
             config,
             guid_prefix: prefix,
@@ -459,6 +465,7 @@ impl Driver {
         match ev {
             Event::PublicationMatched { writer: id, .. }
             | Event::OfferedIncompatibleQos { writer: id, .. }
+            | Event::LivelinessLost { writer: id }
             | Event::SubscriptionMatched { reader: id, .. }
             | Event::RequestedIncompatibleQos { reader: id, .. }
             | Event::LivelinessChanged { reader: id, .. }
@@ -490,7 +497,7 @@ impl Driver {
                 }
                 self.discovered(ev);
             }
-            Event::SubscriptionDiscovered(_) => self.discovered(ev),
+            Event::SubscriptionDiscovered(_) | Event::TopicDiscovered(_) => self.discovered(ev),
             Event::PublicationRemoved { guid } => {
                 lock(&self.remote_writers).remove(guid);
             }

@@ -38,6 +38,8 @@ pub(crate) struct EndpointState<S, L: ?Sized, O> {
     deleted: Arc<AtomicBool>,
     matched: Mutex<Vec<Guid>>,
     handle: Mutex<Weak<EndpointHandle<O>>>,
+    /// Whether the endpoint is enabled (announced and matched); see `dcps::enable`.
+    enabled: AtomicBool,
 }
 
 /// Where a status goes: the entity's own listener, or one of the levels above.
@@ -59,6 +61,7 @@ impl<S: Default, L: ?Sized, O> EndpointState<S, L, O> {
             deleted: Arc::new(AtomicBool::new(false)),
             matched: Mutex::new(Vec::new()),
             handle: Mutex::new(Weak::new()),
+            enabled: AtomicBool::new(true),
         }
     }
 }
@@ -126,7 +129,46 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         if self.deleted.swap(true, Ordering::AcqRel) {
             return Err(DdsError::AlreadyDeleted);
         }
+        if let Some(parent) = self.parent.get() {
+            parent.forget(self.instance());
+        }
         self.driver.delete_endpoint(self.id());
+        Ok(())
+    }
+
+    /// `Err(NotEnabled)` while the endpoint is disabled (after `check_alive`).
+    pub(crate) fn check_enabled(&self) -> DdsResult<()> {
+        self.check_alive()?;
+        if !self.enabled.load(Ordering::Acquire) {
+            return Err(DdsError::NotEnabled);
+        }
+        Ok(())
+    }
+
+    /// Records that the endpoint was created disabled (before it is visible to the application).
+    pub(crate) fn set_created_disabled(&self) {
+        self.enabled.store(false, Ordering::Release);
+    }
+
+    /// `enable()` of a reader or writer: `PreconditionNotMet` while one of its `parents` (group, topic) is
+    /// disabled in `registry`, else [`EndpointState::enable_in_core`].
+    pub(crate) fn enable_under(
+        &self,
+        registry: &super::registry::Registry,
+        parents: impl FnOnce() -> DdsResult<[InstanceHandle; 2]>,
+    ) -> DdsResult<()> {
+        self.check_alive()?;
+        registry.check_parents_enabled(&parents()?)?;
+        self.enable_in_core()
+    }
+
+    /// Enables an endpoint created disabled: the core announces and matches it. Nothing when enabled.
+    pub(crate) fn enable_in_core(&self) -> DdsResult<()> {
+        self.check_alive()?;
+        if !self.enabled.swap(true, Ordering::AcqRel) {
+            let id = self.id();
+            self.driver.with_core(|c, now| c.enable_endpoint(now, id));
+        }
         Ok(())
     }
 
@@ -158,13 +200,19 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
     /// A read or take: the subscriber's DATA_ON_READERS is reset (DDS 1.4 §2.2.4.1).
     pub(crate) fn data_read(&self) {
         if let Some(parent) = self.parent.get() {
-            parent.clear_up(StatusMask::DATA_ON_READERS | StatusMask::DATA_AVAILABLE);
+            parent.clear_up(self.instance(), StatusMask::DATA_AVAILABLE);
+            parent.clear_up(parent.handle, StatusMask::DATA_ON_READERS);
         }
     }
 
     /// The GUID of the endpoint.
     fn guid(&self) -> Guid {
         Guid::new(self.driver.guid_prefix, self.id())
+    }
+
+    /// The endpoint's instance handle, as the levels above know it.
+    fn instance(&self) -> InstanceHandle {
+        InstanceHandle::from_guid(self.guid())
     }
 
     /// The GUIDs of the matched remote endpoints.
@@ -184,7 +232,7 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         s.reset_changes();
         self.status_core.clear(mask);
         if let Some(parent) = self.parent.get() {
-            parent.clear_up(mask);
+            parent.clear_up(self.instance(), mask);
         }
         out
     }
@@ -198,8 +246,22 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E, T),
     ) {
-        let (target, status) = self.update(mask, update, false);
-        self.deliver(mask, target, status, entity, call);
+        if let Some((target, status)) = self.update(mask, |s| Some(update(s)), false) {
+            self.deliver(mask, target, status, entity, call);
+        }
+    }
+
+    /// [`EndpointState::signal`] when `update` changed the status (returns it), nothing otherwise.
+    pub(crate) fn signal_if<T: ErasedStatus, E>(
+        &self,
+        mask: StatusMask,
+        update: impl FnOnce(&mut S) -> Option<&mut T>,
+        entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
+        call: impl FnOnce(&L, &E, T),
+    ) {
+        if let Some((target, status)) = self.update(mask, update, false) {
+            self.deliver(mask, target, status, entity, call);
+        }
     }
 
     /// [`EndpointState::signal`] for a status whose listener consumes the change counts (DDS 1.4 §2.2.4.2.1),
@@ -211,8 +273,9 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E, T),
     ) {
-        let (target, status) = self.update(mask, update, true);
-        self.deliver(mask, target, status, entity, call);
+        if let Some((target, status)) = self.update(mask, |s| Some(update(s)), true) {
+            self.deliver(mask, target, status, entity, call);
+        }
     }
 
     /// Records that `remote` matched or unmatched (see [`EndpointState::signal`]); a listener consumes the
@@ -225,38 +288,40 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         entity: impl FnOnce(Arc<EndpointHandle<O>>) -> E,
         call: impl FnOnce(&L, &E, T),
     ) {
-        let (target, status) = {
+        let updated = {
             let mut list = lock(&self.matched);
             self.update(
                 mask,
                 |st| {
                     let s = field(st);
                     s.record_match(&mut list, remote, matched);
-                    s
+                    Some(s)
                 },
                 true,
             )
         };
-        self.deliver(mask, target, status, entity, call);
+        if let Some((target, status)) = updated {
+            self.deliver(mask, target, status, entity, call);
+        }
     }
 
-    /// Applies `update` to a status. With `consume`, a listener consumes the change counts (DDS 2.2.4.2.1):
-    /// the next callback reports only what happened since this one.
+    /// Applies `update` to a status (`None`: it did not change). With `consume`, a listener consumes the
+    /// change counts (DDS 2.2.4.2.1): the next callback reports only what happened since this one.
     #[allow(clippy::type_complexity)]
     fn update<T: ErasedStatus>(
         &self,
         mask: StatusMask,
-        update: impl FnOnce(&mut S) -> &mut T,
+        update: impl FnOnce(&mut S) -> Option<&mut T>,
         consume: bool,
-    ) -> (Option<Target<L, Arc<EndpointHandle<O>>>>, T) {
+    ) -> Option<(Option<Target<L, Arc<EndpointHandle<O>>>>, T)> {
         let target = self.target(mask);
         let mut st = lock(&self.statuses);
-        let s = update(&mut st);
+        let s = update(&mut st)?;
         let out = s.clone();
         if consume && target.is_some() {
             s.reset_changes();
         }
-        (target, out)
+        Some((target, out))
     }
 
     /// Raises `mask`, then (no lock held) calls the listener chosen by [`EndpointState::target`].
@@ -270,7 +335,7 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
     ) {
         self.status_core.raise(mask);
         if let Some(parent) = self.parent.get() {
-            parent.raise_up(mask);
+            parent.raise_up(self.instance(), mask);
         }
         match target {
             Some(Target::Own(l, h)) => call(&l, &entity(h), status),
@@ -304,9 +369,10 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         call: impl FnOnce(&L, &E),
     ) {
         if let Some(parent) = self.parent.get() {
-            parent.raise_up(StatusMask::DATA_ON_READERS | StatusMask::DATA_AVAILABLE);
+            parent.raise_up(self.instance(), StatusMask::DATA_AVAILABLE);
+            parent.raise_up(parent.handle, StatusMask::DATA_ON_READERS);
             if let Some(l) = parent.find(StatusMask::DATA_ON_READERS) {
-                parent.clear_up(StatusMask::DATA_ON_READERS);
+                parent.clear_up(parent.handle, StatusMask::DATA_ON_READERS);
                 l.on_data_on_readers(parent.handle);
                 return;
             }

@@ -44,6 +44,10 @@ pub enum DdsError {
     /// The QoS values contradict each other (DDS INCONSISTENT_POLICY).
     #[error("inconsistent policy: {0}")]
     InconsistentPolicy(&'static str),
+    /// The entity is not enabled yet (DDS NOT_ENABLED): see `enable()` and
+    /// ENTITY_FACTORY.autoenable_created_entities.
+    #[error("entity not enabled")]
+    NotEnabled,
     /// The feature is not implemented.
     #[error("unsupported: {0}")]
     Unsupported(&'static str),

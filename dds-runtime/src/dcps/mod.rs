@@ -28,12 +28,15 @@
 //! key hash when a sample of that instance carrying the same hash was seen before.
 
 pub mod builtin;
+mod builtin_reader;
+mod builtin_subscriber;
 mod cache;
 mod chain;
 pub mod condition;
 mod decode;
 mod driver;
 pub mod durability;
+mod enable;
 mod endpoint;
 mod error;
 pub mod filter;
@@ -53,8 +56,11 @@ mod writer_filter;
 /// GUIDs name entities in the DCPS API ([`DataWriter::guid`], [`SampleInfo::publication_guid`], ...).
 pub use crate::rtps::{Guid, GuidPrefix};
 pub use builtin::{
-    ParticipantBuiltinTopicData, PublicationBuiltinTopicData, SubscriptionBuiltinTopicData,
+    EndpointBuiltinTopicData, ParticipantBuiltinTopicData, PublicationBuiltinTopicData,
+    SubscriptionBuiltinTopicData, TopicBuiltinTopicData,
 };
+pub use builtin_reader::{BuiltinDataReader, BuiltinDataReaderListener};
+pub use builtin_subscriber::BuiltinSubscriber;
 pub use chain::StatusChange;
 pub use condition::{
     Condition, GuardCondition, QueryCondition, ReadCondition, StatusCondition, WaitSet,

@@ -23,7 +23,7 @@ use crate::transport::UdpTransport;
 use super::condition::StatusCondition;
 use super::driver::Driver;
 use super::durability::DurabilityServiceConfig;
-use super::error::{DdsError, DdsResult};
+use super::error::DdsResult;
 use super::registry::Registry;
 use super::sample::InstanceHandle;
 
@@ -282,15 +282,10 @@ impl DomainParticipantBuilder {
         let qos = self.qos.clone().unwrap_or_else(|| {
             factory::DomainParticipantFactory::get_instance().default_participant_qos()
         });
-        if !qos.autoenable_created_entities
-            || !factory::DomainParticipantFactory::get_instance()
-                .qos()
-                .autoenable_created_entities
-        {
-            return Err(DdsError::Unsupported(
-                "disabled entities: every entity is enabled when created",
-            ));
-        }
+        // A participant is created disabled when the factory does not autoenable (DDS 1.4 §2.2.2.1.1.7).
+        let enabled = factory::DomainParticipantFactory::get_instance()
+            .qos()
+            .autoenable_created_entities;
         let user_data = if qos.user_data.0.is_empty() {
             self.user_data
         } else {
@@ -298,13 +293,16 @@ impl DomainParticipantBuilder {
         };
         let mut qos = qos;
         qos.user_data = user_data.clone().into();
-        let driver = Driver::start(config, user_data, self.name)?;
+        let driver = Driver::start(config, user_data, self.name, enabled)?;
         let guard = Arc::new(Guard(driver.clone()));
         let registry = Arc::new(Registry::new(
             driver.guid_prefix,
             driver.status.clone(),
             qos,
         ));
+        if !enabled {
+            registry.with(|e| e.disabled.insert(registry.node.handle));
+        }
         ops::install_discovery_hook(&driver, &registry);
         super::durability::install(&driver, &durability)?;
         let p = DomainParticipant {
@@ -372,6 +370,7 @@ impl DomainParticipant {
     /// kind MANUAL goes to every participant (see the liveliness section of docs/dcps-api.md).
     pub fn assert_liveliness(&self) -> DdsResult<()> {
         self.driver.check_alive()?;
+        self.registry.check_participant_enabled()?;
         self.driver.with_core(|c, now| c.assert_liveliness(now));
         Ok(())
     }

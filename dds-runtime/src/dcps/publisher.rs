@@ -24,8 +24,8 @@ use super::participant::DomainParticipant;
 use super::presentation::CoherentGroup;
 use super::sample::InstanceHandle;
 use super::status::{
-    DeadlineMissedStatus, IncompatibleQosStatus, PublicationMatchedStatus, StatusMask,
-    WriterStatuses,
+    DeadlineMissedStatus, IncompatibleQosStatus, LivelinessLostStatus, PublicationMatchedStatus,
+    StatusMask, WriterStatuses,
 };
 use super::sync::{lock, read};
 use super::topic::Topic;
@@ -42,6 +42,8 @@ pub trait DataWriterListener<T: DdsType>: Send + Sync {
     fn on_offered_incompatible_qos(&self, writer: &DataWriter<T>, status: IncompatibleQosStatus) {}
     /// The writer missed its offered deadline for an instance.
     fn on_offered_deadline_missed(&self, writer: &DataWriter<T>, status: DeadlineMissedStatus) {}
+    /// The writer did not assert its manual liveliness within its lease.
+    fn on_liveliness_lost(&self, writer: &DataWriter<T>, status: LivelinessLostStatus) {}
 }
 
 /// Groups writers; carries the partition and presentation QoS.
@@ -124,6 +126,10 @@ impl Publisher {
     ) -> DdsResult<DataWriter<T>> {
         let driver = self.participant.driver().clone();
         let parent = ops::writer_parent(self, topic)?;
+        let enabled = self
+            .participant
+            .registry()
+            .group_creates_enabled::<PublisherQos>(Arc::as_ptr(&self.qos) as *const ())?;
         let (version, rep) = writer_version::<T>(&qos.data_representation);
         let mut wq = qos.clone();
         wq.data_representation = rep;
@@ -154,9 +160,16 @@ impl Publisher {
         };
         inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
+        if !enabled {
+            inner.state.set_created_disabled();
+        }
         let handle = inner.state.create(sink, owner, |c, now| {
             super::participant::register_local_types::<T>(c);
-            c.create_writer(now, spec)
+            if enabled {
+                c.create_writer(now, spec)
+            } else {
+                c.create_writer_disabled(now, spec)
+            }
         })?;
         ops::register_writer(self, &inner, topic.name());
         let id = handle.id();
@@ -215,8 +228,8 @@ struct WriterInner<T: DdsType> {
 /// QoS enforced on the writer side by the RTPS core: reliability, durability (volatile, transient-local),
 /// history, resource limits, partitions, ownership strength (announced). Here: writer data lifecycle
 /// (autodispose on unregister; a deleted writer only unregisters), offered deadline missed (checked every 50 ms per instance).
-/// Lifespan is announced and applied by readers. Manual liveliness: see `assert_liveliness`; LIVELINESS_LOST
-/// on the writer is not raised yet.
+/// Lifespan is announced and applied by readers. Manual liveliness: see `assert_liveliness`; a writer that
+/// fails to assert within its lease raises LIVELINESS_LOST.
 pub struct DataWriter<T: DdsType> {
     inner: Arc<WriterInner<T>>,
     handle: Arc<EndpointHandle<WriterOwner<T>>>,
@@ -321,7 +334,7 @@ impl<T: DdsType> DataWriter<T> {
     /// `sample`, the matched readers' content filters are evaluated on it (writer-side filtering).
     fn submit(&self, change: WriteChange, sample: Option<&T>) -> DdsResult<()> {
         let driver = &self.inner.state.driver;
-        driver.check_alive()?;
+        self.inner.state.check_enabled()?;
         let max_block = match self.inner.qos.reliability {
             Reliability::Reliable { max_blocking_time } => max_blocking_time,
             Reliability::BestEffort => Duration::ZERO,
@@ -549,7 +562,7 @@ impl<T: DdsType> DataWriter<T> {
     /// liveliness flag to its matched readers. Writing a sample asserts it too.
     pub fn assert_liveliness(&self) -> DdsResult<()> {
         let driver = &self.inner.state.driver;
-        driver.check_alive()?;
+        self.inner.state.check_enabled()?;
         let id = self.id();
         driver.with_core(|c, now| c.assert_writer_liveliness(now, id));
         Ok(())
@@ -558,7 +571,7 @@ impl<T: DdsType> DataWriter<T> {
     /// Blocks until every matched reliable reader acknowledged everything written, or `Timeout`.
     pub fn wait_for_acknowledgments(&self, timeout: Duration) -> DdsResult<()> {
         let driver = &self.inner.state.driver;
-        driver.check_alive()?;
+        self.inner.state.check_enabled()?;
         let id = self.id();
         let deadline = Instant::now().checked_add(timeout);
         if driver.wait_progress(deadline, || driver.with_core(|c, _| c.is_acknowledged(id))) {
@@ -594,6 +607,14 @@ impl<T: DdsType> DataWriter<T> {
             .take_status(StatusMask::OFFERED_DEADLINE_MISSED, |s| {
                 &mut s.offered_deadline_missed
             })
+    }
+
+    /// LIVELINESS_LOST (resets the change count): how often this writer failed to assert its manual
+    /// liveliness within its lease.
+    pub fn liveliness_lost_status(&self) -> LivelinessLostStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::LIVELINESS_LOST, |s| &mut s.liveliness_lost)
     }
 
     /// Handles of the matched readers.
@@ -711,6 +732,18 @@ impl<T: DdsType> Endpoint for WriterInner<T> {
                     },
                     self.writer(),
                     |l, w, s| l.on_offered_incompatible_qos(w, s),
+                );
+            }
+            Event::LivelinessLost { .. } => {
+                tracing::info!(writer = ?id, "liveliness lost");
+                self.state.signal_consumed(
+                    StatusMask::LIVELINESS_LOST,
+                    |st| {
+                        st.liveliness_lost.record();
+                        &mut st.liveliness_lost
+                    },
+                    self.writer(),
+                    |l, w, s| l.on_liveliness_lost(w, s),
                 );
             }
             _ => {}

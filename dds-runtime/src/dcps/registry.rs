@@ -56,6 +56,8 @@ pub(crate) struct TopicEntry {
     pub(crate) qos: TopicQos,
     pub(crate) inconsistent: InconsistentTopicStatus,
     pub(crate) deleted: bool,
+    /// The GUID of its SEDP announcement (DCPSTopic), once announced.
+    pub(crate) wire: Option<Guid>,
 }
 
 /// A reader or writer.
@@ -83,6 +85,9 @@ pub(crate) trait Registered: Send + Sync {
     }
     /// Calls the reader's `on_data_available` (`notify_datareaders`); nothing for writers.
     fn notify_data_available(self: Arc<Self>) {}
+    /// Enables the reader or writer (`enable`): `PreconditionNotMet` while its factory or topic is
+    /// disabled.
+    fn enable(self: Arc<Self>) -> DdsResult<()>;
 }
 
 impl EndpointEntry {
@@ -104,12 +109,16 @@ pub(crate) struct Entities {
     pub(crate) readers: Vec<EndpointEntry>,
     /// Topic name → type name of remote endpoints (for `find_topic` and INCONSISTENT_TOPIC).
     pub(crate) remote_topics: HashMap<String, String>,
-    /// Remote endpoints already counted in an INCONSISTENT_TOPIC status (announced again on QoS changes).
-    inconsistent_seen: HashSet<Guid>,
+    /// Remote topics (participant, topic name) already counted in an INCONSISTENT_TOPIC status: a remote
+    /// participant's topic counts once, whether learnt from its SEDP topic announcement or from its readers
+    /// and writers (announced again on QoS changes).
+    inconsistent_seen: HashSet<(GuidPrefix, String)>,
     pub(crate) participant_qos: DomainParticipantQos,
     pub(crate) default_publisher_qos: PublisherQos,
     pub(crate) default_subscriber_qos: SubscriberQos,
     pub(crate) default_topic_qos: TopicQos,
+    /// The disabled participant, topics, publishers and subscribers (see `dcps::enable`).
+    pub(crate) disabled: HashSet<InstanceHandle>,
 }
 
 impl Entities {
@@ -137,6 +146,8 @@ pub(crate) struct Registry {
     entities: Mutex<Entities>,
     /// Notified when a remote topic is discovered (`find_topic` waits on it).
     discovered: Condvar,
+    /// The built-in subscriber, created when first asked for.
+    pub(crate) builtin: std::sync::OnceLock<super::builtin_subscriber::BuiltinSubscriber>,
 }
 
 impl Registry {
@@ -156,6 +167,7 @@ impl Registry {
                 ..Entities::default()
             }),
             discovered: Condvar::new(),
+            builtin: std::sync::OnceLock::new(),
         }
     }
 
@@ -224,14 +236,25 @@ impl Registry {
                 qos,
                 inconsistent,
                 deleted: false,
+                wire: None,
             });
             clash
         });
         if clash {
             // Known before the topic existed: the status is set, no listener can have been installed yet.
-            node.raise_up(StatusMask::INCONSISTENT_TOPIC);
+            node.raise_up(node.handle, StatusMask::INCONSISTENT_TOPIC);
         }
         handle
+    }
+
+    /// Takes the GUID of the SEDP announcement of the topic at `ptr` (to withdraw it). Works while the topic
+    /// is being dropped: the entry is looked up before dead entries are pruned.
+    pub(crate) fn take_topic_wire(&self, ptr: *const ()) -> Option<Guid> {
+        lock(&self.entities)
+            .topics
+            .iter_mut()
+            .find(|t| same(&t.identity, ptr))
+            .and_then(|t| t.wire.take())
     }
 
     /// Registers a writer (`writer` true) or reader of the group `group` on `topic`.
@@ -255,6 +278,7 @@ impl Registry {
         let (guid, topic, type_name) = match ev {
             Event::PublicationDiscovered(w) => (w.guid, &w.topic_name, &w.type_name),
             Event::SubscriptionDiscovered(r) => (r.guid, &r.topic_name, &r.type_name),
+            Event::TopicDiscovered(t) => (t.guid, &t.topic_name, &t.type_name),
             _ => return Vec::new(),
         };
         let out = self.with(|e| {
@@ -268,7 +292,7 @@ impl Registry {
             if !inconsistent || e.inconsistent_seen.len() >= MAX_REMOTE_TOPICS {
                 return Vec::new();
             }
-            if !e.inconsistent_seen.insert(guid) {
+            if !e.inconsistent_seen.insert((guid.prefix, topic.clone())) {
                 return Vec::new();
             }
             e.topics
@@ -426,11 +450,6 @@ impl Registry {
         ptr: *const (),
         qos: &Q,
     ) -> DdsResult<Vec<Weak<dyn Registered>>> {
-        if !qos.autoenable() {
-            return Err(DdsError::Unsupported(
-                "disabled entities: every entity is enabled when created",
-            ));
-        }
         let (handle, changed) = self.with_group::<Q, _>(ptr, |g| {
             if let Some(p) = g.qos.immutable_change(qos) {
                 return Err(DdsError::ImmutablePolicy(p));

@@ -1,5 +1,7 @@
 //! Communication statuses (DDS 1.4 §2.2.4.1). Getters return the status and reset its `*_change` counts.
 
+use std::collections::HashMap;
+
 use crate::qos::QosPolicyId;
 use crate::rtps::Guid;
 
@@ -216,6 +218,31 @@ pub struct LivelinessChangedStatus {
     pub last_publication_handle: InstanceHandle,
 }
 
+/// LIVELINESS_LOST: the writer did not assert its liveliness within its lease (MANUAL_BY_PARTICIPANT or
+/// MANUAL_BY_TOPIC), so its readers consider it not alive.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct LivelinessLostStatus {
+    /// Times the writer lost its liveliness.
+    pub total_count: u32,
+    /// Change since the last get.
+    pub total_count_change: u32,
+}
+
+impl Status for LivelinessLostStatus {
+    fn reset_changes(&mut self) {
+        self.total_count_change = 0;
+    }
+}
+
+impl LivelinessLostStatus {
+    /// Records one lapse.
+    pub(crate) fn record(&mut self) {
+        self.total_count = self.total_count.saturating_add(1);
+        self.total_count_change = self.total_count_change.saturating_add(1);
+    }
+}
+
 matched_status!(PublicationMatchedStatus, last_subscription_handle);
 matched_status!(SubscriptionMatchedStatus, last_publication_handle);
 
@@ -280,24 +307,32 @@ impl Status for LivelinessChangedStatus {
 }
 
 impl LivelinessChangedStatus {
-    /// Records that `writer` became alive or not alive.
-    pub(crate) fn record(&mut self, writer: Guid, alive: bool) {
-        if alive {
-            self.alive_count += 1;
-            self.alive_count_change += 1;
-            if self.not_alive_count > 0 {
-                self.not_alive_count -= 1;
-                self.not_alive_count_change -= 1;
-            }
-        } else {
-            self.not_alive_count += 1;
-            self.not_alive_count_change += 1;
-            if self.alive_count > 0 {
-                self.alive_count -= 1;
-                self.alive_count_change -= 1;
-            }
+    /// Moves `writer` from the state in `writers` (absent: not matched) to `to` (`None`: unmatched),
+    /// keeping the counts equal to the matched writers alive and not alive. Whether anything changed.
+    pub(crate) fn record(
+        &mut self,
+        writers: &mut HashMap<Guid, bool>,
+        writer: Guid,
+        to: Option<bool>,
+    ) -> bool {
+        let from = match to {
+            Some(alive) => writers.insert(writer, alive),
+            None => writers.remove(&writer),
+        };
+        if from == to {
+            return false;
+        }
+        for (state, delta) in [(from, -1), (to, 1)] {
+            let (count, change) = match state {
+                Some(true) => (&mut self.alive_count, &mut self.alive_count_change),
+                Some(false) => (&mut self.not_alive_count, &mut self.not_alive_count_change),
+                None => continue,
+            };
+            *count = count.saturating_add_signed(delta);
+            *change = change.saturating_add(delta);
         }
         self.last_publication_handle = InstanceHandle::from_guid(writer);
+        true
     }
 }
 
@@ -307,6 +342,7 @@ pub(crate) struct WriterStatuses {
     pub(crate) publication_matched: PublicationMatchedStatus,
     pub(crate) offered_incompatible_qos: IncompatibleQosStatus,
     pub(crate) offered_deadline_missed: DeadlineMissedStatus,
+    pub(crate) liveliness_lost: LivelinessLostStatus,
 }
 
 /// The statuses of a data reader.
@@ -318,6 +354,8 @@ pub(crate) struct ReaderStatuses {
     pub(crate) sample_lost: SampleLostStatus,
     pub(crate) sample_rejected: SampleRejectedStatus,
     pub(crate) liveliness_changed: LivelinessChangedStatus,
+    /// The matched writers and whether each is alive (what `liveliness_changed` counts).
+    pub(crate) writers_alive: HashMap<Guid, bool>,
 }
 
 /// INCONSISTENT_TOPIC: a remote topic of the same name with another type was discovered.

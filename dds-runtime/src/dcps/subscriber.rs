@@ -128,6 +128,10 @@ impl Subscriber {
     ) -> DdsResult<DataReader<T>> {
         let driver = self.participant.driver().clone();
         let parent = ops::reader_parent(self, topic.topic())?;
+        let enabled = self
+            .participant
+            .registry()
+            .group_creates_enabled::<SubscriberQos>(Arc::as_ptr(&self.qos) as *const ())?;
         let mut rq = qos.clone();
         if rq.data_representation.ids().is_empty() {
             rq.data_representation = DataRepresentation::accept_both();
@@ -175,9 +179,16 @@ impl Subscriber {
         };
         inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
+        if !enabled {
+            inner.state.set_created_disabled();
+        }
         let handle = inner.state.create(sink, owner, |c, now| {
             super::participant::register_local_types::<T>(c);
-            let id = c.create_reader(now, spec)?;
+            let id = if enabled {
+                c.create_reader(now, spec)?
+            } else {
+                c.create_reader_disabled(now, spec)?
+            };
             if credit_limit.is_some() {
                 c.set_reader_credit(id, credit_limit);
             }
@@ -341,7 +352,7 @@ impl<T: DdsType> DataReader<T> {
         take: bool,
         mut emit: impl FnMut(&mut Option<T>, SampleInfo),
     ) -> DdsResult<usize> {
-        self.inner.state.check_alive()?;
+        self.inner.state.check_enabled()?;
         self.inner.state.data_read();
         let mut n = 0;
         {
@@ -521,6 +532,7 @@ impl<T: DdsType> DataReader<T> {
 
     /// Blocks until a not-read sample is available (`Ok(true)`) or `timeout` passes (`Ok(false)`).
     pub fn wait_for_data(&self, timeout: Duration) -> DdsResult<bool> {
+        self.inner.state.check_enabled()?;
         let deadline = Instant::now().checked_add(timeout);
         let unread = Selection {
             sample_states: SampleStateMask::NOT_READ,
@@ -576,13 +588,12 @@ impl<T: DdsType> DataReader<T> {
         view_states: ViewStateMask,
         instance_states: InstanceStateMask,
     ) -> ReadCondition {
-        ReadCondition {
-            source: self.inner.clone(),
+        ReadCondition::on(
+            self.inner.clone(),
             sample_states,
             view_states,
             instance_states,
-            query: None,
-        }
+        )
     }
 
     /// A query condition on this reader: a read condition whose samples must also satisfy `expression` (the
@@ -712,6 +723,21 @@ impl<T: DdsType> ReaderInner<T> {
         move |handle| DataReader { inner, handle }
     }
 
+    /// `writer` became alive (`Some(true)`), not alive (`Some(false)`) or unmatched (`None`): LIVELINESS_CHANGED
+    /// when that changed the counts.
+    fn liveliness(self: &Arc<Self>, writer: Guid, to: Option<bool>) {
+        self.state.signal_if(
+            StatusMask::LIVELINESS_CHANGED,
+            |st| {
+                st.liveliness_changed
+                    .record(&mut st.writers_alive, writer, to)
+                    .then_some(&mut st.liveliness_changed)
+            },
+            self.reader(),
+            |l, r, s| l.on_liveliness_changed(r, s),
+        );
+    }
+
     /// Gives the core back the room freed by a take. Under the core lock every delivered sample is either
     /// queued in `pending` or in the cache, so the credit is exact.
     fn refresh_credit(&self) {
@@ -832,6 +858,9 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                     self.reader(),
                     |l, r, s| l.on_subscription_matched(r, s),
                 );
+                // A writer matched is alive until its lease says otherwise; an unmatched one is no longer
+                // counted.
+                self.liveliness(*writer, matched.then_some(true));
             }
             Event::RequestedIncompatibleQos { policy, writer, .. } => {
                 tracing::warn!(reader = ?id, ?writer, ?policy, "requested incompatible QoS");
@@ -852,15 +881,7 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                         self.notify_data();
                     }
                 }
-                self.state.signal(
-                    StatusMask::LIVELINESS_CHANGED,
-                    |st| {
-                        st.liveliness_changed.record(*writer, *alive);
-                        &mut st.liveliness_changed
-                    },
-                    self.reader(),
-                    |l, r, s| l.on_liveliness_changed(r, s),
-                );
+                self.liveliness(*writer, Some(*alive));
             }
             Event::SampleLost { count, .. } => {
                 self.state.signal(

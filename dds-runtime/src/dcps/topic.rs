@@ -23,6 +23,14 @@ struct TopicInner {
     qos: TopicQos,
 }
 
+impl Drop for TopicInner {
+    /// The last handle is gone: the topic's SEDP announcement is withdrawn.
+    fn drop(&mut self) {
+        self.participant
+            .withdraw_topic(self as *const TopicInner as *const ());
+    }
+}
+
 /// A named topic of type `T` in a participant.
 pub struct Topic<T> {
     inner: Arc<TopicInner>,

@@ -558,6 +558,12 @@ pub enum Event {
         /// Whether the writer is alive now.
         alive: bool,
     },
+    /// A local writer with manual liveliness did not assert it within its lease (LIVELINESS_LOST; once per
+    /// lapse: the next write or assertion renews it).
+    LivelinessLost {
+        /// The local writer.
+        writer: EntityId,
+    },
     /// Samples from `writer` that `reader` will never get (writer no longer had them, or buffers overflowed).
     SampleLost {
         /// The local reader.
@@ -571,6 +577,18 @@ pub enum Event {
     WriterDeleted {
         /// The local writer.
         writer: EntityId,
+    },
+    /// A remote topic was announced in SEDP (DCPSTopic), or announced again with other data.
+    TopicDiscovered(Box<crate::rtps::discovery::TopicData>),
+    /// A remote topic announced in SEDP was withdrawn (or its participant left).
+    TopicRemoved {
+        /// The topic's GUID.
+        guid: Guid,
+    },
+    /// A local reader was deleted (after its unmatch events).
+    ReaderDeleted {
+        /// The local reader.
+        reader: EntityId,
     },
     /// Flow control released a writer that returned WouldBlock: unacknowledged bytes fell below the low watermark.
     WriterUnblocked {

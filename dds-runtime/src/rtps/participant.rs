@@ -5,11 +5,13 @@
 mod coherent;
 mod control;
 mod discovery;
+mod enable;
 mod filtering;
 mod historical;
 mod liveliness;
 mod receive;
 mod timers;
+mod topics;
 mod type_lookup;
 
 use std::cell::Cell;
@@ -42,6 +44,14 @@ pub struct Participant {
     events: VecDeque<Event>,
     /// Leases of matched writers with manual liveliness.
     leases: crate::rtps::liveliness::Leases,
+    /// Leases of our own writers with manual liveliness (LIVELINESS_LOST).
+    own_leases: super::writer::OwnLeases,
+    /// Whether the participant sends and receives (see `enable`).
+    enabled: bool,
+    /// Local endpoints created disabled, not announced yet.
+    deferred: enable::DeferredEndpoints,
+    /// Remote topics announced in SEDP (DCPSTopic).
+    known_topics: HashMap<Guid, super::discovery::TopicData>,
     /// Reused buffer for what readers deliver while a datagram is processed.
     scratch: Vec<Event>,
     writers: BTreeMap<EntityId, Writer>,
@@ -142,6 +152,10 @@ impl Participant {
             out: Outbox::new(header, config.max_message_size),
             events: VecDeque::new(),
             leases: Default::default(),
+            own_leases: Default::default(),
+            enabled: true,
+            deferred: Default::default(),
+            known_topics: HashMap::new(),
             scratch: Vec::new(),
             writers: BTreeMap::new(),
             readers: BTreeMap::new(),
@@ -178,6 +192,7 @@ impl Participant {
                 Reader::new(Guid::new(prefix, r), reader_params(&p.config, true)),
             );
         }
+        p.add_topic_builtins();
         p.spdp_payload = p.participant_data().encode();
         p.service(now);
         p
@@ -207,7 +222,8 @@ impl Participant {
             default_unicast: c.default_unicast.clone(),
             default_multicast: c.default_multicast.clone(),
             lease_duration: c.lease_duration,
-            builtin_endpoints: super::discovery::builtin::OURS,
+            builtin_endpoints: super::discovery::builtin::OURS
+                | super::discovery::topics::TOPIC_BITS,
             manual_liveliness_count: 0,
             user_data: c.user_data.clone(),
             properties: c.properties.clone(),
@@ -295,6 +311,15 @@ impl Participant {
 
     /// Creates a local writer and announces it in SEDP; it matches local and remote readers from then on.
     pub fn create_writer(&mut self, now: Instant, spec: WriterSpec) -> Result<EntityId, CoreError> {
+        let data = self.add_writer(spec)?;
+        let id = data.guid.entity_id;
+        self.own_leases.track(now, id, &data.qos.writer.liveliness);
+        self.publish_endpoint(now, data);
+        Ok(id)
+    }
+
+    /// Adds a local writer, not yet announced.
+    fn add_writer(&mut self, spec: WriterSpec) -> Result<WriterData, CoreError> {
         let keyed = spec.keyed;
         let kinds = [
             entity_kind::USER_WRITER_NO_KEY,
@@ -305,12 +330,19 @@ impl Participant {
         let params = user_writer_params(&self.config, &data.qos.writer, keyed);
         self.writers.insert(id, Writer::new(data.guid, params));
         self.user_writers.insert(id);
-        self.publish_endpoint(now, data);
-        Ok(id)
+        Ok(data)
     }
 
     /// Creates a local reader and announces it in SEDP; it matches local and remote writers from then on.
     pub fn create_reader(&mut self, now: Instant, spec: ReaderSpec) -> Result<EntityId, CoreError> {
+        let data = self.add_reader(spec)?;
+        let id = data.guid.entity_id;
+        self.publish_endpoint(now, data);
+        Ok(id)
+    }
+
+    /// Adds a local reader, not yet announced.
+    fn add_reader(&mut self, spec: ReaderSpec) -> Result<ReaderData, CoreError> {
         let kinds = [
             entity_kind::USER_READER_NO_KEY,
             entity_kind::USER_READER_WITH_KEY,
@@ -321,14 +353,16 @@ impl Participant {
         let params = reader_params(&self.config, reliable);
         self.readers.insert(id, Reader::new(data.guid, params));
         self.user_readers.insert(id);
-        self.publish_endpoint(now, data);
-        Ok(id)
+        Ok(data)
     }
 
     /// Deletes a writer. A reliable writer with unacknowledged data lingers (still repairing, refusing writes)
     /// until acknowledged or `writer_linger_duration` passes; then `Event::WriterDeleted`.
     pub fn delete_writer(&mut self, now: Instant, id: EntityId) {
         self.timers_changed();
+        if self.drop_deferred(id) {
+            return;
+        }
         if !self.user_writers.contains(&id) {
             return;
         }
@@ -338,6 +372,7 @@ impl Participant {
         if w.linger_until.is_some() {
             return;
         }
+        self.own_leases.untrack(id);
         if w.is_acknowledged() {
             self.finish_writer(now, id);
         } else {
@@ -349,6 +384,9 @@ impl Participant {
     /// Deletes a reader at once: unmatch events and an SEDP dispose.
     pub fn delete_reader(&mut self, now: Instant, id: EntityId) {
         self.timers_changed();
+        if self.drop_deferred(id) {
+            return;
+        }
         if !self.user_readers.remove(&id) {
             return;
         }
@@ -370,11 +408,13 @@ impl Participant {
             Vec::new(),
         );
         self.forget_endpoint::<ReaderQos>(guid);
+        self.events.push_back(Event::ReaderDeleted { reader: id });
         self.service(now);
     }
 
     fn finish_writer(&mut self, now: Instant, id: EntityId) {
         self.user_writers.remove(&id);
+        self.own_leases.untrack(id);
         let guid = Guid::new(self.config.guid_prefix, id);
         if let Some(w) = self.writers.remove(&id) {
             for r in w.matched() {

@@ -148,9 +148,9 @@ fn cyclone_to_us(domain: u32) -> Result<(), Skip> {
     );
     let before = r.liveliness_changed_status();
     check!(
-        before.not_alive_count == 0,
+        before.not_alive_count == 0 && before.alive_count == 1,
         &[&w],
-        "lost while asserting: {before:?}"
+        "lost while asserting (the matched writer counts alive): {before:?}"
     );
     check!(
         wait_until(Duration::from_secs(3), || r
@@ -209,6 +209,8 @@ fn us_to_cyclone(domain: u32) -> Result<(), Skip> {
         ..Default::default()
     })
     .expect("write");
+    // Matching may take longer than the lease: count lapses from the first write on.
+    let base = w.liveliness_lost_status().total_count;
     let assert_for = |d: Duration| {
         let end = Instant::now() + d;
         while Instant::now() < end {
@@ -223,6 +225,11 @@ fn us_to_cyclone(domain: u32) -> Result<(), Skip> {
         &[&rd],
         "lost while asserting"
     );
+    check!(
+        w.liveliness_lost_status().total_count == base,
+        &[&rd],
+        "our writer reported LIVELINESS_LOST while asserting"
+    );
     std::thread::sleep(Duration::from_secs(2));
     check!(
         rd.wait_line(Duration::from_secs(2), |l| l
@@ -230,6 +237,12 @@ fn us_to_cyclone(domain: u32) -> Result<(), Skip> {
             .is_some(),
         &[&rd],
         "not lost while silent"
+    );
+    // Our writer knows it too: LIVELINESS_LOST once for the lapse.
+    check!(
+        w.liveliness_lost_status().total_count == base + 1,
+        &[&rd],
+        "our writer did not report LIVELINESS_LOST"
     );
     // Cyclone renews a live writer's lease on a HEARTBEAT with the liveliness flag (checked above: no loss
     // while asserting) but revives a writer it declared lost only when DATA arrives from it.
@@ -254,5 +267,10 @@ fn us_to_cyclone(domain: u32) -> Result<(), Skip> {
     );
     let lost = rd.grep(|l| l == "liveliness alive=0 not_alive=1");
     check!(lost.len() == 1, &[&rd], "lost {} times", lost.len());
+    check!(
+        w.liveliness_lost_status().total_count == base + 1,
+        &[&rd],
+        "our writer lost liveliness again after writing and asserting"
+    );
     Ok(())
 }

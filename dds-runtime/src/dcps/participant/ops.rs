@@ -10,7 +10,8 @@ use crate::qos::{ChangeableQos, DomainParticipantQos, PublisherQos, SubscriberQo
 use crate::rtps::{EntityId, Guid, GuidPrefix};
 
 use super::super::builtin::{
-    ParticipantBuiltinTopicData, PublicationBuiltinTopicData, SubscriptionBuiltinTopicData,
+    topic_key, ParticipantBuiltinTopicData, PublicationBuiltinTopicData,
+    SubscriptionBuiltinTopicData,
 };
 use super::super::chain::{ParentListener, StatusChange};
 use super::super::driver::Driver;
@@ -33,6 +34,8 @@ pub trait DomainParticipantListener: Send + Sync {
     fn on_offered_incompatible_qos(&self, writer: InstanceHandle, status: IncompatibleQosStatus) {}
     /// A writer missed its offered deadline.
     fn on_offered_deadline_missed(&self, writer: InstanceHandle, status: DeadlineMissedStatus) {}
+    /// A writer did not assert its manual liveliness within its lease.
+    fn on_liveliness_lost(&self, writer: InstanceHandle, status: LivelinessLostStatus) {}
     /// A reader matched or unmatched a writer.
     fn on_subscription_matched(&self, reader: InstanceHandle, status: SubscriptionMatchedStatus) {}
     /// A reader found a writer with incompatible QoS.
@@ -63,6 +66,7 @@ impl ParentListener for ParticipantLevel {
             StatusChange::PublicationMatched(s) => l.on_publication_matched(e, s),
             StatusChange::OfferedIncompatibleQos(s) => l.on_offered_incompatible_qos(e, s),
             StatusChange::OfferedDeadlineMissed(s) => l.on_offered_deadline_missed(e, s),
+            StatusChange::LivelinessLost(s) => l.on_liveliness_lost(e, s),
             StatusChange::SubscriptionMatched(s) => l.on_subscription_matched(e, s),
             StatusChange::RequestedIncompatibleQos(s) => l.on_requested_incompatible_qos(e, s),
             StatusChange::RequestedDeadlineMissed(s) => l.on_requested_deadline_missed(e, s),
@@ -85,7 +89,7 @@ pub(super) fn install_discovery_hook(driver: &Driver, registry: &Arc<Registry>) 
         let Some(reg) = weak.upgrade() else { return };
         for (node, status) in reg.on_discovery(ev) {
             tracing::warn!(topic = ?node.handle, "inconsistent topic");
-            node.raise_up(StatusMask::INCONSISTENT_TOPIC);
+            node.raise_up(node.handle, StatusMask::INCONSISTENT_TOPIC);
             if let Some(l) = node.find(StatusMask::INCONSISTENT_TOPIC) {
                 l.on_status(node.handle, StatusChange::InconsistentTopic(status));
             }
@@ -99,16 +103,10 @@ impl DomainParticipant {
         self.registry.with(|e| e.participant_qos.clone())
     }
 
-    /// Changes the participant QoS (`set_qos`): a new USER_DATA is announced in SPDP at once.
-    /// `autoenable_created_entities = false` is refused with `Unsupported` (entities are enabled when
-    /// created).
+    /// Changes the participant QoS (`set_qos`): a new USER_DATA is announced in SPDP at once;
+    /// `autoenable_created_entities` applies to the entities created from then on.
     pub fn set_qos(&self, qos: &DomainParticipantQos) -> DdsResult<()> {
         self.driver.check_alive()?;
-        if !qos.autoenable_created_entities {
-            return Err(DdsError::Unsupported(
-                "disabled entities: every entity is enabled when created",
-            ));
-        }
         let old = self.get_qos();
         if let Some(p) = old.immutable_change(qos) {
             return Err(DdsError::ImmutablePolicy(p));
@@ -133,10 +131,24 @@ impl DomainParticipant {
         self.registry.node.set_listener(None);
     }
 
-    /// Enables the participant (`enable`): entities are enabled when created, so this only checks that the
-    /// participant was not deleted.
+    /// Enables the participant (`enable`): it starts announcing itself (SPDP) and receiving. With
+    /// `autoenable_created_entities`, the topics, publishers and subscribers it created disabled are
+    /// enabled too (and their readers and writers as their own QoS says). Nothing when enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.driver.check_alive()
+        self.driver.check_alive()?;
+        if self.registry.enable(self.registry.node.handle, &[])? {
+            self.driver.with_core(|c, now| c.set_enabled(now, true));
+            if self.get_qos().autoenable_created_entities {
+                self.registry.enable_participant_contents();
+                self.registry.announce_topics(&self.driver);
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether the participant is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.registry.is_enabled(self.registry.node.handle)
     }
 
     /// The current time (`get_current_time`), as source timestamps use it.
@@ -162,12 +174,26 @@ impl DomainParticipant {
         Ok(())
     }
 
-    /// Ignores every remote endpoint on the topic `name` (`ignore_topic`, by name: topics have no
-    /// discovery handle here).
+    /// Ignores every remote endpoint on the topic `name` (`ignore_topic` by name).
     pub fn ignore_topic(&self, name: &str) -> DdsResult<()> {
         self.driver.check_alive()?;
         self.driver.with_core(|c, _| c.ignore_topic(name))?;
         Ok(())
+    }
+
+    /// Ignores a remote topic by its handle (`ignore_topic` as DDS defines it): the instance handle of its
+    /// `DCPSTopic` sample (`TopicBuiltinTopicData::key`). `BadParameter` for a topic not discovered.
+    pub fn ignore_topic_by_handle(&self, handle: InstanceHandle) -> DdsResult<()> {
+        let name = self
+            .registry
+            .with(|e| {
+                e.remote_topics
+                    .iter()
+                    .find(|(n, t)| topic_key(n, t) == handle)
+                    .map(|(n, _)| n.clone())
+            })
+            .ok_or_else(|| DdsError::BadParameter(format!("no discovered topic {handle:?}")))?;
+        self.ignore_topic(&name)
     }
 
     /// Ignores a remote writer (`ignore_publication`), by its handle (`SampleInfo::publication_handle`,

@@ -33,6 +33,8 @@ pub trait PublisherListener: Send + Sync {
     fn on_offered_incompatible_qos(&self, writer: InstanceHandle, status: IncompatibleQosStatus) {}
     /// A writer missed its offered deadline.
     fn on_offered_deadline_missed(&self, writer: InstanceHandle, status: DeadlineMissedStatus) {}
+    /// A writer did not assert its manual liveliness within its lease.
+    fn on_liveliness_lost(&self, writer: InstanceHandle, status: LivelinessLostStatus) {}
 }
 
 /// The publisher listener as a level of the chain.
@@ -44,6 +46,7 @@ impl ParentListener for PublisherLevel {
             StatusChange::PublicationMatched(s) => self.0.on_publication_matched(w, s),
             StatusChange::OfferedIncompatibleQos(s) => self.0.on_offered_incompatible_qos(w, s),
             StatusChange::OfferedDeadlineMissed(s) => self.0.on_offered_deadline_missed(w, s),
+            StatusChange::LivelinessLost(s) => self.0.on_liveliness_lost(w, s),
             _ => {}
         }
     }
@@ -53,9 +56,9 @@ impl ParentListener for PublisherLevel {
 /// Registers a new publisher in its participant.
 pub(super) fn register_publisher(p: &Publisher) {
     let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&p.qos) as Weak<PublisherQos>;
-    p.participant
-        .registry()
-        .add_group(identity, (*p.qos).clone());
+    let registry = p.participant.registry();
+    let node = registry.add_group(identity, (*p.qos).clone());
+    registry.created_by_participant(node.handle);
 }
 
 /// The publisher level of a new writer's listener chain; `AlreadyDeleted` for a deleted publisher.
@@ -104,6 +107,14 @@ impl<T: DdsType> Registered for WriterInner<T> {
                 tracing::debug!(error = %e, "writer QoS not announced again");
             }
         }
+    }
+    fn enable(self: Arc<Self>) -> DdsResult<()> {
+        let handle = self.state.handle().ok_or(DdsError::AlreadyDeleted)?;
+        DataWriter {
+            inner: self,
+            handle,
+        }
+        .enable()
     }
 }
 
@@ -181,9 +192,19 @@ impl Publisher {
         })
     }
 
-    /// Enables the publisher (`enable`): entities are enabled when created.
+    /// Enables the publisher (`enable`): `PreconditionNotMet` while its participant is disabled. With
+    /// `autoenable_created_entities`, the writers it created disabled are enabled too.
     pub fn enable(&self) -> DdsResult<()> {
-        self.with_group(|_| ())
+        self.participant.driver().check_alive()?;
+        self.participant
+            .registry()
+            .enable_group::<PublisherQos>(Arc::as_ptr(&self.qos) as *const ())
+    }
+
+    /// Whether the publisher is enabled.
+    pub fn is_enabled(&self) -> bool {
+        let registry = self.participant.registry();
+        self.instance_handle().is_ok_and(|h| registry.is_enabled(h))
     }
 
     /// Sets the QoS `create_datawriter` callers get from [`default_datawriter_qos`](Self::default_datawriter_qos)
@@ -345,9 +366,19 @@ impl<T: DdsType> DataWriter<T> {
             .set_listener_with_mask(Some(Arc::from(listener)), mask);
     }
 
-    /// Enables the writer (`enable`): writers are enabled when created.
+    /// Enables the writer (`enable`): it is announced in SEDP and matched from now on.
+    /// `PreconditionNotMet` while its publisher or topic is disabled; nothing when enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.inner.state.check_alive()
+        let (group, topic) = (self.publisher(), self.topic());
+        let registry = group.participant().registry();
+        self.inner.state.enable_under(registry, || {
+            Ok([group.instance_handle()?, topic.instance_handle()?])
+        })
+    }
+
+    /// Whether the writer is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.inner.state.check_enabled().is_ok()
     }
 
     /// Writes `sample` as an instance of `handle` (`write_w_handle`); `NIL` looks the instance up from the

@@ -10,6 +10,7 @@ use crate::cdr::{self, DdsType};
 use crate::qos::{ChangeableQos, DataReaderQos, ReaderQos, SubscriberQos, TopicQos};
 
 use super::super::builtin::PublicationBuiltinTopicData;
+use super::super::builtin_subscriber::BuiltinSubscriber;
 use super::super::chain::{ListenerNode, ParentListener, StatusChange};
 use super::super::condition::{ReadCondition, ReadConditionSource, StatusCondition};
 use super::super::error::{DdsError, DdsResult};
@@ -86,9 +87,9 @@ impl ParentListener for SubscriberLevel {
 /// Registers a new subscriber in its participant.
 pub(super) fn register_subscriber(s: &Subscriber) {
     let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&s.qos) as Weak<SubscriberQos>;
-    s.participant
-        .registry()
-        .add_group(identity, (*s.qos).clone());
+    let registry = s.participant.registry();
+    let node = registry.add_group(identity, (*s.qos).clone());
+    registry.created_by_participant(node.handle);
 }
 
 /// The subscriber level of a new reader's listener chain; `AlreadyDeleted` for a deleted subscriber.
@@ -165,6 +166,14 @@ impl<T: DdsType> Registered for ReaderInner<T> {
         self.state
             .call_own_listener(self.reader(), |l, r| l.on_data_available(r));
     }
+    fn enable(self: Arc<Self>) -> DdsResult<()> {
+        let handle = self.state.handle().ok_or(DdsError::AlreadyDeleted)?;
+        DataReader {
+            inner: self,
+            handle,
+        }
+        .enable()
+    }
 }
 
 impl DomainParticipant {
@@ -176,12 +185,17 @@ impl DomainParticipant {
             .delete_group::<SubscriberQos>(Arc::as_ptr(&subscriber.qos) as *const ())
     }
 
-    /// `get_builtin_subscriber`: not supported (built-in topics are not readable as topics; discovery
-    /// data is available through `discovered_participants`, `get_matched_*_data`).
-    pub fn get_builtin_subscriber(&self) -> DdsResult<Subscriber> {
-        Err(DdsError::Unsupported(
-            "built-in topic readers: use get_matched_publication_data and friends",
-        ))
+    /// The built-in subscriber (`get_builtin_subscriber`): readers of `DCPSParticipant`,
+    /// `DCPSPublication`, `DCPSSubscription` and `DCPSTopic`. Created on the first call with what
+    /// discovery knows by then; every call returns the same readers.
+    pub fn get_builtin_subscriber(&self) -> DdsResult<BuiltinSubscriber> {
+        self.driver().check_alive()?;
+        let driver = self.driver();
+        Ok(self
+            .registry()
+            .builtin
+            .get_or_init(|| BuiltinSubscriber::start(driver))
+            .clone())
     }
 }
 
@@ -257,9 +271,19 @@ impl Subscriber {
         })
     }
 
-    /// Enables the subscriber (`enable`): entities are enabled when created.
+    /// Enables the subscriber (`enable`): `PreconditionNotMet` while its participant is disabled. With
+    /// `autoenable_created_entities`, the readers it created disabled are enabled too.
     pub fn enable(&self) -> DdsResult<()> {
-        self.with_group(|_| ())
+        self.participant.driver().check_alive()?;
+        self.participant
+            .registry()
+            .enable_group::<SubscriberQos>(Arc::as_ptr(&self.qos) as *const ())
+    }
+
+    /// Whether the subscriber is enabled.
+    pub fn is_enabled(&self) -> bool {
+        let registry = self.participant.registry();
+        self.instance_handle().is_ok_and(|h| registry.is_enabled(h))
     }
 
     /// Sets the default reader QoS (`set_default_datareader_qos`).
@@ -425,9 +449,19 @@ impl<T: DdsType> DataReader<T> {
             .set_listener_with_mask(Some(Arc::from(listener)), mask);
     }
 
-    /// Enables the reader (`enable`): readers are enabled when created.
+    /// Enables the reader (`enable`): it is announced in SEDP and matched from now on.
+    /// `PreconditionNotMet` while its subscriber or topic is disabled; nothing when enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.inner.state.check_alive()
+        let (group, topic) = (self.subscriber(), self.topic());
+        let registry = group.participant().registry();
+        self.inner.state.enable_under(registry, || {
+            Ok([group.instance_handle()?, topic.instance_handle()?])
+        })
+    }
+
+    /// Whether the reader is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.inner.state.check_enabled().is_ok()
     }
 
     /// The key of the instance `handle` (`get_key_value`): a sample whose key members are the instance's

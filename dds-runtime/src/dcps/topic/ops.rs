@@ -38,12 +38,10 @@ impl ParentListener for TopicLevel {
 /// Registers a new topic in its participant.
 pub(super) fn register_topic<T: DdsType>(t: &Topic<T>) {
     let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&t.inner) as Weak<TopicInner>;
-    t.inner.participant.registry().add_topic(
-        identity,
-        &t.inner.name,
-        T::TYPE_NAME,
-        t.inner.qos.clone(),
-    );
+    let registry = t.inner.participant.registry();
+    let handle = registry.add_topic(identity, &t.inner.name, T::TYPE_NAME, t.inner.qos.clone());
+    registry.created_by_participant(handle);
+    registry.announce_topics(t.inner.participant.driver());
 }
 
 impl<T: DdsType> Topic<T> {
@@ -131,14 +129,27 @@ impl<T: DdsType> Topic<T> {
         self.with_entry(|t| {
             let s = t.inconsistent.clone();
             t.inconsistent.total_count_change = 0;
-            t.node.clear_up(StatusMask::INCONSISTENT_TOPIC);
+            t.node
+                .clear_up(t.node.handle, StatusMask::INCONSISTENT_TOPIC);
             s
         })
     }
 
-    /// Enables the topic (`enable`): topics are enabled when created.
+    /// Enables the topic (`enable`): `PreconditionNotMet` while its participant is disabled; nothing when
+    /// enabled already.
     pub fn enable(&self) -> DdsResult<()> {
-        self.check_alive()
+        let h = self.instance_handle()?;
+        let registry = self.participant().registry();
+        if registry.enable(h, &[registry.node.handle])? {
+            registry.announce_topics(self.participant().driver());
+        }
+        Ok(())
+    }
+
+    /// Whether the topic is enabled.
+    pub fn is_enabled(&self) -> bool {
+        self.instance_handle()
+            .is_ok_and(|h| self.participant().registry().is_enabled(h))
     }
 }
 
@@ -168,7 +179,18 @@ impl DomainParticipant {
             }
             t.deleted = true;
             Ok(())
-        })
+        })?;
+        self.withdraw_topic(ptr);
+        Ok(())
+    }
+
+    /// Withdraws the SEDP announcement of the topic at `ptr`, if it was announced.
+    pub(super) fn withdraw_topic(&self, ptr: *const ()) {
+        if let Some(g) = self.registry().take_topic_wire(ptr) {
+            if self.driver().check_alive().is_ok() {
+                self.driver().with_core(|c, now| c.withdraw_topic(now, g));
+            }
+        }
     }
 
     /// The local topic named `name` (`lookup_topicdescription`); `None` when there is none, or it has

@@ -7,11 +7,13 @@ pub mod ports;
 mod qos_params;
 mod sedp;
 mod spdp;
+pub mod topics;
 
 pub use content_filter::ContentFilterProperty;
 pub(crate) use sedp::{encode_endpoint_key, endpoint_guid as endpoint_guid_of};
 pub use sedp::{EndpointData, EndpointQos, ReaderData, WriterData};
 pub use spdp::ParticipantData;
+pub use topics::TopicData;
 
 /// Encapsulation of discovery payloads: PL_CDR little-endian (0x0003) and big-endian (0x0002).
 pub(crate) const PL_CDR_LE: [u8; 4] = [0x00, 0x03, 0x00, 0x00];

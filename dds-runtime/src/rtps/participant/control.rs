@@ -128,6 +128,9 @@ impl Participant {
         writer: EntityId,
         qos: WriterQos,
     ) -> Result<(), CoreError> {
+        let Some(qos) = self.update_deferred_writer(writer, qos) else {
+            return Ok(());
+        };
         self.update_endpoint_qos(now, writer, qos)
     }
 
@@ -138,6 +141,9 @@ impl Participant {
         reader: EntityId,
         qos: ReaderQos,
     ) -> Result<(), CoreError> {
+        let Some(qos) = self.update_deferred_reader(reader, qos) else {
+            return Ok(());
+        };
         self.update_endpoint_qos(now, reader, qos)
     }
 

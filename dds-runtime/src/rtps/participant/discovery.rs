@@ -132,6 +132,7 @@ impl Participant {
                 }
             }
         }
+        self.match_topic_builtins(now, prefix, bits, &meta);
         // Answer directly so the newcomer need not wait for our next periodic announcement.
         if !meta.is_empty() {
             self.send_spdp(Some(meta[..1].to_vec()));
@@ -143,6 +144,7 @@ impl Participant {
             return;
         }
         self.readers_by_writer.retain(|w, _| w.prefix != prefix);
+        self.forget_topics_of(prefix);
         for (ours, theirs, _) in builtin::WRITER_PAIRS {
             if let Some(w) = self.writers.get_mut(&ours) {
                 w.remove_proxy(&Guid::new(prefix, theirs), &mut self.events);
@@ -199,6 +201,7 @@ impl Participant {
             EntityId::SEDP_SUBSCRIPTIONS_READER => self.on_sedp::<ReaderQos>(now, &s),
             EntityId::TYPELOOKUP_REQUEST_READER => self.on_type_lookup_request(now, &s),
             EntityId::TYPELOOKUP_REPLY_READER => self.on_type_lookup_reply(now, &s),
+            EntityId::SEDP_TOPICS_READER => self.on_sedp_topic(&s),
             EntityId::P2P_MESSAGE_READER => {
                 if let Some((prefix, kind)) = builtin::decode_participant_message(&s.payload) {
                     if prefix == s.writer.prefix {

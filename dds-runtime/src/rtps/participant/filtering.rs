@@ -45,6 +45,9 @@ impl Participant {
             w.write_filtered(now, change, rejected, &mut self.out, events)
         };
         timers::lower_floor(&self.timer_floor, w.next_timeout());
+        if r.is_ok() && self.own_leases.assert_writer(now, writer) {
+            self.timers_changed();
+        }
         r
     }
 

@@ -47,11 +47,15 @@ impl Participant {
     /// Leases that ran out.
     pub(super) fn expire_leases(&mut self, now: Instant) {
         self.leases.expire(now, &mut self.events);
+        self.own_leases.expire(now, &mut self.events);
     }
 
     /// Asserts the liveliness of this participant's MANUAL_BY_PARTICIPANT writers (DDS
     /// `DomainParticipant::assert_liveliness`): a ParticipantMessageData of kind MANUAL to every participant.
     pub fn assert_liveliness(&mut self, now: Instant) {
+        if self.own_leases.assert_participant(now) {
+            self.timers_changed();
+        }
         self.send_participant_message(now, builtin::PMD_KIND_MANUAL);
     }
 
@@ -67,9 +71,12 @@ impl Participant {
 
     /// Asserts the liveliness of the local writer `writer` (DDS `DataWriter::assert_liveliness`): a HEARTBEAT
     /// with the liveliness flag to its matched readers.
-    pub fn assert_writer_liveliness(&mut self, _now: Instant, writer: EntityId) {
+    pub fn assert_writer_liveliness(&mut self, now: Instant, writer: EntityId) {
         if !self.user_writers.contains(&writer) {
             return;
+        }
+        if self.own_leases.assert_writer(now, writer) {
+            self.timers_changed();
         }
         if let Some(w) = self.writers.get_mut(&writer) {
             w.send_liveliness(&mut self.out);

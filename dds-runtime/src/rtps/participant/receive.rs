@@ -27,6 +27,9 @@ impl Participant {
     }
 
     fn receive(&mut self, now: Instant, data: &[u8], shared: Option<&Payload>) {
+        if !self.enabled {
+            return;
+        }
         let (header, subs) = match MessageIter::parse(data) {
             Ok(x) => x,
             Err(e) => {

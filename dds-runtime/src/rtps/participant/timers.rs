@@ -29,6 +29,9 @@ pub(super) fn lower_floor(floor: &Cell<Option<Instant>>, t: Option<Instant>) {
 impl Participant {
     /// When `handle_timeout` must be called next.
     pub fn poll_timeout(&self) -> Option<Instant> {
+        if !self.enabled {
+            return None;
+        }
         let t = match self.timer_floor.get() {
             Some(t) => t,
             None => {
@@ -57,6 +60,9 @@ impl Participant {
         if let Some(x) = self.leases.next_deadline() {
             t = t.min(x);
         }
+        if let Some(x) = self.own_leases.next_deadline() {
+            t = t.min(x);
+        }
         for w in self.writers.values() {
             if let Some(x) = w.next_timeout() {
                 t = t.min(x);
@@ -80,7 +86,7 @@ impl Participant {
 
     /// Runs everything due at `now`.
     pub(super) fn service(&mut self, now: Instant) {
-        if self.timer_floor.get().is_some_and(|floor| now < floor) {
+        if !self.enabled || self.timer_floor.get().is_some_and(|floor| now < floor) {
             return;
         }
         if now >= self.spdp_due {

@@ -1,7 +1,13 @@
-//! A writer asserting its liveliness on the wire (MANUAL_BY_TOPIC, RTPS 2.5 §8.4.13): a HEARTBEAT with the
-//! liveliness flag to every matched reader.
+//! A writer's liveliness: asserting it on the wire (MANUAL_BY_TOPIC, RTPS 2.5 §8.4.13: a HEARTBEAT with the
+//! liveliness flag to every matched reader), and the leases our own writers committed to, which raise
+//! LIVELINESS_LOST when a writer fails to assert in time.
+
+use std::collections::{BTreeMap, VecDeque};
+use std::time::{Duration, Instant};
 
 use super::Writer;
+use crate::qos::{Liveliness, LivelinessKind, INFINITE};
+use crate::rtps::api::Event;
 use crate::rtps::messages::Submessage;
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::{EntityId, Locator};
@@ -24,5 +30,165 @@ impl Writer {
             h.liveliness_flag = true;
         }
         out.push(&dest, None, Ts::Any, &hb);
+    }
+}
+
+/// The liveliness our own writers committed to (DDS 1.4 §2.2.3.11): one lease per local writer with
+/// MANUAL_BY_PARTICIPANT or MANUAL_BY_TOPIC liveliness and a finite lease duration. A write or
+/// `assert_liveliness` of the writer renews it (for MANUAL_BY_PARTICIPANT, those of every such writer of
+/// the participant, and the participant's `assert_liveliness`); a lease that runs out reports
+/// [`Event::LivelinessLost`] once, until the writer asserts again. AUTOMATIC writers live as long as their
+/// participant runs, so they are not tracked. Sans-I/O: time comes in as an argument.
+#[derive(Debug, Default)]
+pub(crate) struct OwnLeases {
+    writers: BTreeMap<EntityId, OwnLease>,
+}
+
+#[derive(Debug)]
+struct OwnLease {
+    by_participant: bool,
+    duration: Duration,
+    deadline: Instant,
+    lost: bool,
+}
+
+impl OwnLeases {
+    /// The local writer `writer` was created with `liveliness`; its lease starts now.
+    pub(crate) fn track(&mut self, now: Instant, writer: EntityId, liveliness: &Liveliness) {
+        if liveliness.kind == LivelinessKind::Automatic || liveliness.lease_duration >= INFINITE {
+            return;
+        }
+        let Some(deadline) = now.checked_add(liveliness.lease_duration) else {
+            return;
+        };
+        self.writers.insert(
+            writer,
+            OwnLease {
+                by_participant: liveliness.kind == LivelinessKind::ManualByParticipant,
+                duration: liveliness.lease_duration,
+                deadline,
+                lost: false,
+            },
+        );
+    }
+
+    /// The writer is gone.
+    pub(crate) fn untrack(&mut self, writer: EntityId) {
+        self.writers.remove(&writer);
+    }
+
+    /// The writer wrote or asserted its liveliness. Cheap when no writer is tracked (the write path).
+    /// Returns whether a lease that had run out was revived (a timer to arm again).
+    pub(crate) fn assert_writer(&mut self, now: Instant, writer: EntityId) -> bool {
+        if self.writers.is_empty() {
+            return false;
+        }
+        match self.writers.get_mut(&writer) {
+            Some(l) if l.by_participant => self.assert_participant(now),
+            Some(l) => l.renew(now),
+            None => false,
+        }
+    }
+
+    /// The participant asserted its liveliness: renews every MANUAL_BY_PARTICIPANT writer. Returns whether
+    /// a lease that had run out was revived.
+    pub(crate) fn assert_participant(&mut self, now: Instant) -> bool {
+        let mut revived = false;
+        for l in self.writers.values_mut().filter(|l| l.by_participant) {
+            revived |= l.renew(now);
+        }
+        revived
+    }
+
+    /// Leases that ran out by `now`: [`Event::LivelinessLost`] for each writer that had not lost it yet.
+    pub(crate) fn expire(&mut self, now: Instant, out: &mut VecDeque<Event>) {
+        for (id, l) in &mut self.writers {
+            if !l.lost && now >= l.deadline {
+                l.lost = true;
+                out.push_back(Event::LivelinessLost { writer: *id });
+            }
+        }
+    }
+
+    /// When the next lease that has not run out yet runs out.
+    pub(crate) fn next_deadline(&self) -> Option<Instant> {
+        self.writers
+            .values()
+            .filter(|l| !l.lost)
+            .map(|l| l.deadline)
+            .min()
+    }
+}
+
+impl OwnLease {
+    /// Renews the lease; whether it had run out.
+    fn renew(&mut self, now: Instant) -> bool {
+        self.deadline = now.checked_add(self.duration).unwrap_or(self.deadline);
+        std::mem::replace(&mut self.lost, false)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lease(kind: LivelinessKind, ms: u64) -> Liveliness {
+        Liveliness {
+            kind,
+            lease_duration: Duration::from_millis(ms),
+        }
+    }
+
+    fn lost(out: &mut VecDeque<Event>) -> Vec<EntityId> {
+        out.drain(..)
+            .filter_map(|e| match e {
+                Event::LivelinessLost { writer } => Some(writer),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn by_topic_writer_loses_once_and_recovers_by_writing() {
+        let t0 = Instant::now();
+        let ms = Duration::from_millis;
+        let (w, other) = (EntityId([0, 0, 1, 2]), EntityId([0, 0, 2, 2]));
+        let mut l = OwnLeases::default();
+        let mut out = VecDeque::new();
+        l.track(t0, w, &lease(LivelinessKind::ManualByTopic, 100));
+        l.track(t0, other, &Liveliness::default());
+        assert_eq!(l.next_deadline(), Some(t0 + ms(100)));
+        assert!(!l.assert_writer(t0 + ms(90), w));
+        l.expire(t0 + ms(150), &mut out);
+        assert!(lost(&mut out).is_empty(), "renewed at 90 ms");
+        // The participant's assertion does not count for a MANUAL_BY_TOPIC writer.
+        assert!(!l.assert_participant(t0 + ms(180)));
+        l.expire(t0 + ms(190), &mut out);
+        l.expire(t0 + ms(300), &mut out);
+        assert_eq!(lost(&mut out), vec![w], "reported once per lapse");
+        assert_eq!(l.next_deadline(), None);
+        assert!(l.assert_writer(t0 + ms(310), w), "revived");
+        l.expire(t0 + ms(410), &mut out);
+        assert_eq!(lost(&mut out), vec![w]);
+        l.untrack(w);
+        assert_eq!(l.next_deadline(), None);
+    }
+
+    #[test]
+    fn by_participant_writers_are_renewed_together() {
+        let t0 = Instant::now();
+        let ms = Duration::from_millis;
+        let (a, b) = (EntityId([0, 0, 1, 2]), EntityId([0, 0, 2, 2]));
+        let mut l = OwnLeases::default();
+        let mut out = VecDeque::new();
+        l.track(t0, a, &lease(LivelinessKind::ManualByParticipant, 100));
+        l.track(t0, b, &lease(LivelinessKind::ManualByParticipant, 100));
+        assert!(!l.assert_writer(t0 + ms(80), a));
+        l.expire(t0 + ms(150), &mut out);
+        assert!(lost(&mut out).is_empty(), "a's write renewed b");
+        l.expire(t0 + ms(180), &mut out);
+        assert_eq!(lost(&mut out), vec![a, b]);
+        assert!(l.assert_participant(t0 + ms(200)));
+        assert_eq!(l.next_deadline(), Some(t0 + ms(300)));
     }
 }

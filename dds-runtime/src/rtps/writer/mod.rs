@@ -10,6 +10,7 @@ pub(crate) use coherent::CoherentMark;
 use coherent::CoherentState;
 pub(crate) use content_filter::ReaderFilters;
 pub(crate) use history::{CacheChange, HistoryCache};
+pub(crate) use liveliness::OwnLeases;
 pub(crate) use reader_proxy::ReaderProxy;
 
 use std::collections::{BTreeMap, BTreeSet, VecDeque};

@@ -1,0 +1,184 @@
+//! enable() and ENTITY_FACTORY.autoenable_created_entities (DDS 1.4 §2.2.2.1.1.7): entities created
+//! disabled announce nothing and match nothing, refuse their other operations with `NotEnabled`, cannot
+//! be enabled before their factory (`PreconditionNotMet`), and an enabled factory that autoenables enables
+//! what it created disabled. Run inside `scripts/isolated` (loopback only).
+mod dcps_util;
+
+use std::time::Duration;
+
+use dcps_util::*;
+use dds_runtime::prelude::*;
+
+/// Long enough for discovery to have happened had anything been announced (SPDP every 200 ms).
+const QUIET: Duration = Duration::from_millis(1200);
+
+fn no_autoenable_participant() -> DomainParticipantQos {
+    DomainParticipantQos::builder()
+        .autoenable_created_entities(false)
+        .build()
+}
+
+#[test]
+fn factory_without_autoenable_creates_a_silent_participant() {
+    let f = DomainParticipantFactory::get_instance();
+    let off = DomainParticipantFactoryQos::builder()
+        .autoenable_created_entities(false)
+        .build();
+    f.set_qos(&off).unwrap();
+    let quiet = participant(224);
+    f.set_qos(&DomainParticipantFactoryQos::default()).unwrap();
+    let other = participant(224);
+    assert!(!quiet.is_enabled());
+    assert!(other.is_enabled());
+    assert!(matches!(
+        quiet.assert_liveliness(),
+        Err(DdsError::NotEnabled)
+    ));
+    // Not announced, and deaf: neither side discovers the other.
+    std::thread::sleep(QUIET);
+    assert!(other.discovered_participants().is_empty());
+    assert!(quiet.discovered_participants().is_empty());
+    // Children of a disabled participant are disabled whatever its QoS says, and cannot be enabled.
+    let publisher = quiet.create_publisher(&PublisherQos::default()).unwrap();
+    assert!(!publisher.is_enabled());
+    assert!(matches!(
+        publisher.enable(),
+        Err(DdsError::PreconditionNotMet(_))
+    ));
+    quiet.enable().unwrap();
+    quiet.enable().unwrap();
+    assert!(quiet.is_enabled());
+    // Its QoS autoenables: enabling it enabled the publisher too.
+    assert!(publisher.is_enabled());
+    assert!(wait_until(MATCH_TIMEOUT, || other
+        .discovered_participants()
+        .len()
+        == 1));
+    assert!(wait_until(MATCH_TIMEOUT, || quiet
+        .discovered_participants()
+        .len()
+        == 1));
+}
+
+#[test]
+fn disabled_writer_is_not_announced_until_enabled() {
+    let pw = participant(225);
+    let pr = participant(225);
+    let r = reader::<ShapeType>(&pr, "Enable", &DataReaderQos::default());
+    let t = pw
+        .create_topic::<ShapeType>("Enable", &TopicQos::default())
+        .unwrap();
+    let publisher = pw
+        .create_publisher(
+            &PublisherQos::builder()
+                .autoenable_created_entities(false)
+                .build(),
+        )
+        .unwrap();
+    assert!(publisher.is_enabled());
+    let w = publisher
+        .create_datawriter(&t, &DataWriterQos::default())
+        .unwrap();
+    assert!(!w.is_enabled());
+    assert!(matches!(
+        w.write(&shape("RED", 1)),
+        Err(DdsError::NotEnabled)
+    ));
+    assert!(matches!(w.assert_liveliness(), Err(DdsError::NotEnabled)));
+    // QoS, listener and status condition are allowed on a disabled entity.
+    w.set_qos(&DataWriterQos::builder().user_data(b"late".to_vec()).build())
+        .unwrap();
+    let _ = w.status_condition();
+    assert!(wait_until(MATCH_TIMEOUT, || pr
+        .discovered_participants()
+        .len()
+        == 1));
+    std::thread::sleep(QUIET);
+    assert_eq!(r.subscription_matched_status().current_count, 0);
+    assert_eq!(w.publication_matched_status().current_count, 0);
+    w.enable().unwrap();
+    assert!(w.is_enabled());
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        w.publication_matched_status().current_count == 1
+    }));
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        r.subscription_matched_status().current_count == 1
+    }));
+    // The QoS set while disabled is what was announced.
+    let seen = r.get_matched_publication_data(w.instance_handle()).unwrap();
+    assert_eq!(seen.qos.writer.user_data.0, b"late");
+    w.write(&shape("RED", 2)).unwrap();
+    assert!(r.wait_for_data(MATCH_TIMEOUT).unwrap());
+    assert_eq!(r.take().unwrap()[0].data.as_ref().unwrap().x, 2);
+}
+
+#[test]
+fn disabled_reader_matches_once_enabled_and_deleting_it_announces_nothing() {
+    let pw = participant(226);
+    let pr = participant(226);
+    let w = writer::<ShapeType>(&pw, "EnableR", &DataWriterQos::default());
+    let t = pr
+        .create_topic::<ShapeType>("EnableR", &TopicQos::default())
+        .unwrap();
+    let sub = pr
+        .create_subscriber(
+            &SubscriberQos::builder()
+                .autoenable_created_entities(false)
+                .build(),
+        )
+        .unwrap();
+    let gone = sub
+        .create_datareader::<ShapeType, _>(&t, &DataReaderQos::default())
+        .unwrap();
+    sub.delete_datareader(&gone).unwrap();
+    let r = sub
+        .create_datareader::<ShapeType, _>(&t, &DataReaderQos::default())
+        .unwrap();
+    assert!(matches!(r.take(), Err(DdsError::NotEnabled)));
+    assert!(matches!(
+        r.wait_for_data(Duration::ZERO),
+        Err(DdsError::NotEnabled)
+    ));
+    std::thread::sleep(QUIET);
+    assert_eq!(w.publication_matched_status().current_count, 0);
+    // The subscriber is enabled already (only its children start disabled): enabling it changes nothing.
+    sub.enable().unwrap();
+    assert!(!r.is_enabled());
+    r.enable().unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        w.publication_matched_status().current_count == 1
+    }));
+    assert_eq!(r.take().unwrap().len(), 0);
+}
+
+#[test]
+fn enabling_follows_the_factory_chain() {
+    let p = participant(227);
+    p.set_qos(&no_autoenable_participant()).unwrap();
+    let t = p
+        .create_topic::<ShapeType>("Chain", &TopicQos::default())
+        .unwrap();
+    let publisher = p.create_publisher(&PublisherQos::default()).unwrap();
+    assert!(!t.is_enabled() && !publisher.is_enabled());
+    let w = publisher
+        .create_datawriter(&t, &DataWriterQos::default())
+        .unwrap();
+    assert!(!w.is_enabled());
+    // The writer's publisher is disabled.
+    assert!(matches!(w.enable(), Err(DdsError::PreconditionNotMet(_))));
+    // The publisher autoenables: enabling it enables the writer, but not while the topic is disabled.
+    publisher.enable().unwrap();
+    assert!(publisher.is_enabled());
+    assert!(!w.is_enabled());
+    assert!(matches!(w.enable(), Err(DdsError::PreconditionNotMet(_))));
+    t.enable().unwrap();
+    w.enable().unwrap();
+    assert!(w.is_enabled());
+    w.write(&shape("RED", 1)).unwrap();
+    // Entities created after autoenable is switched back on are enabled.
+    p.set_qos(&DomainParticipantQos::default()).unwrap();
+    assert!(p
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .is_enabled());
+}
