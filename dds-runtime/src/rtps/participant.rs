@@ -8,6 +8,7 @@ mod discovery;
 mod filtering;
 mod historical;
 mod liveliness;
+mod local;
 mod receive;
 mod timers;
 
@@ -67,6 +68,8 @@ pub struct Participant {
     last_full_scan: Instant,
     /// What the application ignores (`ignore_participant`, `ignore_endpoint`, `ignore_topic`).
     ignored: control::Ignored,
+    /// Pairs of our own endpoints matched for intra-process delivery.
+    local: local::LocalMatches,
 }
 
 fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
@@ -155,6 +158,7 @@ impl Participant {
             timer_floor: Cell::new(None),
             last_full_scan: now,
             ignored: control::Ignored::new(),
+            local: Default::default(),
             config,
         };
         let prefix = p.config.guid_prefix;
@@ -416,10 +420,15 @@ impl Participant {
         if !self.user_writers.contains(&writer) {
             return Vec::new();
         }
+        let prefix = self.config.guid_prefix;
+        let local = self.local_readers(writer).iter();
         self.writers
             .get(&writer)
-            .map(|w| w.matched().copied().collect())
-            .unwrap_or_default()
+            .map(|w| w.matched().copied())
+            .into_iter()
+            .flatten()
+            .chain(local.map(|r| Guid::new(prefix, *r)))
+            .collect()
     }
 
     /// Back-pressure for a reliable reader: it delivers at most `credit` more changes (`None`: no limit)
@@ -439,10 +448,15 @@ impl Participant {
         if !self.user_readers.contains(&reader) {
             return Vec::new();
         }
+        let prefix = self.config.guid_prefix;
+        let local = self.local_writers_of(reader).map(|w| Guid::new(prefix, w));
         self.readers
             .get(&reader)
-            .map(|r| r.matched().copied().collect())
-            .unwrap_or_default()
+            .map(|r| r.matched().copied())
+            .into_iter()
+            .flatten()
+            .chain(local)
+            .collect()
     }
 
     /// Discovered remote participants.
