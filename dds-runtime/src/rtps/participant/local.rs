@@ -9,7 +9,7 @@
 
 use std::time::Instant;
 
-use foldhash::HashMap;
+use foldhash::{HashMap, HashSet};
 
 use super::discovery::Local;
 use super::Participant;
@@ -17,20 +17,30 @@ use crate::qos::{Durability, History, Reliability};
 use crate::rtps::api::{Event, ReceivedSample, WriteChange, WriteError};
 use crate::rtps::types::{EntityId, Guid, GuidPrefix, SequenceNumber};
 
-/// The local pairs matched for intra-process delivery: writer → its readers.
+/// The local pairs matched for intra-process delivery. Each side records its own match, as each side of a
+/// wire match has its own proxy: the writer's side (writer → its readers, what delivery reads) and the
+/// reader's side.
 #[derive(Debug, Default)]
 pub(super) struct LocalMatches {
     readers: HashMap<EntityId, Vec<EntityId>>,
+    reader_side: HashSet<(EntityId, EntityId)>,
 }
 
 impl LocalMatches {
-    fn has(&self, writer: EntityId, reader: EntityId) -> bool {
-        self.readers
-            .get(&writer)
-            .is_some_and(|rs| rs.contains(&reader))
+    fn has(&self, side: Local, writer: EntityId, reader: EntityId) -> bool {
+        match side {
+            Local::Writer(_) => self
+                .readers
+                .get(&writer)
+                .is_some_and(|rs| rs.contains(&reader)),
+            Local::Reader(_) => self.reader_side.contains(&(writer, reader)),
+        }
     }
 
-    fn remove(&mut self, writer: EntityId, reader: EntityId) -> bool {
+    fn remove(&mut self, side: Local, writer: EntityId, reader: EntityId) -> bool {
+        if let Local::Reader(_) = side {
+            return self.reader_side.remove(&(writer, reader));
+        }
         let Some(rs) = self.readers.get_mut(&writer) else {
             return false;
         };
@@ -63,7 +73,7 @@ impl Participant {
     /// Whether `local` and `remote` are matched for intra-process delivery.
     pub(super) fn has_local_match(&self, local: Local, remote: Guid) -> bool {
         pair(self.config.guid_prefix, local, remote)
-            .is_some_and(|(w, r)| self.local.has(w, r))
+            .is_some_and(|(w, r)| self.local.has(local, w, r))
     }
 
     /// Whether this pair of user endpoints of ours is delivered intra-process (see the module doc).
@@ -96,33 +106,23 @@ impl Participant {
         if !self.delivers_locally(w, r) {
             return false;
         }
-        self.local.readers.entry(w).or_default().push(r);
         let wguid = self.own_guid(w);
-        if let Some(wd) = self.known_writers.get(&wguid) {
-            let liveliness = wd.qos.writer.liveliness;
-            self.track_liveliness(now, wguid, r, &liveliness);
+        if let Local::Reader(_) = local {
+            self.local.reader_side.insert((w, r));
+            if let Some(wd) = self.known_writers.get(&wguid) {
+                let liveliness = wd.qos.writer.liveliness;
+                self.track_liveliness(now, wguid, r, &liveliness);
+            }
+            return true;
         }
+        self.local.readers.entry(w).or_default().push(r);
         self.refresh_reader_filter(w, self.own_guid(r));
         let durable = self
             .known_readers
             .get(&self.own_guid(r))
             .is_some_and(|rd| rd.qos.reader.durability >= Durability::TransientLocal);
         if durable {
-            if let Some(wr) = self.writers.get_mut(&w) {
-                let rguid = Guid::new(wguid.prefix, r);
-                let events = &mut self.events;
-                wr.for_each_historical(now, &rguid, |c| {
-                    events.push_back(Event::Sample(ReceivedSample {
-                        reader: r,
-                        writer: wguid,
-                        sequence: c.sn,
-                        kind: c.kind,
-                        payload: c.payload.clone(),
-                        key_hash: c.key_hash,
-                        source_timestamp: c.source_timestamp,
-                    }));
-                });
-            }
+            self.replay_history(now, w, r);
         }
         tracing::debug!(writer = ?w, reader = ?r, "matched for intra-process delivery");
         true
@@ -133,10 +133,20 @@ impl Participant {
         let Some((w, r)) = pair(self.config.guid_prefix, local, remote) else {
             return false;
         };
-        if !self.local.remove(w, r) {
+        if !self.local.remove(local, w, r) {
             return false;
         }
-        self.untrack_liveliness(&self.own_guid(w), r);
+        // A deleted endpoint has no side left to unmatch: drop its side with the other one.
+        if !self.user_readers.contains(&r) {
+            self.local.reader_side.remove(&(w, r));
+        }
+        if !self.user_writers.contains(&w) {
+            self.local.remove(Local::Writer(w), w, r);
+        }
+        if let Local::Reader(_) = local {
+            self.untrack_liveliness(&self.own_guid(w), r);
+            return true;
+        }
         let rguid = self.own_guid(r);
         if let Some(wr) = self.writers.get_mut(&w) {
             wr.filters.set(rguid, None);
@@ -144,12 +154,33 @@ impl Participant {
         true
     }
 
+    /// A durable reader `r` that joins durable writer `w` gets its history as events.
+    fn replay_history(&mut self, now: Instant, w: EntityId, r: EntityId) {
+        let wguid = self.own_guid(w);
+        let rguid = self.own_guid(r);
+        let Some(wr) = self.writers.get_mut(&w) else {
+            return;
+        };
+        let events = &mut self.events;
+        wr.for_each_historical(now, &rguid, |c| {
+            events.push_back(Event::Sample(ReceivedSample {
+                reader: r,
+                writer: wguid,
+                sequence: c.sn,
+                kind: c.kind,
+                payload: c.payload.clone(),
+                key_hash: c.key_hash,
+                source_timestamp: c.source_timestamp,
+            }));
+        });
+    }
+
     /// The writers of this participant that deliver to `reader` intra-process.
     pub(super) fn local_writers_of(&self, reader: EntityId) -> impl Iterator<Item = EntityId> + '_ {
         self.local
-            .readers
+            .reader_side
             .iter()
-            .filter(move |(_, rs)| rs.contains(&reader))
+            .filter(move |(_, r)| *r == reader)
             .map(|(w, _)| *w)
     }
 
