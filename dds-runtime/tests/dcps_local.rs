@@ -122,7 +122,10 @@ fn local_delivery_keeps_history_instance_states_and_lifespan() {
     assert!(!green.is_empty(), "the dispose reached the local reader");
     // Lifespan: samples expire in the reader.
     w.write(&shape("RED", 9)).unwrap();
-    assert!(wait_until(Duration::from_secs(3), || r.read().unwrap().is_empty()));
+    assert!(wait_until(Duration::from_secs(3), || r
+        .read()
+        .unwrap()
+        .is_empty()));
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! Intra-process delivery: a user writer and a user reader of this participant match without wire state
-//! (no reader proxy, no writer proxy, no datagram, no acknowledgement). Their changes reach the reader as
-//! [`Event::Sample`]s, or, for the typed DCPS write path, not at all from the core: the caller hands the
-//! sample itself to [`Participant::local_readers`] (see [`Participant::write_bypassing_local`]).
+//! (no reader proxy, no writer proxy, no datagram, no acknowledgement). Each change the writer writes
+//! reaches the reader as an [`Event::Sample`] sharing the writer's payload (no copy), in the same call; a
+//! durable reader that joins late gets the writer's history the same way.
 //!
 //! A pair keeps the wire path when intra-process delivery is off, when the writer's publisher has coherent
 //! access (coherent sets are assembled by the RTPS reader), or when the reader is reliable KEEP_ALL with
@@ -14,7 +14,7 @@ use foldhash::{HashMap, HashSet};
 use super::discovery::Local;
 use super::Participant;
 use crate::qos::{Durability, History, Reliability};
-use crate::rtps::api::{Event, ReceivedSample, WriteChange, WriteError};
+use crate::rtps::api::{Event, ReceivedSample, WriteChange};
 use crate::rtps::types::{EntityId, Guid, GuidPrefix, SequenceNumber};
 
 /// The local pairs matched for intra-process delivery. Each side records its own match, as each side of a
@@ -187,23 +187,6 @@ impl Participant {
     /// The readers of this participant that `writer` delivers to intra-process (empty for most writers).
     pub fn local_readers(&self, writer: EntityId) -> &[EntityId] {
         self.local.readers.get(&writer).map_or(&[], Vec::as_slice)
-    }
-
-    /// [`Participant::write_filtered`] for a caller that delivers the sample itself to
-    /// [`local_readers`](Self::local_readers) (except the `rejected` ones): the core sends it to the
-    /// readers on the wire only, and keeps it in the writer's history (for late joiners, local or not).
-    pub fn write_bypassing_local(
-        &mut self,
-        now: Instant,
-        writer: EntityId,
-        change: WriteChange,
-        rejected: Vec<Guid>,
-    ) -> Result<SequenceNumber, WriteError> {
-        let sn = self.write_wire(now, writer, change, rejected)?;
-        if !self.local_readers(writer).is_empty() {
-            self.writer_asserted(now, self.own_guid(writer));
-        }
-        Ok(sn)
     }
 
     /// Gives a change just written as `sn` to the writer's intra-process readers, as events (the
