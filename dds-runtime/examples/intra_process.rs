@@ -25,10 +25,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let size: usize = args.next().map_or(Ok(16), |s| s.parse())?;
     let count: u64 = args.next().map_or(Ok(200_000), |s| s.parse())?;
     let local = args.next().is_none_or(|m| m != "udp");
-    let mut c = Config::default();
-    c.domain_id = 120;
-    c.interface = InterfaceSelection::Name("lo".into());
-    c.intra_process = local;
+    let c = Config {
+        domain_id: 120,
+        interface: InterfaceSelection::Name("lo".into()),
+        intra_process: local,
+        ..Config::default()
+    };
     let p = DomainParticipant::builder().config(c).build()?;
     let topic = p.create_topic::<Payload>("IntraBench", &TopicQos::default())?;
     let reliable = Reliability::Reliable {

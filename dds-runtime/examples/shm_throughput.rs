@@ -64,7 +64,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             lost += seq.saturating_sub(n);
         }
         next = Some(seq + 1);
-        sum = s.iter().step_by(64).fold(sum, |a, b| a.wrapping_add(u64::from(*b)));
+        sum = s
+            .iter()
+            .step_by(64)
+            .fold(sum, |a, b| a.wrapping_add(u64::from(*b)));
         if Instant::now() >= warm {
             start.get_or_insert_with(Instant::now);
             count += 1;

@@ -72,10 +72,12 @@ fn local_reader_gets_every_sample_without_a_datagram_and_a_remote_one_over_udp()
 fn without_intra_process_the_same_exchange_goes_over_udp() {
     require_netns();
     init_tracing();
-    let mut c = Config::default();
-    c.domain_id = 102;
-    c.interface = dds_runtime::config::InterfaceSelection::Name("lo".into());
-    c.intra_process = false;
+    let c = Config {
+        domain_id: 102,
+        interface: dds_runtime::config::InterfaceSelection::Name("lo".into()),
+        intra_process: false,
+        ..Config::default()
+    };
     let p = DomainParticipant::builder().config(c).build().unwrap();
     let (wq, rq) = reliable_keep_all();
     let (w, r) = matched::<ShapeType>(&p, &p, "Udp", &wq, &rq);
