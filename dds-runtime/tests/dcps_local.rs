@@ -20,16 +20,6 @@ fn xs(samples: &[Sample<ShapeType>]) -> Vec<i32> {
         .collect()
 }
 
-/// Takes until `n` samples arrived (or 10 s passed).
-fn take_n(r: &DataReader<ShapeType>, n: usize) -> Vec<Sample<ShapeType>> {
-    let mut got = Vec::new();
-    wait_until(MATCH_TIMEOUT, || {
-        got.extend(r.take().unwrap());
-        got.len() >= n
-    });
-    got
-}
-
 #[test]
 fn local_reader_gets_every_sample_without_a_datagram_and_a_remote_one_over_udp() {
     let p = participant(101);
