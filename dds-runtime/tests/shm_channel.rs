@@ -180,3 +180,37 @@ fn a_publisher_killed_while_holding_loans_leaks_and_corrupts_nothing() {
         assert_eq!(receive_checked(&sub, n, 1), 1, "sample {n}");
     }
 }
+
+#[test]
+fn spdp_says_which_peers_can_use_shared_memory() {
+    use dds_runtime::prelude::*;
+    use dds_runtime::transport::shm::{peer_can_use_shm, SHM_HOST_PROPERTY};
+    if std::env::var("DDS_IN_NETNS").as_deref() != Ok("1") {
+        // Opens sockets: only inside scripts/isolated.
+        return;
+    }
+    let build = || {
+        DomainParticipant::builder()
+            .domain_id(105)
+            .interface("lo")
+            .spdp_interval(Duration::from_millis(200))
+            .build()
+            .unwrap()
+    };
+    let (a, b) = (build(), build());
+    let end = Instant::now() + Duration::from_secs(10);
+    let peer = loop {
+        if let Some(p) = a
+            .discovered_participants()
+            .into_iter()
+            .find(|p| p.guid_prefix == b.guid_prefix())
+        {
+            break p;
+        }
+        assert!(Instant::now() < end, "b not discovered");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let data = a.get_discovered_participant_data(peer.handle).unwrap();
+    assert!(data.property(SHM_HOST_PROPERTY).is_some());
+    assert!(peer_can_use_shm(&data.properties));
+}

@@ -11,9 +11,12 @@
 //! releases what it held. Nothing a dead process wrote half-way is ever delivered: only sent samples reach
 //! subscribers.
 //!
-//! Not wired into the DCPS writers and readers yet (see `docs/performance.md`, "Shared memory").
+//! Discovery says which peers can use it ([`peer_can_use_shm`]: same host, same feature). Not wired into
+//! the DCPS writers and readers yet (see `docs/performance.md`, "Shared memory").
 //!
 //! [iceoryx2]: https://docs.rs/iceoryx2
+
+mod discovery;
 
 use std::ops::{Deref, DerefMut};
 
@@ -23,6 +26,8 @@ use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use iceoryx2::sample::Sample;
 use iceoryx2::sample_mut::SampleMut;
+
+pub use discovery::{host_id, peer_can_use_shm, SHM_HOST_PROPERTY};
 
 /// What can go wrong with a shared-memory channel (the iceoryx2 error, as text).
 #[derive(Debug, thiserror::Error)]
