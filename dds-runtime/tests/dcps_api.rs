@@ -140,15 +140,6 @@ fn pair(p1: &DomainParticipant, p2: &DomainParticipant, topic: &str) -> Pair {
     }
 }
 
-fn take_n(r: &DataReader<ShapeType>, n: usize) -> Vec<Sample<ShapeType>> {
-    let mut got = Vec::new();
-    wait_until(MATCH_TIMEOUT, || {
-        got.extend(r.take().unwrap());
-        got.len() >= n
-    });
-    got
-}
-
 // ---- DomainParticipantFactory -------------------------------------------------------------------
 
 #[test]

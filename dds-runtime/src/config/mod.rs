@@ -16,6 +16,7 @@
 //! | `DDS_FRAGMENT_SIZE` | DATA_FRAG fragment size | bytes, `256`..=`65000` | `1344` |
 //! | `DDS_MAX_MESSAGE_SIZE` | largest RTPS message (datagram) we send | bytes, `512`..=`65500` | `14720` |
 //! | `DDS_SOCKET_BUFFER_SIZE` | requested SO_RCVBUF / SO_SNDBUF | bytes | `4194304` |
+//! | `DDS_INTRA_PROCESS` | deliver to readers of the same participant directly (no serialization for them, no socket) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_WRITE_BATCH` | write batching: samples share datagrams until full, flushed, or this delay has passed | `off`, `on` (1 ms), or a delay in microseconds | `off` |
 //!
 //! Invalid values are reported as [`ConfigError`] rather than silently ignored.
@@ -204,6 +205,9 @@ pub struct Config {
     /// Write batching: how long a written sample may wait for others to share its datagram. `None` sends
     /// each write at once (lowest latency); `Some` trades up to that much latency for throughput.
     pub write_batch_delay: Option<Duration>,
+    /// Intra-process delivery: a writer gives its samples to readers of the same participant directly,
+    /// with no serialization for the reader and no socket (`DDS_INTRA_PROCESS`, default on).
+    pub intra_process: bool,
 }
 
 impl Default for Config {
@@ -221,6 +225,7 @@ impl Default for Config {
             max_message_size: 14720,
             socket_buffer_size: 4 << 20,
             write_batch_delay: None,
+            intra_process: true,
         }
     }
 }
@@ -321,6 +326,9 @@ impl Config {
         }
         if let Some(v) = lookup("DDS_SOCKET_BUFFER_SIZE") {
             c.socket_buffer_size = parse_num("DDS_SOCKET_BUFFER_SIZE", &v)?;
+        }
+        if let Some(v) = lookup("DDS_INTRA_PROCESS") {
+            c.intra_process = parse_bool("DDS_INTRA_PROCESS", &v)?;
         }
         if let Some(v) = lookup("DDS_WRITE_BATCH") {
             c.write_batch_delay = parse_batch_delay(&v)?;

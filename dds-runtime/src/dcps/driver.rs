@@ -203,6 +203,7 @@ fn core_config(
     .max_message_size(config.max_message_size)
     .fragment_size(config.fragment_size)
     .write_batch_delay(config.write_batch_delay)
+    .intra_process(config.intra_process)
     .user_data(user_data)
     .properties(super::process_info::properties())
     .entity_name(name)

@@ -342,6 +342,11 @@ impl DomainParticipant {
         &self.driver.config
     }
 
+    /// Counters of the participant's UDP transport (datagrams sent and received).
+    pub fn transport_stats(&self) -> &crate::transport::TransportStats {
+        self.driver.transport.stats()
+    }
+
     /// The RTPS GUID prefix.
     pub fn guid_prefix(&self) -> GuidPrefix {
         self.driver.guid_prefix

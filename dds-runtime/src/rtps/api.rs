@@ -223,6 +223,10 @@ participant_config! {
     /// earlier when the datagram is full, on [`Participant::flush`](super::Participant::flush), or with any
     /// other outgoing traffic. `None` (the default) sends every write at once.
     write_batch_delay: Option<Duration> = copy,
+    /// Intra-process delivery (default on): a local writer and a local reader of this participant match
+    /// without wire state; the writer's changes reach the reader as events, never as datagrams (see
+    /// `docs/rtps-core.md`, "Intra-process delivery").
+    intra_process: bool = copy,
 }
 
 impl ParticipantConfig {
@@ -272,6 +276,7 @@ impl ParticipantConfig {
             writer_linger_duration: Duration::from_secs(1),
             max_repair_bytes: 256 * 1024,
             write_batch_delay: None,
+            intra_process: true,
         }))
     }
 

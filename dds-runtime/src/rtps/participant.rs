@@ -9,6 +9,7 @@ mod enable;
 mod filtering;
 mod historical;
 mod liveliness;
+mod local;
 mod receive;
 mod timers;
 mod topics;
@@ -82,6 +83,8 @@ pub struct Participant {
     ignored: control::Ignored,
     /// The TypeLookup service: the type store, its server and client.
     type_lookup: type_lookup::TypeLookupService,
+    /// Pairs of our own endpoints matched for intra-process delivery.
+    local: local::LocalMatches,
 }
 
 fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
@@ -175,6 +178,7 @@ impl Participant {
             last_full_scan: now,
             ignored: control::Ignored::new(),
             type_lookup: type_lookup::TypeLookupService::new(config.guid_prefix),
+            local: Default::default(),
             config,
         };
         let prefix = p.config.guid_prefix;
@@ -464,10 +468,15 @@ impl Participant {
         if !self.user_writers.contains(&writer) {
             return Vec::new();
         }
+        let prefix = self.config.guid_prefix;
+        let local = self.local_readers(writer).iter();
         self.writers
             .get(&writer)
-            .map(|w| w.matched().copied().collect())
-            .unwrap_or_default()
+            .map(|w| w.matched().copied())
+            .into_iter()
+            .flatten()
+            .chain(local.map(|r| Guid::new(prefix, *r)))
+            .collect()
     }
 
     /// Back-pressure for a reliable reader: it delivers at most `credit` more changes (`None`: no limit)
@@ -487,10 +496,15 @@ impl Participant {
         if !self.user_readers.contains(&reader) {
             return Vec::new();
         }
+        let prefix = self.config.guid_prefix;
+        let local = self.local_writers_of(reader).map(|w| Guid::new(prefix, w));
         self.readers
             .get(&reader)
-            .map(|r| r.matched().copied().collect())
-            .unwrap_or_default()
+            .map(|r| r.matched().copied())
+            .into_iter()
+            .flatten()
+            .chain(local)
+            .collect()
     }
 
     /// Discovered remote participants.

@@ -24,6 +24,8 @@ pub mod iface;
 #[cfg(target_os = "linux")]
 mod mmsg;
 mod recv;
+#[cfg(feature = "shm")]
+pub mod shm;
 mod socket;
 mod udp;
 

@@ -149,3 +149,13 @@ pub(crate) fn matched<T: DdsType>(
     );
     (w, r)
 }
+
+/// Takes from `r` until `n` samples arrived (or [`MATCH_TIMEOUT`] passed); what arrived.
+pub(crate) fn take_n(r: &DataReader<ShapeType>, n: usize) -> Vec<Sample<ShapeType>> {
+    let mut got = Vec::new();
+    wait_until(MATCH_TIMEOUT, || {
+        got.extend(r.take().unwrap());
+        got.len() >= n
+    });
+    got
+}

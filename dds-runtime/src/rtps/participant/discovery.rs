@@ -337,18 +337,22 @@ impl Participant {
 
     /// Whether `local` already has a proxy for `remote`; `None` when it cannot match (gone or lingering).
     fn has_proxy(&self, local: Local, remote: Guid) -> Option<bool> {
-        match local {
+        let wire = match local {
             Local::Writer(id) => self
                 .writers
                 .get(&id)
                 .filter(|w| w.linger_until.is_none())
                 .map(|w| w.has_proxy(&remote)),
             Local::Reader(id) => self.readers.get(&id).map(|r| r.has_proxy(&remote)),
-        }
+        };
+        wire.map(|has| has || self.has_local_match(local, remote))
     }
 
     /// Gives `local` a proxy for the known endpoint `remote`.
     fn add_proxy(&mut self, now: Instant, local: Local, remote: Guid) {
+        if self.add_local_match(now, local, remote) {
+            return;
+        }
         match local {
             Local::Writer(id) => {
                 let Some(rd) = self.known_readers.get(&remote) else {
@@ -387,6 +391,9 @@ impl Participant {
 
     /// Removes `local`'s proxy for `remote`; whether it had one.
     fn remove_proxy(&mut self, local: Local, remote: Guid) -> bool {
+        if self.remove_local_match(local, remote) {
+            return true;
+        }
         match local {
             Local::Writer(id) => self
                 .writers

@@ -23,7 +23,25 @@ impl Participant {
     /// [`Participant::write`] of a change that the content filters of the `rejected` readers refused (as
     /// evaluated by the caller on the sample, see [`Participant::writer_reader_filters`]): the change goes
     /// to the other readers as DATA and to the rejecting reliable ones as GAP, now and on repair.
+    /// Readers of this participant matched for intra-process delivery get it as an event.
     pub fn write_filtered(
+        &mut self,
+        now: Instant,
+        writer: EntityId,
+        change: WriteChange,
+        rejected: Vec<Guid>,
+    ) -> Result<SequenceNumber, WriteError> {
+        if self.local_readers(writer).is_empty() {
+            return self.write_wire(now, writer, change, rejected);
+        }
+        let (local, local_rejected) = (change.clone(), rejected.clone());
+        let sn = self.write_wire(now, writer, change, rejected)?;
+        self.deliver_local(now, writer, sn, local, &local_rejected);
+        Ok(sn)
+    }
+
+    /// Writes a change to the writer's history and its readers on the wire.
+    pub(super) fn write_wire(
         &mut self,
         now: Instant,
         writer: EntityId,

@@ -4,6 +4,7 @@ mod coherent;
 mod content_filter;
 mod history;
 mod liveliness;
+mod local;
 mod reader_proxy;
 
 pub(crate) use coherent::CoherentMark;

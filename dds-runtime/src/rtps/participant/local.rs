@@ -1,0 +1,222 @@
+//! Intra-process delivery: a user writer and a user reader of this participant match without wire state
+//! (no reader proxy, no writer proxy, no datagram, no acknowledgement). Each change the writer writes
+//! reaches the reader as an [`Event::Sample`] sharing the writer's payload (no copy), in the same call; a
+//! durable reader that joins late gets the writer's history the same way.
+//!
+//! A pair keeps the wire path when intra-process delivery is off, when the writer's publisher has coherent
+//! access (coherent sets are assembled by the RTPS reader), or when the reader is reliable KEEP_ALL with
+//! `max_samples` (its back-pressure is the RTPS reader's delivery credit).
+
+use std::time::Instant;
+
+use foldhash::{HashMap, HashSet};
+
+use super::discovery::Local;
+use super::Participant;
+use crate::qos::{Durability, History, Reliability};
+use crate::rtps::api::{Event, ReceivedSample, WriteChange};
+use crate::rtps::types::{EntityId, Guid, GuidPrefix, SequenceNumber};
+
+/// The local pairs matched for intra-process delivery. Each side records its own match, as each side of a
+/// wire match has its own proxy: the writer's side (writer → its readers, what delivery reads) and the
+/// reader's side.
+#[derive(Debug, Default)]
+pub(super) struct LocalMatches {
+    readers: HashMap<EntityId, Vec<EntityId>>,
+    reader_side: HashSet<(EntityId, EntityId)>,
+}
+
+impl LocalMatches {
+    fn has(&self, side: Local, writer: EntityId, reader: EntityId) -> bool {
+        match side {
+            Local::Writer(_) => self
+                .readers
+                .get(&writer)
+                .is_some_and(|rs| rs.contains(&reader)),
+            Local::Reader(_) => self.reader_side.contains(&(writer, reader)),
+        }
+    }
+
+    fn remove(&mut self, side: Local, writer: EntityId, reader: EntityId) -> bool {
+        if let Local::Reader(_) = side {
+            return self.reader_side.remove(&(writer, reader));
+        }
+        let Some(rs) = self.readers.get_mut(&writer) else {
+            return false;
+        };
+        let before = rs.len();
+        rs.retain(|r| *r != reader);
+        let removed = rs.len() != before;
+        if rs.is_empty() {
+            self.readers.remove(&writer);
+        }
+        removed
+    }
+}
+
+/// The (writer, reader) entity ids of `local` and `remote`, when `remote` is an endpoint of this participant.
+fn pair(own: GuidPrefix, local: Local, remote: Guid) -> Option<(EntityId, EntityId)> {
+    if remote.prefix != own {
+        return None;
+    }
+    Some(match local {
+        Local::Writer(w) => (w, remote.entity_id),
+        Local::Reader(r) => (remote.entity_id, r),
+    })
+}
+
+impl Participant {
+    fn own_guid(&self, id: EntityId) -> Guid {
+        Guid::new(self.config.guid_prefix, id)
+    }
+
+    /// Whether `local` and `remote` are matched for intra-process delivery.
+    pub(super) fn has_local_match(&self, local: Local, remote: Guid) -> bool {
+        pair(self.config.guid_prefix, local, remote)
+            .is_some_and(|(w, r)| self.local.has(local, w, r))
+    }
+
+    /// Whether this pair of user endpoints of ours is delivered intra-process (see the module doc).
+    fn delivers_locally(&self, writer: EntityId, reader: EntityId) -> bool {
+        if !self.config.intra_process
+            || !self.user_writers.contains(&writer)
+            || !self.user_readers.contains(&reader)
+        {
+            return false;
+        }
+        let (Some(wd), Some(rd)) = (
+            self.known_writers.get(&self.own_guid(writer)),
+            self.known_readers.get(&self.own_guid(reader)),
+        ) else {
+            return false;
+        };
+        let rq = &rd.qos.reader;
+        let credit = matches!(rq.reliability, Reliability::Reliable { .. })
+            && matches!(rq.history, History::KeepAll)
+            && rq.resource_limits.max_samples.is_some();
+        !wd.qos.presentation.coherent_access && !credit
+    }
+
+    /// Matches `local` with `remote` for intra-process delivery when both are ours and the pair qualifies;
+    /// a durable reader of a durable writer gets the writer's history at once. False: use a proxy.
+    pub(super) fn add_local_match(&mut self, now: Instant, local: Local, remote: Guid) -> bool {
+        let Some((w, r)) = pair(self.config.guid_prefix, local, remote) else {
+            return false;
+        };
+        if !self.delivers_locally(w, r) {
+            return false;
+        }
+        let wguid = self.own_guid(w);
+        if let Local::Reader(_) = local {
+            self.local.reader_side.insert((w, r));
+            if let Some(wd) = self.known_writers.get(&wguid) {
+                let liveliness = wd.qos.writer.liveliness;
+                self.track_liveliness(now, wguid, r, &liveliness);
+            }
+            return true;
+        }
+        self.local.readers.entry(w).or_default().push(r);
+        self.refresh_reader_filter(w, self.own_guid(r));
+        let durable = self
+            .known_readers
+            .get(&self.own_guid(r))
+            .is_some_and(|rd| rd.qos.reader.durability >= Durability::TransientLocal);
+        if durable {
+            self.replay_history(now, w, r);
+        }
+        tracing::debug!(writer = ?w, reader = ?r, "matched for intra-process delivery");
+        true
+    }
+
+    /// Unmatches an intra-process pair; whether it was one.
+    pub(super) fn remove_local_match(&mut self, local: Local, remote: Guid) -> bool {
+        let Some((w, r)) = pair(self.config.guid_prefix, local, remote) else {
+            return false;
+        };
+        if !self.local.remove(local, w, r) {
+            return false;
+        }
+        // A deleted endpoint has no side left to unmatch: drop its side with the other one.
+        if !self.user_readers.contains(&r) {
+            self.local.reader_side.remove(&(w, r));
+        }
+        if !self.user_writers.contains(&w) {
+            self.local.remove(Local::Writer(w), w, r);
+        }
+        if let Local::Reader(_) = local {
+            self.untrack_liveliness(&self.own_guid(w), r);
+            return true;
+        }
+        let rguid = self.own_guid(r);
+        if let Some(wr) = self.writers.get_mut(&w) {
+            wr.filters.set(rguid, None);
+        }
+        true
+    }
+
+    /// A durable reader `r` that joins durable writer `w` gets its history as events.
+    fn replay_history(&mut self, now: Instant, w: EntityId, r: EntityId) {
+        let wguid = self.own_guid(w);
+        let rguid = self.own_guid(r);
+        let Some(wr) = self.writers.get_mut(&w) else {
+            return;
+        };
+        let events = &mut self.events;
+        wr.for_each_historical(now, &rguid, |c| {
+            events.push_back(Event::Sample(ReceivedSample {
+                reader: r,
+                writer: wguid,
+                sequence: c.sn,
+                kind: c.kind,
+                payload: c.payload.clone(),
+                key_hash: c.key_hash,
+                source_timestamp: c.source_timestamp,
+            }));
+        });
+    }
+
+    /// The writers of this participant that deliver to `reader` intra-process.
+    pub(super) fn local_writers_of(&self, reader: EntityId) -> impl Iterator<Item = EntityId> + '_ {
+        self.local
+            .reader_side
+            .iter()
+            .filter(move |(_, r)| *r == reader)
+            .map(|(w, _)| *w)
+    }
+
+    /// The readers of this participant that `writer` delivers to intra-process (empty for most writers).
+    pub fn local_readers(&self, writer: EntityId) -> &[EntityId] {
+        self.local.readers.get(&writer).map_or(&[], Vec::as_slice)
+    }
+
+    /// Gives a change just written as `sn` to the writer's intra-process readers, as events (the
+    /// serialized form: for writes that do not come with a typed sample).
+    pub(super) fn deliver_local(
+        &mut self,
+        now: Instant,
+        writer: EntityId,
+        sn: SequenceNumber,
+        change: WriteChange,
+        rejected: &[Guid],
+    ) {
+        let wguid = self.own_guid(writer);
+        let Some(readers) = self.local.readers.get(&writer) else {
+            return;
+        };
+        for &r in readers {
+            if rejected.contains(&Guid::new(wguid.prefix, r)) {
+                continue;
+            }
+            self.events.push_back(Event::Sample(ReceivedSample {
+                reader: r,
+                writer: wguid,
+                sequence: sn,
+                kind: change.kind,
+                payload: change.payload.clone(),
+                key_hash: change.key_hash,
+                source_timestamp: change.source_timestamp,
+            }));
+        }
+        self.writer_asserted(now, wguid);
+    }
+}

@@ -1,0 +1,272 @@
+//! Shared-memory channels between processes on one host, on [iceoryx2] (feature `shm`).
+//!
+//! A channel carries byte samples (serialized DDS samples, typically) from publishers to subscribers of the
+//! same name, with no copy: a publisher loans a buffer from its shared-memory segment
+//! ([`ShmPublisher::loan`]), the caller writes the sample into it in place and sends it; a subscriber gets a
+//! [`ShmSample`] that reads the publisher's buffer in place, and the buffer returns to the publisher when
+//! the last subscriber drops it.
+//!
+//! A process that dies (even by `SIGKILL`) while it holds loans or received samples leaves its node's
+//! resources behind; [`remove_dead_nodes`] (also run whenever a [`ShmNode`] is created) frees them and
+//! releases what it held. Nothing a dead process wrote half-way is ever delivered: only sent samples reach
+//! subscribers.
+//!
+//! Discovery says which peers can use it ([`peer_can_use_shm`]: same host, same feature). Not wired into
+//! the DCPS writers and readers yet (see `docs/performance.md`, "Shared memory").
+//!
+//! [iceoryx2]: https://docs.rs/iceoryx2
+
+mod discovery;
+
+use std::ops::{Deref, DerefMut};
+
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::prelude::*;
+use iceoryx2::sample::Sample;
+use iceoryx2::sample_mut::SampleMut;
+
+pub use discovery::{host_id, peer_can_use_shm, SHM_HOST_PROPERTY};
+
+/// What can go wrong with a shared-memory channel (the iceoryx2 error, as text).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ShmError {
+    /// The node, the service or a port could not be created or opened.
+    #[error("shared-memory channel setup: {0}")]
+    Setup(String),
+    /// No buffer could be loaned (too many loans held, or out of shared memory).
+    #[error("shared-memory loan: {0}")]
+    Loan(String),
+    /// A sample could not be sent or received.
+    #[error("shared-memory transfer: {0}")]
+    Transfer(String),
+}
+
+fn setup<E: std::fmt::Debug>(e: E) -> ShmError {
+    ShmError::Setup(format!("{e:?}"))
+}
+
+/// Sizes of a channel: how many samples a subscriber queues and how many a publisher may loan at once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShmChannelConfig {
+    /// Largest sample expected at first (the segment grows by powers of two beyond it).
+    pub initial_max_sample: usize,
+    /// Samples queued per subscriber before the publisher waits for it (back-pressure, no loss).
+    pub queue_depth: usize,
+    /// Most buffers a publisher may hold loaned at once.
+    pub max_loans: usize,
+    /// Most subscribers (readers on other processes) of one channel.
+    pub max_subscribers: usize,
+}
+
+impl Default for ShmChannelConfig {
+    fn default() -> Self {
+        ShmChannelConfig {
+            initial_max_sample: 64 * 1024,
+            queue_depth: 16,
+            max_loans: 4,
+            max_subscribers: 16,
+        }
+    }
+}
+
+/// One process's (or participant's) presence in shared memory: channels are opened through it.
+pub struct ShmNode {
+    node: Node<ipc::Service>,
+}
+
+impl std::fmt::Debug for ShmNode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShmNode").finish_non_exhaustive()
+    }
+}
+
+/// Frees what processes that died left in shared memory (their nodes, ports, segments and the buffers
+/// they held); returns how many dead nodes were removed.
+pub fn remove_dead_nodes() -> usize {
+    let mut dead = Vec::new();
+    let listed = Node::<ipc::Service>::list(Config::global_config(), |state| {
+        if let NodeState::Dead(view) = state {
+            dead.push(view);
+        }
+        CallbackProgression::Continue
+    });
+    if let Err(e) = listed {
+        tracing::warn!(error = ?e, "cannot list shared-memory nodes");
+    }
+    dead.into_iter()
+        .filter(|view| match view.clone().try_remove_stale_resources() {
+            Ok(()) => true,
+            Err(e) => {
+                tracing::warn!(error = ?e, "cannot remove a dead shared-memory node");
+                false
+            }
+        })
+        .count()
+}
+
+impl ShmNode {
+    /// Creates this process's node (removing dead nodes first).
+    pub fn new() -> Result<Self, ShmError> {
+        let removed = remove_dead_nodes();
+        if removed > 0 {
+            tracing::info!(removed, "removed dead shared-memory nodes");
+        }
+        let node = NodeBuilder::new()
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<ipc::Service>()
+            .map_err(setup)?;
+        Ok(ShmNode { node })
+    }
+
+    fn service(
+        &self,
+        channel: &str,
+        c: &ShmChannelConfig,
+    ) -> Result<
+        iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, [u8], ()>,
+        ShmError,
+    > {
+        let name: ServiceName = channel.try_into().map_err(setup)?;
+        self.node
+            .service_builder(&name)
+            .publish_subscribe::<[u8]>()
+            .enable_safe_overflow(false)
+            .subscriber_max_buffer_size(c.queue_depth)
+            .subscriber_max_borrowed_samples(c.queue_depth)
+            .max_subscribers(c.max_subscribers)
+            .history_size(0)
+            .open_or_create()
+            .map_err(setup)
+    }
+
+    /// A publisher on `channel`.
+    pub fn publisher(&self, channel: &str, c: &ShmChannelConfig) -> Result<ShmPublisher, ShmError> {
+        let publisher = self
+            .service(channel, c)?
+            .publisher_builder()
+            .initial_max_slice_len(c.initial_max_sample)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .max_loaned_samples(c.max_loans)
+            .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+            .create()
+            .map_err(setup)?;
+        Ok(ShmPublisher { publisher })
+    }
+
+    /// A subscriber on `channel`.
+    pub fn subscriber(
+        &self,
+        channel: &str,
+        c: &ShmChannelConfig,
+    ) -> Result<ShmSubscriber, ShmError> {
+        let subscriber = self
+            .service(channel, c)?
+            .subscriber_builder()
+            .create()
+            .map_err(setup)?;
+        Ok(ShmSubscriber { subscriber })
+    }
+}
+
+/// Sends samples on one channel.
+pub struct ShmPublisher {
+    publisher: Publisher<ipc::Service, [u8], ()>,
+}
+
+impl std::fmt::Debug for ShmPublisher {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShmPublisher").finish_non_exhaustive()
+    }
+}
+
+impl ShmPublisher {
+    /// Loans a zeroed buffer of `len` bytes in shared memory: write the sample into it, then
+    /// [`ShmLoan::send`] it. Dropping the loan gives it back unsent.
+    pub fn loan(&self, len: usize) -> Result<ShmLoan<'_>, ShmError> {
+        let sample = self
+            .publisher
+            .loan_slice(len)
+            .map_err(|e| ShmError::Loan(format!("{e:?}")))?;
+        Ok(ShmLoan {
+            sample,
+            _publisher: std::marker::PhantomData,
+        })
+    }
+
+    /// Connects subscribers that appeared since the last send (sending does it too).
+    pub fn update_connections(&self) -> Result<(), ShmError> {
+        self.publisher
+            .update_connections()
+            .map_err(|e| ShmError::Transfer(format!("{e:?}")))
+    }
+}
+
+/// A buffer loaned from a publisher's segment, written in place.
+pub struct ShmLoan<'a> {
+    sample: SampleMut<ipc::Service, [u8], ()>,
+    _publisher: std::marker::PhantomData<&'a ShmPublisher>,
+}
+
+impl ShmLoan<'_> {
+    /// Sends the buffer to every subscriber; how many got it.
+    pub fn send(self) -> Result<usize, ShmError> {
+        self.sample
+            .send()
+            .map_err(|e| ShmError::Transfer(format!("{e:?}")))
+    }
+}
+
+impl Deref for ShmLoan<'_> {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        self.sample.payload()
+    }
+}
+
+impl DerefMut for ShmLoan<'_> {
+    fn deref_mut(&mut self) -> &mut [u8] {
+        self.sample.payload_mut()
+    }
+}
+
+/// Receives samples on one channel.
+pub struct ShmSubscriber {
+    subscriber: Subscriber<ipc::Service, [u8], ()>,
+}
+
+impl std::fmt::Debug for ShmSubscriber {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShmSubscriber").finish_non_exhaustive()
+    }
+}
+
+impl ShmSubscriber {
+    /// The next sample, if one is queued (never blocks).
+    pub fn receive(&self) -> Result<Option<ShmSample>, ShmError> {
+        self.subscriber
+            .receive()
+            .map(|s| s.map(|sample| ShmSample { sample }))
+            .map_err(|e| ShmError::Transfer(format!("{e:?}")))
+    }
+}
+
+/// A received sample, read in place in the publisher's shared memory; released when dropped.
+pub struct ShmSample {
+    sample: Sample<ipc::Service, [u8], ()>,
+}
+
+impl Deref for ShmSample {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        self.sample.payload()
+    }
+}
+
+impl std::fmt::Debug for ShmSample {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ShmSample({} bytes)", self.len())
+    }
+}
