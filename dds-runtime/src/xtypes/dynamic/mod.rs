@@ -11,6 +11,7 @@ mod builder;
 mod decode;
 mod encode;
 mod error;
+mod filter;
 mod from_object;
 #[cfg(feature = "idl")]
 mod idl;
