@@ -156,6 +156,20 @@ impl DynamicWriter {
         true
     }
 
+    /// Waits until every matched reliable reader acknowledged everything written; `Timeout` past `timeout`.
+    pub fn wait_for_acknowledgments(&self, timeout: Duration) -> DdsResult<()> {
+        let driver = self.handle_driver();
+        driver.check_alive()?;
+        let id = self.handle.id();
+        let deadline = Instant::now().checked_add(timeout);
+        if driver.wait_progress(deadline, || driver.with_core(|c, _| c.is_acknowledged(id))) {
+            Ok(())
+        } else {
+            driver.check_alive()?;
+            Err(DdsError::Timeout)
+        }
+    }
+
     fn check_type(&self, sample: &DynamicData) -> DdsResult<()> {
         if sample.dynamic_type() != self.topic().dynamic_type() {
             return Err(DdsError::BadParameter(format!(

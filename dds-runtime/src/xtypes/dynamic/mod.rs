@@ -15,6 +15,7 @@ mod filter;
 mod from_object;
 #[cfg(feature = "idl")]
 mod idl;
+mod idl_text;
 #[cfg(feature = "json")]
 mod json;
 mod layout;
