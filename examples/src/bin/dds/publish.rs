@@ -10,6 +10,9 @@ use serde_json::Value as Json;
 
 use crate::resolve::Resolved;
 
+/// Pause between the first match and the first write.
+const SETTLE: Duration = Duration::from_millis(500);
+
 /// What `publish` was asked for.
 pub(crate) struct Options {
     pub(crate) repeat: usize,
