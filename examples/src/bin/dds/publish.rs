@@ -67,7 +67,11 @@ pub(crate) fn run(
         .create_publisher(&PublisherQos::default())
         .and_then(|publ| publ.create_dynamic_writer(&t, &qos))
         .map_err(|e| e.to_string())?;
-    if !w.wait_for_readers(1, o.wait) {
+    if w.wait_for_readers(1, o.wait) {
+        // Our side matched; give the reader's side the moment it takes to match us too, or a volatile reader
+        // misses what is written before (discovery is not symmetric in time).
+        std::thread::sleep(SETTLE);
+    } else {
         eprintln!(
             "dds publish: no reader of {topic:?} matched within {:?}; writing anyway",
             o.wait
