@@ -6,9 +6,15 @@ use crate::cdr::Extensibility;
 
 use super::error::DynamicError;
 
-/// A type known at run time. Cloning shares the description.
-#[derive(Clone, PartialEq)]
+/// A type known at run time. Cloning shares the description; equality is structural (clones compare in O(1)).
+#[derive(Clone)]
 pub struct DynamicType(pub(super) Arc<TypeKind>);
+
+impl PartialEq for DynamicType {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0) || self.0 == other.0
+    }
+}
 
 impl std::fmt::Debug for DynamicType {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
