@@ -16,7 +16,7 @@ fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut V
 
 /// Pads the payload to a multiple of 4 and records the padding in the header options, as Cyclone DDS does;
 /// on error removes what was appended.
-fn finish_payload(
+pub(crate) fn finish_payload(
     start: usize,
     r: Result<(), EncodeError>,
     out: &mut Vec<u8>,

@@ -10,13 +10,15 @@
 mod reader;
 mod writer;
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use crate::qos::TopicQos;
 use crate::xtypes::dynamic::{DynamicData, DynamicType};
 
 use super::error::{DdsError, DdsResult};
 use super::participant::DomainParticipant;
+use super::sync::lock;
+use crate::rtps::Guid;
 
 pub use reader::{DynamicReader, DynamicSample};
 pub use writer::DynamicWriter;
@@ -120,5 +122,14 @@ impl DynamicTopic {
 
     fn type_information(&self) -> Option<crate::xtypes::TypeInformation> {
         crate::xtypes::announced_type_information(self.inner.type_information.as_deref())
+    }
+}
+
+/// Records that `peer` matched (or unmatched) an endpoint whose matched peers are `list`.
+fn record_match(list: &Mutex<Vec<Guid>>, peer: Guid, matched: bool) {
+    let mut m = lock(list);
+    m.retain(|g| *g != peer);
+    if matched {
+        m.push(peer);
     }
 }

@@ -72,11 +72,7 @@ impl Endpoint for Inner {
             writer, matched, ..
         } = ev
         {
-            let mut m = lock(&self.matched);
-            m.retain(|g| g != writer);
-            if *matched {
-                m.push(*writer);
-            }
+            super::record_match(&self.matched, *writer, *matched);
         }
     }
 

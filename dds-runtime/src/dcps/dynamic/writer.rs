@@ -32,11 +32,7 @@ impl Endpoint for Inner {
             reader, matched, ..
         } = ev
         {
-            let mut m = lock(&self.matched);
-            m.retain(|g| g != reader);
-            if *matched {
-                m.push(*reader);
-            }
+            super::record_match(&self.matched, *reader, *matched);
             self.matched_cv.notify_all();
         }
     }

@@ -2,7 +2,9 @@
 //! left before anything is allocated, nesting is limited), and hostile bytes are an error, never a panic.
 
 use crate::cdr::members::{begin_decode, end_member, skip_member};
-use crate::cdr::{ByteOrder, CdrReader, DecodeError, DecodeErrorKind, Extensibility, Layout};
+use crate::cdr::{
+    ByteOrder, CdrReader, CdrType, DecodeError, DecodeErrorKind, Extensibility, Layout, WString,
+};
 
 use super::layout::layout;
 use super::types::{DynamicType, Primitive, StructType, TypeKind, UnionType};
@@ -32,10 +34,11 @@ pub(super) fn decode(r: &mut CdrReader<'_>, ty: &DynamicType) -> Result<Value, D
     match ty.resolved().kind() {
         TypeKind::Primitive(p) => decode_primitive(r, *p),
         TypeKind::String { wide: false, bound } => {
-            decode_str(r, bound.map_or(usize::MAX, |b| b as usize))
+            crate::cdr::decode_str(r, bound.map_or(usize::MAX, |b| b as usize)).map(Value::String)
         }
         TypeKind::String { wide: true, bound } => {
-            decode_wstr(r, bound.map_or(usize::MAX, |b| b as usize))
+            WString::decode_bounded(r, bound.map_or(usize::MAX, |b| b as usize))
+                .map(|s| Value::String(s.0))
         }
         TypeKind::Enum(e) => {
             let raw = read_sized(r, e.size(), "enum")?;
@@ -56,18 +59,7 @@ pub(super) fn decode(r: &mut CdrReader<'_>, ty: &DynamicType) -> Result<Value, D
         TypeKind::Sequence { element, bound } => {
             let dheader = !layout(element).is_primitive() && r.is_xcdr2();
             delimited(r, dheader, "sequence", |r| {
-                let at = r.offset();
-                let n = r.read_count(min_size(element), "sequence length")?;
-                if bound.is_some_and(|b| n > b as usize) {
-                    return Err(DecodeError::new(
-                        at,
-                        "sequence within its bound",
-                        DecodeErrorKind::BoundExceeded {
-                            bound: bound.unwrap_or(0) as usize,
-                            len: n,
-                        },
-                    ));
-                }
+                let n = read_count(r, min_size(element), *bound, "sequence length")?;
                 let mut items = Vec::with_capacity(n.min(r.remaining()));
                 for _ in 0..n {
                     items.push(decode(r, element)?);
@@ -88,18 +80,7 @@ pub(super) fn decode(r: &mut CdrReader<'_>, ty: &DynamicType) -> Result<Value, D
             } else {
                 None
             };
-            let at = r.offset();
-            let n = r.read_count(min_size(key) + min_size(value), "map length")?;
-            if bound.is_some_and(|b| n > b as usize) {
-                return Err(DecodeError::new(
-                    at,
-                    "map within its bound",
-                    DecodeErrorKind::BoundExceeded {
-                        bound: bound.unwrap_or(0) as usize,
-                        len: n,
-                    },
-                ));
-            }
+            let n = read_count(r, min_size(key) + min_size(value), *bound, "map length")?;
             let mut entries = Vec::with_capacity(n.min(r.remaining()));
             for _ in 0..n {
                 let k = decode(r, key)?;
@@ -113,6 +94,28 @@ pub(super) fn decode(r: &mut CdrReader<'_>, ty: &DynamicType) -> Result<Value, D
             Ok(Value::Map(entries))
         }
         TypeKind::Alias { .. } => Err(invalid(r, "a resolved type", 0)),
+    }
+}
+
+/// An element count that the bytes left can hold (`min` bytes each at least) and within the IDL `bound`.
+fn read_count(
+    r: &mut CdrReader<'_>,
+    min: usize,
+    bound: Option<u32>,
+    what: &'static str,
+) -> Result<usize, DecodeError> {
+    let at = r.offset();
+    let n = r.read_count(min, what)?;
+    match bound {
+        Some(b) if n > b as usize => Err(DecodeError::new(
+            at,
+            "a length within its bound",
+            DecodeErrorKind::BoundExceeded {
+                bound: b as usize,
+                len: n,
+            },
+        )),
+        _ => Ok(n),
     }
 }
 
@@ -204,73 +207,6 @@ fn decode_primitive(r: &mut CdrReader<'_>, p: Primitive) -> Result<Value, Decode
             Value::Float128(b)
         }
     })
-}
-
-fn decode_str(r: &mut CdrReader<'_>, bound: usize) -> Result<Value, DecodeError> {
-    let at = r.offset();
-    let n = r.read_count(1, "string length")?;
-    if n == 0 {
-        return Ok(Value::String(String::new()));
-    }
-    if n - 1 > bound {
-        return Err(DecodeError::new(
-            at,
-            "string within its bound",
-            DecodeErrorKind::BoundExceeded { bound, len: n - 1 },
-        ));
-    }
-    let body = r.offset();
-    let bytes = r.read_bytes(n, "string characters")?;
-    let (text, nul) = bytes.split_at(n - 1);
-    if nul[0] != 0 || text.contains(&0) {
-        return Err(DecodeError::new(
-            body,
-            "NUL-terminated string",
-            DecodeErrorKind::MalformedString,
-        ));
-    }
-    std::str::from_utf8(text)
-        .map(|s| Value::String(s.to_owned()))
-        .map_err(|e| {
-            DecodeError::new(
-                body + e.valid_up_to(),
-                "UTF-8 string",
-                DecodeErrorKind::MalformedString,
-            )
-        })
-}
-
-fn decode_wstr(r: &mut CdrReader<'_>, bound: usize) -> Result<Value, DecodeError> {
-    let at = r.offset();
-    let n = r.read_count(1, "wstring length")?;
-    if n % 2 != 0 {
-        return Err(DecodeError::new(
-            at,
-            "even wstring byte length",
-            DecodeErrorKind::InvalidValue { found: n as u64 },
-        ));
-    }
-    if n / 2 > bound {
-        return Err(DecodeError::new(
-            at,
-            "wstring within its bound",
-            DecodeErrorKind::BoundExceeded { bound, len: n / 2 },
-        ));
-    }
-    let body = r.offset();
-    let big = r.order() == ByteOrder::BigEndian;
-    let bytes = r.read_bytes(n, "wstring characters")?;
-    let units = bytes.chunks_exact(2).map(|c| {
-        if big {
-            u16::from_be_bytes([c[0], c[1]])
-        } else {
-            u16::from_le_bytes([c[0], c[1]])
-        }
-    });
-    char::decode_utf16(units)
-        .collect::<Result<String, _>>()
-        .map(Value::String)
-        .map_err(|_| DecodeError::new(body, "UTF-16 wstring", DecodeErrorKind::MalformedString))
 }
 
 fn decode_struct(r: &mut CdrReader<'_>, s: &StructType) -> Result<Value, DecodeError> {

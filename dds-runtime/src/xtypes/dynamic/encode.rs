@@ -2,7 +2,9 @@
 //! rule (so that both give the same bytes).
 
 use crate::cdr::members::{begin_encode, end_encode};
-use crate::cdr::{ByteOrder, CdrWriter, EncodeError, EncodeMode, Extensibility, Layout};
+use crate::cdr::{
+    ByteOrder, CdrType, CdrWriter, EncodeError, EncodeMode, Extensibility, Layout, WString,
+};
 
 use super::layout::layout;
 use super::types::{DynamicType, Member, Primitive, StructType, TypeKind, UnionType};
@@ -23,9 +25,10 @@ pub(super) fn encode(
         (TypeKind::String { wide, bound }, Value::String(s)) => {
             let bound = bound.map_or(usize::MAX, |b| b as usize);
             if *wide {
-                encode_wstr(w, s, bound)
+                // The wrapper's encoder; a copy of the text is the price of sharing it.
+                WString(s.clone()).encode_bounded(w, bound)
             } else {
-                encode_str(w, s, bound)
+                crate::cdr::encode_str(s, w, bound)
             }
         }
         (TypeKind::Enum(e), Value::Enum(x)) => {
@@ -160,45 +163,6 @@ fn encode_primitive(w: &mut CdrWriter<'_>, p: Primitive, v: &Value) -> Result<()
             w.write_bytes(&b);
         }
         _ => return Err(mismatch("a primitive of another kind")),
-    }
-    Ok(())
-}
-
-fn encode_str(w: &mut CdrWriter<'_>, s: &str, bound: usize) -> Result<(), EncodeError> {
-    if s.len() > bound {
-        return Err(EncodeError::BoundExceeded {
-            what: "string",
-            bound,
-            len: s.len(),
-        });
-    }
-    if s.as_bytes().contains(&0) {
-        return Err(EncodeError::InvalidValue {
-            what: "NUL inside a string",
-            value: 0,
-        });
-    }
-    w.write_len(s.len() + 1, "string length")?;
-    w.write_bytes(s.as_bytes());
-    w.write_u8(0);
-    Ok(())
-}
-
-fn encode_wstr(w: &mut CdrWriter<'_>, s: &str, bound: usize) -> Result<(), EncodeError> {
-    let units = s.encode_utf16().count();
-    if units > bound {
-        return Err(EncodeError::BoundExceeded {
-            what: "wstring",
-            bound,
-            len: units,
-        });
-    }
-    w.write_len(units * 2, "wstring length")?;
-    for u in s.encode_utf16() {
-        match w.order() {
-            ByteOrder::BigEndian => w.write_bytes(&u.to_be_bytes()),
-            ByteOrder::LittleEndian => w.write_bytes(&u.to_le_bytes()),
-        }
     }
     Ok(())
 }

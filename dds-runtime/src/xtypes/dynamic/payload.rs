@@ -1,11 +1,9 @@
 //! Whole payloads of [`DynamicData`]: encapsulation header, sample or key, end padding; the key hash and the
 //! instance key. The same rules as `cdr::{serialize, deserialize, serialize_key, key_hash, instance_key}`.
 
-use md5::{Digest, Md5};
-
 use crate::cdr::{
-    ByteOrder, CdrReader, CdrWriter, DecodeError, EncapsulationHeader, EncodeError, EncodeMode,
-    XcdrVersion,
+    finish_payload, hash_key_stream, ByteOrder, CdrReader, CdrWriter, DecodeError,
+    EncapsulationHeader, EncodeError, EncodeMode, XcdrVersion,
 };
 
 use super::layout::{key_has_mutable, key_max_end};
@@ -28,14 +26,7 @@ fn encode_payload(
         d.dynamic_type(),
         d.value(),
     );
-    if let Err(e) = r {
-        out.truncate(start);
-        return Err(e);
-    }
-    let pad = (out.len() - start).wrapping_neg() & 3;
-    out.extend_from_slice(&[0u8; 3][..pad]);
-    out[start + 3] = (out[start + 3] & !3) | pad as u8;
-    Ok(())
+    finish_payload(start, r, out)
 }
 
 fn decode_payload(
@@ -94,23 +85,14 @@ impl DynamicData {
     /// The 16-byte RTPS key hash for a payload of XCDR version `version` (zeros for an unkeyed type): the key
     /// stream zero-padded when it always fits in 16 bytes, else its MD5, as libddsc decides.
     pub fn key_hash(&self, version: XcdrVersion) -> Result<[u8; 16], EncodeError> {
-        let mut h = [0u8; 16];
         let ty = self.dynamic_type();
         if !ty.is_keyed() {
-            return Ok(h);
+            return Ok([0u8; 16]);
         }
         let mut buf = Vec::with_capacity(32);
         self.key_stream(version, &mut buf)?;
-        let fixed = match key_max_end(ty, 0, version, None) {
-            Some(max) => max <= 16 && !(version == XcdrVersion::Xcdr1 && key_has_mutable(ty)),
-            None => false,
-        };
-        if fixed && buf.len() <= 16 {
-            h[..buf.len()].copy_from_slice(&buf);
-        } else {
-            h.copy_from_slice(&Md5::digest(&buf));
-        }
-        Ok(h)
+        let max_end = key_max_end(ty, 0, version, None);
+        Ok(hash_key_stream(&buf, max_end, version, key_has_mutable(ty)))
     }
 
     /// Appends the instance's identity bytes (the XCDR2 big-endian key stream); nothing for unkeyed types.
