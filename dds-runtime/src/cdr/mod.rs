@@ -24,8 +24,8 @@ pub use header::{ByteOrder, EncapsulationHeader, Extensibility, Representation, 
 pub(crate) use key::hash_key_stream;
 pub use key::{deserialize_key, instance_key, key_hash, serialize_key};
 pub use members::{DefaultSearch, Discriminator, StructMembers};
-pub(crate) use payload::finish_payload;
 pub use payload::{deserialize, serialize};
+pub(crate) use payload::{finish_payload, payload_reader};
 pub use reader::{CdrReader, Limit};
 pub use traits::{CdrType, DdsType, Layout, MemberDescriptor, TypeDescriptor};
 pub use wrappers::{BoundedSeq, BoundedString, LongDouble, WChar, WString};

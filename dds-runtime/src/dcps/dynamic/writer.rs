@@ -154,16 +154,8 @@ impl DynamicWriter {
 
     /// Waits until every matched reliable reader acknowledged everything written; `Timeout` past `timeout`.
     pub fn wait_for_acknowledgments(&self, timeout: Duration) -> DdsResult<()> {
-        let driver = self.handle_driver();
-        driver.check_alive()?;
-        let id = self.handle.id();
-        let deadline = Instant::now().checked_add(timeout);
-        if driver.wait_progress(deadline, || driver.with_core(|c, _| c.is_acknowledged(id))) {
-            Ok(())
-        } else {
-            driver.check_alive()?;
-            Err(DdsError::Timeout)
-        }
+        self.handle_driver()
+            .wait_acknowledged(self.handle.id(), timeout)
     }
 
     fn check_type(&self, sample: &DynamicData) -> DdsResult<()> {

@@ -2,7 +2,7 @@
 //! instance key. The same rules as `cdr::{serialize, deserialize, serialize_key, key_hash, instance_key}`.
 
 use crate::cdr::{
-    finish_payload, hash_key_stream, ByteOrder, CdrReader, CdrWriter, DecodeError,
+    finish_payload, hash_key_stream, payload_reader, ByteOrder, CdrWriter, DecodeError,
     EncapsulationHeader, EncodeError, EncodeMode, XcdrVersion,
 };
 
@@ -34,14 +34,7 @@ fn decode_payload(
     payload: &[u8],
     key_only: bool,
 ) -> Result<DynamicData, DecodeError> {
-    let h = EncapsulationHeader::parse(payload)?;
-    let mut r = CdrReader::new(
-        payload,
-        EncapsulationHeader::SIZE,
-        h.version()?,
-        h.byte_order(),
-        key_only,
-    );
+    let mut r = payload_reader(payload, key_only)?;
     let v = decode::decode(&mut r, ty)?;
     Ok(DynamicData::from_value_unchecked(ty.clone(), v))
 }
