@@ -234,6 +234,7 @@ pub fn check<T: DdsType + PartialEq + Debug>(name: &str, samples: Vec<(&str, T)>
         check_sample(&mut rep, &ty, sname, sample, f);
     }
     assert!(rep.checked > 0, "{}: nothing checked", rep.name);
+    println!("{}: {} checks", rep.name, rep.checked);
     assert!(
         rep.bad.is_empty(),
         "{}: {} of {} checks failed:\n  {}",
