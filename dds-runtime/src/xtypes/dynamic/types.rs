@@ -507,12 +507,9 @@ impl DynamicType {
         }
     }
 
-    /// Whether samples have a key (a struct with key members, or a union with a key discriminator).
+    /// Whether samples have a key: a struct with key members. A union topic type is unkeyed, as for the derive
+    /// (its `disc_key` is kept for the type's description only).
     pub fn is_keyed(&self) -> bool {
-        match self.resolved().kind() {
-            TypeKind::Struct(s) => s.has_keys(),
-            TypeKind::Union(u) => u.disc_key,
-            _ => false,
-        }
+        self.as_struct().is_some_and(StructType::has_keys)
     }
 }
