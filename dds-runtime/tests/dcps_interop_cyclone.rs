@@ -1,5 +1,6 @@
 //! Scratch interop check against a real Cyclone DDS 11 peer (python `cyclonedds`), both directions, and
-//! content filtering with Cyclone (which has no SQL filters) as a plain writer and as a plain reader.
+//! content filtering with Cyclone (which has no SQL filters) as a plain writer and as a plain reader, and
+//! dynamic writers and readers (features `idl` and `json`) in both directions.
 //! Ignored by default (needs python3 + cyclonedds): run with
 //! `scripts/isolated cargo test -p dds-runtime --test dcps_interop_cyclone -- --ignored`.
 mod dcps_util;
@@ -228,4 +229,99 @@ fn rust_writer_filters_for_our_reader_while_cyclone_gets_everything() {
             .filter_map(|s| s.data.map(|d| d.x)),
     );
     assert_eq!(ours, [0, 1, 2]);
+}
+
+/// The shapes type as a dynamic type, from IDL text (as `dds subscribe --idl` builds it).
+#[cfg(all(feature = "idl", feature = "json"))]
+fn dynamic_shape_type() -> dds_runtime::xtypes::dynamic::DynamicType {
+    let idl =
+        "@appendable struct ShapeType { @key string color; long x; long y; long shapesize; };";
+    dds_runtime::xtypes::dynamic::types_from_idl("shape.idl", idl)
+        .unwrap()
+        .remove("ShapeType")
+        .unwrap()
+}
+
+#[cfg(all(feature = "idl", feature = "json"))]
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn dynamic_writer_to_cyclone_reader() {
+    use dds_runtime::xtypes::dynamic::DynamicData;
+    let p = participant(63);
+    let ty = dynamic_shape_type();
+    let t = p
+        .create_dynamic_topic("Square", ty.clone(), &TopicQos::default())
+        .unwrap();
+    let w = p
+        .create_publisher(&PublisherQos::default())
+        .and_then(|publ| publ.create_dynamic_writer(&t, &tl_reliable_writer()))
+        .unwrap();
+    let mut child = python(63, &["sub", "Square", "10", "dispose"]);
+    assert!(
+        w.wait_for_readers(1, Duration::from_secs(20)),
+        "no match with Cyclone"
+    );
+    for i in 0..10 {
+        let j = serde_json::json!({"color": "RED", "x": i, "y": 2 * i, "shapesize": 30});
+        w.write(&DynamicData::from_json(&ty, &j).unwrap()).unwrap();
+    }
+    w.dispose(&DynamicData::from_json(&ty, &serde_json::json!({"color": "RED"})).unwrap())
+        .unwrap();
+    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
+    let out = BufReader::new(child.stdout.take().unwrap());
+    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
+    assert!(
+        child.wait().unwrap().success(),
+        "cyclone sub failed: {lines:?}"
+    );
+    let xs: Vec<i64> = lines
+        .iter()
+        .filter(|l| l.contains("\"RED\""))
+        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
+        .collect();
+    assert_eq!(xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
+    assert!(
+        lines.iter().any(|l| l.contains("\"disposed\": true")),
+        "no dispose seen by Cyclone: {lines:?}"
+    );
+}
+
+#[cfg(all(feature = "idl", feature = "json"))]
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn cyclone_writer_to_dynamic_reader() {
+    use dds_runtime::rtps::ChangeKind;
+    use dds_runtime::xtypes::dynamic::Value;
+    let p = participant(64);
+    let t = p
+        .create_dynamic_topic("Circle", dynamic_shape_type(), &TopicQos::default())
+        .unwrap();
+    let r = p
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| s.create_dynamic_reader(&t, &tl_reliable_reader()))
+        .unwrap();
+    let mut child = python(64, &["pub", "Circle", "BLUE", "10"]);
+    let (mut xs, mut disposed) = (Vec::new(), false);
+    wait_until(Duration::from_secs(25), || {
+        r.wait_for_data(Duration::from_millis(100));
+        for s in r.take() {
+            match (s.kind, s.data) {
+                (ChangeKind::Alive, Some(d)) => {
+                    assert_eq!(d.get("color"), Some(&Value::String("BLUE".into())));
+                    if let (Some(Value::Int32(x)), Some(Value::Int32(y))) = (d.get("x"), d.get("y"))
+                    {
+                        assert_eq!(*y, 2 * *x);
+                        xs.push(*x);
+                    }
+                }
+                (k, _) => {
+                    disposed |= matches!(k, ChangeKind::Dispose | ChangeKind::DisposeUnregister)
+                }
+            }
+        }
+        xs.len() >= 10 && disposed
+    });
+    assert!(child.wait().unwrap().success());
+    assert_eq!(xs, (0..10).collect::<Vec<_>>());
+    assert!(disposed, "dispose from Cyclone not seen");
 }

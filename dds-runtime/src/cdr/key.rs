@@ -44,22 +44,38 @@ fn key_stream<T: DdsType>(
 /// only if no @mutable type is on the key path, as libddsc decides), else hashed with MD5 as it is. Unkeyed
 /// types hash to zeros. Use it on the wire only: instance identity is [`instance_key`].
 pub fn key_hash<T: DdsType>(sample: &T, version: XcdrVersion) -> Result<[u8; 16], EncodeError> {
-    let mut h = [0u8; 16];
     if !T::IS_KEYED {
-        return Ok(h);
+        return Ok([0u8; 16]);
     }
     let mut buf = Vec::with_capacity(32);
     key_stream(sample, version, &mut buf)?;
-    let fixed = match T::key_max_end(0, version, None) {
-        Some(max) => max <= 16 && !(version == XcdrVersion::Xcdr1 && T::KEY_HAS_MUTABLE),
+    Ok(hash_key_stream(
+        &buf,
+        T::key_max_end(0, version, None),
+        version,
+        T::KEY_HAS_MUTABLE,
+    ))
+}
+
+/// The key hash of a key stream: zero-padded to 16 bytes when the type's largest stream (`max_end`) fits in 16
+/// (in XCDR1 only if no @mutable type is on the key path, as libddsc decides), else its MD5.
+pub(crate) fn hash_key_stream(
+    stream: &[u8],
+    max_end: Option<usize>,
+    version: XcdrVersion,
+    key_has_mutable: bool,
+) -> [u8; 16] {
+    let mut h = [0u8; 16];
+    let fixed = match max_end {
+        Some(max) => max <= 16 && !(version == XcdrVersion::Xcdr1 && key_has_mutable),
         None => false,
     };
-    if fixed && buf.len() <= 16 {
-        h[..buf.len()].copy_from_slice(&buf);
+    if fixed && stream.len() <= 16 {
+        h[..stream.len()].copy_from_slice(stream);
     } else {
-        h.copy_from_slice(&Md5::digest(&buf));
+        h.copy_from_slice(&Md5::digest(stream));
     }
-    Ok(h)
+    h
 }
 
 /// Appends canonical identity bytes for the instance of `sample` (the XCDR2 big-endian key stream, never

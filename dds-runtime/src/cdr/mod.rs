@@ -17,12 +17,15 @@ mod traits;
 mod wrappers;
 mod writer;
 
+pub(crate) use collections::{decode_str, encode_str};
 pub use error::{DecodeError, DecodeErrorKind, EncodeError};
 pub use fixed::{Fixed, FixedError};
 pub use header::{ByteOrder, EncapsulationHeader, Extensibility, Representation, XcdrVersion};
+pub(crate) use key::hash_key_stream;
 pub use key::{deserialize_key, instance_key, key_hash, serialize_key};
 pub use members::{DefaultSearch, Discriminator, StructMembers};
 pub use payload::{deserialize, serialize};
+pub(crate) use payload::{finish_payload, payload_reader};
 pub use reader::{CdrReader, Limit};
 pub use traits::{CdrType, DdsType, Layout, MemberDescriptor, TypeDescriptor};
 pub use wrappers::{BoundedSeq, BoundedString, LongDouble, WChar, WString};

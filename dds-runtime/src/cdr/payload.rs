@@ -16,7 +16,7 @@ fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut V
 
 /// Pads the payload to a multiple of 4 and records the padding in the header options, as Cyclone DDS does;
 /// on error removes what was appended.
-fn finish_payload(
+pub(crate) fn finish_payload(
     start: usize,
     r: Result<(), EncodeError>,
     out: &mut Vec<u8>,
@@ -44,17 +44,22 @@ pub(crate) fn encode_payload<T: DdsType>(
     finish_payload(start, r, out)
 }
 
-/// Decodes a payload that starts with its encapsulation header; `key_only` for a key-only payload.
-pub(crate) fn decode_payload<T: DdsType>(payload: &[u8], key_only: bool) -> Result<T, DecodeError> {
+/// A reader of the body of a payload that starts with its encapsulation header (its version and byte order);
+/// `key_only` for a key-only payload.
+pub(crate) fn payload_reader(payload: &[u8], key_only: bool) -> Result<CdrReader<'_>, DecodeError> {
     let h = EncapsulationHeader::parse(payload)?;
-    let mut r = CdrReader::new(
+    Ok(CdrReader::new(
         payload,
         EncapsulationHeader::SIZE,
         h.version()?,
         h.byte_order(),
         key_only,
-    );
-    T::decode(&mut r)
+    ))
+}
+
+/// Decodes a payload that starts with its encapsulation header; `key_only` for a key-only payload.
+pub(crate) fn decode_payload<T: DdsType>(payload: &[u8], key_only: bool) -> Result<T, DecodeError> {
+    T::decode(&mut payload_reader(payload, key_only)?)
 }
 
 /// Appends the encapsulation header and the encoding of `sample` to `out`. Allocates nothing when `out` has

@@ -604,6 +604,21 @@ impl Driver {
         self.progress_waiters.fetch_sub(1, Ordering::SeqCst);
     }
 
+    /// Waits until every reliable reader matched with `writer` acknowledged everything it wrote; `Timeout`
+    /// past `timeout`.
+    pub(crate) fn wait_acknowledged(&self, writer: EntityId, timeout: Duration) -> DdsResult<()> {
+        self.check_alive()?;
+        let deadline = Instant::now().checked_add(timeout);
+        if self.wait_progress(deadline, || {
+            self.with_core(|c, _| c.is_acknowledged(writer))
+        }) {
+            Ok(())
+        } else {
+            self.check_alive()?;
+            Err(DdsError::Timeout)
+        }
+    }
+
     /// Waits until `done` holds (re-checked after each core progress) or `deadline` passes.
     pub(crate) fn wait_progress(
         &self,

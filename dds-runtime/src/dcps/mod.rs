@@ -36,6 +36,7 @@ pub mod condition;
 mod decode;
 mod driver;
 pub mod durability;
+mod dynamic;
 mod enable;
 mod endpoint;
 mod error;
@@ -66,6 +67,7 @@ pub use condition::{
     Condition, GuardCondition, QueryCondition, ReadCondition, StatusCondition, WaitSet,
 };
 pub use durability::{DurabilityServiceConfig, DurabilityServiceMode};
+pub use dynamic::{DynamicReader, DynamicSample, DynamicTopic, DynamicWriter};
 pub use error::{DdsError, DdsResult};
 pub use filter::{ContentFilter, FieldValue, FilterError, FilterFields};
 pub use listener::{

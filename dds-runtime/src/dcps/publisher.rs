@@ -570,16 +570,11 @@ impl<T: DdsType> DataWriter<T> {
 
     /// Blocks until every matched reliable reader acknowledged everything written, or `Timeout`.
     pub fn wait_for_acknowledgments(&self, timeout: Duration) -> DdsResult<()> {
-        let driver = &self.inner.state.driver;
         self.inner.state.check_enabled()?;
-        let id = self.id();
-        let deadline = Instant::now().checked_add(timeout);
-        if driver.wait_progress(deadline, || driver.with_core(|c, _| c.is_acknowledged(id))) {
-            Ok(())
-        } else {
-            driver.check_alive()?;
-            Err(DdsError::Timeout)
-        }
+        self.inner
+            .state
+            .driver
+            .wait_acknowledged(self.id(), timeout)
     }
 
     /// PUBLICATION_MATCHED (resets the change counts).

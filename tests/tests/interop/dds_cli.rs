@@ -1,5 +1,7 @@
 //! The `dds` command line against Cyclone DDS 11 (Python binding): `dds ls --json` lists a Cyclone writer
-//! and reader with their topic and type names, and `dds ps` shows the Cyclone process.
+//! and reader with their topic and type names, `dds ps` shows the Cyclone process, `dds subscribe --idl`
+//! prints what the Cyclone writer writes, `dds publish --idl` reaches the Cyclone reader, and `dds typeof`
+//! without `--idl` says why the discovered type cannot be used yet.
 
 use std::process::Command;
 use std::time::Duration;
@@ -23,6 +25,8 @@ from cyclonedds.sub import DataReader
 from cyclonedds.idl import IdlStruct
 from cyclonedds.idl.types import int32
 from cyclonedds.idl.annotations import key
+from cyclonedds.core import Qos, Policy
+from cyclonedds.util import duration
 
 @dataclass
 class ShapeType(IdlStruct, typename="ShapeType"):
@@ -34,10 +38,31 @@ class ShapeType(IdlStruct, typename="ShapeType"):
 
 dp = DomainParticipant(int(sys.argv[1]))
 w = DataWriter(dp, Topic(dp, "Square", ShapeType))
-r = DataReader(dp, Topic(dp, "Circle", ShapeType))
+r = DataReader(dp, Topic(dp, "Circle", ShapeType), qos=Qos(Policy.Reliability.Reliable(duration(seconds=1))))
 print("ready", os.getpid(), flush=True)
-time.sleep(60)
+i = 0
+end = time.time() + 60
+while time.time() < end:
+    w.write(ShapeType(color="RED", x=i, y=2 * i, shapesize=30))
+    i += 1
+    for s in r.take(N=100):
+        if isinstance(s, ShapeType):
+            print("got", s.color, s.x, s.y, s.shapesize, flush=True)
+    time.sleep(0.1)
 "#;
+
+/// The peer's type as IDL (the Python binding's structs are @final).
+const IDL: &str =
+    "@final struct ShapeType { @key string color; long x; long y; long shapesize; };\n";
+
+/// Writes [`IDL`] to a file of its own.
+fn idl_file() -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("dds-cli-interop-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let f = dir.join("shape.idl");
+    std::fs::write(&f, IDL).expect("IDL file");
+    f
+}
 
 /// Starts the peer and returns it with its process id.
 fn peer() -> Result<(Proc, String), Skip> {
@@ -121,12 +146,105 @@ fn dds_ps_shows_cyclone_process() {
 }
 
 #[test]
-fn dds_typeof_says_not_yet() {
+fn dds_typeof_explains_a_discovered_type_without_type_objects() {
+    let Ok((mut p, _)) = peer() else { return };
     let Ok(bin) = our_bin("dds") else { return };
     let out = Command::new(bin)
-        .args(["typeof", "Square"])
+        .args([
+            "typeof",
+            "Square",
+            "--domain",
+            &DOMAIN.to_string(),
+            "--wait",
+            "5",
+        ])
         .output()
         .expect("running dds");
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("needs XTypes dynamic types"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    check!(
+        out.status.code() == Some(3),
+        &[&p],
+        "exit {:?}: {err}",
+        out.status
+    );
+    check!(
+        err.contains("TypeLookup") && err.contains("--idl"),
+        &[&p],
+        "message: {err}"
+    );
+    let _ = p.interrupt(WAIT);
+}
+
+#[test]
+fn dds_subscribe_idl_prints_cyclone_samples() {
+    let Ok((mut p, _)) = peer() else { return };
+    let Ok(bin) = our_bin("dds") else { return };
+    let idl = idl_file();
+    let out = Command::new(bin)
+        .args([
+            "subscribe",
+            "Square",
+            "--ndjson",
+            "-n",
+            "3",
+            "--timeout",
+            "20",
+            "--filter",
+            "x >= 0",
+        ])
+        .arg("--idl")
+        .arg(&idl)
+        .args(["--domain", &DOMAIN.to_string()])
+        .output()
+        .expect("running dds");
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    check!(out.status.success(), &[&p], "dds subscribe failed: {out:?}");
+    let rows: Vec<Value> = text
+        .lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect();
+    check!(rows.len() == 3, &[&p], "three samples expected: {text}");
+    for r in &rows {
+        let x = r["x"].as_i64().unwrap_or(-1);
+        check!(
+            r["color"] == "RED" && x >= 0 && r["y"].as_i64() == Some(2 * x) && r["shapesize"] == 30,
+            &[&p],
+            "sample: {r}"
+        );
+    }
+    let _ = p.interrupt(WAIT);
+}
+
+#[test]
+fn dds_publish_idl_reaches_cyclone_reader() {
+    let Ok((mut p, _)) = peer() else { return };
+    let Ok(bin) = our_bin("dds") else { return };
+    let idl = idl_file();
+    let out = Command::new(bin)
+        .args([
+            "publish",
+            "Circle",
+            r#"[{"color":"BLUE","x":7,"y":8,"shapesize":9},{"color":"GREEN","x":1}]"#,
+        ])
+        .arg("--idl")
+        .arg(&idl)
+        .args(["--domain", &DOMAIN.to_string(), "--wait", "10"])
+        .output()
+        .expect("running dds");
+    check!(out.status.success(), &[&p], "dds publish failed: {out:?}");
+    let got = p
+        .wait_lines(WAIT, 2, |l| l.starts_with("got "))
+        .unwrap_or_default();
+    check!(got.len() >= 2, &[&p], "the Cyclone reader got {got:?}");
+    check!(
+        got.iter().any(|l| l == "got BLUE 7 8 9"),
+        &[&p],
+        "BLUE: {got:?}"
+    );
+    check!(
+        got.iter().any(|l| l == "got GREEN 1 0 0"),
+        &[&p],
+        "GREEN: {got:?}"
+    );
+    let _ = p.interrupt(WAIT);
 }

@@ -31,6 +31,11 @@ impl Observer {
         std::thread::sleep(d);
     }
 
+    /// The participant (for the dynamic endpoints of `subscribe` and `publish`).
+    pub(crate) fn participant(&self) -> &DomainParticipant {
+        &self.participant
+    }
+
     /// What is known now.
     pub(crate) fn snapshot(&self) -> Snapshot {
         Snapshot::of(&self.participant)

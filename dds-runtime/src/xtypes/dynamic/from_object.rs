@@ -1,0 +1,292 @@
+//! [`DynamicType`] from XTypes type objects: a discovered type (TypeInformation + the objects of a TypeMapping,
+//! a TypeLookup reply or a local store).
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use crate::cdr::Extensibility;
+use crate::xtypes::typeobject::{
+    kind, MemberFlag, MemberName, TypeBody, TypeFlag, TypeIdentifier, TypeInformation, TypeMapping,
+    TypeObject,
+};
+
+use super::error::DynamicError;
+use super::types::{
+    BitFlag, BitmaskType, DynamicType, EnumType, Enumerator, Member, Primitive, StructType,
+    TypeKind, UnionCase, UnionType,
+};
+
+/// Deepest chain of type references followed (a hostile cycle of hashes ends here).
+const MAX_TYPE_DEPTH: u32 = 64;
+
+/// Where type objects come from: a type's identifier to its object (complete or minimal).
+pub type TypeObjectLookup<'a> = dyn Fn(&TypeIdentifier) -> Option<Arc<TypeObject>> + 'a;
+
+struct Resolver<'a> {
+    lookup: &'a TypeObjectLookup<'a>,
+    done: HashMap<TypeIdentifier, DynamicType>,
+}
+
+impl DynamicType {
+    /// The type `id` names, its hashed parts found through `lookup`. Complete type objects give names;
+    /// minimal ones give members named after their name hash (`_1a2b3c4d`) and types named `?`.
+    pub fn from_type_identifier(
+        id: &TypeIdentifier,
+        lookup: &TypeObjectLookup<'_>,
+    ) -> Result<Self, DynamicError> {
+        Resolver {
+            lookup,
+            done: HashMap::new(),
+        }
+        .resolve(id, 0)
+    }
+
+    /// The topic type a `TypeInformation` describes, from the objects of a `TypeMapping` (complete
+    /// preferred).
+    pub fn from_type_mapping(
+        info: &TypeInformation,
+        mapping: &TypeMapping,
+    ) -> Result<Self, DynamicError> {
+        let mut objects: HashMap<TypeIdentifier, Arc<TypeObject>> = HashMap::new();
+        for p in mapping
+            .identifier_object_pair_complete
+            .iter()
+            .chain(&mapping.identifier_object_pair_minimal)
+        {
+            objects.insert(p.type_identifier.clone(), Arc::new(p.type_object.clone()));
+        }
+        let root = if objects.contains_key(&info.complete.typeid_with_size.type_id) {
+            &info.complete.typeid_with_size.type_id
+        } else {
+            &info.minimal.typeid_with_size.type_id
+        };
+        DynamicType::from_type_identifier(root, &|id| objects.get(id).cloned())
+    }
+}
+
+fn primitive(k: u8) -> Option<Primitive> {
+    Some(match k {
+        kind::TK_BOOLEAN => Primitive::Bool,
+        kind::TK_BYTE => Primitive::Byte,
+        kind::TK_INT8 => Primitive::Int8,
+        kind::TK_UINT8 => Primitive::UInt8,
+        kind::TK_INT16 => Primitive::Int16,
+        kind::TK_UINT16 => Primitive::UInt16,
+        kind::TK_INT32 => Primitive::Int32,
+        kind::TK_UINT32 => Primitive::UInt32,
+        kind::TK_INT64 => Primitive::Int64,
+        kind::TK_UINT64 => Primitive::UInt64,
+        kind::TK_FLOAT32 => Primitive::Float32,
+        kind::TK_FLOAT64 => Primitive::Float64,
+        kind::TK_FLOAT128 => Primitive::Float128,
+        kind::TK_CHAR8 => Primitive::Char8,
+        kind::TK_CHAR16 => Primitive::Char16,
+        _ => return None,
+    })
+}
+
+fn bound(b: u32) -> Option<u32> {
+    (b != 0).then_some(b)
+}
+
+fn extensibility(f: TypeFlag) -> Extensibility {
+    if f.contains(TypeFlag::IS_MUTABLE) {
+        Extensibility::Mutable
+    } else if f.contains(TypeFlag::IS_APPENDABLE) {
+        Extensibility::Appendable
+    } else {
+        Extensibility::Final
+    }
+}
+
+fn member_name(n: &MemberName) -> String {
+    match n {
+        MemberName::Name(s) => s.clone(),
+        MemberName::Hash(h) => format!("_{:02x}{:02x}{:02x}{:02x}", h[0], h[1], h[2], h[3]),
+    }
+}
+
+fn type_name(body: &TypeBody) -> String {
+    match body.type_name() {
+        "" => "?".to_string(),
+        n => n.to_string(),
+    }
+}
+
+impl Resolver<'_> {
+    fn resolve(&mut self, id: &TypeIdentifier, depth: u32) -> Result<DynamicType, DynamicError> {
+        if depth > MAX_TYPE_DEPTH {
+            return Err(DynamicError::Unresolved(
+                "type references nested too deeply".into(),
+            ));
+        }
+        let d = depth + 1;
+        Ok(match id {
+            TypeIdentifier::None => return Err(DynamicError::Unresolved("TK_NONE".into())),
+            TypeIdentifier::Primitive(k) => DynamicType::primitive(
+                primitive(*k)
+                    .ok_or_else(|| DynamicError::Unresolved(format!("type kind {k:#x}")))?,
+            ),
+            TypeIdentifier::String8 { bound: b } => DynamicType::string(bound(*b)),
+            TypeIdentifier::String16 { bound: b } => DynamicType::wstring(bound(*b)),
+            TypeIdentifier::PlainSequence {
+                bound: b, element, ..
+            } => DynamicType::sequence(self.resolve(element, d)?, bound(*b)),
+            TypeIdentifier::PlainArray {
+                bounds, element, ..
+            } => DynamicType::array(self.resolve(element, d)?, bounds.clone())?,
+            TypeIdentifier::PlainMap {
+                bound: b,
+                element,
+                key,
+                ..
+            } => DynamicType::map(self.resolve(key, d)?, self.resolve(element, d)?, bound(*b)),
+            TypeIdentifier::StronglyConnected(_) => {
+                return Err(DynamicError::Unresolved(
+                    "recursive types (strongly connected components)".into(),
+                ))
+            }
+            TypeIdentifier::Minimal(_) | TypeIdentifier::Complete(_) => {
+                if let Some(t) = self.done.get(id) {
+                    return Ok(t.clone());
+                }
+                let obj = (self.lookup)(id).ok_or_else(|| {
+                    DynamicError::Unresolved(format!(
+                        "no type object for {:02x?}",
+                        id.hash().unwrap_or(&[0; 14])
+                    ))
+                })?;
+                let body = match &*obj {
+                    TypeObject::Minimal(m) => &m.0,
+                    TypeObject::Complete(c) => &c.0,
+                };
+                let t = self.body(body, d)?;
+                self.done.insert(id.clone(), t.clone());
+                t
+            }
+        })
+    }
+
+    fn body(&mut self, body: &TypeBody, d: u32) -> Result<DynamicType, DynamicError> {
+        Ok(match body {
+            TypeBody::Alias { related_type, .. } => {
+                DynamicType::alias(type_name(body), self.resolve(related_type, d)?)
+            }
+            TypeBody::Struct {
+                flags,
+                base,
+                members,
+                ..
+            } => {
+                let base = match base {
+                    TypeIdentifier::None => None,
+                    b => Some(self.resolve(b, d)?),
+                };
+                let (mut all, mut levels) = match base.as_ref().map(|b| b.resolved().kind()) {
+                    None => (Vec::new(), Vec::new()),
+                    Some(TypeKind::Struct(s)) => (s.members.clone(), s.levels.clone()),
+                    Some(_) => {
+                        return Err(DynamicError::Invalid(
+                            "a struct's base is not a struct".into(),
+                        ))
+                    }
+                };
+                for m in members {
+                    all.push(Member {
+                        name: member_name(&m.detail.name),
+                        id: m.id,
+                        ty: self.resolve(&m.type_id, d)?,
+                        key: m.flags.contains(MemberFlag::IS_KEY),
+                        optional: m.flags.contains(MemberFlag::IS_OPTIONAL),
+                        external: m.flags.contains(MemberFlag::IS_EXTERNAL),
+                        must_understand: m.flags.contains(MemberFlag::IS_MUST_UNDERSTAND),
+                    });
+                }
+                levels.push(all.len());
+                DynamicType::new(TypeKind::Struct(StructType {
+                    name: type_name(body),
+                    extensibility: extensibility(*flags),
+                    base,
+                    members: all,
+                    levels,
+                }))
+            }
+            TypeBody::Union {
+                flags,
+                disc_flags,
+                disc_type,
+                members,
+                ..
+            } => {
+                let mut cases = Vec::with_capacity(members.len());
+                for m in members {
+                    cases.push(UnionCase {
+                        name: member_name(&m.detail.name),
+                        id: m.id,
+                        ty: self.resolve(&m.type_id, d)?,
+                        labels: m.labels.iter().map(|l| i64::from(*l)).collect(),
+                        is_default: m.flags.contains(MemberFlag::IS_DEFAULT),
+                        external: m.flags.contains(MemberFlag::IS_EXTERNAL),
+                    });
+                }
+                DynamicType::new(TypeKind::Union(UnionType {
+                    name: type_name(body),
+                    extensibility: extensibility(*flags),
+                    discriminator: self.resolve(disc_type, d)?,
+                    disc_key: disc_flags.contains(MemberFlag::IS_KEY),
+                    cases,
+                }))
+            }
+            TypeBody::Enum {
+                bit_bound,
+                literals,
+                ..
+            } => DynamicType::new(TypeKind::Enum(EnumType {
+                name: type_name(body),
+                bit_bound: *bit_bound,
+                default: literals
+                    .iter()
+                    .position(|l| l.flags.contains(MemberFlag::IS_DEFAULT))
+                    .unwrap_or(0),
+                literals: literals
+                    .iter()
+                    .map(|l| Enumerator {
+                        name: member_name(&l.detail.name),
+                        value: l.value,
+                    })
+                    .collect(),
+            })),
+            TypeBody::Bitmask {
+                bit_bound,
+                bitflags,
+                ..
+            } => DynamicType::new(TypeKind::Bitmask(BitmaskType {
+                name: type_name(body),
+                bit_bound: *bit_bound,
+                flags: bitflags
+                    .iter()
+                    .map(|f| BitFlag {
+                        name: member_name(&f.detail.name),
+                        position: f.position,
+                    })
+                    .collect(),
+            })),
+            TypeBody::Sequence {
+                bound: b, element, ..
+            } => DynamicType::sequence(self.resolve(&element.type_id, d)?, bound(*b)),
+            TypeBody::Array {
+                bounds, element, ..
+            } => DynamicType::array(self.resolve(&element.type_id, d)?, bounds.clone())?,
+            TypeBody::Map {
+                bound: b,
+                key,
+                element,
+                ..
+            } => DynamicType::map(
+                self.resolve(&key.type_id, d)?,
+                self.resolve(&element.type_id, d)?,
+                bound(*b),
+            ),
+        })
+    }
+}

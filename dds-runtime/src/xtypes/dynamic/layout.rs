@@ -1,0 +1,202 @@
+//! What the derive computes at compile time, computed from a [`DynamicType`]: the layout the XCDR rules see,
+//! whether XCDR1 carries it by default, the key-stream size scan and whether a mutable type is on the key path.
+
+use crate::cdr::members::prim_end;
+use crate::cdr::{Extensibility, Layout, XcdrVersion};
+
+use super::types::{DynamicType, Primitive, TypeKind};
+
+/// Key-size scans give up past this (the key is then hashed).
+const KEY_SCAN_LIMIT: usize = 64;
+
+/// The type's [`Layout`] (as `CdrType::LAYOUT` of the derived type).
+pub(super) fn layout(ty: &DynamicType) -> Layout {
+    match ty.resolved().kind() {
+        TypeKind::Primitive(p) => Layout::Primitive(p.size() as u8),
+        TypeKind::String { .. } => Layout::String,
+        TypeKind::Enum(e) => Layout::Enumerated(e.size() as u8),
+        TypeKind::Bitmask(b) => Layout::Enumerated(b.size() as u8),
+        TypeKind::Sequence { element, .. } => match layout(element) {
+            Layout::Primitive(n) => Layout::PrimitiveSequence(n),
+            _ => Layout::Delimited,
+        },
+        TypeKind::Array { element, .. } => match layout(element) {
+            Layout::Primitive(_) | Layout::PrimitiveArray => Layout::PrimitiveArray,
+            _ => Layout::DelimitedArray,
+        },
+        TypeKind::Map { key, value, .. } => {
+            if layout(key).is_primitive() && layout(value).is_primitive() {
+                Layout::Other
+            } else {
+                Layout::Delimited
+            }
+        }
+        TypeKind::Struct(_) | TypeKind::Union(_) | TypeKind::Alias { .. } => Layout::Other,
+    }
+}
+
+/// Whether XCDR1 carries the type as Cyclone does by default (final, no optional members, all the way down):
+/// the derive's `XCDR1_PLAIN`. External members count as plain.
+pub(super) fn xcdr1_plain(ty: &DynamicType) -> bool {
+    match ty.resolved().kind() {
+        TypeKind::Struct(s) => {
+            s.extensibility == Extensibility::Final
+                && s.members
+                    .iter()
+                    .all(|m| !m.optional && (m.external || xcdr1_plain(&m.ty)))
+        }
+        TypeKind::Union(u) => {
+            u.extensibility == Extensibility::Final
+                && u.cases.iter().all(|c| c.external || xcdr1_plain(&c.ty))
+        }
+        TypeKind::Sequence { element, .. } | TypeKind::Array { element, .. } => {
+            xcdr1_plain(element)
+        }
+        TypeKind::Map { key, value, .. } => xcdr1_plain(key) && xcdr1_plain(value),
+        _ => true,
+    }
+}
+
+/// The XCDR version a writer uses when its QoS names none (the derive's `DEFAULT_VERSION`).
+pub fn default_version(ty: &DynamicType) -> XcdrVersion {
+    if xcdr1_plain(ty) {
+        XcdrVersion::Xcdr1
+    } else {
+        XcdrVersion::Xcdr2
+    }
+}
+
+/// Whether a @mutable type lies on the key path (the derive's `KEY_HAS_MUTABLE`); external members do not
+/// count.
+pub(super) fn key_has_mutable(ty: &DynamicType) -> bool {
+    match ty.resolved().kind() {
+        TypeKind::Struct(s) => {
+            if s.extensibility == Extensibility::Mutable {
+                return true;
+            }
+            // Per level: the level's own keys, or all its members when it has none.
+            let mut start = 0;
+            for &end in &s.levels {
+                let level = &s.members[start..end];
+                let own_keys = level.iter().any(|m| m.key);
+                if level
+                    .iter()
+                    .filter(|m| !own_keys || m.key)
+                    .any(|m| !m.external && key_has_mutable(&m.ty))
+                {
+                    return true;
+                }
+                start = end;
+            }
+            false
+        }
+        TypeKind::Union(u) => {
+            u.extensibility == Extensibility::Mutable
+                || u.cases
+                    .iter()
+                    .any(|c| !c.external && key_has_mutable(&c.ty))
+        }
+        TypeKind::Sequence { element, .. } | TypeKind::Array { element, .. } => {
+            key_has_mutable(element)
+        }
+        TypeKind::Map { key, value, .. } => key_has_mutable(key) || key_has_mutable(value),
+        _ => false,
+    }
+}
+
+/// The largest end offset of the plain key stream of `ty` from `start` (`None`: unbounded, or past the scan
+/// limit): the derive's `key_max_end`.
+pub(super) fn key_max_end(
+    ty: &DynamicType,
+    start: usize,
+    version: XcdrVersion,
+    bound: Option<usize>,
+) -> Option<usize> {
+    let align4 = |p: usize| (p + 3) & !3;
+    match ty.resolved().kind() {
+        TypeKind::Primitive(Primitive::Float128) => {
+            let a = version.max_align();
+            Some(start.div_ceil(a) * a + 16)
+        }
+        TypeKind::Primitive(p) => Some(prim_end(start, p.size(), version)),
+        TypeKind::Enum(e) => Some(prim_end(start, e.size(), version)),
+        TypeKind::Bitmask(b) => Some(prim_end(start, b.size(), version)),
+        TypeKind::String {
+            wide: false,
+            bound: b,
+        } => b
+            .or(bound.map(|x| x as u32))
+            .map(|b| align4(start) + 4 + b as usize + 1),
+        TypeKind::String {
+            wide: true,
+            bound: b,
+        } => b
+            .or(bound.map(|x| x as u32))
+            .map(|b| align4(start) + 4 + 2 * b as usize),
+        TypeKind::Sequence { element, bound: b } => {
+            let bound = b.map(|b| b as usize).or(bound)?;
+            if start > KEY_SCAN_LIMIT || bound > KEY_SCAN_LIMIT {
+                return None;
+            }
+            let mut p = align4(start) + 4;
+            for _ in 0..bound {
+                p = key_max_end(element, p, version, None)?;
+                if p > KEY_SCAN_LIMIT {
+                    return None;
+                }
+            }
+            Some(p)
+        }
+        TypeKind::Array { element, dims } => {
+            let n: usize = dims
+                .iter()
+                .try_fold(1usize, |a, d| a.checked_mul(*d as usize))?;
+            if start > KEY_SCAN_LIMIT || n > KEY_SCAN_LIMIT {
+                return None;
+            }
+            let mut p = start;
+            for _ in 0..n {
+                p = key_max_end(element, p, version, None)?;
+                if p > KEY_SCAN_LIMIT {
+                    return None;
+                }
+            }
+            Some(p)
+        }
+        TypeKind::Map { .. } => None,
+        TypeKind::Struct(s) => {
+            if start > KEY_SCAN_LIMIT {
+                return None;
+            }
+            let keys = s.has_keys();
+            let mut p = start;
+            for i in s.by_id() {
+                let m = &s.members[i];
+                if keys && !m.key {
+                    continue;
+                }
+                if m.optional {
+                    p = if version == XcdrVersion::Xcdr2 {
+                        p + 1
+                    } else {
+                        align4(p) + 12
+                    };
+                }
+                p = key_max_end(&m.ty, p, version, None)?;
+            }
+            Some(p)
+        }
+        TypeKind::Union(u) => {
+            if start > KEY_SCAN_LIMIT {
+                return None;
+            }
+            let p = key_max_end(&u.discriminator, start, version, None)?;
+            let mut end = p;
+            for c in &u.cases {
+                end = end.max(key_max_end(&c.ty, p, version, None)?);
+            }
+            Some(end)
+        }
+        TypeKind::Alias { .. } => None,
+    }
+}

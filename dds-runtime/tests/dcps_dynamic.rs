@@ -1,0 +1,137 @@
+//! Dynamic writers and readers against typed ones, in one process over loopback: the same discovery and
+//! matching, the same bytes. Run inside `scripts/isolated`.
+mod dcps_util;
+
+use std::time::Duration;
+
+use dcps_util::*;
+use dds_runtime::cdr::Extensibility;
+use dds_runtime::filter::ContentFilter;
+use dds_runtime::prelude::*;
+use dds_runtime::rtps::ChangeKind;
+use dds_runtime::xtypes::dynamic::{
+    types_from_idl, DynamicData, DynamicType, MemberBuilder, Primitive, StructBuilder, Value,
+};
+
+const SHAPE_IDL: &str =
+    "@appendable struct ShapeType { @key string color; long x; long y; long shapesize; };";
+
+fn shape_from_builder() -> DynamicType {
+    let long = DynamicType::primitive(Primitive::Int32);
+    StructBuilder::new("ShapeType")
+        .extensibility(Extensibility::Appendable)
+        .with(MemberBuilder::new("color", DynamicType::string(None)).key())
+        .member("x", long.clone())
+        .member("y", long.clone())
+        .member("shapesize", long)
+        .build()
+        .expect("ShapeType")
+}
+
+fn dynamic_shape(ty: &DynamicType, color: &str, x: i32) -> DynamicData {
+    let mut d = DynamicData::new(ty.clone());
+    d.set("color", Value::String(color.into())).unwrap();
+    d.set("x", Value::Int32(x)).unwrap();
+    d.set("y", Value::Int32(2 * x)).unwrap();
+    d.set("shapesize", Value::Int32(30)).unwrap();
+    d
+}
+
+#[test]
+fn dynamic_writer_from_idl_to_typed_reader() {
+    let ty = types_from_idl("shape.idl", SHAPE_IDL)
+        .unwrap()
+        .remove("ShapeType")
+        .expect("ShapeType from IDL");
+    let (p1, p2) = (participant(91), participant(91));
+    let (wq, rq) = reliable_keep_all();
+    let topic = p1
+        .create_dynamic_topic("Square", ty.clone(), &TopicQos::default())
+        .unwrap();
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .and_then(|p| p.create_dynamic_writer(&topic, &wq))
+        .unwrap();
+    let r = reader::<ShapeType>(&p2, "Square", &rq);
+    assert!(
+        w.wait_for_readers(1, MATCH_TIMEOUT),
+        "dynamic writer matched the typed reader"
+    );
+    assert!(wait_until(MATCH_TIMEOUT, || r
+        .subscription_matched_status()
+        .current_count
+        == 1));
+    for i in 0..10 {
+        w.write(&dynamic_shape(
+            &ty,
+            if i % 2 == 0 { "RED" } else { "BLUE" },
+            i,
+        ))
+        .unwrap();
+    }
+    let mut got = Vec::new();
+    wait_until(Duration::from_secs(10), || {
+        got.extend(r.take().unwrap().into_iter().filter_map(|s| s.data));
+        got.len() >= 10
+    });
+    let want: Vec<ShapeType> = (0..10)
+        .map(|i| shape(if i % 2 == 0 { "RED" } else { "BLUE" }, i))
+        .collect();
+    assert_eq!(got, want);
+    assert_eq!(
+        r.instance_count(),
+        2,
+        "the dynamic key hash gives the typed instances"
+    );
+}
+
+#[test]
+fn typed_writer_to_dynamic_reader_with_dispose_and_filter() {
+    let ty = shape_from_builder();
+    let (p1, p2) = (participant(92), participant(92));
+    let (wq, rq) = reliable_keep_all();
+    let w = writer::<ShapeType>(&p1, "Circle", &wq);
+    let topic = p2
+        .create_dynamic_topic("Circle", ty.clone(), &TopicQos::default())
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| s.create_dynamic_reader(&topic, &rq))
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    assert!(wait_until(MATCH_TIMEOUT, || r.matched_writers().len() == 1));
+    for i in 0..5 {
+        w.write(&shape("GREEN", i)).unwrap();
+    }
+    w.dispose(&shape("GREEN", 0)).unwrap();
+    let mut got = Vec::new();
+    wait_until(Duration::from_secs(10), || {
+        r.wait_for_data(Duration::from_millis(100));
+        got.extend(r.take());
+        got.len() >= 6
+    });
+    assert_eq!(got.len(), 6);
+    for (i, s) in got[..5].iter().enumerate() {
+        assert_eq!(s.kind, ChangeKind::Alive);
+        assert_eq!(
+            s.data.as_ref(),
+            Some(&dynamic_shape(&ty, "GREEN", i as i32))
+        );
+        assert_eq!(s.writer, w.guid());
+    }
+    assert!(matches!(
+        got[5].kind,
+        ChangeKind::Dispose | ChangeKind::DisposeUnregister
+    ));
+    let key = got[5].data.as_ref().expect("the dispose carries the key");
+    assert_eq!(key.get("color"), Some(&Value::String("GREEN".into())));
+    let f = ContentFilter::new("x > 2 AND color = 'GREEN'", &[] as &[&str]).unwrap();
+    let passed: Vec<_> = got[..5]
+        .iter()
+        .filter(|s| f.matches(s.data.as_ref().unwrap()))
+        .collect();
+    assert_eq!(passed.len(), 2);
+}
