@@ -200,7 +200,8 @@ participant_config! {
     /// Delay before answering a HEARTBEAT with an ACKNACK (default 0).
     heartbeat_response_delay: Duration = copy,
     /// Flow control: `write` refuses (WouldBlock) once this many bytes are unacknowledged (default 512 KiB),
-    /// until they drop below [`whc_low_watermark`](Self::whc_low_watermark).
+    /// until they drop below [`whc_low_watermark`](Self::whc_low_watermark). For large samples the window
+    /// grows to hold four samples of the size last written (at most 4 MiB), released at half of it.
     whc_high_watermark: usize = copy,
     /// Flow control: where a blocked writer is released (default 128 KiB).
     whc_low_watermark: usize = copy,

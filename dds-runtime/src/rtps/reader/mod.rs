@@ -351,7 +351,12 @@ impl Reader {
                     p.defrag_bytes -= old.bytes;
                 }
             }
+            let cost = defrag::cost(d.sample_size, d.fragment_size);
+            if p.defrag_bytes + cost > self.params.defrag_max_bytes {
+                return;
+            }
             let mut df = Defrag::new(d.sample_size, d.fragment_size);
+            p.defrag_bytes += df.bytes;
             df.status_info = d.inline_qos.and_then(|q| q.status_info());
             df.key_hash = d.inline_qos.and_then(|q| q.key_hash());
             df.key_flag = d.key_flag;
@@ -369,12 +374,7 @@ impl Reader {
         }
         let fs = d.fragment_size as usize;
         for (i, chunk) in d.payload.chunks(fs).enumerate() {
-            if p.defrag_bytes + chunk.len() + defrag::FRAGMENT_OVERHEAD
-                > self.params.defrag_max_bytes
-            {
-                break;
-            }
-            p.defrag_bytes += df.add(d.fragment_starting_num.saturating_add(i as u32), chunk);
+            df.add(d.fragment_starting_num.saturating_add(i as u32), chunk);
         }
         if df.is_complete() {
             let Some(df) = p.defrag.remove(&sn) else {
@@ -387,7 +387,9 @@ impl Reader {
             let key_hash = df.key_hash;
             let source_timestamp = df.source_timestamp;
             let coherent = df.coherent_set.map(|set| SetMark { set, end: false });
-            let payload = df.assemble();
+            let Some(payload) = df.assemble() else {
+                return;
+            };
             let slot = Slot::Change(PendingChange {
                 kind,
                 payload,

@@ -2,6 +2,7 @@
 
 mod coherent;
 mod content_filter;
+mod flow;
 mod history;
 mod liveliness;
 mod reader_proxy;
@@ -73,6 +74,8 @@ pub(crate) struct Writer {
     bytes_since_hb: usize,
     unacked_bytes: usize,
     blocked: bool,
+    /// Flow control's watermarks, scaled to the sample size (see `flow.rs`).
+    window: flow::Window,
     /// Set when deleted: lingers until acknowledged or this deadline.
     pub linger_until: Option<Instant>,
     /// The open coherent set, if any (see `coherent.rs`).
@@ -101,6 +104,7 @@ impl Writer {
             bytes_since_hb: 0,
             unacked_bytes: 0,
             blocked: false,
+            window: flow::Window::new(params.high_watermark, params.low_watermark),
             linger_until: None,
             coherent: CoherentState::Off,
             filters: ReaderFilters::default(),
@@ -196,7 +200,7 @@ impl Writer {
         } else {
             0
         };
-        if self.blocked && self.unacked_bytes <= self.params.low_watermark {
+        if self.blocked && self.unacked_bytes <= self.window.low() {
             self.blocked = false;
             ev.push_back(Event::WriterUnblocked {
                 writer: self.guid.entity_id,
@@ -233,6 +237,7 @@ impl Writer {
             return Err(WriteError::MissingKeyHash);
         }
         let len = change.payload.len();
+        self.window.note(len);
         if self.has_reliable_proxy() {
             if self.blocked {
                 self.update_acked(ev);
@@ -241,7 +246,7 @@ impl Writer {
                     return Err(WriteError::WouldBlock);
                 }
             }
-            if self.unacked_bytes > 0 && self.unacked_bytes + len > self.params.high_watermark {
+            if self.unacked_bytes > 0 && self.unacked_bytes + len > self.window.high() {
                 self.blocked = true;
                 self.solicit_acks(now);
                 return Err(WriteError::WouldBlock);
@@ -287,7 +292,7 @@ impl Writer {
                 // limit), so that flow control keeps moving without waiting for the periodic heartbeat (and
                 // without an ACKNACK per datagram); otherwise the piggy-backed heartbeat only announces.
                 let final_flag =
-                    self.bytes_since_nonfinal_hb < self.params.high_watermark / 4
+                    self.bytes_since_nonfinal_hb < self.window.high() / 4
                         && self.params.limits.max_samples.is_none_or(|m| {
                             self.changes_since_nonfinal_hb < (m as usize / 4).max(1)
                         });
@@ -344,7 +349,7 @@ impl Writer {
     /// are past half the high watermark, or the history is past half its sample limit.
     fn under_pressure(&self) -> bool {
         self.blocked
-            || self.unacked_bytes >= self.params.high_watermark / 2
+            || self.unacked_bytes >= self.window.high() / 2
             || self
                 .params
                 .limits
