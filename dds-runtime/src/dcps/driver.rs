@@ -14,7 +14,7 @@ use foldhash::{HashMap, HashMapExt};
 
 use crate::config::Config;
 use crate::rtps::{
-    CoreError, EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig, Payload,
+    CoreError, EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig,
     ReceivedSample, Transmit, WriteChange,
 };
 use crate::transport::{Channel, Datagram, UdpTransport};
@@ -265,14 +265,11 @@ impl Driver {
         if self.stopped.load(Ordering::Acquire) {
             return;
         }
-        // One copy per datagram out of the reusable receive buffers; samples share it.
-        let shared: Vec<Payload> = batch
-            .iter()
-            .map(|d| Payload::copy_from_slice(d.data))
-            .collect();
+        // A datagram with DATA is copied once out of the reusable receive buffers, and its samples share
+        // the copy; fragments are copied straight into their reassembly buffers.
         self.with_core(|c, now| {
-            for d in &shared {
-                c.handle_shared_datagram(now, d);
+            for d in batch {
+                c.handle_datagram_sharing(now, d.data);
             }
         });
     }

@@ -43,6 +43,8 @@ pub struct Participant {
     leases: crate::rtps::liveliness::Leases,
     /// Reused buffer for what readers deliver while a datagram is processed.
     scratch: Vec<Event>,
+    /// Reusable buffers of received samples (see `pool.rs`).
+    rx_pools: crate::rtps::pool::ReceivePools,
     writers: BTreeMap<EntityId, Writer>,
     readers: BTreeMap<EntityId, Reader>,
     /// User endpoints (builtin ones are only in `writers`/`readers`).
@@ -138,6 +140,7 @@ impl Participant {
             events: VecDeque::new(),
             leases: Default::default(),
             scratch: Vec::new(),
+            rx_pools: Default::default(),
             writers: BTreeMap::new(),
             readers: BTreeMap::new(),
             user_writers: BTreeSet::new(),

@@ -11,22 +11,57 @@ use super::timers::lower_floor;
 use super::Participant;
 use crate::rtps::api::{Event, Payload};
 use crate::rtps::messages::{MessageIter, Submessage};
+use crate::rtps::pool::BufferPool;
 use crate::rtps::reader::Reader;
 use crate::rtps::types::*;
+
+/// Whether the samples of a datagram may share its buffer.
+enum Share<'a> {
+    /// No: each kept payload is copied out.
+    Copy,
+    /// Yes: the datagram is in this shared buffer.
+    Given(&'a Payload),
+    /// Yes, once copied into a shared buffer of the pool (done at the first DATA).
+    Lazy(Option<Payload>),
+}
+
+impl Share<'_> {
+    fn get(&mut self, data: &[u8], pool: &mut BufferPool) -> Option<&Payload> {
+        match self {
+            Share::Copy => None,
+            Share::Given(p) => Some(p),
+            Share::Lazy(p) => Some(p.get_or_insert_with(|| {
+                pool.fill(|v| {
+                    v.extend_from_slice(data);
+                    Ok::<_, std::convert::Infallible>(())
+                })
+                .unwrap_or_default()
+            })),
+        }
+    }
+}
 
 impl Participant {
     /// Processes one datagram. Never panics; malformed input is dropped with a `tracing` event.
     pub fn handle_datagram(&mut self, now: Instant, data: &[u8]) {
-        self.receive(now, data, None);
+        self.receive(now, data, &mut Share::Copy);
     }
 
     /// Like [`handle_datagram`](Self::handle_datagram), for a datagram already in shared memory: delivered
     /// samples share its buffer rather than copying their payloads out of it.
     pub fn handle_shared_datagram(&mut self, now: Instant, datagram: &Payload) {
-        self.receive(now, datagram, Some(datagram));
+        self.receive(now, datagram, &mut Share::Given(datagram));
     }
 
-    fn receive(&mut self, now: Instant, data: &[u8], shared: Option<&Payload>) {
+    /// Like [`handle_shared_datagram`](Self::handle_shared_datagram) for a datagram in a buffer the caller
+    /// reuses: it is copied into a shared buffer only when it holds a DATA for a local reader (whose samples
+    /// then share that copy). Fragments go straight to their reassembly buffers, so a datagram of
+    /// DATA_FRAGs is copied once, not twice.
+    pub fn handle_datagram_sharing(&mut self, now: Instant, data: &[u8]) {
+        self.receive(now, data, &mut Share::Lazy(None));
+    }
+
+    fn receive(&mut self, now: Instant, data: &[u8], share: &mut Share<'_>) {
         let (header, subs) = match MessageIter::parse(data) {
             Ok(x) => x,
             Err(e) => {
@@ -63,6 +98,7 @@ impl Participant {
                         self.timers_changed();
                     } else {
                         let scratch = &mut self.scratch;
+                        let shared = share.get(data, &mut self.rx_pools.datagrams);
                         for_readers(
                             &mut self.readers,
                             &mut self.readers_by_writer,
@@ -76,12 +112,13 @@ impl Participant {
                 Submessage::DataFrag(d) => {
                     let wguid = Guid::new(src, d.writer_id);
                     let scratch = &mut self.scratch;
+                    let pool = &mut self.rx_pools.samples;
                     for_readers(
                         &mut self.readers,
                         &mut self.readers_by_writer,
                         d.reader_id,
                         wguid,
-                        |r| r.on_data_frag(wguid, &d, ts, scratch),
+                        |r| r.on_data_frag(wguid, &d, ts, pool, scratch),
                     );
                     self.writer_asserted(now, wguid);
                 }

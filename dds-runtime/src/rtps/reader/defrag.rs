@@ -1,12 +1,13 @@
-//! Reassembly of DATA_FRAG samples into one buffer of the sample's size, which becomes the delivered
-//! payload as it is: each fragment is copied once, out of its datagram, to its place; completion costs no
-//! further copy. The buffer (and the bitmap of fragments received) is charged against the reader's limits
-//! when it is allocated, so a sender claiming large samples cannot make us hold more than those limits.
+//! Reassembly of DATA_FRAG samples into one buffer of the sample's size (from the participant's pool of
+//! reusable buffers), which becomes the delivered payload as it is: each fragment is copied once, out of
+//! its datagram, to its place; completion costs no further copy. The buffer (and the bitmap of fragments
+//! received) is charged against the reader's limits when it is taken, so a sender claiming large samples
+//! cannot make us hold more than those limits.
 
-use std::mem::MaybeUninit;
 use std::sync::Arc;
 
 use crate::rtps::api::Payload;
+use crate::rtps::pool::BufferPool;
 use crate::rtps::types::SequenceNumber;
 
 /// What one sample being reassembled costs beyond its buffer and bitmap (its map node and this struct).
@@ -17,8 +18,9 @@ pub(super) const SAMPLE_OVERHEAD: usize = 128;
 pub(crate) struct Defrag {
     pub sample_size: u32,
     pub fragment_size: u16,
-    /// The sample's bytes; those of the fragments marked in `have` are initialised.
-    buf: Arc<[MaybeUninit<u8>]>,
+    /// The sample's bytes, in the buffer's spare capacity (its length stays 0 until complete); those of
+    /// the fragments marked in `have` are initialised.
+    buf: Arc<Vec<u8>>,
     /// One bit per fragment (bit `n - 1` for fragment `n`): received.
     have: Vec<u64>,
     received: u32,
@@ -45,14 +47,18 @@ fn total(sample_size: u32, fragment_size: u16) -> u32 {
 }
 
 impl Defrag {
-    /// An empty reassembly buffer; the caller has checked [`cost`] against its limits.
-    pub(crate) fn new(sample_size: u32, fragment_size: u16) -> Self {
+    /// An empty reassembly buffer in `buf` (empty, referenced by nobody else); the caller has checked
+    /// [`cost`] against its limits.
+    pub(crate) fn new(sample_size: u32, fragment_size: u16, mut buf: Arc<Vec<u8>>) -> Self {
         let fragment_size = fragment_size.max(1);
         let words = total(sample_size, fragment_size).div_ceil(64) as usize;
+        let v = Arc::make_mut(&mut buf);
+        v.clear();
+        v.reserve_exact(sample_size as usize);
         Defrag {
             sample_size,
             fragment_size,
-            buf: Arc::new_uninit_slice(sample_size as usize),
+            buf,
             have: vec![0; words],
             received: 0,
             bytes: cost(sample_size, fragment_size),
@@ -88,7 +94,7 @@ impl Defrag {
         let Some(buf) = Arc::get_mut(&mut self.buf) else {
             return;
         };
-        let dst = &mut buf[start..start + expect];
+        let dst = &mut buf.spare_capacity_mut()[start..start + expect];
         // SAFETY: `dst` and `data` have the same length, and a buffer of ours cannot overlap the datagram;
         // `MaybeUninit<u8>` has the layout of `u8`.
         unsafe {
@@ -122,15 +128,18 @@ impl Defrag {
         v
     }
 
-    /// The reassembled sample, without a copy; `None` unless complete.
-    pub(crate) fn assemble(self) -> Option<Payload> {
+    /// The reassembled sample, without a copy (its buffer goes back to `pool` once the payload is gone);
+    /// `None` unless complete.
+    pub(crate) fn assemble(mut self, pool: &mut BufferPool) -> Option<Payload> {
         if !self.is_complete() {
             return None;
         }
-        // SAFETY: every fragment was received, and the fragments (all but the last of `fragment_size`
-        // bytes, the last one the rest) cover the whole buffer, so every byte was written.
-        let buf: Arc<[u8]> = unsafe { self.buf.assume_init() };
-        Some(Payload::new(buf))
+        let v = Arc::get_mut(&mut self.buf)?;
+        // SAFETY: the capacity is at least `sample_size` (reserved in `new`), and every fragment was
+        // received: the fragments (all but the last of `fragment_size` bytes, the last one the rest) cover
+        // the first `sample_size` bytes, so all of them were written.
+        unsafe { v.set_len(self.sample_size as usize) };
+        Some(pool.share(self.buf))
     }
 }
 
@@ -141,7 +150,8 @@ mod tests {
     #[test]
     fn reassembles_out_of_order_and_ignores_bad_fragments() {
         let sample: Vec<u8> = (0..2500u32).map(|i| i as u8).collect();
-        let mut d = Defrag::new(2500, 1000);
+        let mut pool = BufferPool::new(4, 1 << 20);
+        let mut d = Defrag::new(2500, 1000, pool.take());
         assert_eq!(d.total(), 3);
         d.add(3, &sample[2000..]);
         d.add(3, &sample[2000..]);
@@ -153,17 +163,29 @@ mod tests {
         d.add(1, &sample[..1000]);
         d.add(2, &sample[1000..2000]);
         assert!(d.missing(3).is_empty());
-        let p = d.assemble().expect("complete");
+        let p = d.assemble(&mut pool).expect("complete");
         assert_eq!(&p[..], &sample[..]);
+        let at = p.as_ptr();
+        drop(p);
+        let mut d = Defrag::new(3, 2, pool.take());
+        d.add(2, &[3]);
+        d.add(1, &[1, 2]);
+        let p = d.assemble(&mut pool).expect("complete");
+        assert_eq!(
+            (&p[..], p.as_ptr()),
+            (&[1u8, 2, 3][..], at),
+            "buffer reused"
+        );
     }
 
     #[test]
     fn incomplete_sample_does_not_assemble_and_cost_counts_buffer() {
-        let d = Defrag::new(10_000, 1344);
+        let mut pool = BufferPool::new(4, 1 << 20);
+        let d = Defrag::new(10_000, 1344, pool.take());
         assert!(d.bytes >= 10_000);
         assert_eq!(d.bytes, cost(10_000, 1344));
-        assert!(d.assemble().is_none());
+        assert!(d.assemble(&mut pool).is_none());
         // A zero fragment size is never divided by.
-        assert_eq!(Defrag::new(10, 0).total(), 10);
+        assert_eq!(Defrag::new(10, 0, pool.take()).total(), 10);
     }
 }
