@@ -148,17 +148,21 @@ impl Writer {
         self.params.reliable && self.proxies.values().any(|p| p.reliable)
     }
 
+    /// The destinations of new data. Readers of our own participant come last: a datagram to ourselves
+    /// costs the sending thread a pass through the receive path (loopback delivers in the sender's
+    /// context), which would otherwise delay the remote readers' copy, e.g. the pong in a ping/pong.
     fn rebuild_dest(&mut self) {
+        let own = self.guid.prefix;
         let dest = |key_hash_only: Option<bool>| {
-            let mut d: Vec<Locator> = self
+            let mut d: Vec<(bool, Locator)> = self
                 .proxies
-                .values()
-                .filter(|p| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
-                .filter_map(|p| p.destination().first().copied())
+                .iter()
+                .filter(|(_, p)| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
+                .filter_map(|(g, p)| Some((g.prefix == own, *p.destination().first()?)))
                 .collect();
             d.sort();
             d.dedup();
-            d
+            d.into_iter().map(|(_, l)| l).collect::<Vec<Locator>>()
         };
         self.data_dest = dest(None);
         self.key_hash_dest = dest(Some(true));
