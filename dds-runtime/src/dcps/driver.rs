@@ -111,7 +111,14 @@ pub(crate) struct Driver {
 thread_local! {
     /// Each thread's reusable vector of datagrams to send, for `Driver::with_core`.
     static BATCH: std::cell::RefCell<Vec<Transmit>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// Each thread's reusable vectors of what `Driver::with_core` routed: events to dispatch, and the
+    /// readers given samples.
+    static ROUTED: std::cell::RefCell<Routed> =
+        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
 }
+
+/// Events to dispatch after the core's lock is released, and the readers to process then.
+type Routed = (Vec<Event>, Vec<(EntityId, Arc<dyn Endpoint>)>);
 
 /// See [`Driver::set_discovery_hook`].
 type DiscoveryHook = Box<dyn Fn(&Event) + Send + Sync>;
@@ -298,8 +305,7 @@ impl Driver {
         let now = Instant::now();
         // The batch vector is kept per thread (a nested call, from a listener, gets a fresh one).
         let mut batch: Vec<Transmit> = BATCH.with(|b| std::mem::take(&mut *b.borrow_mut()));
-        let mut deferred: Vec<Event> = Vec::new();
-        let mut touched: Vec<(EntityId, Arc<dyn Endpoint>)> = Vec::new();
+        let (mut deferred, mut touched) = ROUTED.with(|b| std::mem::take(&mut *b.borrow_mut()));
         let (r, next_timeout) = {
             let mut core = lock(&self.core);
             // Sent datagrams go back to the core for reuse (saves allocations per datagram).
@@ -325,7 +331,8 @@ impl Driver {
             }
         }
         BATCH.with(|b| *b.borrow_mut() = batch);
-        self.after_unlock(deferred, touched, next_timeout, progress);
+        self.after_unlock(&mut deferred, &mut touched, next_timeout, progress);
+        ROUTED.with(|b| *b.borrow_mut() = (deferred, touched));
         r
     }
 
@@ -391,8 +398,8 @@ impl Driver {
 
     fn after_unlock(
         &self,
-        deferred: Vec<Event>,
-        touched: Vec<(EntityId, Arc<dyn Endpoint>)>,
+        deferred: &mut Vec<Event>,
+        touched: &mut Vec<(EntityId, Arc<dyn Endpoint>)>,
         next_timeout: Option<Instant>,
         progress: bool,
     ) {
@@ -412,10 +419,10 @@ impl Driver {
                 _ => {}
             }
         }
-        for ev in deferred {
+        for ev in deferred.drain(..) {
             self.dispatch_event(ev);
         }
-        for (_, r) in touched {
+        for (_, r) in touched.drain(..) {
             r.process();
         }
     }

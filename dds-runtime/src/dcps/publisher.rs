@@ -243,8 +243,8 @@ impl<T: DdsType> std::fmt::Debug for DataWriter<T> {
 /// Runs `f` on a cleared per-thread buffer (a fresh one if the thread's is in use), so that serializing a
 /// sample or its key allocates nothing once the buffer has grown.
 /// Buffers a writer's payload pool keeps: enough for the samples a reliable writer has in flight at the
-/// default flow-control window (512 KiB of 512-byte samples) and more.
-const WRITER_POOL_BUFFERS: usize = 1024;
+/// default flow-control window (512 KiB of 128-byte samples) and a history of a few thousand samples.
+const WRITER_POOL_BUFFERS: usize = 4096;
 /// Bytes of capacity a writer's payload pool keeps: the largest flow-control window (4 MiB) four times.
 const WRITER_POOL_BYTES: usize = 16 << 20;
 

@@ -4,9 +4,10 @@
 //!
 //! The pool keeps a clone of each buffer it handed out. A buffer is free again when that clone is the only
 //! reference left ([`Arc::get_mut`] succeeds). Buffers are reused oldest first, which is the order in which a
-//! writer's history and a reader's deliveries release them; one still held (a sample kept in a reader
-//! cache, say) moves to the back so it does not hold up the others. The pool is bounded in buffers and in
-//! bytes of capacity: what does not fit is simply not kept.
+//! writer's history and a reader's deliveries release them; while the oldest is still held, a new buffer
+//! is made. The pool is bounded in buffers and in bytes of capacity: when full, it forgets its oldest
+//! buffers (their holders still free them), so one held for long (a sample kept in a reader cache, say)
+//! cannot stop reuse for good.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -21,6 +22,8 @@ pub(crate) struct BufferPool {
     bytes: usize,
     max_buffers: usize,
     max_bytes: usize,
+    /// Length of the last buffer shared: the capacity a new buffer starts with.
+    last_len: usize,
 }
 
 impl BufferPool {
@@ -31,23 +34,21 @@ impl BufferPool {
             bytes: 0,
             max_buffers,
             max_bytes,
+            last_len: 0,
         }
     }
 
-    /// An empty buffer referenced by nobody else: a free one from the pool, else a new one.
+    /// An empty buffer referenced by nobody else: a free one from the pool, else a new one (with the
+    /// capacity of the last buffer shared, so that filling it does not regrow it step by step).
     pub(crate) fn take(&mut self) -> Arc<Vec<u8>> {
-        for _ in 0..2 {
-            let Some(mut b) = self.bufs.pop_front() else {
-                break;
-            };
-            if let Some(v) = Arc::get_mut(&mut b) {
+        if let Some(front) = self.bufs.front_mut() {
+            if let Some(v) = Arc::get_mut(front) {
                 v.clear();
                 self.bytes -= v.capacity();
-                return b;
+                return self.bufs.pop_front().unwrap_or_default();
             }
-            self.bufs.push_back(b);
         }
-        Arc::new(Vec::new())
+        Arc::new(Vec::with_capacity(self.last_len))
     }
 
     /// A payload of the bytes `fill` appends to a pooled buffer; the pool keeps the buffer for reuse.
@@ -65,10 +66,18 @@ impl BufferPool {
     pub(crate) fn share(&mut self, b: Arc<Vec<u8>>) -> Payload {
         let p = Payload::from_shared_vec(b.clone());
         let cap = b.capacity();
-        if self.bufs.len() < self.max_buffers && self.bytes + cap <= self.max_bytes {
-            self.bytes += cap;
-            self.bufs.push_back(b);
+        self.last_len = b.len();
+        if self.max_buffers == 0 || cap > self.max_bytes {
+            return p;
         }
+        while self.bufs.len() >= self.max_buffers || self.bytes + cap > self.max_bytes {
+            let Some(old) = self.bufs.pop_front() else {
+                break;
+            };
+            self.bytes -= old.capacity();
+        }
+        self.bytes += cap;
+        self.bufs.push_back(b);
         p
     }
 }
@@ -123,10 +132,16 @@ mod tests {
         let kept: Vec<Payload> = (0..4)
             .map(|_| pool.share(Arc::new(Vec::with_capacity(40))))
             .collect();
-        assert_eq!(pool.bufs.len(), 2);
+        assert_eq!(
+            (pool.bufs.len(), pool.bytes),
+            (2, 80),
+            "the oldest forgotten"
+        );
         let big = pool.share(Arc::new(Vec::with_capacity(1000)));
-        assert_eq!(pool.bufs.len(), 2);
-        drop((kept, big));
-        assert_eq!(pool.bytes, 80);
+        assert_eq!(pool.bufs.len(), 2, "larger than the pool: not kept");
+        let mid = pool.share(Arc::new(Vec::with_capacity(70)));
+        assert_eq!((pool.bufs.len(), pool.bytes), (1, 70), "room made by bytes");
+        drop((kept, big, mid));
+        assert_eq!(pool.take().capacity(), 70);
     }
 }

@@ -10,58 +10,68 @@ use tracing::{debug, trace};
 use super::timers::lower_floor;
 use super::Participant;
 use crate::rtps::api::{Event, Payload};
-use crate::rtps::messages::{MessageIter, Submessage};
-use crate::rtps::pool::BufferPool;
+use crate::rtps::messages::{id, MessageIter, Submessage};
 use crate::rtps::reader::Reader;
 use crate::rtps::types::*;
 
-/// Whether the samples of a datagram may share its buffer.
-enum Share<'a> {
-    /// No: each kept payload is copied out.
-    Copy,
-    /// Yes: the datagram is in this shared buffer.
-    Given(&'a Payload),
-    /// Yes, once copied into a shared buffer of the pool (done at the first DATA).
-    Lazy(Option<Payload>),
-}
-
-impl Share<'_> {
-    fn get(&mut self, data: &[u8], pool: &mut BufferPool) -> Option<&Payload> {
-        match self {
-            Share::Copy => None,
-            Share::Given(p) => Some(p),
-            Share::Lazy(p) => Some(p.get_or_insert_with(|| {
-                pool.fill(|v| {
-                    v.extend_from_slice(data);
-                    Ok::<_, std::convert::Infallible>(())
-                })
-                .unwrap_or_default()
-            })),
+/// Whether the message holds a DATA submessage: a walk over the submessage headers only. A malformed
+/// message may give either answer; it is rejected by the parse that follows.
+fn holds_data(msg: &[u8]) -> bool {
+    const HEADER: usize = 20;
+    let mut at = HEADER;
+    while let Some(h) = msg.get(at..at + 4) {
+        if h[0] == id::DATA {
+            return true;
         }
+        let len = if h[1] & 1 != 0 {
+            u16::from_le_bytes([h[2], h[3]])
+        } else {
+            u16::from_be_bytes([h[2], h[3]])
+        };
+        if len == 0 {
+            // Runs to the end of the message (or is empty, and then only INFO_TS/PAD may follow).
+            if h[0] != id::INFO_TS && h[0] != id::PAD {
+                return false;
+            }
+        }
+        at += 4 + usize::from(len);
     }
+    false
 }
 
 impl Participant {
     /// Processes one datagram. Never panics; malformed input is dropped with a `tracing` event.
     pub fn handle_datagram(&mut self, now: Instant, data: &[u8]) {
-        self.receive(now, data, &mut Share::Copy);
+        self.receive(now, data, None);
     }
 
     /// Like [`handle_datagram`](Self::handle_datagram), for a datagram already in shared memory: delivered
     /// samples share its buffer rather than copying their payloads out of it.
     pub fn handle_shared_datagram(&mut self, now: Instant, datagram: &Payload) {
-        self.receive(now, datagram, &mut Share::Given(datagram));
+        self.receive(now, datagram, Some(datagram));
     }
 
     /// Like [`handle_shared_datagram`](Self::handle_shared_datagram) for a datagram in a buffer the caller
-    /// reuses: it is copied into a shared buffer only when it holds a DATA for a local reader (whose samples
-    /// then share that copy). Fragments go straight to their reassembly buffers, so a datagram of
-    /// DATA_FRAGs is copied once, not twice.
+    /// reuses: when it holds DATA it is copied into a reusable buffer of the participant's pool, which its
+    /// samples share; otherwise it is read where it is, and fragments go straight to their reassembly
+    /// buffers (one copy, not two).
     pub fn handle_datagram_sharing(&mut self, now: Instant, data: &[u8]) {
-        self.receive(now, data, &mut Share::Lazy(None));
+        if holds_data(data) {
+            let copy = self
+                .rx_pools
+                .datagrams
+                .fill(|v| {
+                    v.extend_from_slice(data);
+                    Ok::<_, std::convert::Infallible>(())
+                })
+                .unwrap_or_default();
+            self.receive(now, &copy, Some(&copy));
+        } else {
+            self.receive(now, data, None);
+        }
     }
 
-    fn receive(&mut self, now: Instant, data: &[u8], share: &mut Share<'_>) {
+    fn receive(&mut self, now: Instant, data: &[u8], shared: Option<&Payload>) {
         let (header, subs) = match MessageIter::parse(data) {
             Ok(x) => x,
             Err(e) => {
@@ -98,7 +108,6 @@ impl Participant {
                         self.timers_changed();
                     } else {
                         let scratch = &mut self.scratch;
-                        let shared = share.get(data, &mut self.rx_pools.datagrams);
                         for_readers(
                             &mut self.readers,
                             &mut self.readers_by_writer,

@@ -6,6 +6,7 @@ mod flow;
 mod history;
 mod liveliness;
 mod reader_proxy;
+mod sn_map;
 
 pub(crate) use coherent::CoherentMark;
 use coherent::CoherentState;
