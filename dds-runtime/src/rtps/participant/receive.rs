@@ -263,3 +263,37 @@ fn for_readers(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A message: the 20-byte header, then (id, little-endian length, body length) submessages.
+    fn msg(subs: &[(u8, u16, usize)]) -> Vec<u8> {
+        let mut m = vec![0u8; 20];
+        for &(id, len, body) in subs {
+            m.extend_from_slice(&[id, 1]);
+            m.extend_from_slice(&len.to_le_bytes());
+            m.resize(m.len() + body, 0);
+        }
+        m
+    }
+
+    #[test]
+    fn holds_data_scans_submessage_headers_only() {
+        assert!(holds_data(&msg(&[(id::INFO_TS, 8, 8), (id::DATA, 4, 4)])));
+        assert!(holds_data(&msg(&[(id::INFO_TS, 0, 0), (id::DATA, 0, 12)])));
+        assert!(!holds_data(&msg(&[
+            (id::INFO_TS, 8, 8),
+            (id::DATA_FRAG, 4, 4)
+        ])));
+        // A submessage of length 0 other than INFO_TS/PAD runs to the end: nothing follows it.
+        assert!(!holds_data(&msg(&[
+            (id::HEARTBEAT_FRAG, 0, 0),
+            (id::DATA, 4, 4)
+        ])));
+        assert!(!holds_data(&[0u8; 10]));
+        // A length past the end stops the scan.
+        assert!(!holds_data(&msg(&[(id::DATA_FRAG, 900, 4)])));
+    }
+}
