@@ -110,6 +110,8 @@ pub(crate) struct ReaderCache<T> {
     instance_order: bool,
     /// Makes the key holder of a new instance from its first data (`get_key_value`).
     key_of: Option<fn(&T) -> Option<T>>,
+    /// `collect_with`'s working vectors, kept (empty) between calls so that a take allocates nothing.
+    collect_scratch: (Vec<Touched>, Vec<(u64, usize, usize)>),
 }
 
 /// The sample a read (copying the data with `copy`, if any) or a take (moving it out) returns for `slot`.
@@ -144,6 +146,7 @@ impl<T: FilterFields> ReaderCache<T> {
             total: 0,
             filter: None,
             instance_order: false,
+            collect_scratch: (Vec::new(), Vec::new()),
             key_of: None,
         }
     }
@@ -506,8 +509,9 @@ impl<T: FilterFields> ReaderCache<T> {
         let q = read_query(sel);
         let q = q.as_deref();
         // Instances with a selected sample, and the selection as (seq, instance ordinal, index in instance).
-        let mut touched: Vec<Touched> = Vec::new();
-        let mut picked: Vec<(u64, usize, usize)> = Vec::new();
+        let (mut touched, mut picked) = std::mem::take(&mut self.collect_scratch);
+        touched.clear();
+        picked.clear();
         let mut gather = |h: InstanceHandle, inst: &Instance<T>| {
             let before = picked.len();
             for (i, s) in inst.samples.iter().enumerate() {
@@ -607,6 +611,9 @@ impl<T: FilterFields> ReaderCache<T> {
                 self.maybe_drop_instance(t.handle);
             }
         }
+        touched.clear();
+        picked.clear();
+        self.collect_scratch = (touched, picked);
     }
 
     /// An instance with no samples, no writers and not alive is forgotten.

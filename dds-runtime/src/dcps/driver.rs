@@ -14,7 +14,7 @@ use foldhash::{HashMap, HashMapExt};
 
 use crate::config::Config;
 use crate::rtps::{
-    CoreError, EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig, Payload,
+    CoreError, EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig,
     ReceivedSample, Transmit, WriteChange,
 };
 use crate::transport::{Channel, Datagram, UdpTransport};
@@ -111,7 +111,14 @@ pub(crate) struct Driver {
 thread_local! {
     /// Each thread's reusable vector of datagrams to send, for `Driver::with_core`.
     static BATCH: std::cell::RefCell<Vec<Transmit>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// Each thread's reusable vectors of what `Driver::with_core` routed: events to dispatch, and the
+    /// readers given samples.
+    static ROUTED: std::cell::RefCell<Routed> =
+        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
 }
+
+/// Events to dispatch after the core's lock is released, and the readers to process then.
+type Routed = (Vec<Event>, Vec<(EntityId, Arc<dyn Endpoint>)>);
 
 /// See [`Driver::set_discovery_hook`].
 type DiscoveryHook = Box<dyn Fn(&Event) + Send + Sync>;
@@ -272,14 +279,11 @@ impl Driver {
         if self.stopped.load(Ordering::Acquire) {
             return;
         }
-        // One copy per datagram out of the reusable receive buffers; samples share it.
-        let shared: Vec<Payload> = batch
-            .iter()
-            .map(|d| Payload::copy_from_slice(d.data))
-            .collect();
+        // A datagram with DATA is copied once out of the reusable receive buffers, and its samples share
+        // the copy; fragments are copied straight into their reassembly buffers.
         self.with_core(|c, now| {
-            for d in &shared {
-                c.handle_shared_datagram(now, d);
+            for d in batch {
+                c.handle_datagram_sharing(now, d.data);
             }
         });
     }
@@ -308,8 +312,7 @@ impl Driver {
         let now = Instant::now();
         // The batch vector is kept per thread (a nested call, from a listener, gets a fresh one).
         let mut batch: Vec<Transmit> = BATCH.with(|b| std::mem::take(&mut *b.borrow_mut()));
-        let mut deferred: Vec<Event> = Vec::new();
-        let mut touched: Vec<(EntityId, Arc<dyn Endpoint>)> = Vec::new();
+        let (mut deferred, mut touched) = ROUTED.with(|b| std::mem::take(&mut *b.borrow_mut()));
         let (r, next_timeout) = {
             let mut core = lock(&self.core);
             // Sent datagrams go back to the core for reuse (saves allocations per datagram).
@@ -335,7 +338,8 @@ impl Driver {
             }
         }
         BATCH.with(|b| *b.borrow_mut() = batch);
-        self.after_unlock(deferred, touched, next_timeout, progress);
+        self.after_unlock(&mut deferred, &mut touched, next_timeout, progress);
+        ROUTED.with(|b| *b.borrow_mut() = (deferred, touched));
         r
     }
 
@@ -401,8 +405,8 @@ impl Driver {
 
     fn after_unlock(
         &self,
-        deferred: Vec<Event>,
-        touched: Vec<(EntityId, Arc<dyn Endpoint>)>,
+        deferred: &mut Vec<Event>,
+        touched: &mut Vec<(EntityId, Arc<dyn Endpoint>)>,
         next_timeout: Option<Instant>,
         progress: bool,
     ) {
@@ -422,10 +426,10 @@ impl Driver {
                 _ => {}
             }
         }
-        for ev in deferred {
+        for ev in deferred.drain(..) {
             self.dispatch_event(ev);
         }
-        for (_, r) in touched {
+        for (_, r) in touched.drain(..) {
             r.process();
         }
     }

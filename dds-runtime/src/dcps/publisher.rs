@@ -30,6 +30,7 @@ use super::status::{
 use super::sync::{lock, read};
 use super::topic::Topic;
 use super::writer_filter::WriterFilters;
+use crate::rtps::pool::BufferPool;
 
 pub use ops::PublisherListener;
 
@@ -153,6 +154,7 @@ impl Publisher {
             version,
             instances: Mutex::new(WriterInstances::default()),
             filters: Mutex::new(WriterFilters::default()),
+            payloads: Mutex::new(BufferPool::new(WRITER_POOL_BUFFERS, WRITER_POOL_BYTES)),
         });
         let owner = WriterOwner {
             topic: topic.clone(),
@@ -220,6 +222,8 @@ struct WriterInner<T: DdsType> {
     instances: Mutex<WriterInstances>,
     /// Matched readers' content filters, for writer-side filtering.
     filters: Mutex<WriterFilters>,
+    /// Serialized samples' buffers, reused once the history has let go of them.
+    payloads: Mutex<BufferPool>,
 }
 
 /// Writes samples of type `T`. Cheap to clone; the writer is deleted when the last clone is dropped (a
@@ -255,6 +259,12 @@ impl<T: DdsType> std::fmt::Debug for DataWriter<T> {
 
 /// Runs `f` on a cleared per-thread buffer (a fresh one if the thread's is in use), so that serializing a
 /// sample or its key allocates nothing once the buffer has grown.
+/// Buffers a writer's payload pool keeps: enough for the samples a reliable writer has in flight at the
+/// default flow-control window (512 KiB of 128-byte samples) and a history of a few thousand samples.
+const WRITER_POOL_BUFFERS: usize = 4096;
+/// Bytes of capacity a writer's payload pool keeps: the largest flow-control window (4 MiB) four times.
+const WRITER_POOL_BYTES: usize = 16 << 20;
+
 fn with_scratch<R>(f: impl FnOnce(&mut Vec<u8>) -> R) -> R {
     thread_local! {
         static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
@@ -313,13 +323,17 @@ impl<T: DdsType> DataWriter<T> {
         self.inner.version
     }
 
-    /// Serializes into a per-thread scratch buffer and copies the bytes once into the shared payload: one
-    /// allocation per sample instead of a growing `Vec` plus its conversion into an `Arc<[u8]>`.
+    /// Serializes straight into a buffer of the writer's pool, which the payload shares: no copy, and
+    /// no allocation once the pool holds the buffers the history has released.
     fn serialize(&self, sample: &T) -> DdsResult<Payload> {
-        with_scratch(|buf| {
-            cdr::serialize(sample, self.inner.version, ByteOrder::NATIVE, buf)?;
-            Ok(Payload::copy_from_slice(buf))
-        })
+        let mut buf = lock(&self.inner.payloads).take();
+        cdr::serialize(
+            sample,
+            self.inner.version,
+            ByteOrder::NATIVE,
+            Arc::make_mut(&mut buf),
+        )?;
+        Ok(lock(&self.inner.payloads).share(buf))
     }
 
     fn key_hash(&self, sample: &T) -> DdsResult<Option<[u8; 16]>> {

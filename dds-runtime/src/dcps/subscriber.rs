@@ -322,6 +322,14 @@ impl<'a, T: DdsType> Selector<'a, T> {
     pub fn take(self) -> DdsResult<Vec<Sample<T>>> {
         self.reader.collect(self.sel, self.next_after, true, None)
     }
+    /// Takes the selected samples, appending them to `out`; returns how many. A vector the caller keeps
+    /// and clears between calls makes the take allocate nothing once it has grown to the usual batch.
+    pub fn take_into(self, out: &mut Vec<Sample<T>>) -> DdsResult<usize> {
+        self.reader
+            .visit(self.sel, self.next_after, true, |slot, info| {
+                out.push(to_sample(slot, info, true, None))
+            })
+    }
     /// Zero-copy read (a loan in callback form): calls `f` with a reference to each selected sample in the
     /// cache, marks them read and returns how many there were. The cache lock is held during the calls:
     /// keep `f` short and do not call back into this reader from it.
@@ -427,6 +435,26 @@ impl<T: DdsType> DataReader<T> {
     /// Takes all samples out of the cache.
     pub fn take(&self) -> DdsResult<Vec<Sample<T>>> {
         self.select().take()
+    }
+
+    /// Takes all samples out of the cache, appending them to `out` (see [`Selector::take_into`]); returns
+    /// how many.
+    ///
+    /// ```no_run
+    /// # use dds_runtime::prelude::*;
+    /// # fn f<T: DdsType>(reader: &DataReader<T>) -> dds_runtime::dcps::DdsResult<()> {
+    /// let mut batch = Vec::new();
+    /// loop {
+    ///     batch.clear();
+    ///     reader.take_into(&mut batch)?;
+    ///     for s in &batch { /* ... */ }
+    /// #   break;
+    /// }
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn take_into(&self, out: &mut Vec<Sample<T>>) -> DdsResult<usize> {
+        self.select().take_into(out)
     }
 
     /// Reads the oldest not-read sample.

@@ -14,9 +14,25 @@ use crate::xtypes::TypeInformation;
 /// Immutable shared bytes (a sample's serialized form). Cloning is a reference-count increment.
 #[derive(Clone, Default)]
 pub struct Payload {
-    buf: Option<Arc<[u8]>>,
+    buf: Option<Buf>,
     start: usize,
     end: usize,
+}
+
+/// A payload's storage: a buffer of its own, or a reusable one of a pool (`rtps/pool.rs`).
+#[derive(Clone)]
+enum Buf {
+    Slice(Arc<[u8]>),
+    Vec(Arc<Vec<u8>>),
+}
+
+impl Buf {
+    fn bytes(&self) -> &[u8] {
+        match self {
+            Buf::Slice(b) => b,
+            Buf::Vec(v) => v,
+        }
+    }
 }
 
 impl Payload {
@@ -25,7 +41,16 @@ impl Payload {
         let buf: Arc<[u8]> = bytes.into();
         let end = buf.len();
         Payload {
-            buf: Some(buf),
+            buf: Some(Buf::Slice(buf)),
+            start: 0,
+            end,
+        }
+    }
+    /// Shares the bytes of a pooled buffer whole.
+    pub(crate) fn from_shared_vec(v: Arc<Vec<u8>>) -> Self {
+        let end = v.len();
+        Payload {
+            buf: Some(Buf::Vec(v)),
             start: 0,
             end,
         }
@@ -49,7 +74,7 @@ impl Payload {
     /// keeping them does not keep the rest alive.
     pub fn compact(self) -> Payload {
         match &self.buf {
-            Some(b) if b.len() > self.len() => Payload::copy_from_slice(&self),
+            Some(b) if b.bytes().len() > self.len() => Payload::copy_from_slice(&self),
             _ => self,
         }
     }
@@ -69,7 +94,7 @@ impl Deref for Payload {
     type Target = [u8];
     fn deref(&self) -> &[u8] {
         match &self.buf {
-            Some(b) => &b[self.start..self.end],
+            Some(b) => &b.bytes()[self.start..self.end],
             None => &[],
         }
     }
@@ -200,7 +225,8 @@ participant_config! {
     /// Delay before answering a HEARTBEAT with an ACKNACK (default 0).
     heartbeat_response_delay: Duration = copy,
     /// Flow control: `write` refuses (WouldBlock) once this many bytes are unacknowledged (default 512 KiB),
-    /// until they drop below [`whc_low_watermark`](Self::whc_low_watermark).
+    /// until they drop below [`whc_low_watermark`](Self::whc_low_watermark). For large samples the window
+    /// grows to hold four samples of the size last written (at most 4 MiB), released at half of it.
     whc_high_watermark: usize = copy,
     /// Flow control: where a blocked writer is released (default 128 KiB).
     whc_low_watermark: usize = copy,

@@ -10,6 +10,7 @@ mod liveliness;
 pub mod messages;
 mod outbox;
 mod participant;
+pub(crate) mod pool;
 pub(crate) mod reader;
 pub mod types;
 pub(crate) mod writer;

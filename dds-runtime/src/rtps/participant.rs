@@ -55,6 +55,8 @@ pub struct Participant {
     known_topics: HashMap<Guid, super::discovery::TopicData>,
     /// Reused buffer for what readers deliver while a datagram is processed.
     scratch: Vec<Event>,
+    /// Reusable buffers of received samples (see `pool.rs`).
+    rx_pools: crate::rtps::pool::ReceivePools,
     writers: BTreeMap<EntityId, Writer>,
     readers: BTreeMap<EntityId, Reader>,
     /// User endpoints (builtin ones are only in `writers`/`readers`).
@@ -160,6 +162,7 @@ impl Participant {
             deferred: Default::default(),
             known_topics: HashMap::new(),
             scratch: Vec::new(),
+            rx_pools: Default::default(),
             writers: BTreeMap::new(),
             readers: BTreeMap::new(),
             user_writers: BTreeSet::new(),

@@ -40,6 +40,9 @@ pub struct TransportStats {
     pub send_errors: AtomicU64,
 }
 
+/// Most datagrams one read of a socket returns.
+pub(super) const MAX_BATCH: usize = 8;
+
 /// Largest UDP payload we can receive.
 pub(super) const RECV_BUFFER: usize = 65536;
 

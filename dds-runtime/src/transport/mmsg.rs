@@ -4,10 +4,10 @@ use std::io;
 use std::net::{Ipv4Addr, SocketAddr, SocketAddrV4, UdpSocket};
 use std::os::fd::AsRawFd;
 
-use super::datagram::{Datagram, RecvBatch, RECV_BUFFER};
+use super::datagram::{Datagram, RecvBatch, MAX_BATCH, RECV_BUFFER};
 
 /// Datagrams received per `recvmmsg` call.
-const RECV_BATCH: usize = 8;
+const RECV_BATCH: usize = MAX_BATCH;
 
 /// Buffers for one `recvmmsg` call. The pointers inside `hdrs` point into the other vectors' heap storage,
 /// which never reallocates after construction.

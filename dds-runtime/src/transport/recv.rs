@@ -5,7 +5,18 @@ use std::io;
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::datagram::{Channel, Datagram, Receiver, RecvBatch, TransportStats, RECV_BUFFER};
+use super::datagram::{
+    Channel, Datagram, Receiver, RecvBatch, TransportStats, MAX_BATCH, RECV_BUFFER,
+};
+
+/// A placeholder for the unused entries of a batch.
+const NO_DATAGRAM: Datagram<'static> = Datagram {
+    data: &[],
+    from: SocketAddr::V4(std::net::SocketAddrV4::new(
+        std::net::Ipv4Addr::UNSPECIFIED,
+        0,
+    )),
+};
 
 /// How the receive threads read their sockets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -101,20 +112,26 @@ fn recv_loop(
                 if stop.load(Ordering::Relaxed) {
                     break;
                 }
-                let grams: Vec<Datagram<'_>> = (0..n)
-                    .filter_map(|i| batch.datagram(i))
-                    .filter(|d| !d.data.is_empty())
-                    .collect();
+                // On the stack: no allocation per batch.
+                let mut grams = [NO_DATAGRAM; MAX_BATCH];
+                let mut k = 0;
+                for d in (0..n.min(MAX_BATCH)).filter_map(|i| batch.datagram(i)) {
+                    if !d.data.is_empty() {
+                        grams[k] = d;
+                        k += 1;
+                    }
+                }
+                let grams = &grams[..k];
                 if grams.is_empty() {
                     continue;
                 }
                 stats
                     .received
                     .fetch_add(grams.len() as u64, Ordering::Relaxed);
-                for d in &grams {
+                for d in grams {
                     tracing::trace!(channel = ?ch, from = %d.from, len = d.data.len(), "received");
                 }
-                rx(ch, &grams);
+                rx(ch, grams);
             }
             Err(e)
                 if matches!(

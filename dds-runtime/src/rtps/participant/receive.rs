@@ -10,9 +10,34 @@ use tracing::{debug, trace};
 use super::timers::lower_floor;
 use super::Participant;
 use crate::rtps::api::{Event, Payload};
-use crate::rtps::messages::{MessageIter, Submessage};
+use crate::rtps::messages::{id, MessageIter, Submessage};
 use crate::rtps::reader::Reader;
 use crate::rtps::types::*;
+
+/// Whether the message holds a DATA submessage: a walk over the submessage headers only. A malformed
+/// message may give either answer; it is rejected by the parse that follows.
+fn holds_data(msg: &[u8]) -> bool {
+    const HEADER: usize = 20;
+    let mut at = HEADER;
+    while let Some(h) = msg.get(at..at + 4) {
+        if h[0] == id::DATA {
+            return true;
+        }
+        let len = if h[1] & 1 != 0 {
+            u16::from_le_bytes([h[2], h[3]])
+        } else {
+            u16::from_be_bytes([h[2], h[3]])
+        };
+        if len == 0 {
+            // Runs to the end of the message (or is empty, and then only INFO_TS/PAD may follow).
+            if h[0] != id::INFO_TS && h[0] != id::PAD {
+                return false;
+            }
+        }
+        at += 4 + usize::from(len);
+    }
+    false
+}
 
 impl Participant {
     /// Processes one datagram. Never panics; malformed input is dropped with a `tracing` event.
@@ -24,6 +49,26 @@ impl Participant {
     /// samples share its buffer rather than copying their payloads out of it.
     pub fn handle_shared_datagram(&mut self, now: Instant, datagram: &Payload) {
         self.receive(now, datagram, Some(datagram));
+    }
+
+    /// Like [`handle_shared_datagram`](Self::handle_shared_datagram) for a datagram in a buffer the caller
+    /// reuses: when it holds DATA it is copied into a reusable buffer of the participant's pool, which its
+    /// samples share; otherwise it is read where it is, and fragments go straight to their reassembly
+    /// buffers (one copy, not two).
+    pub fn handle_datagram_sharing(&mut self, now: Instant, data: &[u8]) {
+        if holds_data(data) {
+            let copy = self
+                .rx_pools
+                .datagrams
+                .fill(|v| {
+                    v.extend_from_slice(data);
+                    Ok::<_, std::convert::Infallible>(())
+                })
+                .unwrap_or_default();
+            self.receive(now, &copy, Some(&copy));
+        } else {
+            self.receive(now, data, None);
+        }
     }
 
     fn receive(&mut self, now: Instant, data: &[u8], shared: Option<&Payload>) {
@@ -79,12 +124,13 @@ impl Participant {
                 Submessage::DataFrag(d) => {
                     let wguid = Guid::new(src, d.writer_id);
                     let scratch = &mut self.scratch;
+                    let pool = &mut self.rx_pools.samples;
                     for_readers(
                         &mut self.readers,
                         &mut self.readers_by_writer,
                         d.reader_id,
                         wguid,
-                        |r| r.on_data_frag(wguid, &d, ts, scratch),
+                        |r| r.on_data_frag(wguid, &d, ts, pool, scratch),
                     );
                     self.writer_asserted(now, wguid);
                 }
@@ -218,5 +264,39 @@ fn for_readers(
                 f(r);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A message: the 20-byte header, then (id, little-endian length, body length) submessages.
+    fn msg(subs: &[(u8, u16, usize)]) -> Vec<u8> {
+        let mut m = vec![0u8; 20];
+        for &(id, len, body) in subs {
+            m.extend_from_slice(&[id, 1]);
+            m.extend_from_slice(&len.to_le_bytes());
+            m.resize(m.len() + body, 0);
+        }
+        m
+    }
+
+    #[test]
+    fn holds_data_scans_submessage_headers_only() {
+        assert!(holds_data(&msg(&[(id::INFO_TS, 8, 8), (id::DATA, 4, 4)])));
+        assert!(holds_data(&msg(&[(id::INFO_TS, 0, 0), (id::DATA, 0, 12)])));
+        assert!(!holds_data(&msg(&[
+            (id::INFO_TS, 8, 8),
+            (id::DATA_FRAG, 4, 4)
+        ])));
+        // A submessage of length 0 other than INFO_TS/PAD runs to the end: nothing follows it.
+        assert!(!holds_data(&msg(&[
+            (id::HEARTBEAT_FRAG, 0, 0),
+            (id::DATA, 4, 4)
+        ])));
+        assert!(!holds_data(&[0u8; 10]));
+        // A length past the end stops the scan.
+        assert!(!holds_data(&msg(&[(id::DATA_FRAG, 900, 4)])));
     }
 }

@@ -17,6 +17,7 @@ use crate::rtps::messages::{
     AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, NackFrag, Submessage,
 };
 use crate::rtps::outbox::{Outbox, Ts};
+use crate::rtps::pool::BufferPool;
 use crate::rtps::types::*;
 use coherent::{Assembler, SetLimits, SetMark};
 use defrag::Defrag;
@@ -302,11 +303,12 @@ impl Reader {
         writer: Guid,
         d: &DataFrag<'_>,
         ts: Option<Time>,
+        pool: &mut BufferPool,
         out: &mut Vec<Event>,
     ) {
         let mut proxies = std::mem::take(&mut self.proxies);
         if let Some(p) = proxies.get_mut(&writer) {
-            self.data_frag(p, d, ts, out);
+            self.data_frag(p, d, ts, pool, out);
         }
         self.proxies = proxies;
     }
@@ -316,6 +318,7 @@ impl Reader {
         p: &mut WriterProxy,
         d: &DataFrag<'_>,
         ts: Option<Time>,
+        pool: &mut BufferPool,
         out: &mut Vec<Event>,
     ) {
         let sn = d.writer_sn;
@@ -351,7 +354,12 @@ impl Reader {
                     p.defrag_bytes -= old.bytes;
                 }
             }
-            let mut df = Defrag::new(d.sample_size, d.fragment_size);
+            let cost = defrag::cost(d.sample_size, d.fragment_size);
+            if p.defrag_bytes + cost > self.params.defrag_max_bytes {
+                return;
+            }
+            let mut df = Defrag::new(d.sample_size, d.fragment_size, pool.take());
+            p.defrag_bytes += df.bytes;
             df.status_info = d.inline_qos.and_then(|q| q.status_info());
             df.key_hash = d.inline_qos.and_then(|q| q.key_hash());
             df.key_flag = d.key_flag;
@@ -369,12 +377,7 @@ impl Reader {
         }
         let fs = d.fragment_size as usize;
         for (i, chunk) in d.payload.chunks(fs).enumerate() {
-            if p.defrag_bytes + chunk.len() + defrag::FRAGMENT_OVERHEAD
-                > self.params.defrag_max_bytes
-            {
-                break;
-            }
-            p.defrag_bytes += df.add(d.fragment_starting_num.saturating_add(i as u32), chunk);
+            df.add(d.fragment_starting_num.saturating_add(i as u32), chunk);
         }
         if df.is_complete() {
             let Some(df) = p.defrag.remove(&sn) else {
@@ -387,7 +390,9 @@ impl Reader {
             let key_hash = df.key_hash;
             let source_timestamp = df.source_timestamp;
             let coherent = df.coherent_set.map(|set| SetMark { set, end: false });
-            let payload = df.assemble();
+            let Some(payload) = df.assemble(pool) else {
+                return;
+            };
             let slot = Slot::Change(PendingChange {
                 kind,
                 payload,

@@ -1,6 +1,6 @@
 //! The writer history cache: changes by sequence number, with KEEP_LAST per instance and resource limits.
 
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::VecDeque;
 use std::time::Instant;
 
 use foldhash::{HashMap, HashMapExt};
@@ -8,6 +8,11 @@ use foldhash::{HashMap, HashMapExt};
 use crate::qos::{History, ResourceLimits};
 use crate::rtps::api::{ChangeKind, Payload};
 use crate::rtps::types::*;
+
+use super::sn_map::SnMap;
+
+/// Largest instance queue (in sequence numbers) kept for reuse when its instance empties.
+const SPARE_QUEUE_MAX: usize = 1 << 16;
 
 /// One change in the history.
 #[derive(Debug, Clone)]
@@ -36,7 +41,7 @@ pub(crate) enum HistoryFull {
 
 #[derive(Debug)]
 pub(crate) struct HistoryCache {
-    changes: BTreeMap<SequenceNumber, CacheChange>,
+    changes: SnMap<CacheChange>,
     instances: HashMap<[u8; 16], VecDeque<SequenceNumber>>,
     history: History,
     limits: ResourceLimits,
@@ -49,7 +54,7 @@ pub(crate) struct HistoryCache {
 impl HistoryCache {
     pub(crate) fn new(history: History, limits: ResourceLimits) -> Self {
         HistoryCache {
-            changes: BTreeMap::new(),
+            changes: SnMap::new(),
             instances: HashMap::new(),
             history,
             limits,
@@ -62,20 +67,20 @@ impl HistoryCache {
         self.changes.len()
     }
     pub(crate) fn is_empty(&self) -> bool {
-        self.changes.is_empty()
+        self.changes.len() == 0
     }
     #[cfg(test)]
     pub(crate) fn bytes(&self) -> usize {
         self.bytes
     }
     pub(crate) fn get(&self, sn: SequenceNumber) -> Option<&CacheChange> {
-        self.changes.get(&sn)
+        self.changes.get(sn)
     }
     pub(crate) fn first_sn(&self) -> Option<SequenceNumber> {
-        self.changes.keys().next().copied()
+        self.changes.first().map(|(sn, _)| sn)
     }
     pub(crate) fn range(&self, from: SequenceNumber) -> impl Iterator<Item = &CacheChange> {
-        self.changes.range(from..).map(|(_, c)| c)
+        self.changes.range_from(from)
     }
 
     /// Whether adding a change for `key` needs room that only acknowledged changes below `acked` could give.
@@ -134,7 +139,7 @@ impl HistoryCache {
     }
 
     pub(crate) fn remove(&mut self, sn: SequenceNumber) -> Option<CacheChange> {
-        let c = self.changes.remove(&sn)?;
+        let c = self.changes.remove(sn)?;
         self.bytes -= c.payload.len();
         let key = c.key_hash.unwrap_or_default();
         if let Some(q) = self.instances.get_mut(&key) {
@@ -143,7 +148,9 @@ impl HistoryCache {
             }
             if q.is_empty() {
                 if let Some(q) = self.instances.remove(&key) {
-                    if q.capacity() <= 64 {
+                    // Kept unless huge: the queue of an unkeyed writer that drains now and then has
+                    // grown to the samples in flight, and regrowing it would cost a dozen allocations.
+                    if q.capacity() <= SPARE_QUEUE_MAX {
                         self.spare_queue = Some(q);
                     }
                 }
@@ -156,7 +163,7 @@ impl HistoryCache {
     /// were written (one lifespan per writer), so only the expired front of the history is visited.
     pub(crate) fn expire(&mut self, now: Instant) -> usize {
         let mut n = 0;
-        while let Some((&sn, c)) = self.changes.first_key_value() {
+        while let Some((sn, c)) = self.changes.first() {
             if c.expires.is_none_or(|e| e > now) {
                 break;
             }
@@ -180,23 +187,21 @@ impl HistoryCache {
     /// Called after every acknowledgement: walks only the smaller side of `sn` (the total is kept), so a
     /// volatile writer, whose history starts at the acknowledged floor, pays nothing.
     pub(crate) fn bytes_from(&self, sn: SequenceNumber) -> usize {
-        let (Some((first, _)), Some((last, _))) = (
-            self.changes.first_key_value(),
-            self.changes.last_key_value(),
-        ) else {
+        let (Some((first, _)), Some((last, _))) = (self.changes.first(), self.changes.last())
+        else {
             return 0;
         };
-        if sn <= *first {
+        if sn <= first {
             return self.bytes;
         }
-        if sn > *last {
+        if sn > last {
             return 0;
         }
         if sn.0 - first.0 <= last.0 - sn.0 {
-            let below: usize = self.changes.range(..sn).map(|(_, c)| c.payload.len()).sum();
+            let below: usize = self.changes.range_below(sn).map(|c| c.payload.len()).sum();
             self.bytes - below
         } else {
-            self.changes.range(sn..).map(|(_, c)| c.payload.len()).sum()
+            self.changes.range_from(sn).map(|c| c.payload.len()).sum()
         }
     }
 
@@ -208,7 +213,7 @@ impl HistoryCache {
             .values()
             .filter_map(|q| {
                 let last = *q.back()?;
-                let c = self.changes.get(&last)?;
+                let c = self.changes.get(last)?;
                 (matches!(
                     c.kind,
                     ChangeKind::Unregister | ChangeKind::DisposeUnregister
@@ -282,8 +287,8 @@ mod tests {
         for sn in 0..45 {
             let walk: usize = h
                 .changes
-                .range(SequenceNumber(sn)..)
-                .map(|(_, c)| c.payload.len())
+                .range_from(SequenceNumber(sn))
+                .map(|c| c.payload.len())
                 .sum();
             assert_eq!(h.bytes_from(SequenceNumber(sn)), walk, "from {sn}");
         }

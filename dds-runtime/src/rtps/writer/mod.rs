@@ -2,10 +2,12 @@
 
 mod coherent;
 mod content_filter;
+mod flow;
 mod history;
 mod liveliness;
 mod local;
 mod reader_proxy;
+mod sn_map;
 
 pub(crate) use coherent::CoherentMark;
 use coherent::CoherentState;
@@ -75,6 +77,8 @@ pub(crate) struct Writer {
     bytes_since_hb: usize,
     unacked_bytes: usize,
     blocked: bool,
+    /// Flow control's watermarks, scaled to the sample size (see `flow.rs`).
+    window: flow::Window,
     /// Set when deleted: lingers until acknowledged or this deadline.
     pub linger_until: Option<Instant>,
     /// The open coherent set, if any (see `coherent.rs`).
@@ -103,6 +107,7 @@ impl Writer {
             bytes_since_hb: 0,
             unacked_bytes: 0,
             blocked: false,
+            window: flow::Window::new(params.high_watermark, params.low_watermark),
             linger_until: None,
             coherent: CoherentState::Off,
             filters: ReaderFilters::default(),
@@ -146,17 +151,21 @@ impl Writer {
         self.params.reliable && self.proxies.values().any(|p| p.reliable)
     }
 
+    /// The destinations of new data. Readers of our own participant come last: a datagram to ourselves
+    /// costs the sending thread a pass through the receive path (loopback delivers in the sender's
+    /// context), which would otherwise delay the remote readers' copy, e.g. the pong in a ping/pong.
     fn rebuild_dest(&mut self) {
+        let own = self.guid.prefix;
         let dest = |key_hash_only: Option<bool>| {
-            let mut d: Vec<Locator> = self
+            let mut d: Vec<(bool, Locator)> = self
                 .proxies
-                .values()
-                .filter(|p| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
-                .filter_map(|p| p.destination().first().copied())
+                .iter()
+                .filter(|(_, p)| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
+                .filter_map(|(g, p)| Some((g.prefix == own, *p.destination().first()?)))
                 .collect();
             d.sort();
             d.dedup();
-            d
+            d.into_iter().map(|(_, l)| l).collect::<Vec<Locator>>()
         };
         self.data_dest = dest(None);
         self.key_hash_dest = dest(Some(true));
@@ -198,7 +207,7 @@ impl Writer {
         } else {
             0
         };
-        if self.blocked && self.unacked_bytes <= self.params.low_watermark {
+        if self.blocked && self.unacked_bytes <= self.window.low() {
             self.blocked = false;
             ev.push_back(Event::WriterUnblocked {
                 writer: self.guid.entity_id,
@@ -235,6 +244,7 @@ impl Writer {
             return Err(WriteError::MissingKeyHash);
         }
         let len = change.payload.len();
+        self.window.note(len);
         if self.has_reliable_proxy() {
             if self.blocked {
                 self.update_acked(ev);
@@ -243,7 +253,7 @@ impl Writer {
                     return Err(WriteError::WouldBlock);
                 }
             }
-            if self.unacked_bytes > 0 && self.unacked_bytes + len > self.params.high_watermark {
+            if self.unacked_bytes > 0 && self.unacked_bytes + len > self.window.high() {
                 self.blocked = true;
                 self.solicit_acks(now);
                 return Err(WriteError::WouldBlock);
@@ -289,7 +299,7 @@ impl Writer {
                 // limit), so that flow control keeps moving without waiting for the periodic heartbeat (and
                 // without an ACKNACK per datagram); otherwise the piggy-backed heartbeat only announces.
                 let final_flag =
-                    self.bytes_since_nonfinal_hb < self.params.high_watermark / 4
+                    self.bytes_since_nonfinal_hb < self.window.high() / 4
                         && self.params.limits.max_samples.is_none_or(|m| {
                             self.changes_since_nonfinal_hb < (m as usize / 4).max(1)
                         });
@@ -346,7 +356,7 @@ impl Writer {
     /// are past half the high watermark, or the history is past half its sample limit.
     fn under_pressure(&self) -> bool {
         self.blocked
-            || self.unacked_bytes >= self.params.high_watermark / 2
+            || self.unacked_bytes >= self.window.high() / 2
             || self
                 .params
                 .limits

@@ -1,0 +1,147 @@
+//! Reusable payload buffers: a pool of `Arc<Vec<u8>>` that hands a buffer out again once every
+//! [`Payload`](super::Payload) made from it is gone, so that a steady stream of samples of similar sizes
+//! allocates nothing per sample.
+//!
+//! The pool keeps a clone of each buffer it handed out. A buffer is free again when that clone is the only
+//! reference left ([`Arc::get_mut`] succeeds). Buffers are reused oldest first, which is the order in which a
+//! writer's history and a reader's deliveries release them; while the oldest is still held, a new buffer
+//! is made. The pool is bounded in buffers and in bytes of capacity: when full, it forgets its oldest
+//! buffers (their holders still free them), so one held for long (a sample kept in a reader cache, say)
+//! cannot stop reuse for good.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+use super::api::Payload;
+
+/// A bounded pool of reusable payload buffers.
+#[derive(Debug)]
+pub(crate) struct BufferPool {
+    bufs: VecDeque<Arc<Vec<u8>>>,
+    /// Capacity of the buffers held.
+    bytes: usize,
+    max_buffers: usize,
+    max_bytes: usize,
+    /// Length of the last buffer shared: the capacity a new buffer starts with.
+    last_len: usize,
+}
+
+impl BufferPool {
+    /// A pool keeping at most `max_buffers` buffers of at most `max_bytes` capacity in all.
+    pub(crate) const fn new(max_buffers: usize, max_bytes: usize) -> Self {
+        BufferPool {
+            bufs: VecDeque::new(),
+            bytes: 0,
+            max_buffers,
+            max_bytes,
+            last_len: 0,
+        }
+    }
+
+    /// An empty buffer referenced by nobody else: a free one from the pool, else a new one (with the
+    /// capacity of the last buffer shared, so that filling it does not regrow it step by step).
+    pub(crate) fn take(&mut self) -> Arc<Vec<u8>> {
+        if let Some(front) = self.bufs.front_mut() {
+            if let Some(v) = Arc::get_mut(front) {
+                v.clear();
+                self.bytes -= v.capacity();
+                return self.bufs.pop_front().unwrap_or_default();
+            }
+        }
+        Arc::new(Vec::with_capacity(self.last_len))
+    }
+
+    /// A payload of the bytes `fill` appends to a pooled buffer; the pool keeps the buffer for reuse.
+    pub(crate) fn fill<E>(
+        &mut self,
+        fill: impl FnOnce(&mut Vec<u8>) -> Result<(), E>,
+    ) -> Result<Payload, E> {
+        let mut b = self.take();
+        // `take` returns a buffer nobody else references: `make_mut` does not copy.
+        fill(Arc::make_mut(&mut b))?;
+        Ok(self.share(b))
+    }
+
+    /// A payload of `b` (filled by the caller); the pool keeps `b` for reuse once the payload is gone.
+    pub(crate) fn share(&mut self, b: Arc<Vec<u8>>) -> Payload {
+        let p = Payload::from_shared_vec(b.clone());
+        let cap = b.capacity();
+        self.last_len = b.len();
+        if self.max_buffers == 0 || cap > self.max_bytes {
+            return p;
+        }
+        while self.bufs.len() >= self.max_buffers || self.bytes + cap > self.max_bytes {
+            let Some(old) = self.bufs.pop_front() else {
+                break;
+            };
+            self.bytes -= old.capacity();
+        }
+        self.bytes += cap;
+        self.bufs.push_back(b);
+        p
+    }
+}
+
+/// The receive path's pools: copies of datagrams whose DATA samples share them, and reassembly buffers.
+#[derive(Debug)]
+pub(crate) struct ReceivePools {
+    pub datagrams: BufferPool,
+    pub samples: BufferPool,
+}
+
+impl Default for ReceivePools {
+    fn default() -> Self {
+        ReceivePools {
+            datagrams: BufferPool::new(256, 8 << 20),
+            samples: BufferPool::new(32, 16 << 20),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_buffer_is_reused_once_its_payloads_are_gone() {
+        let mut pool = BufferPool::new(4, 1 << 20);
+        let p = pool
+            .fill(|v| {
+                v.extend_from_slice(&[1, 2, 3]);
+                Ok::<_, ()>(())
+            })
+            .unwrap();
+        assert_eq!(&p[..], &[1, 2, 3]);
+        let held = p.as_ptr();
+        // Still referenced: a new buffer.
+        let q = pool.fill(|v| v.try_reserve(3)).unwrap();
+        assert!(q.is_empty());
+        drop(p);
+        let r = pool.fill(|v| {
+            v.push(9);
+            Ok::<_, ()>(())
+        });
+        let r = r.unwrap();
+        assert_eq!(r.as_ptr(), held, "the first buffer came back");
+        assert_eq!(&r[..], &[9]);
+    }
+
+    #[test]
+    fn bounded_in_buffers_and_bytes() {
+        let mut pool = BufferPool::new(2, 100);
+        let kept: Vec<Payload> = (0..4)
+            .map(|_| pool.share(Arc::new(Vec::with_capacity(40))))
+            .collect();
+        assert_eq!(
+            (pool.bufs.len(), pool.bytes),
+            (2, 80),
+            "the oldest forgotten"
+        );
+        let big = pool.share(Arc::new(Vec::with_capacity(1000)));
+        assert_eq!(pool.bufs.len(), 2, "larger than the pool: not kept");
+        let mid = pool.share(Arc::new(Vec::with_capacity(70)));
+        assert_eq!((pool.bufs.len(), pool.bytes), (1, 70), "room made by bytes");
+        drop((kept, big, mid));
+        assert_eq!(pool.take().capacity(), 70);
+    }
+}
