@@ -156,7 +156,7 @@ impl Publisher {
             .create(sink, owner, |c, now| c.create_writer(now, spec))?;
         ops::register_writer(self, &inner, topic.name());
         let id = handle.id();
-        self.group.add_writer(&driver, id);
+        self.group.add_writer(&driver, id, &self.qos.presentation);
         tracing::info!(
             topic = topic.name(),
             type_name = T::TYPE_NAME,

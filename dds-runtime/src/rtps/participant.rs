@@ -6,6 +6,7 @@ mod coherent;
 mod control;
 mod discovery;
 mod filtering;
+mod group;
 mod historical;
 mod liveliness;
 mod receive;
@@ -67,6 +68,8 @@ pub struct Participant {
     last_full_scan: Instant,
     /// What the application ignores (`ignore_participant`, `ignore_endpoint`, `ignore_topic`).
     ignored: control::Ignored,
+    /// Group coherent sets waiting for the parts of all their writers.
+    group_sets: group::GroupSets,
 }
 
 fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
@@ -155,6 +158,7 @@ impl Participant {
             timer_floor: Cell::new(None),
             last_full_scan: now,
             ignored: control::Ignored::new(),
+            group_sets: group::GroupSets::default(),
             config,
         };
         let prefix = p.config.guid_prefix;
@@ -240,6 +244,7 @@ impl Participant {
                     continue;
                 }
             }
+            self.note_polled(&e);
             return Some(e);
         }
     }
