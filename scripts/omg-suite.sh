@@ -88,7 +88,7 @@ case $cmd in
       for q in $p; do
         case $q in
           cyclone) build_cyclone ;; fastdds) build_fastdds ;; dust) build_dust ;;
-          ours) cargo build --release -p examples --bin shape_main ;;
+          ours) cargo build --release -p dds-examples --bin shape_main ;;
           *) usage ;;
         esac
       done

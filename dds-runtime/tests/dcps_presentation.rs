@@ -231,3 +231,78 @@ fn access_scope_nests() {
     assert!(!sub.in_access());
     assert!(sub.end_access().is_err());
 }
+
+/// GROUP scope: a coherent set spans the publisher's two writers (two topics) and reaches the two readers
+/// of the subscriber only once both parts arrived; a set cut short by deleting one of its writers is never
+/// seen, not even the other writer's whole part; the next set (one writer only) arrives.
+#[test]
+fn group_set_spans_writers_and_a_cut_set_is_never_seen() {
+    let g = presentation(PresentationAccessScope::Group, true, false);
+    let (p1, p2) = (participant(138), participant(138));
+    let (wq, rq) = reliable_keep_all();
+    let publ = p1
+        .create_publisher(&PublisherQos::builder().presentation(g).build())
+        .unwrap();
+    let sub = p2
+        .create_subscriber(&SubscriberQos::builder().presentation(g).build())
+        .unwrap();
+    let mut ws = Vec::new();
+    let mut rs = Vec::new();
+    for name in ["Square", "Circle"] {
+        let t1 = p1
+            .create_topic::<ShapeType>(name, &TopicQos::default())
+            .unwrap();
+        let t2 = p2
+            .create_topic::<ShapeType>(name, &TopicQos::default())
+            .unwrap();
+        ws.push(publ.create_datawriter(&t1, &wq).unwrap());
+        rs.push(sub.create_datareader(&t2, &rq).unwrap());
+    }
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        ws.iter()
+            .all(|w| w.publication_matched_status().current_count == 1)
+            && rs
+                .iter()
+                .all(|r| r.subscription_matched_status().current_count == 1)
+    }));
+    // Set 1: both writers.
+    publ.begin_coherent_changes().unwrap();
+    ws[0].write(&shape("RED", 1)).unwrap();
+    ws[1].write(&shape("RED", 1)).unwrap();
+    for w in &ws {
+        w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    }
+    std::thread::sleep(Duration::from_millis(50));
+    assert_eq!(rs[0].sample_count() + rs[1].sample_count(), 0, "set open");
+    publ.end_coherent_changes().unwrap();
+    assert!(wait_until(Duration::from_secs(5), || rs
+        .iter()
+        .all(|r| r.sample_count() == 1)));
+    // Set 2: cut short by deleting the Circle writer before the set ends.
+    publ.begin_coherent_changes().unwrap();
+    ws[0].write(&shape("RED", 2)).unwrap();
+    ws[1].write(&shape("RED", 2)).unwrap();
+    for w in &ws {
+        w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    }
+    drop(ws.pop());
+    assert!(wait_until(Duration::from_secs(5), || rs[1]
+        .subscription_matched_status()
+        .current_count
+        == 0));
+    publ.end_coherent_changes().unwrap();
+    // Set 3: the Square writer alone.
+    publ.begin_coherent_changes().unwrap();
+    ws[0].write(&shape("RED", 3)).unwrap();
+    publ.end_coherent_changes().unwrap();
+    assert!(wait_until(Duration::from_secs(5), || rs[0].sample_count() == 2));
+    std::thread::sleep(Duration::from_millis(100));
+    let xs: Vec<i32> = rs[0]
+        .take()
+        .unwrap()
+        .iter()
+        .filter_map(|s| s.data.as_ref().map(|d| d.x))
+        .collect();
+    assert_eq!(xs, vec![1, 3], "the cut set is never seen");
+    drop((p1, p2));
+}

@@ -218,7 +218,11 @@ fn presentation_cyclone_writer_to_ours_group_scope() -> Result<(), Skip> {
     )?;
     let mut p = cyclone_presentation_writer(189, "Group", true)?;
     let got = s.wait_lines(WAIT, 10, is_sample);
-    check!(got.is_some(), &[&p, &s], "our GROUP reader read Cyclone's samples");
+    check!(
+        got.is_some(),
+        &[&p, &s],
+        "our GROUP reader read Cyclone's samples"
+    );
     let sizes: Vec<u32> = s.grep(is_sample).iter().filter_map(|l| size(l)).collect();
     check!(
         sizes.windows(2).all(|w| w[1] == w[0] + 1),
@@ -293,7 +297,11 @@ fn group_coherent_sets_ours_to_cyclone_reader_on_the_wire() -> Result<(), Skip> 
     std::thread::sleep(Duration::from_millis(300));
     let _ = s.interrupt(Duration::from_secs(5));
     let _ = t.interrupt(Duration::from_secs(10));
-    check!(got.is_some(), &[&p, &s], "Cyclone read 30 samples of Square1");
+    check!(
+        got.is_some(),
+        &[&p, &s],
+        "Cyclone read 30 samples of Square1"
+    );
     for topic in ["Square", "Square1"] {
         let sizes: Vec<u32> = s
             .grep(|l| l.split(' ').next() == Some(topic))
@@ -307,7 +315,12 @@ fn group_coherent_sets_ours_to_cyclone_reader_on_the_wire() -> Result<(), Skip> 
         );
     }
     let out = Command::new("tshark")
-        .args(["-r", &cap_s, "-Y", "rtps.vendorId == 0x01dd && rtps.sm.id == 0x15"])
+        .args([
+            "-r",
+            &cap_s,
+            "-Y",
+            "rtps.vendorId == 0x01dd && rtps.sm.id == 0x15",
+        ])
         .args(["-T", "fields", "-e", "rtps.param.id"])
         .output()
         .expect("tshark -r");
@@ -318,7 +331,12 @@ fn group_coherent_sets_ours_to_cyclone_reader_on_the_wire() -> Result<(), Skip> 
         ("0x0063", "PID_GROUP_COHERENT_SET"),
         ("0x0065", "PID_WRITER_GROUP_INFO"),
     ] {
-        check!(ids.contains(id), &[&t], "{name} ({id}) on our DATA: {}", &ids[..ids.len().min(2000)]);
+        check!(
+            ids.contains(id),
+            &[&t],
+            "{name} ({id}) on our DATA: {}",
+            &ids[..ids.len().min(2000)]
+        );
     }
     let _ = std::fs::remove_file(&cap);
     Ok(())

@@ -8,7 +8,8 @@
 //! readers match (their parts can never come; at most [`MAX_UNMATCHED`] such writers are tried).
 //!
 //! A set is discarded (its held parts counted lost) when a part of it is known lost (the reader saw a hole
-//! in it), when a writer that may belong to it goes away, when its participant goes away, when more than
+//! in it), when a writer that may belong to it goes away (before or after its other parts arrive: the
+//! last writers gone are remembered), when its participant goes away, when more than
 //! [`MAX_PENDING`] sets of one participant wait (the oldest first), and, for best-effort readers (which
 //! get no repairs), when a later set of the same participant completes. A complete set waits for the
 //! earlier sets of its participant to be delivered or discarded.
@@ -43,6 +44,8 @@ struct Publisher {
     done: VecDeque<SequenceNumber>,
     /// The first change of the latest set released or discarded: a part of an earlier set comes too late.
     released: Option<SequenceNumber>,
+    /// Writers of this participant that went away lately: a set naming one of them never completes.
+    gone: VecDeque<EntityId>,
 }
 
 impl Publisher {
@@ -109,6 +112,10 @@ impl GroupSets {
             s.writers.insert(part.writer.entity_id);
             s.parts.push(part.ev);
             s.complete = complete(&s.writers, part.id.writers, unmatched);
+            if !s.complete && !p.gone.is_empty() {
+                let either: Vec<EntityId> = unmatched.iter().chain(&p.gone).copied().collect();
+                s.dead = complete(&s.writers, part.id.writers, &either);
+            }
         }
         if part.best_effort && s.complete {
             p.pending.range_mut(..set).for_each(|(_, s)| s.dead = true);
@@ -123,9 +130,11 @@ impl GroupSets {
 
     /// A writer went away (or no longer matches): the sets it may belong to can never complete.
     fn writer_gone(&mut self, writer: Guid, unmatched: &[EntityId], out: &mut VecDeque<Event>) {
-        let Some(p) = self.by_prefix.get_mut(&writer.prefix) else {
-            return;
-        };
+        let p = self.by_prefix.entry(writer.prefix).or_default();
+        if p.gone.len() >= MAX_DONE {
+            p.gone.pop_front();
+        }
+        p.gone.push_back(writer.entity_id);
         for s in p.pending.values_mut() {
             if s.complete || s.writers.contains(&writer.entity_id) {
                 continue;
