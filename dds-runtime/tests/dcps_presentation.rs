@@ -306,3 +306,81 @@ fn group_set_spans_writers_and_a_cut_set_is_never_seen() {
     assert_eq!(xs, vec![1, 3], "the cut set is never seen");
     drop((p1, p2));
 }
+
+/// Counts what both readers hold at each `on_data_on_readers`.
+struct SeesBoth {
+    readers: Vec<DataReader<ShapeType>>,
+    calls: Arc<Mutex<Vec<(usize, usize)>>>,
+}
+
+impl SubscriberListener for SeesBoth {
+    fn on_data_on_readers(&self, _s: &Subscriber) {
+        let c = (
+            self.readers[0].sample_count(),
+            self.readers[1].sample_count(),
+        );
+        self.calls.lock().unwrap().push(c);
+    }
+}
+
+/// GROUP scope: `on_data_on_readers` fires once per group set, when both readers hold their part.
+#[test]
+fn data_on_readers_fires_once_per_group_set_with_all_of_it() {
+    let g = presentation(PresentationAccessScope::Group, true, false);
+    let (p1, p2) = (participant(139), participant(139));
+    let (wq, rq) = reliable_keep_all();
+    let publ = p1
+        .create_publisher(&PublisherQos::builder().presentation(g).build())
+        .unwrap();
+    let sub = p2
+        .create_subscriber(&SubscriberQos::builder().presentation(g).build())
+        .unwrap();
+    let mut ws = Vec::new();
+    let mut rs = Vec::new();
+    for name in ["Square", "Circle"] {
+        let t1 = p1
+            .create_topic::<ShapeType>(name, &TopicQos::default())
+            .unwrap();
+        let t2 = p2
+            .create_topic::<ShapeType>(name, &TopicQos::default())
+            .unwrap();
+        ws.push(publ.create_datawriter(&t1, &wq).unwrap());
+        rs.push(sub.create_datareader(&t2, &rq).unwrap());
+    }
+    let calls = Arc::new(Mutex::new(Vec::new()));
+    sub.set_listener(
+        Box::new(SeesBoth {
+            readers: rs.clone(),
+            calls: calls.clone(),
+        }),
+        StatusMask::DATA_ON_READERS,
+    )
+    .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        ws.iter()
+            .all(|w| w.publication_matched_status().current_count == 1)
+            && rs
+                .iter()
+                .all(|r| r.subscription_matched_status().current_count == 1)
+    }));
+    for set in 1..=3 {
+        publ.begin_coherent_changes().unwrap();
+        for i in 0..2 {
+            ws[0].write(&shape("RED", set * 10 + i)).unwrap();
+            ws[1].write(&shape("RED", set * 10 + i)).unwrap();
+        }
+        publ.end_coherent_changes().unwrap();
+        let n = 2 * set as usize;
+        assert!(wait_until(Duration::from_secs(5), || rs
+            .iter()
+            .all(|r| r.sample_count() == n)));
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let calls = calls.lock().unwrap().clone();
+    assert_eq!(
+        calls,
+        vec![(2, 2), (4, 4), (6, 6)],
+        "once per set, all of it"
+    );
+    drop((p1, p2));
+}

@@ -306,6 +306,9 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         if let Some(parent) = self.parent.get() {
             parent.raise_up(StatusMask::DATA_ON_READERS | StatusMask::DATA_AVAILABLE);
             if let Some(l) = parent.find(StatusMask::DATA_ON_READERS) {
+                if super::presentation::defer_data_on_readers(parent) {
+                    return;
+                }
                 parent.clear_up(StatusMask::DATA_ON_READERS);
                 l.on_data_on_readers(parent.handle);
                 return;
