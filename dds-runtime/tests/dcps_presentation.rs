@@ -232,13 +232,20 @@ fn access_scope_nests() {
     assert!(sub.end_access().is_err());
 }
 
-/// GROUP scope: a coherent set spans the publisher's two writers (two topics) and reaches the two readers
-/// of the subscriber only once both parts arrived; a set cut short by deleting one of its writers is never
-/// seen, not even the other writer's whole part; the next set (one writer only) arrives.
-#[test]
-fn group_set_spans_writers_and_a_cut_set_is_never_seen() {
+/// Two writers (topics Square and Circle) under one GROUP-scope coherent publisher and two readers under
+/// one GROUP-scope coherent subscriber, matched.
+#[allow(clippy::type_complexity)]
+fn group_pair(
+    domain: u32,
+) -> (
+    (DomainParticipant, DomainParticipant),
+    Publisher,
+    Subscriber,
+    Vec<DataWriter<ShapeType>>,
+    Vec<DataReader<ShapeType>>,
+) {
     let g = presentation(PresentationAccessScope::Group, true, false);
-    let (p1, p2) = (participant(138), participant(138));
+    let (p1, p2) = (participant(domain), participant(domain));
     let (wq, rq) = reliable_keep_all();
     let publ = p1
         .create_publisher(&PublisherQos::builder().presentation(g).build())
@@ -265,6 +272,15 @@ fn group_set_spans_writers_and_a_cut_set_is_never_seen() {
                 .iter()
                 .all(|r| r.subscription_matched_status().current_count == 1)
     }));
+    ((p1, p2), publ, sub, ws, rs)
+}
+
+/// GROUP scope: a coherent set spans the publisher's two writers (two topics) and reaches the two readers
+/// of the subscriber only once both parts arrived; a set cut short by deleting one of its writers is never
+/// seen, not even the other writer's whole part; the next set (one writer only) arrives.
+#[test]
+fn group_set_spans_writers_and_a_cut_set_is_never_seen() {
+    let (_ps, publ, _sub, mut ws, rs) = group_pair(138);
     // Set 1: both writers.
     publ.begin_coherent_changes().unwrap();
     ws[0].write(&shape("RED", 1)).unwrap();
@@ -304,7 +320,6 @@ fn group_set_spans_writers_and_a_cut_set_is_never_seen() {
         .filter_map(|s| s.data.as_ref().map(|d| d.x))
         .collect();
     assert_eq!(xs, vec![1, 3], "the cut set is never seen");
-    drop((p1, p2));
 }
 
 /// Counts what both readers hold at each `on_data_on_readers`.
@@ -326,27 +341,7 @@ impl SubscriberListener for SeesBoth {
 /// GROUP scope: `on_data_on_readers` fires once per group set, when both readers hold their part.
 #[test]
 fn data_on_readers_fires_once_per_group_set_with_all_of_it() {
-    let g = presentation(PresentationAccessScope::Group, true, false);
-    let (p1, p2) = (participant(139), participant(139));
-    let (wq, rq) = reliable_keep_all();
-    let publ = p1
-        .create_publisher(&PublisherQos::builder().presentation(g).build())
-        .unwrap();
-    let sub = p2
-        .create_subscriber(&SubscriberQos::builder().presentation(g).build())
-        .unwrap();
-    let mut ws = Vec::new();
-    let mut rs = Vec::new();
-    for name in ["Square", "Circle"] {
-        let t1 = p1
-            .create_topic::<ShapeType>(name, &TopicQos::default())
-            .unwrap();
-        let t2 = p2
-            .create_topic::<ShapeType>(name, &TopicQos::default())
-            .unwrap();
-        ws.push(publ.create_datawriter(&t1, &wq).unwrap());
-        rs.push(sub.create_datareader(&t2, &rq).unwrap());
-    }
+    let (_ps, publ, sub, ws, rs) = group_pair(139);
     let calls = Arc::new(Mutex::new(Vec::new()));
     sub.set_listener(
         Box::new(SeesBoth {
@@ -356,13 +351,6 @@ fn data_on_readers_fires_once_per_group_set_with_all_of_it() {
         StatusMask::DATA_ON_READERS,
     )
     .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || {
-        ws.iter()
-            .all(|w| w.publication_matched_status().current_count == 1)
-            && rs
-                .iter()
-                .all(|r| r.subscription_matched_status().current_count == 1)
-    }));
     for set in 1..=3 {
         publ.begin_coherent_changes().unwrap();
         for i in 0..2 {
@@ -382,5 +370,4 @@ fn data_on_readers_fires_once_per_group_set_with_all_of_it() {
         vec![(2, 2), (4, 4), (6, 6)],
         "once per set, all of it"
     );
-    drop((p1, p2));
 }

@@ -11,16 +11,6 @@ use dds_runtime::qos::*;
 use dds_runtime::rtps::*;
 use rtps_support::*;
 
-fn sample(i: u32) -> Vec<u8> {
-    let mut v = vec![0, 1, 0, 0];
-    v.extend_from_slice(&i.to_le_bytes());
-    v
-}
-
-fn index_of(p: &[u8]) -> u32 {
-    u32::from_le_bytes([p[4], p[5], p[6], p[7]])
-}
-
 /// What the readers got, in order: a sample outside any set (`Plain`), or a whole group set: each
 /// writer's part (0 = writer A, 1 = writer B) with its samples, in delivery order.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -40,16 +30,7 @@ fn setup(seed: u64, faults: Faults, reliable: bool) -> Setup {
     let mut sim = Sim::with_participants(seed, faults, 2);
     sim.faults_on_discovery = false;
     let now = sim.now;
-    let wq = DataWriterQos::builder().history(History::KeepAll).build();
-    let rel = if reliable {
-        Reliability::RELIABLE
-    } else {
-        Reliability::BestEffort
-    };
-    let rq = DataReaderQos::builder()
-        .reliability(rel)
-        .history(History::KeepAll)
-        .build();
+    let (wq, rq) = keep_all_qos(reliable);
     let group = WriterGroup::default();
     let mut w = [EntityId::UNKNOWN; 2];
     let mut r = [EntityId::UNKNOWN; 2];
@@ -79,7 +60,7 @@ fn take(sim: &mut Sim, r: [EntityId; 2]) -> (Vec<Got>, u64) {
     let mut last_group = None;
     sim.nodes[1].events.retain(|e| match e {
         Event::Sample(x) if r.contains(&x.reader) => {
-            got.push(Got::Plain(index_of(&x.payload)));
+            got.push(Got::Plain(payload_index(&x.payload)));
             last_group = None;
             false
         }
@@ -90,7 +71,10 @@ fn take(sim: &mut Sim, r: [EntityId; 2]) -> (Vec<Got>, u64) {
             ..
         } if r.contains(reader) => {
             let k = usize::from(*reader == r[1]);
-            let part = (k, samples.iter().map(|x| index_of(&x.payload)).collect());
+            let part = (
+                k,
+                samples.iter().map(|x| payload_index(&x.payload)).collect(),
+            );
             match (&mut got.last_mut(), group) {
                 (Some(Got::Group(parts)), Some(g)) if last_group == Some(*g) => parts.push(part),
                 _ => got.push(Got::Group(vec![part])),
@@ -108,32 +92,11 @@ fn take(sim: &mut Sim, r: [EntityId; 2]) -> (Vec<Got>, u64) {
 }
 
 fn write(s: &mut Setup, k: usize, i: u32) {
-    loop {
-        let now = s.sim.now;
-        match s.sim.nodes[0]
-            .p
-            .write(now, s.w[k], WriteChange::alive(sample(i)))
-        {
-            Ok(_) => return,
-            Err(WriteError::WouldBlock) => {
-                s.sim.step();
-            }
-            Err(e) => panic!("write: {e}"),
-        }
-    }
+    write_indexed(&mut s.sim, s.w[k], i);
 }
 
 fn end_set(s: &mut Setup, k: usize) {
-    loop {
-        let now = s.sim.now;
-        match s.sim.nodes[0].p.end_coherent_set(now, s.w[k]) {
-            Ok(_) => return,
-            Err(WriteError::WouldBlock) => {
-                s.sim.step();
-            }
-            Err(e) => panic!("end_coherent_set: {e}"),
-        }
-    }
+    end_coherent(&mut s.sim, s.w[k]);
 }
 
 /// Writes group sets spanning both writers (and one writer only), with plain samples between them;
@@ -305,7 +268,7 @@ fn group_set_with_a_writer_no_reader_matches_completes() {
     let now = s.sim.now;
     s.sim.nodes[0]
         .p
-        .write(now, c, WriteChange::alive(sample(99)))
+        .write(now, c, WriteChange::alive(indexed_payload(99)))
         .unwrap();
     write(&mut s, 1, 1);
     end_set(&mut s, 0);

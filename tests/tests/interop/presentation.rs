@@ -8,8 +8,9 @@
 use std::process::Command;
 use std::time::Duration;
 
-use super::harness::{cyclone_peer, require_netns, root, tshark, Proc, Skip};
+use super::harness::{cyclone_peer, require_netns, root, Proc, Skip};
 use super::shapes::Prog;
+use super::tshark::start_capture;
 use crate::check;
 
 const WAIT: Duration = Duration::from_secs(20);
@@ -86,16 +87,17 @@ for i in range(400):
     Ok(Proc::spawn(&format!("cyclone {scope} writer"), c))
 }
 
-/// Cyclone announces PRESENTATION (TOPIC, coherent, ordered) and our coherent, ordered TOPIC-scope reader
-/// matches it and reads its samples (Cyclone sends them outside any set) in order.
-#[test]
-fn presentation_cyclone_writer_to_ours_topic_scope() -> Result<(), Skip> {
+/// Cyclone announces PRESENTATION (`scope`, coherent, ordered) and our coherent, ordered reader with the
+/// same scope (`flag`) matches it and reads its samples (Cyclone sends them outside any set) in order.
+fn presentation_cyclone_writer_to_ours(domain: u32, scope: &str, flag: char) -> Result<(), Skip> {
     require_netns()?;
     let mut s = Prog::Ours.spawn(
         "sub",
-        "-S -t Square -d 184 -r -k 0 -x 2 --coherent --ordered --access-scope t",
+        &format!(
+            "-S -t Square -d {domain} -r -k 0 -x 2 --coherent --ordered --access-scope {flag}"
+        ),
     )?;
-    let mut p = cyclone_presentation_writer(184, "Topic", true)?;
+    let mut p = cyclone_presentation_writer(domain, scope, true)?;
     let got = s.wait_lines(WAIT, 10, is_sample);
     check!(
         got.is_some(),
@@ -118,6 +120,16 @@ fn presentation_cyclone_writer_to_ours_topic_scope() -> Result<(), Skip> {
     let _ = s.interrupt(Duration::from_secs(10));
     let _ = p.interrupt(Duration::from_secs(5));
     Ok(())
+}
+
+#[test]
+fn presentation_cyclone_writer_to_ours_topic_scope() -> Result<(), Skip> {
+    presentation_cyclone_writer_to_ours(184, "Topic", 't')
+}
+
+#[test]
+fn presentation_cyclone_writer_to_ours_group_scope() -> Result<(), Skip> {
+    presentation_cyclone_writer_to_ours(189, "Group", 'g')
 }
 
 /// Offered INSTANCE scope against requested TOPIC scope: both sides report PRESENTATION (id 3) incompatible.
@@ -207,33 +219,6 @@ fn coherent_sets_instance_scope_ours_to_ours() -> Result<(), Skip> {
     coherent_sets_ours(188, 'i')
 }
 
-/// Cyclone announces PRESENTATION (GROUP, coherent, ordered) and our GROUP-scope coherent reader matches
-/// it and reads its samples (outside any set: Cyclone 11 cannot write sets) in order.
-#[test]
-fn presentation_cyclone_writer_to_ours_group_scope() -> Result<(), Skip> {
-    require_netns()?;
-    let mut s = Prog::Ours.spawn(
-        "sub",
-        "-S -t Square -d 189 -r -k 0 -x 2 --coherent --ordered --access-scope g",
-    )?;
-    let mut p = cyclone_presentation_writer(189, "Group", true)?;
-    let got = s.wait_lines(WAIT, 10, is_sample);
-    check!(
-        got.is_some(),
-        &[&p, &s],
-        "our GROUP reader read Cyclone's samples"
-    );
-    let sizes: Vec<u32> = s.grep(is_sample).iter().filter_map(|l| size(l)).collect();
-    check!(
-        sizes.windows(2).all(|w| w[1] == w[0] + 1),
-        &[&p, &s],
-        "in order: {sizes:?}"
-    );
-    let _ = s.interrupt(Duration::from_secs(10));
-    let _ = p.interrupt(Duration::from_secs(5));
-    Ok(())
-}
-
 /// A Cyclone GROUP-scope coherent subscriber reading `Square` and `Square1`, printing `TOPIC SIZE` per
 /// sample.
 fn cyclone_group_reader(domain: u32) -> Result<Proc, Skip> {
@@ -275,16 +260,7 @@ while True:
 #[test]
 fn group_coherent_sets_ours_to_cyclone_reader_on_the_wire() -> Result<(), Skip> {
     require_netns()?;
-    let ts = tshark()?;
-    let dir = root().join("target/interop");
-    std::fs::create_dir_all(&dir).expect("target/interop");
-    let cap = dir.join(format!("group-{}.pcapng", std::process::id()));
-    let cap_s = cap.to_string_lossy().to_string();
-    let mut c = Command::new(ts);
-    c.args(["-i", "lo", "-w", &cap_s]);
-    let mut t = Proc::spawn("tshark", c);
-    let started = t.wait_line(Duration::from_secs(15), |l| l.contains("Capturing on"));
-    check!(started.is_some(), &[&t], "tshark did not start capturing");
+    let (mut t, cap_s) = start_capture("group")?;
     let mut s = cyclone_group_reader(190)?;
     let mut p = Prog::Ours.spawn(
         "pub",
@@ -338,6 +314,6 @@ fn group_coherent_sets_ours_to_cyclone_reader_on_the_wire() -> Result<(), Skip> 
             &ids[..ids.len().min(2000)]
         );
     }
-    let _ = std::fs::remove_file(&cap);
+    let _ = std::fs::remove_file(&cap_s);
     Ok(())
 }

@@ -214,17 +214,18 @@ impl<'a> ParameterList<'a> {
 
     /// Inline QoS: PID_COHERENT_SET, the first sequence number of the change's coherent set.
     pub fn coherent_set(&self) -> Option<SequenceNumber> {
-        let v = self.get(pid::COHERENT_SET)?;
-        let mut c = self.cursor(v);
-        let high = c.i32().ok()?;
-        let low = c.u32().ok()?;
-        Some(SequenceNumber::from_parts(high, low))
+        self.sequence_number(pid::COHERENT_SET)
     }
 
     /// Inline QoS: PID_GROUP_COHERENT_SET, the group sequence number of the first change of the group
     /// coherent set.
     pub fn group_coherent_set(&self) -> Option<SequenceNumber> {
-        let v = self.get(pid::GROUP_COHERENT_SET)?;
+        self.sequence_number(pid::GROUP_COHERENT_SET)
+    }
+
+    /// A parameter holding a `SequenceNumber_t`.
+    fn sequence_number(&self, id: u16) -> Option<SequenceNumber> {
+        let v = self.get(id)?;
         let mut c = self.cursor(v);
         let high = c.i32().ok()?;
         let low = c.u32().ok()?;
