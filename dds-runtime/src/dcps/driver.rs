@@ -418,7 +418,7 @@ impl Driver {
         for ev in deferred {
             self.dispatch_event(ev);
         }
-        let _batch = super::presentation::DataOnReadersBatch::start();
+        let _batch = super::data_on_readers::DataOnReadersBatch::start();
         for (_, r) in touched {
             r.process();
         }

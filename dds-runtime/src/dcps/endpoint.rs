@@ -306,7 +306,7 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         if let Some(parent) = self.parent.get() {
             parent.raise_up(StatusMask::DATA_ON_READERS | StatusMask::DATA_AVAILABLE);
             if let Some(l) = parent.find(StatusMask::DATA_ON_READERS) {
-                if super::presentation::defer_data_on_readers(parent) {
+                if super::data_on_readers::defer_data_on_readers(parent) {
                     return;
                 }
                 parent.clear_up(StatusMask::DATA_ON_READERS);

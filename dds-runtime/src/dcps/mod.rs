@@ -31,6 +31,7 @@ pub mod builtin;
 mod cache;
 mod chain;
 pub mod condition;
+mod data_on_readers;
 mod decode;
 mod driver;
 pub mod durability;

@@ -7,15 +7,12 @@
 //! With GROUP access scope the writers also share a [`WriterGroup`]: group sequence numbers on every
 //! change, and a group coherent set whose parts readers deliver together (`rtps::participant::group`).
 
-use std::cell::RefCell;
-use std::sync::{Arc, Mutex};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use crate::dcps::status::StatusMask;
 use crate::qos::{Presentation, PresentationAccessScope};
 use crate::rtps::{EntityId, WriteError, WriterGroup};
 
-use super::chain::ListenerNode;
 use super::driver::Driver;
 use super::error::{DdsError, DdsResult};
 use super::sync::lock;
@@ -165,61 +162,4 @@ impl AccessScope {
 /// in reception order across instances (the default, and what TOPIC and GROUP scope ask for).
 pub(crate) fn instance_ordered(p: &Presentation) -> bool {
     p.ordered_access && p.access_scope == PresentationAccessScope::Instance
-}
-
-thread_local! {
-    /// While the driver feeds one batch of core events to readers: the subscribers (listener levels) that
-    /// got DATA_ON_READERS, notified once each when the batch is done.
-    static DATA_ON_READERS: RefCell<Option<Vec<Arc<ListenerNode>>>> = const { RefCell::new(None) };
-}
-
-/// One batch of deliveries (`Driver::after_unlock`): DATA_ON_READERS reaches each subscriber's listener
-/// once for the batch, after every reader of the batch stored its samples, rather than once per reader.
-/// A coherent set (a group set spanning readers included) arrives in one batch, so `on_data_on_readers`
-/// fires once per set and sees all of it. Nested batches (a listener that drives the core) join the
-/// outer one.
-pub(crate) struct DataOnReadersBatch {
-    owner: bool,
-}
-
-impl DataOnReadersBatch {
-    /// Starts a batch on this thread (or joins the one running).
-    pub(crate) fn start() -> Self {
-        let owner = DATA_ON_READERS.with(|d| {
-            let mut d = d.borrow_mut();
-            d.is_none().then(|| *d = Some(Vec::new())).is_some()
-        });
-        DataOnReadersBatch { owner }
-    }
-}
-
-impl Drop for DataOnReadersBatch {
-    fn drop(&mut self) {
-        if !self.owner {
-            return;
-        }
-        let nodes = DATA_ON_READERS
-            .with(|d| d.borrow_mut().take())
-            .unwrap_or_default();
-        for node in nodes {
-            if let Some(l) = node.find(StatusMask::DATA_ON_READERS) {
-                node.clear_up(StatusMask::DATA_ON_READERS);
-                l.on_data_on_readers(node.handle);
-            }
-        }
-    }
-}
-
-/// Inside a batch: records that `node`'s DATA_ON_READERS listener is due, and returns true (the caller
-/// does not call it now). Outside a batch: false.
-pub(crate) fn defer_data_on_readers(node: &Arc<ListenerNode>) -> bool {
-    DATA_ON_READERS.with(|d| match &mut *d.borrow_mut() {
-        Some(nodes) => {
-            if !nodes.iter().any(|n| Arc::ptr_eq(n, node)) {
-                nodes.push(node.clone());
-            }
-            true
-        }
-        None => false,
-    })
 }
