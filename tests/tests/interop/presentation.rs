@@ -317,3 +317,38 @@ fn group_coherent_sets_ours_to_cyclone_reader_on_the_wire() -> Result<(), Skip> 
     let _ = std::fs::remove_file(&cap_s);
     Ok(())
 }
+
+/// Why no test here has Cyclone write coherent sets: Cyclone DDS 11.0.1 refuses `begin_coherent` on a
+/// GROUP-scope coherent publisher with DDS_RETCODE_UNSUPPORTED. When a later Cyclone accepts it, this
+/// fails, and Cyclone-written sets (TOPIC and GROUP scope) can be tested against our readers.
+#[test]
+fn cyclone_11_refuses_begin_coherent() -> Result<(), Skip> {
+    require_netns()?;
+    cyclone_peer()?;
+    let script = r#"
+from cyclonedds.core import Qos, Policy, DDSException
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.pub import Publisher
+dp = DomainParticipant(191)
+for scope in (Policy.PresentationAccessScope.Topic, Policy.PresentationAccessScope.Group):
+    pub = Publisher(dp, qos=Qos(scope(coherent_access=True, ordered_access=True)))
+    try:
+        pub.begin_coherent()
+        print("accepted", flush=True)
+    except DDSException as e:
+        print("refused %s" % e.code, flush=True)
+"#;
+    let mut c = Command::new("python3");
+    c.arg("-u").arg("-c").arg(script);
+    let mut p = Proc::spawn("cyclone begin_coherent", c);
+    let _ = p.wait_exit(Duration::from_secs(20));
+    // DDS_RETCODE_UNSUPPORTED is -2 in Cyclone's C API.
+    let refused = p.grep(|l| l == "refused -2");
+    check!(
+        refused.len() == 2,
+        &[&p],
+        "Cyclone 11 refuses begin_coherent (TOPIC and GROUP scope): {:?}",
+        p.lines()
+    );
+    Ok(())
+}
