@@ -101,9 +101,27 @@ impl CoherentGroup {
         };
         let (writers, group) = writers;
         let deadline = Instant::now().checked_add(max_blocking);
-        let r = writers
-            .into_iter()
-            .try_for_each(|w| end_one(driver, w, deadline));
+        // Every writer's end-of-set marker in one core call, so that they leave in one datagram per
+        // destination and readers see the writers' parts of the set arrive together; writers that flow
+        // control holds back end one by one after.
+        let (blocked, failed) = driver.with_core(|c, now| {
+            let mut blocked = Vec::new();
+            let mut failed = None;
+            for w in writers {
+                match c.end_coherent_set(now, w) {
+                    Err(WriteError::WouldBlock) => blocked.push(w),
+                    Ok(_) | Err(WriteError::UnknownWriter(_)) | Err(WriteError::Deleted) => {}
+                    Err(e) => failed = failed.or(Some(e)),
+                }
+            }
+            (blocked, failed)
+        });
+        let r = match failed {
+            Some(e) => Err(DdsError::Write(e)),
+            None => blocked
+                .into_iter()
+                .try_for_each(|w| end_one(driver, w, deadline)),
+        };
         // Closed even when a marker timed out: that part never completes, so readers discard the set.
         if let Some(g) = group {
             driver.with_core(|c, _| c.end_group_set(&g));
