@@ -231,3 +231,143 @@ fn access_scope_nests() {
     assert!(!sub.in_access());
     assert!(sub.end_access().is_err());
 }
+
+/// Two writers (topics Square and Circle) under one GROUP-scope coherent publisher and two readers under
+/// one GROUP-scope coherent subscriber, matched.
+#[allow(clippy::type_complexity)]
+fn group_pair(
+    domain: u32,
+) -> (
+    (DomainParticipant, DomainParticipant),
+    Publisher,
+    Subscriber,
+    Vec<DataWriter<ShapeType>>,
+    Vec<DataReader<ShapeType>>,
+) {
+    let g = presentation(PresentationAccessScope::Group, true, false);
+    let (p1, p2) = (participant(domain), participant(domain));
+    let (wq, rq) = reliable_keep_all();
+    let publ = p1
+        .create_publisher(&PublisherQos::builder().presentation(g).build())
+        .unwrap();
+    let sub = p2
+        .create_subscriber(&SubscriberQos::builder().presentation(g).build())
+        .unwrap();
+    let mut ws = Vec::new();
+    let mut rs = Vec::new();
+    for name in ["Square", "Circle"] {
+        let t1 = p1
+            .create_topic::<ShapeType>(name, &TopicQos::default())
+            .unwrap();
+        let t2 = p2
+            .create_topic::<ShapeType>(name, &TopicQos::default())
+            .unwrap();
+        ws.push(publ.create_datawriter(&t1, &wq).unwrap());
+        rs.push(sub.create_datareader(&t2, &rq).unwrap());
+    }
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        ws.iter()
+            .all(|w| w.publication_matched_status().current_count == 1)
+            && rs
+                .iter()
+                .all(|r| r.subscription_matched_status().current_count == 1)
+    }));
+    ((p1, p2), publ, sub, ws, rs)
+}
+
+/// GROUP scope: a coherent set spans the publisher's two writers (two topics) and reaches the two readers
+/// of the subscriber only once both parts arrived; a set cut short by deleting one of its writers is never
+/// seen, not even the other writer's whole part; the next set (one writer only) arrives.
+#[test]
+fn group_set_spans_writers_and_a_cut_set_is_never_seen() {
+    let (_ps, publ, _sub, mut ws, rs) = group_pair(138);
+    // Set 1: both writers.
+    publ.begin_coherent_changes().unwrap();
+    ws[0].write(&shape("RED", 1)).unwrap();
+    ws[1].write(&shape("RED", 1)).unwrap();
+    for w in &ws {
+        w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    }
+    std::thread::sleep(Duration::from_millis(50));
+    assert_eq!(rs[0].sample_count() + rs[1].sample_count(), 0, "set open");
+    publ.end_coherent_changes().unwrap();
+    assert!(wait_until(Duration::from_secs(5), || rs
+        .iter()
+        .all(|r| r.sample_count() == 1)));
+    // Set 2: cut short by deleting the Circle writer before the set ends.
+    publ.begin_coherent_changes().unwrap();
+    ws[0].write(&shape("RED", 2)).unwrap();
+    ws[1].write(&shape("RED", 2)).unwrap();
+    for w in &ws {
+        w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    }
+    drop(ws.pop());
+    assert!(wait_until(Duration::from_secs(5), || rs[1]
+        .subscription_matched_status()
+        .current_count
+        == 0));
+    publ.end_coherent_changes().unwrap();
+    // Set 3: the Square writer alone.
+    publ.begin_coherent_changes().unwrap();
+    ws[0].write(&shape("RED", 3)).unwrap();
+    publ.end_coherent_changes().unwrap();
+    assert!(wait_until(Duration::from_secs(5), || rs[0].sample_count() == 2));
+    std::thread::sleep(Duration::from_millis(100));
+    let xs: Vec<i32> = rs[0]
+        .take()
+        .unwrap()
+        .iter()
+        .filter_map(|s| s.data.as_ref().map(|d| d.x))
+        .collect();
+    assert_eq!(xs, vec![1, 3], "the cut set is never seen");
+}
+
+/// Counts what both readers hold at each `on_data_on_readers`.
+struct SeesBoth {
+    readers: Vec<DataReader<ShapeType>>,
+    calls: Arc<Mutex<Vec<(usize, usize)>>>,
+}
+
+impl SubscriberListener for SeesBoth {
+    fn on_data_on_readers(&self, _s: &Subscriber) {
+        let c = (
+            self.readers[0].sample_count(),
+            self.readers[1].sample_count(),
+        );
+        self.calls.lock().unwrap().push(c);
+    }
+}
+
+/// GROUP scope: `on_data_on_readers` fires once per group set, when both readers hold their part.
+#[test]
+fn data_on_readers_fires_once_per_group_set_with_all_of_it() {
+    let (_ps, publ, sub, ws, rs) = group_pair(139);
+    let calls = Arc::new(Mutex::new(Vec::new()));
+    sub.set_listener(
+        Box::new(SeesBoth {
+            readers: rs.clone(),
+            calls: calls.clone(),
+        }),
+        StatusMask::DATA_ON_READERS,
+    )
+    .unwrap();
+    for set in 1..=3 {
+        publ.begin_coherent_changes().unwrap();
+        for i in 0..2 {
+            ws[0].write(&shape("RED", set * 10 + i)).unwrap();
+            ws[1].write(&shape("RED", set * 10 + i)).unwrap();
+        }
+        publ.end_coherent_changes().unwrap();
+        let n = 2 * set as usize;
+        assert!(wait_until(Duration::from_secs(5), || rs
+            .iter()
+            .all(|r| r.sample_count() == n)));
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let calls = calls.lock().unwrap().clone();
+    assert_eq!(
+        calls,
+        vec![(2, 2), (4, 4), (6, 6)],
+        "once per set, all of it"
+    );
+}

@@ -9,17 +9,6 @@ use dds_runtime::qos::*;
 use dds_runtime::rtps::*;
 use rtps_support::*;
 
-/// A payload holding its index (encapsulation header first).
-fn sample(i: u32) -> Vec<u8> {
-    let mut v = vec![0, 1, 0, 0];
-    v.extend_from_slice(&i.to_le_bytes());
-    v
-}
-
-fn index_of(p: &[u8]) -> u32 {
-    u32::from_le_bytes([p[4], p[5], p[6], p[7]])
-}
-
 /// What the reader got, in order: `Plain(i)` for a sample outside any set, `Set([i..])` for a whole set.
 #[derive(Debug, Clone, PartialEq, Eq)]
 enum Got {
@@ -34,16 +23,7 @@ struct Setup {
 }
 
 fn setup(seed: u64, faults: Faults, reliable: bool) -> Setup {
-    let wq = DataWriterQos::builder().history(History::KeepAll).build();
-    let rel = if reliable {
-        Reliability::RELIABLE
-    } else {
-        Reliability::BestEffort
-    };
-    let rq = DataReaderQos::builder()
-        .reliability(rel)
-        .history(History::KeepAll)
-        .build();
+    let (wq, rq) = keep_all_qos(reliable);
     let (sim, w, r) = Sim::writer_and_reader(seed, faults, wq, rq);
     Setup { sim, w, r }
 }
@@ -54,14 +34,14 @@ fn take(sim: &mut Sim, r: EntityId) -> (Vec<Got>, u64) {
     let mut lost = 0;
     sim.nodes[1].events.retain(|e| match e {
         Event::Sample(s) if s.reader == r => {
-            got.push(Got::Plain(index_of(&s.payload)));
+            got.push(Got::Plain(payload_index(&s.payload)));
             false
         }
         Event::CoherentSet {
             reader, samples, ..
         } if *reader == r => {
             got.push(Got::Set(
-                samples.iter().map(|s| index_of(&s.payload)).collect(),
+                samples.iter().map(|s| payload_index(&s.payload)).collect(),
             ));
             false
         }
@@ -76,32 +56,11 @@ fn take(sim: &mut Sim, r: EntityId) -> (Vec<Got>, u64) {
 
 /// Writes one change, running the network while flow control refuses it.
 fn write(s: &mut Setup, i: u32) {
-    loop {
-        let now = s.sim.now;
-        match s.sim.nodes[0]
-            .p
-            .write(now, s.w, WriteChange::alive(sample(i)))
-        {
-            Ok(_) => return,
-            Err(WriteError::WouldBlock) => {
-                s.sim.step();
-            }
-            Err(e) => panic!("write: {e}"),
-        }
-    }
+    write_indexed(&mut s.sim, s.w, i);
 }
 
 fn end_set(s: &mut Setup) {
-    loop {
-        let now = s.sim.now;
-        match s.sim.nodes[0].p.end_coherent_set(now, s.w) {
-            Ok(_) => return,
-            Err(WriteError::WouldBlock) => {
-                s.sim.step();
-            }
-            Err(e) => panic!("end_coherent_set: {e}"),
-        }
-    }
+    end_coherent(&mut s.sim, s.w);
 }
 
 /// The script every test writes: plain samples and sets of several sizes, interleaved. Returns what a
@@ -224,7 +183,7 @@ fn late_volatile_reader_discards_the_set_it_joined_in_the_middle_of() {
     for i in 0..3 {
         sim.nodes[0]
             .p
-            .write(now, w, WriteChange::alive(sample(i)))
+            .write(now, w, WriteChange::alive(indexed_payload(i)))
             .unwrap();
     }
     let rq = DataReaderQos::builder()

@@ -429,6 +429,7 @@ impl Driver {
         for ev in deferred.drain(..) {
             self.dispatch_event(ev);
         }
+        let _batch = super::data_on_readers::DataOnReadersBatch::start();
         for (_, r) in touched.drain(..) {
             r.process();
         }

@@ -372,6 +372,9 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
             parent.raise_up(self.instance(), StatusMask::DATA_AVAILABLE);
             parent.raise_up(parent.handle, StatusMask::DATA_ON_READERS);
             if let Some(l) = parent.find(StatusMask::DATA_ON_READERS) {
+                if super::data_on_readers::defer_data_on_readers(parent) {
+                    return;
+                }
                 parent.clear_up(parent.handle, StatusMask::DATA_ON_READERS);
                 l.on_data_on_readers(parent.handle);
                 return;

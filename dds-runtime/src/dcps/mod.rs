@@ -33,6 +33,7 @@ mod builtin_subscriber;
 mod cache;
 mod chain;
 pub mod condition;
+mod data_on_readers;
 mod decode;
 mod driver;
 pub mod durability;

@@ -4,12 +4,14 @@
 //! A publisher's coherent set spans all its writers: while one is open, each writer (also one created
 //! meanwhile) has a coherent set open in the RTPS core, and ending it sends every writer's end-of-set
 //! marker. Readers deliver each writer's part of the set whole or not at all (see `rtps::reader::coherent`).
+//! With GROUP access scope the writers also share a [`WriterGroup`]: group sequence numbers on every
+//! change, and a group coherent set whose parts readers deliver together (`rtps::participant::group`).
 
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use crate::qos::{Presentation, PresentationAccessScope};
-use crate::rtps::{EntityId, WriteError};
+use crate::rtps::{EntityId, WriteError, WriterGroup};
 
 use super::driver::Driver;
 use super::error::{DdsError, DdsResult};
@@ -20,6 +22,8 @@ struct GroupState {
     writers: Vec<EntityId>,
     /// Nesting depth of begin_coherent_changes.
     depth: u32,
+    /// GROUP access scope (coherent or ordered): the state the writers share on the wire.
+    group: Option<WriterGroup>,
 }
 
 /// A publisher's writers and its open coherent set.
@@ -31,15 +35,26 @@ pub(crate) struct CoherentGroup {
 impl CoherentGroup {
     /// Records a new writer of the publisher; it joins the open set, if any. (No lock of this group is
     /// held while the core is called: listeners run from there and may call back.)
-    pub(crate) fn add_writer(&self, driver: &Driver, id: EntityId) {
-        let open = {
+    pub(crate) fn add_writer(&self, driver: &Driver, id: EntityId, p: &Presentation) {
+        let (open, group) = {
             let mut st = lock(&self.state);
             st.writers.push(id);
-            st.depth > 0
+            if p.access_scope == PresentationAccessScope::Group
+                && (p.coherent_access || p.ordered_access)
+            {
+                st.group.get_or_insert_with(WriterGroup::default);
+            }
+            (st.depth > 0, st.group.clone())
         };
-        if open {
-            let _ = driver.with_core(|c, _| c.begin_coherent_set(id));
-        }
+        let _ = driver.with_core(|c, _| {
+            if let Some(g) = &group {
+                c.join_writer_group(id, g)?;
+            }
+            if open {
+                c.begin_coherent_set(id)?;
+            }
+            Ok::<_, WriteError>(())
+        });
     }
 
     /// Opens a coherent set on every writer (nested calls only count).
@@ -51,9 +66,13 @@ impl CoherentGroup {
             if st.depth > 1 {
                 return Ok(());
             }
-            st.writers.clone()
+            (st.writers.clone(), st.group.clone())
         };
+        let (writers, group) = writers;
         let gone = driver.with_core(|c, _| {
+            if let Some(g) = &group {
+                c.begin_group_set(g);
+            }
             writers
                 .into_iter()
                 .filter(|w| c.begin_coherent_set(*w).is_err())
@@ -78,13 +97,36 @@ impl CoherentGroup {
             if st.depth > 0 {
                 return Ok(());
             }
-            st.writers.clone()
+            (st.writers.clone(), st.group.clone())
         };
+        let (writers, group) = writers;
         let deadline = Instant::now().checked_add(max_blocking);
-        for w in writers {
-            end_one(driver, w, deadline)?;
+        // Every writer's end-of-set marker in one core call, so that they leave in one datagram per
+        // destination and readers see the writers' parts of the set arrive together; writers that flow
+        // control holds back end one by one after.
+        let (blocked, failed) = driver.with_core(|c, now| {
+            let mut blocked = Vec::new();
+            let mut failed = None;
+            for w in writers {
+                match c.end_coherent_set(now, w) {
+                    Err(WriteError::WouldBlock) => blocked.push(w),
+                    Ok(_) | Err(WriteError::UnknownWriter(_)) | Err(WriteError::Deleted) => {}
+                    Err(e) => failed = failed.or(Some(e)),
+                }
+            }
+            (blocked, failed)
+        });
+        let r = match failed {
+            Some(e) => Err(DdsError::Write(e)),
+            None => blocked
+                .into_iter()
+                .try_for_each(|w| end_one(driver, w, deadline)),
+        };
+        // Closed even when a marker timed out: that part never completes, so readers discard the set.
+        if let Some(g) = group {
+            driver.with_core(|c, _| c.end_group_set(&g));
         }
-        Ok(())
+        r
     }
 }
 

@@ -104,8 +104,9 @@ impl Publisher {
     /// [`Publisher::end_coherent_changes`] reaches each matched reader as one whole, or not at all (a set
     /// cut short by the writer's deletion or loss is discarded). Calls nest; only the outermost pair
     /// counts. On the wire: `PID_COHERENT_SET` on every change and an end-of-set marker per writer.
-    /// Readers hold each writer's part of the set until it is whole; the guarantee is per writer (a set
-    /// spanning several writers is not made atomic across them).
+    /// Readers hold each writer's part of the set until it is whole. With GROUP access scope the set is
+    /// one group set across the writers (`PID_GROUP_COHERENT_SET`, `PID_WRITER_GROUP_INFO`): the
+    /// subscribing participant delivers it once every writer's part arrived, or not at all.
     pub fn begin_coherent_changes(&self) -> DdsResult<()> {
         self.group.begin(self.participant.driver())
     }
@@ -175,7 +176,7 @@ impl Publisher {
         })?;
         ops::register_writer(self, &inner, topic.name());
         let id = handle.id();
-        self.group.add_writer(&driver, id);
+        self.group.add_writer(&driver, id, &self.qos.presentation);
         tracing::info!(
             topic = topic.name(),
             type_name = T::TYPE_NAME,

@@ -506,6 +506,17 @@ pub struct ReceivedSample {
     pub source_timestamp: Option<Time>,
 }
 
+/// Names a group coherent set (RTPS 2.5 §8.7.6): the group sequence number of its first change and the
+/// digest of its writers (`PID_GROUP_COHERENT_SET`, `PID_WRITER_GROUP_INFO`), both from the end-of-set
+/// markers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct GroupSetId {
+    /// The group sequence number of the set's first change.
+    pub set: SequenceNumber,
+    /// The digest of the writers of the set (`GroupDigest_t`).
+    pub writers: [u8; 4],
+}
+
 /// What the core reports to the DCPS layer.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -522,6 +533,9 @@ pub enum Event {
         writer: Guid,
         /// The changes of the set (never empty).
         samples: Vec<ReceivedSample>,
+        /// For a writer's part of a group coherent set (GROUP access scope): the set. The parts of one
+        /// group set are delivered one after the other, once every writer's part arrived.
+        group: Option<GroupSetId>,
     },
     /// A local writer matched or unmatched a reader.
     PublicationMatched {

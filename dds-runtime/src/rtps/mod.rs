@@ -20,3 +20,4 @@ mod api;
 pub use api::*;
 pub use participant::Participant;
 pub use types::*;
+pub use writer::WriterGroup;

@@ -7,6 +7,7 @@ mod control;
 mod discovery;
 mod enable;
 mod filtering;
+mod group;
 mod historical;
 mod liveliness;
 mod local;
@@ -87,6 +88,8 @@ pub struct Participant {
     type_lookup: type_lookup::TypeLookupService,
     /// Pairs of our own endpoints matched for intra-process delivery.
     local: local::LocalMatches,
+    /// Group coherent sets waiting for the parts of all their writers.
+    group_sets: group::GroupSets,
 }
 
 fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
@@ -182,6 +185,7 @@ impl Participant {
             ignored: control::Ignored::new(),
             type_lookup: type_lookup::TypeLookupService::new(config.guid_prefix),
             local: Default::default(),
+            group_sets: group::GroupSets::default(),
             config,
         };
         let prefix = p.config.guid_prefix;
@@ -271,6 +275,7 @@ impl Participant {
                     continue;
                 }
             }
+            self.note_polled(&e);
             return Some(e);
         }
     }

@@ -344,3 +344,72 @@ fn is_user_traffic(msg: &[u8]) -> bool {
     }
     false
 }
+
+/// A payload holding index `i` (a little-endian CDR encapsulation header first), for tests that track
+/// which change arrived.
+pub(crate) fn indexed_payload(i: u32) -> Vec<u8> {
+    let mut v = vec![0, 1, 0, 0];
+    v.extend_from_slice(&i.to_le_bytes());
+    v
+}
+
+/// The index an [`indexed_payload`] holds.
+pub(crate) fn payload_index(p: &[u8]) -> u32 {
+    u32::from_le_bytes([p[4], p[5], p[6], p[7]])
+}
+
+/// Calls `f` (a write, an end of a coherent set) until flow control stops refusing it, running the network
+/// between attempts; panics on any other error.
+pub(crate) fn until_accepted<T>(
+    sim: &mut Sim,
+    mut f: impl FnMut(&mut Sim) -> Result<T, WriteError>,
+) -> T {
+    loop {
+        match f(sim) {
+            Ok(v) => return v,
+            Err(WriteError::WouldBlock) => {
+                sim.step();
+            }
+            Err(e) => panic!("{e}"),
+        }
+    }
+}
+
+/// Writes [`indexed_payload`]`(i)` with node 0's writer `w`, waiting out flow control.
+pub(crate) fn write_indexed(sim: &mut Sim, w: EntityId, i: u32) {
+    until_accepted(sim, |sim| {
+        let now = sim.now;
+        sim.nodes[0]
+            .p
+            .write(now, w, WriteChange::alive(indexed_payload(i)))
+    });
+}
+
+/// Ends node 0's writer `w`'s coherent set, waiting out flow control.
+pub(crate) fn end_coherent(sim: &mut Sim, w: EntityId) {
+    until_accepted(sim, |sim| {
+        let now = sim.now;
+        sim.nodes[0].p.end_coherent_set(now, w)
+    });
+}
+
+/// KEEP_ALL writer and reader QoS, the reader reliable or best effort.
+pub(crate) fn keep_all_qos(
+    reliable: bool,
+) -> (
+    dds_runtime::qos::DataWriterQos,
+    dds_runtime::qos::DataReaderQos,
+) {
+    use dds_runtime::qos::*;
+    let wq = DataWriterQos::builder().history(History::KeepAll).build();
+    let rel = if reliable {
+        Reliability::RELIABLE
+    } else {
+        Reliability::BestEffort
+    };
+    let rq = DataReaderQos::builder()
+        .reliability(rel)
+        .history(History::KeepAll)
+        .build();
+    (wq, rq)
+}

@@ -81,6 +81,40 @@ struct Printer {
     topic: String,
 }
 
+impl Printer {
+    fn for_topic(topic: &str) -> Self {
+        Printer {
+            topic: topic.to_string(),
+        }
+    }
+
+    /// A match or an incompatible QoS found between creating the writer and installing its listener
+    /// reached no listener: print it from the status (reading it consumes the change, as a listener call
+    /// does, so nothing prints twice).
+    fn catch_up_writer(&self, w: &DataWriter<ShapeType>) {
+        let m = w.publication_matched_status();
+        if m.current_count_change != 0 {
+            self.on_publication_matched(w, m);
+        }
+        let q = w.offered_incompatible_qos_status();
+        if q.total_count_change > 0 {
+            self.on_offered_incompatible_qos(w, q);
+        }
+    }
+
+    /// As [`Printer::catch_up_writer`], for a reader.
+    fn catch_up_reader(&self, r: &DataReader<ShapeType>) {
+        let m = r.subscription_matched_status();
+        if m.current_count_change != 0 {
+            self.on_subscription_matched(r, m);
+        }
+        let q = r.requested_incompatible_qos_status();
+        if q.total_count_change > 0 {
+            self.on_requested_incompatible_qos(r, q);
+        }
+    }
+}
+
 impl DataWriterListener<ShapeType> for Printer {
     fn on_publication_matched(&self, w: &DataWriter<ShapeType>, st: PublicationMatchedStatus) {
         println!(
@@ -277,16 +311,8 @@ impl App {
                     o.color.as_deref().unwrap_or("BLUE")
                 );
                 let w = publisher.create_datawriter(t, &qos)?;
-                let printer = Printer {
-                    topic: t.name().to_string(),
-                };
-                // A reader known before this writer existed is matched (or found incompatible) inside
-                // create_datawriter, before the listener is set: report what the listener missed.
-                let st = w.offered_incompatible_qos_status();
-                if st.total_count_change > 0 {
-                    printer.on_offered_incompatible_qos(&w, st);
-                }
-                w.set_listener(Box::new(printer));
+                w.set_listener(Box::new(Printer::for_topic(t.name())));
+                Printer::for_topic(t.name()).catch_up_writer(&w);
                 writers.push(w);
             }
             Role::Publisher(publisher, writers)
@@ -338,15 +364,8 @@ impl App {
                         subscriber.create_datareader(t, &qos)?
                     }
                 };
-                let printer = Printer {
-                    topic: t.name().to_string(),
-                };
-                // As for writers: an incompatible writer known before this reader existed.
-                let st = r.requested_incompatible_qos_status();
-                if st.total_count_change > 0 {
-                    printer.on_requested_incompatible_qos(&r, st);
-                }
-                r.set_listener(Box::new(printer));
+                r.set_listener(Box::new(Printer::for_topic(t.name())));
+                Printer::for_topic(t.name()).catch_up_reader(&r);
                 readers.push(r);
             }
             Role::Subscriber(subscriber, readers)

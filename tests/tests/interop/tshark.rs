@@ -42,18 +42,25 @@ fn dissector_accepts_all_our_packets() {
     let _ = run();
 }
 
-fn run() -> Result<(), Skip> {
-    require_netns()?;
+/// Starts tshark capturing on `lo` into `target/interop/NAME-PID.pcapng`; returns it once it captures,
+/// with the capture's path.
+pub(super) fn start_capture(name: &str) -> Result<(Proc, String), Skip> {
     let ts = tshark()?;
     let dir = root().join("target/interop");
     std::fs::create_dir_all(&dir).expect("target/interop");
-    let cap = dir.join(format!("rtps-{}.pcapng", std::process::id()));
+    let cap = dir.join(format!("{name}-{}.pcapng", std::process::id()));
     let cap_s = cap.to_string_lossy().to_string();
     let mut c = Command::new(ts);
     c.args(["-i", "lo", "-w", &cap_s]);
-    let mut t = Proc::spawn("tshark", c);
+    let t = Proc::spawn("tshark", c);
     let started = t.wait_line(Duration::from_secs(15), |l| l.contains("Capturing on"));
     check!(started.is_some(), &[&t], "tshark did not start capturing");
+    Ok((t, cap_s))
+}
+
+fn run() -> Result<(), Skip> {
+    require_netns()?;
+    let (mut t, cap_s) = start_capture("rtps")?;
 
     let d = 120;
     let mut sub = spawn("sub", "shape_main", &format!("-S -t Square -d {d} -D l -r"))?;
@@ -125,6 +132,6 @@ fn run() -> Result<(), Skip> {
         );
     }
     eprintln!("submessage kinds we sent, all decoded cleanly: {kinds:?}");
-    let _ = std::fs::remove_file(&cap);
+    let _ = std::fs::remove_file(&cap_s);
     Ok(())
 }

@@ -214,11 +214,28 @@ impl<'a> ParameterList<'a> {
 
     /// Inline QoS: PID_COHERENT_SET, the first sequence number of the change's coherent set.
     pub fn coherent_set(&self) -> Option<SequenceNumber> {
-        let v = self.get(pid::COHERENT_SET)?;
+        self.sequence_number(pid::COHERENT_SET)
+    }
+
+    /// Inline QoS: PID_GROUP_COHERENT_SET, the group sequence number of the first change of the group
+    /// coherent set.
+    pub fn group_coherent_set(&self) -> Option<SequenceNumber> {
+        self.sequence_number(pid::GROUP_COHERENT_SET)
+    }
+
+    /// A parameter holding a `SequenceNumber_t`.
+    fn sequence_number(&self, id: u16) -> Option<SequenceNumber> {
+        let v = self.get(id)?;
         let mut c = self.cursor(v);
         let high = c.i32().ok()?;
         let low = c.u32().ok()?;
         Some(SequenceNumber::from_parts(high, low))
+    }
+
+    /// Inline QoS: PID_WRITER_GROUP_INFO, the digest of the writers of a group coherent set.
+    pub fn writer_group_info(&self) -> Option<[u8; 4]> {
+        let v = self.get(pid::WRITER_GROUP_INFO)?.get(..4)?;
+        Some([v[0], v[1], v[2], v[3]])
     }
 
     /// Inline QoS: the status-info flags (last byte; 0x01 disposed, 0x02 unregistered).

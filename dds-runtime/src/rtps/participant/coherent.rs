@@ -7,7 +7,7 @@ use std::time::Instant;
 use super::{timers, Participant};
 use crate::rtps::api::WriteError;
 use crate::rtps::types::{EntityId, SequenceNumber};
-use crate::rtps::writer::Writer;
+use crate::rtps::writer::{Writer, WriterGroup};
 
 impl Participant {
     /// Starts a coherent set on a user writer: every change it writes until
@@ -35,6 +35,30 @@ impl Participant {
         let r = w.end_coherent(now, &mut self.out, &mut self.events);
         timers::lower_floor(&self.timer_floor, w.next_timeout());
         r
+    }
+
+    /// Makes a user writer a member of a publisher's group (GROUP access scope): from now on its changes
+    /// carry `PID_GROUP_SEQ_NUM` from the group's counter, and while the group has a coherent set open
+    /// ([`Participant::begin_group_set`]) `PID_GROUP_COHERENT_SET`; its end-of-set markers then carry
+    /// `PID_WRITER_GROUP_INFO`, the digest of the writers of the set.
+    pub fn join_writer_group(
+        &mut self,
+        writer: EntityId,
+        group: &WriterGroup,
+    ) -> Result<(), WriteError> {
+        self.user_writer(writer)?.group = Some(group.clone());
+        Ok(())
+    }
+
+    /// Opens a group coherent set: call before [`Participant::begin_coherent_set`] on its members. The
+    /// set spans every member that writes before [`Participant::end_group_set`].
+    pub fn begin_group_set(&mut self, group: &WriterGroup) {
+        group.begin_set();
+    }
+
+    /// Closes the group coherent set, once every member's [`Participant::end_coherent_set`] succeeded.
+    pub fn end_group_set(&mut self, group: &WriterGroup) {
+        group.end_set();
     }
 
     fn user_writer(&mut self, id: EntityId) -> Result<&mut Writer, WriteError> {

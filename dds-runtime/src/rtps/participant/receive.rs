@@ -219,7 +219,7 @@ impl Participant {
                     self.timers_changed();
                 }
                 Event::SampleLost { reader, .. } if reader.is_builtin() => {}
-                e => self.events.push_back(e),
+                e => self.push_delivery(e),
             }
         }
         self.scratch = batch;

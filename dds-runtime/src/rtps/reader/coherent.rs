@@ -9,8 +9,19 @@
 //! goes away takes its open set with it. Memory is bounded: a set larger than the reorder limits is
 //! counted as lost instead of held.
 
-use crate::rtps::api::{Event, ReceivedSample};
+use crate::rtps::api::{Event, GroupSetId, ReceivedSample};
+use crate::rtps::messages::ParameterList;
 use crate::rtps::types::{EntityId, Guid, SequenceNumber};
+
+/// The group set an end-of-set marker names: `PID_GROUP_COHERENT_SET` and `PID_WRITER_GROUP_INFO`, both
+/// needed (a marker of a writer-scope set has neither).
+pub(crate) fn group_set(q: Option<&ParameterList<'_>>) -> Option<GroupSetId> {
+    let q = q?;
+    Some(GroupSetId {
+        set: q.group_coherent_set()?,
+        writers: q.writer_group_info()?,
+    })
+}
 
 /// How a received change belongs to a coherent set.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -19,6 +30,10 @@ pub(crate) struct SetMark {
     pub set: SequenceNumber,
     /// The change is the end-of-set marker (no data).
     pub end: bool,
+    /// On an end-of-set marker of a group coherent set: the group set.
+    pub group: Option<GroupSetId>,
+    /// On a change of a group coherent set: the set's first group sequence number.
+    pub group_set: Option<SequenceNumber>,
 }
 
 /// Limits on what one writer's open set may hold.
@@ -38,6 +53,8 @@ struct OpenSet {
     count: u64,
     bytes: usize,
     samples: Vec<ReceivedSample>,
+    /// The group set the changes named (`PID_GROUP_COHERENT_SET`), if any.
+    group_set: Option<SequenceNumber>,
 }
 
 /// One matched writer's open coherent set.
@@ -45,6 +62,8 @@ struct OpenSet {
 pub(crate) struct Assembler {
     open: Option<OpenSet>,
     limits: SetLimits,
+    /// The group set the closing marker named (taken by `close`).
+    group: Option<GroupSetId>,
 }
 
 impl Default for Assembler {
@@ -59,7 +78,11 @@ impl Default for Assembler {
 impl Assembler {
     /// An assembler holding at most `limits` of one set.
     pub(crate) fn new(limits: SetLimits) -> Self {
-        Assembler { open: None, limits }
+        Assembler {
+            open: None,
+            limits,
+            group: None,
+        }
     }
 
     /// Takes the next change delivered in order from the writer, `sn` being its sequence number.
@@ -75,7 +98,10 @@ impl Assembler {
                 self.close(sn, sample.reader, sample.writer, out);
                 out.push(Event::Sample(sample));
             }
-            Some(m) if m.end => self.close(sn, sample.reader, sample.writer, out),
+            Some(m) if m.end => {
+                self.group = m.group;
+                self.close(sn, sample.reader, sample.writer, out)
+            }
             Some(m) => {
                 if self.open.as_ref().is_some_and(|o| o.set != m.set) {
                     self.close(sn, sample.reader, sample.writer, out);
@@ -87,6 +113,7 @@ impl Assembler {
                     count: 0,
                     bytes: 0,
                     samples: Vec::new(),
+                    group_set: m.group_set,
                 });
                 o.whole &= sn == o.last.next();
                 o.last = sn;
@@ -113,6 +140,7 @@ impl Assembler {
         writer: Guid,
         out: &mut Vec<Event>,
     ) {
+        let group = self.group.take();
         let Some(o) = self.open.take() else {
             return;
         };
@@ -121,6 +149,7 @@ impl Assembler {
                 reader,
                 writer,
                 samples: o.samples,
+                group,
             });
         } else {
             tracing::debug!(?writer, set = o.set.0, "incomplete coherent set discarded");
@@ -129,6 +158,20 @@ impl Assembler {
                 writer,
                 count: o.count,
             });
+            // A part of a group set that will never be whole: the rest of the set waits for nothing. Said
+            // with an empty part (the participant's group assembly takes it; it never reaches the
+            // application).
+            if let Some(set) = group.map(|g| g.set).or(o.group_set) {
+                out.push(Event::CoherentSet {
+                    reader,
+                    writer,
+                    samples: Vec::new(),
+                    group: Some(GroupSetId {
+                        set,
+                        writers: [0; 4],
+                    }),
+                });
+            }
         }
     }
 

@@ -19,7 +19,7 @@ use crate::rtps::messages::{
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::pool::BufferPool;
 use crate::rtps::types::*;
-use coherent::{Assembler, SetLimits, SetMark};
+use coherent::{group_set, Assembler, SetLimits, SetMark};
 use defrag::Defrag;
 
 fn slot_size(s: &Slot) -> usize {
@@ -100,6 +100,11 @@ impl Reader {
                 true
             }
         }
+    }
+
+    /// Whether the reader is reliable.
+    pub(crate) fn is_reliable(&self) -> bool {
+        self.params.reliable
     }
 
     pub(crate) fn matched(&self) -> impl Iterator<Item = &Guid> {
@@ -264,14 +269,16 @@ impl Reader {
         let status = d.inline_qos.and_then(|q| q.status_info());
         let kind = status.map_or(ChangeKind::Alive, ChangeKind::from_status_info);
         let key_hash = d.inline_qos.and_then(|q| q.key_hash());
-        let coherent = d
-            .inline_qos
-            .and_then(|q| q.coherent_set())
-            .map(|set| SetMark {
+        let coherent = d.inline_qos.and_then(|q| q.coherent_set()).map(|set| {
+            // The end-of-set marker: no data, no key, no status.
+            let end = d.payload.is_none() && status.is_none();
+            SetMark {
                 set,
-                // The end-of-set marker: no data, no key, no status.
-                end: d.payload.is_none() && status.is_none(),
-            });
+                end,
+                group: end.then(|| group_set(d.inline_qos.as_ref())).flatten(),
+                group_set: d.inline_qos.and_then(|q| q.group_coherent_set()),
+            }
+        });
         let slot = match d.payload {
             Some(b) if b.len() > self.params.max_sample_size => {
                 out.push(Event::SampleLost {
@@ -389,7 +396,12 @@ impl Reader {
                 .map_or(ChangeKind::Alive, ChangeKind::from_status_info);
             let key_hash = df.key_hash;
             let source_timestamp = df.source_timestamp;
-            let coherent = df.coherent_set.map(|set| SetMark { set, end: false });
+            let coherent = df.coherent_set.map(|set| SetMark {
+                set,
+                end: false,
+                group: None,
+                group_set: None,
+            });
             let Some(payload) = df.assemble(pool) else {
                 return;
             };

@@ -9,6 +9,7 @@
 use std::collections::VecDeque;
 use std::time::Instant;
 
+use super::group::GroupMark;
 use super::Writer;
 use crate::rtps::api::{ChangeKind, Event, Payload, WriteChange, WriteError};
 use crate::rtps::messages::parameter::pid;
@@ -22,6 +23,21 @@ pub(crate) struct CoherentMark {
     pub set: SequenceNumber,
     /// This change is the end-of-set marker.
     pub end: bool,
+}
+
+/// What a change of a writer carries in its inline QoS beyond key and status: its coherent set and, for
+/// members of a GROUP-scope publisher, its group mark (see `group.rs`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct Marks {
+    pub coherent: Option<CoherentMark>,
+    pub group: Option<GroupMark>,
+}
+
+impl Marks {
+    /// This change is an end-of-set marker.
+    pub(crate) fn is_marker(&self) -> bool {
+        self.coherent.is_some_and(|m| m.end)
+    }
 }
 
 /// The writer's coherent-set state.
@@ -50,13 +66,21 @@ impl CoherentState {
     }
 }
 
-/// Writes `PID_COHERENT_SET` (little-endian) at the start of `buf`; returns its length (12).
-pub(crate) fn put_coherent_set(m: &CoherentMark, buf: &mut [u8]) -> usize {
-    buf[0..2].copy_from_slice(&pid::COHERENT_SET.to_le_bytes());
-    buf[2..4].copy_from_slice(&8u16.to_le_bytes());
-    buf[4..8].copy_from_slice(&((m.set.0 >> 32) as i32).to_le_bytes());
-    buf[8..12].copy_from_slice(&(m.set.0 as u32).to_le_bytes());
-    12
+/// Writes `PID_COHERENT_SET` and the group parameters (little-endian) at the start of `buf`; returns
+/// their length (at most 12 + [`super::group::GROUP_QOS_MAX`]).
+pub(crate) fn put_marks(m: &Marks, buf: &mut [u8]) -> usize {
+    let mut n = 0;
+    if let Some(c) = &m.coherent {
+        buf[0..2].copy_from_slice(&pid::COHERENT_SET.to_le_bytes());
+        buf[2..4].copy_from_slice(&8u16.to_le_bytes());
+        buf[4..8].copy_from_slice(&((c.set.0 >> 32) as i32).to_le_bytes());
+        buf[8..12].copy_from_slice(&(c.set.0 as u32).to_le_bytes());
+        n = 12;
+    }
+    if let Some(g) = &m.group {
+        n += g.put(&mut buf[n..]);
+    }
+    n
 }
 
 /// The instance key of end-of-set markers in a keyed writer's history (no real instance hashes to it in
@@ -64,6 +88,18 @@ pub(crate) fn put_coherent_set(m: &CoherentMark, buf: &mut [u8]) -> usize {
 pub(crate) const MARKER_KEY: [u8; 16] = [0xff; 16];
 
 impl Writer {
+    /// The marks of change `sn`, written now: its coherent set, and its group mark when the writer is a
+    /// member of a GROUP-scope publisher.
+    pub(crate) fn marks(&mut self, sn: SequenceNumber) -> Marks {
+        let coherent = self.coherent.mark(sn);
+        let marker = coherent.is_some_and(|m| m.end);
+        let id = self.guid.entity_id;
+        Marks {
+            coherent,
+            group: self.group.as_ref().map(|g| g.stamp(id, marker)),
+        }
+    }
+
     /// Starts a coherent set (nested calls keep the open one).
     pub(crate) fn begin_coherent(&mut self) {
         if self.coherent == CoherentState::Off {

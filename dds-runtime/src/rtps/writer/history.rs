@@ -23,7 +23,7 @@ pub(crate) struct CacheChange {
     pub key_hash: Option<[u8; 16]>,
     pub source_timestamp: Option<Time>,
     /// Membership in a coherent set, sent again with every repair.
-    pub coherent: Option<super::CoherentMark>,
+    pub marks: super::Marks,
     /// Readers whose content filter rejected this change (sorted; empty for most changes).
     pub rejected: Vec<Guid>,
     /// PID_CONTENT_FILTER_INFO to send with it, when matched readers filter.
@@ -239,7 +239,7 @@ mod tests {
             payload: vec![0u8; 10].into(),
             key_hash: Some([key; 16]),
             source_timestamp: None,
-            coherent: None,
+            marks: Default::default(),
             rejected: Vec::new(),
             filter_info: None,
             expires: None,

@@ -3,15 +3,18 @@
 mod coherent;
 mod content_filter;
 mod flow;
+mod group;
 mod history;
 mod liveliness;
 mod local;
 mod reader_proxy;
 mod sn_map;
 
-pub(crate) use coherent::CoherentMark;
 use coherent::CoherentState;
+pub(crate) use coherent::Marks;
 pub(crate) use content_filter::ReaderFilters;
+pub(crate) use group::writer_set_digest;
+pub use group::WriterGroup;
 pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use liveliness::OwnLeases;
 pub(crate) use reader_proxy::ReaderProxy;
@@ -83,6 +86,8 @@ pub(crate) struct Writer {
     pub linger_until: Option<Instant>,
     /// The open coherent set, if any (see `coherent.rs`).
     coherent: CoherentState,
+    /// The publisher group this writer is a member of (GROUP access scope).
+    pub group: Option<WriterGroup>,
     /// The content filters of the matched readers that announced one.
     pub filters: ReaderFilters,
 }
@@ -110,6 +115,7 @@ impl Writer {
             window: flow::Window::new(params.high_watermark, params.low_watermark),
             linger_until: None,
             coherent: CoherentState::Off,
+            group: None,
             filters: ReaderFilters::default(),
         }
     }
@@ -273,7 +279,7 @@ impl Writer {
             payload: change.payload,
             key_hash: change.key_hash,
             source_timestamp: change.source_timestamp,
-            coherent: self.coherent.mark(sn),
+            marks: self.marks(sn),
             filter_info: if change.kind == ChangeKind::Alive {
                 self.filters.info(&rejected)
             } else {
@@ -673,8 +679,8 @@ impl Writer {
     }
 }
 
-/// Room for the inline QoS of one change: coherent set (12), key hash (20), status info (8).
-const INLINE_QOS_MAX: usize = 40;
+/// Room for the inline QoS of one change: coherent set (12), group marks, key hash (20), status info (8).
+const INLINE_QOS_MAX: usize = 40 + group::GROUP_QOS_MAX;
 
 /// SEQUENCE_NUMBER_SET bits: what one ACKNACK can ask for.
 const BITMAP_BITS: u32 = 256;
@@ -728,11 +734,9 @@ fn send_gaps(
 /// (an end-of-set marker carries only that). Built on the stack.
 fn inline_qos(c: &CacheChange, buf: &mut [u8; INLINE_QOS_MAX]) -> usize {
     let mut n = 0;
-    if let Some(m) = &c.coherent {
-        n = coherent::put_coherent_set(m, buf);
-        if m.end {
-            return n;
-        }
+    n += coherent::put_marks(&c.marks, buf);
+    if c.marks.is_marker() {
+        return n;
     }
     if let Some(k) = &c.key_hash {
         buf[n..n + 2].copy_from_slice(&pid::KEY_HASH.to_le_bytes());
@@ -787,7 +791,7 @@ pub(crate) fn send_change(
     let len = c.payload.len();
     let alive = c.kind == ChangeKind::Alive;
     if len <= frag || frag == 0 || (key_hash_only && !alive) {
-        let marker = c.coherent.is_some_and(|m| m.end);
+        let marker = c.marks.is_marker();
         let payload = (!marker && (alive || (len > 0 && !key_hash_only))).then_some(&c.payload[..]);
         let d = Submessage::Data(Data {
             reader_id: rid,
