@@ -223,6 +223,12 @@ participant_config! {
     /// earlier when the datagram is full, on [`Participant::flush`](super::Participant::flush), or with any
     /// other outgoing traffic. `None` (the default) sends every write at once.
     write_batch_delay: Option<Duration> = copy,
+    /// Multicast user data (Cyclone's `AllowMulticast` for data): when on, a writer sends each new sample
+    /// once to a multicast locator shared by two or more of its matched readers (the readers' own
+    /// multicast locators, else their participants' default multicast locators) instead of once per reader;
+    /// repairs still go to each reader's unicast locator. Off (the default): data goes unicast only. What
+    /// *our* readers announce is [`default_multicast`](Self::default_multicast).
+    multicast_data: bool = copy,
 }
 
 impl ParticipantConfig {
@@ -272,6 +278,7 @@ impl ParticipantConfig {
             writer_linger_duration: Duration::from_secs(1),
             max_repair_bytes: 256 * 1024,
             write_batch_delay: None,
+            multicast_data: false,
         }))
     }
 

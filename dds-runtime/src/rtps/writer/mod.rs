@@ -4,6 +4,7 @@ mod coherent;
 mod content_filter;
 mod history;
 mod liveliness;
+mod multicast;
 mod reader_proxy;
 
 pub(crate) use coherent::CoherentMark;
@@ -145,12 +146,13 @@ impl Writer {
     }
 
     fn rebuild_dest(&mut self) {
+        self.choose_multicast();
         let dest = |key_hash_only: Option<bool>| {
             let mut d: Vec<Locator> = self
                 .proxies
                 .values()
                 .filter(|p| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
-                .filter_map(|p| p.destination().first().copied())
+                .filter_map(|p| p.data_destination())
                 .collect();
             d.sort();
             d.dedup();
@@ -563,7 +565,7 @@ impl Writer {
                         .proxies
                         .values()
                         .filter(|p| p.reliable && p.acked < self.next_sn)
-                        .filter_map(|p| p.destination().first().copied())
+                        .filter_map(|p| p.data_destination())
                         .collect();
                     d.sort();
                     d.dedup();
