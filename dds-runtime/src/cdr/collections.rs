@@ -53,11 +53,28 @@ pub(crate) fn encode_str(s: &str, w: &mut CdrWriter<'_>, bound: usize) -> Result
 
 /// Decodes a string body with one allocation.
 pub(crate) fn decode_str(r: &mut CdrReader<'_>, bound: usize) -> Result<String, DecodeError> {
+    str_body(r, bound).map(str::to_owned)
+}
+
+/// Decodes a string body into `s`, reusing its buffer.
+pub(crate) fn decode_str_in_place(
+    s: &mut String,
+    r: &mut CdrReader<'_>,
+    bound: usize,
+) -> Result<(), DecodeError> {
+    let text = str_body(r, bound)?;
+    s.clear();
+    s.push_str(text);
+    Ok(())
+}
+
+/// The characters of a string body, checked (bound, terminating NUL, no NUL inside, UTF-8).
+fn str_body<'a>(r: &mut CdrReader<'a>, bound: usize) -> Result<&'a str, DecodeError> {
     let at = r.offset();
     let n = r.read_count(1, "string length")?;
     if n == 0 {
         // Some implementations send an empty string as length 0.
-        return Ok(String::new());
+        return Ok("");
     }
     if n - 1 > bound {
         return Err(bound_error(r, at, "string within its bound", n - 1, bound));
@@ -73,7 +90,7 @@ pub(crate) fn decode_str(r: &mut CdrReader<'_>, bound: usize) -> Result<String, 
         ));
     }
     match std::str::from_utf8(text) {
-        Ok(s) => Ok(s.to_owned()),
+        Ok(s) => Ok(s),
         Err(e) => Err(DecodeError::new(
             body_at + e.valid_up_to(),
             "UTF-8 string",
@@ -112,6 +129,11 @@ impl CdrType for String {
         decode_str(r, bound)
     }
 
+    #[inline]
+    fn decode_in_place(&mut self, r: &mut CdrReader<'_>, bound: usize) -> Result<(), DecodeError> {
+        decode_str_in_place(self, r, bound)
+    }
+
     fn key_max_end(start: usize, _version: XcdrVersion, bound: Option<usize>) -> Option<usize> {
         string_key_max_end(start, bound)
     }
@@ -148,6 +170,18 @@ pub(crate) fn decode_seq<T: CdrType>(
     r: &mut CdrReader<'_>,
     bound: usize,
 ) -> Result<Vec<T>, DecodeError> {
+    let mut v = Vec::new();
+    decode_seq_in_place(&mut v, r, bound)?;
+    Ok(v)
+}
+
+/// Decodes a sequence body into `v`, reusing its buffer and, for non-primitive elements, the elements it
+/// already holds (decoded in place).
+pub(crate) fn decode_seq_in_place<T: CdrType>(
+    v: &mut Vec<T>,
+    r: &mut CdrReader<'_>,
+    bound: usize,
+) -> Result<(), DecodeError> {
     let limit = if !T::LAYOUT.is_primitive() && r.is_xcdr2() {
         r.enter("sequence")?;
         let len = r.read_u32("sequence DHEADER")? as usize;
@@ -160,13 +194,23 @@ pub(crate) fn decode_seq<T: CdrType>(
     if n > bound {
         return Err(bound_error(r, at, "sequence within its bound", n, bound));
     }
-    let mut v = Vec::with_capacity(capacity_for::<T>(n, r.remaining()));
-    T::decode_into(&mut v, n, r)?;
+    // Primitives are copied in bulk; other elements are decoded over the ones already there.
+    let keep = if T::LAYOUT.is_primitive() {
+        0
+    } else {
+        v.len().min(n)
+    };
+    v.truncate(keep);
+    for e in v.iter_mut() {
+        e.decode_in_place(r, usize::MAX)?;
+    }
+    v.reserve(capacity_for::<T>(n - keep, r.remaining()));
+    T::decode_into(v, n - keep, r)?;
     if let Some(l) = limit {
         r.end_limit(l);
         r.leave();
     }
-    Ok(v)
+    Ok(())
 }
 
 pub(crate) fn seq_key_max_end<T: CdrType>(
@@ -218,6 +262,11 @@ impl<T: CdrType> CdrType for Vec<T> {
 
     fn decode_bounded(r: &mut CdrReader<'_>, bound: usize) -> Result<Self, DecodeError> {
         decode_seq(r, bound)
+    }
+
+    #[inline]
+    fn decode_in_place(&mut self, r: &mut CdrReader<'_>, bound: usize) -> Result<(), DecodeError> {
+        decode_seq_in_place(self, r, bound)
     }
 
     fn key_max_end(start: usize, version: XcdrVersion, bound: Option<usize>) -> Option<usize> {

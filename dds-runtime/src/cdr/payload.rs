@@ -44,17 +44,21 @@ pub(crate) fn encode_payload<T: DdsType>(
     finish_payload(start, r, out)
 }
 
-/// Decodes a payload that starts with its encapsulation header; `key_only` for a key-only payload.
-pub(crate) fn decode_payload<T: DdsType>(payload: &[u8], key_only: bool) -> Result<T, DecodeError> {
+/// A reader past the encapsulation header of `payload`; `key_only` for a key-only payload.
+fn payload_reader(payload: &[u8], key_only: bool) -> Result<CdrReader<'_>, DecodeError> {
     let h = EncapsulationHeader::parse(payload)?;
-    let mut r = CdrReader::new(
+    Ok(CdrReader::new(
         payload,
         EncapsulationHeader::SIZE,
         h.version()?,
         h.byte_order(),
         key_only,
-    );
-    T::decode(&mut r)
+    ))
+}
+
+/// Decodes a payload that starts with its encapsulation header; `key_only` for a key-only payload.
+pub(crate) fn decode_payload<T: DdsType>(payload: &[u8], key_only: bool) -> Result<T, DecodeError> {
+    T::decode(&mut payload_reader(payload, key_only)?)
 }
 
 /// Appends the encapsulation header and the encoding of `sample` to `out`. Allocates nothing when `out` has
@@ -71,4 +75,11 @@ pub fn serialize<T: DdsType>(
 /// Decodes a payload that starts with its encapsulation header. Never panics; see [`DecodeError`].
 pub fn deserialize<T: DdsType>(payload: &[u8]) -> Result<T, DecodeError> {
     decode_payload(payload, false)
+}
+
+/// [`deserialize`] into an existing sample, reusing the buffers of its strings and sequences: decoding a
+/// stream of samples into one value allocates nothing once its buffers are large enough. On error `sample`
+/// holds some mix of old and new members.
+pub fn deserialize_into<T: DdsType>(payload: &[u8], sample: &mut T) -> Result<(), DecodeError> {
+    sample.decode_in_place(&mut payload_reader(payload, false)?, usize::MAX)
 }
