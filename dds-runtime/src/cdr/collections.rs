@@ -16,6 +16,7 @@ const fn align4(p: usize) -> usize {
     (p + 3) & !3
 }
 
+#[inline(always)]
 fn check_bound(what: &'static str, len: usize, bound: usize) -> Result<(), EncodeError> {
     if len > bound {
         Err(EncodeError::BoundExceeded { what, bound, len })
@@ -36,19 +37,11 @@ fn bound_error(
 }
 
 /// Encodes a string body (length with NUL, bytes, NUL); shared by `String` and `BoundedString`.
+#[inline]
 pub(crate) fn encode_str(s: &str, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
     check_bound("string", s.len(), bound)?;
-    // `contains` on bytes is memchr (vectorised); the position is only looked for on error.
-    if s.as_bytes().contains(&0) {
-        return Err(EncodeError::InvalidValue {
-            what: "NUL inside a string",
-            value: s.bytes().position(|b| b == 0).unwrap_or(0) as u64,
-        });
-    }
-    w.write_len(s.len() + 1, "string length")?;
-    w.write_bytes(s.as_bytes());
-    w.write_u8(0);
-    Ok(())
+    // The writer checks for a NUL inside (on the words it copies, for short strings).
+    w.write_string(s.as_bytes())
 }
 
 /// Decodes a string body with one allocation.
@@ -140,6 +133,7 @@ impl CdrType for String {
 }
 
 /// Encodes a sequence body; shared by `Vec` and `BoundedSeq`.
+#[inline]
 pub(crate) fn encode_seq<T: CdrType>(
     items: &[T],
     w: &mut CdrWriter<'_>,

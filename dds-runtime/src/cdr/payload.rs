@@ -4,7 +4,7 @@ use super::error::{DecodeError, EncodeError};
 use super::header::{ByteOrder, EncapsulationHeader, XcdrVersion};
 use super::reader::CdrReader;
 use super::traits::DdsType;
-use super::writer::{CdrWriter, EncodeMode};
+use super::writer::{push_zeros, CdrWriter, EncodeMode};
 
 fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut Vec<u8>) -> usize {
     let start = out.len();
@@ -26,8 +26,10 @@ fn finish_payload(
         return Err(e);
     }
     let pad = (out.len() - start).wrapping_neg() & 3;
-    out.extend_from_slice(&[0u8; 3][..pad]);
-    out[start + 3] = (out[start + 3] & !3) | pad as u8;
+    push_zeros(out, pad);
+    if let Some(options) = out.get_mut(start + 3) {
+        *options = (*options & !3) | pad as u8;
+    }
     Ok(())
 }
 
