@@ -75,6 +75,10 @@ fn str_body<'a>(r: &mut CdrReader<'a>, bound: usize) -> Result<&'a str, DecodeEr
     let body_at = r.offset();
     let bytes = r.read_bytes(n, "string characters")?;
     let (text, nul) = bytes.split_at(n - 1);
+    if nul[0] == 0 && short_ascii_without_nul(text) {
+        // SAFETY: ASCII is UTF-8.
+        return Ok(unsafe { std::str::from_utf8_unchecked(text) });
+    }
     if nul[0] != 0 || text.contains(&0) {
         return Err(DecodeError::new(
             body_at,
@@ -89,6 +93,31 @@ fn str_body<'a>(r: &mut CdrReader<'a>, bound: usize) -> Result<&'a str, DecodeEr
             "UTF-8 string",
             DecodeErrorKind::MalformedString,
         )),
+    }
+}
+
+/// Whether `b` is at most 16 bytes of ASCII without a NUL, tested on two overlapping words (the common short
+/// string, for which `memchr` and `from_utf8` cost more than the characters); `false` sends the caller to the
+/// full checks.
+#[inline(always)]
+fn short_ascii_without_nul(b: &[u8]) -> bool {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    const HI: u64 = 0x8080_8080_8080_8080;
+    // A byte is 0 or >= 0x80 exactly when the result has its high bit set.
+    let bad = |v: u64, lo: u64, hi: u64| (v.wrapping_sub(lo) | v) & hi != 0;
+    let n = b.len();
+    let word = |s: &[u8]| -> u64 {
+        let mut a = [0u8; 8];
+        a[..s.len()].copy_from_slice(s);
+        u64::from_le_bytes(a)
+    };
+    match n {
+        8..=16 => !(bad(word(&b[..8]), LO, HI) || bad(word(&b[n - 8..]), LO, HI)),
+        4..=7 => {
+            let (lo, hi) = (LO & 0xffff_ffff, HI & 0xffff_ffff);
+            !(bad(word(&b[..4]), lo, hi) || bad(word(&b[n - 4..]), lo, hi))
+        }
+        _ => n < 4 && b.iter().all(|&c| c != 0 && c < 0x80),
     }
 }
 
@@ -114,6 +143,7 @@ impl CdrType for String {
         String::new()
     }
 
+    #[inline]
     fn encode_bounded(&self, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
         encode_str(self, w, bound)
     }
@@ -250,6 +280,7 @@ impl<T: CdrType> CdrType for Vec<T> {
         Vec::new()
     }
 
+    #[inline]
     fn encode_bounded(&self, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
         encode_seq(self, w, bound)
     }
@@ -485,5 +516,46 @@ impl<T: CdrType> CdrType for Box<T> {
             return None;
         }
         T::key_max_end(start, version, bound)
+    }
+}
+
+#[cfg(test)]
+mod string_tests {
+    use super::*;
+    use crate::cdr::ByteOrder;
+
+    /// The short-string fast path agrees with the full checks for every length up to 40 and every position
+    /// of a NUL, a byte above 0x7f (invalid alone), and a two-byte UTF-8 character.
+    #[test]
+    fn short_string_checks_agree_with_the_full_ones() {
+        let decode = |text: &[u8]| {
+            let mut p = ((text.len() + 1) as u32).to_le_bytes().to_vec();
+            p.extend_from_slice(text);
+            p.push(0);
+            let mut r = CdrReader::new(&p, 0, XcdrVersion::Xcdr1, ByteOrder::LittleEndian, false);
+            decode_str(&mut r, usize::MAX).ok()
+        };
+        let reference = |text: &[u8]| {
+            (!text.contains(&0))
+                .then(|| std::str::from_utf8(text).ok().map(str::to_owned))
+                .flatten()
+        };
+        for n in 0..=40usize {
+            let base: Vec<u8> = (0..n).map(|i| b'A' + (i % 26) as u8).collect();
+            assert_eq!(decode(&base), reference(&base), "plain {n}");
+            for at in 0..n {
+                for b in [0u8, 0x80, 0xff] {
+                    let mut t = base.clone();
+                    t[at] = b;
+                    assert_eq!(decode(&t), reference(&t), "n {n}, byte {b:#x} at {at}");
+                }
+                if at + 1 < n {
+                    let mut t = base.clone();
+                    t[at] = 0xc3;
+                    t[at + 1] = 0xa9; // é
+                    assert_eq!(decode(&t), reference(&t), "n {n}, é at {at}");
+                }
+            }
+        }
     }
 }

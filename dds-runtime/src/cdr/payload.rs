@@ -6,6 +6,7 @@ use super::reader::CdrReader;
 use super::traits::DdsType;
 use super::writer::{push_zeros, CdrWriter, EncodeMode};
 
+#[inline]
 fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut Vec<u8>) -> usize {
     let start = out.len();
     out.extend_from_slice(
@@ -16,6 +17,7 @@ fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut V
 
 /// Pads the payload to a multiple of 4 and records the padding in the header options, as Cyclone DDS does;
 /// on error removes what was appended.
+#[inline]
 fn finish_payload(
     start: usize,
     r: Result<(), EncodeError>,
@@ -34,6 +36,7 @@ fn finish_payload(
 }
 
 /// Appends the encapsulation header and the encoding of `sample` in `mode`, then pads (see [`finish_payload`]).
+#[inline]
 pub(crate) fn encode_payload<T: DdsType>(
     sample: &T,
     version: XcdrVersion,

@@ -227,22 +227,11 @@ impl<'a> CdrWriter<'a> {
     /// Writes a string body: the aligned length (with the NUL), the characters and the NUL. Fails when
     /// `text` holds a NUL (nothing is appended then). Strings of up to 16 bytes take one capacity check and
     /// a few word stores, with the NUL check on the same words; longer ones use `memchr` and `memcpy`.
-    #[inline]
+    #[inline(always)]
     pub fn write_string(&mut self, text: &[u8]) -> Result<(), EncodeError> {
         let n = text.len();
         if n > SHORT {
-            if text.contains(&0) {
-                return Err(nul_in_string(text));
-            }
-            let len = u32::try_from(n + 1).map_err(|_| EncodeError::TooLarge {
-                what: "string length",
-                len: n as u64 + 1,
-            })?;
-            self.write_u32(len);
-            self.buf.reserve(n + 1);
-            self.buf.extend_from_slice(text);
-            self.buf.push(0);
-            return Ok(());
+            return self.write_long_string(text);
         }
         let len = match self.order {
             ByteOrder::BigEndian => (n as u32 + 1).to_be_bytes(),
@@ -264,6 +253,24 @@ impl<'a> CdrWriter<'a> {
             p.add(pad + 4 + n).write(0);
             self.buf.set_len(at + pad + 4 + n + 1);
         }
+        Ok(())
+    }
+
+    /// [`write_string`](Self::write_string) for strings longer than [`SHORT`]: `memchr` and `memcpy`.
+    #[inline(never)]
+    fn write_long_string(&mut self, text: &[u8]) -> Result<(), EncodeError> {
+        if text.contains(&0) {
+            return Err(nul_in_string(text));
+        }
+        let n = text.len();
+        let len = u32::try_from(n + 1).map_err(|_| EncodeError::TooLarge {
+            what: "string length",
+            len: n as u64 + 1,
+        })?;
+        self.write_u32(len);
+        self.buf.reserve(n + 1);
+        self.buf.extend_from_slice(text);
+        self.buf.push(0);
         Ok(())
     }
 
