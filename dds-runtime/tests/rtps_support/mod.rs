@@ -85,9 +85,12 @@ pub(crate) struct Sim {
     pub(crate) datagrams_sent: u64,
     /// Faults apply only to user traffic when set (discovery then completes quickly).
     pub(crate) faults_on_discovery: bool,
-    /// When `Some`, every datagram sent is logged here: (sending node, destinations, payload).
-    pub(crate) trace: Option<Vec<(usize, Vec<Locator>, Vec<u8>)>>,
+    /// When `Some`, every datagram sent is logged here.
+    pub(crate) trace: Option<Vec<Sent>>,
 }
+
+/// A datagram as sent: (sending node, destinations, payload).
+pub(crate) type Sent = (usize, Vec<Locator>, Vec<u8>);
 
 pub(crate) fn prefix(i: usize) -> GuidPrefix {
     let mut p = [0u8; 12];
