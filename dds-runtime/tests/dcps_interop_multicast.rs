@@ -18,7 +18,6 @@ use std::time::Duration;
 
 use dcps_util::*;
 use dds_runtime::config::{AddressFamily, Config, InterfaceSelection, MulticastData};
-use dds_runtime::prelude::*;
 
 /// The Cyclone peer: `pub DOMAIN TOPIC COUNT MATCHES` waits for MATCHES readers, writes shapes x = 0..COUNT
 /// (color CYAN) and waits for acknowledgements; `sub DOMAIN TOPIC COUNT` prints `ready` once matched, then
@@ -246,19 +245,6 @@ impl Drop for Capture {
     }
 }
 
-fn participant_with(domain: u32, c: Config) -> DomainParticipant {
-    require_netns();
-    init_tracing();
-    DomainParticipant::builder()
-        .config(Config {
-            domain_id: domain,
-            spdp_interval: Duration::from_millis(200),
-            ..c
-        })
-        .build()
-        .expect("participant")
-}
-
 fn v4_multicast_data() -> Config {
     Config {
         interface: InterfaceSelection::Name("lo".into()),
@@ -274,22 +260,6 @@ fn user_multicast_port(domain: u32) -> String {
 
 fn args(v: &[&str]) -> Vec<String> {
     v.iter().map(|s| s.to_string()).collect()
-}
-
-/// Takes from `r` until `n` samples arrived; their x values.
-fn take_xs(r: &DataReader<ShapeType>, n: usize, timeout: Duration) -> Vec<i32> {
-    let mut got = Vec::new();
-    wait_until(timeout, || {
-        got.extend(
-            r.take()
-                .unwrap()
-                .into_iter()
-                .filter_map(|s| s.data)
-                .map(|d| d.x),
-        );
-        got.len() >= n
-    });
-    got
 }
 
 #[test]

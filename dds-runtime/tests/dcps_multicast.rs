@@ -9,20 +9,6 @@ use dcps_util::*;
 use dds_runtime::config::{AddressFamily, Config, InterfaceSelection, MulticastData};
 use dds_runtime::prelude::*;
 
-fn participant_with(domain: u32, c: Config) -> DomainParticipant {
-    require_netns();
-    init_tracing();
-    DomainParticipant::builder()
-        .config(Config {
-            domain_id: domain,
-            spdp_interval: Duration::from_millis(200),
-            lease_duration: Duration::from_secs(5),
-            ..c
-        })
-        .build()
-        .expect("participant")
-}
-
 fn multicast_data_config() -> Config {
     Config {
         interface: InterfaceSelection::Name("lo".into()),
@@ -38,17 +24,7 @@ fn exchange(w: &DataWriter<ShapeType>, readers: &[DataReader<ShapeType>], n: i32
     }
     w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
     for r in readers {
-        let mut got = Vec::new();
-        wait_until(Duration::from_secs(10), || {
-            got.extend(
-                r.take()
-                    .unwrap()
-                    .into_iter()
-                    .filter_map(|s| s.data)
-                    .map(|d| d.x),
-            );
-            got.len() >= n as usize
-        });
+        let got = take_xs(r, n as usize, Duration::from_secs(10));
         assert_eq!(got, (0..n).collect::<Vec<_>>());
     }
 }
