@@ -4,6 +4,8 @@
 //! What each entry measures (per sample):
 //! - `ours_xcdr1` / `ours_xcdr2`: `cdr::serialize` into one reused `Vec` (cleared each time; encapsulation
 //!   header included) / `cdr::deserialize` of a complete payload.
+//! - `ours_into_xcdr1` / `ours_into_xcdr2` (decode only): `cdr::deserialize_into` one reused sample, as a
+//!   reader that keeps its sample does (strings and sequences keep their buffers).
 //! - `dust_xcdr1` / `dust_xcdr2`: what a Dust DDS DataWriter does per write, `create_dynamic_sample` (the API
 //!   consumes the sample, so a clone made outside the timed region is handed in) then
 //!   `Cdr{1,2}LeSerializer::serialize` (returns a fresh `Vec`); decode is what its DataReader does,
@@ -148,6 +150,16 @@ where
     for (_, tag, ours, _, _) in &payloads {
         g.bench_function(format!("ours_{tag}"), |b| {
             b.iter(|| cdr::deserialize::<T>(black_box(ours)).unwrap())
+        });
+    }
+    // What a reader that keeps a sample to decode into does: its strings and sequences keep their buffers.
+    for (_, tag, ours, _, _) in &payloads {
+        let mut sample = v.clone();
+        g.bench_function(format!("ours_into_{tag}"), |b| {
+            b.iter(|| {
+                cdr::deserialize_into::<T>(black_box(ours), &mut sample).unwrap();
+                black_box(&sample);
+            })
         });
     }
     for (_, tag, _, dust, _) in payloads.iter().filter(|p| p.4) {

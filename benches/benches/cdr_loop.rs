@@ -1,5 +1,6 @@
 //! Runs one codec operation in a loop, for profilers:
-//! `cdr_loop TYPE OP LIB [ITERATIONS]` with TYPE shape|octets1k|nested|wide, OP encode|decode,
+//! `cdr_loop TYPE OP LIB [ITERATIONS]` with TYPE shape|octets1k|nested|wide, OP encode|decode|into (ours:
+//! `deserialize_into` a reused sample),
 //! LIB ours1|ours2|serde (cdr-encoding, XCDR1)|dust1|dust2 (the same calls as `cdr.rs` makes). Example, instructions per operation with callgrind:
 //! `valgrind --tool=callgrind --callgrind-out-file=cg.out target/bench-cdr/release/examples/cdr_loop shape decode ours1 10000`
 
@@ -60,6 +61,7 @@ fn run<T: DdsType + TypeSupport + Clone + Serialize + DeserializeOwned>(
         cdr::serialize(&v, version, ByteOrder::LittleEndian, &mut buf).unwrap();
     }
     let bytes = buf.clone();
+    let mut reused = v.clone();
     for _ in 0..n {
         match (op, lib) {
             ("encode", "serde") => {
@@ -75,6 +77,10 @@ fn run<T: DdsType + TypeSupport + Clone + Serialize + DeserializeOwned>(
                 black_box(
                     cdr_encoding::from_bytes::<T, LittleEndian>(black_box(&bytes[4..])).unwrap(),
                 );
+            }
+            ("into", _) => {
+                cdr::deserialize_into::<T>(black_box(&bytes), &mut reused).unwrap();
+                black_box(&reused);
             }
             ("decode", _) => {
                 black_box(cdr::deserialize::<T>(black_box(&bytes)).unwrap());

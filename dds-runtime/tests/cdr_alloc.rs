@@ -1,10 +1,10 @@
 //! Fast paths: encoding into a reused `Vec` allocates nothing; decoding a string or a primitive sequence
-//! allocates once; a hostile length allocates nothing.
+//! allocates once; decoding into a reused sample allocates nothing; a hostile length allocates nothing.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use dds_runtime::cdr::{deserialize, serialize, ByteOrder, XcdrVersion};
+use dds_runtime::cdr::{deserialize, deserialize_into, serialize, ByteOrder, XcdrVersion};
 use dds_runtime::DdsType;
 
 struct Counting;
@@ -110,4 +110,43 @@ fn allocation_counts() {
     let (n, r) = allocations(|| deserialize::<Prims>(&hostile));
     assert!(r.is_err());
     assert_eq!(n, 0, "a hostile length allocates nothing");
+}
+
+#[derive(DdsType, Debug, PartialEq, Clone)]
+#[dds(appendable)]
+struct Shape {
+    #[dds(key, bound = 128)]
+    color: String,
+    x: i32,
+    y: i32,
+    names: Vec<String>,
+    payload: Vec<u8>,
+}
+
+#[test]
+fn decoding_into_a_reused_sample_allocates_nothing() {
+    let shape = |i: i32| Shape {
+        color: format!("COLOR{i}"),
+        x: i,
+        y: 2 * i,
+        names: vec![format!("n{i}"), "m".into()],
+        payload: vec![i as u8; 64],
+    };
+    let mut reused = shape(1000);
+    let mut buf = Vec::with_capacity(1024);
+    for version in [XcdrVersion::Xcdr1, XcdrVersion::Xcdr2] {
+        for order in [ByteOrder::LittleEndian, ByteOrder::BigEndian] {
+            for i in 0..10 {
+                buf.clear();
+                serialize(&shape(i), version, order, &mut buf).unwrap();
+                let (n, r) = allocations(|| deserialize_into(&buf, &mut reused));
+                r.unwrap();
+                assert_eq!(reused, shape(i));
+                assert_eq!(
+                    n, 0,
+                    "decoding into a reused sample allocated ({version:?} {order:?})"
+                );
+            }
+        }
+    }
 }

@@ -5,8 +5,8 @@ mod cdr_families;
 
 use cdr_families::*;
 use dds_runtime::cdr::{
-    deserialize, deserialize_key, instance_key, key_hash, serialize, serialize_key, ByteOrder,
-    DdsType, XcdrVersion,
+    deserialize, deserialize_into, deserialize_key, instance_key, key_hash, serialize,
+    serialize_key, ByteOrder, DdsType, XcdrVersion,
 };
 use proptest::prelude::*;
 
@@ -15,6 +15,8 @@ const ORDERS: [ByteOrder; 2] = [ByteOrder::LittleEndian, ByteOrder::BigEndian];
 
 fn all_encodings<T: DdsType + PartialEq + std::fmt::Debug>(v: &T) -> Result<(), TestCaseError> {
     let mut out = Vec::new();
+    // Decoded over the type's default first, then over the previous decoding (buffers reused).
+    let mut reused = T::default_value();
     for version in VERSIONS {
         for order in ORDERS {
             out.clear();
@@ -24,6 +26,10 @@ fn all_encodings<T: DdsType + PartialEq + std::fmt::Debug>(v: &T) -> Result<(), 
             let back = deserialize::<T>(&out)
                 .map_err(|e| TestCaseError::fail(format!("{version:?} {order:?}: {e}")))?;
             prop_assert_eq!(&back, v, "{:?} {:?}", version, order);
+            // Decoding in place over whatever the sample held before gives the same value.
+            deserialize_into(&out, &mut reused)
+                .map_err(|e| TestCaseError::fail(format!("into, {version:?} {order:?}: {e}")))?;
+            prop_assert_eq!(&reused, v, "into, {:?} {:?}", version, order);
         }
     }
     Ok(())

@@ -33,7 +33,10 @@ fn auto_index_probes_and_multicast_reaches_every_participant() {
         ports::metatraffic_unicast(51, 0).unwrap()
     );
     assert_eq!(b.user_unicast().port(), ports::user_unicast(51, 1).unwrap());
-    assert_eq!(a.metatraffic_unicast().ip().octets(), [127, 0, 0, 1]);
+    assert_eq!(
+        a.metatraffic_unicast().ip(),
+        std::net::IpAddr::from([127, 0, 0, 1])
+    );
     assert!(Config {
         participant_index: ParticipantIndex::Fixed(0),
         ..cfg(51, ParticipantIndex::Auto)

@@ -209,6 +209,54 @@ pub(super) fn struct_decode(c: &Container, ext: Ext) -> TokenStream {
     }
 }
 
+/// A final or appendable struct's `CdrType::decode_in_place`: each member decoded over the old one (strings
+/// and sequences keep their buffers), a member the sample lacks set to its default. Mutable structs, derived
+/// structs and key-only payloads keep the trait's default (decode, then replace).
+pub(super) fn struct_decode_in_place(c: &Container, s: &Struct) -> TokenStream {
+    if s.ext == Ext::Mutable || s.base.is_some() {
+        return quote!();
+    }
+    let cdr = c.cdr();
+    let ext_t = ext_tokens(c, s.ext);
+    let fields = s.fields.iter().map(|f| {
+        let (ident, ty, inner) = (f.ident, f.ty, f.inner);
+        let d = default_of(c, f);
+        let bound = bound_limit(f.attrs.bound.as_ref());
+        if f.attrs.non_serialized {
+            quote!(self.#ident = ::core::default::Default::default();)
+        } else if f.optional {
+            quote!(self.#ident = if st.has_more(r) {
+                #cdr::members::decode_optional::<#inner>(r, #bound)?
+            } else {
+                #d
+            };)
+        } else {
+            quote!(if st.has_more(r) {
+                <#ty as #cdr::CdrType>::decode_in_place(&mut self.#ident, r, #bound)?;
+            } else {
+                self.#ident = #d;
+            })
+        }
+    });
+    quote! {
+        fn decode_in_place(
+            &mut self,
+            r: &mut #cdr::CdrReader<'_>,
+            bound: usize,
+        ) -> ::core::result::Result<(), #cdr::DecodeError> {
+            let _ = bound;
+            if r.key_only() {
+                *self = <Self as #cdr::CdrType>::decode(r)?;
+                return ::core::result::Result::Ok(());
+            }
+            let st = #cdr::members::begin_decode(r, #ext_t)?;
+            #(#fields)*
+            st.end(r);
+            ::core::result::Result::Ok(())
+        }
+    }
+}
+
 /// A struct's `CdrType::default_value`.
 pub(super) fn struct_default_value(c: &Container, s: &Struct) -> TokenStream {
     let cdr = c.cdr();

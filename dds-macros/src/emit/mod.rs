@@ -62,6 +62,7 @@ fn struct_impls(c: &Container, s: &Struct) -> TokenStream {
     let next_id = layout::next_member_id(c, s);
     let encode = encode::struct_encode(c, s.ext);
     let decode = decode::struct_decode(c, s.ext);
+    let decode_in_place = decode::struct_decode_in_place(c, s);
     let default_value = decode::struct_default_value(c, s);
     let key_max_end = key::struct_key_max_end(c, s.ext);
     let dds_type = describe::dds_type(
@@ -94,6 +95,7 @@ fn struct_impls(c: &Container, s: &Struct) -> TokenStream {
             const NEXT_MEMBER_ID: u32 = #next_id;
             #encode
             #decode
+            #decode_in_place
             #default_value
             #key_max_end
         }

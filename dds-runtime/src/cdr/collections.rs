@@ -16,6 +16,7 @@ const fn align4(p: usize) -> usize {
     (p + 3) & !3
 }
 
+#[inline(always)]
 fn check_bound(what: &'static str, len: usize, bound: usize) -> Result<(), EncodeError> {
     if len > bound {
         Err(EncodeError::BoundExceeded { what, bound, len })
@@ -36,28 +37,37 @@ fn bound_error(
 }
 
 /// Encodes a string body (length with NUL, bytes, NUL); shared by `String` and `BoundedString`.
+#[inline]
 pub(crate) fn encode_str(s: &str, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
     check_bound("string", s.len(), bound)?;
-    // `contains` on bytes is memchr (vectorised); the position is only looked for on error.
-    if s.as_bytes().contains(&0) {
-        return Err(EncodeError::InvalidValue {
-            what: "NUL inside a string",
-            value: s.bytes().position(|b| b == 0).unwrap_or(0) as u64,
-        });
-    }
-    w.write_len(s.len() + 1, "string length")?;
-    w.write_bytes(s.as_bytes());
-    w.write_u8(0);
-    Ok(())
+    // The writer checks for a NUL inside (on the words it copies, for short strings).
+    w.write_string(s.as_bytes())
 }
 
 /// Decodes a string body with one allocation.
 pub(crate) fn decode_str(r: &mut CdrReader<'_>, bound: usize) -> Result<String, DecodeError> {
+    str_body(r, bound).map(str::to_owned)
+}
+
+/// Decodes a string body into `s`, reusing its buffer.
+pub(crate) fn decode_str_in_place(
+    s: &mut String,
+    r: &mut CdrReader<'_>,
+    bound: usize,
+) -> Result<(), DecodeError> {
+    let text = str_body(r, bound)?;
+    s.clear();
+    s.push_str(text);
+    Ok(())
+}
+
+/// The characters of a string body, checked (bound, terminating NUL, no NUL inside, UTF-8).
+fn str_body<'a>(r: &mut CdrReader<'a>, bound: usize) -> Result<&'a str, DecodeError> {
     let at = r.offset();
     let n = r.read_count(1, "string length")?;
     if n == 0 {
         // Some implementations send an empty string as length 0.
-        return Ok(String::new());
+        return Ok("");
     }
     if n - 1 > bound {
         return Err(bound_error(r, at, "string within its bound", n - 1, bound));
@@ -65,6 +75,10 @@ pub(crate) fn decode_str(r: &mut CdrReader<'_>, bound: usize) -> Result<String, 
     let body_at = r.offset();
     let bytes = r.read_bytes(n, "string characters")?;
     let (text, nul) = bytes.split_at(n - 1);
+    if nul[0] == 0 && short_ascii_without_nul(text) {
+        // SAFETY: ASCII is UTF-8.
+        return Ok(unsafe { std::str::from_utf8_unchecked(text) });
+    }
     if nul[0] != 0 || text.contains(&0) {
         return Err(DecodeError::new(
             body_at,
@@ -73,12 +87,37 @@ pub(crate) fn decode_str(r: &mut CdrReader<'_>, bound: usize) -> Result<String, 
         ));
     }
     match std::str::from_utf8(text) {
-        Ok(s) => Ok(s.to_owned()),
+        Ok(s) => Ok(s),
         Err(e) => Err(DecodeError::new(
             body_at + e.valid_up_to(),
             "UTF-8 string",
             DecodeErrorKind::MalformedString,
         )),
+    }
+}
+
+/// Whether `b` is at most 16 bytes of ASCII without a NUL, tested on two overlapping words (the common short
+/// string, for which `memchr` and `from_utf8` cost more than the characters); `false` sends the caller to the
+/// full checks.
+#[inline(always)]
+fn short_ascii_without_nul(b: &[u8]) -> bool {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    const HI: u64 = 0x8080_8080_8080_8080;
+    // A byte is 0 or >= 0x80 exactly when the result has its high bit set.
+    let bad = |v: u64, lo: u64, hi: u64| (v.wrapping_sub(lo) | v) & hi != 0;
+    let n = b.len();
+    let word = |s: &[u8]| -> u64 {
+        let mut a = [0u8; 8];
+        a[..s.len()].copy_from_slice(s);
+        u64::from_le_bytes(a)
+    };
+    match n {
+        8..=16 => !(bad(word(&b[..8]), LO, HI) || bad(word(&b[n - 8..]), LO, HI)),
+        4..=7 => {
+            let (lo, hi) = (LO & 0xffff_ffff, HI & 0xffff_ffff);
+            !(bad(word(&b[..4]), lo, hi) || bad(word(&b[n - 4..]), lo, hi))
+        }
+        _ => n < 4 && b.iter().all(|&c| c != 0 && c < 0x80),
     }
 }
 
@@ -104,6 +143,7 @@ impl CdrType for String {
         String::new()
     }
 
+    #[inline]
     fn encode_bounded(&self, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
         encode_str(self, w, bound)
     }
@@ -112,12 +152,18 @@ impl CdrType for String {
         decode_str(r, bound)
     }
 
+    #[inline]
+    fn decode_in_place(&mut self, r: &mut CdrReader<'_>, bound: usize) -> Result<(), DecodeError> {
+        decode_str_in_place(self, r, bound)
+    }
+
     fn key_max_end(start: usize, _version: XcdrVersion, bound: Option<usize>) -> Option<usize> {
         string_key_max_end(start, bound)
     }
 }
 
 /// Encodes a sequence body; shared by `Vec` and `BoundedSeq`.
+#[inline]
 pub(crate) fn encode_seq<T: CdrType>(
     items: &[T],
     w: &mut CdrWriter<'_>,
@@ -148,6 +194,18 @@ pub(crate) fn decode_seq<T: CdrType>(
     r: &mut CdrReader<'_>,
     bound: usize,
 ) -> Result<Vec<T>, DecodeError> {
+    let mut v = Vec::new();
+    decode_seq_in_place(&mut v, r, bound)?;
+    Ok(v)
+}
+
+/// Decodes a sequence body into `v`, reusing its buffer and, for non-primitive elements, the elements it
+/// already holds (decoded in place).
+pub(crate) fn decode_seq_in_place<T: CdrType>(
+    v: &mut Vec<T>,
+    r: &mut CdrReader<'_>,
+    bound: usize,
+) -> Result<(), DecodeError> {
     let limit = if !T::LAYOUT.is_primitive() && r.is_xcdr2() {
         r.enter("sequence")?;
         let len = r.read_u32("sequence DHEADER")? as usize;
@@ -160,13 +218,23 @@ pub(crate) fn decode_seq<T: CdrType>(
     if n > bound {
         return Err(bound_error(r, at, "sequence within its bound", n, bound));
     }
-    let mut v = Vec::with_capacity(capacity_for::<T>(n, r.remaining()));
-    T::decode_into(&mut v, n, r)?;
+    // Primitives are copied in bulk; other elements are decoded over the ones already there.
+    let keep = if T::LAYOUT.is_primitive() {
+        0
+    } else {
+        v.len().min(n)
+    };
+    v.truncate(keep);
+    for e in v.iter_mut() {
+        e.decode_in_place(r, usize::MAX)?;
+    }
+    v.reserve(capacity_for::<T>(n - keep, r.remaining()));
+    T::decode_into(v, n - keep, r)?;
     if let Some(l) = limit {
         r.end_limit(l);
         r.leave();
     }
-    Ok(v)
+    Ok(())
 }
 
 pub(crate) fn seq_key_max_end<T: CdrType>(
@@ -212,12 +280,18 @@ impl<T: CdrType> CdrType for Vec<T> {
         Vec::new()
     }
 
+    #[inline]
     fn encode_bounded(&self, w: &mut CdrWriter<'_>, bound: usize) -> Result<(), EncodeError> {
         encode_seq(self, w, bound)
     }
 
     fn decode_bounded(r: &mut CdrReader<'_>, bound: usize) -> Result<Self, DecodeError> {
         decode_seq(r, bound)
+    }
+
+    #[inline]
+    fn decode_in_place(&mut self, r: &mut CdrReader<'_>, bound: usize) -> Result<(), DecodeError> {
+        decode_seq_in_place(self, r, bound)
     }
 
     fn key_max_end(start: usize, version: XcdrVersion, bound: Option<usize>) -> Option<usize> {
@@ -442,5 +516,46 @@ impl<T: CdrType> CdrType for Box<T> {
             return None;
         }
         T::key_max_end(start, version, bound)
+    }
+}
+
+#[cfg(test)]
+mod string_tests {
+    use super::*;
+    use crate::cdr::ByteOrder;
+
+    /// The short-string fast path agrees with the full checks for every length up to 40 and every position
+    /// of a NUL, a byte above 0x7f (invalid alone), and a two-byte UTF-8 character.
+    #[test]
+    fn short_string_checks_agree_with_the_full_ones() {
+        let decode = |text: &[u8]| {
+            let mut p = ((text.len() + 1) as u32).to_le_bytes().to_vec();
+            p.extend_from_slice(text);
+            p.push(0);
+            let mut r = CdrReader::new(&p, 0, XcdrVersion::Xcdr1, ByteOrder::LittleEndian, false);
+            decode_str(&mut r, usize::MAX).ok()
+        };
+        let reference = |text: &[u8]| {
+            (!text.contains(&0))
+                .then(|| std::str::from_utf8(text).ok().map(str::to_owned))
+                .flatten()
+        };
+        for n in 0..=40usize {
+            let base: Vec<u8> = (0..n).map(|i| b'A' + (i % 26) as u8).collect();
+            assert_eq!(decode(&base), reference(&base), "plain {n}");
+            for at in 0..n {
+                for b in [0u8, 0x80, 0xff] {
+                    let mut t = base.clone();
+                    t[at] = b;
+                    assert_eq!(decode(&t), reference(&t), "n {n}, byte {b:#x} at {at}");
+                }
+                if at + 1 < n {
+                    let mut t = base.clone();
+                    t[at] = 0xc3;
+                    t[at + 1] = 0xa9; // é
+                    assert_eq!(decode(&t), reference(&t), "n {n}, é at {at}");
+                }
+            }
+        }
     }
 }

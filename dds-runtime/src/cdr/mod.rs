@@ -1,6 +1,7 @@
 //! XCDR1/XCDR2 serialization (XTypes 1.3 §7.4).
 //!
-//! The entry points are [`serialize`], [`deserialize`], [`serialize_key`], [`deserialize_key`], [`key_hash`]
+//! The entry points are [`serialize`], [`deserialize`] (and [`deserialize_into`], which reuses a sample),
+//! [`serialize_key`], [`deserialize_key`], [`key_hash`]
 //! and [`instance_key`], over types implementing [`DdsType`] (usually through `#[derive(DdsType)]`).
 //! Generated code drives [`CdrWriter`] and [`CdrReader`] through the helpers in [`members`].
 
@@ -24,7 +25,7 @@ pub use header::{ByteOrder, EncapsulationHeader, Extensibility, Representation, 
 pub(crate) use key::hash_key_stream;
 pub use key::{deserialize_key, instance_key, key_hash, serialize_key};
 pub use members::{DefaultSearch, Discriminator, StructMembers};
-pub use payload::{deserialize, serialize};
+pub use payload::{deserialize, deserialize_into, serialize};
 pub(crate) use payload::{finish_payload, payload_reader};
 pub use reader::{CdrReader, Limit};
 pub use traits::{CdrType, DdsType, Layout, MemberDescriptor, TypeDescriptor};

@@ -4,8 +4,9 @@ use super::error::{DecodeError, EncodeError};
 use super::header::{ByteOrder, EncapsulationHeader, XcdrVersion};
 use super::reader::CdrReader;
 use super::traits::DdsType;
-use super::writer::{CdrWriter, EncodeMode};
+use super::writer::{push_zeros, CdrWriter, EncodeMode};
 
+#[inline]
 fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut Vec<u8>) -> usize {
     let start = out.len();
     out.extend_from_slice(
@@ -16,6 +17,7 @@ fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut V
 
 /// Pads the payload to a multiple of 4 and records the padding in the header options, as Cyclone DDS does;
 /// on error removes what was appended.
+#[inline]
 pub(crate) fn finish_payload(
     start: usize,
     r: Result<(), EncodeError>,
@@ -26,12 +28,15 @@ pub(crate) fn finish_payload(
         return Err(e);
     }
     let pad = (out.len() - start).wrapping_neg() & 3;
-    out.extend_from_slice(&[0u8; 3][..pad]);
-    out[start + 3] = (out[start + 3] & !3) | pad as u8;
+    push_zeros(out, pad);
+    if let Some(options) = out.get_mut(start + 3) {
+        *options = (*options & !3) | pad as u8;
+    }
     Ok(())
 }
 
 /// Appends the encapsulation header and the encoding of `sample` in `mode`, then pads (see [`finish_payload`]).
+#[inline]
 pub(crate) fn encode_payload<T: DdsType>(
     sample: &T,
     version: XcdrVersion,
@@ -76,4 +81,11 @@ pub fn serialize<T: DdsType>(
 /// Decodes a payload that starts with its encapsulation header. Never panics; see [`DecodeError`].
 pub fn deserialize<T: DdsType>(payload: &[u8]) -> Result<T, DecodeError> {
     decode_payload(payload, false)
+}
+
+/// [`deserialize`] into an existing sample, reusing the buffers of its strings and sequences: decoding a
+/// stream of samples into one value allocates nothing once its buffers are large enough. On error `sample`
+/// holds some mix of old and new members.
+pub fn deserialize_into<T: DdsType>(payload: &[u8], sample: &mut T) -> Result<(), DecodeError> {
+    sample.decode_in_place(&mut payload_reader(payload, false)?, usize::MAX)
 }

@@ -280,7 +280,17 @@ macro_rules! byte_like {
                 r: &mut CdrReader<'_>,
             ) -> Result<(), DecodeError> {
                 let bytes = r.read_bytes(n, $what)?;
-                out.extend(bytes.iter().map(|&b| b as $t));
+                out.reserve(n);
+                // SAFETY: `reserve(n)` made room for n more elements; a byte is a valid u8/i8, and `bytes`
+                // holds exactly n of them.
+                unsafe {
+                    std::ptr::copy_nonoverlapping(
+                        bytes.as_ptr(),
+                        out.as_mut_ptr().add(out.len()).cast::<u8>(),
+                        n,
+                    );
+                    out.set_len(out.len() + n);
+                }
                 Ok(())
             }
         }

@@ -98,6 +98,15 @@ pub trait CdrType: Sized {
         Self::decode(r)
     }
 
+    /// Decodes one value (with an IDL bound) into `self`, reusing what `self` owns: strings and sequences keep
+    /// their buffers, derived final/appendable structs decode member by member in place. The default
+    /// replaces `self`. On error `self` holds some mix of old and new members (still a valid value).
+    #[inline]
+    fn decode_in_place(&mut self, r: &mut CdrReader<'_>, bound: usize) -> Result<(), DecodeError> {
+        *self = Self::decode_bounded(r, bound)?;
+        Ok(())
+    }
+
     /// End offset of the largest key-hash stream of this type (key members only, plain, no DHEADER/EMHEADER)
     /// starting at `start`, or `None` when unbounded; decides between zero-padding and MD5 for the key hash.
     /// `bound` is the member's IDL bound, if any.

@@ -42,14 +42,90 @@ pub struct ParamSlot {
     saved_origin: usize,
 }
 
+/// An aligned primitive: its padding and its bytes in the writer's byte order, in one append
+/// ([`CdrWriter::put_padded`]).
 macro_rules! put {
     ($self:ident, $v:expr) => {{
         let v = $v;
-        match $self.order {
-            ByteOrder::BigEndian => $self.buf.extend_from_slice(&v.to_be_bytes()),
-            ByteOrder::LittleEndian => $self.buf.extend_from_slice(&v.to_le_bytes()),
-        }
+        let bytes = match $self.order {
+            ByteOrder::BigEndian => v.to_be_bytes(),
+            ByteOrder::LittleEndian => v.to_le_bytes(),
+        };
+        let pad = $self.padding(bytes.len());
+        $self.put_padded(pad, bytes);
     }};
+}
+
+/// Strings and byte runs up to this long are copied with word stores ([`copy_short`]).
+const SHORT: usize = 16;
+
+/// Copies `src` (at most [`SHORT`] bytes) to `dst` with two overlapping word loads and stores (or three byte
+/// copies below 4 bytes), and tells whether `src` holds a NUL, tested on the same words.
+///
+/// # Safety
+/// `dst` must be valid for writes of `src.len()` bytes and must not overlap `src`.
+#[inline(always)]
+unsafe fn copy_short(src: &[u8], dst: *mut u8) -> bool {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    const HI: u64 = 0x8080_8080_8080_8080;
+    let n = src.len();
+    debug_assert!(n <= SHORT);
+    let s = src.as_ptr();
+    // SAFETY (all branches): every load reads inside `src` (offsets 0..n) and every store writes inside
+    // `dst[..n]`, as the caller guarantees.
+    unsafe {
+        if n >= 8 {
+            let a = s.cast::<u64>().read_unaligned();
+            let b = s.add(n - 8).cast::<u64>().read_unaligned();
+            dst.cast::<u64>().write_unaligned(a);
+            dst.add(n - 8).cast::<u64>().write_unaligned(b);
+            let zero = |v: u64| v.wrapping_sub(LO) & !v & HI != 0;
+            zero(a) | zero(b)
+        } else if n >= 4 {
+            let a = s.cast::<u32>().read_unaligned();
+            let b = s.add(n - 4).cast::<u32>().read_unaligned();
+            dst.cast::<u32>().write_unaligned(a);
+            dst.add(n - 4).cast::<u32>().write_unaligned(b);
+            let zero = |v: u32| v.wrapping_sub(LO as u32) & !v & HI as u32 != 0;
+            zero(a) | zero(b)
+        } else if n > 0 {
+            let (a, b, c) = (*s, *s.add(n / 2), *s.add(n - 1));
+            *dst = a;
+            *dst.add(n / 2) = b;
+            *dst.add(n - 1) = c;
+            a == 0 || b == 0 || c == 0
+        } else {
+            false
+        }
+    }
+}
+
+/// The error for a string holding a NUL (out of line: never the hot path).
+#[cold]
+#[inline(never)]
+fn nul_in_string(text: &[u8]) -> EncodeError {
+    EncodeError::InvalidValue {
+        what: "NUL inside a string",
+        value: text.iter().position(|&b| b == 0).unwrap_or(0) as u64,
+    }
+}
+
+/// Appends `pad` (< 8) zero bytes to `buf` with one capacity check and two plain stores: a slice copy of a
+/// run-time length, or `resize`, would call `memcpy`/`memset`, which costs more than the bytes themselves.
+#[inline(always)]
+pub(crate) fn push_zeros(buf: &mut Vec<u8>, pad: usize) {
+    debug_assert!(pad < 8);
+    buf.reserve(8);
+    let len = buf.len();
+    // SAFETY: `reserve` made room for 8 bytes after `len`, and `pad < 8`: the store stays within the
+    // capacity, and every byte below the new length has been written.
+    unsafe {
+        buf.as_mut_ptr()
+            .add(len)
+            .cast::<[u8; 8]>()
+            .write_unaligned([0; 8]);
+        buf.set_len(len + (pad & 7));
+    }
 }
 
 impl<'a> CdrWriter<'a> {
@@ -117,18 +193,103 @@ impl<'a> CdrWriter<'a> {
     /// Pads with zeros to a multiple of `n` (a power of two; capped at 4 in XCDR2).
     #[inline]
     pub fn align(&mut self, n: usize) {
-        let n = n.min(self.max_align);
-        let pad = self.position().wrapping_neg() & (n - 1);
+        let pad = self.padding(n);
         if pad != 0 {
-            // A slice copy of at most 7 bytes compiles to plain stores; `resize` calls memset.
-            self.buf.extend_from_slice(&[0u8; 8][..pad]);
+            push_zeros(self.buf, pad);
         }
     }
 
-    /// Appends raw bytes (no alignment).
+    /// The padding before a value aligned to `n` (a power of two, capped at the version's maximum).
+    #[inline(always)]
+    fn padding(&self, n: usize) -> usize {
+        // Every version aligns up to 4 bytes: only 8-byte values depend on it (a constant `n` folds).
+        let n = if n <= 4 { n } else { n.min(self.max_align) };
+        self.position().wrapping_neg() & (n - 1)
+    }
+
+    /// Appends `pad` (< 8) zero bytes and then `bytes`, with one capacity check and no libc call.
+    #[inline(always)]
+    fn put_padded<const N: usize>(&mut self, pad: usize, bytes: [u8; N]) {
+        debug_assert!(pad < 8);
+        let pad = pad & 7;
+        self.buf.reserve(8 + N);
+        let len = self.buf.len();
+        // SAFETY: `reserve` made room for 8 + N bytes after `len`; with `pad < 8` both stores stay within
+        // the capacity, and every byte below the new length (len + pad + N) has been written.
+        unsafe {
+            let p = self.buf.as_mut_ptr().add(len);
+            p.cast::<[u8; 8]>().write_unaligned([0; 8]);
+            p.add(pad).cast::<[u8; N]>().write_unaligned(bytes);
+            self.buf.set_len(len + pad + N);
+        }
+    }
+
+    /// Writes a string body: the aligned length (with the NUL), the characters and the NUL. Fails when
+    /// `text` holds a NUL (nothing is appended then). Strings of up to 16 bytes take one capacity check and
+    /// a few word stores, with the NUL check on the same words; longer ones use `memchr` and `memcpy`.
+    #[inline(always)]
+    pub fn write_string(&mut self, text: &[u8]) -> Result<(), EncodeError> {
+        let n = text.len();
+        if n > SHORT {
+            return self.write_long_string(text);
+        }
+        let len = match self.order {
+            ByteOrder::BigEndian => (n as u32 + 1).to_be_bytes(),
+            ByteOrder::LittleEndian => (n as u32 + 1).to_le_bytes(),
+        };
+        let pad = self.padding(4) & 3;
+        self.buf.reserve(8 + 4 + SHORT + 1);
+        let at = self.buf.len();
+        // SAFETY: `reserve` made room for 8 + 4 + SHORT + 1 bytes after `at`: the zero word (8 bytes), the
+        // length at `pad` < 4, `n` <= SHORT characters after it and the NUL all stay within the capacity. The
+        // length is only raised (to cover exactly what was written) when no NUL was found.
+        unsafe {
+            let p = self.buf.as_mut_ptr().add(at);
+            p.cast::<[u8; 8]>().write_unaligned([0; 8]);
+            p.add(pad).cast::<[u8; 4]>().write_unaligned(len);
+            if copy_short(text, p.add(pad + 4)) {
+                return Err(nul_in_string(text));
+            }
+            p.add(pad + 4 + n).write(0);
+            self.buf.set_len(at + pad + 4 + n + 1);
+        }
+        Ok(())
+    }
+
+    /// [`write_string`](Self::write_string) for strings longer than [`SHORT`]: `memchr` and `memcpy`.
+    #[inline(never)]
+    fn write_long_string(&mut self, text: &[u8]) -> Result<(), EncodeError> {
+        if text.contains(&0) {
+            return Err(nul_in_string(text));
+        }
+        let n = text.len();
+        let len = u32::try_from(n + 1).map_err(|_| EncodeError::TooLarge {
+            what: "string length",
+            len: n as u64 + 1,
+        })?;
+        self.write_u32(len);
+        self.buf.reserve(n + 1);
+        self.buf.extend_from_slice(text);
+        self.buf.push(0);
+        Ok(())
+    }
+
+    /// Appends raw bytes (no alignment). Up to 16 bytes are copied with word stores (no `memcpy` call).
     #[inline]
     pub fn write_bytes(&mut self, bytes: &[u8]) {
-        self.buf.extend_from_slice(bytes);
+        let n = bytes.len();
+        if n > SHORT {
+            self.buf.extend_from_slice(bytes);
+            return;
+        }
+        self.buf.reserve(SHORT);
+        let at = self.buf.len();
+        // SAFETY: `reserve` made room for SHORT >= n bytes after `at`; all n are written before the length
+        // covers them.
+        unsafe {
+            copy_short(bytes, self.buf.as_mut_ptr().add(at));
+            self.buf.set_len(at + n);
+        }
     }
 
     /// Writes an octet.
@@ -137,24 +298,21 @@ impl<'a> CdrWriter<'a> {
         self.buf.push(v);
     }
 
-    /// Writes an aligned 16-bit value.
+    /// Writes an aligned 16-bit value (its padding included).
     #[inline]
     pub fn write_u16(&mut self, v: u16) {
-        self.align(2);
         put!(self, v);
     }
 
     /// Writes an aligned 32-bit value.
     #[inline]
     pub fn write_u32(&mut self, v: u32) {
-        self.align(4);
         put!(self, v);
     }
 
     /// Writes an aligned 64-bit value.
     #[inline]
     pub fn write_u64(&mut self, v: u64) {
-        self.align(8);
         put!(self, v);
     }
 
@@ -307,5 +465,71 @@ impl<'a> CdrWriter<'a> {
         let r = f(self);
         self.mode = saved;
         r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every length around the short/long boundary, a NUL at every position of each: an error and nothing
+    /// appended; without a NUL the exact bytes (length, characters, NUL) after the padding.
+    #[test]
+    fn strings_of_every_short_length_and_nul_position() {
+        for order in [ByteOrder::LittleEndian, ByteOrder::BigEndian] {
+            for prefix in 0..4usize {
+                for n in 0..=40usize {
+                    let text: Vec<u8> = (0..n).map(|i| b'a' + (i % 26) as u8).collect();
+                    let mut buf = vec![7u8; prefix];
+                    let mut w =
+                        CdrWriter::new(&mut buf, XcdrVersion::Xcdr1, order, EncodeMode::Sample);
+                    w.write_u8(1);
+                    w.write_string(&text).unwrap();
+                    let len = (n as u32 + 1).to_le_bytes();
+                    let len = match order {
+                        ByteOrder::LittleEndian => len,
+                        ByteOrder::BigEndian => (n as u32 + 1).to_be_bytes(),
+                    };
+                    let mut want = vec![7u8; prefix];
+                    want.extend_from_slice(&[1, 0, 0, 0]);
+                    want.extend_from_slice(&len);
+                    want.extend_from_slice(&text);
+                    want.push(0);
+                    assert_eq!(buf, want, "n {n}, prefix {prefix}");
+                    for at in 0..n {
+                        let mut bad = text.clone();
+                        bad[at] = 0;
+                        let mut buf = vec![7u8; prefix];
+                        let mut w =
+                            CdrWriter::new(&mut buf, XcdrVersion::Xcdr1, order, EncodeMode::Sample);
+                        assert_eq!(
+                            w.write_string(&bad),
+                            Err(EncodeError::InvalidValue {
+                                what: "NUL inside a string",
+                                value: at as u64
+                            })
+                        );
+                        assert_eq!(buf, vec![7u8; prefix], "nothing appended on error");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn short_byte_runs_are_copied_exactly() {
+        for n in 0..=40usize {
+            let bytes: Vec<u8> = (0..n as u8).collect();
+            let mut buf = vec![9u8];
+            let mut w = CdrWriter::new(
+                &mut buf,
+                XcdrVersion::Xcdr2,
+                ByteOrder::LittleEndian,
+                EncodeMode::Sample,
+            );
+            w.write_bytes(&bytes);
+            assert_eq!(buf[0], 9);
+            assert_eq!(&buf[1..], &bytes[..]);
+        }
     }
 }

@@ -6,9 +6,11 @@
 //! | variable | meaning | values | default |
 //! |---|---|---|---|
 //! | `DDS_DOMAIN_ID` | domain id | `0`..=`232` | `0` |
-//! | `DDS_INTERFACE` | network interface for all traffic | interface name (`lo`, `eth0`) or IPv4 address (`127.0.0.1`) | first up, multicast-capable, non-loopback IPv4 interface, else loopback |
-//! | `DDS_MULTICAST` | use multicast for SPDP (send and receive) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
-//! | `DDS_PEERS` | unicast discovery peers | comma-separated `ip` or `ip:port`; a bare ip expands to the SPDP ports of participant indices `0..=DDS_MAX_PARTICIPANT_INDEX` | none |
+//! | `DDS_TRANSPORT` | address family of every socket and locator | `udp` (or `udp4`: IPv4), `udp6` (IPv6), as Cyclone's `General/Transport` | `udp` |
+//! | `DDS_INTERFACE` | network interface for all traffic | interface name (`lo`, `eth0`) or address (`127.0.0.1`, `::1`) | first up, multicast-capable, non-loopback interface of the family, else loopback |
+//! | `DDS_MULTICAST` | use multicast (SPDP send and receive; the switch for multicast data too) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
+//! | `DDS_MULTICAST_DATA` | multicast user data: our readers announce and join a multicast group, and our writers send a sample once to a group that two or more of their readers share | `off`, `on` (239.255.0.1, or ff02::ffff:239.255.0.1 with `udp6`, on the domain's user multicast port), or a group address | `off` |
+//! | `DDS_PEERS` | unicast discovery peers | comma-separated `ip`, `ip:port`, `[ipv6]:port`; a bare ip expands to the SPDP ports of participant indices `0..=DDS_MAX_PARTICIPANT_INDEX` | none |
 //! | `DDS_PARTICIPANT_INDEX` | participant index in the port formula | `auto` (probe `0..=max` by binding unicast ports), `none` (ephemeral ports), or a number | `auto` |
 //! | `DDS_MAX_PARTICIPANT_INDEX` | highest index probed by `auto` and expanded by `DDS_PEERS` | number | `9` |
 //! | `DDS_SPDP_INTERVAL_MS` | period of SPDP announcements | milliseconds | `1000` |
@@ -21,7 +23,7 @@
 //!
 //! Invalid values are reported as [`ConfigError`] rather than silently ignored.
 
-use std::net::{IpAddr, Ipv4Addr, SocketAddrV4};
+use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr};
 use std::time::Duration;
 
 use crate::rtps::discovery::ports::{self, PortError};
@@ -55,11 +57,33 @@ pub enum ConfigError {
         /// The value given.
         value: String,
     },
-    /// A peer is not an IPv4 address or `address:port`.
-    #[error("invalid value {value:?} for DDS_PEERS: expected an IPv4 address or address:port")]
+    /// A peer is not an IP address or `address:port`.
+    #[error("invalid value {value:?} for DDS_PEERS: expected an IP address or address:port")]
     Peer {
         /// The value given.
         value: String,
+    },
+    /// `DDS_TRANSPORT` is not `udp`, `udp4` or `udp6`.
+    #[error("invalid value {value:?} for DDS_TRANSPORT: expected udp, udp4 or udp6")]
+    Transport {
+        /// The value given.
+        value: String,
+    },
+    /// `DDS_MULTICAST_DATA` is neither on/off nor a multicast address.
+    #[error("invalid value {value:?} for DDS_MULTICAST_DATA: expected off, on or a multicast group address")]
+    MulticastData {
+        /// The value given.
+        value: String,
+    },
+    /// An address (interface, peer or multicast group) is not of the configured address family.
+    #[error("{name} {addr} is not an address of the configured family ({family:?})")]
+    AddressFamily {
+        /// Setting name.
+        name: &'static str,
+        /// The address given.
+        addr: IpAddr,
+        /// The configured family.
+        family: AddressFamily,
     },
     /// A size is outside its range.
     #[error("invalid value {value} for {name}: must be {min}..={max}")]
@@ -110,25 +134,120 @@ impl From<PortError> for ConfigError {
     }
 }
 
+/// The address family of the participant's sockets and locators (Cyclone's `General/Transport`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AddressFamily {
+    /// UDP over IPv4 (`udp`, `udp4`): LOCATOR_KIND_UDPv4.
+    #[default]
+    Ipv4,
+    /// UDP over IPv6 (`udp6`): LOCATOR_KIND_UDPv6; SPDP multicast on ff02::ffff:239.255.0.1, as Cyclone.
+    Ipv6,
+}
+
+impl AddressFamily {
+    /// Parses `udp`, `udp4` or `udp6` (case-insensitive).
+    pub fn parse(s: &str) -> Result<Self, ConfigError> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "udp" | "udp4" | "ipv4" => Ok(AddressFamily::Ipv4),
+            "udp6" | "ipv6" => Ok(AddressFamily::Ipv6),
+            _ => Err(ConfigError::Transport {
+                value: s.to_string(),
+            }),
+        }
+    }
+
+    /// Whether `a` belongs to this family.
+    pub fn contains(self, a: IpAddr) -> bool {
+        matches!(
+            (self, a),
+            (AddressFamily::Ipv4, IpAddr::V4(_)) | (AddressFamily::Ipv6, IpAddr::V6(_))
+        )
+    }
+
+    /// The SPDP multicast group: 239.255.0.1, or ff02::ffff:239.255.0.1 (Cyclone's IPv6 default).
+    pub fn spdp_group(self) -> IpAddr {
+        match self {
+            AddressFamily::Ipv4 => IpAddr::V4(ports::SPDP_MULTICAST_GROUP),
+            AddressFamily::Ipv6 => IpAddr::V6(SPDP_MULTICAST_GROUP_V6),
+        }
+    }
+
+    /// The loopback address of the family.
+    pub fn loopback(self) -> IpAddr {
+        match self {
+            AddressFamily::Ipv4 => IpAddr::V4(Ipv4Addr::LOCALHOST),
+            AddressFamily::Ipv6 => IpAddr::V6(Ipv6Addr::LOCALHOST),
+        }
+    }
+}
+
+/// The IPv6 SPDP multicast group Cyclone uses: ff02::ffff:239.255.0.1 (link-local scope).
+pub const SPDP_MULTICAST_GROUP_V6: Ipv6Addr =
+    Ipv6Addr::new(0xff02, 0, 0, 0, 0, 0xffff, 0xefff, 0x0001);
+
+/// Multicast user data (`DDS_MULTICAST_DATA`), like Cyclone's `AllowMulticast` for data.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MulticastData {
+    /// Readers announce no multicast locator; writers send user data unicast only.
+    #[default]
+    Off,
+    /// The SPDP group of the address family (as Cyclone's default) on the domain's user multicast port.
+    On,
+    /// This group on the domain's user multicast port.
+    Group(IpAddr),
+}
+
+impl MulticastData {
+    /// `off`/`on` (any form [`Config::from_lookup`] accepts for a switch) or a multicast group address.
+    pub fn parse(s: &str) -> Result<Self, ConfigError> {
+        let err = || ConfigError::MulticastData {
+            value: s.to_string(),
+        };
+        if let Ok(a) = s.trim().parse::<IpAddr>() {
+            return if a.is_multicast() {
+                Ok(MulticastData::Group(a))
+            } else {
+                Err(err())
+            };
+        }
+        match parse_bool("DDS_MULTICAST_DATA", s) {
+            Ok(true) => Ok(MulticastData::On),
+            Ok(false) => Ok(MulticastData::Off),
+            Err(_) => Err(err()),
+        }
+    }
+
+    /// The group to join and announce for `family`, `None` when off.
+    pub fn group(self, family: AddressFamily) -> Option<IpAddr> {
+        match self {
+            MulticastData::Off => None,
+            MulticastData::On => Some(family.spdp_group()),
+            MulticastData::Group(g) => Some(g),
+        }
+    }
+}
+
 /// Which network interface the participant uses.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub enum InterfaceSelection {
-    /// First up, multicast-capable, non-loopback IPv4 interface; loopback when there is none.
+    /// First up, multicast-capable, non-loopback interface of the address family; loopback when there is
+    /// none.
     #[default]
     Auto,
     /// Interface by name, e.g. `lo`.
     Name(String),
-    /// Interface by (one of) its IPv4 addresses.
-    Address(Ipv4Addr),
+    /// Interface by (one of) its addresses, IPv4 or IPv6.
+    Address(IpAddr),
 }
 
 impl InterfaceSelection {
-    /// Parses `lo`, `eth0` or `127.0.0.1`; an empty string or `auto` means [`InterfaceSelection::Auto`].
+    /// Parses `lo`, `eth0`, `127.0.0.1` or `::1`; an empty string or `auto` means
+    /// [`InterfaceSelection::Auto`].
     pub fn parse(s: &str) -> Self {
         let s = s.trim();
         if s.is_empty() || s.eq_ignore_ascii_case("auto") {
             InterfaceSelection::Auto
-        } else if let Ok(a) = s.parse::<Ipv4Addr>() {
+        } else if let Ok(a) = s.parse::<IpAddr>() {
             InterfaceSelection::Address(a)
         } else {
             InterfaceSelection::Name(s.to_string())
@@ -152,24 +271,24 @@ pub enum ParticipantIndex {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Peer {
     /// An address: SPDP goes to the metatraffic unicast ports of every participant index up to the maximum.
-    Address(Ipv4Addr),
+    Address(IpAddr),
     /// An exact address and port.
-    SocketAddr(SocketAddrV4),
+    SocketAddr(SocketAddr),
 }
 
 impl Peer {
-    /// Parses `127.0.0.1` or `127.0.0.1:7410`.
+    /// Parses `127.0.0.1`, `127.0.0.1:7410`, `::1` or `[::1]:7410`.
     pub fn parse(s: &str) -> Result<Self, ConfigError> {
         let s = s.trim();
-        if let Ok(a) = s.parse::<Ipv4Addr>() {
+        if let Ok(a) = s.parse::<IpAddr>() {
             return Ok(Peer::Address(a));
         }
-        if let Ok(sa) = s.parse::<SocketAddrV4>() {
+        if let Ok(sa) = s.parse::<SocketAddr>() {
             return Ok(Peer::SocketAddr(sa));
         }
         // Accept `localhost` for convenience; nothing else is resolved (no DNS from a DDS stack).
         if s.eq_ignore_ascii_case("localhost") {
-            return Ok(Peer::Address(Ipv4Addr::LOCALHOST));
+            return Ok(Peer::Address(IpAddr::V4(Ipv4Addr::LOCALHOST)));
         }
         Err(ConfigError::Peer {
             value: s.to_string(),
@@ -182,10 +301,16 @@ impl Peer {
 pub struct Config {
     /// DDS domain id.
     pub domain_id: u32,
+    /// Address family of the sockets and locators (IPv4 or IPv6).
+    pub transport: AddressFamily,
     /// Network interface used for sending, receiving and multicast membership.
     pub interface: InterfaceSelection,
-    /// Whether SPDP uses multicast (239.255.0.1 on the domain's discovery port).
+    /// Whether SPDP uses multicast (239.255.0.1, or ff02::ffff:239.255.0.1, on the domain's discovery
+    /// port). Off also turns multicast user data off.
     pub multicast: bool,
+    /// Multicast user data: a group our readers join and announce, and whether our writers send to the
+    /// groups their readers share.
+    pub multicast_data: MulticastData,
     /// Unicast discovery peers.
     pub peers: Vec<Peer>,
     /// Participant index choice.
@@ -214,8 +339,10 @@ impl Default for Config {
     fn default() -> Self {
         Config {
             domain_id: 0,
+            transport: AddressFamily::Ipv4,
             interface: InterfaceSelection::Auto,
             multicast: true,
+            multicast_data: MulticastData::Off,
             peers: Vec::new(),
             participant_index: ParticipantIndex::Auto,
             max_participant_index: 9,
@@ -288,6 +415,12 @@ impl Config {
         let mut c = Config::default();
         if let Some(v) = lookup("DDS_DOMAIN_ID") {
             c.domain_id = parse_num("DDS_DOMAIN_ID", &v)?;
+        }
+        if let Some(v) = lookup("DDS_TRANSPORT") {
+            c.transport = AddressFamily::parse(&v)?;
+        }
+        if let Some(v) = lookup("DDS_MULTICAST_DATA") {
+            c.multicast_data = MulticastData::parse(&v)?;
         }
         if let Some(v) = lookup("DDS_INTERFACE") {
             c.interface = InterfaceSelection::parse(&v);
@@ -363,7 +496,42 @@ impl Config {
         if let ParticipantIndex::Fixed(i) = self.participant_index {
             ports::check(self.domain_id, i)?;
         }
+        self.check_family()
+    }
+
+    /// Every address given (interface, peers, multicast data group) is of the configured family.
+    fn check_family(&self) -> Result<(), ConfigError> {
+        let family = self.transport;
+        let check = |name, addr: IpAddr| {
+            if family.contains(addr) {
+                Ok(())
+            } else {
+                Err(ConfigError::AddressFamily { name, addr, family })
+            }
+        };
+        if let InterfaceSelection::Address(a) = self.interface {
+            check("interface", a)?;
+        }
+        for p in &self.peers {
+            match *p {
+                Peer::Address(a) => check("peer", a)?,
+                Peer::SocketAddr(sa) => check("peer", sa.ip())?,
+            }
+        }
+        if let MulticastData::Group(g) = self.multicast_data {
+            check("multicast data group", g)?;
+        }
         Ok(())
+    }
+
+    /// The multicast group our readers join and announce for user data, `None` when multicast data (or
+    /// multicast) is off.
+    pub fn multicast_data_group(&self) -> Option<IpAddr> {
+        if self.multicast {
+            self.multicast_data.group(self.transport)
+        } else {
+            None
+        }
     }
 
     /// Whether `ip` is loopback (used to decide multicast-loop defaults and logging).
@@ -403,7 +571,7 @@ mod tests {
         assert_eq!(
             c.peers,
             vec![
-                Peer::Address(Ipv4Addr::LOCALHOST),
+                Peer::Address(Ipv4Addr::LOCALHOST.into()),
                 Peer::SocketAddr("127.0.0.2:7410".parse().unwrap())
             ]
         );
@@ -417,7 +585,7 @@ mod tests {
         .unwrap();
         assert_eq!(
             c.interface,
-            InterfaceSelection::Address(Ipv4Addr::LOCALHOST)
+            InterfaceSelection::Address(Ipv4Addr::LOCALHOST.into())
         );
         assert_eq!(c.participant_index, ParticipantIndex::Fixed(3));
     }
@@ -503,6 +671,62 @@ mod tests {
                 }
             })
         );
+    }
+
+    #[test]
+    fn address_family_and_multicast_data() {
+        let c = env(&[]).unwrap();
+        assert_eq!(c.transport, AddressFamily::Ipv4);
+        assert_eq!(c.multicast_data_group(), None);
+        let c = env(&[
+            ("DDS_TRANSPORT", "udp6"),
+            ("DDS_INTERFACE", "::1"),
+            ("DDS_PEERS", "::1,[::1]:7410"),
+            ("DDS_MULTICAST_DATA", "on"),
+        ])
+        .unwrap();
+        assert_eq!(c.transport, AddressFamily::Ipv6);
+        assert_eq!(
+            c.interface,
+            InterfaceSelection::Address(Ipv6Addr::LOCALHOST.into())
+        );
+        assert_eq!(
+            c.peers,
+            vec![
+                Peer::Address(Ipv6Addr::LOCALHOST.into()),
+                Peer::SocketAddr("[::1]:7410".parse().unwrap())
+            ]
+        );
+        assert_eq!(
+            c.multicast_data_group(),
+            Some("ff02::ffff:239.255.0.1".parse().unwrap())
+        );
+        let c = env(&[("DDS_MULTICAST_DATA", "239.255.0.9")]).unwrap();
+        assert_eq!(
+            c.multicast_data_group(),
+            Some("239.255.0.9".parse().unwrap())
+        );
+        let c = env(&[("DDS_MULTICAST_DATA", "on"), ("DDS_MULTICAST", "off")]).unwrap();
+        assert_eq!(c.multicast_data_group(), None, "multicast off wins");
+        assert!(matches!(
+            env(&[("DDS_TRANSPORT", "tcp")]),
+            Err(ConfigError::Transport { .. })
+        ));
+        assert!(matches!(
+            env(&[("DDS_MULTICAST_DATA", "10.0.0.1")]),
+            Err(ConfigError::MulticastData { .. })
+        ));
+        assert!(matches!(
+            env(&[("DDS_TRANSPORT", "udp6"), ("DDS_INTERFACE", "127.0.0.1")]),
+            Err(ConfigError::AddressFamily {
+                name: "interface",
+                ..
+            })
+        ));
+        assert!(matches!(
+            env(&[("DDS_PEERS", "::1")]),
+            Err(ConfigError::AddressFamily { name: "peer", .. })
+        ));
     }
 
     #[test]

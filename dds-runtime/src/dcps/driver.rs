@@ -4,7 +4,7 @@
 //! internals; the driver knows no entity type.
 
 use std::hash::{BuildHasher, Hasher};
-use std::net::{IpAddr, SocketAddr, SocketAddrV4};
+use std::net::{IpAddr, SocketAddr};
 use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, OnceLock, RwLock, Weak};
 use std::thread::JoinHandle;
@@ -136,15 +136,12 @@ struct TimerState {
     waiting_until: Option<Instant>,
 }
 
-fn to_socket(l: &Locator) -> Option<SocketAddrV4> {
-    match l.to_socket_addr()? {
-        SocketAddr::V4(a) => Some(a),
-        SocketAddr::V6(_) => None,
-    }
+fn to_socket(l: &Locator) -> Option<SocketAddr> {
+    l.to_socket_addr()
 }
 
-fn locator(a: SocketAddrV4) -> Locator {
-    Locator::udpv4(a.ip().octets(), a.port())
+fn locator(a: SocketAddr) -> Locator {
+    Locator::from_socket_addr(a)
 }
 
 static PREFIX_COUNTER: AtomicU16 = AtomicU16::new(0);
@@ -175,7 +172,8 @@ fn core_config(
     user_data: Vec<u8>,
     name: Option<String>,
 ) -> DdsResult<ParticipantConfig> {
-    let ip = match IpAddr::V4(transport.interface().addr) {
+    // IPv6: the builder's IPv4 locators are all replaced below.
+    let ip = match transport.interface().addr {
         IpAddr::V4(a) => a.octets(),
         IpAddr::V6(_) => [127, 0, 0, 1],
     };
@@ -195,8 +193,16 @@ fn core_config(
             .into_iter()
             .collect::<Vec<_>>(),
     )
-    // We do not listen on the user multicast port: peers send user data unicast.
-    .default_multicast(Vec::new())
+    // Our readers announce the user-data group when multicast data is on (and we joined it); our writers
+    // then also send to groups their readers share.
+    .default_multicast(
+        transport
+            .user_multicast()
+            .map(locator)
+            .into_iter()
+            .collect::<Vec<_>>(),
+    )
+    .multicast_data(transport.user_multicast().is_some())
     .initial_peers(
         transport
             .spdp_peers()

@@ -253,6 +253,12 @@ participant_config! {
     /// without wire state; the writer's changes reach the reader as events, never as datagrams (see
     /// `docs/rtps-core.md`, "Intra-process delivery").
     intra_process: bool = copy,
+    /// Multicast user data (Cyclone's `AllowMulticast` for data): when on, a writer sends each new sample
+    /// once to a multicast locator shared by two or more of its matched readers (the readers' own
+    /// multicast locators, else their participants' default multicast locators) instead of once per reader;
+    /// repairs still go to each reader's unicast locator. Off (the default): data goes unicast only. What
+    /// *our* readers announce is [`default_multicast`](Self::default_multicast).
+    multicast_data: bool = copy,
 }
 
 impl ParticipantConfig {
@@ -303,6 +309,7 @@ impl ParticipantConfig {
             max_repair_bytes: 256 * 1024,
             write_batch_delay: None,
             intra_process: true,
+            multicast_data: false,
         }))
     }
 

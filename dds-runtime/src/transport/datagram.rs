@@ -9,12 +9,14 @@ use std::sync::Arc;
 /// Which socket a datagram arrived on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Channel {
-    /// SPDP multicast (239.255.0.1 on the domain's discovery port).
+    /// SPDP multicast (239.255.0.1, or ff02::ffff:239.255.0.1, on the domain's discovery port).
     SpdpMulticast,
     /// Metatraffic unicast (SPDP to peers, SEDP).
     MetaUnicast,
     /// User-traffic unicast.
     UserUnicast,
+    /// User-traffic multicast (the group of `DDS_MULTICAST_DATA`).
+    UserMulticast,
 }
 
 /// One received datagram.
@@ -50,6 +52,6 @@ pub(super) const RECV_BUFFER: usize = 65536;
 pub(super) trait RecvBatch {
     /// Blocks for the first datagram, then takes what else the implementation can; returns how many arrived.
     fn recv(&mut self, sock: &UdpSocket) -> io::Result<usize>;
-    /// The `i`th datagram of the last batch; `None` when its sender is not IPv4.
+    /// The `i`th datagram of the last batch; `None` when its sender is neither IPv4 nor IPv6.
     fn datagram(&self, i: usize) -> Option<Datagram<'_>>;
 }

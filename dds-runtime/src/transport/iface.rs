@@ -1,22 +1,22 @@
-//! Network interface discovery and selection (IPv4 only).
+//! Network interface discovery and selection, IPv4 and IPv6.
 //!
 //! On Unix the list comes from `getifaddrs`; elsewhere from [`list_portable`], which knows only the loopback
-//! address and the address the host would send multicast from.
+//! addresses and the IPv4 address the host would send multicast from.
 
 use std::io;
-use std::net::{Ipv4Addr, SocketAddrV4, UdpSocket};
+use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddrV4, UdpSocket};
 
-use crate::config::InterfaceSelection;
+use crate::config::{AddressFamily, InterfaceSelection};
 
-/// One IPv4 address of one network interface.
+/// One address (IPv4 or IPv6) of one network interface.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Interface {
     /// Interface name, e.g. `lo`.
     pub name: String,
     /// Kernel interface index.
     pub index: u32,
-    /// The IPv4 address.
-    pub addr: Ipv4Addr,
+    /// The address.
+    pub addr: IpAddr,
     /// IFF_UP.
     pub up: bool,
     /// IFF_LOOPBACK.
@@ -25,7 +25,7 @@ pub struct Interface {
     pub multicast: bool,
 }
 
-/// All IPv4 interface addresses of this host (of this network namespace).
+/// All IPv4 and IPv6 interface addresses of this host (of this network namespace).
 pub fn list() -> io::Result<Vec<Interface>> {
     os_list()
 }
@@ -35,18 +35,22 @@ fn os_list() -> io::Result<Vec<Interface>> {
     list_portable()
 }
 
-/// The portable fallback of [`list`]: loopback (`lo`, index 0), and the address the host picks as the source
-/// of a datagram to the SPDP multicast group (`default`, index 0: multicast is joined by address), when there
-/// is a route. Connecting a UDP socket sends nothing.
+/// The portable fallback of [`list`]: loopback (`lo`, index 0, 127.0.0.1 and ::1), and the address the host
+/// picks as the source of a datagram to the SPDP multicast group (`default`, index 0: multicast is joined by
+/// address), when there is a route. Connecting a UDP socket sends nothing.
 pub fn list_portable() -> io::Result<Vec<Interface>> {
-    let mut out = vec![Interface {
+    let lo = |addr: IpAddr| Interface {
         name: "lo".into(),
         index: 0,
-        addr: Ipv4Addr::LOCALHOST,
+        addr,
         up: true,
         loopback: true,
         multicast: true,
-    }];
+    };
+    let mut out = vec![
+        lo(Ipv4Addr::LOCALHOST.into()),
+        lo(Ipv6Addr::LOCALHOST.into()),
+    ];
     let probe = UdpSocket::bind(SocketAddrV4::new(Ipv4Addr::UNSPECIFIED, 0))?;
     let group = crate::rtps::discovery::ports::SPDP_MULTICAST_GROUP;
     if probe.connect(SocketAddrV4::new(group, 7400)).is_ok() {
@@ -55,7 +59,7 @@ pub fn list_portable() -> io::Result<Vec<Interface>> {
                 out.push(Interface {
                     name: "default".into(),
                     index: 0,
-                    addr: *a.ip(),
+                    addr: IpAddr::V4(*a.ip()),
                     up: true,
                     loopback: false,
                     multicast: true,
@@ -66,7 +70,7 @@ pub fn list_portable() -> io::Result<Vec<Interface>> {
     Ok(out)
 }
 
-/// Every AF_INET address of `getifaddrs`.
+/// Every AF_INET and AF_INET6 address of `getifaddrs`.
 #[cfg(unix)]
 fn os_list() -> io::Result<Vec<Interface>> {
     use std::ffi::CStr;
@@ -86,12 +90,17 @@ fn os_list() -> io::Result<Vec<Interface>> {
         }
         // SAFETY: ifa_addr is non-null and points to a sockaddr of the family it declares.
         let family = unsafe { (*ifa.ifa_addr).sa_family } as i32;
-        if family != libc::AF_INET {
+        let addr = if family == libc::AF_INET {
+            // SAFETY: family is AF_INET, so the address is a sockaddr_in.
+            let sin = unsafe { &*(ifa.ifa_addr as *const libc::sockaddr_in) };
+            IpAddr::V4(Ipv4Addr::from(u32::from_be(sin.sin_addr.s_addr)))
+        } else if family == libc::AF_INET6 {
+            // SAFETY: family is AF_INET6, so the address is a sockaddr_in6.
+            let sin6 = unsafe { &*(ifa.ifa_addr as *const libc::sockaddr_in6) };
+            IpAddr::V6(Ipv6Addr::from(sin6.sin6_addr.s6_addr))
+        } else {
             continue;
-        }
-        // SAFETY: family is AF_INET, so the address is a sockaddr_in.
-        let sin = unsafe { &*(ifa.ifa_addr as *const libc::sockaddr_in) };
-        let addr = Ipv4Addr::from(u32::from_be(sin.sin_addr.s_addr));
+        };
         // SAFETY: ifa_name is a NUL-terminated C string owned by the list.
         let name = unsafe { CStr::from_ptr(ifa.ifa_name) }
             .to_string_lossy()
@@ -113,23 +122,43 @@ fn os_list() -> io::Result<Vec<Interface>> {
     Ok(out)
 }
 
-/// Picks the interface described by `sel` from `all`.
+/// Picks the IPv4 interface described by `sel` from `all` (see [`select_in`]).
 pub fn select(sel: &InterfaceSelection, all: &[Interface]) -> io::Result<Interface> {
+    select_in(AddressFamily::Ipv4, sel, all)
+}
+
+/// Picks the interface described by `sel` from the addresses of `family` in `all`. By name, an IPv6
+/// interface's global (or unique-local) address is preferred to its link-local one, which needs a scope.
+pub fn select_in(
+    family: AddressFamily,
+    sel: &InterfaceSelection,
+    all: &[Interface],
+) -> io::Result<Interface> {
+    let mut of: Vec<&Interface> = all.iter().filter(|i| family.contains(i.addr)).collect();
+    // Stable: link-local IPv6 addresses after the others of the same interface.
+    of.sort_by_key(|i| is_link_local(i.addr));
     let found = match sel {
-        InterfaceSelection::Name(n) => all.iter().find(|i| &i.name == n),
-        InterfaceSelection::Address(a) => all.iter().find(|i| &i.addr == a),
-        InterfaceSelection::Auto => all
+        InterfaceSelection::Name(n) => of.iter().find(|i| &i.name == n),
+        InterfaceSelection::Address(a) => of.iter().find(|i| &i.addr == a),
+        InterfaceSelection::Auto => of
             .iter()
             .find(|i| i.up && i.multicast && !i.loopback)
-            .or_else(|| all.iter().find(|i| i.up && i.loopback))
-            .or_else(|| all.first()),
+            .or_else(|| of.iter().find(|i| i.up && i.loopback))
+            .or_else(|| of.first()),
     };
-    found.cloned().ok_or_else(|| {
+    found.map(|i| (*i).clone()).ok_or_else(|| {
         io::Error::new(
             io::ErrorKind::NotFound,
-            format!("no IPv4 interface matches {sel:?} (have: {:?})", names(all)),
+            format!(
+                "no {family:?} interface matches {sel:?} (have: {:?})",
+                names(all)
+            ),
         )
     })
+}
+
+fn is_link_local(a: IpAddr) -> bool {
+    matches!(a, IpAddr::V6(v6) if v6.segments()[0] & 0xffc0 == 0xfe80)
 }
 
 fn names(all: &[Interface]) -> Vec<String> {
@@ -147,7 +176,7 @@ mod tests {
             Interface {
                 name: "lo".into(),
                 index: 1,
-                addr: Ipv4Addr::LOCALHOST,
+                addr: Ipv4Addr::LOCALHOST.into(),
                 up: true,
                 loopback: true,
                 multicast: false,
@@ -155,7 +184,7 @@ mod tests {
             Interface {
                 name: "eth0".into(),
                 index: 2,
-                addr: Ipv4Addr::new(10, 0, 0, 5),
+                addr: Ipv4Addr::new(10, 0, 0, 5).into(),
                 up: true,
                 loopback: false,
                 multicast: true,
@@ -174,7 +203,7 @@ mod tests {
         );
         assert_eq!(
             select(
-                &InterfaceSelection::Address(Ipv4Addr::new(10, 0, 0, 5)),
+                &InterfaceSelection::Address(Ipv4Addr::new(10, 0, 0, 5).into()),
                 &all
             )
             .unwrap()
@@ -202,6 +231,7 @@ mod tests {
     fn portable_list_has_loopback_first() {
         let all = list_portable().unwrap();
         assert_eq!(all[0].addr, Ipv4Addr::LOCALHOST);
+        assert!(all.iter().any(|i| i.addr == Ipv6Addr::LOCALHOST), "{all:?}");
         assert!(
             all.iter().all(|i| i.up && !i.addr.is_unspecified()),
             "{all:?}"
@@ -211,6 +241,52 @@ mod tests {
                 .unwrap()
                 .addr,
             Ipv4Addr::LOCALHOST
+        );
+    }
+
+    #[test]
+    fn selects_within_the_address_family() {
+        let mut all = ifs();
+        let v6 = |name: &str, index, addr: &str, loopback| Interface {
+            name: name.into(),
+            index,
+            addr: addr.parse().unwrap(),
+            up: true,
+            loopback,
+            multicast: !loopback,
+        };
+        all.push(v6("eth0", 2, "fe80::1", false));
+        all.push(v6("eth0", 2, "fd00::5", false));
+        all.push(v6("lo", 1, "::1", true));
+        let pick =
+            |sel: &InterfaceSelection| select_in(AddressFamily::Ipv6, sel, &all).unwrap().addr;
+        assert_eq!(
+            pick(&InterfaceSelection::Auto),
+            "fd00::5".parse::<IpAddr>().unwrap()
+        );
+        assert_eq!(
+            pick(&InterfaceSelection::Name("eth0".into())),
+            "fd00::5".parse::<IpAddr>().unwrap()
+        );
+        assert_eq!(
+            pick(&InterfaceSelection::Name("lo".into())),
+            IpAddr::from(Ipv6Addr::LOCALHOST)
+        );
+        assert_eq!(
+            pick(&InterfaceSelection::Address("fe80::1".parse().unwrap())),
+            "fe80::1".parse::<IpAddr>().unwrap()
+        );
+        assert!(select_in(
+            AddressFamily::Ipv6,
+            &InterfaceSelection::Address(Ipv4Addr::LOCALHOST.into()),
+            &all
+        )
+        .is_err());
+        assert_eq!(
+            select(&InterfaceSelection::Name("eth0".into()), &all)
+                .unwrap()
+                .addr,
+            IpAddr::from(Ipv4Addr::new(10, 0, 0, 5))
         );
     }
 }

@@ -1,7 +1,7 @@
 //! Linux `recvmmsg`: one system call reads up to [`RECV_BATCH`] queued datagrams.
 
 use std::io;
-use std::net::{Ipv4Addr, SocketAddr, SocketAddrV4, UdpSocket};
+use std::net::{Ipv4Addr, Ipv6Addr, SocketAddr, SocketAddrV4, SocketAddrV6, UdpSocket};
 use std::os::fd::AsRawFd;
 
 use super::datagram::{Datagram, RecvBatch, MAX_BATCH, RECV_BUFFER};
@@ -82,7 +82,7 @@ impl RecvBatch for MmsgBatch {
 
     fn datagram(&self, i: usize) -> Option<Datagram<'_>> {
         let len = (self.hdrs[i].msg_len as usize).min(self.bufs[i].len());
-        let from = sockaddr_v4(&self.addrs[i])?;
+        let from = sockaddr(&self.addrs[i])?;
         Some(Datagram {
             data: &self.bufs[i][..len],
             from,
@@ -90,7 +90,17 @@ impl RecvBatch for MmsgBatch {
     }
 }
 
-fn sockaddr_v4(a: &libc::sockaddr_storage) -> Option<SocketAddr> {
+fn sockaddr(a: &libc::sockaddr_storage) -> Option<SocketAddr> {
+    if i32::from(a.ss_family) == libc::AF_INET6 {
+        // SAFETY: the family says this storage holds a sockaddr_in6.
+        let sin6 = unsafe { &*(a as *const libc::sockaddr_storage).cast::<libc::sockaddr_in6>() };
+        return Some(SocketAddr::V6(SocketAddrV6::new(
+            Ipv6Addr::from(sin6.sin6_addr.s6_addr),
+            u16::from_be(sin6.sin6_port),
+            u32::from_be(sin6.sin6_flowinfo),
+            sin6.sin6_scope_id,
+        )));
+    }
     if i32::from(a.ss_family) != libc::AF_INET {
         return None;
     }

@@ -1,4 +1,4 @@
-//! UDPv4 transport: interface selection, participant index probing (with the core's port formula,
+//! UDP transport over IPv4 or IPv6 ([`AddressFamily`](crate::config::AddressFamily)): interface selection, participant index probing (with the core's port formula,
 //! [`crate::rtps::discovery::ports`]), the shared
 //! SPDP multicast socket and receive threads.
 //!
@@ -12,7 +12,13 @@
 //!   socket also sends, with `IP_MULTICAST_IF` set to the interface and `IP_MULTICAST_LOOP` on so that
 //!   participants on the same host see each other;
 //! - when multicast is on, the SPDP multicast socket: `SO_REUSEADDR` + `SO_REUSEPORT` on the domain's
-//!   discovery port, joined to 239.255.0.1 on the selected interface only (`IP_MULTICAST_ALL` off).
+//!   discovery port, joined to 239.255.0.1 (IPv6: ff02::ffff:239.255.0.1) on the selected interface only
+//!   (`IP_MULTICAST_ALL` off);
+//! - when multicast data is on (`DDS_MULTICAST_DATA`), the same for the user-data group on the domain's
+//!   user multicast port: our readers announce it, and peers' writers send there once for all of them.
+//!
+//! IPv6 sockets are IPv6-only; a participant speaks one family (`DDS_TRANSPORT`), and destinations of the
+//! other family are skipped.
 //!
 //! On Linux, receive threads read with `recvmmsg` (up to 8 datagrams per call) and hand the whole batch to
 //! the receiver, so the core's lock is taken once per batch; elsewhere, or with [`ReceivePath::OneByOne`],

@@ -62,7 +62,7 @@ impl RecvBatch for SingleRecv {
     fn recv(&mut self, sock: &UdpSocket) -> io::Result<usize> {
         let (len, from) = sock.recv_from(&mut self.buf)?;
         self.len = len;
-        self.from = Some(from).filter(SocketAddr::is_ipv4);
+        self.from = Some(from);
         Ok(1)
     }
 

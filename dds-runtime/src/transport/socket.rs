@@ -1,14 +1,30 @@
 //! Socket creation and options. Linux-only options sit behind `cfg`; elsewhere the portable subset is used.
 
 use std::io;
-use std::net::{Ipv4Addr, SocketAddrV4};
+use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr};
 
 use socket2::{Domain, InterfaceIndexOrAddress, Protocol, Socket, Type};
 
 use super::iface::Interface;
 
-fn new_udp() -> io::Result<Socket> {
-    Socket::new(Domain::IPV4, Type::DGRAM, Some(Protocol::UDP))
+/// A UDP socket of the interface's address family; IPv6 sockets are IPv6-only.
+fn new_udp(iface: &Interface) -> io::Result<Socket> {
+    match iface.addr {
+        IpAddr::V4(_) => Socket::new(Domain::IPV4, Type::DGRAM, Some(Protocol::UDP)),
+        IpAddr::V6(_) => {
+            let s = Socket::new(Domain::IPV6, Type::DGRAM, Some(Protocol::UDP))?;
+            s.set_only_v6(true)?;
+            Ok(s)
+        }
+    }
+}
+
+/// The wildcard address of the interface's family at `port`.
+fn any(iface: &Interface, port: u16) -> SocketAddr {
+    match iface.addr {
+        IpAddr::V4(_) => (Ipv4Addr::UNSPECIFIED, port).into(),
+        IpAddr::V6(_) => (Ipv6Addr::UNSPECIFIED, port).into(),
+    }
 }
 
 fn set_buffers(s: &Socket, size: usize) {
@@ -67,23 +83,33 @@ mod linux {
 
 /// A unicast socket on `port` (0: ephemeral), also used to send (multicast interface and loop set).
 pub(super) fn unicast_socket(iface: &Interface, port: u16, buf: usize) -> io::Result<Socket> {
-    let s = new_udp()?;
+    let s = new_udp(iface)?;
     set_buffers(&s, buf);
-    s.set_multicast_if_v4(&iface.addr)?;
-    s.set_multicast_loop_v4(true)?;
-    s.set_multicast_ttl_v4(1)?;
-    s.bind(&SocketAddrV4::new(Ipv4Addr::UNSPECIFIED, port).into())?;
+    match iface.addr {
+        IpAddr::V4(a) => {
+            s.set_multicast_if_v4(&a)?;
+            s.set_multicast_loop_v4(true)?;
+            s.set_multicast_ttl_v4(1)?;
+        }
+        IpAddr::V6(_) => {
+            s.set_multicast_if_v6(iface.index)?;
+            s.set_multicast_loop_v6(true)?;
+            s.set_multicast_hops_v6(1)?;
+        }
+    }
+    s.bind(&any(iface, port).into())?;
     Ok(s)
 }
 
-/// The shared multicast socket: every participant on the host binds the same port.
+/// A multicast socket on `group`: every participant on the host binds the same port (the SPDP group's, or
+/// the user-data group's).
 pub(super) fn multicast_socket(
     iface: &Interface,
-    group: Ipv4Addr,
+    group: IpAddr,
     port: u16,
     buf: usize,
 ) -> io::Result<Socket> {
-    let s = new_udp()?;
+    let s = new_udp(iface)?;
     s.set_reuse_address(true)?;
     // Windows shares the port with SO_REUSEADDR alone; the BSDs and Linux need SO_REUSEPORT too.
     #[cfg(all(
@@ -92,14 +118,33 @@ pub(super) fn multicast_socket(
     ))]
     s.set_reuse_port(true)?;
     set_buffers(&s, buf);
-    s.bind(&SocketAddrV4::new(Ipv4Addr::UNSPECIFIED, port).into())?;
-    // Without this, Linux delivers to a wildcard-bound socket the groups joined by any socket on the host.
-    #[cfg(target_os = "linux")]
-    s.set_multicast_all_v4(false)?;
-    let on = match iface.index {
-        0 => InterfaceIndexOrAddress::Address(iface.addr),
-        index => InterfaceIndexOrAddress::Index(index),
-    };
-    s.join_multicast_v4_n(&group, &on)?;
+    s.bind(&any(iface, port).into())?;
+    match (group, iface.addr) {
+        (IpAddr::V4(group), IpAddr::V4(addr)) => {
+            // Without this, Linux delivers to a wildcard-bound socket the groups joined by any socket on
+            // the host.
+            #[cfg(target_os = "linux")]
+            s.set_multicast_all_v4(false)?;
+            let on = match iface.index {
+                0 => InterfaceIndexOrAddress::Address(addr),
+                index => InterfaceIndexOrAddress::Index(index),
+            };
+            s.join_multicast_v4_n(&group, &on)?;
+        }
+        (IpAddr::V6(group), IpAddr::V6(_)) => {
+            #[cfg(target_os = "linux")]
+            s.set_multicast_all_v6(false)?;
+            s.join_multicast_v6(&group, iface.index)?;
+        }
+        _ => {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "multicast group {group} is not of the family of {}",
+                    iface.addr
+                ),
+            ))
+        }
+    }
     Ok(s)
 }

@@ -1,7 +1,7 @@
-//! UDPv4 sockets of one participant and the threads that receive on them.
+//! UDP sockets (IPv4 or IPv6) of one participant and the threads that receive on them.
 
 use std::io;
-use std::net::{SocketAddrV4, UdpSocket};
+use std::net::{IpAddr, SocketAddr, SocketAddrV6, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
@@ -13,20 +13,23 @@ use super::datagram::{Channel, Receiver, TransportStats};
 use super::iface::{self, Interface};
 use super::recv::{self, ReceivePath};
 use super::socket::{multicast_socket, unicast_socket};
-use crate::config::{Config, ParticipantIndex, Peer};
+use crate::config::{AddressFamily, Config, ParticipantIndex, Peer};
 use crate::rtps::discovery::ports::{self, PortError};
 
 /// The sockets of one participant: metatraffic and user unicast (the index's ports, or ephemeral ones),
-/// and optionally the shared SPDP multicast socket.
+/// and optionally the shared SPDP multicast socket and the user-data multicast socket.
 pub struct UdpTransport {
     iface: Interface,
+    family: AddressFamily,
     domain_id: u32,
     participant_index: Option<u32>,
     multicast: bool,
     meta_uc: Arc<UdpSocket>,
     user_uc: Arc<UdpSocket>,
     spdp_mc: Option<Arc<UdpSocket>>,
-    spdp_peers: Vec<SocketAddrV4>,
+    /// The user-data group and its socket, when multicast data is on.
+    user_mc: Option<(SocketAddr, Arc<UdpSocket>)>,
+    spdp_peers: Vec<SocketAddr>,
     stop: Arc<AtomicBool>,
     threads: Mutex<Vec<JoinHandle<()>>>,
     stats: Arc<TransportStats>,
@@ -41,6 +44,7 @@ impl std::fmt::Debug for UdpTransport {
             .field("meta_unicast", &self.metatraffic_unicast())
             .field("user_unicast", &self.user_unicast())
             .field("multicast", &self.multicast)
+            .field("user_multicast", &self.user_multicast())
             .finish()
     }
 }
@@ -99,7 +103,7 @@ fn bind_unicast(config: &Config, iface: &Interface) -> io::Result<UnicastSockets
 }
 
 /// Unicast SPDP destinations: each peer's address, or its metatraffic ports of every index up to the maximum.
-fn spdp_peers(config: &Config) -> Vec<SocketAddrV4> {
+fn spdp_peers(config: &Config) -> Vec<SocketAddr> {
     let mut spdp_peers = Vec::new();
     for p in &config.peers {
         match *p {
@@ -107,13 +111,27 @@ fn spdp_peers(config: &Config) -> Vec<SocketAddrV4> {
             Peer::Address(a) => {
                 for i in 0..=config.max_participant_index {
                     if let Ok(port) = ports::metatraffic_unicast(config.domain_id, i) {
-                        spdp_peers.push(SocketAddrV4::new(a, port));
+                        spdp_peers.push(SocketAddr::new(a, port));
                     }
                 }
             }
         }
     }
     spdp_peers
+}
+
+/// The group socket for `group` on `port`, or `None` when there is no group.
+fn group_socket(
+    iface: &Interface,
+    group: Option<IpAddr>,
+    port: u16,
+    buf: usize,
+) -> io::Result<Option<(SocketAddr, Arc<UdpSocket>)>> {
+    let Some(group) = group else {
+        return Ok(None);
+    };
+    let s = multicast_socket(iface, group, port, buf)?;
+    Ok(Some((SocketAddr::new(group, port), Arc::new(s.into()))))
 }
 
 /// A port that does not fit is invalid input to [`UdpTransport::bind`]; the typed error is the source.
@@ -128,33 +146,33 @@ fn local_port(s: &UdpSocket) -> u16 {
 impl UdpTransport {
     /// Chooses the interface, the participant index and binds the sockets. Starts no thread.
     pub fn bind(config: &Config) -> io::Result<Self> {
+        config
+            .validate()
+            .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, e))?;
+        let family = config.transport;
         let all = iface::list()?;
-        let iface = iface::select(&config.interface, &all)?;
+        let iface = iface::select_in(family, &config.interface, &all)?;
         let buf = config.socket_buffer_size;
         let domain = config.domain_id;
 
         let (participant_index, meta_uc, user_uc) = bind_unicast(config, &iface)?;
         let spdp_port = ports::spdp_multicast(domain).map_err(port_error)?;
-        let spdp_mc = if config.multicast {
-            Some(Arc::new(UdpSocket::from(multicast_socket(
-                &iface,
-                ports::SPDP_MULTICAST_GROUP,
-                spdp_port,
-                buf,
-            )?)))
-        } else {
-            None
-        };
+        let spdp_group = config.multicast.then(|| family.spdp_group());
+        let spdp_mc = group_socket(&iface, spdp_group, spdp_port, buf)?.map(|(_, s)| s);
+        let user_port = ports::user_multicast(domain).map_err(port_error)?;
+        let user_mc = group_socket(&iface, config.multicast_data_group(), user_port, buf)?;
 
         let spdp_peers = spdp_peers(config);
         let t = UdpTransport {
             iface,
+            family,
             domain_id: domain,
             participant_index,
             multicast: config.multicast,
             meta_uc: Arc::new(meta_uc.into()),
             user_uc: Arc::new(user_uc.into()),
             spdp_mc,
+            user_mc,
             spdp_peers,
             stop: Arc::new(AtomicBool::new(false)),
             threads: Mutex::new(Vec::new()),
@@ -179,6 +197,9 @@ impl UdpTransport {
         if let Some(mc) = &self.spdp_mc {
             socks.push((Channel::SpdpMulticast, mc.clone()));
         }
+        if let Some((_, mc)) = &self.user_mc {
+            socks.push((Channel::UserMulticast, mc.clone()));
+        }
         let mut threads = self.threads.lock().unwrap_or_else(|e| e.into_inner());
         for (ch, sock) in socks {
             // A timeout so that the thread notices `stop` even if shutdown() cannot wake it.
@@ -194,9 +215,11 @@ impl UdpTransport {
         Ok(())
     }
 
-    /// Sends one datagram. Multicast destinations are skipped when multicast is off.
-    pub fn send_to(&self, payload: &[u8], dest: SocketAddrV4) {
-        if dest.ip().is_multicast() && !self.multicast {
+    /// Sends one datagram. Multicast destinations are skipped when multicast is off, and destinations of
+    /// the other address family always (a peer may announce both).
+    pub fn send_to(&self, payload: &[u8], dest: impl Into<SocketAddr>) {
+        let dest = self.scoped(dest.into());
+        if (dest.ip().is_multicast() && !self.multicast) || !self.family.contains(dest.ip()) {
             return;
         }
         match self.meta_uc.send_to(payload, dest) {
@@ -212,9 +235,19 @@ impl UdpTransport {
     }
 
     /// Sends `payload` to each destination.
-    pub fn send_all(&self, payload: &[u8], dests: &[SocketAddrV4]) {
+    pub fn send_all(&self, payload: &[u8], dests: &[SocketAddr]) {
         for d in dests {
             self.send_to(payload, *d);
+        }
+    }
+
+    /// A link-local IPv6 destination gets our interface as its scope (a locator carries no scope).
+    fn scoped(&self, dest: SocketAddr) -> SocketAddr {
+        match dest {
+            SocketAddr::V6(v6) if v6.scope_id() == 0 && needs_scope(v6.ip()) => SocketAddr::V6(
+                SocketAddrV6::new(*v6.ip(), v6.port(), v6.flowinfo(), self.iface.index),
+            ),
+            d => d,
         }
     }
 
@@ -234,24 +267,33 @@ impl UdpTransport {
     pub fn multicast_enabled(&self) -> bool {
         self.multicast
     }
+    /// The address family of every socket.
+    pub fn address_family(&self) -> AddressFamily {
+        self.family
+    }
     /// Metatraffic unicast locator to announce.
-    pub fn metatraffic_unicast(&self) -> SocketAddrV4 {
-        SocketAddrV4::new(self.iface.addr, local_port(&self.meta_uc))
+    pub fn metatraffic_unicast(&self) -> SocketAddr {
+        SocketAddr::new(self.iface.addr, local_port(&self.meta_uc))
     }
     /// User-traffic unicast locator to announce.
-    pub fn user_unicast(&self) -> SocketAddrV4 {
-        SocketAddrV4::new(self.iface.addr, local_port(&self.user_uc))
+    pub fn user_unicast(&self) -> SocketAddr {
+        SocketAddr::new(self.iface.addr, local_port(&self.user_uc))
     }
     /// SPDP multicast locator to announce, if multicast is on.
-    pub fn spdp_multicast(&self) -> Option<SocketAddrV4> {
+    pub fn spdp_multicast(&self) -> Option<SocketAddr> {
         self.spdp_mc.as_ref().and_then(|_| {
             ports::spdp_multicast(self.domain_id)
                 .ok()
-                .map(|p| SocketAddrV4::new(ports::SPDP_MULTICAST_GROUP, p))
+                .map(|p| SocketAddr::new(self.family.spdp_group(), p))
         })
     }
+    /// User-data multicast locator our readers announce (and whose group we joined), if multicast data
+    /// is on.
+    pub fn user_multicast(&self) -> Option<SocketAddr> {
+        self.user_mc.as_ref().map(|(a, _)| *a)
+    }
     /// Unicast SPDP destinations from the configured peers.
-    pub fn spdp_peers(&self) -> &[SocketAddrV4] {
+    pub fn spdp_peers(&self) -> &[SocketAddr] {
         &self.spdp_peers
     }
     /// Datagram counters.
@@ -266,6 +308,9 @@ impl UdpTransport {
         }
         let mut socks: Vec<&UdpSocket> = vec![&self.meta_uc, &self.user_uc];
         if let Some(mc) = &self.spdp_mc {
+            socks.push(mc);
+        }
+        if let Some((_, mc)) = &self.user_mc {
             socks.push(mc);
         }
         for s in socks {
@@ -288,4 +333,10 @@ impl Drop for UdpTransport {
     fn drop(&mut self) {
         self.shutdown();
     }
+}
+
+/// Link-local unicast (fe80::/10) and link- or interface-local multicast (ff01::/16, ff02::/16) need a scope.
+fn needs_scope(a: &std::net::Ipv6Addr) -> bool {
+    let s0 = a.segments()[0];
+    s0 & 0xffc0 == 0xfe80 || (s0 & 0xff00 == 0xff00 && matches!(s0 & 0x000f, 1 | 2))
 }

@@ -63,6 +63,37 @@ pub(crate) fn participant(domain: u32) -> DomainParticipant {
         .expect("participant")
 }
 
+/// A participant with configuration `c` (environment ignored) on `domain`, with quick SPDP and a short lease.
+pub(crate) fn participant_with(domain: u32, c: dds_runtime::config::Config) -> DomainParticipant {
+    require_netns();
+    init_tracing();
+    DomainParticipant::builder()
+        .config(dds_runtime::config::Config {
+            domain_id: domain,
+            spdp_interval: Duration::from_millis(200),
+            lease_duration: Duration::from_secs(5),
+            ..c
+        })
+        .build()
+        .expect("participant")
+}
+
+/// Takes shapes from `r` until `n` have arrived or `timeout` passes; their x values in arrival order.
+pub(crate) fn take_xs(r: &DataReader<ShapeType>, n: usize, timeout: Duration) -> Vec<i32> {
+    let mut got = Vec::new();
+    wait_until(timeout, || {
+        got.extend(
+            r.take()
+                .unwrap()
+                .into_iter()
+                .filter_map(|s| s.data)
+                .map(|d| d.x),
+        );
+        got.len() >= n
+    });
+    got
+}
+
 /// Polls `f` until it holds or `timeout` passes.
 pub(crate) fn wait_until(timeout: Duration, mut f: impl FnMut() -> bool) -> bool {
     let end = Instant::now() + timeout;

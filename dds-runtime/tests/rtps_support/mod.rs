@@ -85,7 +85,12 @@ pub(crate) struct Sim {
     pub(crate) datagrams_sent: u64,
     /// Faults apply only to user traffic when set (discovery then completes quickly).
     pub(crate) faults_on_discovery: bool,
+    /// When `Some`, every datagram sent is logged here.
+    pub(crate) trace: Option<Vec<Sent>>,
 }
+
+/// A datagram as sent: (sending node, destinations, payload).
+pub(crate) type Sent = (usize, Vec<Locator>, Vec<u8>);
 
 pub(crate) fn prefix(i: usize) -> GuidPrefix {
     let mut p = [0u8; 12];
@@ -114,6 +119,7 @@ impl Sim {
             seq: 0,
             datagrams_sent: 0,
             faults_on_discovery: true,
+            trace: None,
         }
     }
 
@@ -164,6 +170,9 @@ impl Sim {
                 targets.sort();
                 targets.dedup();
                 let user = is_user_traffic(&t.payload);
+                if let Some(log) = &mut self.trace {
+                    log.push((i, t.destinations.clone(), t.payload.clone()));
+                }
                 if !self.nodes[i].up {
                     targets.clear();
                 }

@@ -271,6 +271,28 @@ impl Participant {
         mc.to_vec()
     }
 
+    /// A multicast locator a known reader listens on, when multicast user data is on: its own multicast
+    /// locators first, else its participant's defaults; only of the address family we send with.
+    fn endpoint_multicast<Q>(&self, d: &EndpointData<Q>) -> Option<Locator> {
+        if !self.config.multicast_data {
+            return None;
+        }
+        let kind = self.config.default_unicast.first()?.kind;
+        let participant = if d.guid.prefix == self.config.guid_prefix {
+            Some(&self.config.default_multicast)
+        } else {
+            self.participants
+                .get(&d.guid.prefix)
+                .map(|p| &p.data.default_multicast)
+        };
+        let usable = |l: &&Locator| l.kind == kind && l.is_multicast();
+        d.multicast_locators
+            .iter()
+            .find(usable)
+            .or_else(|| participant?.iter().find(usable))
+            .copied()
+    }
+
     /// Announces a new local endpoint in SEDP and matches it.
     pub(super) fn publish_endpoint<Q: Direction>(&mut self, now: Instant, d: EndpointData<Q>) {
         self.announce(now, Q::ANNOUNCER, d.guid, ChangeKind::Alive, d.encode());
@@ -362,6 +384,7 @@ impl Participant {
                 let reliable = rd.qos.reader.reliability.is_reliable();
                 let durable = rd.qos.reader.durability >= Durability::TransientLocal;
                 let locators = self.endpoint_locators(rd);
+                let multicast = self.endpoint_multicast(rd);
                 // The reader's implementation decides some wire forms (see `ReaderProxy::for_vendor`); our
                 // own readers are not in `participants`.
                 let vendor = self
@@ -369,7 +392,9 @@ impl Participant {
                     .get(&remote.prefix)
                     .map_or(VendorId::THIS, |p| p.data.vendor_id);
                 if let Some(w) = self.writers.get_mut(&id) {
-                    let proxy = ReaderProxy::new(remote, locators, reliable).for_vendor(vendor);
+                    let proxy = ReaderProxy::new(remote, locators, reliable)
+                        .with_multicast(multicast)
+                        .for_vendor(vendor);
                     w.add_proxy(now, proxy, durable, &mut self.events);
                 }
                 self.refresh_reader_filter(id, remote);

@@ -7,6 +7,7 @@ mod group;
 mod history;
 mod liveliness;
 mod local;
+mod multicast;
 mod reader_proxy;
 mod sn_map;
 
@@ -162,15 +163,18 @@ impl Writer {
     /// context), which would otherwise delay the remote readers' copy, e.g. the pong in a ping/pong.
     fn rebuild_dest(&mut self) {
         let own = self.guid.prefix;
+        self.choose_multicast();
         let dest = |key_hash_only: Option<bool>| {
             let mut d: Vec<(bool, Locator)> = self
                 .proxies
                 .iter()
                 .filter(|(_, p)| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
-                .filter_map(|(g, p)| Some((g.prefix == own, *p.destination().first()?)))
+                .filter_map(|(g, p)| Some((g.prefix == own, p.data_destination()?)))
                 .collect();
-            d.sort();
-            d.dedup();
+            // Each locator once (a multicast group may serve our own and remote readers), remote ones first.
+            d.sort_by_key(|&(own, l)| (l, own));
+            d.dedup_by_key(|(_, l)| *l);
+            d.sort_by_key(|&(own, _)| own);
             d.into_iter().map(|(_, l)| l).collect::<Vec<Locator>>()
         };
         self.data_dest = dest(None);
@@ -581,7 +585,7 @@ impl Writer {
                         .proxies
                         .values()
                         .filter(|p| p.reliable && p.acked < self.next_sn)
-                        .filter_map(|p| p.destination().first().copied())
+                        .filter_map(|p| p.data_destination())
                         .collect();
                     d.sort();
                     d.dedup();

@@ -14,6 +14,12 @@ pub(crate) struct ReaderProxy {
     pub guid: Guid,
     /// Where to send; the first is used.
     pub locators: Vec<Locator>,
+    /// A multicast locator the reader listens on, when multicast user data is on (see
+    /// `ParticipantConfig::multicast_data`).
+    pub multicast: Option<Locator>,
+    /// New data (and the periodic heartbeat) goes to `multicast` instead of `locators`: set by the writer
+    /// when another matched reader shares that multicast locator.
+    pub via_multicast: bool,
     /// Reliable protocol with this reader (both sides reliable).
     pub reliable: bool,
     /// Every change below this is acknowledged.
@@ -37,6 +43,8 @@ impl ReaderProxy {
         ReaderProxy {
             guid,
             locators,
+            multicast: None,
+            via_multicast: false,
             reliable,
             acked: SequenceNumber(1),
             floor: SequenceNumber(1),
@@ -55,7 +63,23 @@ impl ReaderProxy {
         self
     }
 
+    /// Where to send what is for this reader alone (repairs, GAPs): its first unicast locator.
     pub(crate) fn destination(&self) -> &[Locator] {
         &self.locators[..self.locators.len().min(1)]
+    }
+
+    /// Where new data for this reader goes: the shared multicast locator when the writer chose it, else
+    /// [`destination`](Self::destination).
+    pub(crate) fn data_destination(&self) -> Option<Locator> {
+        match self.multicast {
+            Some(m) if self.via_multicast => Some(m),
+            _ => self.destination().first().copied(),
+        }
+    }
+
+    /// Gives the reader a multicast locator it can be reached on (none: unicast only).
+    pub(crate) fn with_multicast(mut self, multicast: Option<Locator>) -> Self {
+        self.multicast = multicast;
+        self
     }
 }
