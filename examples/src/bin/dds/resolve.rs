@@ -1,7 +1,7 @@
 //! "What is the type of topic T": from an IDL file, or from discovery. The discovery side finds the topic's
-//! type name and the `TypeInformation` its endpoints announce; turning that into a `DynamicType` needs the
-//! type objects, which only the TypeLookup service can fetch from the peer. [`DiscoveredTypes::type_objects`]
-//! is where that client plugs in (it returns `None` until then).
+//! type name and the `TypeInformation` its endpoints announce, then fetches the complete type objects of the
+//! type and its dependencies from the peer through the XTypes TypeLookup service
+//! ([`DomainParticipant::discovered_topic_type`]) and builds a `DynamicType` from them.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 
 use dds_runtime::prelude::*;
 use dds_runtime::xtypes::dynamic::{types_from_idl_file, DynamicType, IdlOptions};
+use dds_runtime::xtypes::typeobject::TypeIdentifier;
 use dds_runtime::xtypes::TypeInformation;
 
 /// The type a topic is read or written with.
@@ -73,13 +74,23 @@ impl<'a> DiscoveredTypes<'a> {
         }
     }
 
-    /// The type objects behind `info`, as a `DynamicType`. The TypeLookup client plugs in here: resolve
-    /// `info.complete` (else `info.minimal`) with the participant's type store and call
-    /// `DynamicType::from_type_identifier(id, &|id| store.get(id))`. Until it is merged there is no source of
-    /// type objects for a remote type, so this returns `None`.
-    fn type_objects(&self, info: &TypeInformation) -> Option<DynamicType> {
-        let _ = info.decode().ok()?;
-        None
+    /// The topic's type as a `DynamicType`, from the complete type objects fetched through the TypeLookup
+    /// service (the topic type and its dependencies, each checked against its hash).
+    fn type_objects(&self, topic: &str) -> Result<DynamicType, String> {
+        let d = self
+            .participant
+            .discovered_topic_type(topic, self.wait)
+            .map_err(|e| {
+                format!("the TypeLookup service did not give the type objects of {topic:?}: {e}")
+            })?;
+        let id = d.information.complete.typeid_with_size.type_id.clone();
+        let lookup = |i: &TypeIdentifier| {
+            d.object(i)
+                .cloned()
+                .or_else(|| self.participant.type_object(i))
+        };
+        DynamicType::from_type_identifier(&id, &lookup)
+            .map_err(|e| format!("the discovered type of {topic:?} cannot be used: {e}"))
     }
 }
 
@@ -98,14 +109,13 @@ impl TopicTypes for DiscoveredTypes<'_> {
                 d.type_name
             ));
         };
-        match self.type_objects(&info) {
-            Some(ty) => Ok(Resolved { ty, type_information: Some(info.0) }),
-            None => Err(format!(
-                "topic {topic:?} (type {}) announces type information, but its type objects cannot be fetched \
-                 yet (no TypeLookup client): give the type with --idl FILE",
-                d.type_name
-            )),
-        }
+        let ty = self
+            .type_objects(topic)
+            .map_err(|e| format!("{e} (type {}); give the type with --idl FILE", d.type_name))?;
+        Ok(Resolved {
+            ty,
+            type_information: Some(info.0),
+        })
     }
 }
 
