@@ -12,6 +12,7 @@ mod interop {
     pub mod ddsperf;
     pub mod deadline;
     pub mod durability;
+    pub mod evolution;
     pub mod harness;
     pub mod liveliness;
     pub mod main_job;

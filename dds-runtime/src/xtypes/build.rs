@@ -109,6 +109,7 @@ impl TypeSupport {
                 })
                 .collect(),
         };
+        super::assign::local_types().register(&mapping);
         Ok(TypeSupport {
             information_bytes: to_bytes(&information)?,
             mapping_bytes: to_bytes(&mapping)?,

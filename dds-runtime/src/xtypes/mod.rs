@@ -1,6 +1,7 @@
 //! XTypes 1.3: the type system ([`typeobject`]), what a Rust type says about itself ([`XTypesType`], emitted by
 //! `#[derive(DdsType)]`), and the per-type [`TypeInformation`]/[`typeobject::TypeMapping`] built from it.
 
+pub mod assign;
 pub mod dynamic;
 pub mod store;
 pub mod typelookup;

@@ -8,13 +8,15 @@ use tracing::{debug, trace};
 use super::{Participant, ProxyParticipant};
 use crate::qos::{Durability, QosPolicyId, ReaderQos, WriterQos};
 use crate::rtps::api::{ChangeKind, Event, ReceivedSample, WriteChange};
-use crate::rtps::discovery::matching::{match_endpoints, MatchResult};
+use crate::rtps::discovery::matching::{match_endpoints_with, MatchResult};
 use crate::rtps::discovery::{builtin, EndpointData, EndpointQos, ParticipantData};
 use crate::rtps::messages::parameter::pid;
 use crate::rtps::messages::Data;
 use crate::rtps::reader::WriterProxy;
 use crate::rtps::types::*;
 use crate::rtps::writer::ReaderProxy;
+use crate::xtypes::assign::{local_types, TypeResolver};
+use crate::xtypes::typeobject::TypeIdentifier;
 
 /// Upper bound on remote participants and endpoints, so discovery traffic cannot exhaust memory.
 const MAX_PARTICIPANTS: usize = 4096;
@@ -331,7 +333,11 @@ impl Participant {
         ) else {
             return;
         };
-        let res = match_endpoints(wd, rd);
+        // Assignability resolves types from this participant's store (ours, and peers' types learnt through
+        // TypeLookup), then from the process's own types.
+        let store = self.type_store();
+        let types = |id: &TypeIdentifier| store.get(id).or_else(|| local_types().resolve(id));
+        let res = match_endpoints_with(wd, rd, &types);
         let Some(has) = self.has_proxy(local, remote) else {
             return;
         };
