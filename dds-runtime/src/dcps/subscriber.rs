@@ -752,11 +752,15 @@ impl<T: DdsType> ReaderInner<T> {
     }
 
     /// `writer` became alive (`Some(true)`), not alive (`Some(false)`) or unmatched (`None`): LIVELINESS_CHANGED
-    /// when that changed the counts.
-    fn liveliness(self: &Arc<Self>, writer: Guid, to: Option<bool>) {
+    /// when that changed the counts. A liveliness change (`matched_only`) of a writer that is no longer matched
+    /// (it can trail the unmatch) changes nothing: only matched writers are counted.
+    fn liveliness(self: &Arc<Self>, writer: Guid, to: Option<bool>, matched_only: bool) {
         self.state.signal_if(
             StatusMask::LIVELINESS_CHANGED,
             |st| {
+                if matched_only && !st.writers_alive.contains_key(&writer) {
+                    return None;
+                }
                 st.liveliness_changed
                     .record(&mut st.writers_alive, writer, to)
                     .then_some(&mut st.liveliness_changed)
@@ -888,7 +892,7 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                 );
                 // A writer matched is alive until its lease says otherwise; an unmatched one is no longer
                 // counted.
-                self.liveliness(*writer, matched.then_some(true));
+                self.liveliness(*writer, matched.then_some(true), false);
             }
             Event::RequestedIncompatibleQos { policy, writer, .. } => {
                 tracing::warn!(reader = ?id, ?writer, ?policy, "requested incompatible QoS");
@@ -909,7 +913,7 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                         self.notify_data();
                     }
                 }
-                self.liveliness(*writer, Some(*alive));
+                self.liveliness(*writer, Some(*alive), true);
             }
             Event::SampleLost { count, .. } => {
                 self.state.signal(
