@@ -348,7 +348,7 @@ fn evolution_against_cyclone() -> Result<(), Skip> {
             })
             .collect::<Vec<_>>()
     );
-    let m: Vec<MutV1> = read_all(&reader::<MutV1>(&p, "EvoMut"), |s| s.x);
+    let m: Vec<MutV1> = read_all(&rm, |s| s.x);
     assert_eq!(
         m,
         (0..COUNT)
