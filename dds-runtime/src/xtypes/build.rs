@@ -109,6 +109,7 @@ impl TypeSupport {
                 })
                 .collect(),
         };
+        #[cfg(feature = "rtps")]
         super::assign::local_types().register(&mapping);
         Ok(TypeSupport {
             information_bytes: to_bytes(&information)?,

@@ -1,6 +1,8 @@
 //! XTypes 1.3: the type system ([`typeobject`]), what a Rust type says about itself ([`XTypesType`], emitted by
 //! `#[derive(DdsType)]`), and the per-type [`TypeInformation`]/[`typeobject::TypeMapping`] built from it.
 
+// Assignability decides matching, and reads the TYPE_CONSISTENCY_ENFORCEMENT policy of `qos`.
+#[cfg(feature = "rtps")]
 pub mod assign;
 pub mod dynamic;
 pub mod store;
