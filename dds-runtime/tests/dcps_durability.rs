@@ -71,6 +71,17 @@ fn take_all(r: &DataReader<ShapeType>, n: usize) -> Vec<(String, i32)> {
     got
 }
 
+/// A TRANSIENT reader joining `topic` late: waits for a match and the historical data, then takes `n` samples.
+fn late_transient_reader(p: &DomainParticipant, topic: &str, n: usize) -> Vec<(String, i32)> {
+    let r = reader::<ShapeType>(p, topic, &durable_reader_qos(Durability::Transient));
+    assert!(wait_until(HISTORY_TIMEOUT, || r
+        .subscription_matched_status()
+        .current_count
+        >= 1));
+    assert!(r.wait_for_historical_data(HISTORY_TIMEOUT).unwrap());
+    take_all(&r, n)
+}
+
 fn write_rounds(w: &DataWriter<ShapeType>, rounds: i32) {
     for x in 1..=rounds {
         for color in ["BLUE", "RED"] {
@@ -99,14 +110,8 @@ fn transient_data_outlives_its_writer() {
     drop(w);
     std::thread::sleep(Duration::from_millis(300));
     let pr = participant(141);
-    let r = reader::<ShapeType>(&pr, "Transient", &durable_reader_qos(Durability::Transient));
-    assert!(wait_until(HISTORY_TIMEOUT, || r
-        .subscription_matched_status()
-        .current_count
-        >= 1));
-    assert!(r.wait_for_historical_data(HISTORY_TIMEOUT).unwrap());
     // DURABILITY_SERVICE keeps the last 2 per instance.
-    assert_eq!(take_all(&r, 4), expected(2, 3));
+    assert_eq!(late_transient_reader(&pr, "Transient", 4), expected(2, 3));
 }
 
 #[test]
@@ -183,13 +188,7 @@ fn a_late_domain_service_aligns_from_another_service() {
         .any(
             |d| d.topic_name == "Aligned" && d.key.prefix != ps.guid_prefix()
         )));
-    let r = reader::<ShapeType>(&pr, "Aligned", &durable_reader_qos(Durability::Transient));
-    assert!(wait_until(HISTORY_TIMEOUT, || r
-        .subscription_matched_status()
-        .current_count
-        >= 1));
-    assert!(r.wait_for_historical_data(HISTORY_TIMEOUT).unwrap());
-    assert_eq!(take_all(&r, 4), expected(2, 3));
+    assert_eq!(late_transient_reader(&pr, "Aligned", 4), expected(2, 3));
 }
 
 #[test]

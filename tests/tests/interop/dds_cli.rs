@@ -182,10 +182,7 @@ fn dds_typeof_and_subscribe_through_type_discovery() {
         .expect("running dds");
     let text = String::from_utf8_lossy(&out.stdout).to_string();
     check!(out.status.success(), &[&p], "dds subscribe failed: {out:?}");
-    let rows: Vec<Value> = text
-        .lines()
-        .filter_map(|l| serde_json::from_str(l).ok())
-        .collect();
+    let rows = ndjson_rows(&text);
     check!(
         rows.len() == 3 && rows.iter().all(|r| r["color"] == "RED"),
         &[&p],
@@ -218,10 +215,7 @@ fn dds_subscribe_idl_prints_cyclone_samples() {
         .expect("running dds");
     let text = String::from_utf8_lossy(&out.stdout).to_string();
     check!(out.status.success(), &[&p], "dds subscribe failed: {out:?}");
-    let rows: Vec<Value> = text
-        .lines()
-        .filter_map(|l| serde_json::from_str(l).ok())
-        .collect();
+    let rows = ndjson_rows(&text);
     check!(rows.len() == 3, &[&p], "three samples expected: {text}");
     for r in &rows {
         let x = r["x"].as_i64().unwrap_or(-1);
@@ -266,4 +260,11 @@ fn dds_publish_idl_reaches_cyclone_reader() {
         "GREEN: {got:?}"
     );
     let _ = p.interrupt(WAIT);
+}
+
+/// The JSON documents of `dds subscribe --ndjson` output, one per line (other lines skipped).
+fn ndjson_rows(text: &str) -> Vec<Value> {
+    text.lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect()
 }
