@@ -237,6 +237,45 @@ fn persistent_data_survives_a_restart_of_the_service() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The participant's own durability service subscribes to its TRANSIENT writers and stands in for them, but
+/// users never see those endpoints: a TRANSIENT writer alone matches no reader, and a reader of the same
+/// participant matches exactly the one writer (OMG suite `Test_Durability_11` checked that the writer reports
+/// the incompatible PERSISTENT reader before any match).
+#[test]
+fn the_service_endpoints_are_not_counted_in_user_statuses() {
+    let p = participant(149);
+    let w = writer::<ShapeType>(&p, "Hidden", &durable_writer_qos(Durability::Transient, 2));
+    write_rounds(&w, 1);
+    std::thread::sleep(Duration::from_millis(800));
+    let st = w.publication_matched_status();
+    assert_eq!(
+        (st.total_count, st.current_count),
+        (0, 0),
+        "service reader counted"
+    );
+    assert!(w.matched_subscriptions().is_empty());
+
+    let r = reader::<ShapeType>(&p, "Hidden", &durable_reader_qos(Durability::Transient));
+    let persistent = reader::<ShapeType>(&p, "Hidden", &durable_reader_qos(Durability::Persistent));
+    assert!(wait_until(HISTORY_TIMEOUT, || {
+        w.publication_matched_status().current_count >= 1
+            && persistent.requested_incompatible_qos_status().total_count >= 1
+    }));
+    assert_eq!(take_all(&r, 2), expected(1, 1), "each sample once");
+    std::thread::sleep(Duration::from_millis(500));
+    let st = w.publication_matched_status();
+    assert_eq!((st.total_count, st.current_count), (1, 1));
+    assert_eq!(w.matched_subscriptions().len(), 1);
+    let st = r.subscription_matched_status();
+    assert_eq!(
+        (st.total_count, st.current_count),
+        (1, 1),
+        "stand-in counted"
+    );
+    assert_eq!(r.matched_publications().len(), 1);
+    assert_eq!(w.offered_incompatible_qos_status().total_count, 1);
+}
+
 #[test]
 fn durability_kinds_match_in_order() {
     let p1 = participant(145);

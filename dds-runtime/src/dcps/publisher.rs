@@ -147,6 +147,7 @@ impl Publisher {
             ),
             entity_name: None,
             content_filter: None,
+            internal: false,
         };
         let inner = Arc::new(WriterInner::<T> {
             state: EndpointState::new(driver.clone()),

@@ -149,6 +149,7 @@ impl Subscriber {
             ),
             entity_name: None,
             content_filter: topic.content_filter_property(),
+            internal: false,
         };
         let credit_limit = match (&rq.reliability, &rq.history, rq.resource_limits.max_samples) {
             (crate::qos::Reliability::Reliable { .. }, crate::qos::History::KeepAll, Some(m)) => {

@@ -466,6 +466,10 @@ pub struct EndpointSpec<Q> {
     pub entity_name: Option<String>,
     /// PID_CONTENT_FILTER_PROPERTY to announce (readers on a content-filtered topic).
     pub content_filter: Option<ContentFilterProperty>,
+    /// A service's endpoint inside this participant (the durability service's, for one): it matches the
+    /// participant's other endpoints as usual, but their matched, incompatible-QoS and liveliness events
+    /// never mention it, so users' statuses count only what users created. Peers see it as any endpoint.
+    pub internal: bool,
 }
 
 /// A local writer to create.
@@ -490,6 +494,7 @@ impl<Q> EndpointSpec<Q> {
             type_information: None,
             entity_name: None,
             content_filter: None,
+            internal: false,
         }
     }
 }

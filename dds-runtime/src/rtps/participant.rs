@@ -9,6 +9,7 @@ mod enable;
 mod filtering;
 mod group;
 mod historical;
+mod internal;
 mod liveliness;
 mod local;
 mod receive;
@@ -63,6 +64,8 @@ pub struct Participant {
     /// User endpoints (builtin ones are only in `writers`/`readers`).
     user_writers: BTreeSet<EntityId>,
     user_readers: BTreeSet<EntityId>,
+    /// Service-internal endpoints (`internal.rs`).
+    internal: BTreeSet<EntityId>,
     participants: HashMap<GuidPrefix, ProxyParticipant>,
     /// Every known publication and subscription, remote and local (local ones match locally too).
     /// Every known endpoint, local and remote. Boxed: a table slot is then a pointer, not a whole
@@ -170,6 +173,7 @@ impl Participant {
             readers: BTreeMap::new(),
             user_writers: BTreeSet::new(),
             user_readers: BTreeSet::new(),
+            internal: BTreeSet::new(),
             participants: HashMap::new(),
             known_writers: HashMap::new(),
             known_readers: HashMap::new(),
@@ -275,6 +279,9 @@ impl Participant {
                     continue;
                 }
             }
+            if self.hides(&e) {
+                continue;
+            }
             self.note_polled(&e);
             return Some(e);
         }
@@ -333,6 +340,7 @@ impl Participant {
     /// Adds a local writer, not yet announced.
     fn add_writer(&mut self, spec: WriterSpec) -> Result<WriterData, CoreError> {
         let keyed = spec.keyed;
+        let internal = spec.internal;
         let kinds = [
             entity_kind::USER_WRITER_NO_KEY,
             entity_kind::USER_WRITER_WITH_KEY,
@@ -342,6 +350,9 @@ impl Participant {
         let params = user_writer_params(&self.config, &data.qos.writer, keyed);
         self.writers.insert(id, Writer::new(data.guid, params));
         self.user_writers.insert(id);
+        if internal {
+            self.mark_internal(id);
+        }
         Ok(data)
     }
 
@@ -359,12 +370,16 @@ impl Participant {
             entity_kind::USER_READER_NO_KEY,
             entity_kind::USER_READER_WITH_KEY,
         ];
+        let internal = spec.internal;
         let data = self.new_endpoint(spec, kinds)?;
         let id = data.guid.entity_id;
         let reliable = data.qos.reader.reliability.is_reliable();
         let params = reader_params(&self.config, reliable);
         self.readers.insert(id, Reader::new(data.guid, params));
         self.user_readers.insert(id);
+        if internal {
+            self.mark_internal(id);
+        }
         Ok(data)
     }
 

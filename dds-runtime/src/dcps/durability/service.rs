@@ -236,12 +236,13 @@ impl Service {
             service: self.me.clone(),
             queue: Mutex::new(Vec::new()),
         });
-        let spec = ReaderSpec::new(
+        let mut spec = ReaderSpec::new(
             w.topic_name.clone(),
             w.type_name.clone(),
             w.guid.entity_id.is_keyed(),
             channel_qos(w),
         );
+        spec.internal = true;
         match driver.create_endpoint(sink, |c, now| c.create_reader(now, spec)) {
             Ok(id) => {
                 lock(&self.state).channels.insert(key, Some(id));
@@ -264,6 +265,7 @@ impl Service {
         );
         spec.type_information = w.type_information.clone();
         spec.entity_name = Some(format!("durability stand-in for {}", w.topic_name));
+        spec.internal = true;
         let id = match driver.create_endpoint(sink, |c, now| c.create_writer(now, spec)) {
             Ok(id) => id,
             Err(e) => {

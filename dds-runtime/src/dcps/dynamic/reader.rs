@@ -121,6 +121,7 @@ impl Subscriber {
             type_information: topic.type_information(),
             entity_name: None,
             content_filter: None,
+            internal: false,
         };
         let inner = Arc::new(Inner {
             ty,

@@ -88,6 +88,7 @@ impl Publisher {
             type_information: topic.type_information(),
             entity_name: None,
             content_filter: None,
+            internal: false,
         };
         let inner = Arc::new(Inner {
             version,
