@@ -3,7 +3,7 @@
 //! Helpers (QoS matching, wire forms) stay in their modules.
 
 pub use crate::cdr::{DdsType, XcdrVersion};
-pub use crate::config::{Config, ParticipantIndex};
+pub use crate::config::{AddressFamily, Config, MulticastData, ParticipantIndex};
 pub use crate::dcps::*;
 pub use crate::qos::{
     DataReaderQos, DataReaderQosBuilder, DataRepresentation, DataWriterQos, DataWriterQosBuilder,

@@ -31,7 +31,14 @@ fn exchange(w: &DataWriter<ShapeType>, readers: &[DataReader<ShapeType>], n: i32
 
 #[test]
 fn readers_on_a_multicast_group_get_every_sample() {
-    let pw = participant_with(81, multicast_data_config());
+    // The writer's participant is set up through the builder, the readers' through `Config`.
+    let pw = DomainParticipant::builder()
+        .domain_id(81)
+        .interface("lo")
+        .multicast_data(MulticastData::On)
+        .ignore_env()
+        .build()
+        .unwrap();
     let prs: Vec<_> = (0..3)
         .map(|_| participant_with(81, multicast_data_config()))
         .collect();
@@ -58,7 +65,17 @@ fn ipv6_loopback_unicast_discovery_and_data() {
         peers: vec![dds_runtime::config::Peer::parse("::1").unwrap()],
         ..Config::default()
     };
-    let pw = participant_with(82, v6());
+    // One participant through the builder, the other through `Config`.
+    let pw = DomainParticipant::builder()
+        .domain_id(82)
+        .transport(AddressFamily::Ipv6)
+        .interface("::1")
+        .multicast(false)
+        .peers(["::1"])
+        .unwrap()
+        .ignore_env()
+        .build()
+        .unwrap();
     let pr = participant_with(82, v6());
     let (wq, rq) = reliable_keep_all();
     let (w, r) = matched::<ShapeType>(&pw, &pr, "V6Square", &wq, &rq);

@@ -15,7 +15,9 @@ pub use types::DiscoveredType;
 use std::sync::{Arc, Weak};
 use std::time::Duration;
 
-use crate::config::{Config, InterfaceSelection, ParticipantIndex, Peer};
+use crate::config::{
+    AddressFamily, Config, InterfaceSelection, MulticastData, ParticipantIndex, Peer,
+};
 use crate::qos::DomainParticipantQos;
 use crate::rtps::{EntityId, Guid, GuidPrefix};
 use crate::transport::UdpTransport;
@@ -120,6 +122,8 @@ pub struct DomainParticipantBuilder {
     domain_id: Option<u32>,
     interface: Option<InterfaceSelection>,
     multicast: Option<bool>,
+    transport: Option<AddressFamily>,
+    multicast_data: Option<MulticastData>,
     peers: Option<Vec<Peer>>,
     participant_index: Option<ParticipantIndex>,
     spdp_interval: Option<Duration>,
@@ -149,6 +153,17 @@ impl DomainParticipantBuilder {
     /// Multicast discovery on or off (overrides `DDS_MULTICAST`).
     pub fn multicast(mut self, on: bool) -> Self {
         self.multicast = Some(on);
+        self
+    }
+    /// UDP over IPv4 or IPv6 (overrides `DDS_TRANSPORT`).
+    pub fn transport(mut self, family: AddressFamily) -> Self {
+        self.transport = Some(family);
+        self
+    }
+    /// Multicast user data: readers announce a multicast locator and writers send each sample once to it
+    /// (overrides `DDS_MULTICAST_DATA`; see `docs/network.md`).
+    pub fn multicast_data(mut self, m: MulticastData) -> Self {
+        self.multicast_data = Some(m);
         self
     }
     /// Unicast discovery peers, `"127.0.0.1"` or `"127.0.0.1:7410"` (overrides `DDS_PEERS`).
@@ -237,6 +252,12 @@ impl DomainParticipantBuilder {
         }
         if let Some(m) = self.multicast {
             c.multicast = m;
+        }
+        if let Some(t) = self.transport {
+            c.transport = t;
+        }
+        if let Some(m) = self.multicast_data {
+            c.multicast_data = m;
         }
         if let Some(p) = &self.peers {
             c.peers = p.clone();

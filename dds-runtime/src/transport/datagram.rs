@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 /// Which socket a datagram arrived on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Channel {
     /// SPDP multicast (239.255.0.1, or ff02::ffff:239.255.0.1, on the domain's discovery port).
     SpdpMulticast,
