@@ -39,6 +39,8 @@ pub(crate) struct TypeAttrs {
     pub(crate) ext: Option<Ext>,
     /// `autoid = "hash"`: members without an id take the hash of their name.
     pub(crate) autoid_hash: bool,
+    /// `@nested`: not a topic type (IS_NESTED in the type object).
+    pub(crate) nested: bool,
     pub(crate) bit_bound: Option<(u32, Span)>,
     pub(crate) discriminator: Option<Type>,
     pub(crate) bitmask: bool,
@@ -63,6 +65,8 @@ pub(crate) struct FieldAttrs {
     pub(crate) non_serialized: bool,
     /// The field's type leads back to this type (mutual recursion): left out of the compile-time constants.
     pub(crate) recursive: bool,
+    /// `u8` is IDL `octet` here (`TK_BYTE` in the type objects), not `uint8`.
+    pub(crate) octet: bool,
 }
 
 /// Enum variant attributes (enumerators and union cases).
@@ -157,7 +161,8 @@ fn type_item(cx: &mut Ctxt, t: &mut TypeAttrs, m: &ParseNestedMeta) -> Result<bo
             set_ext(cx, &mut t.ext, ext, &s);
         }
     } else if p.is_ident("nested") {
-        // Metadata only: every type can be nested.
+        // Every type can still be a topic type: this only marks the type object (IS_NESTED).
+        t.nested = true;
     } else if p.is_ident("autoid") {
         let s: LitStr = m.value()?.parse()?;
         match s.value().as_str() {
@@ -199,6 +204,7 @@ fn field_item(cx: &mut Ctxt, f: &mut FieldAttrs, m: &ParseNestedMeta) -> Result<
         ("base", &mut f.base),
         ("non_serialized", &mut f.non_serialized),
         ("recursive", &mut f.recursive),
+        ("octet", &mut f.octet),
     ];
     if let Some((_, flag)) = flags.into_iter().find(|(n, _)| p.is_ident(n)) {
         *flag = true;

@@ -185,6 +185,8 @@ pub(crate) struct Payload<'a> {
 pub(crate) struct Transparent<'a> {
     pub(crate) ty: &'a Type,
     pub(crate) bound: Option<Expr>,
+    /// `#[dds(octet)]` on the field.
+    pub(crate) octet: bool,
 }
 
 /// A `#[dds(bitmask)]` tuple struct made by `bitflags!`.
@@ -208,8 +210,12 @@ impl<'a> Container<'a> {
             }
             SynData::Struct(s) if attrs.transparent => {
                 let f = single_field(cx, input, &s.fields, "transparent")?;
-                let bound = parse_field_attrs(cx, &f.attrs).bound;
-                Data::Transparent(Transparent { ty: &f.ty, bound })
+                let fa = parse_field_attrs(cx, &f.attrs);
+                Data::Transparent(Transparent {
+                    ty: &f.ty,
+                    bound: fa.bound,
+                    octet: fa.octet,
+                })
             }
             SynData::Struct(s) => Data::Struct(Struct::from_ast(cx, input, &attrs, &s.fields)?),
             SynData::Enum(e) => {

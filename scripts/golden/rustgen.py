@@ -61,6 +61,17 @@ def rust_type(t, nested):
     raise TypeError(f"no Rust mapping for {t!r}")
 
 
+def is_octet(t):
+    """Whether the innermost element of `t` (through options, sequences, arrays and typedefs) is IDL octet."""
+    while True:
+        if isinstance(t, WrapOpt):
+            t = t.inner
+        elif isinstance(t, (sequence, array, typedef)):
+            t = t.subtype
+        else:
+            return t is byte or t == byte
+
+
 def bound_of(t):
     if isinstance(t, WrapOpt):
         return bound_of(t.inner)
@@ -116,6 +127,8 @@ def emit_type(t):
         out.append(f"#[dds({', '.join(attrs)})]")
         out.append(f"pub enum {name} {{")
         for e in t:
+            if camel(e.name) != e.name:
+                out.append(f'    #[dds(name = "{e.name}")]')
             out.append(f"    {camel(e.name)} = {e.value},")
         out.append("}")
     elif issubclass(t, IdlBitmask):
@@ -137,12 +150,14 @@ def emit_type(t):
         out.append(f'#[dds(name = "{tn}", {ext}, discriminator = {dname})]')
         out.append(f"pub enum {name} {{")
         for mname, ct in get_extended_type_hints(t).items():
+            rename = f', name = "{mname}"' if camel(mname) != mname else ""
             if isinstance(ct, default):
-                out.append("    #[dds(default)]")
+                out.append(f"    #[dds(default{rename})]")
             else:
                 labels = ", ".join(f"case = {rust_value(disc, lab)}" for lab in ct.labels)
-                out.append(f"    #[dds({labels})]")
-            out.append(f"    {camel(mname)}({rust_type(ct.subtype, True)}),")
+                out.append(f"    #[dds({labels}{rename})]")
+            octet = "#[dds(octet)] " if is_octet(ct.subtype) else ""
+            out.append(f"    {camel(mname)}({octet}{rust_type(ct.subtype, True)}),")
         out.append("}")
     else:
         ann = get_idl_annotations(t)
@@ -175,6 +190,8 @@ def emit_type(t):
             b = bound_of(ft)
             if b:
                 a.append(f"bound = {b}")
+            if is_octet(ft):
+                a.append("octet")
             rt = rust_type(ft, False)
             if fa.get("external"):
                 rt = f"Option<Box<{rt[7:-1]}>>" if rt.startswith("Option<") else f"Box<{rt}>"

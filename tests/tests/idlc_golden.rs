@@ -13,6 +13,9 @@
 
 use dds_runtime::cdr::{BoundedSeq, BoundedString};
 
+#[path = "golden/explain.rs"]
+mod explain;
+
 /// Includes one generated file as a module, when idlc accepted it.
 macro_rules! idl {
     ($m:ident, $stem:literal) => {
@@ -197,12 +200,67 @@ mod check {
         }
     }
 
+    /// Types whose TypeInformation differs from Cyclone's Python binding for a stated reason. The check fails if
+    /// one of them starts to agree, so the list stays true.
+    const KNOWN_TYPE_INFORMATION: &[(&str, &str)] = &[
+        ("CdrStreamSignedUnion.t4", "the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
+        ("UnionDiscriminatorShort", "the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
+        ("UnionDiscriminatorEnum", "the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
+        ("UnionSeveralFieldsWithDefault", "the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
+        ("SequenceUnion", "the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
+        ("test_struct_keys", "holds a union: the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
+        ("InnerStructureHelperChildChild", "the binding's subclass inherits @nested from its base class; the IDL does not mark the derived struct @nested"),
+        ("test_struct_inherit_mutable_keys", "the binding's subclass inherits @nested from its base class; the IDL does not mark the derived struct @nested"),
+        ("NoCommon_Module.My_Structure", "idlc writes IDL typedefs as Rust type aliases, so there are no alias type objects"),
+        ("sensor_msgs.msg.Imu", "idlc writes IDL typedefs as Rust type aliases, so there are no alias type objects"),
+        ("sensor_msgs.msg.Imu.final", "idlc writes IDL typedefs as Rust type aliases, so there are no alias type objects"),
+    ];
+
+    /// Our TypeInformation and TypeMapping against Cyclone's for the same IDL type
+    /// (`fixtures/typeinfo/idlc.<fixture>.json`, from `scripts/golden/typeinfo.py`); see
+    /// [`KNOWN_TYPE_INFORMATION`].
+    fn check_type_information<T: DdsType>(name: &str, bad: &mut Vec<String>) {
+        let mut differs = Vec::new();
+        type_information_differences::<T>(name, &mut differs);
+        match KNOWN_TYPE_INFORMATION.iter().find(|(n, _)| *n == name) {
+            Some((_, why)) if differs.is_empty() => bad.push(format!(
+                "type information is listed as differing ({why}) but agrees: drop it from the list"
+            )),
+            Some(_) => {}
+            None => bad.extend(differs),
+        }
+    }
+
+    fn type_information_differences<T: DdsType>(name: &str, bad: &mut Vec<String>) {
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("fixtures/typeinfo")
+            .join(format!("idlc.{name}.json"));
+        let text =
+            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let fx: Value = serde_json::from_str(&text).expect("typeinfo json");
+        let ours = [T::type_information(), T::type_mapping()];
+        for (what, mine) in ["type_information", "type_mapping"].into_iter().zip(ours) {
+            let want = unhex(fx[what].as_str().unwrap_or_default());
+            match mine {
+                Some(got) if got == want.as_slice() => {}
+                Some(got) if what == "type_mapping" => bad.push(format!(
+                    "{what}: {}{}",
+                    describe(&want, got),
+                    super::explain::explain(got, &hex(&want))
+                )),
+                Some(got) => bad.push(format!("{what}: {}", describe(&want, got))),
+                None => bad.push(format!("{what}: none")),
+            }
+        }
+    }
+
     /// Checks one type against its fixture; panics listing every mismatch.
     pub fn check<T: DdsType + PartialEq + Debug>(name: &str, samples: Vec<(&str, T)>) {
         let fx = fixture(name);
         let mut bad = Vec::new();
         let mut checked = 0usize;
         check_constants::<T>(&fx, &mut bad);
+        check_type_information::<T>(name, &mut bad);
         let keyed = fx["keyed"].as_bool().unwrap_or_default();
 
         let fixture_samples = fx["samples"].as_array().cloned().unwrap_or_default();
@@ -297,7 +355,7 @@ mod check {
             fx["corpus_file"].as_str().unwrap_or_default(),
             fx["corpus_type"].as_str().unwrap_or_default(),
             bad.len(),
-            checked + 4, // and the four constants
+            checked + 6, // and the four constants, the type information and mapping
             bad.join("\n  ")
         );
     }

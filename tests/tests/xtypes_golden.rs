@@ -9,6 +9,11 @@
 #[allow(dead_code)]
 mod types;
 
+#[path = "golden/explain.rs"]
+mod explain;
+
+use explain::explain;
+
 use std::path::PathBuf;
 
 use dds_runtime::cdr::DdsType;
@@ -16,22 +21,12 @@ use dds_runtime::xtypes::XTypesType;
 
 /// Types whose Rust mirror cannot say what the Python type says, so the bytes differ for a stated reason.
 const KNOWN: &[(&str, &str)] = &[
-    ("Arrays", "octet and uint8 are both u8 in Rust, which is described as uint8 (TK_UINT8); the Python type has octet (TK_BYTE)"),
-    ("ArraysMutable", "octet and uint8 are both u8 in Rust, which is described as uint8 (TK_UINT8); the Python type has octet (TK_BYTE)"),
-    ("Enums", "the Rust mirror's enumerators are CamelCase (Red), the IDL names upper case (RED): complete objects differ"),
-    ("EnumsMutable", "the Rust mirror's enumerators are CamelCase (Red), the IDL names upper case (RED): complete objects differ"),
-    ("KeyAllPrims", "octet and uint8 are both u8 in Rust, which is described as uint8 (TK_UINT8); the Python type has octet (TK_BYTE)"),
-    ("KeyEnum", "the Rust mirror's enumerators are CamelCase (Red), the IDL names upper case (RED): complete objects differ"),
-    ("Large", "octet and uint8 are both u8 in Rust, which is described as uint8 (TK_UINT8); the Python type has octet (TK_BYTE)"),
-    ("Primitives", "octet and uint8 are both u8 in Rust, which is described as uint8 (TK_UINT8); the Python type has octet (TK_BYTE)"),
-    ("PrimitivesMutable", "octet and uint8 are both u8 in Rust, which is described as uint8 (TK_UINT8); the Python type has octet (TK_BYTE)"),
-    ("Sequences", "octet and uint8 are both u8 in Rust, which is described as uint8 (TK_UINT8); the Python type has octet (TK_BYTE)"),
     ("Typedefs", "the Rust mirror writes typedefs as their aliased types: no alias type objects"),
-    ("UnionAppendable", "the binding numbers union members from 0, libddsc's wire and the derive from 1; case names differ in case too"),
-    ("UnionHolder", "the Rust mirror's enumerators are CamelCase (Red), the IDL names upper case (RED): complete objects differ"),
-    ("UnionHolderAppendable", "the Rust mirror's enumerators are CamelCase (Red), the IDL names upper case (RED): complete objects differ"),
-    ("UnionHolderMutable", "the Rust mirror's enumerators are CamelCase (Red), the IDL names upper case (RED): complete objects differ"),
-    ("UnionLongLast", "the binding numbers union members from 0, libddsc's wire and the derive from 1; case names differ in case too"),
+    ("UnionAppendable", "the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
+    ("UnionHolder", "holds unions, whose members the binding numbers from 0; libddsc's wire and the derive from 1"),
+    ("UnionHolderAppendable", "holds unions, whose members the binding numbers from 0; libddsc's wire and the derive from 1"),
+    ("UnionHolderMutable", "holds unions, whose members the binding numbers from 0; libddsc's wire and the derive from 1"),
+    ("UnionLongLast", "the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
 ];
 
 fn fixture(name: &str) -> serde_json::Value {
@@ -90,38 +85,4 @@ pub fn check<T: DdsType + XTypesType>(name: &str, _samples: Vec<(&str, T)>) {
             );
         }
     }
-}
-
-fn unhex(s: &str) -> Vec<u8> {
-    (0..s.len())
-        .step_by(2)
-        .map(|i| u8::from_str_radix(&s[i..i + 2], 16).expect("hex"))
-        .collect()
-}
-
-/// The first type object that differs between our mapping and Cyclone's, both decoded.
-fn explain(ours: &[u8], theirs: &str) -> String {
-    use dds_runtime::xtypes::typeobject::{from_bytes, TypeMapping};
-    let a: TypeMapping = from_bytes(ours).expect("our mapping decodes");
-    let b: TypeMapping = from_bytes(&unhex(theirs)).expect("Cyclone's mapping decodes");
-    let pairs = |m: &TypeMapping| {
-        m.identifier_object_pair_minimal
-            .iter()
-            .chain(&m.identifier_object_pair_complete)
-            .cloned()
-            .collect::<Vec<_>>()
-    };
-    let (pa, pb) = (pairs(&a), pairs(&b));
-    for (x, y) in pa.iter().zip(&pb).rev() {
-        if x.type_object != y.type_object {
-            return format!("\nours:   {:?}\ntheirs: {:?}", x.type_object, y.type_object);
-        }
-    }
-    format!(
-        "{} vs {} objects; same objects, order or identifiers differ\nours:   {:?}\ntheirs: {:?}",
-        pa.len(),
-        pb.len(),
-        pa.iter().map(|p| &p.type_identifier).collect::<Vec<_>>(),
-        pb.iter().map(|p| &p.type_identifier).collect::<Vec<_>>()
-    )
 }

@@ -56,12 +56,17 @@ pub(super) fn xtypes_impl(c: &Container) -> TokenStream {
     }
 }
 
-/// The description function of a member type, with its bound.
-fn type_ref(c: &Container, ty: &Type, bound: Option<&Expr>) -> TokenStream {
-    let rt = c.runtime();
-    match bound {
-        Some(b) => quote!(#rt::xtypes::TypeRef(#rt::xtypes::bounded_desc::<#ty, { (#b) as u32 }>)),
-        None => quote!(#rt::xtypes::TypeRef(<#ty as #rt::xtypes::XTypesType>::xtypes_desc)),
+/// The description function of a member type, with its bound and `octet` mark.
+fn type_ref(c: &Container, ty: &Type, bound: Option<&Expr>, octet: bool) -> TokenStream {
+    let x = {
+        let rt = c.runtime();
+        quote!(#rt::xtypes)
+    };
+    match (bound, octet) {
+        (Some(b), false) => quote!(#x::TypeRef(#x::bounded_desc::<#ty, { (#b) as u32 }>)),
+        (Some(b), true) => quote!(#x::TypeRef(#x::bounded_octet_desc::<#ty, { (#b) as u32 }>)),
+        (None, false) => quote!(#x::TypeRef(<#ty as #x::XTypesType>::xtypes_desc)),
+        (None, true) => quote!(#x::TypeRef(#x::octet_desc::<#ty>)),
     }
 }
 
@@ -88,9 +93,10 @@ fn struct_def(c: &Container, s: &Struct) -> TokenStream {
     let x = quote!(#rt::xtypes);
     let ext = ext_tokens(c, s.ext);
     let autoid_hash = c.attrs.autoid_hash;
+    let nested = c.attrs.nested;
     let base = match &s.base {
         Some(b) => {
-            let r = type_ref(c, b.ty, None);
+            let r = type_ref(c, b.ty, None, false);
             quote!(::core::option::Option::Some(#r))
         }
         None => quote!(::core::option::Option::None),
@@ -103,7 +109,7 @@ fn struct_def(c: &Container, s: &Struct) -> TokenStream {
             let name = &f.wire_name;
             let id = member_id(c, s, f.id);
             let flags = member_flags(c, &f.attrs, f.key(), f.optional);
-            let ty = type_ref(c, f.inner, f.attrs.bound.as_ref());
+            let ty = type_ref(c, f.inner, f.attrs.bound.as_ref(), f.attrs.octet);
             let hash_id = match &f.attrs.hashid {
                 HashId::Unset => quote!(::core::option::Option::None),
                 HashId::OfName => quote!(::core::option::Option::Some("")),
@@ -118,6 +124,7 @@ fn struct_def(c: &Container, s: &Struct) -> TokenStream {
     quote!(#x::TypeDef::Struct(#x::StructDef {
         extensibility: #ext,
         autoid_hash: #autoid_hash,
+        nested: #nested,
         base: #base,
         members: ::std::vec![#(#members),*],
     }))
@@ -146,7 +153,7 @@ fn union_def(c: &Container, u: &Union) -> TokenStream {
     let x = quote!(#rt::xtypes);
     let ext = ext_tokens(c, u.ext);
     let disc = &u.disc;
-    let disc_ref = type_ref(c, disc, None);
+    let disc_ref = type_ref(c, disc, None, false);
     let cases = u.cases.iter().map(|k| {
         let name = &k.name;
         let id = k.id;
@@ -156,7 +163,7 @@ fn union_def(c: &Container, u: &Union) -> TokenStream {
             .map(|l| quote!((#l) as i32));
         let (ty, external) = match &k.payload {
             Some(p) => {
-                let r = type_ref(c, p.ty, p.attrs.bound.as_ref());
+                let r = type_ref(c, p.ty, p.attrs.bound.as_ref(), p.attrs.octet);
                 (quote!(::core::option::Option::Some(#r)), p.attrs.external)
             }
             None => (quote!(::core::option::Option::None), false),
@@ -170,8 +177,10 @@ fn union_def(c: &Container, u: &Union) -> TokenStream {
             external: #external,
         })
     });
+    let nested = c.attrs.nested;
     quote!(#x::TypeDef::Union(#x::UnionDef {
         extensibility: #ext,
+        nested: #nested,
         discriminator: #disc_ref,
         discriminator_key: false,
         cases: ::std::vec![#(#cases),*],
@@ -202,7 +211,7 @@ fn transparent(c: &Container, t: &Transparent) -> TokenStream {
     let x = quote!(#rt::xtypes);
     let name = c.ident();
     let attrs = impl_attrs();
-    let r = type_ref(c, t.ty, t.bound.as_ref());
+    let r = type_ref(c, t.ty, t.bound.as_ref(), t.octet);
     quote! {
         #attrs
         impl #x::XTypesType for #name {

@@ -125,6 +125,8 @@ pub struct StructDef {
     pub extensibility: Extensibility,
     /// `@autoid(HASH)`.
     pub autoid_hash: bool,
+    /// `@nested` (IS_NESTED).
+    pub nested: bool,
     /// The base struct.
     pub base: Option<TypeRef>,
     /// Own members (not the base's), in declaration order.
@@ -169,6 +171,8 @@ impl MemberDef {
 pub struct UnionDef {
     /// Extensibility.
     pub extensibility: Extensibility,
+    /// `@nested` (IS_NESTED).
+    pub nested: bool,
     /// Discriminator type.
     pub discriminator: TypeRef,
     /// The discriminator is a key.
@@ -219,15 +223,37 @@ pub struct BitmaskDef {
 /// The description of `T` with an IDL bound applied to its outermost string, sequence or map (what
 /// `#[dds(bound = N)]` means).
 pub fn bounded_desc<T: XTypesType + ?Sized, const N: u32>() -> TypeDesc {
-    match T::xtypes_desc() {
-        TypeDesc::String { wide, .. } => TypeDesc::String { wide, bound: N },
-        TypeDesc::Sequence { element, .. } => TypeDesc::Sequence { bound: N, element },
+    with_bound(T::xtypes_desc(), N)
+}
+
+/// `desc` with the IDL bound `n` applied to its outermost string, sequence or map.
+pub(crate) fn with_bound(desc: TypeDesc, n: u32) -> TypeDesc {
+    match desc {
+        TypeDesc::String { wide, .. } => TypeDesc::String { wide, bound: n },
+        TypeDesc::Sequence { element, .. } => TypeDesc::Sequence { bound: n, element },
         TypeDesc::Map { key, value, .. } => TypeDesc::Map {
-            bound: N,
+            bound: n,
             key,
             value,
         },
         other => other,
+    }
+}
+
+/// An array of `n` elements of `element` (an array of arrays is one multi-dimensional array, as in IDL).
+pub(crate) fn array_of(n: u32, element: TypeRef) -> TypeDesc {
+    match element.desc() {
+        TypeDesc::Array {
+            mut bounds,
+            element,
+        } => {
+            bounds.insert(0, n);
+            TypeDesc::Array { bounds, element }
+        }
+        _ => TypeDesc::Array {
+            bounds: vec![n],
+            element,
+        },
     }
 }
 
@@ -294,19 +320,7 @@ impl<T: XTypesType, const N: usize> XTypesType for BoundedSeq<T, N> {
 
 impl<T: XTypesType, const N: usize> XTypesType for [T; N] {
     fn xtypes_desc() -> TypeDesc {
-        match T::xtypes_desc() {
-            TypeDesc::Array {
-                mut bounds,
-                element,
-            } => {
-                bounds.insert(0, N as u32);
-                TypeDesc::Array { bounds, element }
-            }
-            _ => TypeDesc::Array {
-                bounds: vec![N as u32],
-                element: TypeRef::of::<T>(),
-            },
-        }
+        array_of(N as u32, TypeRef::of::<T>())
     }
 }
 

@@ -67,6 +67,7 @@ mod compat;
 mod describe;
 mod error;
 mod objects;
+mod octet;
 
 pub use build::TypeSupport;
 pub use describe::{
@@ -74,3 +75,4 @@ pub use describe::{
     TypeRef, UnionDef, XTypesType,
 };
 pub use error::BuildError;
+pub use octet::{bounded_octet_desc, octet_desc, OctetType};

@@ -19,7 +19,7 @@ pub(super) fn body(
     };
     Ok(match def {
         TypeDef::Struct(s) => TypeBody::Struct {
-            flags: type_flags(s.extensibility, s.autoid_hash),
+            flags: type_flags(s.extensibility, s.autoid_hash, s.nested),
             base: match &s.base {
                 Some(b) => id(b, complete)?,
                 None => TypeIdentifier::None,
@@ -65,7 +65,7 @@ pub(super) fn body(
                 });
             }
             TypeBody::Union {
-                flags: type_flags(u.extensibility, false),
+                flags: type_flags(u.extensibility, false, u.nested),
                 detail,
                 disc_flags,
                 disc_type: id(&u.discriminator, complete)?,
@@ -90,7 +90,7 @@ pub(super) fn body(
                 .collect();
             literals.sort_by_key(|l| l.value);
             TypeBody::Enum {
-                flags: type_flags(e.extensibility, false),
+                flags: type_flags(e.extensibility, false, false),
                 bit_bound: e.bit_bound,
                 detail,
                 literals,
@@ -108,7 +108,7 @@ pub(super) fn body(
                 .collect();
             bitflags.sort_by_key(|f| f.position);
             TypeBody::Bitmask {
-                flags: type_flags(b.extensibility, false),
+                flags: type_flags(b.extensibility, false, false),
                 bit_bound: b.bit_bound,
                 detail,
                 bitflags,
@@ -125,8 +125,8 @@ pub(super) fn body(
     })
 }
 
-/// The type flags of an extensibility.
-fn type_flags(ext: Extensibility, autoid_hash: bool) -> TypeFlag {
+/// The type flags of an extensibility, `@autoid(HASH)` and `@nested`.
+fn type_flags(ext: Extensibility, autoid_hash: bool, nested: bool) -> TypeFlag {
     let mut f = match ext {
         Extensibility::Final => TypeFlag::IS_FINAL,
         Extensibility::Appendable => TypeFlag::IS_APPENDABLE,
@@ -134,6 +134,9 @@ fn type_flags(ext: Extensibility, autoid_hash: bool) -> TypeFlag {
     };
     if autoid_hash {
         f |= TypeFlag::IS_AUTOID_HASH;
+    }
+    if nested {
+        f |= TypeFlag::IS_NESTED;
     }
     f
 }

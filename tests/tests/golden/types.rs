@@ -14,6 +14,7 @@ use dds_runtime::DdsType;
 #[dds(name = "Golden::Primitives", final)]
 pub struct Primitives {
     pub b: bool,
+    #[dds(octet)]
     pub o: u8,
     pub i8: i8,
     pub u8: u8,
@@ -44,6 +45,7 @@ pub struct PrimitivesAppendable {
 #[dds(name = "Golden::PrimitivesMutable", mutable)]
 pub struct PrimitivesMutable {
     pub b: bool,
+    #[dds(octet)]
     pub o: u8,
     pub i8: i8,
     pub c: char,
@@ -227,6 +229,7 @@ pub struct MutableKeyedOpt {
 #[dds(name = "Golden::Sequences", final)]
 pub struct Sequences {
     pub longs: Vec<i32>,
+    #[dds(octet)]
     pub octets: Vec<u8>,
     pub bools: Vec<bool>,
     pub doubles: Vec<f64>,
@@ -275,6 +278,7 @@ pub struct NestedSeqsAppendable {
 #[dds(name = "Golden::Arrays", final)]
 pub struct Arrays {
     pub longs: [i32; 3],
+    #[dds(octet)]
     pub octets: [u8; 4],
     pub strs: [String; 2],
     pub matrix: [[i16; 3]; 2],
@@ -290,6 +294,7 @@ pub struct ArraysMutable {
     pub strs: [String; 2],
     pub matrix: [[i16; 2]; 2],
     pub apoints: [PointA; 2],
+    #[dds(octet)]
     pub octets: [u8; 3],
 }
 
@@ -303,75 +308,79 @@ pub struct SeqOfArrays {
 #[derive(DdsType, Debug, Clone, Copy, PartialEq, Eq)]
 #[dds(name = "Golden::Color")]
 pub enum Color {
+    #[dds(name = "RED")]
     Red = 0,
+    #[dds(name = "GREEN")]
     Green = 1,
+    #[dds(name = "BLUE")]
     Blue = 2,
+    #[dds(name = "YELLOW")]
     Yellow = 3,
 }
 
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::UnionEnum", final, discriminator = Color)]
 pub enum UnionEnum {
-    #[dds(case = Color::Red)]
+    #[dds(case = Color::Red, name = "red")]
     Red(i32),
-    #[dds(default)]
+    #[dds(default, name = "other")]
     Other(String),
-    #[dds(case = Color::Blue)]
+    #[dds(case = Color::Blue, name = "blue")]
     Blue(f64),
 }
 
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::UnionOctet", final, discriminator = u8)]
 pub enum UnionOctet {
-    #[dds(case = 1u8)]
+    #[dds(case = 1u8, name = "small")]
     Small(u8),
-    #[dds(case = 2u8)]
+    #[dds(case = 2u8, name = "seq")]
     Seq(Vec<Point>),
-    #[dds(default)]
+    #[dds(default, name = "other")]
     Other(i64),
 }
 
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::UnionBool", final, discriminator = bool)]
 pub enum UnionBool {
-    #[dds(case = true)]
+    #[dds(case = true, name = "yes")]
     Yes(i32),
-    #[dds(default)]
+    #[dds(default, name = "no")]
     No(String),
 }
 
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::UnionLong", final, discriminator = i32)]
 pub enum UnionLong {
-    #[dds(case = 1i32, case = 2i32)]
+    #[dds(case = 1i32, case = 2i32, name = "text")]
     Text(String),
-    #[dds(default)]
+    #[dds(default, name = "other")]
     Other(u16),
-    #[dds(case = 3i32)]
+    #[dds(case = 3i32, name = "point")]
     Point(Point),
-    #[dds(case = i32::MIN)]
+    #[dds(case = i32::MIN, name = "big")]
     Big(i64),
 }
 
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::UnionEnumLast", final, discriminator = Color)]
 pub enum UnionEnumLast {
-    #[dds(case = Color::Red)]
+    #[dds(case = Color::Red, name = "red")]
     Red(i32),
-    #[dds(case = Color::Blue)]
+    #[dds(case = Color::Blue, name = "blue")]
     Blue(f64),
-    #[dds(default)]
+    #[dds(default, name = "other")]
     Other(String),
 }
 
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::UnionLongLast", final, discriminator = i32)]
 pub enum UnionLongLast {
-    #[dds(case = 1i32, case = 2i32)]
+    #[dds(case = 1i32, case = 2i32, name = "text")]
     Text(String),
-    #[dds(case = 3i32)]
+    #[dds(case = 3i32, name = "point")]
     Point(Point),
-    #[dds(default)]
+    #[dds(default, name = "other")]
     Other(u16),
 }
 
@@ -391,11 +400,11 @@ pub struct UnionHolder {
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::UnionAppendable", appendable, discriminator = i16)]
 pub enum UnionAppendable {
-    #[dds(case = 1i16)]
+    #[dds(case = 1i16, name = "p")]
     P(PointA),
-    #[dds(case = 2i16)]
+    #[dds(case = 2i16, name = "d")]
     D(f64),
-    #[dds(case = 3i16)]
+    #[dds(case = 3i16, name = "s")]
     S(String),
 }
 
@@ -848,7 +857,7 @@ pub struct KeyMutableNested {
 pub struct KeyAllPrims {
     #[dds(key)]
     pub b: bool,
-    #[dds(key)]
+    #[dds(key, octet)]
     pub o: u8,
     #[dds(key)]
     pub c: char,
@@ -875,6 +884,7 @@ pub struct NestedBounds {
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::Large", appendable)]
 pub struct Large {
+    #[dds(octet)]
     pub blob: Vec<u8>,
     pub text: String,
     pub longs: Vec<i32>,

@@ -184,6 +184,9 @@ impl Emitter<'_> {
         if let Some(b) = self.field_bound(&f.ty) {
             a.push(format!("bound = {b}"));
         }
+        if self.is_octet(&f.ty) {
+            a.push("octet".into());
+        }
         a
     }
 
@@ -240,6 +243,9 @@ impl Emitter<'_> {
             // The derive has no `external` for variants: the Box is the whole story.
             if c.external {
                 ty = format!("{}<{ty}>", self.std("Box"));
+            }
+            if self.is_octet(&c.ty) {
+                ty = format!("#[dds(octet)] {ty}");
             }
             variants.push(Member {
                 docs: c.doc.clone(),

@@ -111,6 +111,17 @@ impl Emitter<'_> {
         }
     }
 
+    /// Whether `t` is IDL `octet` or a sequence or array (of sequences or arrays) of it, through typedefs:
+    /// such a member carries `#[dds(octet)]`, so that its `u8` is described as `octet` (`TK_BYTE`), not
+    /// `uint8`.
+    pub(super) fn is_octet(&self, t: &Type) -> bool {
+        match self.model.resolve_alias(t) {
+            Type::Prim { prim } => *prim == Prim::Octet,
+            Type::Sequence { elem, .. } | Type::Array { elem, .. } => self.is_octet(elem),
+            _ => false,
+        }
+    }
+
     /// `Eq` and `Hash` are derivable (no floating point anywhere inside).
     fn eq_hash_in(&self, t: &Type, visiting: &mut Vec<DeclId>) -> bool {
         match t {
