@@ -122,3 +122,72 @@ fn dependencies_are_asked_for_when_the_list_is_cut_short() {
             .all(|d| s.nodes[1].p.type_store().contains(&d.type_id))
     }));
 }
+
+/// Cyclone's TypeInformation and TypeMapping bytes for a type of the CDR golden corpus
+/// (`tests/fixtures/typeinfo`, written from Cyclone's Python binding). No type of that corpus is compiled into
+/// this test binary, so the process-wide registry of our own types cannot resolve it.
+fn cyclone_type(name: &str) -> (Vec<u8>, Vec<u8>) {
+    let path = format!(
+        "{}/../tests/fixtures/typeinfo/{name}.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let field = |key: &str| {
+        let at = text.find(&format!("\"{key}\"")).expect(key) + key.len() + 2;
+        let start = text[at..].find('"').unwrap() + at + 1;
+        let hex = &text[start..start + text[start..].find('"').unwrap()];
+        (0..hex.len() / 2)
+            .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap())
+            .collect::<Vec<u8>>()
+    };
+    (field("type_information"), field("type_mapping"))
+}
+
+/// Node `n` owns the Cyclone type `fixture` and makes a `T`-named endpoint of it on topic "Evolving".
+fn typed_spec<Q: Default>(sim: &mut Sim, n: usize, fixture: &str) -> EndpointSpec<Q> {
+    let (info, mapping) = cyclone_type(fixture);
+    sim.nodes[n].p.register_types(&info, &mapping).unwrap();
+    let mut spec = EndpointSpec::new("Evolving", "T", false, Q::default());
+    spec.type_information = Some(dds_runtime::xtypes::TypeInformation(info));
+    spec
+}
+
+/// A reader matched by type name while the writer's type was still unresolved is re-matched once the type
+/// arrives through TypeLookup: the types are not assignable, so the match is undone and reported as an
+/// incompatible TYPE_CONSISTENCY_ENFORCEMENT.
+#[test]
+fn a_match_made_by_name_is_revisited_when_the_type_arrives() {
+    let mut sim = Sim::with_participants(5, Faults::NONE, 2);
+    let now = sim.now;
+    let ws: WriterSpec = typed_spec(&mut sim, 0, "Primitives");
+    sim.nodes[0].p.create_writer(now, ws).unwrap();
+    let rs: ReaderSpec = typed_spec(&mut sim, 1, "Sequences");
+    let r = sim.nodes[1].p.create_reader(now, rs).unwrap();
+    let matched = |on: bool| move |e: &Event| matches!(e, Event::SubscriptionMatched { reader, matched, .. } if *reader == r && *matched == on);
+    assert!(sim.run_until(Duration::from_secs(5), |s| s.has_event(1, matched(false))));
+    assert!(sim.has_event(1, matched(true)), "first matched by name");
+    assert!(sim.has_event(1, |e| matches!(
+        e,
+        Event::RequestedIncompatibleQos { reader, policy: QosPolicyId::TypeConsistencyEnforcement, .. } if *reader == r
+    )));
+}
+
+/// The same with assignable types: the match made by name stays.
+#[test]
+fn a_match_made_by_name_stays_when_the_arriving_type_is_assignable() {
+    let mut sim = Sim::with_participants(6, Faults::NONE, 2);
+    let now = sim.now;
+    let ws: WriterSpec = typed_spec(&mut sim, 0, "Primitives");
+    sim.nodes[0].p.create_writer(now, ws).unwrap();
+    let rs: ReaderSpec = typed_spec(&mut sim, 1, "Primitives");
+    let r = sim.nodes[1].p.create_reader(now, rs).unwrap();
+    sim.run_for(Duration::from_secs(3));
+    assert!(sim.has_event(
+        1,
+        |e| matches!(e, Event::SubscriptionMatched { reader, matched: true, .. } if *reader == r)
+    ));
+    assert!(!sim.has_event(1, |e| matches!(
+        e,
+        Event::SubscriptionMatched { matched: false, .. } | Event::RequestedIncompatibleQos { .. }
+    )));
+}

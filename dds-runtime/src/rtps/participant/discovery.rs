@@ -319,6 +319,33 @@ impl Participant {
         }
     }
 
+    /// Re-evaluates every match between a local endpoint and a peer's endpoint that announces type
+    /// information: called when types arrive through TypeLookup, so that a pair matched (or refused) by type
+    /// name while the peer's type was unresolved is decided by assignability, as if the type had been known
+    /// from the start (a match that no longer holds is unmatched and reported incompatible).
+    pub(super) fn rematch_typed(&mut self, now: Instant) {
+        self.rematch_typed_of::<WriterQos>(now);
+        self.rematch_typed_of::<ReaderQos>(now);
+    }
+
+    fn rematch_typed_of<Q: Direction>(&mut self, now: Instant) {
+        let own = self.config.guid_prefix;
+        let typed: Vec<Guid> = Q::known(self)
+            .iter()
+            .filter(|(g, d)| g.prefix != own && d.type_information.is_some())
+            .map(|(g, _)| *g)
+            .collect();
+        if typed.is_empty() {
+            return;
+        }
+        let locals = Q::local_peers(self);
+        for remote in typed {
+            for &local in &locals {
+                self.rematch(now, local, remote);
+            }
+        }
+    }
+
     /// Matches (or unmatches) one local endpoint with one known endpoint of the other direction, and reports
     /// what changed.
     fn rematch(&mut self, now: Instant, local: Local, remote: Guid) {

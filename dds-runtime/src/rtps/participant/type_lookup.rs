@@ -185,6 +185,8 @@ impl Participant {
         }
         if !out.stored.is_empty() {
             debug!(writer = ?s.writer, stored = out.stored.len(), "types learnt through TypeLookup");
+            // Pairs decided by type name while a peer's type was unresolved are decided by assignability now.
+            self.rematch_typed(now);
         }
         // A dependencies answer may have queued more requests.
         self.send_type_requests(now);
