@@ -152,17 +152,24 @@ fn typed_spec<Q: Default>(sim: &mut Sim, n: usize, fixture: &str) -> EndpointSpe
     spec
 }
 
+/// Node 0 writes Cyclone's `Primitives`, node 1 reads the Cyclone type `reader_type`, both named `T`; returns
+/// the simulator and the reader.
+fn primitives_writer_and_reader_of(seed: u64, reader_type: &str) -> (Sim, EntityId) {
+    let mut sim = Sim::with_participants(seed, Faults::NONE, 2);
+    let now = sim.now;
+    let ws: WriterSpec = typed_spec(&mut sim, 0, "Primitives");
+    sim.nodes[0].p.create_writer(now, ws).unwrap();
+    let rs: ReaderSpec = typed_spec(&mut sim, 1, reader_type);
+    let r = sim.nodes[1].p.create_reader(now, rs).unwrap();
+    (sim, r)
+}
+
 /// A reader matched by type name while the writer's type was still unresolved is re-matched once the type
 /// arrives through TypeLookup: the types are not assignable, so the match is undone and reported as an
 /// incompatible TYPE_CONSISTENCY_ENFORCEMENT.
 #[test]
 fn a_match_made_by_name_is_revisited_when_the_type_arrives() {
-    let mut sim = Sim::with_participants(5, Faults::NONE, 2);
-    let now = sim.now;
-    let ws: WriterSpec = typed_spec(&mut sim, 0, "Primitives");
-    sim.nodes[0].p.create_writer(now, ws).unwrap();
-    let rs: ReaderSpec = typed_spec(&mut sim, 1, "Sequences");
-    let r = sim.nodes[1].p.create_reader(now, rs).unwrap();
+    let (mut sim, r) = primitives_writer_and_reader_of(5, "Sequences");
     let matched = |on: bool| move |e: &Event| matches!(e, Event::SubscriptionMatched { reader, matched, .. } if *reader == r && *matched == on);
     assert!(sim.run_until(Duration::from_secs(5), |s| s.has_event(1, matched(false))));
     assert!(sim.has_event(1, matched(true)), "first matched by name");
@@ -175,12 +182,7 @@ fn a_match_made_by_name_is_revisited_when_the_type_arrives() {
 /// The same with assignable types: the match made by name stays.
 #[test]
 fn a_match_made_by_name_stays_when_the_arriving_type_is_assignable() {
-    let mut sim = Sim::with_participants(6, Faults::NONE, 2);
-    let now = sim.now;
-    let ws: WriterSpec = typed_spec(&mut sim, 0, "Primitives");
-    sim.nodes[0].p.create_writer(now, ws).unwrap();
-    let rs: ReaderSpec = typed_spec(&mut sim, 1, "Primitives");
-    let r = sim.nodes[1].p.create_reader(now, rs).unwrap();
+    let (mut sim, r) = primitives_writer_and_reader_of(6, "Primitives");
     sim.run_for(Duration::from_secs(3));
     assert!(sim.has_event(
         1,
