@@ -871,6 +871,68 @@ fn publisher_delete_datawriter() {
     ));
 }
 
+/// `create_datawriter` with a listener: the listener gets the match with a reader that already exists, made
+/// inside the create call, with the writer's own handle.
+#[test]
+fn publisher_create_datawriter_with_listener() {
+    let p = participant(205);
+    let t = p
+        .create_topic::<ShapeType>("CWL", &TopicQos::default())
+        .unwrap();
+    let (wq, rq) = reliable_qos();
+    let _reader = reader::<ShapeType>(&p, "CWL", &rq);
+    let log = Log::default();
+    let publ = p.create_publisher(&PublisherQos::default()).unwrap();
+    let w = publ
+        .create_datawriter_with_listener(&t, &wq, Box::new(log.clone()), StatusMask::all())
+        .unwrap();
+    let expected = format!("writer:publication_matched {}", w.instance_handle().0);
+    assert!(log.wait(&expected), "listener saw {:?}", log.lines());
+    assert_eq!(w.publication_matched_status().total_count, 1);
+}
+
+/// `create_datareader` with a listener: a TRANSIENT_LOCAL writer of the same participant hands its history
+/// over inside the create call; the listener gets that match and the data, with the reader's own handle.
+#[test]
+fn subscriber_create_datareader_with_listener() {
+    let p = participant(206);
+    let t = p
+        .create_topic::<ShapeType>("CRL", &TopicQos::default())
+        .unwrap();
+    let (wq, rq) = reliable_qos();
+    let (wq, rq) = (
+        DataWriterQos {
+            durability: Durability::TransientLocal,
+            ..wq
+        },
+        DataReaderQos {
+            durability: Durability::TransientLocal,
+            ..rq
+        },
+    );
+    let w = writer::<ShapeType>(&p, "CRL", &wq);
+    for i in 0..3 {
+        w.write(&shape("RED", i)).unwrap();
+    }
+    let log = Log::default();
+    let sub = p.create_subscriber(&SubscriberQos::default()).unwrap();
+    let r = sub
+        .create_datareader_with_listener(&t, &rq, Box::new(log.clone()), StatusMask::all())
+        .unwrap();
+    let h = r.instance_handle().0;
+    assert!(
+        log.wait(&format!("reader:subscription_matched {h}")),
+        "listener saw {:?}",
+        log.lines()
+    );
+    assert!(
+        log.wait(&format!("reader:data_available {h}")),
+        "listener saw {:?}",
+        log.lines()
+    );
+    assert_eq!(take_n(&r, 3).len(), 3);
+}
+
 #[test]
 fn publisher_lookup_datawriter() {
     let p = participant(180);

@@ -75,15 +75,25 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         owner: O,
         create: impl FnOnce(&mut Participant, Instant) -> Result<EntityId, CoreError>,
     ) -> DdsResult<Arc<EndpointHandle<O>>> {
-        let id = self.driver.create_endpoint(sink, |c, now| {
+        let mut owner = Some(owner);
+        let mut handle = None;
+        self.driver.create_endpoint(sink, |c, now| {
             let id = create(c, now)?;
-            // Set once, here: the core reports nothing for the endpoint before `create` returns.
+            // Set once, here, under the core lock: the core reports nothing for the endpoint before `create`
+            // returns, and its first events (matches with known peers, a late joiner's history) are handed
+            // to listeners only after the lock is released. So a listener installed before creation gets
+            // them with a valid handle.
             let _ = self.id.set(id);
+            if let Some(owner) = owner.take() {
+                let h = Arc::new(EndpointHandle::new(self.driver.clone(), id, owner));
+                *lock(&self.handle) = Arc::downgrade(&h);
+                handle = Some(h);
+            }
             Ok(id)
         })?;
-        let handle = Arc::new(EndpointHandle::new(self.driver.clone(), id, owner));
-        *lock(&self.handle) = Arc::downgrade(&handle);
-        Ok(handle)
+        handle.ok_or(DdsError::PreconditionNotMet(
+            "endpoint created without a handle",
+        ))
     }
 
     /// The entity id (`UNKNOWN` until created).

@@ -126,6 +126,28 @@ impl Publisher {
         topic: &Topic<T>,
         qos: &DataWriterQos,
     ) -> DdsResult<DataWriter<T>> {
+        self.create_writer(topic, qos, None)
+    }
+
+    /// Creates a writer with its listener installed first, enabled for the statuses in `mask`
+    /// (`create_datawriter` with a listener, DDS 1.4 §2.2.2.4.1.5): the listener gets every status of the
+    /// writer from its creation on, including the matches with readers already known.
+    pub fn create_datawriter_with_listener<T: DdsType>(
+        &self,
+        topic: &Topic<T>,
+        qos: &DataWriterQos,
+        listener: Box<dyn DataWriterListener<T>>,
+        mask: StatusMask,
+    ) -> DdsResult<DataWriter<T>> {
+        self.create_writer(topic, qos, Some((Arc::from(listener), mask)))
+    }
+
+    fn create_writer<T: DdsType>(
+        &self,
+        topic: &Topic<T>,
+        qos: &DataWriterQos,
+        listener: Option<(Arc<dyn DataWriterListener<T>>, StatusMask)>,
+    ) -> DdsResult<DataWriter<T>> {
         let driver = self.participant.driver().clone();
         let parent = ops::writer_parent(self, topic)?;
         let enabled = self
@@ -166,6 +188,9 @@ impl Publisher {
         let sink: Arc<dyn Endpoint> = inner.clone();
         if !enabled {
             inner.state.set_created_disabled();
+        }
+        if let Some((l, mask)) = listener {
+            inner.state.set_listener_with_mask(Some(l), mask);
         }
         let handle = inner.state.create(sink, owner, |c, now| {
             super::participant::register_local_types::<T>(c);

@@ -126,6 +126,29 @@ impl Subscriber {
         topic: &D,
         qos: &DataReaderQos,
     ) -> DdsResult<DataReader<T>> {
+        self.create_reader(topic, qos, None)
+    }
+
+    /// Creates a reader with its listener installed first, enabled for the statuses in `mask`
+    /// (`create_datareader` with a listener, DDS 1.4 §2.2.2.5.2.5): the listener gets every status of the
+    /// reader from its creation on, including the matches with writers already known and the history a
+    /// TRANSIENT_LOCAL writer of the same participant hands over at once.
+    pub fn create_datareader_with_listener<T: DdsType, D: TopicDescription<T>>(
+        &self,
+        topic: &D,
+        qos: &DataReaderQos,
+        listener: Box<dyn DataReaderListener<T>>,
+        mask: StatusMask,
+    ) -> DdsResult<DataReader<T>> {
+        self.create_reader(topic, qos, Some((Arc::from(listener), mask)))
+    }
+
+    fn create_reader<T: DdsType, D: TopicDescription<T>>(
+        &self,
+        topic: &D,
+        qos: &DataReaderQos,
+        listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
+    ) -> DdsResult<DataReader<T>> {
         let driver = self.participant.driver().clone();
         let parent = ops::reader_parent(self, topic.topic())?;
         let enabled = self
@@ -182,6 +205,9 @@ impl Subscriber {
         let sink: Arc<dyn Endpoint> = inner.clone();
         if !enabled {
             inner.state.set_created_disabled();
+        }
+        if let Some((l, mask)) = listener {
+            inner.state.set_listener_with_mask(Some(l), mask);
         }
         let handle = inner.state.create(sink, owner, |c, now| {
             super::participant::register_local_types::<T>(c);

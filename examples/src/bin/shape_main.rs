@@ -82,36 +82,11 @@ struct Printer {
 }
 
 impl Printer {
-    fn for_topic(topic: &str) -> Self {
-        Printer {
+    /// The listener of an endpoint on `topic`.
+    fn for_topic(topic: &str) -> Box<Self> {
+        Box::new(Printer {
             topic: topic.to_string(),
-        }
-    }
-
-    /// A match or an incompatible QoS found between creating the writer and installing its listener
-    /// reached no listener: print it from the status (reading it consumes the change, as a listener call
-    /// does, so nothing prints twice).
-    fn catch_up_writer(&self, w: &DataWriter<ShapeType>) {
-        let m = w.publication_matched_status();
-        if m.current_count_change != 0 {
-            self.on_publication_matched(w, m);
-        }
-        let q = w.offered_incompatible_qos_status();
-        if q.total_count_change > 0 {
-            self.on_offered_incompatible_qos(w, q);
-        }
-    }
-
-    /// As [`Printer::catch_up_writer`], for a reader.
-    fn catch_up_reader(&self, r: &DataReader<ShapeType>) {
-        let m = r.subscription_matched_status();
-        if m.current_count_change != 0 {
-            self.on_subscription_matched(r, m);
-        }
-        let q = r.requested_incompatible_qos_status();
-        if q.total_count_change > 0 {
-            self.on_requested_incompatible_qos(r, q);
-        }
+        })
     }
 }
 
@@ -310,9 +285,13 @@ impl App {
                     t.name(),
                     o.color.as_deref().unwrap_or("BLUE")
                 );
-                let w = publisher.create_datawriter(t, &qos)?;
-                w.set_listener(Box::new(Printer::for_topic(t.name())));
-                Printer::for_topic(t.name()).catch_up_writer(&w);
+                // Created with its listener, so that a match made inside the call is printed too.
+                let w = publisher.create_datawriter_with_listener(
+                    t,
+                    &qos,
+                    Printer::for_topic(t.name()),
+                    StatusMask::all(),
+                )?;
                 writers.push(w);
             }
             Role::Publisher(publisher, writers)
@@ -357,15 +336,23 @@ impl App {
                         println!("Create reader for topic: {name}");
                         let cft =
                             participant.create_content_filtered_topic(&name, t, expr, &params)?;
-                        subscriber.create_datareader(&cft, &qos)?
+                        subscriber.create_datareader_with_listener(
+                            &cft,
+                            &qos,
+                            Printer::for_topic(t.name()),
+                            StatusMask::all(),
+                        )?
                     }
                     None => {
                         println!("Create reader for topic: {}", t.name());
-                        subscriber.create_datareader(t, &qos)?
+                        subscriber.create_datareader_with_listener(
+                            t,
+                            &qos,
+                            Printer::for_topic(t.name()),
+                            StatusMask::all(),
+                        )?
                     }
                 };
-                r.set_listener(Box::new(Printer::for_topic(t.name())));
-                Printer::for_topic(t.name()).catch_up_reader(&r);
                 readers.push(r);
             }
             Role::Subscriber(subscriber, readers)
