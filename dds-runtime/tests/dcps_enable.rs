@@ -182,3 +182,85 @@ fn enabling_follows_the_factory_chain() {
         .unwrap()
         .is_enabled());
 }
+
+/// Immutable policies may change until the entity is enabled (DDS 1.4 §2.2.2.1.1.7): a disabled writer
+/// and reader take a new durability, history and data representation, and behave by them once enabled;
+/// after that the same change is `ImmutablePolicy`.
+#[test]
+fn immutable_policies_change_until_enabled() {
+    let pw = participant(207);
+    let pr = participant(207);
+    let no_autoenable = || {
+        PublisherQos::builder()
+            .autoenable_created_entities(false)
+            .build()
+    };
+    let tw = pw
+        .create_topic::<ShapeType>("Respecify", &TopicQos::default())
+        .unwrap();
+    let w = pw
+        .create_publisher(&no_autoenable())
+        .unwrap()
+        .create_datawriter(&tw, &DataWriterQos::default())
+        .unwrap();
+    // ShapeType is appendable: XCDR2 unless told otherwise.
+    assert_eq!(w.data_representation(), XcdrVersion::Xcdr2);
+    let durable = DataWriterQos {
+        durability: Durability::TransientLocal,
+        history: History::KeepLast(5),
+        data_representation: DataRepresentation::xcdr1(),
+        ..w.get_qos().unwrap()
+    };
+    w.set_qos(&durable).unwrap();
+    assert_eq!(w.get_qos().unwrap().history, History::KeepLast(5));
+    assert_eq!(w.data_representation(), XcdrVersion::Xcdr1);
+    w.enable().unwrap();
+    let volatile = DataWriterQos {
+        durability: Durability::Volatile,
+        ..durable.clone()
+    };
+    assert!(matches!(
+        w.set_qos(&volatile),
+        Err(DdsError::ImmutablePolicy(QosPolicyId::Durability))
+    ));
+    for x in 0..8 {
+        w.write(&shape("RED", x)).unwrap();
+    }
+
+    let tr = pr
+        .create_topic::<ShapeType>("Respecify", &TopicQos::default())
+        .unwrap();
+    let sub = pr
+        .create_subscriber(
+            &SubscriberQos::builder()
+                .autoenable_created_entities(false)
+                .build(),
+        )
+        .unwrap();
+    let r = sub
+        .create_datareader::<ShapeType, _>(&tr, &DataReaderQos::default())
+        .unwrap();
+    let late_joiner = DataReaderQos {
+        durability: Durability::TransientLocal,
+        history: History::KeepAll,
+        ..r.get_qos().unwrap()
+    };
+    r.set_qos(&late_joiner).unwrap();
+    r.enable().unwrap();
+    // The writer's history kept the last 5 of the 8 (KEEP_LAST 5, not the default 1), and the reader,
+    // TRANSIENT_LOCAL and KEEP_ALL by now, gets all of them.
+    let got = take_n(&r, 5);
+    let xs: Vec<i32> = got
+        .iter()
+        .filter_map(|s| s.data.as_ref())
+        .map(|d| d.x)
+        .collect();
+    assert_eq!(xs, vec![3, 4, 5, 6, 7]);
+    assert!(matches!(
+        r.set_qos(&DataReaderQos {
+            durability: Durability::Volatile,
+            ..late_joiner
+        }),
+        Err(DdsError::ImmutablePolicy(QosPolicyId::Durability))
+    ));
+}

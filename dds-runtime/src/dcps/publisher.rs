@@ -2,6 +2,7 @@
 
 mod ops;
 
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering as AtomicOrdering};
 use std::sync::{Arc, Mutex, RwLock};
 use std::time::{Duration, Instant, SystemTime};
 
@@ -174,8 +175,7 @@ impl Publisher {
         let inner = Arc::new(WriterInner::<T> {
             state: EndpointState::new(driver.clone()),
             current: RwLock::new(wq.clone()),
-            qos: wq,
-            version,
+            fixed: WritePath::new(version, &wq.reliability),
             instances: Mutex::new(WriterInstances::default()),
             filters: Mutex::new(WriterFilters::default()),
             payloads: Mutex::new(BufferPool::new(WRITER_POOL_BUFFERS, WRITER_POOL_BYTES)),
@@ -214,6 +214,48 @@ impl Publisher {
     }
 }
 
+/// The write path's view of the writer's immutable policies: the XCDR version (DATA_REPRESENTATION) and
+/// how long a write may block (RELIABILITY). Set at creation, and again by a `set_qos` while the writer is
+/// disabled, when immutable policies may still change; atomics, so a write reads them without a lock.
+struct WritePath {
+    xcdr2: AtomicBool,
+    max_block_nanos: AtomicU64,
+}
+
+impl WritePath {
+    fn new(version: XcdrVersion, reliability: &Reliability) -> Self {
+        let p = WritePath {
+            xcdr2: AtomicBool::new(false),
+            max_block_nanos: AtomicU64::new(0),
+        };
+        p.set(version, reliability);
+        p
+    }
+
+    fn set(&self, version: XcdrVersion, reliability: &Reliability) {
+        let block = match reliability {
+            Reliability::Reliable { max_blocking_time } => *max_blocking_time,
+            Reliability::BestEffort => Duration::ZERO,
+        };
+        let nanos = u64::try_from(block.as_nanos()).unwrap_or(u64::MAX);
+        self.xcdr2
+            .store(version == XcdrVersion::Xcdr2, AtomicOrdering::Relaxed);
+        self.max_block_nanos.store(nanos, AtomicOrdering::Relaxed);
+    }
+
+    fn version(&self) -> XcdrVersion {
+        if self.xcdr2.load(AtomicOrdering::Relaxed) {
+            XcdrVersion::Xcdr2
+        } else {
+            XcdrVersion::Xcdr1
+        }
+    }
+
+    fn max_block(&self) -> Duration {
+        Duration::from_nanos(self.max_block_nanos.load(AtomicOrdering::Relaxed))
+    }
+}
+
 /// One instance the writer knows (registered or written).
 struct WriterInstance {
     key: Vec<u8>,
@@ -241,11 +283,10 @@ struct WriterOwner<T> {
 
 struct WriterInner<T: DdsType> {
     state: EndpointState<WriterStatuses, dyn DataWriterListener<T>, WriterOwner<T>>,
-    /// The QoS it was created with.
-    qos: DataWriterQos,
     /// The QoS in effect (changed by `set_qos`).
     current: RwLock<DataWriterQos>,
-    version: XcdrVersion,
+    /// What the immutable policies fix for the write path.
+    fixed: WritePath,
     instances: Mutex<WriterInstances>,
     /// Matched readers' content filters, for writer-side filtering.
     filters: Mutex<WriterFilters>,
@@ -339,15 +380,15 @@ impl<T: DdsType> DataWriter<T> {
         &self.handle.owner().publisher
     }
 
-    /// The QoS the writer was created with (with the data representation resolved); `get_qos` returns
-    /// the one in effect after `set_qos`.
-    pub fn qos(&self) -> &DataWriterQos {
-        &self.inner.qos
+    /// The QoS in effect, with the data representation resolved (as [`get_qos`](Self::get_qos), for a
+    /// writer not deleted).
+    pub fn qos(&self) -> DataWriterQos {
+        read(&self.inner.current).clone()
     }
 
     /// The XCDR version samples are written with.
     pub fn data_representation(&self) -> XcdrVersion {
-        self.inner.version
+        self.inner.fixed.version()
     }
 
     /// Serializes straight into a buffer of the writer's pool, which the payload shares: no copy, and
@@ -356,7 +397,7 @@ impl<T: DdsType> DataWriter<T> {
         let mut buf = lock(&self.inner.payloads).take();
         cdr::serialize(
             sample,
-            self.inner.version,
+            self.inner.fixed.version(),
             ByteOrder::NATIVE,
             Arc::make_mut(&mut buf),
         )?;
@@ -365,7 +406,7 @@ impl<T: DdsType> DataWriter<T> {
 
     fn key_hash(&self, sample: &T) -> DdsResult<Option<[u8; 16]>> {
         if T::IS_KEYED {
-            Ok(Some(cdr::key_hash(sample, self.inner.version)?))
+            Ok(Some(cdr::key_hash(sample, self.inner.fixed.version())?))
         } else {
             Ok(None)
         }
@@ -376,10 +417,7 @@ impl<T: DdsType> DataWriter<T> {
     fn submit(&self, change: WriteChange, sample: Option<&T>) -> DdsResult<()> {
         let driver = &self.inner.state.driver;
         self.inner.state.check_enabled()?;
-        let max_block = match self.inner.qos.reliability {
-            Reliability::Reliable { max_blocking_time } => max_blocking_time,
-            Reliability::BestEffort => Duration::ZERO,
-        };
+        let max_block = self.inner.fixed.max_block();
         // Only a refused write needs the clock.
         let mut deadline: Option<Option<Instant>> = None;
         let id = self.id();
@@ -483,7 +521,12 @@ impl<T: DdsType> DataWriter<T> {
             }
         }
         let mut kp = Vec::new();
-        cdr::serialize_key(sample, self.inner.version, ByteOrder::NATIVE, &mut kp)?;
+        cdr::serialize_key(
+            sample,
+            self.inner.fixed.version(),
+            ByteOrder::NATIVE,
+            &mut kp,
+        )?;
         let kh = self.key_hash(sample)?;
         inst.next += 1;
         let h = InstanceHandle(inst.next);

@@ -174,12 +174,7 @@ impl Subscriber {
             content_filter: topic.content_filter_property(),
             internal: false,
         };
-        let credit_limit = match (&rq.reliability, &rq.history, rq.resource_limits.max_samples) {
-            (crate::qos::Reliability::Reliable { .. }, crate::qos::History::KeepAll, Some(m)) => {
-                Some(m as usize)
-            }
-            _ => None,
-        };
+        let credit_limit = credit_limit(&rq);
         let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
         cache.set_filter(topic.sample_filter());
         cache.set_instance_order(instance_ordered(&self.qos.presentation));
@@ -195,7 +190,7 @@ impl Subscriber {
             data_waiters: AtomicUsize::new(0),
             wakers: Mutex::new(Vec::new()),
             data_signal: Signal::default(),
-            credit_limit,
+            credit_limit: AtomicUsize::new(credit_limit.unwrap_or(NO_CREDIT_LIMIT)),
         });
         let owner = ReaderOwner {
             topic: t.clone(),
@@ -234,6 +229,20 @@ impl Subscriber {
     }
 }
 
+/// `ReaderInner::credit_limit` when the reader has none.
+const NO_CREDIT_LIMIT: usize = usize::MAX;
+
+/// The credit a reader gives the core: reliable KEEP_ALL with `max_samples` delivers (and acknowledges)
+/// only what fits in the cache.
+fn credit_limit(q: &DataReaderQos) -> Option<usize> {
+    match (&q.reliability, &q.history, q.resource_limits.max_samples) {
+        (crate::qos::Reliability::Reliable { .. }, crate::qos::History::KeepAll, Some(m)) => {
+            Some(m as usize)
+        }
+        _ => None,
+    }
+}
+
 struct CacheState<T> {
     cache: ReaderCache<T>,
     /// Key hash → serialized key, learnt from samples that carried both (for key-hash-only disposes).
@@ -269,8 +278,9 @@ struct ReaderInner<T: DdsType> {
     data_waiters: AtomicUsize,
     wakers: Mutex<Vec<Waker>>,
     data_signal: Signal,
-    /// Reliable KEEP_ALL with max_samples: the core delivers (and acknowledges) only what fits.
-    credit_limit: Option<usize>,
+    /// Reliable KEEP_ALL with max_samples: the core delivers (and acknowledges) only what fits
+    /// ([`NO_CREDIT_LIMIT`] otherwise). Changes only while the reader is disabled.
+    credit_limit: AtomicUsize,
 }
 
 /// Reads samples of type `T`. Cheap to clone; the reader is deleted when the last clone (and the last
@@ -800,9 +810,10 @@ impl<T: DdsType> ReaderInner<T> {
     /// Gives the core back the room freed by a take. Under the core lock every delivered sample is either
     /// queued in `pending` or in the cache, so the credit is exact.
     fn refresh_credit(&self) {
-        let Some(limit) = self.credit_limit else {
+        let limit = self.credit_limit.load(AtomicOrdering::Relaxed);
+        if limit == NO_CREDIT_LIMIT {
             return;
-        };
+        }
         let id = self.state.id();
         self.state.driver.with_core(|c, _| {
             let held = lock(&self.cache).cache.len() + lock(&self.pending).len();

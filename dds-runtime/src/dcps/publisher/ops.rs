@@ -13,6 +13,7 @@ use crate::rtps::EntityId;
 use super::super::builtin::SubscriptionBuiltinTopicData;
 use super::super::chain::{ListenerNode, ParentListener, StatusChange};
 use super::super::condition::StatusCondition;
+use super::super::endpoint::check_history;
 use super::super::error::{DdsError, DdsResult};
 use super::super::participant::DomainParticipant;
 use super::super::registry::{Child, EndpointEntry, Group, Registered};
@@ -326,7 +327,9 @@ impl<T: DdsType> DataWriter<T> {
     /// Changes the QoS (`set_qos`). DEADLINE, LATENCY_BUDGET, TRANSPORT_PRIORITY, LIFESPAN, USER_DATA,
     /// OWNERSHIP_STRENGTH and WRITER_DATA_LIFECYCLE may change: the writer applies them and announces them
     /// again in SEDP, so matched readers see the new strength and lifespan. The others cannot
-    /// (`ImmutablePolicy`). An empty `data_representation` keeps the current one.
+    /// (`ImmutablePolicy`), unless the writer is still disabled: then every policy may change, and the
+    /// writer is rebuilt with them (DDS 1.4 §2.2.2.1.1.7). An empty `data_representation` keeps the
+    /// current one.
     pub fn set_qos(&self, qos: &DataWriterQos) -> DdsResult<()> {
         self.inner.state.check_alive()?;
         let mut new = qos.clone();
@@ -335,10 +338,37 @@ impl<T: DdsType> DataWriter<T> {
             new.data_representation = current.data_representation.clone();
         }
         if let Some(p) = current.immutable_change(&new) {
-            return Err(DdsError::ImmutablePolicy(p));
+            if self.is_enabled() {
+                return Err(DdsError::ImmutablePolicy(p));
+            }
+            return self.respecify(new);
         }
         *write(&self.inner.current) = new.clone();
         self.announce(new)
+    }
+
+    /// `set_qos` with immutable changes on a disabled writer: the core rebuilds the writer first (it
+    /// refuses once the writer is enabled), then the write path takes the new version and blocking time.
+    fn respecify(&self, new: DataWriterQos) -> DdsResult<()> {
+        check_history(&new.history)?;
+        let (version, rep) = super::writer_version::<T>(&new.data_representation);
+        let new = DataWriterQos {
+            data_representation: rep,
+            ..new
+        };
+        let wq = WriterQos::new(
+            new.clone(),
+            &self.publisher().get_qos()?,
+            &self.topic().get_qos()?,
+        );
+        let id = self.handle.id();
+        self.inner
+            .state
+            .driver
+            .with_core(|c, _| c.respecify_disabled_writer(id, wq))?;
+        self.inner.fixed.set(version, &new.reliability);
+        *write(&self.inner.current) = new;
+        Ok(())
     }
 
     /// Announces `qos` with the publisher's and topic's current parts.

@@ -13,6 +13,7 @@ use super::super::builtin::PublicationBuiltinTopicData;
 use super::super::builtin_subscriber::BuiltinSubscriber;
 use super::super::chain::{ListenerNode, ParentListener, StatusChange};
 use super::super::condition::{ReadCondition, ReadConditionSource, StatusCondition};
+use super::super::endpoint::check_history;
 use super::super::error::{DdsError, DdsResult};
 use super::super::participant::{DomainParticipant, WeakParticipant};
 use super::super::registry::{Child, EndpointEntry, Group, Registered};
@@ -400,28 +401,53 @@ impl<T: DdsType> DataReader<T> {
 
     /// Changes the QoS (`set_qos`). DEADLINE, LATENCY_BUDGET, USER_DATA, TIME_BASED_FILTER and
     /// READER_DATA_LIFECYCLE may change: the reader applies them from the next sample or check, and
-    /// announces them again in SEDP. The others cannot (`ImmutablePolicy`); a time-based filter longer than
-    /// the deadline is `InconsistentPolicy`. An empty `data_representation` keeps the current one.
+    /// announces them again in SEDP. The others cannot (`ImmutablePolicy`), unless the reader is still
+    /// disabled: then every policy may change (DDS 1.4 §2.2.2.1.1.7). A time-based filter longer than the
+    /// deadline is `InconsistentPolicy`. An empty `data_representation` keeps the current one.
     pub fn set_qos(&self, qos: &DataReaderQos) -> DdsResult<()> {
         self.inner.state.check_alive()?;
         let mut new = qos.clone();
-        {
-            let mut st = lock(&self.inner.cache);
-            let current = st.cache.qos();
-            if new.data_representation.ids().is_empty() {
-                new.data_representation = current.data_representation.clone();
-            }
-            if let Some(p) = current.immutable_change(&new) {
-                return Err(DdsError::ImmutablePolicy(p));
-            }
-            if new.time_based_filter.minimum_separation > new.deadline.0 {
-                return Err(DdsError::InconsistentPolicy(
-                    "time-based filter separation longer than the deadline",
-                ));
-            }
-            st.cache.set_qos(new.clone());
+        if new.time_based_filter.minimum_separation > new.deadline.0 {
+            return Err(DdsError::InconsistentPolicy(
+                "time-based filter separation longer than the deadline",
+            ));
         }
-        self.announce(new)
+        let current = lock(&self.inner.cache).cache.qos().clone();
+        if new.data_representation.ids().is_empty() {
+            new.data_representation = current.data_representation.clone();
+        }
+        // The core is called without the cache lock (the core lock comes first, as in `refresh_credit`).
+        match current.immutable_change(&new) {
+            Some(p) if self.is_enabled() => return Err(DdsError::ImmutablePolicy(p)),
+            // A disabled reader has received nothing: its cache takes the new history and limits as is.
+            Some(_) => self.respecify(&new)?,
+            None => self.announce(new.clone())?,
+        }
+        lock(&self.inner.cache).cache.set_qos(new);
+        Ok(())
+    }
+
+    /// `set_qos` with immutable changes on a disabled reader: the core rebuilds the reader (it refuses
+    /// once the reader is enabled) and is given the new credit.
+    fn respecify(&self, new: &DataReaderQos) -> DdsResult<()> {
+        check_history(&new.history)?;
+        let rq = ReaderQos::new(
+            new.clone(),
+            &self.subscriber().get_qos()?,
+            &self.topic().get_qos()?,
+        );
+        let id = self.handle.id();
+        let credit = super::credit_limit(new);
+        self.inner.state.driver.with_core(|c, _| {
+            c.respecify_disabled_reader(id, rq)?;
+            c.set_reader_credit(id, credit);
+            Ok::<_, crate::rtps::CoreError>(())
+        })?;
+        self.inner.credit_limit.store(
+            credit.unwrap_or(super::NO_CREDIT_LIMIT),
+            std::sync::atomic::Ordering::Relaxed,
+        );
+        Ok(())
     }
 
     /// Announces `qos` with the subscriber's and topic's current parts.

@@ -10,7 +10,9 @@ use super::Participant;
 use crate::qos::{ReaderQos, WriterQos};
 use crate::rtps::api::{CoreError, ReaderSpec, WriterSpec};
 use crate::rtps::discovery::{ReaderData, WriterData};
-use crate::rtps::types::EntityId;
+use crate::rtps::reader::Reader;
+use crate::rtps::types::{entity_kind, EntityId};
+use crate::rtps::writer::Writer;
 
 /// A local endpoint created disabled: what it will announce once enabled.
 #[derive(Debug)]
@@ -112,6 +114,51 @@ impl Participant {
                 None
             }
             _ => Some(qos),
+        }
+    }
+
+    /// Replaces every policy of a disabled writer, immutable ones included (DDS 1.4 §2.2.2.1.1.7: they may
+    /// change until the entity is enabled). Its protocol state is rebuilt from the new QoS (history, limits,
+    /// reliability, durability, lifespan); nothing was written or matched yet, so nothing is lost.
+    /// `BadParameter` once the writer is enabled, `UnknownEntity` for no local writer.
+    pub fn respecify_disabled_writer(
+        &mut self,
+        id: EntityId,
+        qos: WriterQos,
+    ) -> Result<(), CoreError> {
+        self.timers_changed();
+        let Some(Deferred::Writer(d)) = self.deferred.get_mut(&id) else {
+            return Err(self.not_deferred(id));
+        };
+        let keyed = id.kind() == entity_kind::USER_WRITER_WITH_KEY;
+        let params = super::user_writer_params(&self.config, &qos.writer, keyed);
+        d.qos = qos;
+        self.writers.insert(id, Writer::new(d.guid, params));
+        Ok(())
+    }
+
+    /// [`Participant::respecify_disabled_writer`] for a reader (its reliability may change). A credit set
+    /// with [`Participant::set_reader_credit`] must be set again.
+    pub fn respecify_disabled_reader(
+        &mut self,
+        id: EntityId,
+        qos: ReaderQos,
+    ) -> Result<(), CoreError> {
+        self.timers_changed();
+        let Some(Deferred::Reader(d)) = self.deferred.get_mut(&id) else {
+            return Err(self.not_deferred(id));
+        };
+        let params = super::reader_params(&self.config, qos.reader.reliability.is_reliable());
+        d.qos = qos;
+        self.readers.insert(id, Reader::new(d.guid, params));
+        Ok(())
+    }
+
+    fn not_deferred(&self, id: EntityId) -> CoreError {
+        if self.user_writers.contains(&id) || self.user_readers.contains(&id) {
+            CoreError::BadParameter("the endpoint is enabled already")
+        } else {
+            CoreError::UnknownEntity(id)
         }
     }
 
