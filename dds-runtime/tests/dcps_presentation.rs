@@ -237,6 +237,7 @@ fn access_scope_nests() {
 #[allow(clippy::type_complexity)]
 fn group_pair(
     domain: u32,
+    g: Presentation,
 ) -> (
     (DomainParticipant, DomainParticipant),
     Publisher,
@@ -244,7 +245,6 @@ fn group_pair(
     Vec<DataWriter<ShapeType>>,
     Vec<DataReader<ShapeType>>,
 ) {
-    let g = presentation(PresentationAccessScope::Group, true, false);
     let (p1, p2) = (participant(domain), participant(domain));
     let (wq, rq) = reliable_keep_all();
     let publ = p1
@@ -280,7 +280,10 @@ fn group_pair(
 /// seen, not even the other writer's whole part; the next set (one writer only) arrives.
 #[test]
 fn group_set_spans_writers_and_a_cut_set_is_never_seen() {
-    let (_ps, publ, _sub, mut ws, rs) = group_pair(138);
+    let (_ps, publ, _sub, mut ws, rs) = group_pair(
+        138,
+        presentation(PresentationAccessScope::Group, true, false),
+    );
     // Set 1: both writers.
     publ.begin_coherent_changes().unwrap();
     ws[0].write(&shape("RED", 1)).unwrap();
@@ -341,7 +344,10 @@ impl SubscriberListener for SeesBoth {
 /// GROUP scope: `on_data_on_readers` fires once per group set, when both readers hold their part.
 #[test]
 fn data_on_readers_fires_once_per_group_set_with_all_of_it() {
-    let (_ps, publ, sub, ws, rs) = group_pair(139);
+    let (_ps, publ, sub, ws, rs) = group_pair(
+        139,
+        presentation(PresentationAccessScope::Group, true, false),
+    );
     let calls = Arc::new(Mutex::new(Vec::new()));
     sub.set_listener(
         Box::new(SeesBoth {
@@ -370,4 +376,49 @@ fn data_on_readers_fires_once_per_group_set_with_all_of_it() {
         vec![(2, 2), (4, 4), (6, 6)],
         "once per set, all of it"
     );
+}
+
+/// GROUP ordered access: `get_datareaders` lists the subscriber's readers once per sample, in the order
+/// the samples were written across the publisher's writers; reading one sample from each listed reader in
+/// turn gives the samples in that order.
+#[test]
+fn group_ordered_access_lists_readers_in_sample_order() {
+    let ordered = presentation(PresentationAccessScope::Group, false, true);
+    let (_ps, _publ, sub, ws, rs) = group_pair(208, ordered);
+    let writes = [(0, 1), (1, 1), (0, 2), (1, 2), (1, 3), (0, 3)];
+    for &(w, x) in &writes {
+        ws[w].write(&shape("RED", x)).unwrap();
+    }
+    let any = (
+        SampleStateMask::ANY,
+        ViewStateMask::ANY,
+        InstanceStateMask::ANY,
+    );
+    assert!(wait_until(MATCH_TIMEOUT, || sub
+        .get_datareaders(any.0, any.1, any.2)
+        .unwrap()
+        .len()
+        == writes.len()));
+    sub.begin_access().unwrap();
+    let list = sub
+        .get_datareaders(SampleStateMask::NOT_READ, any.1, any.2)
+        .unwrap();
+    let expected: Vec<InstanceHandle> = writes
+        .iter()
+        .map(|&(w, _)| rs[w].instance_handle())
+        .collect();
+    assert_eq!(list, expected);
+    let mut seen = Vec::new();
+    for h in &list {
+        let (i, r) = rs
+            .iter()
+            .enumerate()
+            .find(|(_, r)| r.instance_handle() == *h)
+            .unwrap();
+        let s = r.select().max_samples(1).take().unwrap();
+        seen.push((i, s[0].data.as_ref().unwrap().x));
+    }
+    sub.end_access().unwrap();
+    assert_eq!(seen, writes);
+    assert!(sub.get_datareaders(any.0, any.1, any.2).unwrap().is_empty());
 }

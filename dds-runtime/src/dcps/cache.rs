@@ -155,6 +155,12 @@ impl<T: FilterFields> ReaderCache<T> {
         self.filter = f;
     }
 
+    /// Numbers the next samples from `floor` on, if that is above the numbers given so far: readers that
+    /// share one order (GROUP ordered access) number their samples from a counter they share.
+    pub(crate) fn order_from(&mut self, floor: u64) {
+        self.next_seq = self.next_seq.max(floor);
+    }
+
     pub(crate) fn set_instance_order(&mut self, on: bool) {
         self.instance_order = on;
     }
@@ -462,6 +468,20 @@ impl<T: FilterFields> ReaderCache<T> {
                 .iter()
                 .any(|s| Self::selected(i, s, sel, q.as_deref()))
         })
+    }
+
+    /// Appends the number (the order of reception, see [`ReaderCache::order_from`]) of every selected
+    /// sample to `out`.
+    pub(crate) fn matching_order(&self, sel: &Selection, out: &mut Vec<u64>) {
+        let q = read_query(sel);
+        for i in self.instances.values() {
+            out.extend(
+                i.samples
+                    .iter()
+                    .filter(|s| Self::selected(i, s, sel, q.as_deref()))
+                    .map(|s| s.seq),
+            );
+        }
     }
 
     /// The smallest instance handle above `prev` that has a matching sample.

@@ -7,7 +7,8 @@
 //! With GROUP access scope the writers also share a [`WriterGroup`]: group sequence numbers on every
 //! change, and a group coherent set whose parts readers deliver together (`rtps::participant::group`).
 
-use std::sync::Mutex;
+use std::sync::atomic::AtomicU64;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use crate::qos::{Presentation, PresentationAccessScope};
@@ -149,13 +150,20 @@ fn end_one(driver: &Driver, w: EntityId, deadline: Option<Instant>) -> DdsResult
     }
 }
 
-/// A subscriber's access scope: `begin_access` / `end_access` nesting.
+/// A subscriber's access scope: `begin_access` / `end_access` nesting, and the counter its readers number
+/// their samples from with GROUP ordered access (one order across the readers, for `get_datareaders`).
 #[derive(Debug, Default)]
 pub(crate) struct AccessScope {
     depth: Mutex<u32>,
+    order: Arc<AtomicU64>,
 }
 
 impl AccessScope {
+    /// The counter the subscriber's readers share with GROUP ordered access.
+    pub(crate) fn order(&self) -> Arc<AtomicU64> {
+        self.order.clone()
+    }
+
     pub(crate) fn begin(&self) {
         *lock(&self.depth) += 1;
     }
@@ -180,4 +188,10 @@ impl AccessScope {
 /// in reception order across instances (the default, and what TOPIC and GROUP scope ask for).
 pub(crate) fn instance_ordered(p: &Presentation) -> bool {
     p.ordered_access && p.access_scope == PresentationAccessScope::Instance
+}
+
+/// Whether a subscriber's readers share one order (ordered access with GROUP scope): `get_datareaders`
+/// then lists a reader once per sample, in the order the samples were received.
+pub(crate) fn group_ordered(p: &Presentation) -> bool {
+    p.ordered_access && p.access_scope == PresentationAccessScope::Group
 }

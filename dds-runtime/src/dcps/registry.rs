@@ -83,6 +83,16 @@ pub(crate) trait Registered: Send + Sync {
     fn has_samples(&self, _s: SampleStateMask, _v: ViewStateMask, _i: InstanceStateMask) -> bool {
         false
     }
+    /// Appends the numbers of a reader's samples in these states to `out`: with GROUP ordered access, their
+    /// place in the subscriber's order (`get_datareaders`). Nothing for writers.
+    fn sample_order(
+        &self,
+        _s: SampleStateMask,
+        _v: ViewStateMask,
+        _i: InstanceStateMask,
+        _out: &mut Vec<u64>,
+    ) {
+    }
     /// Calls the reader's `on_data_available` (`notify_datareaders`); nothing for writers.
     fn notify_data_available(self: Arc<Self>) {}
     /// Enables the reader or writer (`enable`): `PreconditionNotMet` while its factory or topic is

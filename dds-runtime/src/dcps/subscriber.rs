@@ -4,7 +4,7 @@ mod ops;
 
 use std::collections::VecDeque;
 use std::pin::Pin;
-use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering as AtomicOrdering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::task::{Context, Poll, Waker};
 use std::time::{Duration, Instant, SystemTime};
@@ -25,7 +25,7 @@ use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
 use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
 use super::participant::DomainParticipant;
-use super::presentation::{instance_ordered, AccessScope};
+use super::presentation::{group_ordered, instance_ordered, AccessScope};
 use super::sample::{
     InstanceHandle, InstanceStateMask, Sample, SampleInfo, SampleStateMask, ViewStateMask,
 };
@@ -178,9 +178,11 @@ impl Subscriber {
         let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
         cache.set_filter(topic.sample_filter());
         cache.set_instance_order(instance_ordered(&self.qos.presentation));
+
         let inner = Arc::new(ReaderInner::<T> {
             state: EndpointState::new(driver.clone()),
             pending: Mutex::new(VecDeque::new()),
+            group_order: group_ordered(&self.qos.presentation).then(|| self.access.order()),
             cache: Mutex::new(CacheState {
                 cache,
                 by_hash: HashMap::new(),
@@ -248,7 +250,7 @@ struct CacheState<T> {
     /// Key hash → serialized key, learnt from samples that carried both (for key-hash-only disposes).
     by_hash: HashMap<[u8; 16], Vec<u8>>,
     /// The queue being processed, swapped with `pending` (one lock round per batch, buffers reused).
-    batch: VecDeque<Pending>,
+    batch: VecDeque<(u64, Pending)>,
 }
 
 /// One pass of `process` over a reader's queue.
@@ -270,7 +272,10 @@ struct ReaderOwner<T> {
 
 struct ReaderInner<T: DdsType> {
     state: EndpointState<ReaderStatuses, dyn DataReaderListener<T>, ReaderOwner<T>>,
-    pending: Mutex<VecDeque<Pending>>,
+    /// Queued changes, each with its place in the subscriber's order (GROUP ordered access; else 0).
+    pending: Mutex<VecDeque<(u64, Pending)>>,
+    /// GROUP ordered access: the subscriber's counter, which places each change as the core delivers it.
+    group_order: Option<Arc<AtomicU64>>,
     cache: Mutex<CacheState<T>>,
     data_cv: Condvar,
     /// Threads in `wait_for_data`; registered under the cache lock so that `notify_data` (called after the
@@ -290,10 +295,10 @@ struct ReaderInner<T: DdsType> {
 /// (max_samples, max_instances, max_samples_per_instance), exclusive ownership (strongest writer, ties to
 /// the lowest GUID), time-based filter (per instance, no delayed delivery of the last filtered sample),
 /// reader data lifecycle (both autopurge delays), lifespan (from the writer's announced lifespan, counted
-/// from the source timestamp), requested deadline missed (checked every 50 ms).
+/// from the source timestamp), requested deadline missed (checked every 50 ms),
+/// destination order by source timestamp (a change older than the instance's newest is dropped).
 /// Coherent sets are stored whole or not at all; ordered access with INSTANCE scope groups reads by
-/// instance. Not enforced: destination order by source timestamp (reception order is used), GROUP-scope
-/// presentation across writers, liveliness kinds other than what the core reports.
+/// instance; with GROUP scope the subscriber's readers share one order (see `Subscriber::get_datareaders`).
 pub struct DataReader<T: DdsType> {
     inner: Arc<ReaderInner<T>>,
     handle: Arc<EndpointHandle<ReaderOwner<T>>>,
@@ -860,7 +865,16 @@ impl<T: DdsType> ReaderInner<T> {
 
 impl<T: DdsType> Endpoint for ReaderInner<T> {
     fn enqueue(&self, item: Pending) {
-        lock(&self.pending).push_back(item);
+        // Numbered here, under the core lock, in the core's order across the subscriber's readers (they
+        // store their queues one after the other).
+        let place = self.group_order.as_ref().map_or(0, |c| {
+            let n = match &item {
+                Pending::CoherentSet(set) => set.len() as u64,
+                _ => 1,
+            };
+            c.fetch_add(n, AtomicOrdering::Relaxed)
+        });
+        lock(&self.pending).push_back((place, item));
     }
 
     fn process(self: Arc<Self>) {
@@ -877,7 +891,8 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
             // Taking the queue under the cache lock keeps the core's order even with several receive threads.
             let mut batch = std::mem::take(&mut st.batch);
             std::mem::swap(&mut batch, &mut *lock(&self.pending));
-            for item in batch.drain(..) {
+            for (place, item) in batch.drain(..) {
+                st.cache.order_from(place);
                 match item {
                     Pending::Sample(s) => self.store(st, s, &mut pass),
                     // Under one lock hold: a read sees all of the set or none of it.

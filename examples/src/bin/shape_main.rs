@@ -488,6 +488,114 @@ fn run_publisher(
     Ok(())
 }
 
+/// Ordered access with GROUP scope: the subscriber orders samples across its readers.
+fn group_ordered(o: &ShapeOptions) -> bool {
+    o.ordered && presentation(o).access_scope == PresentationAccessScope::Group
+}
+
+/// Reads in the subscriber's order: `get_datareaders` lists a reader once per sample, and each turn reads
+/// that reader's next sample.
+fn read_in_group_order(
+    o: &ShapeOptions,
+    subscriber: &Subscriber,
+    readers: &[DataReader<ShapeType>],
+    colors: &mut HashMap<(usize, InstanceHandle), String>,
+) -> DdsResult<()> {
+    let order = subscriber.get_datareaders(
+        SampleStateMask::NOT_READ,
+        ViewStateMask::ANY,
+        InstanceStateMask::ANY,
+    )?;
+    for h in order {
+        let Some((i, r)) = readers
+            .iter()
+            .enumerate()
+            .find(|(_, r)| r.instance_handle() == h)
+        else {
+            continue;
+        };
+        let next = r
+            .select()
+            .sample_state(SampleStateMask::NOT_READ)
+            .max_samples(1);
+        let samples = if o.use_read {
+            next.read()?
+        } else {
+            next.take()?
+        };
+        print_samples(o, (i, r), &samples, colors);
+    }
+    Ok(())
+}
+
+/// Reads the readers one after the other (by instance with `--take-read-next-instance`).
+fn read_each_reader(
+    o: &ShapeOptions,
+    readers: &[DataReader<ShapeType>],
+    colors: &mut HashMap<(usize, InstanceHandle), String>,
+) -> DdsResult<()> {
+    for (i, r) in readers.iter().enumerate() {
+        let mut previous = InstanceHandle::NIL;
+        loop {
+            let samples = match (o.use_read, o.take_read_next_instance) {
+                (false, true) => r.take_next_instance(previous)?,
+                (true, true) => r.read_next_instance(previous)?,
+                (false, false) => r.take()?,
+                (true, false) => r.read()?,
+            };
+            let Some(first) = samples.first() else { break };
+            previous = first.info.instance_handle;
+            print_samples(o, (i, r), &samples, colors);
+            if !o.take_read_next_instance {
+                break;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Prints what one read or take of reader `i` returned: a line per sample with data, and a line per
+/// instance state change.
+fn print_samples(
+    o: &ShapeOptions,
+    (i, r): (usize, &DataReader<ShapeType>),
+    samples: &[Sample<ShapeType>],
+    colors: &mut HashMap<(usize, InstanceHandle), String>,
+) {
+    let topic = r.topic().name();
+    for s in samples {
+        let handle = s.info.instance_handle;
+        if let Some(d) = &s.data {
+            colors.insert((i, handle), d.color.clone());
+            if o.color.as_ref().is_none_or(|c| *c == d.color) {
+                println!(
+                    "{}",
+                    shape_output::sample_line(
+                        topic,
+                        &d.color,
+                        d.x,
+                        d.y,
+                        d.shapesize,
+                        &d.additional_payload_size
+                    )
+                );
+            }
+        }
+        let state = match s.info.instance_state {
+            InstanceState::Alive => continue,
+            InstanceState::NotAliveDisposed => NotAlive::Disposed,
+            InstanceState::NotAliveNoWriters => NotAlive::NoWriters,
+        };
+        let color = colors.get(&(i, handle)).cloned().unwrap_or_default();
+        if o.color.as_ref().is_none_or(|c| *c == color) {
+            println!(
+                "{}",
+                shape_output::instance_state_line(topic, &color, state)
+            );
+        }
+    }
+}
+
 fn run_subscriber(
     o: &ShapeOptions,
     subscriber: &Subscriber,
@@ -507,53 +615,10 @@ fn run_subscriber(
         if access {
             subscriber.begin_access()?;
         }
-        for (i, r) in readers.iter().enumerate() {
-            let topic = r.topic().name().to_string();
-            let mut previous = InstanceHandle::NIL;
-            loop {
-                let samples = match (o.use_read, o.take_read_next_instance) {
-                    (false, true) => r.take_next_instance(previous)?,
-                    (true, true) => r.read_next_instance(previous)?,
-                    (false, false) => r.take()?,
-                    (true, false) => r.read()?,
-                };
-                let Some(first) = samples.first() else { break };
-                previous = first.info.instance_handle;
-                for s in &samples {
-                    let handle = s.info.instance_handle;
-                    if let Some(d) = &s.data {
-                        colors.insert((i, handle), d.color.clone());
-                        if o.color.as_ref().is_none_or(|c| *c == d.color) {
-                            println!(
-                                "{}",
-                                shape_output::sample_line(
-                                    &topic,
-                                    &d.color,
-                                    d.x,
-                                    d.y,
-                                    d.shapesize,
-                                    &d.additional_payload_size
-                                )
-                            );
-                        }
-                    }
-                    let state = match s.info.instance_state {
-                        InstanceState::Alive => continue,
-                        InstanceState::NotAliveDisposed => NotAlive::Disposed,
-                        InstanceState::NotAliveNoWriters => NotAlive::NoWriters,
-                    };
-                    let color = colors.get(&(i, handle)).cloned().unwrap_or_default();
-                    if o.color.as_ref().is_none_or(|c| *c == color) {
-                        println!(
-                            "{}",
-                            shape_output::instance_state_line(&topic, &color, state)
-                        );
-                    }
-                }
-                if !o.take_read_next_instance {
-                    break;
-                }
-            }
+        if group_ordered(o) {
+            read_in_group_order(o, subscriber, readers, &mut colors)?;
+        } else {
+            read_each_reader(o, readers, &mut colors)?;
         }
         if access {
             subscriber.end_access()?;

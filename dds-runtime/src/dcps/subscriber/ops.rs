@@ -11,17 +11,20 @@ use crate::qos::{ChangeableQos, DataReaderQos, ReaderQos, SubscriberQos, TopicQo
 
 use super::super::builtin::PublicationBuiltinTopicData;
 use super::super::builtin_subscriber::BuiltinSubscriber;
+use super::super::cache::Selection;
 use super::super::chain::{ListenerNode, ParentListener, StatusChange};
 use super::super::condition::{ReadCondition, ReadConditionSource, StatusCondition};
 use super::super::endpoint::check_history;
 use super::super::error::{DdsError, DdsResult};
 use super::super::participant::{DomainParticipant, WeakParticipant};
+use super::super::presentation::group_ordered;
 use super::super::registry::{Child, EndpointEntry, Group, Registered};
 use super::super::sample::{InstanceHandle, InstanceStateMask, SampleStateMask, ViewStateMask};
 use super::super::status::*;
 use super::super::sync::lock;
 use super::super::topic::Topic;
 use super::{DataReader, DataReaderListener, ReaderInner, Subscriber};
+use crate::rtps::EntityId;
 
 /// Callbacks of a [`Subscriber`] for its readers' statuses that have no listener of their own enabled for
 /// them (DDS 1.4 §2.2.4.1). Readers are identified by their instance handle. Every method has an empty
@@ -162,6 +165,21 @@ impl<T: DdsType> Registered for ReaderInner<T> {
     }
     fn has_samples(&self, s: SampleStateMask, v: ViewStateMask, i: InstanceStateMask) -> bool {
         self.has_matching(s, v, i, None)
+    }
+    fn sample_order(
+        &self,
+        s: SampleStateMask,
+        v: ViewStateMask,
+        i: InstanceStateMask,
+        out: &mut Vec<u64>,
+    ) {
+        let sel = Selection {
+            sample_states: s,
+            view_states: v,
+            instance_states: i,
+            ..Selection::default()
+        };
+        lock(&self.cache).cache.matching_order(&sel, out);
     }
     fn notify_data_available(self: Arc<Self>) {
         self.state
@@ -361,16 +379,23 @@ impl Subscriber {
         views: ViewStateMask,
         instances: InstanceStateMask,
     ) -> DdsResult<Vec<InstanceHandle>> {
-        let handle = self.participant.driver().guid_prefix;
-        Ok(self
-            .readers()?
+        let prefix = self.participant.driver().guid_prefix;
+        let handle = |id| InstanceHandle::from_guid(crate::rtps::Guid::new(prefix, id));
+        let readers = self.readers()?;
+        if group_ordered(&self.qos.presentation) {
+            return Ok(group_order(&readers, samples, views, instances)
+                .into_iter()
+                .map(handle)
+                .collect());
+        }
+        Ok(readers
             .into_iter()
             .filter(|r| {
                 r.entity
                     .upgrade()
                     .is_some_and(|e| e.has_samples(samples, views, instances))
             })
-            .map(|r| InstanceHandle::from_guid(crate::rtps::Guid::new(handle, r.id)))
+            .map(|r| handle(r.id))
             .collect())
     }
 
@@ -390,6 +415,27 @@ impl Subscriber {
         }
         Ok(())
     }
+}
+
+/// GROUP ordered access: the readers once per sample in these states, in the order the subscriber received
+/// the samples (the readers number their samples from one counter).
+fn group_order(
+    readers: &[Child],
+    samples: SampleStateMask,
+    views: ViewStateMask,
+    instances: InstanceStateMask,
+) -> Vec<EntityId> {
+    let mut order: Vec<(u64, EntityId)> = Vec::new();
+    let mut seqs = Vec::new();
+    for r in readers {
+        if let Some(e) = r.entity.upgrade() {
+            seqs.clear();
+            e.sample_order(samples, views, instances, &mut seqs);
+            order.extend(seqs.iter().map(|&n| (n, r.id)));
+        }
+    }
+    order.sort_unstable_by_key(|&(n, _)| n);
+    order.into_iter().map(|(_, id)| id).collect()
 }
 
 impl<T: DdsType> DataReader<T> {
