@@ -91,9 +91,16 @@ fn persistent_writer_transient_local_reader_match_cyclone_to_us() {
 }
 
 fn service(domain: u32, store: &std::path::Path) -> Result<Proc, Skip> {
+    service_with(domain, Some(store))
+}
+
+/// `dds-durability` on `domain`, with a persistent store or without.
+fn service_with(domain: u32, store: Option<&std::path::Path>) -> Result<Proc, Skip> {
     let mut c = Command::new(our_bin("dds-durability")?);
-    c.args(["--domain", &domain.to_string(), "--store"])
-        .arg(store);
+    c.args(["--domain", &domain.to_string()]);
+    if let Some(store) = store {
+        c.arg("--store").arg(store);
+    }
     let p = Proc::spawn("dds-durability", c);
     check!(
         p.wait_line(WAIT, |l| l.ends_with("ready")).is_some(),
@@ -168,5 +175,47 @@ fn kill_test(domain: u32) -> Result<(), Skip> {
     let _ = r.interrupt(WAIT);
     drop(svc);
     let _ = std::fs::remove_dir_all(&dir);
+    Ok(())
+}
+
+/// Cyclone sends no key hash. `dds-durability` keeps a Cyclone TRANSIENT writer's changes by instance all the
+/// same, computing each key hash from the payload through the type Cyclone announced (and TypeLookup
+/// fetched): with Cyclone's default DURABILITY_SERVICE history (KEEP_LAST 1), a reader that joins after the
+/// writer was killed gets one sample of the instance, the last one written, not one per change.
+#[test]
+fn the_service_keeps_a_cyclone_writers_changes_by_instance() {
+    let _ = keyed_without_key_hash(197);
+}
+
+fn keyed_without_key_hash(domain: u32) -> Result<(), Skip> {
+    require_netns()?;
+    let svc = service_with(domain, None)?;
+    let writer = Prog::Cyclone.spawn(
+        "writer",
+        &format!("-P -t Square -d {domain} -c RED -r -D t -k 0 -w"),
+    )?;
+    let enough = writer
+        .wait_lines(WAIT, 10, |l| l.starts_with("Square     RED"))
+        .is_some();
+    check!(enough, &[&svc, &writer], "Cyclone did not write 10 samples");
+    // Let the service receive what was printed, then kill -9 the writer.
+    std::thread::sleep(Duration::from_secs(1));
+    let written = samples(&writer, "RED");
+    drop(writer);
+    let mut r = Prog::Ours.spawn("reader", &format!("-S -t Square -d {domain} -r -D t -k 0"))?;
+    let got_one = r
+        .wait_line(WAIT, |l| l.starts_with("Square     RED"))
+        .is_some();
+    std::thread::sleep(Duration::from_secs(2));
+    let got = samples(&r, "RED");
+    check!(got_one, &[&svc, &r], "no sample from the service");
+    check!(
+        got.len() == 1 && written.last() == got.first(),
+        &[&svc, &r],
+        "expected the last of {} written ({:?}), got {got:?}",
+        written.len(),
+        written.last()
+    );
+    let _ = r.interrupt(WAIT);
     Ok(())
 }

@@ -9,6 +9,7 @@
 
 mod dedup;
 mod history;
+mod key;
 mod marker;
 mod service;
 #[cfg(feature = "persistence")]

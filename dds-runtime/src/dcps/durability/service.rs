@@ -9,6 +9,7 @@ use std::sync::{Arc, Mutex, Weak};
 use std::time::{Duration, Instant};
 
 use super::history::{instance_of, Limits, StoredChange, WriterHistory};
+use super::key::KeyTypes;
 use super::marker;
 #[cfg(feature = "persistence")]
 use super::store::{Batch, PersistentStore};
@@ -74,6 +75,8 @@ pub(crate) struct Service {
     #[cfg(feature = "persistence")]
     store: Option<PersistentStore>,
     state: Mutex<State>,
+    /// Writers' types, for the key hashes of changes that come without one.
+    key_types: KeyTypes,
     me: Weak<Service>,
 }
 
@@ -137,6 +140,7 @@ impl Service {
             #[cfg(feature = "persistence")]
             store,
             state: Mutex::new(State::default()),
+            key_types: KeyTypes::default(),
             me: me.clone(),
         })
     }
@@ -288,10 +292,11 @@ impl Service {
     }
 
     /// Keeps and republishes what a channel reader received.
-    fn ingest(&self, samples: Vec<ReceivedSample>) {
+    fn ingest(&self, mut samples: Vec<ReceivedSample>) {
         let Some(driver) = self.driver.upgrade() else {
             return;
         };
+        self.fill_key_hashes(&driver, &mut samples);
         let mut out: Vec<(EntityId, WriteChange)> = Vec::new();
         #[cfg(feature = "persistence")]
         let mut batch = Batch::default();
@@ -356,6 +361,24 @@ impl Service {
         }
     }
 
+    /// Keyed changes that come without a key hash get the one their writer's type gives (see
+    /// [`KeyTypes`]); without the type they keep none, and are kept under a digest of their payload.
+    fn fill_key_hashes(&self, driver: &Driver, samples: &mut [ReceivedSample]) {
+        let needs = |s: &ReceivedSample| s.key_hash.is_none() && s.writer.entity_id.is_keyed();
+        for s in samples.iter_mut().filter(|s| needs(s)) {
+            let info = {
+                let st = lock(&self.state);
+                let original = st.sources.get(&s.writer).copied().unwrap_or(s.writer);
+                st.kept
+                    .get(&original)
+                    .and_then(|k| k.data.type_information.clone())
+            };
+            s.key_hash =
+                self.key_types
+                    .key_hash(driver, s.writer, info.as_ref(), s.kind, &s.payload);
+        }
+    }
+
     /// Forgets `original` once it has been gone for its `service_cleanup_delay` and each of its instances is
     /// disposed (DDS 1.4 §2.2.3.5).
     fn cleanup(&self, original: &Guid, now: Instant) {
@@ -371,6 +394,7 @@ impl Service {
             }
             st.kept.remove(original).and_then(|k| k.stand_in)
         };
+        self.key_types.forget(original);
         tracing::info!(writer = ?original, "durability: cleaned up");
         #[cfg(feature = "persistence")]
         if let Some(store) = &self.store {
