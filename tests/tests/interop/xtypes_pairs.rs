@@ -100,7 +100,15 @@ fn qos() -> (DataWriterQos, DataReaderQos) {
     )
 }
 
+/// The peer, once it has created its 625 endpoints (panics with its output if it does not).
 fn spawn_peer(domain: u32, role: &str) -> Proc {
+    let peer = start_peer(domain, role);
+    peer.wait_line(Duration::from_secs(60), |l| l.starts_with("READY "))
+        .unwrap_or_else(|| panic!("the peer did not start\n{}", peer.dump()));
+    peer
+}
+
+fn start_peer(domain: u32, role: &str) -> Proc {
     let script = cyclone_peer()
         .expect("checked")
         .with_file_name("cyclone_xtypes_shapes.py");
@@ -185,6 +193,8 @@ fn parse_pairs(peer: &Proc, pairs: &mut BTreeMap<(usize, usize), Pair>) {
             .filter_map(|x| x.parse().ok())
             .collect();
         assert_eq!(v.len(), 6, "bad line {l:?}");
+        // Type names differ on most topics; with type information Cyclone never calls that inconsistent.
+        assert_eq!(v[5], 0, "inconsistent topic: {l:?}");
         let p = pairs.entry((v[0] as usize, v[1] as usize)).or_default();
         p.cyclone = v[2] > 0;
         p.cyclone_incompatible = (v[3] as u32, v[4] as i32);
