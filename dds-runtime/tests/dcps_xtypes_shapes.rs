@@ -15,57 +15,6 @@ use dds_runtime::xtypes::assign::{is_assignable, local_types};
 use dds_runtime::xtypes::XTypesType;
 use xtypes_shapes::*;
 
-/// The suite's compatibility matrix (its spreadsheet gives the upper triangle; the relation is symmetric for
-/// these types): row = writer variant, column = reader variant, `+` compatible, `-` not.
-const MATRIX: [&str; 25] = [
-    "++--+-----++--+----------",
-    "++--+-----++--+----------",
-    "--+---------+------------",
-    "---+---------+-----------",
-    "++--+-----++--+----------",
-    "-----+-------------------",
-    "------+------------------",
-    "-------+-----------------",
-    "--------+----------------",
-    "---------+---------------",
-    "++--+-----++--+----------",
-    "++--+-----++--+----------",
-    "--+---------+------------",
-    "---+---------+-----------",
-    "++--+-----++--+----------",
-    "---------------+---+-----",
-    "----------------+--+-----",
-    "-----------------+-------",
-    "------------------+------",
-    "---------------++--+-----",
-    "--------------------+++++",
-    "--------------------+++++",
-    "--------------------+++++",
-    "--------------------+++++",
-    "--------------------+++++",
-];
-
-/// (writer, reader) pairs where we (and Cyclone DDS 11, whose rules we follow) disagree with the matrix.
-const DISAGREE: &[(usize, usize, &str)] = &[
-    (7, 10, "Shape2Final and Shape5Final have the same members once Shape5's base is flattened \
-             (XTypes 1.3 §7.2.2.4.5, as Cyclone expands bases); the matrix keeps inheritance apart for @final only"),
-    (10, 7, "the same pair, the other way"),
-    (16, 17, "Shape1Mutable and Shape2Mutable pair every id with the same name; the matrix marks them \
-              incompatible yet Shape1Mutable/Shape5Mutable compatible, and Shape2Mutable and Shape5Mutable have \
-              the same ids and names"),
-    (17, 16, "the same pair, the other way"),
-];
-
-/// Whether the matrix says writer `w` and reader `r` (1-based) match.
-fn matrix(w: usize, r: usize) -> bool {
-    MATRIX[w - 1].as_bytes()[r - 1] == b'+'
-}
-
-/// What we expect: the matrix, but for the listed disagreements.
-fn expected(w: usize, r: usize) -> bool {
-    matrix(w, r) != DISAGREE.iter().any(|(a, b, _)| (*a, *b) == (w, r))
-}
-
 fn minimal_ids() -> Vec<dds_runtime::xtypes::typeobject::TypeIdentifier> {
     let mut ids = Vec::new();
     macro_rules! push {
@@ -96,56 +45,6 @@ fn assignability_follows_the_suite_matrix() {
         }
     }
     assert_eq!(agree, 625 - DISAGREE.len());
-}
-
-/// A writer of some variant, its type erased.
-trait AnyWriter {
-    fn matched(&self) -> i32;
-    fn write(&self, f: &Fields);
-    fn incompatible(&self) -> u32;
-    fn has(&self) -> (bool, bool);
-}
-
-/// A reader of some variant, its type erased.
-trait AnyReader {
-    fn matched(&self) -> i32;
-    fn take(&self) -> Vec<Fields>;
-    fn incompatible(&self) -> IncompatibleQosStatus;
-    fn has(&self) -> (bool, bool);
-}
-
-impl<T: Variant> AnyWriter for DataWriter<T> {
-    fn matched(&self) -> i32 {
-        self.publication_matched_status().current_count as i32
-    }
-    fn write(&self, f: &Fields) {
-        DataWriter::write(self, &T::from_fields(f)).expect("write");
-    }
-    fn incompatible(&self) -> u32 {
-        self.offered_incompatible_qos_status().total_count
-    }
-    fn has(&self) -> (bool, bool) {
-        T::HAS
-    }
-}
-
-impl<T: Variant> AnyReader for DataReader<T> {
-    fn matched(&self) -> i32 {
-        self.subscription_matched_status().current_count as i32
-    }
-    fn take(&self) -> Vec<Fields> {
-        DataReader::take(self)
-            .expect("take")
-            .into_iter()
-            .filter_map(|s| s.data().map(|d| d.fields()))
-            .collect()
-    }
-    fn incompatible(&self) -> IncompatibleQosStatus {
-        self.requested_incompatible_qos_status()
-    }
-    fn has(&self) -> (bool, bool) {
-        T::HAS
-    }
 }
 
 /// All 625 pairs over DCPS: 25 writers on one participant, 25 readers on another, one topic.
@@ -197,7 +96,7 @@ fn all_625_pairs_match_and_read_in_their_own_type() {
             );
         }
         assert_eq!(
-            writers[k - 1].incompatible() as i32,
+            writers[k - 1].incompatible().total_count as i32,
             25 - want_w(k),
             "writer {k}"
         );

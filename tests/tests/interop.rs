@@ -22,4 +22,5 @@ mod interop {
     pub mod tui;
     pub mod typelookup;
     pub mod xtypes;
+    pub mod xtypes_pairs;
 }

@@ -906,3 +906,8 @@ macro_rules! for_each_variant {
         $m!(Shape5MutableExplicitID);
     };
 }
+
+mod erased;
+mod matrix;
+pub(crate) use erased::*;
+pub(crate) use matrix::*;
