@@ -326,11 +326,14 @@ fn replies_not_asked_for_are_ignored() {
     assert!(cstore.missing(&info).is_empty());
 }
 
+/// Over its rate, a participant's requests wait for later seconds (in order, bounded in number) instead
+/// of being dropped: peers such as Cyclone send a burst when they discover many types and never ask again.
 #[test]
 fn requests_are_rate_limited_per_participant() {
     let (sstore, _) = owned_store::<Leaf>();
     let limits = ServerLimits {
         requests_per_second: 5,
+        max_deferred: 12,
         ..ServerLimits::default()
     };
     let mut server = Server::new(limits);
@@ -340,8 +343,19 @@ fn requests_are_rate_limited_per_participant() {
         .filter(|_| server.handle(now, [1; 12], &sstore, &req).is_some())
         .count();
     assert_eq!(answered, 5);
+    // Another participant has its own rate.
     assert!(server.handle(now, [2; 12], &sstore, &req).is_some());
-    assert!(server
-        .handle(now + Duration::from_secs(1), [1; 12], &sstore, &req)
-        .is_some());
+    // 12 of the other 95 wait; none can be answered in this second.
+    assert!(server.poll_deferred(now, &sstore).is_none());
+    let second = now + Duration::from_secs(1);
+    assert_eq!(server.next_deferred(), Some(second));
+    // A request arriving now waits behind them (the peer's order is kept).
+    assert!(server.handle(second, [1; 12], &sstore, &req).is_none());
+    let mut drained = Vec::new();
+    for s in 1..=4 {
+        let t = now + Duration::from_secs(s);
+        drained.push(std::iter::from_fn(|| server.poll_deferred(t, &sstore)).count());
+    }
+    assert_eq!(drained, vec![5, 5, 2, 0], "12 waiting, 5 per second");
+    assert_eq!(server.next_deferred(), None);
 }

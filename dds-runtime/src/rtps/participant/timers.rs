@@ -63,6 +63,9 @@ impl Participant {
         if let Some(x) = self.own_leases.next_deadline() {
             t = t.min(x);
         }
+        if let Some(x) = self.type_lookup_due() {
+            t = t.min(x);
+        }
         for w in self.writers.values() {
             if let Some(x) = w.next_timeout() {
                 t = t.min(x);

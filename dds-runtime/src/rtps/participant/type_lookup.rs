@@ -159,14 +159,24 @@ impl Participant {
         };
         let t = &mut self.type_lookup;
         let Some(reply) = t.server.handle(now, s.writer.prefix.0, &t.store, &req) else {
-            debug!(writer = ?s.writer, "TypeLookup request over the rate limit dropped");
+            debug!(writer = ?s.writer, "TypeLookup request over the rate limit: answered later");
+            self.timers_changed();
             return;
         };
         trace!(writer = ?s.writer, call = ?req.call, "TypeLookup request answered");
-        match typelookup::encode_reply(&reply) {
+        self.send_type_reply(now, &reply);
+    }
+
+    fn send_type_reply(&mut self, now: Instant, reply: &typelookup::Reply) {
+        match typelookup::encode_reply(reply) {
             Ok(bytes) => self.write_service(now, EntityId::TYPELOOKUP_REPLY_WRITER, bytes),
             Err(e) => debug!(error = %e, "TypeLookup reply not encodable"),
         }
+    }
+
+    /// When requests that were over their peer's rate can be answered.
+    pub(super) fn type_lookup_due(&self) -> Option<Instant> {
+        self.type_lookup.server.next_deferred()
     }
 
     /// A reply arrived on our reply reader: if it answers one of our requests, store what checks out.
@@ -192,8 +202,15 @@ impl Participant {
         self.send_type_requests(now);
     }
 
-    /// Expires unanswered requests.
+    /// Expires unanswered requests of ours, and answers the peers' requests that waited for their rate.
     pub(super) fn type_lookup_timeout(&mut self, now: Instant) {
         self.type_lookup.client.handle_timeout(now);
+        loop {
+            let t = &mut self.type_lookup;
+            let Some(reply) = t.server.poll_deferred(now, &t.store) else {
+                break;
+            };
+            self.send_type_reply(now, &reply);
+        }
     }
 }

@@ -1,7 +1,7 @@
 //! The server side: answers `getTypes` and `getTypeDependencies` from a [`TypeStore`], rate-limited per
 //! requesting participant and bounded in what one reply may carry.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::time::{Duration, Instant};
 
 use crate::xtypes::store::TypeStore;
@@ -18,8 +18,12 @@ pub struct ServerLimits {
     pub max_reply_bytes: usize,
     /// Dependencies in one `getTypeDependencies` reply (a continuation point gives the rest).
     pub dependencies_page: usize,
-    /// Requests answered per participant per second (more are dropped).
+    /// Requests answered per participant per second; more wait for a later second (see `max_deferred`).
     pub requests_per_second: u32,
+    /// Requests over the rate kept to be answered later, from all participants together (more are
+    /// dropped). Peers such as Cyclone DDS send a burst of requests when they discover many types and do not
+    /// ask again, so dropping them would leave their types unresolved.
+    pub max_deferred: usize,
     /// Participants whose rate is tracked at once.
     pub max_peers: usize,
 }
@@ -31,10 +35,14 @@ impl Default for ServerLimits {
             max_reply_bytes: 256 << 10,
             dependencies_page: 64,
             requests_per_second: 64,
+            max_deferred: 1024,
             max_peers: 4096,
         }
     }
 }
+
+/// The rate limiter's window.
+const RATE_WINDOW: Duration = Duration::from_secs(1);
 
 /// Requests per peer in one-second windows.
 #[derive(Debug, Default)]
@@ -43,9 +51,20 @@ pub struct RateLimiter {
 }
 
 impl RateLimiter {
+    /// From when `peer` may have one more request answered (`None`: at once, it has no window).
+    fn next_allowed(&self, peer: &[u8; 12], limits: &ServerLimits) -> Option<Instant> {
+        self.windows.get(peer).map(|(start, count)| {
+            if *count < limits.requests_per_second {
+                *start
+            } else {
+                *start + RATE_WINDOW
+            }
+        })
+    }
+
     /// Whether `peer` may have one more request answered at `now` (and counts it).
     pub fn allow(&mut self, now: Instant, peer: [u8; 12], limits: &ServerLimits) -> bool {
-        const WINDOW: Duration = Duration::from_secs(1);
+        const WINDOW: Duration = RATE_WINDOW;
         if !self.windows.contains_key(&peer) && self.windows.len() >= limits.max_peers {
             self.windows
                 .retain(|_, (start, _)| now.saturating_duration_since(*start) < WINDOW);
@@ -68,6 +87,8 @@ impl RateLimiter {
 pub struct Server {
     limits: ServerLimits,
     limiter: RateLimiter,
+    /// Requests over their peer's rate, oldest first, answered by [`Server::poll_deferred`].
+    deferred: VecDeque<([u8; 12], Request)>,
 }
 
 impl Server {
@@ -76,11 +97,13 @@ impl Server {
         Server {
             limits,
             limiter: RateLimiter::default(),
+            deferred: VecDeque::new(),
         }
     }
 
     /// The reply to `req`, which came from participant `peer` (the RTPS source, not the header's claim);
-    /// `None` when `peer` is over its rate.
+    /// `None` when `peer` is over its rate: the request then waits for [`Server::poll_deferred`] (or is
+    /// dropped when `max_deferred` requests wait already).
     pub fn handle(
         &mut self,
         now: Instant,
@@ -88,9 +111,44 @@ impl Server {
         store: &TypeStore,
         req: &Request,
     ) -> Option<Reply> {
-        if !self.limiter.allow(now, peer, &self.limits) {
+        let earlier_waits = self.deferred.iter().any(|(p, _)| *p == peer);
+        if earlier_waits || !self.limiter.allow(now, peer, &self.limits) {
+            if self.deferred.len() < self.limits.max_deferred {
+                self.deferred.push_back((peer, req.clone()));
+            }
             return None;
         }
+        Some(self.answer(store, req))
+    }
+
+    /// The next waiting request whose peer's rate allows it now, answered (call until `None`).
+    pub fn poll_deferred(&mut self, now: Instant, store: &TypeStore) -> Option<Reply> {
+        let limits = &self.limits;
+        let i = self.deferred.iter().position(|(p, _)| {
+            self.limiter
+                .next_allowed(p, limits)
+                .is_none_or(|t| now >= t)
+        })?;
+        let (peer, req) = self.deferred.remove(i)?;
+        if !self.limiter.allow(now, peer, &self.limits) {
+            // Too many peers tracked at once: try again later.
+            self.deferred.push_front((peer, req));
+            return None;
+        }
+        Some(self.answer(store, &req))
+    }
+
+    /// When [`Server::poll_deferred`] has something to answer (`None` while nothing waits; a waiting
+    /// request of a peer no longer tracked is answered at the next poll).
+    pub fn next_deferred(&self) -> Option<Instant> {
+        let limits = &self.limits;
+        self.deferred
+            .iter()
+            .filter_map(|(p, _)| self.limiter.next_allowed(p, limits))
+            .min()
+    }
+
+    fn answer(&self, store: &TypeStore, req: &Request) -> Reply {
         let (remote_ex, return_data) = match &req.call {
             Call::GetTypes(ids) => (
                 RemoteExceptionCode::Ok,
@@ -108,11 +166,11 @@ impl Server {
             },
             Call::Other(d) => (RemoteExceptionCode::UnknownOperation, Return::Other(*d)),
         };
-        Some(Reply {
+        Reply {
             related_request_id: req.request_id,
             remote_ex,
             return_data,
-        })
+        }
     }
 
     fn get_types(&self, store: &TypeStore, ids: &[TypeIdentifier]) -> TypesOut {
