@@ -131,7 +131,10 @@ impl Subscriber {
             matched: Mutex::new(Vec::new()),
         });
         let sink: Arc<dyn Endpoint> = inner.clone();
-        let id = driver.create_endpoint(sink, |c, now| c.create_reader(now, spec))?;
+        let id = driver.create_endpoint(sink, |c, now| {
+            topic.register_types(c);
+            c.create_reader(now, spec)
+        })?;
         let owner = Owner {
             topic: topic.clone(),
             _subscriber: self.clone(),

@@ -97,7 +97,10 @@ impl Publisher {
             matched_cv: Condvar::new(),
         });
         let sink: Arc<dyn Endpoint> = inner.clone();
-        let id = driver.create_endpoint(sink, |c, now| c.create_writer(now, spec))?;
+        let id = driver.create_endpoint(sink, |c, now| {
+            topic.register_types(c);
+            c.create_writer(now, spec)
+        })?;
         let owner = Owner {
             topic: topic.clone(),
             _publisher: self.clone(),
