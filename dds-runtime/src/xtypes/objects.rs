@@ -2,7 +2,7 @@
 //! form.
 
 use super::error::BuildError;
-use super::shape::{Def, Shape};
+use super::shape::{Def, Member, Shape};
 use super::typeobject::*;
 use crate::cdr::Extensibility;
 
@@ -35,18 +35,11 @@ pub(super) fn body<'a>(
             members: members
                 .iter()
                 .map(|m| {
-                    let mut detail = MemberDetail::named(m.name.as_str());
-                    if let Some(h) = &m.hash_id {
-                        detail.ann_builtin = Some(AppliedBuiltinMemberAnnotations {
-                            hash_id: Some(h.clone()),
-                            ..Default::default()
-                        });
-                    }
                     Ok(StructMember {
                         id: m.id,
                         flags: m.flags,
                         type_id: id(&m.ty, complete)?,
-                        detail,
+                        detail: member_detail(m),
                     })
                 })
                 .collect::<Result<_, BuildError>>()?,
@@ -89,27 +82,12 @@ pub(super) fn body<'a>(
             extensibility,
             bit_bound,
             literals,
-        } => {
-            let mut literals: Vec<EnumeratedLiteral> = literals
-                .iter()
-                .map(|(n, v, d)| EnumeratedLiteral {
-                    value: *v,
-                    flags: if *d {
-                        MemberFlag::IS_DEFAULT
-                    } else {
-                        MemberFlag::empty()
-                    },
-                    detail: MemberDetail::named(n.as_str()),
-                })
-                .collect();
-            literals.sort_by_key(|l| l.value);
-            TypeBody::Enum {
-                flags: type_flags(*extensibility, false, false),
-                bit_bound: *bit_bound,
-                detail,
-                literals,
-            }
-        }
+        } => TypeBody::Enum {
+            flags: type_flags(*extensibility, false, false),
+            bit_bound: *bit_bound,
+            detail,
+            literals: enum_literals(literals),
+        },
         Def::Bitmask {
             extensibility,
             bit_bound,
@@ -140,6 +118,36 @@ pub(super) fn body<'a>(
             ann_custom: None,
         },
     })
+}
+
+/// A struct member's detail: its name, and `@hashid` in the builtin annotations.
+fn member_detail(m: &Member) -> MemberDetail {
+    let mut detail = MemberDetail::named(m.name.as_str());
+    if let Some(h) = &m.hash_id {
+        detail.ann_builtin = Some(AppliedBuiltinMemberAnnotations {
+            hash_id: Some(h.clone()),
+            ..Default::default()
+        });
+    }
+    detail
+}
+
+/// Enumerators sorted by value, the default one flagged.
+fn enum_literals(literals: &[(String, i32, bool)]) -> Vec<EnumeratedLiteral> {
+    let mut out: Vec<EnumeratedLiteral> = literals
+        .iter()
+        .map(|(n, v, d)| EnumeratedLiteral {
+            value: *v,
+            flags: if *d {
+                MemberFlag::IS_DEFAULT
+            } else {
+                MemberFlag::empty()
+            },
+            detail: MemberDetail::named(n.as_str()),
+        })
+        .collect();
+    out.sort_by_key(|l| l.value);
+    out
 }
 
 /// The type flags of an extensibility, `@autoid(HASH)` and `@nested`.

@@ -4,7 +4,7 @@ use std::fmt::Write;
 
 use crate::cdr::Extensibility;
 
-use super::types::{DynamicType, TypeKind};
+use super::types::{DynamicType, EnumType, StructType, TypeKind, UnionType};
 
 impl DynamicType {
     /// The type as IDL: every named type it depends on first, each in its modules, then the type itself.
@@ -228,98 +228,9 @@ fn declare(t: &DynamicType, out: &mut String) {
     let raw = local[0];
     let local = ident(raw);
     match t.kind() {
-        TypeKind::Struct(s) => {
-            let base = s
-                .base
-                .as_ref()
-                .map(|b| format!(" : {}", scoped(&b.name())))
-                .unwrap_or_default();
-            let _ = writeln!(
-                out,
-                "{ind}{}{}\n{ind}struct {local}{base} {{",
-                ext_annotation(s.extensibility),
-                type_annotations(s.nested, s.autoid_hash)
-            );
-            for m in s.own_members() {
-                let mut a = match m.hash_id.as_deref() {
-                    Some("") => "@hashid ".to_string(),
-                    Some(h) => format!("@hashid(\"{h}\") "),
-                    None => format!("@id({}) ", m.id),
-                };
-                for (on, name) in [
-                    (m.key, "@key "),
-                    (m.optional, "@optional "),
-                    (m.external, "@external "),
-                    (m.must_understand, "@must_understand "),
-                ] {
-                    if on {
-                        a.push_str(name);
-                    }
-                }
-                let _ = writeln!(out, "{ind}    {a}{};", decl(&m.ty, &m.name));
-            }
-            let _ = writeln!(out, "{ind}}};");
-        }
-        TypeKind::Union(u) => {
-            let key = if u.disc_key { "@key " } else { "" };
-            let _ = writeln!(
-                out,
-                "{ind}{}{}\n{ind}union {local} switch ({key}{}) {{",
-                ext_annotation(u.extensibility),
-                type_annotations(u.nested, false),
-                spelling(&u.discriminator)
-            );
-            let mut next_id = 1;
-            for c in &u.cases {
-                // Ids are written where they are not the default numbering (from 1).
-                let mut a = if c.id == next_id {
-                    String::new()
-                } else {
-                    format!("@id({}) ", c.id)
-                };
-                next_id = c.id.wrapping_add(1);
-                if c.external {
-                    a.push_str("@external ");
-                }
-                let mut labels: Vec<String> = c
-                    .labels
-                    .iter()
-                    .map(|l| format!("case {}:", label(&u.discriminator, *l)))
-                    .collect();
-                if c.is_default {
-                    labels.push("default:".into());
-                }
-                let _ = writeln!(
-                    out,
-                    "{ind}    {}\n{ind}        {a}{};",
-                    labels.join(" "),
-                    decl(&c.ty, &c.name)
-                );
-            }
-            let _ = writeln!(out, "{ind}}};");
-        }
-        TypeKind::Enum(e) => {
-            if e.extensibility != Extensibility::Final {
-                let _ = writeln!(out, "{ind}{}", ext_annotation(e.extensibility));
-            }
-            if e.bit_bound != 32 {
-                let _ = writeln!(out, "{ind}@bit_bound({})", e.bit_bound);
-            }
-            let lits: Vec<String> = e
-                .literals
-                .iter()
-                .enumerate()
-                .map(|(i, l)| {
-                    let d = if i == e.default && i != 0 {
-                        "@default_literal "
-                    } else {
-                        ""
-                    };
-                    format!("{ind}    {d}@value({}) {}", l.value, ident(&l.name))
-                })
-                .collect();
-            let _ = writeln!(out, "{ind}enum {local} {{\n{}\n{ind}}};", lits.join(",\n"));
-        }
+        TypeKind::Struct(s) => declare_struct(s, &local, &ind, out),
+        TypeKind::Union(u) => declare_union(u, &local, &ind, out),
+        TypeKind::Enum(e) => declare_enum(e, &local, &ind, out),
         TypeKind::Bitmask(b) => {
             let flags: Vec<String> = b
                 .flags
@@ -342,6 +253,101 @@ fn declare(t: &DynamicType, out: &mut String) {
         ind.truncate(ind.len() - 4);
         let _ = writeln!(out, "{ind}}};");
     }
+}
+
+fn declare_struct(s: &StructType, local: &str, ind: &str, out: &mut String) {
+    let base = s
+        .base
+        .as_ref()
+        .map(|b| format!(" : {}", scoped(&b.name())))
+        .unwrap_or_default();
+    let _ = writeln!(
+        out,
+        "{ind}{}{}\n{ind}struct {local}{base} {{",
+        ext_annotation(s.extensibility),
+        type_annotations(s.nested, s.autoid_hash)
+    );
+    for m in s.own_members() {
+        let mut a = match m.hash_id.as_deref() {
+            Some("") => "@hashid ".to_string(),
+            Some(h) => format!("@hashid(\"{h}\") "),
+            None => format!("@id({}) ", m.id),
+        };
+        for (on, name) in [
+            (m.key, "@key "),
+            (m.optional, "@optional "),
+            (m.external, "@external "),
+            (m.must_understand, "@must_understand "),
+        ] {
+            if on {
+                a.push_str(name);
+            }
+        }
+        let _ = writeln!(out, "{ind}    {a}{};", decl(&m.ty, &m.name));
+    }
+    let _ = writeln!(out, "{ind}}};");
+}
+
+fn declare_union(u: &UnionType, local: &str, ind: &str, out: &mut String) {
+    let key = if u.disc_key { "@key " } else { "" };
+    let _ = writeln!(
+        out,
+        "{ind}{}{}\n{ind}union {local} switch ({key}{}) {{",
+        ext_annotation(u.extensibility),
+        type_annotations(u.nested, false),
+        spelling(&u.discriminator)
+    );
+    let mut next_id = 1;
+    for c in &u.cases {
+        // Ids are written where they are not the default numbering (from 1).
+        let mut a = if c.id == next_id {
+            String::new()
+        } else {
+            format!("@id({}) ", c.id)
+        };
+        next_id = c.id.wrapping_add(1);
+        if c.external {
+            a.push_str("@external ");
+        }
+        let mut labels: Vec<String> = c
+            .labels
+            .iter()
+            .map(|l| format!("case {}:", label(&u.discriminator, *l)))
+            .collect();
+        if c.is_default {
+            labels.push("default:".into());
+        }
+        let _ = writeln!(
+            out,
+            "{ind}    {}\n{ind}        {a}{};",
+            labels.join(" "),
+            decl(&c.ty, &c.name)
+        );
+    }
+    let _ = writeln!(out, "{ind}}};");
+}
+
+fn declare_enum(e: &EnumType, local: &str, ind: &str, out: &mut String) {
+    if e.extensibility != Extensibility::Final {
+        let _ = writeln!(out, "{ind}{}", ext_annotation(e.extensibility));
+    }
+    if e.bit_bound != 32 {
+        let _ = writeln!(out, "{ind}@bit_bound({})", e.bit_bound);
+    }
+    let lits: Vec<String> = e
+        .literals
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let d = if i == e.default && i != 0 {
+                "@default_literal "
+            } else {
+                ""
+            };
+            format!("{ind}    {d}@value({}) {}", l.value, ident(&l.name))
+        })
+        .collect();
+    let _ = writeln!(out, "{ind}enum {local} {{\n{}\n{ind}}};", lits.join(",\n"));
 }
 
 fn label(disc: &DynamicType, v: i64) -> String {
