@@ -163,6 +163,16 @@ impl DynamicTopic {
     }
 }
 
+/// An incompatible-QoS status so far: a snapshot, its change count reset (as for typed endpoints).
+fn take_incompatible(
+    status: &Mutex<crate::dcps::IncompatibleQosStatus>,
+) -> crate::dcps::IncompatibleQosStatus {
+    let mut s = lock(status);
+    let out = s.clone();
+    s.total_count_change = 0;
+    out
+}
+
 /// Records that `peer` matched (or unmatched) an endpoint whose matched peers are `list`.
 fn record_match(list: &Mutex<Vec<Guid>>, peer: Guid, matched: bool) {
     let mut m = lock(list);
