@@ -36,7 +36,7 @@ pub(crate) enum Shape {
 }
 
 /// A struct member.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Member {
     pub(crate) name: String,
     pub(crate) id: u32,
@@ -48,7 +48,7 @@ pub(crate) struct Member {
 }
 
 /// A union case.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Case {
     pub(crate) name: String,
     pub(crate) id: u32,
@@ -59,7 +59,7 @@ pub(crate) struct Case {
 }
 
 /// A named type's definition.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Def {
     Struct {
         extensibility: Extensibility,

@@ -2,7 +2,8 @@
 //! to, and [`TypeSupport`] builds its objects, identifiers, `TypeInformation` and `TypeMapping` with the same
 //! code (so the same rules: Cyclone DDS 11's). Typedefs keep their alias objects.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
 
 use crate::xtypes::describe::with_try_construct;
 use crate::xtypes::shape::{Case, Def, Described, Member, Shape};
@@ -56,8 +57,9 @@ fn type_kind(p: Primitive) -> u8 {
 #[derive(Default)]
 struct Lowering {
     defs: HashMap<String, Def>,
-    /// The type each name stands for, to refuse two different types of one name.
-    types: HashMap<String, DynamicType>,
+    /// The named types lowered already (by address): each distinct one is lowered once, so the work is
+    /// linear in the type's size even when a type is reached many times.
+    seen: HashSet<usize>,
 }
 
 impl Lowering {
@@ -96,14 +98,19 @@ impl Lowering {
 
     fn named(&mut self, t: &DynamicType) -> Result<Shape, BuildError> {
         let name = t.name();
-        match self.types.get(&name) {
-            Some(seen) if seen == t => return Ok(Shape::Named(name)),
-            Some(_) => return Err(BuildError::Conflict(name)),
-            None => {}
+        if !self.seen.insert(Arc::as_ptr(&t.0) as usize) {
+            return Ok(Shape::Named(name));
         }
-        self.types.insert(name.clone(), t.clone());
+        // Another value of a name already lowered must define the same type (compared lowered: its
+        // named parts by name, so the comparison is linear too).
         let def = self.def(t)?;
-        self.defs.insert(name.clone(), def);
+        match self.defs.get(&name) {
+            Some(d) if *d == def => {}
+            Some(_) => return Err(BuildError::Conflict(name)),
+            None => {
+                self.defs.insert(name.clone(), def);
+            }
+        }
         Ok(Shape::Named(name))
     }
 
@@ -221,6 +228,33 @@ mod tests {
             .unwrap();
         let s = same.type_support().unwrap();
         assert_eq!(s.information.complete.dependent_typeid_count, 1);
+    }
+
+    #[test]
+    fn a_type_reached_many_times_is_lowered_once_per_value() {
+        // 40 levels, each with two members of the level below (built twice: equal values, other
+        // addresses): 2^40 paths, which a walk per path (or a comparison per path) would never finish.
+        let level = |below: Option<DynamicType>, i: usize| {
+            let b = StructBuilder::new(format!("L{i}"));
+            match below {
+                None => b.member("x", long()),
+                Some(t) => b.member("a", t.clone()).member("b", t),
+            }
+            .build()
+            .unwrap()
+        };
+        let (mut one, mut other) = (level(None, 0), level(None, 0));
+        for i in 1..40 {
+            one = level(Some(one), i);
+            other = level(Some(other), i);
+        }
+        let top = StructBuilder::new("Top")
+            .member("one", one)
+            .member("other", other)
+            .build()
+            .unwrap();
+        let s = top.type_support().unwrap();
+        assert_eq!(s.mapping.identifier_object_pair_minimal.len(), 41);
     }
 
     #[test]
