@@ -135,3 +135,151 @@ fn typed_writer_to_dynamic_reader_with_dispose_and_filter() {
         .collect();
     assert_eq!(passed.len(), 2);
 }
+
+#[test]
+fn dynamic_types_have_the_derived_type_information() {
+    let from_idl = types_from_idl("shape.idl", SHAPE_IDL)
+        .unwrap()
+        .remove("ShapeType")
+        .expect("ShapeType from IDL");
+    for ty in [shape_from_builder(), from_idl] {
+        let s = ty.type_support().expect("type support");
+        assert_eq!(
+            Some(s.information_bytes.as_slice()),
+            ShapeType::type_information()
+        );
+        assert_eq!(Some(s.mapping_bytes.as_slice()), ShapeType::type_mapping());
+    }
+}
+
+/// `ShapeType` with `x` a string: not assignable from `ShapeType`, whatever the name.
+fn unassignable_shape() -> DynamicType {
+    let long = DynamicType::primitive(Primitive::Int32);
+    StructBuilder::new("ShapeType")
+        .extensibility(Extensibility::Appendable)
+        .with(MemberBuilder::new("color", DynamicType::string(None)).key())
+        .member("x", DynamicType::string(None))
+        .member("y", long.clone())
+        .member("shapesize", long)
+        .build()
+        .expect("ShapeType")
+}
+
+/// `ShapeType`'s first two members under another name: assignable from `ShapeType` (appendable, members cut
+/// at the end), so it matches although the type names differ.
+fn reduced_shape() -> DynamicType {
+    StructBuilder::new("Shapes::Reduced")
+        .extensibility(Extensibility::Appendable)
+        .with(MemberBuilder::new("color", DynamicType::string(None)).key())
+        .member("x", DynamicType::primitive(Primitive::Int32))
+        .build()
+        .expect("Reduced")
+}
+
+#[test]
+fn dynamic_readers_match_typed_writers_by_assignability() {
+    std::env::set_var(dds_runtime::xtypes::ANNOUNCE_ENV, "on");
+    let (p1, p2) = (participant(96), participant(96));
+    let (wq, rq) = reliable_keep_all();
+    let sub = p2.create_subscriber(&SubscriberQos::default()).unwrap();
+    let dynamic_reader = |topic: &str, ty: DynamicType| {
+        let t = p2
+            .create_dynamic_topic(topic, ty, &TopicQos::default())
+            .unwrap();
+        assert!(
+            t.type_information_bytes().is_some(),
+            "{topic}: no type information"
+        );
+        sub.create_dynamic_reader(&t, &rq).unwrap()
+    };
+    let good = dynamic_reader("Triangle", reduced_shape());
+    let bad = dynamic_reader("Star", unassignable_shape());
+    let w_good = writer::<ShapeType>(&p1, "Triangle", &wq);
+    let w_bad = writer::<ShapeType>(&p1, "Star", &wq);
+    assert!(wait_until(MATCH_TIMEOUT, || good.matched_writers().len()
+        == 1
+        && w_good.publication_matched_status().current_count == 1));
+    assert!(wait_until(MATCH_TIMEOUT, || w_bad
+        .offered_incompatible_qos_status()
+        .total_count
+        >= 1));
+    let st = w_bad.offered_incompatible_qos_status();
+    assert_eq!(
+        st.last_policy_id,
+        Some(QosPolicyId::TypeConsistencyEnforcement)
+    );
+    assert_eq!(w_bad.publication_matched_status().current_count, 0);
+    assert!(bad.matched_writers().is_empty());
+    assert!(wait_until(MATCH_TIMEOUT, || bad
+        .requested_incompatible_qos_status()
+        .total_count
+        >= 1));
+    let st = bad.requested_incompatible_qos_status();
+    assert_eq!(
+        st.last_policy_id,
+        Some(QosPolicyId::TypeConsistencyEnforcement)
+    );
+    assert_eq!(good.requested_incompatible_qos_status().total_count, 0);
+    w_good.write(&shape("RED", 7)).unwrap();
+    let mut got = Vec::new();
+    wait_until(Duration::from_secs(10), || {
+        good.wait_for_data(Duration::from_millis(100));
+        got.extend(good.take());
+        !got.is_empty()
+    });
+    let d = got[0].data.as_ref().expect("a sample");
+    assert_eq!(d.get("color"), Some(&Value::String("RED".into())));
+    assert_eq!(d.get("x"), Some(&Value::Int32(7)));
+}
+
+#[test]
+fn dynamic_writers_match_typed_readers_by_assignability() {
+    std::env::set_var(dds_runtime::xtypes::ANNOUNCE_ENV, "on");
+    let (p1, p2) = (participant(97), participant(97));
+    let (wq, rq) = reliable_keep_all();
+    let publ = p1.create_publisher(&PublisherQos::default()).unwrap();
+    let dynamic_writer = |topic: &str, ty: DynamicType| {
+        let t = p1
+            .create_dynamic_topic(topic, ty, &TopicQos::default())
+            .unwrap();
+        publ.create_dynamic_writer(&t, &wq).unwrap()
+    };
+    let reduced = reduced_shape();
+    let good = dynamic_writer("Pentagon", reduced.clone());
+    let bad = dynamic_writer("Hexagon", unassignable_shape());
+    let r_good = reader::<ShapeType>(&p2, "Pentagon", &rq);
+    let r_bad = reader::<ShapeType>(&p2, "Hexagon", &rq);
+    assert!(good.wait_for_readers(1, MATCH_TIMEOUT));
+    assert!(wait_until(MATCH_TIMEOUT, || bad
+        .offered_incompatible_qos_status()
+        .total_count
+        >= 1));
+    assert_eq!(
+        bad.offered_incompatible_qos_status().last_policy_id,
+        Some(QosPolicyId::TypeConsistencyEnforcement)
+    );
+    assert!(bad.matched_readers().is_empty());
+    assert!(wait_until(MATCH_TIMEOUT, || r_bad
+        .requested_incompatible_qos_status()
+        .last_policy_id
+        == Some(QosPolicyId::TypeConsistencyEnforcement)));
+    let mut d = DynamicData::new(reduced);
+    d.set("color", Value::String("RED".into())).unwrap();
+    d.set("x", Value::Int32(5)).unwrap();
+    good.write(&d).unwrap();
+    let mut got = Vec::new();
+    wait_until(Duration::from_secs(10), || {
+        got.extend(r_good.take().unwrap().into_iter().filter_map(|s| s.data));
+        !got.is_empty()
+    });
+    // The members the writer's type lacks take their defaults.
+    assert_eq!(
+        got.first(),
+        Some(&ShapeType {
+            color: "RED".into(),
+            x: 5,
+            y: 0,
+            shapesize: 0
+        })
+    );
+}

@@ -325,3 +325,90 @@ fn cyclone_writer_to_dynamic_reader() {
     assert_eq!(xs, (0..10).collect::<Vec<_>>());
     assert!(disposed, "dispose from Cyclone not seen");
 }
+
+/// A Cyclone `ShapeType` writer and a dynamic reader of another type name, `Shapes::Reduced` (`color`, `x`),
+/// assignable from it: matched by assignability (both sides resolve the other's type through TypeLookup), and
+/// the reader reads Cyclone's samples in its own type.
+#[cfg(all(feature = "idl", feature = "json"))]
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn cyclone_writer_to_assignable_dynamic_reader() {
+    use dds_runtime::xtypes::dynamic::{types_from_idl, Value};
+    std::env::set_var(dds_runtime::xtypes::ANNOUNCE_ENV, "on");
+    let p = participant(66);
+    let idl = "module Shapes { @appendable struct Reduced { @key string color; long x; }; };";
+    let ty = types_from_idl("reduced.idl", idl)
+        .unwrap()
+        .remove("Shapes::Reduced")
+        .unwrap();
+    let t = p
+        .create_dynamic_topic("Triangle", ty, &TopicQos::default())
+        .unwrap();
+    let r = p
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| s.create_dynamic_reader(&t, &tl_reliable_reader()))
+        .unwrap();
+    let mut child = python(66, &["pub", "Triangle", "GREEN", "10"]);
+    let mut xs = Vec::new();
+    wait_until(Duration::from_secs(25), || {
+        r.wait_for_data(Duration::from_millis(100));
+        for s in r.take() {
+            if let Some(d) = s
+                .data
+                .filter(|_| s.kind == dds_runtime::rtps::ChangeKind::Alive)
+            {
+                assert_eq!(d.get("color"), Some(&Value::String("GREEN".into())));
+                if let Some(Value::Int32(x)) = d.get("x") {
+                    xs.push(*x);
+                }
+            }
+        }
+        xs.len() >= 10
+    });
+    assert!(
+        child.wait().unwrap().success(),
+        "Cyclone's writer did not match"
+    );
+    assert_eq!(xs, (0..10).collect::<Vec<_>>());
+}
+
+/// A Cyclone `ShapeType` writer and a dynamic reader of a `ShapeType` whose `x` is a string: same name, not
+/// assignable. Once the writer's type has arrived through TypeLookup the pair is reported incompatible
+/// (`TypeConsistencyEnforcement`) and nothing is read.
+#[cfg(all(feature = "idl", feature = "json"))]
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn cyclone_writer_and_unassignable_dynamic_reader_are_incompatible() {
+    use dds_runtime::xtypes::dynamic::types_from_idl;
+    std::env::set_var(dds_runtime::xtypes::ANNOUNCE_ENV, "on");
+    let p = participant(67);
+    let idl =
+        "@appendable struct ShapeType { @key string color; string x; long y; long shapesize; };";
+    let ty = types_from_idl("bad.idl", idl)
+        .unwrap()
+        .remove("ShapeType")
+        .unwrap();
+    let t = p
+        .create_dynamic_topic("Octagon", ty, &TopicQos::default())
+        .unwrap();
+    let r = p
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| s.create_dynamic_reader(&t, &tl_reliable_reader()))
+        .unwrap();
+    let mut child = python(67, &["pub", "Octagon", "RED", "10"]);
+    let reported = wait_until(Duration::from_secs(15), || {
+        r.requested_incompatible_qos_status().total_count >= 1
+    });
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(reported, "no incompatibility reported");
+    assert_eq!(
+        r.requested_incompatible_qos_status().last_policy_id,
+        Some(QosPolicyId::TypeConsistencyEnforcement)
+    );
+    assert!(r.matched_writers().is_empty());
+    assert!(
+        r.take().is_empty(),
+        "samples of an unassignable type were read"
+    );
+}

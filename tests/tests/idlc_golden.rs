@@ -220,6 +220,7 @@ mod check {
     /// (`fixtures/typeinfo/idlc.<fixture>.json`, from `scripts/golden/typeinfo.py`); see
     /// [`KNOWN_TYPE_INFORMATION`].
     fn check_type_information<T: DdsType>(name: &str, bad: &mut Vec<String>) {
+        round_trip::<T>(bad);
         let mut differs = Vec::new();
         type_information_differences::<T>(name, &mut differs);
         match KNOWN_TYPE_INFORMATION.iter().find(|(n, _)| *n == name) {
@@ -228,6 +229,26 @@ mod check {
             )),
             Some(_) => {}
             None => bad.extend(differs),
+        }
+    }
+
+    /// The derived type's objects -> a dynamic type -> its objects: the same bytes.
+    fn round_trip<T: DdsType>(bad: &mut Vec<String>) {
+        use dds_runtime::xtypes::dynamic::DynamicType;
+        use dds_runtime::xtypes::typeobject::from_bytes;
+        let (Some(info), Some(map)) = (T::type_information(), T::type_mapping()) else {
+            return bad.push("no type information".into());
+        };
+        let rebuilt = match (from_bytes(info), from_bytes(map)) {
+            (Ok(i), Ok(m)) => DynamicType::from_type_mapping(&i, &m)
+                .map_err(|e| e.to_string())
+                .and_then(|t| t.type_support().map_err(|e| e.to_string())),
+            _ => Err("our type information does not decode".into()),
+        };
+        match rebuilt {
+            Ok(s) if s.information_bytes == info && s.mapping_bytes == map => {}
+            Ok(_) => bad.push("the type objects of its dynamic type differ".into()),
+            Err(e) => bad.push(format!("no dynamic type support: {e}")),
         }
     }
 

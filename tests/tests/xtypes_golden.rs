@@ -17,6 +17,7 @@ use explain::explain;
 use std::path::PathBuf;
 
 use dds_runtime::cdr::DdsType;
+use dds_runtime::xtypes::dynamic::DynamicType;
 use dds_runtime::xtypes::XTypesType;
 
 /// Types whose Rust mirror cannot say what the Python type says, so the bytes differ for a stated reason.
@@ -40,6 +41,25 @@ fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
+/// The derived type's objects -> a dynamic type -> its objects: the same bytes.
+fn round_trip(name: &str, support: &dds_runtime::xtypes::TypeSupport) {
+    let ty = DynamicType::from_type_mapping(&support.information, &support.mapping)
+        .unwrap_or_else(|e| panic!("{name}: no dynamic type: {e}"));
+    let rebuilt = ty
+        .type_support()
+        .unwrap_or_else(|e| panic!("{name}: no type support for the dynamic type: {e}"));
+    assert_eq!(
+        hex(&rebuilt.information_bytes),
+        hex(&support.information_bytes),
+        "{name}: TypeInformation of the dynamic type"
+    );
+    assert_eq!(
+        hex(&rebuilt.mapping_bytes),
+        hex(&support.mapping_bytes),
+        "{name}: TypeMapping of the dynamic type"
+    );
+}
+
 /// Called by every test of `golden/types.rs` (which names it `check`); the samples are not used here.
 pub fn check<T: DdsType + XTypesType>(name: &str, _samples: Vec<(&str, T)>) {
     let fx = fixture(name);
@@ -52,6 +72,7 @@ pub fn check<T: DdsType + XTypesType>(name: &str, _samples: Vec<(&str, T)>) {
         T::type_information(),
         Some(support.information_bytes.as_slice())
     );
+    round_trip(name, support);
     if std::env::var_os("XTYPES_GOLDEN_REPORT").is_some() {
         println!("XTYPES {} {name}", if same { "SAME" } else { "DIFF" });
         if !same {

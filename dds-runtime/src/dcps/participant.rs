@@ -9,8 +9,8 @@ mod types;
 
 pub use factory::DomainParticipantFactory;
 pub use ops::DomainParticipantListener;
-pub(crate) use types::register_local_types;
 pub use types::DiscoveredType;
+pub(crate) use types::{register_local_types, register_type_bytes};
 
 use std::sync::{Arc, Weak};
 use std::time::Duration;

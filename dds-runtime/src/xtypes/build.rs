@@ -1,5 +1,6 @@
-//! From a [`TypeDesc`] to type objects, identifiers, `TypeInformation` and `TypeMapping`, computed the way
-//! Cyclone DDS 11 does (its Python binding's builder, whose bytes are the golden vectors):
+//! From a type's lowered description ([`Described`], made from a derived type's `TypeDesc` or from a dynamic
+//! type) to type objects, identifiers, `TypeInformation` and `TypeMapping`, computed the way Cyclone DDS 11
+//! does (its Python binding's builder, whose bytes are the golden vectors):
 //! - the dependency graph is gathered depth-first from the topic type (a stack; a struct's base, a union's
 //!   enum discriminator, then member types in declaration order, inherited members included);
 //! - the dependent types are those without dependencies of their own (in discovery order), then the others
@@ -8,9 +9,9 @@
 
 use std::collections::HashMap;
 
-use super::describe::{NamedRef, TypeDef, TypeDesc, TypeRef};
+use super::describe::TypeRef;
 use super::error::BuildError;
-use super::typeobject::kind::*;
+use super::shape::{Def, Described, Shape};
 use super::typeobject::*;
 
 /// Everything XTypes says about one topic type, built once ([`TypeSupport::build`]).
@@ -29,15 +30,21 @@ pub struct TypeSupport {
 impl TypeSupport {
     /// Builds the type information and mapping of `root`.
     pub fn build(root: TypeRef) -> Result<Self, BuildError> {
-        let TypeDesc::Named(named) = root.desc() else {
-            return Err(BuildError::NotNamed);
+        Self::from_described(&Described::from_desc(root)?)
+    }
+
+    /// Builds the type information and mapping of a lowered description (a derived or a dynamic type).
+    pub(crate) fn from_described(d: &Described) -> Result<Self, BuildError> {
+        let graph = Graph::gather(d);
+        let mut b = Builder {
+            described: d,
+            done: HashMap::new(),
+            busy: Vec::new(),
         };
-        let graph = Graph::gather(named)?;
-        let mut b = Builder::default();
         let nodes: Vec<Built> = graph
             .nodes
             .iter()
-            .map(|n| b.named(*n))
+            .map(|&n| b.named(n))
             .collect::<Result<_, _>>()?;
         let (inner, leaves): (Vec<usize>, Vec<usize>) =
             (0..nodes.len()).partition(|&i| !graph.edges[i].is_empty());
@@ -49,66 +56,13 @@ impl TypeSupport {
             graph.post_order(0, &inner, &mut post);
             deps.extend(post.into_iter().filter(|&i| i != 0));
         }
-        let with_size = |i: usize, complete: bool| {
-            let n = &nodes[i];
-            let (id, len) = if complete {
-                (&n.complete_id, n.complete_len)
-            } else {
-                (&n.minimal_id, n.minimal_len)
-            };
-            TypeIdentifierWithSize {
-                type_id: id.clone(),
-                typeobject_serialized_size: len as u32,
-            }
-        };
-        let mut minimal_deps: Vec<TypeIdentifierWithSize> = Vec::new();
-        for &d in &deps {
-            let t = with_size(d, false);
-            if !minimal_deps.contains(&t) {
-                minimal_deps.push(t);
-            }
-        }
-        let complete_deps: Vec<_> = deps.iter().map(|&d| with_size(d, true)).collect();
-        let information = TypeInformation {
-            minimal: TypeIdentifierWithDependencies {
-                typeid_with_size: with_size(0, false),
-                dependent_typeid_count: minimal_deps.len() as i32,
-                dependent_typeids: minimal_deps,
-            },
-            complete: TypeIdentifierWithDependencies {
-                typeid_with_size: with_size(0, true),
-                dependent_typeid_count: complete_deps.len() as i32,
-                dependent_typeids: complete_deps,
-            },
-        };
+        let information = information(&nodes, &deps);
         let order: Vec<usize> = if inner.is_empty() {
             vec![0]
         } else {
             inner.iter().chain(&leaves).copied().collect()
         };
-        let mapping = TypeMapping {
-            identifier_object_pair_minimal: order
-                .iter()
-                .map(|&i| TypeIdentifierTypeObjectPair {
-                    type_identifier: nodes[i].minimal_id.clone(),
-                    type_object: TypeObject::Minimal(nodes[i].minimal.clone()),
-                })
-                .collect(),
-            identifier_object_pair_complete: order
-                .iter()
-                .map(|&i| TypeIdentifierTypeObjectPair {
-                    type_identifier: nodes[i].complete_id.clone(),
-                    type_object: TypeObject::Complete(nodes[i].complete.clone()),
-                })
-                .collect(),
-            identifier_complete_minimal: order
-                .iter()
-                .map(|&i| TypeIdentifierPair {
-                    type_identifier1: nodes[i].complete_id.clone(),
-                    type_identifier2: nodes[i].minimal_id.clone(),
-                })
-                .collect(),
-        };
+        let mapping = mapping(&nodes, &order);
         #[cfg(feature = "rtps")]
         super::assign::local_types().register(&mapping);
         Ok(TypeSupport {
@@ -130,34 +84,96 @@ impl TypeSupport {
     }
 }
 
-/// The named type found inside a member type (through sequences and arrays, not maps), as Cyclone looks.
-fn named_inside(d: &TypeDesc) -> Option<NamedRef> {
-    match d {
-        TypeDesc::Named(n) => Some(*n),
-        TypeDesc::Sequence { element, .. } | TypeDesc::Array { element, .. } => {
-            named_inside(&element.desc())
+fn with_size(n: &Built, complete: bool) -> TypeIdentifierWithSize {
+    let (id, len) = if complete {
+        (&n.complete_id, n.complete_len)
+    } else {
+        (&n.minimal_id, n.minimal_len)
+    };
+    TypeIdentifierWithSize {
+        type_id: id.clone(),
+        typeobject_serialized_size: len as u32,
+    }
+}
+
+/// The `TypeInformation` of node 0 with these dependencies (repeats dropped from the minimal list only).
+fn information(nodes: &[Built], deps: &[usize]) -> TypeInformation {
+    let mut minimal_deps: Vec<TypeIdentifierWithSize> = Vec::new();
+    for &d in deps {
+        let t = with_size(&nodes[d], false);
+        if !minimal_deps.contains(&t) {
+            minimal_deps.push(t);
         }
+    }
+    let complete_deps: Vec<_> = deps.iter().map(|&d| with_size(&nodes[d], true)).collect();
+    TypeInformation {
+        minimal: TypeIdentifierWithDependencies {
+            typeid_with_size: with_size(&nodes[0], false),
+            dependent_typeid_count: minimal_deps.len() as i32,
+            dependent_typeids: minimal_deps,
+        },
+        complete: TypeIdentifierWithDependencies {
+            typeid_with_size: with_size(&nodes[0], true),
+            dependent_typeid_count: complete_deps.len() as i32,
+            dependent_typeids: complete_deps,
+        },
+    }
+}
+
+/// The `TypeMapping` of the nodes in `order`.
+fn mapping(nodes: &[Built], order: &[usize]) -> TypeMapping {
+    TypeMapping {
+        identifier_object_pair_minimal: order
+            .iter()
+            .map(|&i| TypeIdentifierTypeObjectPair {
+                type_identifier: nodes[i].minimal_id.clone(),
+                type_object: TypeObject::Minimal(nodes[i].minimal.clone()),
+            })
+            .collect(),
+        identifier_object_pair_complete: order
+            .iter()
+            .map(|&i| TypeIdentifierTypeObjectPair {
+                type_identifier: nodes[i].complete_id.clone(),
+                type_object: TypeObject::Complete(nodes[i].complete.clone()),
+            })
+            .collect(),
+        identifier_complete_minimal: order
+            .iter()
+            .map(|&i| TypeIdentifierPair {
+                type_identifier1: nodes[i].complete_id.clone(),
+                type_identifier2: nodes[i].minimal_id.clone(),
+            })
+            .collect(),
+    }
+}
+
+/// The named type found inside a member type (through sequences and arrays, not maps), as Cyclone looks.
+fn named_inside(s: &Shape) -> Option<&str> {
+    match s {
+        Shape::Named(n) => Some(n),
+        Shape::Sequence { element, .. } | Shape::Array { element, .. } => named_inside(element),
         _ => None,
     }
 }
 
 /// The dependency graph of a topic type, in discovery order (node 0 is the topic type).
-struct Graph {
-    nodes: Vec<NamedRef>,
+struct Graph<'a> {
+    nodes: Vec<&'a str>,
     edges: Vec<Vec<usize>>,
 }
 
-impl Graph {
-    fn gather(root: NamedRef) -> Result<Self, BuildError> {
+impl<'a> Graph<'a> {
+    fn gather(d: &'a Described) -> Self {
+        let root = d.root.as_str();
         let mut g = Graph {
             nodes: vec![root],
             edges: vec![Vec::new()],
         };
-        let mut index: HashMap<&'static str, usize> = HashMap::from([(root.name, 0)]);
+        let mut index: HashMap<&str, usize> = HashMap::from([(root, 0)]);
         let mut stack = vec![0usize];
         while let Some(i) = stack.pop() {
-            for dep in direct_dependencies(&(g.nodes[i].def)())? {
-                let j = *index.entry(dep.name).or_insert_with(|| {
+            for dep in direct_dependencies(d, d.def(g.nodes[i])) {
+                let j = *index.entry(dep).or_insert_with(|| {
                     g.nodes.push(dep);
                     g.edges.push(Vec::new());
                     stack.push(g.nodes.len() - 1);
@@ -168,7 +184,7 @@ impl Graph {
                 }
             }
         }
-        Ok(g)
+        g
     }
 
     fn check_acyclic(&self, inner: &[usize]) -> Result<(), BuildError> {
@@ -177,7 +193,7 @@ impl Graph {
             state[i] = 1;
             for &j in &g.edges[i] {
                 match state[j] {
-                    1 => return Err(BuildError::Recursive(g.nodes[j].name.to_owned())),
+                    1 => return Err(BuildError::Recursive(g.nodes[j].to_owned())),
                     0 => visit(g, j, state)?,
                     _ => {}
                 }
@@ -211,49 +227,42 @@ impl Graph {
 }
 
 /// The named types a definition refers to, in Cyclone's gathering order.
-fn direct_dependencies(def: &TypeDef) -> Result<Vec<NamedRef>, BuildError> {
+fn direct_dependencies<'a>(d: &'a Described, def: &'a Def) -> Vec<&'a str> {
     let mut out = Vec::new();
-    let member = |t: &TypeRef, out: &mut Vec<NamedRef>| -> Result<(), BuildError> {
-        let d = t.desc();
-        if let TypeDesc::Unsupported(why) = d {
-            return Err(BuildError::Unsupported(why));
-        }
-        out.extend(named_inside(&d));
-        Ok(())
-    };
     match def {
-        TypeDef::Struct(s) => {
-            if let Some(base) = &s.base {
-                member(base, &mut out)?;
+        Def::Struct { base, members, .. } => {
+            if let Some(base) = base {
+                out.extend(named_inside(base));
                 // Inherited members count as the derived type's own when gathering.
                 let mut chain = Vec::new();
-                let mut cur = base.desc();
-                while let TypeDesc::Named(n) = cur {
-                    let TypeDef::Struct(bs) = (n.def)() else {
+                let mut cur = Some(base);
+                while let Some(Shape::Named(n)) = cur {
+                    let Def::Struct { base, members, .. } = d.def(n) else {
                         break;
                     };
-                    chain.push(bs.members.clone());
-                    cur = bs.base.map_or(TypeDesc::Primitive(TK_NONE), |b| b.desc());
+                    chain.push(members);
+                    cur = base.as_ref();
                 }
                 for ms in chain.iter().rev() {
-                    ms.iter().try_for_each(|m| member(&m.ty, &mut out))?;
+                    out.extend(ms.iter().filter_map(|m| named_inside(&m.ty)));
                 }
             }
-            s.members.iter().try_for_each(|m| member(&m.ty, &mut out))?;
+            out.extend(members.iter().filter_map(|m| named_inside(&m.ty)));
         }
-        TypeDef::Union(u) => {
-            if let TypeDesc::Named(n) = u.discriminator.desc() {
-                out.push(n);
+        Def::Union {
+            discriminator,
+            cases,
+            ..
+        } => {
+            if let Shape::Named(n) = discriminator {
+                out.push(n.as_str());
             }
-            u.cases
-                .iter()
-                .filter_map(|c| c.ty.as_ref())
-                .try_for_each(|t| member(t, &mut out))?;
+            out.extend(cases.iter().filter_map(|c| named_inside(&c.ty)));
         }
-        TypeDef::Alias(t) => member(t, &mut out)?,
-        TypeDef::Enum(_) | TypeDef::Bitmask(_) => {}
+        Def::Alias(t) => out.extend(named_inside(t)),
+        Def::Enum { .. } | Def::Bitmask { .. } => {}
     }
-    Ok(out)
+    out
 }
 
 /// The objects and identifiers of one named type.
@@ -268,24 +277,24 @@ struct Built {
 }
 
 /// Builds named types once each (by name), recursing into member types.
-#[derive(Default)]
-struct Builder {
-    done: HashMap<&'static str, Built>,
-    busy: Vec<&'static str>,
+struct Builder<'a> {
+    described: &'a Described,
+    done: HashMap<&'a str, Built>,
+    busy: Vec<&'a str>,
 }
 
-impl Builder {
-    fn named(&mut self, n: NamedRef) -> Result<Built, BuildError> {
-        if let Some(b) = self.done.get(n.name) {
+impl<'a> Builder<'a> {
+    fn named(&mut self, name: &'a str) -> Result<Built, BuildError> {
+        if let Some(b) = self.done.get(name) {
             return Ok(b.clone());
         }
-        if self.busy.contains(&n.name) {
-            return Err(BuildError::Recursive(n.name.to_owned()));
+        if self.busy.contains(&name) {
+            return Err(BuildError::Recursive(name.to_owned()));
         }
-        self.busy.push(n.name);
-        let def = (n.def)();
-        let minimal = MinimalTypeObject(self.body(n.name, &def, false)?);
-        let complete = CompleteTypeObject(self.body(n.name, &def, true)?);
+        self.busy.push(name);
+        let def = self.described.def(name);
+        let minimal = MinimalTypeObject(self.body(name, def, false)?);
+        let complete = CompleteTypeObject(self.body(name, def, true)?);
         self.busy.pop();
         let mb = to_bytes(&TypeObject::Minimal(minimal.clone()))?;
         let cb = to_bytes(&TypeObject::Complete(complete.clone()))?;
@@ -297,54 +306,54 @@ impl Builder {
             minimal,
             complete,
         };
-        self.done.insert(n.name, built.clone());
+        self.done.insert(name, built.clone());
         Ok(built)
     }
 
-    fn identifier(&mut self, t: &TypeRef, complete: bool) -> Result<TypeIdentifier, BuildError> {
+    fn identifier(&mut self, t: &'a Shape, complete: bool) -> Result<TypeIdentifier, BuildError> {
         let kind = |fully: bool| match (fully, complete) {
             (true, _) => EquivalenceKind::Both,
             (false, false) => EquivalenceKind::Minimal,
             (false, true) => EquivalenceKind::Complete,
         };
-        Ok(match t.desc() {
-            TypeDesc::Primitive(k) => TypeIdentifier::Primitive(k),
-            TypeDesc::String { wide: false, bound } => TypeIdentifier::String8 { bound },
-            TypeDesc::String { wide: true, bound } => TypeIdentifier::String16 { bound },
-            TypeDesc::Sequence { bound, element } => {
-                let element = self.identifier(&element, complete)?;
+        Ok(match t {
+            Shape::Primitive(k) => TypeIdentifier::Primitive(*k),
+            Shape::String { wide: false, bound } => TypeIdentifier::String8 { bound: *bound },
+            Shape::String { wide: true, bound } => TypeIdentifier::String16 { bound: *bound },
+            Shape::Sequence { bound, element } => {
+                let element = self.identifier(element, complete)?;
                 let header = PlainCollectionHeader {
                     equiv_kind: kind(element.is_fully_descriptive()),
                     element_flags: MemberFlag::TRY_CONSTRUCT1,
                 };
                 TypeIdentifier::PlainSequence {
                     header,
-                    bound,
+                    bound: *bound,
                     element: Box::new(element),
                 }
             }
-            TypeDesc::Array { bounds, element } => {
-                let element = self.identifier(&element, complete)?;
+            Shape::Array { bounds, element } => {
+                let element = self.identifier(element, complete)?;
                 let header = PlainCollectionHeader {
                     equiv_kind: kind(element.is_fully_descriptive()),
                     element_flags: MemberFlag::TRY_CONSTRUCT1,
                 };
                 TypeIdentifier::PlainArray {
                     header,
-                    bounds,
+                    bounds: bounds.clone(),
                     element: Box::new(element),
                 }
             }
-            TypeDesc::Map { bound, key, value } => {
-                let element = self.identifier(&value, complete)?;
-                let key = self.identifier(&key, complete)?;
+            Shape::Map { bound, key, value } => {
+                let element = self.identifier(value, complete)?;
+                let key = self.identifier(key, complete)?;
                 let fully = element.is_fully_descriptive() && key.is_fully_descriptive();
                 let header = PlainCollectionHeader {
                     equiv_kind: kind(fully),
                     element_flags: MemberFlag::empty(),
                 };
                 // Cyclone writes every map in the large form, unbounded as u32::MAX.
-                let bound = if bound == 0 { u32::MAX } else { bound };
+                let bound = if *bound == 0 { u32::MAX } else { *bound };
                 TypeIdentifier::PlainMap {
                     header,
                     bound,
@@ -353,7 +362,7 @@ impl Builder {
                     key: Box::new(key),
                 }
             }
-            TypeDesc::Named(n) => {
+            Shape::Named(n) => {
                 let b = self.named(n)?;
                 if complete {
                     b.complete_id
@@ -361,23 +370,10 @@ impl Builder {
                     b.minimal_id
                 }
             }
-            TypeDesc::Unsupported(why) => return Err(BuildError::Unsupported(why)),
         })
     }
 
-    fn body(
-        &mut self,
-        name: &'static str,
-        def: &TypeDef,
-        complete: bool,
-    ) -> Result<TypeBody, BuildError> {
-        super::objects::body(self_identifier(self), name, def, complete)
+    fn body(&mut self, name: &str, def: &'a Def, complete: bool) -> Result<TypeBody, BuildError> {
+        super::objects::body(|t, c| self.identifier(t, c), name, def, complete)
     }
-}
-
-/// Gives [`super::objects`] a way to resolve member types without seeing the builder's internals.
-fn self_identifier(
-    b: &mut Builder,
-) -> impl FnMut(&TypeRef, bool) -> Result<TypeIdentifier, BuildError> + '_ {
-    move |t, complete| b.identifier(t, complete)
 }

@@ -151,18 +151,22 @@ pub struct MemberDef {
 impl MemberDef {
     /// A member with Cyclone's default flags (`TRY_CONSTRUCT1`: discard) plus `flags`.
     pub fn new(name: &'static str, id: u32, flags: MemberFlag, ty: TypeRef) -> Self {
-        let tc = if flags.contains(MemberFlag::TRY_CONSTRUCT2) {
-            MemberFlag::empty()
-        } else {
-            MemberFlag::TRY_CONSTRUCT1
-        };
         MemberDef {
             name,
             id,
-            flags: flags | tc,
+            flags: with_try_construct(flags),
             ty,
             hash_id: None,
         }
+    }
+}
+
+/// `flags` with Cyclone's default try-construct (`TRY_CONSTRUCT1`: discard) unless they say `TRY_CONSTRUCT2`.
+pub(crate) fn with_try_construct(flags: MemberFlag) -> MemberFlag {
+    if flags.contains(MemberFlag::TRY_CONSTRUCT2) {
+        flags
+    } else {
+        flags | MemberFlag::TRY_CONSTRUCT1
     }
 }
 

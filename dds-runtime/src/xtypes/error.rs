@@ -15,6 +15,9 @@ pub enum BuildError {
     /// Mutually recursive types (strongly connected components) are not built yet.
     #[error("recursive type {0}: strongly connected components are not supported yet")]
     Recursive(String),
+    /// Two different types of one name reached from a topic type (type objects name each type once).
+    #[error("two different types are named {0}")]
+    Conflict(String),
     /// Encoding a type object failed (a name with a NUL, ...).
     #[error("encoding a type object: {0}")]
     Encode(#[from] crate::cdr::EncodeError),

@@ -68,6 +68,7 @@ mod describe;
 mod error;
 mod objects;
 mod octet;
+mod shape;
 
 pub use build::TypeSupport;
 pub use describe::{

@@ -1,15 +1,16 @@
-//! The type objects of one named type, from its [`TypeDef`], in the minimal or the complete form.
+//! The type objects of one named type, from its lowered definition ([`Def`]), in the minimal or the complete
+//! form.
 
-use super::describe::{TypeDef, TypeRef};
 use super::error::BuildError;
+use super::shape::{Def, Member, Shape};
 use super::typeobject::*;
 use crate::cdr::Extensibility;
 
 /// Builds the body; `id` resolves a member type to its identifier (minimal or complete).
-pub(super) fn body(
-    mut id: impl FnMut(&TypeRef, bool) -> Result<TypeIdentifier, BuildError>,
-    name: &'static str,
-    def: &TypeDef,
+pub(super) fn body<'a>(
+    mut id: impl FnMut(&'a Shape, bool) -> Result<TypeIdentifier, BuildError>,
+    name: &str,
+    def: &'a Def,
     complete: bool,
 ) -> Result<TypeBody, BuildError> {
     let detail = TypeDetail {
@@ -18,103 +19,97 @@ pub(super) fn body(
         type_name: name.to_owned(),
     };
     Ok(match def {
-        TypeDef::Struct(s) => TypeBody::Struct {
-            flags: type_flags(s.extensibility, s.autoid_hash, s.nested),
-            base: match &s.base {
+        Def::Struct {
+            extensibility,
+            autoid_hash,
+            nested,
+            base,
+            members,
+        } => TypeBody::Struct {
+            flags: type_flags(*extensibility, *autoid_hash, *nested),
+            base: match base {
                 Some(b) => id(b, complete)?,
                 None => TypeIdentifier::None,
             },
             detail,
-            members: s
-                .members
+            members: members
                 .iter()
                 .map(|m| {
-                    let mut detail = MemberDetail::named(m.name);
-                    if let Some(h) = m.hash_id {
-                        detail.ann_builtin = Some(AppliedBuiltinMemberAnnotations {
-                            hash_id: Some(h.to_owned()),
-                            ..Default::default()
-                        });
-                    }
                     Ok(StructMember {
                         id: m.id,
                         flags: m.flags,
                         type_id: id(&m.ty, complete)?,
-                        detail,
+                        detail: member_detail(m),
                     })
                 })
                 .collect::<Result<_, BuildError>>()?,
         },
-        TypeDef::Union(u) => {
+        Def::Union {
+            extensibility,
+            nested,
+            discriminator,
+            discriminator_key,
+            cases,
+        } => {
             let mut disc_flags = MemberFlag::IS_MUST_UNDERSTAND | MemberFlag::TRY_CONSTRUCT1;
-            if u.discriminator_key {
+            if *discriminator_key {
                 disc_flags |= MemberFlag::IS_KEY;
             }
-            let mut members = Vec::new();
-            for c in &u.cases {
-                let Some(ty) = &c.ty else { continue };
+            let mut members = Vec::with_capacity(cases.len());
+            for c in cases {
                 let mut flags = MemberFlag::TRY_CONSTRUCT1;
                 flags.set(MemberFlag::IS_DEFAULT, c.is_default);
                 flags.set(MemberFlag::IS_EXTERNAL, c.external);
                 members.push(UnionMember {
                     id: c.id,
                     flags,
-                    type_id: id(ty, complete)?,
+                    type_id: id(&c.ty, complete)?,
                     labels: c.labels.clone(),
-                    detail: MemberDetail::named(c.name),
+                    detail: MemberDetail::named(c.name.as_str()),
                 });
             }
             TypeBody::Union {
-                flags: type_flags(u.extensibility, false, u.nested),
+                flags: type_flags(*extensibility, false, *nested),
                 detail,
                 disc_flags,
-                disc_type: id(&u.discriminator, complete)?,
+                disc_type: id(discriminator, complete)?,
                 disc_ann_builtin: None,
                 disc_ann_custom: None,
                 members,
             }
         }
-        TypeDef::Enum(e) => {
-            let mut literals: Vec<EnumeratedLiteral> = e
-                .literals
-                .iter()
-                .map(|(n, v, d)| EnumeratedLiteral {
-                    value: *v,
-                    flags: if *d {
-                        MemberFlag::IS_DEFAULT
-                    } else {
-                        MemberFlag::empty()
-                    },
-                    detail: MemberDetail::named(*n),
-                })
-                .collect();
-            literals.sort_by_key(|l| l.value);
-            TypeBody::Enum {
-                flags: type_flags(e.extensibility, false, false),
-                bit_bound: e.bit_bound,
-                detail,
-                literals,
-            }
-        }
-        TypeDef::Bitmask(b) => {
-            let mut bitflags: Vec<Bitflag> = b
-                .flags
+        Def::Enum {
+            extensibility,
+            bit_bound,
+            literals,
+        } => TypeBody::Enum {
+            flags: type_flags(*extensibility, false, false),
+            bit_bound: *bit_bound,
+            detail,
+            literals: enum_literals(literals),
+        },
+        Def::Bitmask {
+            extensibility,
+            bit_bound,
+            flags,
+        } => {
+            let mut bitflags: Vec<Bitflag> = flags
                 .iter()
                 .map(|(n, p)| Bitflag {
                     position: *p,
                     flags: MemberFlag::empty(),
-                    detail: MemberDetail::named(n.clone()),
+                    detail: MemberDetail::named(n.as_str()),
                 })
                 .collect();
             bitflags.sort_by_key(|f| f.position);
             TypeBody::Bitmask {
-                flags: type_flags(b.extensibility, false, false),
-                bit_bound: b.bit_bound,
+                flags: type_flags(*extensibility, false, false),
+                bit_bound: *bit_bound,
                 detail,
                 bitflags,
             }
         }
-        TypeDef::Alias(t) => TypeBody::Alias {
+        Def::Alias(t) => TypeBody::Alias {
             flags: TypeFlag::empty(),
             detail,
             related_flags: MemberFlag::empty(),
@@ -123,6 +118,36 @@ pub(super) fn body(
             ann_custom: None,
         },
     })
+}
+
+/// A struct member's detail: its name, and `@hashid` in the builtin annotations.
+fn member_detail(m: &Member) -> MemberDetail {
+    let mut detail = MemberDetail::named(m.name.as_str());
+    if let Some(h) = &m.hash_id {
+        detail.ann_builtin = Some(AppliedBuiltinMemberAnnotations {
+            hash_id: Some(h.clone()),
+            ..Default::default()
+        });
+    }
+    detail
+}
+
+/// Enumerators sorted by value, the default one flagged.
+fn enum_literals(literals: &[(String, i32, bool)]) -> Vec<EnumeratedLiteral> {
+    let mut out: Vec<EnumeratedLiteral> = literals
+        .iter()
+        .map(|(n, v, d)| EnumeratedLiteral {
+            value: *v,
+            flags: if *d {
+                MemberFlag::IS_DEFAULT
+            } else {
+                MemberFlag::empty()
+            },
+            detail: MemberDetail::named(n.as_str()),
+        })
+        .collect();
+    out.sort_by_key(|l| l.value);
+    out
 }
 
 /// The type flags of an extensibility, `@autoid(HASH)` and `@nested`.

@@ -1,9 +1,10 @@
 //! Dynamic topics, writers and readers: endpoints whose type is a [`DynamicType`] known only at run time.
 //!
 //! They take part in discovery and matching exactly as typed endpoints do: the same topic and type names, the
-//! same keyedness, the same data representation rules, and the same `TypeInformation` when the topic has it
-//! (a type built from discovered type objects keeps the bytes it came with; see
-//! [`DynamicTopic::with_type_information`]). Samples are [`DynamicData`], byte-identical on the wire to the
+//! same keyedness, the same data representation rules, and a `TypeInformation` built from the dynamic type
+//! ([`DynamicType::type_support`], the derive's builder), so that they match peers by assignability and the
+//! TypeLookup service serves their type objects ([`DynamicTopic::with_type_information`] announces other
+//! bytes instead). Samples are [`DynamicData`], byte-identical on the wire to the
 //! derived code for the same type. Listeners, conditions, instances and read/take by state are left to the
 //! typed API: a dynamic writer writes and disposes, a dynamic reader takes what arrived.
 
@@ -28,7 +29,10 @@ struct TopicInner {
     name: String,
     ty: DynamicType,
     qos: TopicQos,
+    /// The XCDR2 `TypeInformation` its endpoints announce, and the `TypeMapping` (when known) whose
+    /// objects the participant serves.
     type_information: Option<Vec<u8>>,
+    type_mapping: Option<Vec<u8>>,
 }
 
 /// A topic of a dynamic type. Cheap to clone.
@@ -61,13 +65,22 @@ impl DomainParticipant {
                 ty.name()
             )));
         }
+        let (type_information, type_mapping) = match ty.type_support() {
+            Ok(s) => (Some(s.information_bytes), Some(s.mapping_bytes)),
+            Err(e) => {
+                tracing::warn!(topic = name, type_name = %ty.name(), error = %e,
+                    "no type objects: endpoints announce no type information and match by type name");
+                (None, None)
+            }
+        };
         Ok(DynamicTopic {
             inner: Arc::new(TopicInner {
                 participant: self.clone(),
                 name: name.to_string(),
                 ty,
                 qos: qos.clone(),
-                type_information: None,
+                type_information,
+                type_mapping,
             }),
         })
     }
@@ -75,8 +88,9 @@ impl DomainParticipant {
 
 impl DynamicTopic {
     /// The same topic announcing these XCDR2 `TypeInformation` bytes for its endpoints (when type information
-    /// is announced at all: `xtypes::announce_type_information`), e.g. the bytes a discovered endpoint
-    /// announced for the type objects this type was built from.
+    /// is announced at all: `xtypes::announce_type_information`) instead of those built from its type, e.g.
+    /// the bytes a discovered endpoint announced for the type objects this type was built from (the
+    /// participant then serves no objects for it).
     pub fn with_type_information(self, bytes: Vec<u8>) -> Self {
         let i = &self.inner;
         DynamicTopic {
@@ -86,6 +100,7 @@ impl DynamicTopic {
                 ty: i.ty.clone(),
                 qos: i.qos.clone(),
                 type_information: Some(bytes),
+                type_mapping: None,
             }),
         }
     }
@@ -120,9 +135,42 @@ impl DynamicTopic {
         DynamicData::new(self.inner.ty.clone())
     }
 
-    fn type_information(&self) -> Option<crate::xtypes::TypeInformation> {
-        crate::xtypes::announced_type_information(self.inner.type_information.as_deref())
+    /// The XCDR2 `TypeInformation` bytes its endpoints announce (when type information is announced at all).
+    pub fn type_information_bytes(&self) -> Option<&[u8]> {
+        self.inner.type_information.as_deref()
     }
+
+    fn type_information(&self) -> Option<crate::xtypes::TypeInformation> {
+        match &self.inner.type_mapping {
+            Some(m) => crate::xtypes::announced_type_information_for(
+                self.inner.type_information.as_deref(),
+                Some(m),
+            ),
+            None => {
+                crate::xtypes::announced_type_information(self.inner.type_information.as_deref())
+            }
+        }
+    }
+
+    /// Puts the type's objects into the participant's store (for its TypeLookup service).
+    fn register_types(&self, core: &mut crate::rtps::Participant) {
+        super::participant::register_type_bytes(
+            core,
+            &self.type_name(),
+            self.inner.type_information.as_deref(),
+            self.inner.type_mapping.as_deref(),
+        );
+    }
+}
+
+/// An incompatible-QoS status so far: a snapshot, its change count reset (as for typed endpoints).
+fn take_incompatible(
+    status: &Mutex<crate::dcps::IncompatibleQosStatus>,
+) -> crate::dcps::IncompatibleQosStatus {
+    let mut s = lock(status);
+    let out = s.clone();
+    s.total_count_change = 0;
+    out
 }
 
 /// Records that `peer` matched (or unmatched) an endpoint whose matched peers are `list`.

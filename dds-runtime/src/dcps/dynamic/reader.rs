@@ -4,6 +4,7 @@ use std::collections::VecDeque;
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant, SystemTime};
 
+use crate::dcps::IncompatibleQosStatus;
 use crate::qos::{DataReaderQos, DataRepresentation, History, ReaderQos};
 use crate::rtps::{ChangeKind, Event, Guid, ReaderSpec, ReceivedSample};
 use crate::xtypes::dynamic::{DynamicData, DynamicType};
@@ -42,6 +43,7 @@ struct Inner {
     queue: Mutex<VecDeque<ReceivedSample>>,
     data_cv: Condvar,
     matched: Mutex<Vec<Guid>>,
+    incompatible: Mutex<IncompatibleQosStatus>,
 }
 
 impl Inner {
@@ -68,11 +70,14 @@ impl Endpoint for Inner {
     }
 
     fn on_event(self: Arc<Self>, ev: &Event) {
-        if let Event::SubscriptionMatched {
-            writer, matched, ..
-        } = ev
-        {
-            super::record_match(&self.matched, *writer, *matched);
+        match ev {
+            Event::SubscriptionMatched {
+                writer, matched, ..
+            } => super::record_match(&self.matched, *writer, *matched),
+            Event::RequestedIncompatibleQos { policy, .. } => {
+                lock(&self.incompatible).record(*policy)
+            }
+            _ => {}
         }
     }
 
@@ -129,9 +134,13 @@ impl Subscriber {
             queue: Mutex::new(VecDeque::new()),
             data_cv: Condvar::new(),
             matched: Mutex::new(Vec::new()),
+            incompatible: Mutex::new(IncompatibleQosStatus::default()),
         });
         let sink: Arc<dyn Endpoint> = inner.clone();
-        let id = driver.create_endpoint(sink, |c, now| c.create_reader(now, spec))?;
+        let id = driver.create_endpoint(sink, |c, now| {
+            topic.register_types(c);
+            c.create_reader(now, spec)
+        })?;
         let owner = Owner {
             topic: topic.clone(),
             _subscriber: self.clone(),
@@ -158,6 +167,12 @@ impl DynamicReader {
     /// The writers matched now.
     pub fn matched_writers(&self) -> Vec<Guid> {
         lock(&self.inner.matched).clone()
+    }
+
+    /// REQUESTED_INCOMPATIBLE_QOS: writers on the topic not matched for a policy (`TypeConsistencyEnforcement`
+    /// for a type not assignable to the reader's). Resets the change count.
+    pub fn requested_incompatible_qos_status(&self) -> IncompatibleQosStatus {
+        super::take_incompatible(&self.inner.incompatible)
     }
 
     /// Waits until a change is waiting to be taken; `false` on timeout.

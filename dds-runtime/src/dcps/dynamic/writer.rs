@@ -4,6 +4,7 @@ use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant, SystemTime};
 
 use crate::cdr::{ByteOrder, XcdrVersion};
+use crate::dcps::IncompatibleQosStatus;
 use crate::qos::{DataWriterQos, Reliability, WriterQos, XCDR2_DATA_REPRESENTATION};
 use crate::rtps::{ChangeKind, Event, Guid, Payload, Time, WriteChange, WriteError, WriterSpec};
 use crate::xtypes::dynamic::{default_version, DynamicData};
@@ -24,16 +25,22 @@ struct Inner {
     max_block: Duration,
     matched: Mutex<Vec<Guid>>,
     matched_cv: Condvar,
+    incompatible: Mutex<IncompatibleQosStatus>,
 }
 
 impl Endpoint for Inner {
     fn on_event(self: Arc<Self>, ev: &Event) {
-        if let Event::PublicationMatched {
-            reader, matched, ..
-        } = ev
-        {
-            super::record_match(&self.matched, *reader, *matched);
-            self.matched_cv.notify_all();
+        match ev {
+            Event::PublicationMatched {
+                reader, matched, ..
+            } => {
+                super::record_match(&self.matched, *reader, *matched);
+                self.matched_cv.notify_all();
+            }
+            Event::OfferedIncompatibleQos { policy, .. } => {
+                lock(&self.incompatible).record(*policy)
+            }
+            _ => {}
         }
     }
 
@@ -95,9 +102,13 @@ impl Publisher {
             max_block,
             matched: Mutex::new(Vec::new()),
             matched_cv: Condvar::new(),
+            incompatible: Mutex::new(IncompatibleQosStatus::default()),
         });
         let sink: Arc<dyn Endpoint> = inner.clone();
-        let id = driver.create_endpoint(sink, |c, now| c.create_writer(now, spec))?;
+        let id = driver.create_endpoint(sink, |c, now| {
+            topic.register_types(c);
+            c.create_writer(now, spec)
+        })?;
         let owner = Owner {
             topic: topic.clone(),
             _publisher: self.clone(),
@@ -133,6 +144,12 @@ impl DynamicWriter {
     /// The readers matched now.
     pub fn matched_readers(&self) -> Vec<Guid> {
         lock(&self.inner.matched).clone()
+    }
+
+    /// OFFERED_INCOMPATIBLE_QOS: readers on the topic not matched for a policy (`TypeConsistencyEnforcement`
+    /// for a reader type not assignable from the writer's). Resets the change count.
+    pub fn offered_incompatible_qos_status(&self) -> IncompatibleQosStatus {
+        super::take_incompatible(&self.inner.incompatible)
     }
 
     /// Waits until at least `n` readers are matched; `false` on timeout.

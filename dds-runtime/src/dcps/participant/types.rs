@@ -42,9 +42,19 @@ impl DiscoveredType {
 
 /// Puts the type objects of `T` into the core's store, so that the TypeLookup service answers for them.
 pub(crate) fn register_local_types<T: DdsType>(core: &mut Participant) {
-    if let (Some(info), Some(mapping)) = (T::type_information(), T::type_mapping()) {
+    register_type_bytes(core, T::TYPE_NAME, T::type_information(), T::type_mapping());
+}
+
+/// Puts the type objects of a type (its XCDR2 `TypeInformation` and `TypeMapping`) into the core's store.
+pub(crate) fn register_type_bytes(
+    core: &mut Participant,
+    type_name: &str,
+    information: Option<&[u8]>,
+    mapping: Option<&[u8]>,
+) {
+    if let (Some(info), Some(mapping)) = (information, mapping) {
         if let Err(e) = core.register_types(info, mapping) {
-            tracing::warn!(type_name = T::TYPE_NAME, error = %e, "type objects not registered");
+            tracing::warn!(type_name, error = %e, "type objects not registered");
         }
     }
 }

@@ -14,11 +14,12 @@ pub struct MemberBuilder {
     name: String,
     ty: DynamicType,
     id: Option<u32>,
-    hash_id: bool,
+    hash_id: Option<String>,
     key: bool,
     optional: bool,
     external: bool,
     must_understand: bool,
+    use_default: bool,
 }
 
 impl MemberBuilder {
@@ -28,11 +29,12 @@ impl MemberBuilder {
             name: name.into(),
             ty,
             id: None,
-            hash_id: false,
+            hash_id: None,
             key: false,
             optional: false,
             external: false,
             must_understand: false,
+            use_default: false,
         }
     }
 
@@ -44,7 +46,20 @@ impl MemberBuilder {
 
     /// `@hashid`: the id is the hash of the member name.
     pub fn hash_id(mut self) -> Self {
-        self.hash_id = true;
+        self.hash_id = Some(String::new());
+        self
+    }
+
+    /// `@hashid("s")`: the id is the hash of `s`.
+    pub fn hash_id_of(mut self, s: impl Into<String>) -> Self {
+        self.hash_id = Some(s.into());
+        self
+    }
+
+    /// `@default(...)`: a reader that lacks the member takes its default (TRY_CONSTRUCT2 in the type object;
+    /// the value itself is not kept).
+    pub fn use_default(mut self) -> Self {
+        self.use_default = true;
         self
     }
 
@@ -85,6 +100,7 @@ pub struct StructBuilder {
     extensibility: Extensibility,
     base: Option<DynamicType>,
     autoid_hash: bool,
+    nested: bool,
     members: Vec<MemberBuilder>,
 }
 
@@ -96,6 +112,7 @@ impl StructBuilder {
             extensibility: Extensibility::Appendable,
             base: None,
             autoid_hash: false,
+            nested: false,
             members: Vec::new(),
         }
     }
@@ -115,6 +132,12 @@ impl StructBuilder {
     /// `@autoid(HASH)`: members without `@id` get the hash of their name.
     pub fn autoid_hash(mut self) -> Self {
         self.autoid_hash = true;
+        self
+    }
+
+    /// `@nested`: not meant as a topic type (IS_NESTED in the type object).
+    pub fn nested(mut self) -> Self {
+        self.nested = true;
         self
     }
 
@@ -145,10 +168,12 @@ impl StructBuilder {
         };
         let mut next = members.last().map_or(0, |m: &Member| m.id + 1);
         for m in self.members {
-            let id = match m.id {
-                Some(id) => id,
-                None if m.hash_id || self.autoid_hash => hash_member_id(&m.name),
-                None => next,
+            let id = match (m.id, m.hash_id.as_deref()) {
+                (Some(id), _) => id,
+                (None, Some(h)) if !h.is_empty() => hash_member_id(h),
+                (None, Some(_)) => hash_member_id(&m.name),
+                (None, None) if self.autoid_hash => hash_member_id(&m.name),
+                (None, None) => next,
             };
             if id > 0x0fff_ffff {
                 return Err(DynamicError::Invalid(format!(
@@ -171,6 +196,8 @@ impl StructBuilder {
                 optional: m.optional,
                 external: m.external,
                 must_understand: m.must_understand,
+                hash_id: m.hash_id,
+                use_default: m.use_default,
             });
         }
         levels.push(members.len());
@@ -179,6 +206,8 @@ impl StructBuilder {
             extensibility: self.extensibility,
             base: self.base,
             members,
+            autoid_hash: self.autoid_hash,
+            nested: self.nested,
             levels,
         })))
     }
@@ -191,6 +220,7 @@ pub struct UnionBuilder {
     extensibility: Extensibility,
     discriminator: DynamicType,
     disc_key: bool,
+    nested: bool,
     cases: Vec<UnionCase>,
 }
 
@@ -202,6 +232,7 @@ impl UnionBuilder {
             extensibility: Extensibility::Appendable,
             discriminator,
             disc_key: false,
+            nested: false,
             cases: Vec::new(),
         }
     }
@@ -215,6 +246,12 @@ impl UnionBuilder {
     /// `@key` on the discriminator.
     pub fn key(mut self) -> Self {
         self.disc_key = true;
+        self
+    }
+
+    /// `@nested`: not meant as a topic type (IS_NESTED in the type object).
+    pub fn nested(mut self) -> Self {
+        self.nested = true;
         self
     }
 
@@ -278,6 +315,7 @@ impl UnionBuilder {
             discriminator: self.discriminator,
             disc_key: self.disc_key,
             cases: self.cases,
+            nested: self.nested,
         })))
     }
 }
@@ -297,6 +335,7 @@ impl EnumBuilder {
                 bit_bound: 32,
                 literals: Vec::new(),
                 default: 0,
+                extensibility: Extensibility::Final,
             },
         }
     }
@@ -304,6 +343,12 @@ impl EnumBuilder {
     /// `@bit_bound(n)`.
     pub fn bit_bound(mut self, n: u16) -> Self {
         self.ty.bit_bound = n;
+        self
+    }
+
+    /// `@final`, `@appendable` or `@mutable` (in the type object only).
+    pub fn extensibility(mut self, e: Extensibility) -> Self {
+        self.ty.extensibility = e;
         self
     }
 
@@ -362,6 +407,7 @@ impl BitmaskBuilder {
                 name: name.into(),
                 bit_bound: 32,
                 flags: Vec::new(),
+                extensibility: Extensibility::Final,
             },
         }
     }
@@ -369,6 +415,12 @@ impl BitmaskBuilder {
     /// `@bit_bound(n)`.
     pub fn bit_bound(mut self, n: u16) -> Self {
         self.ty.bit_bound = n;
+        self
+    }
+
+    /// `@final`, `@appendable` or `@mutable` (in the type object only).
+    pub fn extensibility(mut self, e: Extensibility) -> Self {
+        self.ty.extensibility = e;
         self
     }
 

@@ -200,6 +200,12 @@ impl Resolver<'_> {
                         optional: m.flags.contains(MemberFlag::IS_OPTIONAL),
                         external: m.flags.contains(MemberFlag::IS_EXTERNAL),
                         must_understand: m.flags.contains(MemberFlag::IS_MUST_UNDERSTAND),
+                        hash_id: m
+                            .detail
+                            .ann_builtin
+                            .as_ref()
+                            .and_then(|a| a.hash_id.clone()),
+                        use_default: m.flags.contains(MemberFlag::TRY_CONSTRUCT2),
                     });
                 }
                 levels.push(all.len());
@@ -208,6 +214,8 @@ impl Resolver<'_> {
                     extensibility: extensibility(*flags),
                     base,
                     members: all,
+                    autoid_hash: flags.contains(TypeFlag::IS_AUTOID_HASH),
+                    nested: flags.contains(TypeFlag::IS_NESTED),
                     levels,
                 }))
             }
@@ -235,14 +243,17 @@ impl Resolver<'_> {
                     discriminator: self.resolve(disc_type, d)?,
                     disc_key: disc_flags.contains(MemberFlag::IS_KEY),
                     cases,
+                    nested: flags.contains(TypeFlag::IS_NESTED),
                 }))
             }
             TypeBody::Enum {
+                flags,
                 bit_bound,
                 literals,
                 ..
             } => DynamicType::new(TypeKind::Enum(EnumType {
                 name: type_name(body),
+                extensibility: extensibility(*flags),
                 bit_bound: *bit_bound,
                 default: literals
                     .iter()
@@ -257,11 +268,13 @@ impl Resolver<'_> {
                     .collect(),
             })),
             TypeBody::Bitmask {
+                flags,
                 bit_bound,
                 bitflags,
                 ..
             } => DynamicType::new(TypeKind::Bitmask(BitmaskType {
                 name: type_name(body),
+                extensibility: extensibility(*flags),
                 bit_bound: *bit_bound,
                 flags: bitflags
                     .iter()

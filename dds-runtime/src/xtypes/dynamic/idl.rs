@@ -11,9 +11,7 @@ use idlc::model::{self, AutoId, DeclId, DeclKind, Model, Type};
 
 use crate::cdr::Extensibility;
 
-use super::builder::{
-    hash_member_id, BitmaskBuilder, EnumBuilder, MemberBuilder, StructBuilder, UnionBuilder,
-};
+use super::builder::{BitmaskBuilder, EnumBuilder, MemberBuilder, StructBuilder, UnionBuilder};
 use super::error::DynamicError;
 use super::types::{DynamicType, Primitive};
 
@@ -169,7 +167,9 @@ impl Converter<'_> {
             DeclKind::Struct(s) => self.structure(name, s, depth)?,
             DeclKind::Union(u) => self.union(name, u, depth)?,
             DeclKind::Enum(e) => {
-                let mut b = EnumBuilder::new(name).default_literal(e.default_index);
+                let mut b = EnumBuilder::new(name)
+                    .default_literal(e.default_index)
+                    .extensibility(ext(e.extensibility));
                 if let Some(bb) = e.bit_bound {
                     b = b.bit_bound(bb as u16);
                 }
@@ -201,6 +201,9 @@ impl Converter<'_> {
         if s.autoid == AutoId::Hash {
             b = b.autoid_hash();
         }
+        if s.nested {
+            b = b.nested();
+        }
         if let Some(base) = s.base {
             b = b.base(self.decl(base, depth + 1)?);
         }
@@ -208,10 +211,12 @@ impl Converter<'_> {
             let mut m = MemberBuilder::new(&f.name, self.ty(&f.ty, depth + 1)?);
             m = match (&f.id, &f.hashid) {
                 (Some(id), _) => m.id(*id),
-                (None, Some(h)) if h.is_empty() => m.hash_id(),
-                (None, Some(h)) => m.id(hash_member_id(h)),
+                (None, Some(h)) => m.hash_id_of(h),
                 (None, None) => m,
             };
+            if f.default.is_some() {
+                m = m.use_default();
+            }
             if f.key {
                 m = m.key();
             }
@@ -239,6 +244,9 @@ impl Converter<'_> {
             .extensibility(ext(u.extensibility));
         if u.disc_key {
             b = b.key();
+        }
+        if u.nested {
+            b = b.nested();
         }
         for c in &u.cases {
             let mut labels = Vec::with_capacity(c.labels.len());

@@ -4,7 +4,7 @@ use std::fmt::Write;
 
 use crate::cdr::Extensibility;
 
-use super::types::{DynamicType, TypeKind};
+use super::types::{DynamicType, EnumType, StructType, TypeKind, UnionType};
 
 impl DynamicType {
     /// The type as IDL: every named type it depends on first, each in its modules, then the type itself.
@@ -17,6 +17,109 @@ impl DynamicType {
         }
         out
     }
+}
+
+/// IDL 4.2's keywords (§7.2.4, Table 7-6): a name equal to one of them, ignoring case, is written escaped.
+const KEYWORDS: &[&str] = &[
+    "abstract",
+    "alias",
+    "any",
+    "attribute",
+    "bitfield",
+    "bitmask",
+    "bitset",
+    "boolean",
+    "case",
+    "char",
+    "component",
+    "connector",
+    "const",
+    "consumes",
+    "context",
+    "custom",
+    "default",
+    "double",
+    "emits",
+    "enum",
+    "eventtype",
+    "exception",
+    "factory",
+    "false",
+    "finder",
+    "fixed",
+    "float",
+    "getraises",
+    "getter",
+    "home",
+    "import",
+    "in",
+    "inout",
+    "int16",
+    "int32",
+    "int64",
+    "int8",
+    "interface",
+    "local",
+    "long",
+    "manages",
+    "map",
+    "mirrorport",
+    "module",
+    "multiple",
+    "native",
+    "object",
+    "octet",
+    "oneway",
+    "out",
+    "port",
+    "porttype",
+    "primarykey",
+    "private",
+    "provides",
+    "public",
+    "publishes",
+    "raises",
+    "readonly",
+    "sequence",
+    "setraises",
+    "setter",
+    "short",
+    "string",
+    "struct",
+    "supports",
+    "switch",
+    "true",
+    "truncatable",
+    "typedef",
+    "typeid",
+    "typename",
+    "typeprefix",
+    "uint16",
+    "uint32",
+    "uint64",
+    "uint8",
+    "union",
+    "unsigned",
+    "uses",
+    "valuebase",
+    "valuetype",
+    "void",
+    "wchar",
+    "wstring",
+];
+
+/// A name as an IDL identifier: escaped with `_` when it is a keyword.
+fn ident(name: &str) -> String {
+    if KEYWORDS.contains(&name.to_ascii_lowercase().as_str()) {
+        format!("_{name}")
+    } else {
+        name.to_string()
+    }
+}
+
+/// A scoped name (`A::B`) with each part an identifier.
+fn scoped(name: &str) -> String {
+    name.split("::").map(ident).collect::<Vec<_>>().join("::")
 }
 
 fn is_named(t: &DynamicType) -> bool {
@@ -40,8 +143,7 @@ fn collect(t: &DynamicType, order: &mut Vec<DynamicType>, depth: u32) {
             if let Some(b) = &s.base {
                 collect(b, order, depth + 1);
             }
-            let own = s.levels.len().checked_sub(2).map_or(0, |i| s.levels[i]);
-            for m in &s.members[own..] {
+            for m in s.own_members() {
                 collect(&m.ty, order, depth + 1);
             }
         }
@@ -71,9 +173,9 @@ fn decl(t: &DynamicType, name: &str) -> String {
     match t.kind() {
         TypeKind::Array { element, dims } => {
             let d: String = dims.iter().map(|d| format!("[{d}]")).collect();
-            format!("{} {name}{d}", spelling(element))
+            format!("{} {}{d}", spelling(element), ident(name))
         }
-        _ => format!("{} {name}", spelling(t)),
+        _ => format!("{} {}", spelling(t), ident(name)),
     }
 }
 
@@ -88,8 +190,21 @@ fn spelling(t: &DynamicType) -> String {
             Some(b) => format!("map<{}, {}, {b}>", spelling(key), spelling(value)),
             None => format!("map<{}, {}>", spelling(key), spelling(value)),
         },
+        _ if is_named(t) => scoped(&t.name()),
         _ => t.name(),
     }
+}
+
+/// ` @nested` and ` @autoid(HASH)` when they apply.
+fn type_annotations(nested: bool, autoid_hash: bool) -> String {
+    let mut a = String::new();
+    if nested {
+        a.push_str(" @nested");
+    }
+    if autoid_hash {
+        a.push_str(" @autoid(HASH)");
+    }
+    a
 }
 
 fn ext_annotation(e: Extensibility) -> &'static str {
@@ -107,81 +222,20 @@ fn declare(t: &DynamicType, out: &mut String) {
     let (modules, local) = parts.split_at(parts.len() - 1);
     let mut ind = String::new();
     for m in modules {
-        let _ = writeln!(out, "{ind}module {m} {{");
+        let _ = writeln!(out, "{ind}module {} {{", ident(m));
         ind.push_str("    ");
     }
-    let local = local[0];
+    let raw = local[0];
+    let local = ident(raw);
     match t.kind() {
-        TypeKind::Struct(s) => {
-            let own = s.levels.len().checked_sub(2).map_or(0, |i| s.levels[i]);
-            let base = s
-                .base
-                .as_ref()
-                .map(|b| format!(" : {}", b.name()))
-                .unwrap_or_default();
-            let _ = writeln!(
-                out,
-                "{ind}{}\n{ind}struct {local}{base} {{",
-                ext_annotation(s.extensibility)
-            );
-            for m in &s.members[own..] {
-                let mut a = format!("@id({}) ", m.id);
-                for (on, name) in [
-                    (m.key, "@key "),
-                    (m.optional, "@optional "),
-                    (m.external, "@external "),
-                    (m.must_understand, "@must_understand "),
-                ] {
-                    if on {
-                        a.push_str(name);
-                    }
-                }
-                let _ = writeln!(out, "{ind}    {a}{};", decl(&m.ty, &m.name));
-            }
-            let _ = writeln!(out, "{ind}}};");
-        }
-        TypeKind::Union(u) => {
-            let key = if u.disc_key { "@key " } else { "" };
-            let _ = writeln!(
-                out,
-                "{ind}{}\n{ind}union {local} switch ({key}{}) {{",
-                ext_annotation(u.extensibility),
-                spelling(&u.discriminator)
-            );
-            for c in &u.cases {
-                let mut labels: Vec<String> = c
-                    .labels
-                    .iter()
-                    .map(|l| format!("case {}:", label(&u.discriminator, *l)))
-                    .collect();
-                if c.is_default {
-                    labels.push("default:".into());
-                }
-                let _ = writeln!(
-                    out,
-                    "{ind}    {}\n{ind}        {};",
-                    labels.join(" "),
-                    decl(&c.ty, &c.name)
-                );
-            }
-            let _ = writeln!(out, "{ind}}};");
-        }
-        TypeKind::Enum(e) => {
-            if e.bit_bound != 32 {
-                let _ = writeln!(out, "{ind}@bit_bound({})", e.bit_bound);
-            }
-            let lits: Vec<String> = e
-                .literals
-                .iter()
-                .map(|l| format!("{ind}    @value({}) {}", l.value, l.name))
-                .collect();
-            let _ = writeln!(out, "{ind}enum {local} {{\n{}\n{ind}}};", lits.join(",\n"));
-        }
+        TypeKind::Struct(s) => declare_struct(s, &local, &ind, out),
+        TypeKind::Union(u) => declare_union(u, &local, &ind, out),
+        TypeKind::Enum(e) => declare_enum(e, &local, &ind, out),
         TypeKind::Bitmask(b) => {
             let flags: Vec<String> = b
                 .flags
                 .iter()
-                .map(|f| format!("{ind}    @position({}) {}", f.position, f.name))
+                .map(|f| format!("{ind}    @position({}) {}", f.position, ident(&f.name)))
                 .collect();
             let _ = writeln!(
                 out,
@@ -191,7 +245,7 @@ fn declare(t: &DynamicType, out: &mut String) {
             );
         }
         TypeKind::Alias { target, .. } => {
-            let _ = writeln!(out, "{ind}typedef {};", decl(target, local));
+            let _ = writeln!(out, "{ind}typedef {};", decl(target, raw));
         }
         _ => {}
     }
@@ -201,14 +255,110 @@ fn declare(t: &DynamicType, out: &mut String) {
     }
 }
 
+fn declare_struct(s: &StructType, local: &str, ind: &str, out: &mut String) {
+    let base = s
+        .base
+        .as_ref()
+        .map(|b| format!(" : {}", scoped(&b.name())))
+        .unwrap_or_default();
+    let _ = writeln!(
+        out,
+        "{ind}{}{}\n{ind}struct {local}{base} {{",
+        ext_annotation(s.extensibility),
+        type_annotations(s.nested, s.autoid_hash)
+    );
+    for m in s.own_members() {
+        let mut a = match m.hash_id.as_deref() {
+            Some("") => "@hashid ".to_string(),
+            Some(h) => format!("@hashid(\"{h}\") "),
+            None => format!("@id({}) ", m.id),
+        };
+        for (on, name) in [
+            (m.key, "@key "),
+            (m.optional, "@optional "),
+            (m.external, "@external "),
+            (m.must_understand, "@must_understand "),
+        ] {
+            if on {
+                a.push_str(name);
+            }
+        }
+        let _ = writeln!(out, "{ind}    {a}{};", decl(&m.ty, &m.name));
+    }
+    let _ = writeln!(out, "{ind}}};");
+}
+
+fn declare_union(u: &UnionType, local: &str, ind: &str, out: &mut String) {
+    let key = if u.disc_key { "@key " } else { "" };
+    let _ = writeln!(
+        out,
+        "{ind}{}{}\n{ind}union {local} switch ({key}{}) {{",
+        ext_annotation(u.extensibility),
+        type_annotations(u.nested, false),
+        spelling(&u.discriminator)
+    );
+    let mut next_id = 1;
+    for c in &u.cases {
+        // Ids are written where they are not the default numbering (from 1).
+        let mut a = if c.id == next_id {
+            String::new()
+        } else {
+            format!("@id({}) ", c.id)
+        };
+        next_id = c.id.wrapping_add(1);
+        if c.external {
+            a.push_str("@external ");
+        }
+        let mut labels: Vec<String> = c
+            .labels
+            .iter()
+            .map(|l| format!("case {}:", label(&u.discriminator, *l)))
+            .collect();
+        if c.is_default {
+            labels.push("default:".into());
+        }
+        let _ = writeln!(
+            out,
+            "{ind}    {}\n{ind}        {a}{};",
+            labels.join(" "),
+            decl(&c.ty, &c.name)
+        );
+    }
+    let _ = writeln!(out, "{ind}}};");
+}
+
+fn declare_enum(e: &EnumType, local: &str, ind: &str, out: &mut String) {
+    if e.extensibility != Extensibility::Final {
+        let _ = writeln!(out, "{ind}{}", ext_annotation(e.extensibility));
+    }
+    if e.bit_bound != 32 {
+        let _ = writeln!(out, "{ind}@bit_bound({})", e.bit_bound);
+    }
+    let lits: Vec<String> = e
+        .literals
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let d = if i == e.default && i != 0 {
+                "@default_literal "
+            } else {
+                ""
+            };
+            format!("{ind}    {d}@value({}) {}", l.value, ident(&l.name))
+        })
+        .collect();
+    let _ = writeln!(out, "{ind}enum {local} {{\n{}\n{ind}}};", lits.join(",\n"));
+}
+
 fn label(disc: &DynamicType, v: i64) -> String {
     match disc.resolved().kind() {
         TypeKind::Enum(e) => e.name_of(v as i32).map_or_else(
             || v.to_string(),
             |n| {
-                format!("{}::{n}", e.name.rsplit_once("::").map_or("", |p| p.0))
-                    .trim_start_matches("::")
-                    .to_string()
+                scoped(
+                    format!("{}::{n}", e.name.rsplit_once("::").map_or("", |p| p.0))
+                        .trim_start_matches("::"),
+                )
             },
         ),
         TypeKind::Primitive(super::Primitive::Bool) => {

@@ -20,6 +20,7 @@ mod idl_text;
 mod json;
 mod layout;
 mod payload;
+mod to_object;
 mod types;
 mod value;
 

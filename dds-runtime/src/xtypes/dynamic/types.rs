@@ -175,6 +175,8 @@ pub struct EnumType {
     pub literals: Vec<Enumerator>,
     /// Index of the default literal.
     pub default: usize,
+    /// Extensibility (in the type object only; `@final` unless annotated).
+    pub extensibility: Extensibility,
 }
 
 impl EnumType {
@@ -222,6 +224,8 @@ pub struct BitmaskType {
     pub bit_bound: u16,
     /// The flags.
     pub flags: Vec<BitFlag>,
+    /// Extensibility (in the type object only; `@final` unless annotated).
+    pub extensibility: Extensibility,
 }
 
 impl BitmaskType {
@@ -253,6 +257,10 @@ pub struct Member {
     pub external: bool,
     /// `@must_understand`.
     pub must_understand: bool,
+    /// `@hashid` as written (the string, empty for the member name): the type object keeps it.
+    pub hash_id: Option<String>,
+    /// `@default`: the member's try-construct behaviour is USE_DEFAULT (TRY_CONSTRUCT2) instead of DISCARD.
+    pub use_default: bool,
 }
 
 /// A struct type. Members of the base come first in [`StructType::members`].
@@ -266,6 +274,10 @@ pub struct StructType {
     pub base: Option<DynamicType>,
     /// Every member, the base's first (a sample's values are in this order).
     pub members: Vec<Member>,
+    /// `@autoid(HASH)`.
+    pub autoid_hash: bool,
+    /// `@nested`: not meant as a topic type.
+    pub nested: bool,
     /// How many of `members` the base (and its bases) contributes, per inheritance level, outermost first.
     pub(super) levels: Vec<usize>,
 }
@@ -279,6 +291,12 @@ impl StructType {
     /// Index of the member with id `id`.
     pub fn index_of_id(&self, id: u32) -> Option<usize> {
         self.members.iter().position(|m| m.id == id)
+    }
+
+    /// The struct's own members (its base's left out).
+    pub fn own_members(&self) -> &[Member] {
+        let start = self.levels.iter().rev().nth(1).copied().unwrap_or(0);
+        &self.members[start..]
     }
 
     /// Whether the struct (or its base) has key members.
@@ -330,6 +348,8 @@ pub struct UnionType {
     pub disc_key: bool,
     /// The cases.
     pub cases: Vec<UnionCase>,
+    /// `@nested`: not meant as a topic type.
+    pub nested: bool,
 }
 
 impl UnionType {
