@@ -148,7 +148,8 @@ fn writer_lifespan_expires_its_history_for_late_joiners() {
     let (p1, p2) = (participant(213), participant(213));
     let durable = |q: &mut DataWriterQos| {
         q.durability = Durability::TransientLocal;
-        q.lifespan = Lifespan(Duration::from_millis(200));
+        // Long enough for a late reader to match before the second sample expires, on a loaded machine.
+        q.lifespan = Lifespan(Duration::from_millis(1000));
     };
     let (mut wq, mut rq) = reliable_keep_all();
     durable(&mut wq);
@@ -163,7 +164,7 @@ fn writer_lifespan_expires_its_history_for_late_joiners() {
     // timestamp) would keep it: only the writer's expiry can hold it back.
     let ahead = SystemTime::now() + Duration::from_secs(3600);
     w.write_w_timestamp(&shape("BLUE", 1), ahead).unwrap();
-    std::thread::sleep(Duration::from_millis(400));
+    std::thread::sleep(Duration::from_millis(1300));
     let late = reader::<ShapeType>(&p2, "Square", &rq);
     assert!(wait_until(MATCH_TIMEOUT, || late
         .subscription_matched_status()
