@@ -17,6 +17,7 @@ fn config() -> ShmChannelConfig {
         queue_depth: 8,
         max_loans: 4,
         max_subscribers: 4,
+        delivery_timeout: None,
     }
 }
 

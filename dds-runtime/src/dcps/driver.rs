@@ -106,6 +106,9 @@ pub(crate) struct Driver {
     has_observers: AtomicBool,
     /// Told of every remote publication and subscription discovered (topics, INCONSISTENT_TOPIC).
     discovery_hook: OnceLock<DiscoveryHook>,
+    /// Shared-memory channels with peers on this host (`None`: off, or not available).
+    #[cfg(feature = "shm")]
+    shm: Option<super::shm::ShmLink>,
 }
 
 thread_local! {
@@ -171,6 +174,7 @@ fn core_config(
     prefix: GuidPrefix,
     user_data: Vec<u8>,
     name: Option<String>,
+    extra_properties: Vec<(String, String)>,
 ) -> DdsResult<ParticipantConfig> {
     // IPv6: the builder's IPv4 locators are all replaced below.
     let ip = match transport.interface().addr {
@@ -218,7 +222,12 @@ fn core_config(
     .write_batch_delay(config.write_batch_delay)
     .intra_process(config.intra_process)
     .user_data(user_data)
-    .properties(super::process_info::properties())
+    .properties(
+        super::process_info::properties()
+            .into_iter()
+            .chain(extra_properties)
+            .collect::<Vec<_>>(),
+    )
     .entity_name(name)
     .build();
     Ok(pc)
@@ -234,7 +243,16 @@ impl Driver {
     ) -> DdsResult<Arc<Driver>> {
         let transport = UdpTransport::bind(&config)?;
         let prefix = new_guid_prefix();
-        let pc = core_config(&config, &transport, prefix, user_data, name)?;
+        #[cfg(feature = "shm")]
+        let (shm, shm_properties) = match config.shm {
+            true => {
+                super::shm::ShmLink::new(prefix).map_or((None, Vec::new()), |(l, p)| (Some(l), p))
+            }
+            false => (None, Vec::new()),
+        };
+        #[cfg(not(feature = "shm"))]
+        let shm_properties = Vec::new();
+        let pc = core_config(&config, &transport, prefix, user_data, name, shm_properties)?;
         let mut core = Participant::new(pc, Instant::now());
         if !enabled {
             // Created disabled: nothing is sent, not even the first SPDP announcement, until `enable`.
@@ -261,6 +279,8 @@ impl Driver {
             observers: RwLock::new(Vec::new()),
             has_observers: AtomicBool::new(false),
             discovery_hook: OnceLock::new(),
+            #[cfg(feature = "shm")]
+            shm,
         });
         let weak: Weak<Driver> = Arc::downgrade(&driver);
         let rx = Arc::new(move |_ch: Channel, batch: &[Datagram<'_>]| {
@@ -269,6 +289,10 @@ impl Driver {
             }
         });
         driver.transport.start(rx)?;
+        #[cfg(feature = "shm")]
+        if let Some(link) = &driver.shm {
+            link.start(Arc::downgrade(&driver))?;
+        }
         let d2 = driver.clone();
         let h = std::thread::Builder::new()
             .name("dds-timer".into())
@@ -284,6 +308,12 @@ impl Driver {
     fn receive(&self, batch: &[Datagram<'_>]) {
         if self.stopped.load(Ordering::Acquire) {
             return;
+        }
+        // What a peer sent over shared memory before this datagram is taken first (a writer's last samples
+        // before the announcement of its deletion, typically).
+        #[cfg(feature = "shm")]
+        if let Some(link) = &self.shm {
+            link.drain(self);
         }
         // A datagram with DATA is copied once out of the reusable receive buffers, and its samples share
         // the copy; fragments are copied straight into their reassembly buffers.
@@ -332,9 +362,17 @@ impl Driver {
             while let Some(ev) = core.poll_event() {
                 self.route_locked(ev, &mut deferred, &mut touched);
             }
+            #[cfg(feature = "shm")]
+            if let Some(link) = &self.shm {
+                link.take_from(&mut core);
+            }
             (r, core.poll_timeout())
         };
         self.send_batch(&batch);
+        #[cfg(feature = "shm")]
+        if let Some(link) = &self.shm {
+            link.flush();
+        }
         {
             let mut spare = lock(&self.spare_buffers);
             for t in batch.drain(..) {
@@ -578,7 +616,17 @@ impl Driver {
                 c.delete_reader(now, id);
             }
         });
+        #[cfg(feature = "shm")]
+        if let (Some(link), true) = (&self.shm, id.is_writer()) {
+            link.close_writer(id);
+        }
         tracing::debug!(?id, "endpoint deleted");
+    }
+
+    /// The participant's shared-memory link, when it has one.
+    #[cfg(feature = "shm")]
+    pub(crate) fn shm_link(&self) -> Option<&super::shm::ShmLink> {
+        self.shm.as_ref()
     }
 
     /// `Err(AlreadyDeleted)` once the participant shut down.
@@ -720,6 +768,10 @@ impl Driver {
             }
         }
         self.transport.shutdown();
+        #[cfg(feature = "shm")]
+        if let Some(link) = &self.shm {
+            link.shutdown();
+        }
         // Readers, writers and observers point back at us: forget them to break the cycle.
         write(&self.endpoints).clear();
         self.has_observers.store(false, Ordering::Release);
