@@ -21,6 +21,8 @@ fn config(size: usize) -> ShmChannelConfig {
         max_loans: 2,
         max_subscribers: 2,
         delivery_timeout: None,
+        max_publishers: 2,
+        latest_only: false,
     }
 }
 

@@ -18,6 +18,8 @@ fn config() -> ShmChannelConfig {
         max_loans: 4,
         max_subscribers: 4,
         delivery_timeout: None,
+        max_publishers: 2,
+        latest_only: false,
     }
 }
 

@@ -333,7 +333,7 @@ impl Driver {
 
     /// Runs `f` on the core, then (lock released) sends what it queued and dispatches its events.
     pub(crate) fn with_core<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R) -> R {
-        self.run_core(f, true)
+        self.run_core(f, true, true)
     }
 
     /// [`with_core`](Self::with_core) for a write: it does not count as progress. A write never gives room
@@ -341,10 +341,25 @@ impl Driver {
     /// its own attempt progress, it would retry at once, spinning (at 64 KiB this was a fifth of the
     /// publisher's CPU, taken from the subscriber on a two-core machine).
     pub(crate) fn with_core_writing<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R) -> R {
-        self.run_core(f, false)
+        self.run_core(f, false, true)
     }
 
-    fn run_core<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R, progress: bool) -> R {
+    /// [`with_core`](Self::with_core) for what arrived over shared memory: changes of our own writers it
+    /// queued are left for another thread to send (the shared-memory thread must never wait on a peer).
+    #[cfg(feature = "shm")]
+    pub(crate) fn with_core_from_shm<R>(
+        &self,
+        f: impl FnOnce(&mut Participant, Instant) -> R,
+    ) -> R {
+        self.run_core(f, true, false)
+    }
+
+    fn run_core<R>(
+        &self,
+        f: impl FnOnce(&mut Participant, Instant) -> R,
+        progress: bool,
+        send_shm: bool,
+    ) -> R {
         let now = Instant::now();
         // The batch vector is kept per thread (a nested call, from a listener, gets a fresh one).
         let mut batch: Vec<Transmit> = BATCH.with(|b| std::mem::take(&mut *b.borrow_mut()));
@@ -368,11 +383,15 @@ impl Driver {
             }
             (r, core.poll_timeout())
         };
-        self.send_batch(&batch);
+        // Shared memory first: what a writer sent there precedes what follows it on the wire (the
+        // announcement of its deletion after its last changes, typically).
         #[cfg(feature = "shm")]
-        if let Some(link) = &self.shm {
+        if let (Some(link), true) = (&self.shm, send_shm) {
             link.flush();
         }
+        #[cfg(not(feature = "shm"))]
+        let _ = send_shm;
+        self.send_batch(&batch);
         {
             let mut spare = lock(&self.spare_buffers);
             for t in batch.drain(..) {
@@ -623,6 +642,22 @@ impl Driver {
         tracing::debug!(?id, "endpoint deleted");
     }
 
+    /// Whether every reliable reader of `writer` acknowledged all it wrote: on the wire, and on shared
+    /// memory.
+    pub(crate) fn is_acknowledged(&self, writer: EntityId) -> bool {
+        self.with_core(|c, _| c.is_acknowledged(writer)) && self.shm_acknowledged(writer)
+    }
+
+    /// Whether the readers of `writer` on shared memory acknowledged all it sent them.
+    fn shm_acknowledged(&self, _writer: EntityId) -> bool {
+        #[cfg(feature = "shm")]
+        if let Some(link) = &self.shm {
+            let nodes = self.query_core(|c| c.shm_nodes(_writer));
+            return link.acknowledged(_writer, &nodes);
+        }
+        true
+    }
+
     /// The participant's shared-memory link, when it has one.
     #[cfg(feature = "shm")]
     pub(crate) fn shm_link(&self) -> Option<&super::shm::ShmLink> {
@@ -668,9 +703,7 @@ impl Driver {
     pub(crate) fn wait_acknowledged(&self, writer: EntityId, timeout: Duration) -> DdsResult<()> {
         self.check_alive()?;
         let deadline = Instant::now().checked_add(timeout);
-        if self.wait_progress(deadline, || {
-            self.with_core(|c, _| c.is_acknowledged(writer))
-        }) {
+        if self.wait_progress(deadline, || self.is_acknowledged(writer)) {
             Ok(())
         } else {
             self.check_alive()?;

@@ -7,8 +7,11 @@
 //! What holds for a pair on shared memory: every change the writer sent reaches the reader's participant,
 //! in order, unless that participant's queue stays full longer than [`DELIVERY_TIMEOUT`] (reliable
 //! writers; best-effort writers drop at once for a full queue), or its subscriber is not connected within
-//! [`CONNECT_TIMEOUT`] of the first send after the match. Nothing is repaired afterwards: iceoryx2's
-//! delivery replaces RTPS acknowledgements for these pairs.
+//! [`CONNECT_TIMEOUT`] of the first change for it (changes wait for it meanwhile, in order). Nothing is
+//! repaired afterwards: iceoryx2's delivery replaces RTPS repair for these pairs. Acknowledgements: once
+//! a reader's participant has put a writer's changes into its readers' caches it says so on the writer's
+//! acknowledgement channel (cumulative sequence numbers, latest only), which `wait_for_acknowledgments`
+//! waits for like RTPS ACKNACKs.
 
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -20,13 +23,15 @@ use foldhash::{HashMap, HashMapExt};
 
 use super::driver::Driver;
 use super::sync::lock;
-use crate::rtps::shm::{shm_channel_name, ShmChange, SHM_HOST_PROPERTY, SHM_NODE_PROPERTY};
+use crate::rtps::shm::{
+    decode_header, shm_channel_name, ShmChange, SHM_HOST_PROPERTY, SHM_NODE_PROPERTY,
+};
 use crate::rtps::{EntityId, Guid, GuidPrefix, Participant, Payload};
 use crate::transport::shm::{
     host_id, ShmChannelConfig, ShmError, ShmNode, ShmPublisher, ShmSubscriber,
 };
 
-/// How long a send waits for the subscribers of the readers' participants to connect to a new channel.
+/// How long a writer's changes wait for the subscribers of its readers' participants to connect.
 pub(crate) const CONNECT_TIMEOUT: Duration = Duration::from_secs(2);
 
 /// How long a reliable writer's send waits for a subscriber whose queue is full.
@@ -38,17 +43,29 @@ const BATCH: usize = 8;
 /// Longest sleep of the polling thread when no frame arrives.
 const MAX_IDLE: Duration = Duration::from_millis(1);
 
-/// One writer's channel, and the set of nodes last seen connected to it.
+/// One writer's channel, the set of nodes last seen connected to it, and its acknowledgements.
 struct Outlet {
     publisher: ShmPublisher,
     connected: Option<Arc<[String]>>,
+    /// Since when a change waits for its nodes to connect.
+    waiting_since: Option<Instant>,
+    acks: ShmSubscriber,
+    /// By node: the highest sequence number sent while it was expected, and the highest it acknowledged.
+    owed: HashMap<String, (i64, i64)>,
+}
+
+/// One peer writer's channel that our readers read, and where we acknowledge what it sent.
+struct Inlet {
+    writer: Guid,
+    subscriber: ShmSubscriber,
+    acks: ShmPublisher,
 }
 
 /// The channels our readers read, and the core generation they were set up for.
 #[derive(Default)]
 struct Inlets {
     generation: u64,
-    subscribers: Vec<(Guid, ShmSubscriber)>,
+    channels: Vec<Inlet>,
 }
 
 /// A participant's presence in shared memory.
@@ -75,6 +92,34 @@ fn channel_config(reliable: bool) -> ShmChannelConfig {
         }),
         ..ShmChannelConfig::default()
     }
+}
+
+/// A writer's acknowledgement channel: many publishers (one per reader participant), small messages,
+/// only the latest matters.
+fn ack_config() -> ShmChannelConfig {
+    let c = ShmChannelConfig::default();
+    ShmChannelConfig {
+        initial_max_sample: 64,
+        max_publishers: c.max_subscribers,
+        latest_only: true,
+        ..c
+    }
+}
+
+/// The acknowledgement channel of the writer whose data channel is `data`.
+fn ack_channel(data: &str) -> String {
+    format!("{data}/ack")
+}
+
+/// An acknowledgement: the sequence number, then the acknowledging node.
+fn encode_ack(sn: i64, node: &str, out: &mut [u8]) {
+    out[..8].copy_from_slice(&sn.to_le_bytes());
+    out[8..].copy_from_slice(node.as_bytes());
+}
+
+fn decode_ack(b: &[u8]) -> Option<(i64, &str)> {
+    let sn = i64::from_le_bytes(b.get(..8)?.try_into().ok()?);
+    Some((sn, std::str::from_utf8(&b[8..]).ok()?))
 }
 
 impl ShmLink {
@@ -123,33 +168,79 @@ impl ShmLink {
         }
     }
 
-    /// Sends what was taken, in order (without the core lock).
+    /// Sends what was taken, in order (without the core lock); may wait for a full reader queue.
     pub(crate) fn flush(&self) {
         if lock(&self.pending).is_empty() {
             return;
         }
-        let mut outlets = lock(&self.outlets);
+        self.flush_with(&mut lock(&self.outlets));
+    }
+
+    /// [`flush`](Self::flush) unless another thread is sending (it sends what is pending too).
+    fn try_flush(&self) {
+        if lock(&self.pending).is_empty() {
+            return;
+        }
+        let mut guard = match self.outlets.try_lock() {
+            Ok(g) => g,
+            Err(std::sync::TryLockError::Poisoned(p)) => p.into_inner(),
+            Err(std::sync::TryLockError::WouldBlock) => return,
+        };
+        self.flush_with(&mut guard);
+    }
+
+    fn flush_with(&self, outlets: &mut HashMap<EntityId, Outlet>) {
+        // Changes of a writer whose readers are not connected yet wait, with those that follow them.
+        let mut held = VecDeque::new();
+        let mut held_writers: Vec<EntityId> = Vec::new();
         loop {
             let Some(c) = lock(&self.pending).pop_front() else {
                 break;
             };
-            let writer = c.writer;
-            if let Err(e) = self.send(&mut outlets, c) {
-                tracing::warn!(?writer, error = %e, "shared-memory send failed");
+            if held_writers.contains(&c.writer) {
+                held.push_back(c);
+                continue;
+            }
+            match self.send(outlets, &c) {
+                Ok(true) => {}
+                Ok(false) => {
+                    held_writers.push(c.writer);
+                    held.push_back(c);
+                }
+                Err(e) => {
+                    tracing::warn!(writer = ?c.writer, error = %e, "shared-memory send failed")
+                }
+            }
+        }
+        if !held.is_empty() {
+            let mut pending = lock(&self.pending);
+            while let Some(c) = held.pop_back() {
+                pending.push_front(c);
             }
         }
     }
 
-    fn send(&self, outlets: &mut HashMap<EntityId, Outlet>, c: ShmChange) -> Result<(), ShmError> {
+    fn open_outlet(&self, writer: EntityId, reliable: bool) -> Result<Outlet, ShmError> {
+        let name = shm_channel_name(&Guid::new(self.prefix, writer));
+        Ok(Outlet {
+            publisher: self.node.publisher(&name, &channel_config(reliable))?,
+            connected: None,
+            waiting_since: None,
+            acks: self.node.subscriber(&ack_channel(&name), &ack_config())?,
+            owed: HashMap::new(),
+        })
+    }
+
+    /// Sends `c`; `Ok(false)` when it must wait for its nodes to connect.
+    fn send(
+        &self,
+        outlets: &mut HashMap<EntityId, Outlet>,
+        c: &ShmChange,
+    ) -> Result<bool, ShmError> {
         let out = match outlets.entry(c.writer) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::hash_map::Entry::Vacant(e) => {
-                let name = shm_channel_name(&Guid::new(self.prefix, c.writer));
-                let publisher = self.node.publisher(&name, &channel_config(c.reliable))?;
-                e.insert(Outlet {
-                    publisher,
-                    connected: None,
-                })
+                e.insert(self.open_outlet(c.writer, c.reliable)?)
             }
         };
         if !out
@@ -157,13 +248,54 @@ impl ShmLink {
             .as_ref()
             .is_some_and(|n| Arc::ptr_eq(n, &c.nodes))
         {
-            wait_connected(&out.publisher, &c.nodes);
+            let subs = out.publisher.subscriber_nodes();
+            let missing = c.nodes.iter().filter(|n| !subs.contains(n)).count();
+            let since = *out.waiting_since.get_or_insert_with(Instant::now);
+            if missing > 0 && since.elapsed() < CONNECT_TIMEOUT {
+                return Ok(false);
+            }
+            if missing > 0 {
+                tracing::warn!(
+                    missing,
+                    "shared-memory readers not connected in time: they miss changes"
+                );
+            }
+            let _ = out.publisher.update_connections();
             out.connected = Some(c.nodes.clone());
+            out.waiting_since = None;
         }
         let mut loan = out.publisher.loan(c.frame_len())?;
         c.write_frame(&mut loan);
         loan.send()?;
-        Ok(())
+        if !c.liveliness {
+            for n in c.nodes.iter() {
+                let owed = out.owed.entry(n.clone()).or_insert((0, 0));
+                owed.0 = owed.0.max(c.sequence.0);
+            }
+        }
+        Ok(true)
+    }
+
+    /// Whether every reader participant in `nodes` acknowledged all that `writer` sent it (true when
+    /// nothing was sent on shared memory).
+    pub(crate) fn acknowledged(&self, writer: EntityId, nodes: &[String]) -> bool {
+        if lock(&self.pending).iter().any(|c| c.writer == writer) {
+            return false;
+        }
+        let mut outlets = lock(&self.outlets);
+        let Some(out) = outlets.get_mut(&writer) else {
+            return true;
+        };
+        while let Ok(Some(ack)) = out.acks.receive() {
+            if let Some((sn, node)) = decode_ack(&ack) {
+                if let Some(owed) = out.owed.get_mut(node) {
+                    owed.1 = owed.1.max(sn);
+                }
+            }
+        }
+        nodes
+            .iter()
+            .all(|n| out.owed.get(n).is_none_or(|(sent, acked)| acked >= sent))
     }
 
     /// The writer was deleted: its channel closes (after what it sent).
@@ -182,17 +314,23 @@ impl ShmLink {
             let wanted = driver.query_core(Participant::shm_subscriptions);
             self.resubscribe(&mut inlets, &wanted);
         }
-        if inlets.subscribers.is_empty() {
+        if inlets.channels.is_empty() {
             return 0;
         }
         let mut frames: Vec<(Guid, Payload)> = Vec::new();
-        for (writer, sub) in &inlets.subscribers {
+        let mut highest = vec![0i64; inlets.channels.len()];
+        for (i, inlet) in inlets.channels.iter().enumerate() {
             for _ in 0..BATCH {
-                match sub.receive() {
-                    Ok(Some(s)) => frames.push((*writer, Payload::from_owner(Arc::new(s)))),
+                match inlet.subscriber.receive() {
+                    Ok(Some(s)) => {
+                        if let Some(h) = decode_header(&s) {
+                            highest[i] = highest[i].max(h.sequence.0);
+                        }
+                        frames.push((inlet.writer, Payload::from_owner(Arc::new(s))));
+                    }
                     Ok(None) => break,
                     Err(e) => {
-                        tracing::warn!(?writer, error = %e, "shared-memory receive failed");
+                        tracing::warn!(writer = ?inlet.writer, error = %e, "shared-memory receive failed");
                         break;
                     }
                 }
@@ -200,27 +338,53 @@ impl ShmLink {
         }
         let n = frames.len();
         if n > 0 {
-            // Still under the inlets lock: two threads draining keep the channels' order.
-            driver.with_core(|c, now| {
+            // Still under the inlets lock: two threads draining keep the channels' order. Our own
+            // changes are not sent from here (see `poll_loop`).
+            driver.with_core_from_shm(|c, now| {
                 for (writer, frame) in frames {
                     c.receive_shm(now, writer, frame);
                 }
             });
+            // They are in the readers' caches now.
+            for (inlet, sn) in inlets.channels.iter().zip(highest) {
+                if sn > 0 {
+                    self.acknowledge(inlet, sn);
+                }
+            }
         }
         n
     }
 
+    fn acknowledge(&self, inlet: &Inlet, sn: i64) {
+        let node = self.node.id();
+        let sent = inlet.acks.loan(8 + node.len()).and_then(|mut loan| {
+            encode_ack(sn, &node, &mut loan);
+            loan.send()
+        });
+        if let Err(e) = sent {
+            tracing::debug!(writer = ?inlet.writer, error = %e, "shared-memory acknowledgement not sent");
+        }
+    }
+
     fn resubscribe(&self, inlets: &mut Inlets, wanted: &[Guid]) {
-        inlets.subscribers.retain(|(w, _)| wanted.contains(w));
+        inlets.channels.retain(|i| wanted.contains(&i.writer));
         for w in wanted {
-            if inlets.subscribers.iter().any(|(g, _)| g == w) {
+            if inlets.channels.iter().any(|i| i.writer == *w) {
                 continue;
             }
-            match self
+            let name = shm_channel_name(w);
+            let opened = self
                 .node
-                .subscriber(&shm_channel_name(w), &ShmChannelConfig::default())
-            {
-                Ok(s) => inlets.subscribers.push((*w, s)),
+                .subscriber(&name, &ShmChannelConfig::default())
+                .and_then(|subscriber| {
+                    Ok(Inlet {
+                        writer: *w,
+                        subscriber,
+                        acks: self.node.publisher(&ack_channel(&name), &ack_config())?,
+                    })
+                });
+            match opened {
+                Ok(i) => inlets.channels.push(i),
                 Err(e) => tracing::warn!(writer = ?w, error = %e, "cannot read a writer's channel"),
             }
         }
@@ -235,27 +399,7 @@ impl ShmLink {
             }
         }
         lock(&self.outlets).clear();
-        lock(&self.inlets).subscribers.clear();
-    }
-}
-
-/// Waits (at most [`CONNECT_TIMEOUT`]) until a subscriber of every node in `nodes` is on the channel.
-fn wait_connected(publisher: &ShmPublisher, nodes: &[String]) {
-    let deadline = Instant::now() + CONNECT_TIMEOUT;
-    loop {
-        let subs = publisher.subscriber_nodes();
-        if nodes.iter().all(|n| subs.contains(n)) {
-            let _ = publisher.update_connections();
-            return;
-        }
-        if Instant::now() >= deadline {
-            tracing::warn!(
-                missing = nodes.iter().filter(|n| !subs.contains(n)).count(),
-                "shared-memory readers not connected in time: they miss what is sent before they connect"
-            );
-            return;
-        }
-        std::thread::sleep(Duration::from_micros(200));
+        lock(&self.inlets).channels.clear();
     }
 }
 
@@ -266,12 +410,19 @@ fn poll_loop(driver: Weak<Driver>) {
         let Some(d) = driver.upgrade() else {
             return;
         };
-        let n = match d.shm_link() {
-            Some(link) if !link.stopped.load(Ordering::Acquire) => link.drain(&d),
+        // The thread never waits to send (a peer's queue may be full while its own thread waits on
+        // ours): it only sends when no other thread is sending, changes held for connecting readers
+        // typically.
+        let (n, held) = match d.shm_link() {
+            Some(link) if !link.stopped.load(Ordering::Acquire) => {
+                let n = link.drain(&d);
+                link.try_flush();
+                (n, !lock(&link.pending).is_empty())
+            }
             _ => return,
         };
         drop(d);
-        if n > 0 {
+        if n > 0 || held {
             idle = Duration::from_micros(20);
             continue;
         }

@@ -73,21 +73,32 @@ pub struct ShmChange {
     pub nodes: Arc<[String]>,
     /// Whether the writer is reliable (a full reader queue is waited for, not skipped).
     pub reliable: bool,
+    /// Only an assertion of the writer's liveliness (`DataWriter::assert_liveliness`): no change.
+    pub liveliness: bool,
 }
 
 const MAGIC: [u8; 4] = *b"DSM1";
 const HAS_KEY_HASH: u8 = 1;
 const HAS_TIMESTAMP: u8 = 2;
 const HAS_TARGET: u8 = 4;
+const LIVELINESS: u8 = 8;
 
 /// A frame's header, decoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct ShmHeader {
-    pub(crate) sequence: SequenceNumber,
-    pub(crate) kind: ChangeKind,
-    pub(crate) key_hash: Option<[u8; 16]>,
-    pub(crate) source_timestamp: Option<Time>,
-    pub(crate) target: Option<Guid>,
+#[non_exhaustive]
+pub struct ShmHeader {
+    /// The change's sequence number (0 for a liveliness assertion).
+    pub sequence: SequenceNumber,
+    /// What it does to its instance.
+    pub kind: ChangeKind,
+    /// Its key hash, when the writer gave one.
+    pub key_hash: Option<[u8; 16]>,
+    /// The writer's timestamp, if any.
+    pub source_timestamp: Option<Time>,
+    /// `Some(reader)`: for that reader only.
+    pub target: Option<Guid>,
+    /// Only a liveliness assertion.
+    pub liveliness: bool,
 }
 
 impl ShmChange {
@@ -122,6 +133,9 @@ impl ShmChange {
             flags |= HAS_TARGET;
             h[40..56].copy_from_slice(&g.to_bytes());
         }
+        if self.liveliness {
+            flags |= LIVELINESS;
+        }
         h[5] = flags;
     }
 
@@ -134,7 +148,7 @@ impl ShmChange {
 }
 
 /// The header of `frame`; `None` for anything that is not one of our frames.
-pub(crate) fn decode_header(frame: &[u8]) -> Option<ShmHeader> {
+pub fn decode_header(frame: &[u8]) -> Option<ShmHeader> {
     let h = frame.get(..ShmChange::HEADER_LEN)?;
     if h[0..4] != MAGIC {
         return None;
@@ -153,6 +167,7 @@ pub(crate) fn decode_header(frame: &[u8]) -> Option<ShmHeader> {
             fraction: u32_at(36),
         }),
         target: (flags & HAS_TARGET != 0).then(|| Guid::from_bytes(arr16(40..56))),
+        liveliness: flags & LIVELINESS != 0,
     })
 }
 
@@ -197,6 +212,7 @@ mod tests {
             target: Some(target),
             nodes: Arc::from(Vec::new()),
             reliable: true,
+            liveliness: false,
         };
         let mut frame = vec![0xff; c.frame_len()];
         c.write_frame(&mut frame);
@@ -206,6 +222,7 @@ mod tests {
         assert_eq!(h.key_hash, Some([3; 16]));
         assert_eq!(h.source_timestamp, c.change.source_timestamp);
         assert_eq!(h.target, Some(target));
+        assert!(!h.liveliness);
         assert_eq!(&frame[ShmChange::HEADER_LEN..], &[0, 1, 0, 0, 9, 9]);
         assert!(decode_header(&frame[..10]).is_none());
         frame[0] = b'X';

@@ -8,7 +8,7 @@
 //! Both sides decide from the same discovery data (both participants' SPDP properties, both endpoints'
 //! SEDP QoS), so a pair is on shared memory on both sides or on neither. A pair keeps the wire when the
 //! writer's publisher has coherent access or the reader is reliable KEEP_ALL with `max_samples` (the same
-//! rule as intra-process pairs, [`pair_qualifies`]); service-internal and builtin endpoints keep it too.
+//! rule as intra-process pairs, [`pair_qualifies`]); builtin endpoints keep it too.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -50,7 +50,8 @@ impl Participant {
             Local::Writer(w) => (w, self.user_writers.contains(&w)),
             Local::Reader(r) => (r, self.user_readers.contains(&r)),
         };
-        if !ours || self.internal.contains(&id) || remote.entity_id.is_builtin() {
+        // Service-internal endpoints are ordinary ones to peers, so they qualify like user endpoints.
+        if !ours || remote.entity_id.is_builtin() {
             return false;
         }
         let Some(peer) = self.participants.get(&remote.prefix) else {
@@ -214,6 +215,7 @@ impl Participant {
                 target: Some(reader),
                 nodes: nodes.clone(),
                 reliable,
+                liveliness: false,
             });
         });
     }
@@ -239,7 +241,33 @@ impl Participant {
             target: None,
             nodes: nodes.clone(),
             reliable: *reliable,
+            liveliness: false,
         });
+    }
+
+    /// `DataWriter::assert_liveliness` of `writer`: its readers over shared memory are told through its
+    /// channel (on the wire it is a HEARTBEAT with the liveliness flag).
+    pub(super) fn assert_liveliness_shm(&mut self, writer: EntityId) {
+        let Some((nodes, reliable)) = self.shm.nodes.get(&writer) else {
+            return;
+        };
+        self.shm.out.push_back(ShmChange {
+            writer,
+            sequence: SequenceNumber(0),
+            change: WriteChange::alive(Payload::default()),
+            target: None,
+            nodes: nodes.clone(),
+            reliable: *reliable,
+            liveliness: true,
+        });
+    }
+
+    /// The shared-memory nodes (participants) of `writer`'s readers over shared memory.
+    pub fn shm_nodes(&self, writer: EntityId) -> Vec<String> {
+        self.shm
+            .nodes
+            .get(&writer)
+            .map_or(Vec::new(), |(n, _)| n.to_vec())
     }
 
     /// Whether `writer` has readers over shared memory.
@@ -289,6 +317,10 @@ impl Participant {
             tracing::debug!(?writer, len = frame.len(), "not a shared-memory frame");
             return;
         };
+        if h.liveliness {
+            self.writer_asserted(now, writer);
+            return;
+        }
         let payload = frame.slice(ShmChange::HEADER_LEN..frame.len());
         let own = self.config.guid_prefix;
         let mut any = false;

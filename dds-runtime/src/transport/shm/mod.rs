@@ -67,6 +67,11 @@ pub struct ShmChannelConfig {
     /// How long a send waits for a subscriber whose queue is full before that subscriber misses the
     /// sample (`None`: it waits as long as it takes).
     pub delivery_timeout: Option<Duration>,
+    /// Most publishers of one channel.
+    pub max_publishers: usize,
+    /// A full subscriber queue drops its oldest sample instead of making the publisher wait (for
+    /// messages where only the latest matters, such as cumulative acknowledgements).
+    pub latest_only: bool,
 }
 
 impl Default for ShmChannelConfig {
@@ -77,6 +82,8 @@ impl Default for ShmChannelConfig {
             max_loans: 4,
             max_subscribers: 16,
             delivery_timeout: None,
+            max_publishers: 2,
+            latest_only: false,
         }
     }
 }
@@ -163,10 +170,11 @@ impl ShmNode {
         self.node
             .service_builder(&name)
             .publish_subscribe::<[u8]>()
-            .enable_safe_overflow(false)
+            .enable_safe_overflow(c.latest_only)
             .subscriber_max_buffer_size(c.queue_depth)
             .subscriber_max_borrowed_samples(c.queue_depth)
             .max_subscribers(c.max_subscribers)
+            .max_publishers(c.max_publishers)
             .history_size(0)
             .open_or_create()
             .map_err(setup)
@@ -182,17 +190,7 @@ impl ShmNode {
             .max_loaned_samples(c.max_loans)
             .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered);
         let builder = match c.delivery_timeout {
-            Some(limit) => builder.set_backpressure_handler(move |info: &BackpressureInfo| {
-                if info.elapsed_time < limit {
-                    BackpressureAction::Retry
-                } else {
-                    tracing::warn!(
-                        ?limit,
-                        "shared-memory subscriber full too long: sample not delivered to it"
-                    );
-                    BackpressureAction::DiscardData
-                }
-            }),
+            Some(limit) => builder.set_backpressure_handler(give_up_after(limit)),
             None => builder,
         };
         let publisher = builder.create().map_err(setup)?;
@@ -211,6 +209,29 @@ impl ShmNode {
             .create()
             .map_err(setup)?;
         Ok(ShmSubscriber { subscriber })
+    }
+}
+
+/// A back-pressure handler that retries delivery to a full subscriber for `limit`, then skips it. It keeps
+/// its own clock: the time iceoryx2 reports can be unavailable (`Duration::MAX`), which would skip at once.
+fn give_up_after(limit: Duration) -> impl Fn(&BackpressureInfo) -> BackpressureAction + Send {
+    let since = std::sync::Mutex::new(std::time::Instant::now());
+    move |info: &BackpressureInfo| {
+        let mut since = since
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if info.retries == 0 {
+            *since = std::time::Instant::now();
+        }
+        if since.elapsed() < limit {
+            BackpressureAction::Retry
+        } else {
+            tracing::warn!(
+                ?limit,
+                "shared-memory subscriber full too long: it misses a sample"
+            );
+            BackpressureAction::DiscardData
+        }
     }
 }
 
