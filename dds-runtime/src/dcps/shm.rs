@@ -264,9 +264,9 @@ impl ShmLink {
             out.connected = Some(c.nodes.clone());
             out.waiting_since = None;
         }
-        let mut loan = out.publisher.loan(c.frame_len())?;
-        c.write_frame(&mut loan);
-        loan.send()?;
+        let mut header = [0u8; ShmChange::HEADER_LEN];
+        c.write_header(&mut header);
+        out.publisher.send_parts(&[&header, &c.change.payload])?;
         if !c.liveliness {
             for n in c.nodes.iter() {
                 let owed = out.owed.entry(n.clone()).or_insert((0, 0));

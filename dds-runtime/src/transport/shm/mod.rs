@@ -224,6 +224,11 @@ fn give_up_after(limit: Duration) -> impl Fn(&BackpressureInfo) -> BackpressureA
             *since = std::time::Instant::now();
         }
         if since.elapsed() < limit {
+            // iceoryx2 yields between retries (10 000 times before it sleeps): past the first few,
+            // sleep instead, so that a waiting writer leaves the processor to the reader it waits for.
+            if info.retries > 64 {
+                std::thread::sleep(Duration::from_micros(50));
+            }
             BackpressureAction::Retry
         } else {
             tracing::warn!(
@@ -269,6 +274,31 @@ impl ShmPublisher {
             CallbackProgression::Continue
         });
         nodes
+    }
+
+    /// Sends `parts`, one after the other, as one sample: each is copied once into a loaned buffer, which
+    /// is not zeroed first. How many subscribers got it.
+    pub fn send_parts(&self, parts: &[&[u8]]) -> Result<usize, ShmError> {
+        let len = parts.iter().map(|p| p.len()).sum();
+        let mut sample = self
+            .publisher
+            .loan_slice_uninit(len)
+            .map_err(|e| ShmError::Loan(format!("{e:?}")))?;
+        let mut at = 0;
+        for p in parts {
+            let dst = &mut sample.payload_mut()[at..at + p.len()];
+            // SAFETY: `dst` and `p` have the same length and do not overlap (`dst` is a loaned buffer);
+            // `MaybeUninit<u8>` has the layout of `u8`.
+            unsafe {
+                std::ptr::copy_nonoverlapping(p.as_ptr(), dst.as_mut_ptr().cast::<u8>(), p.len())
+            };
+            at += p.len();
+        }
+        // SAFETY: the loop above wrote all `len` bytes of the payload.
+        let sample = unsafe { sample.assume_init() };
+        sample
+            .send()
+            .map_err(|e| ShmError::Transfer(format!("{e:?}")))
     }
 
     /// Connects subscribers that appeared since the last send (sending does it too).
