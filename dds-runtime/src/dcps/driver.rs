@@ -344,16 +344,6 @@ impl Driver {
         self.run_core(f, false, true)
     }
 
-    /// [`with_core`](Self::with_core) for what arrived over shared memory: changes of our own writers it
-    /// queued are left for another thread to send (the shared-memory thread must never wait on a peer).
-    #[cfg(feature = "shm")]
-    pub(crate) fn with_core_from_shm<R>(
-        &self,
-        f: impl FnOnce(&mut Participant, Instant) -> R,
-    ) -> R {
-        self.run_core(f, true, false)
-    }
-
     fn run_core<R>(
         &self,
         f: impl FnOnce(&mut Participant, Instant) -> R,
@@ -658,12 +648,6 @@ impl Driver {
         true
     }
 
-    /// The participant's shared-memory link, when it has one.
-    #[cfg(feature = "shm")]
-    pub(crate) fn shm_link(&self) -> Option<&super::shm::ShmLink> {
-        self.shm.as_ref()
-    }
-
     /// `Err(AlreadyDeleted)` once the participant shut down.
     pub(crate) fn check_alive(&self) -> DdsResult<()> {
         if self.stopped.load(Ordering::Acquire) {
@@ -809,6 +793,21 @@ impl Driver {
         write(&self.endpoints).clear();
         self.has_observers.store(false, Ordering::Release);
         write(&self.observers).clear();
+    }
+}
+
+#[cfg(feature = "shm")]
+impl super::shm::ShmHost for Driver {
+    fn shm_link(&self) -> Option<&super::shm::ShmLink> {
+        self.shm.as_ref()
+    }
+
+    fn with_core_from_shm(&self, f: &mut dyn FnMut(&mut Participant, Instant)) {
+        self.run_core(f, true, false);
+    }
+
+    fn query_shm(&self, f: &mut dyn FnMut(&Participant)) {
+        f(&lock(&self.core));
     }
 }
 

@@ -21,7 +21,6 @@ use std::time::{Duration, Instant};
 
 use foldhash::{HashMap, HashMapExt};
 
-use super::driver::Driver;
 use super::sync::lock;
 use crate::rtps::shm::{
     decode_header, shm_channel_name, ShmChange, SHM_HOST_PROPERTY, SHM_NODE_PROPERTY,
@@ -42,6 +41,17 @@ const BATCH: usize = 8;
 
 /// Longest sleep of the polling thread when no frame arrives.
 const MAX_IDLE: Duration = Duration::from_millis(1);
+
+/// What the link needs of the participant's driver (which owns the link; the link does not know it).
+pub(crate) trait ShmHost: Send + Sync + 'static {
+    /// The driver's link.
+    fn shm_link(&self) -> Option<&ShmLink>;
+    /// Runs `f` on the core; changes of our own writers it queued are left for another thread to send
+    /// (the shared-memory thread must never wait on a peer).
+    fn with_core_from_shm(&self, f: &mut dyn FnMut(&mut Participant, Instant));
+    /// Runs `f` on the core for a query.
+    fn query_shm(&self, f: &mut dyn FnMut(&Participant));
+}
 
 /// One writer's channel, the set of nodes last seen connected to it, and its acknowledgements.
 struct Outlet {
@@ -148,7 +158,7 @@ impl ShmLink {
     }
 
     /// Starts the thread that reads the channels.
-    pub(crate) fn start(&self, driver: Weak<Driver>) -> std::io::Result<()> {
+    pub(crate) fn start<H: ShmHost>(&self, driver: Weak<H>) -> std::io::Result<()> {
         let h = std::thread::Builder::new()
             .name("dds-shm".into())
             .spawn(move || poll_loop(driver))?;
@@ -306,12 +316,13 @@ impl ShmLink {
 
     /// Reads what arrived on the channels our readers read and gives it to the core; how many frames.
     /// Also opens and closes channels as the core's pairs changed.
-    pub(crate) fn drain(&self, driver: &Driver) -> usize {
+    pub(crate) fn drain(&self, driver: &dyn ShmHost) -> usize {
         let mut inlets = lock(&self.inlets);
         let generation = self.generation.load(Ordering::Acquire);
         if generation != inlets.generation {
             inlets.generation = generation;
-            let wanted = driver.query_core(Participant::shm_subscriptions);
+            let mut wanted = Vec::new();
+            driver.query_shm(&mut |c| wanted = c.shm_subscriptions());
             self.resubscribe(&mut inlets, &wanted);
         }
         if inlets.channels.is_empty() {
@@ -340,8 +351,9 @@ impl ShmLink {
         if n > 0 {
             // Still under the inlets lock: two threads draining keep the channels' order. Our own
             // changes are not sent from here (see `poll_loop`).
-            driver.with_core_from_shm(|c, now| {
-                for (writer, frame) in frames {
+            let mut frames = Some(frames);
+            driver.with_core_from_shm(&mut |c, now| {
+                for (writer, frame) in frames.take().into_iter().flatten() {
                     c.receive_shm(now, writer, frame);
                 }
             });
@@ -404,7 +416,7 @@ impl ShmLink {
 }
 
 /// The polling thread: drains the channels, sleeping longer (up to [`MAX_IDLE`]) while nothing arrives.
-fn poll_loop(driver: Weak<Driver>) {
+fn poll_loop<H: ShmHost>(driver: Weak<H>) {
     let mut idle = Duration::from_micros(20);
     loop {
         let Some(d) = driver.upgrade() else {
@@ -415,7 +427,7 @@ fn poll_loop(driver: Weak<Driver>) {
         // typically.
         let (n, held) = match d.shm_link() {
             Some(link) if !link.stopped.load(Ordering::Acquire) => {
-                let n = link.drain(&d);
+                let n = link.drain(&*d);
                 link.try_flush();
                 (n, !lock(&link.pending).is_empty())
             }
