@@ -20,6 +20,9 @@ fn config(size: usize) -> ShmChannelConfig {
         queue_depth: 8,
         max_loans: 2,
         max_subscribers: 2,
+        delivery_timeout: None,
+        max_publishers: 2,
+        latest_only: false,
     }
 }
 

@@ -17,6 +17,9 @@ fn config() -> ShmChannelConfig {
         queue_depth: 8,
         max_loans: 4,
         max_subscribers: 4,
+        delivery_timeout: None,
+        max_publishers: 2,
+        latest_only: false,
     }
 }
 

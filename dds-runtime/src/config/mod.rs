@@ -19,6 +19,7 @@
 //! | `DDS_MAX_MESSAGE_SIZE` | largest RTPS message (datagram) we send | bytes, `512`..=`65500` | `14720` |
 //! | `DDS_SOCKET_BUFFER_SIZE` | requested SO_RCVBUF / SO_SNDBUF | bytes | `4194304` |
 //! | `DDS_INTRA_PROCESS` | deliver to readers of the same participant directly (no serialization for them, no socket) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
+//! | `DDS_SHM` | with the `shm` feature: shared memory with peers on this host (their readers get our writers' samples through it, not UDP) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_WRITE_BATCH` | write batching: samples share datagrams until full, flushed, or this delay has passed | `off`, `on` (1 ms), or a delay in microseconds | `off` |
 //!
 //! Invalid values are reported as [`ConfigError`] rather than silently ignored.
@@ -333,6 +334,10 @@ pub struct Config {
     /// Intra-process delivery: a writer gives its samples to readers of the same participant directly,
     /// with no serialization for the reader and no socket (`DDS_INTRA_PROCESS`, default on).
     pub intra_process: bool,
+    /// Shared memory with peers on this host that can use it (`DDS_SHM`, default on; only with the `shm`
+    /// feature, ignored without it): their readers get our writers' samples through shared memory, not
+    /// UDP. Off, the participant does not announce it, and its peers use UDP with it.
+    pub shm: bool,
 }
 
 impl Default for Config {
@@ -353,6 +358,7 @@ impl Default for Config {
             socket_buffer_size: 4 << 20,
             write_batch_delay: None,
             intra_process: true,
+            shm: true,
         }
     }
 }
@@ -462,6 +468,9 @@ impl Config {
         }
         if let Some(v) = lookup("DDS_INTRA_PROCESS") {
             c.intra_process = parse_bool("DDS_INTRA_PROCESS", &v)?;
+        }
+        if let Some(v) = lookup("DDS_SHM") {
+            c.shm = parse_bool("DDS_SHM", &v)?;
         }
         if let Some(v) = lookup("DDS_WRITE_BATCH") {
             c.write_batch_delay = parse_batch_delay(&v)?;

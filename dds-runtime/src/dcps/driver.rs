@@ -106,6 +106,9 @@ pub(crate) struct Driver {
     has_observers: AtomicBool,
     /// Told of every remote publication and subscription discovered (topics, INCONSISTENT_TOPIC).
     discovery_hook: OnceLock<DiscoveryHook>,
+    /// Shared-memory channels with peers on this host (`None`: off, or not available).
+    #[cfg(feature = "shm")]
+    shm: Option<super::shm::ShmLink>,
 }
 
 thread_local! {
@@ -171,6 +174,7 @@ fn core_config(
     prefix: GuidPrefix,
     user_data: Vec<u8>,
     name: Option<String>,
+    extra_properties: Vec<(String, String)>,
 ) -> DdsResult<ParticipantConfig> {
     // IPv6: the builder's IPv4 locators are all replaced below.
     let ip = match transport.interface().addr {
@@ -218,7 +222,12 @@ fn core_config(
     .write_batch_delay(config.write_batch_delay)
     .intra_process(config.intra_process)
     .user_data(user_data)
-    .properties(super::process_info::properties())
+    .properties(
+        super::process_info::properties()
+            .into_iter()
+            .chain(extra_properties)
+            .collect::<Vec<_>>(),
+    )
     .entity_name(name)
     .build();
     Ok(pc)
@@ -234,7 +243,16 @@ impl Driver {
     ) -> DdsResult<Arc<Driver>> {
         let transport = UdpTransport::bind(&config)?;
         let prefix = new_guid_prefix();
-        let pc = core_config(&config, &transport, prefix, user_data, name)?;
+        #[cfg(feature = "shm")]
+        let (shm, shm_properties) = match config.shm {
+            true => {
+                super::shm::ShmLink::new(prefix).map_or((None, Vec::new()), |(l, p)| (Some(l), p))
+            }
+            false => (None, Vec::new()),
+        };
+        #[cfg(not(feature = "shm"))]
+        let shm_properties = Vec::new();
+        let pc = core_config(&config, &transport, prefix, user_data, name, shm_properties)?;
         let mut core = Participant::new(pc, Instant::now());
         if !enabled {
             // Created disabled: nothing is sent, not even the first SPDP announcement, until `enable`.
@@ -261,6 +279,8 @@ impl Driver {
             observers: RwLock::new(Vec::new()),
             has_observers: AtomicBool::new(false),
             discovery_hook: OnceLock::new(),
+            #[cfg(feature = "shm")]
+            shm,
         });
         let weak: Weak<Driver> = Arc::downgrade(&driver);
         let rx = Arc::new(move |_ch: Channel, batch: &[Datagram<'_>]| {
@@ -269,6 +289,10 @@ impl Driver {
             }
         });
         driver.transport.start(rx)?;
+        #[cfg(feature = "shm")]
+        if let Some(link) = &driver.shm {
+            link.start(Arc::downgrade(&driver))?;
+        }
         let d2 = driver.clone();
         let h = std::thread::Builder::new()
             .name("dds-timer".into())
@@ -284,6 +308,12 @@ impl Driver {
     fn receive(&self, batch: &[Datagram<'_>]) {
         if self.stopped.load(Ordering::Acquire) {
             return;
+        }
+        // What a peer sent over shared memory before this datagram is taken first (a writer's last samples
+        // before the announcement of its deletion, typically).
+        #[cfg(feature = "shm")]
+        if let Some(link) = &self.shm {
+            link.drain(self);
         }
         // A datagram with DATA is copied once out of the reusable receive buffers, and its samples share
         // the copy; fragments are copied straight into their reassembly buffers.
@@ -303,7 +333,7 @@ impl Driver {
 
     /// Runs `f` on the core, then (lock released) sends what it queued and dispatches its events.
     pub(crate) fn with_core<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R) -> R {
-        self.run_core(f, true)
+        self.run_core(f, true, true)
     }
 
     /// [`with_core`](Self::with_core) for a write: it does not count as progress. A write never gives room
@@ -311,10 +341,15 @@ impl Driver {
     /// its own attempt progress, it would retry at once, spinning (at 64 KiB this was a fifth of the
     /// publisher's CPU, taken from the subscriber on a two-core machine).
     pub(crate) fn with_core_writing<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R) -> R {
-        self.run_core(f, false)
+        self.run_core(f, false, true)
     }
 
-    fn run_core<R>(&self, f: impl FnOnce(&mut Participant, Instant) -> R, progress: bool) -> R {
+    fn run_core<R>(
+        &self,
+        f: impl FnOnce(&mut Participant, Instant) -> R,
+        progress: bool,
+        send_shm: bool,
+    ) -> R {
         let now = Instant::now();
         // The batch vector is kept per thread (a nested call, from a listener, gets a fresh one).
         let mut batch: Vec<Transmit> = BATCH.with(|b| std::mem::take(&mut *b.borrow_mut()));
@@ -332,8 +367,20 @@ impl Driver {
             while let Some(ev) = core.poll_event() {
                 self.route_locked(ev, &mut deferred, &mut touched);
             }
+            #[cfg(feature = "shm")]
+            if let Some(link) = &self.shm {
+                link.take_from(&mut core);
+            }
             (r, core.poll_timeout())
         };
+        // Shared memory first: what a writer sent there precedes what follows it on the wire (the
+        // announcement of its deletion after its last changes, typically).
+        #[cfg(feature = "shm")]
+        if let (Some(link), true) = (&self.shm, send_shm) {
+            link.flush();
+        }
+        #[cfg(not(feature = "shm"))]
+        let _ = send_shm;
         self.send_batch(&batch);
         {
             let mut spare = lock(&self.spare_buffers);
@@ -578,7 +625,27 @@ impl Driver {
                 c.delete_reader(now, id);
             }
         });
+        #[cfg(feature = "shm")]
+        if let (Some(link), true) = (&self.shm, id.is_writer()) {
+            link.close_writer(id);
+        }
         tracing::debug!(?id, "endpoint deleted");
+    }
+
+    /// Whether every reliable reader of `writer` acknowledged all it wrote: on the wire, and on shared
+    /// memory.
+    pub(crate) fn is_acknowledged(&self, writer: EntityId) -> bool {
+        self.with_core(|c, _| c.is_acknowledged(writer)) && self.shm_acknowledged(writer)
+    }
+
+    /// Whether the readers of `writer` on shared memory acknowledged all it sent them.
+    fn shm_acknowledged(&self, _writer: EntityId) -> bool {
+        #[cfg(feature = "shm")]
+        if let Some(link) = &self.shm {
+            let nodes = self.query_core(|c| c.shm_nodes(_writer));
+            return link.acknowledged(_writer, &nodes);
+        }
+        true
     }
 
     /// `Err(AlreadyDeleted)` once the participant shut down.
@@ -620,9 +687,7 @@ impl Driver {
     pub(crate) fn wait_acknowledged(&self, writer: EntityId, timeout: Duration) -> DdsResult<()> {
         self.check_alive()?;
         let deadline = Instant::now().checked_add(timeout);
-        if self.wait_progress(deadline, || {
-            self.with_core(|c, _| c.is_acknowledged(writer))
-        }) {
+        if self.wait_progress(deadline, || self.is_acknowledged(writer)) {
             Ok(())
         } else {
             self.check_alive()?;
@@ -720,10 +785,29 @@ impl Driver {
             }
         }
         self.transport.shutdown();
+        #[cfg(feature = "shm")]
+        if let Some(link) = &self.shm {
+            link.shutdown();
+        }
         // Readers, writers and observers point back at us: forget them to break the cycle.
         write(&self.endpoints).clear();
         self.has_observers.store(false, Ordering::Release);
         write(&self.observers).clear();
+    }
+}
+
+#[cfg(feature = "shm")]
+impl super::shm::ShmHost for Driver {
+    fn shm_link(&self) -> Option<&super::shm::ShmLink> {
+        self.shm.as_ref()
+    }
+
+    fn with_core_from_shm(&self, f: &mut dyn FnMut(&mut Participant, Instant)) {
+        self.run_core(f, true, false);
+    }
+
+    fn query_shm(&self, f: &mut dyn FnMut(&Participant)) {
+        f(&lock(&self.core));
     }
 }
 

@@ -49,6 +49,8 @@ mod process_info;
 mod publisher;
 mod registry;
 pub mod sample;
+#[cfg(feature = "shm")]
+mod shm;
 pub mod status;
 mod subscriber;
 mod sync;

@@ -9,19 +9,12 @@ pub(crate) const PID: &str = "__Pid";
 pub(crate) const PROCESS_NAME: &str = "__ProcessName";
 
 /// `(name, value)` of the three properties for this process.
-/// With the `shm` feature, also the host identity that tells peers they can use shared memory.
 pub(crate) fn properties() -> Vec<(String, String)> {
-    #[allow(unused_mut)]
-    let mut p = vec![
+    vec![
         (HOSTNAME.to_owned(), hostname()),
         (PID.to_owned(), std::process::id().to_string()),
         (PROCESS_NAME.to_owned(), process_name()),
-    ];
-    #[cfg(feature = "shm")]
-    if let Some(h) = crate::transport::shm::host_id() {
-        p.push((crate::transport::shm::SHM_HOST_PROPERTY.to_owned(), h));
-    }
-    p
+    ]
 }
 
 fn process_name() -> String {

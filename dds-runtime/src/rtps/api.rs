@@ -19,11 +19,13 @@ pub struct Payload {
     end: usize,
 }
 
-/// A payload's storage: a buffer of its own, or a reusable one of a pool (`rtps/pool.rs`).
+/// A payload's storage: a buffer of its own, a reusable one of a pool (`rtps/pool.rs`), or bytes some
+/// other owner keeps (a sample read in place in shared memory, released with the last clone).
 #[derive(Clone)]
 enum Buf {
     Slice(Arc<[u8]>),
     Vec(Arc<Vec<u8>>),
+    Owned(Arc<dyn AsRef<[u8]> + Send + Sync>),
 }
 
 impl Buf {
@@ -31,6 +33,7 @@ impl Buf {
         match self {
             Buf::Slice(b) => b,
             Buf::Vec(v) => v,
+            Buf::Owned(o) => (**o).as_ref(),
         }
     }
 }
@@ -51,6 +54,16 @@ impl Payload {
         let end = v.len();
         Payload {
             buf: Some(Buf::Vec(v)),
+            start: 0,
+            end,
+        }
+    }
+    /// Shares the bytes `owner` keeps, with no copy; they are released when the last clone is dropped.
+    /// The bytes must not change while the payload lives.
+    pub fn from_owner(owner: Arc<dyn AsRef<[u8]> + Send + Sync>) -> Self {
+        let end = (*owner).as_ref().len();
+        Payload {
+            buf: Some(Buf::Owned(owner)),
             start: 0,
             end,
         }

@@ -12,6 +12,7 @@ mod outbox;
 mod participant;
 pub(crate) mod pool;
 pub(crate) mod reader;
+pub mod shm;
 pub mod types;
 pub(crate) mod writer;
 

@@ -13,6 +13,7 @@ mod internal;
 mod liveliness;
 mod local;
 mod receive;
+mod shm;
 mod timers;
 mod topics;
 mod type_lookup;
@@ -91,6 +92,8 @@ pub struct Participant {
     type_lookup: type_lookup::TypeLookupService,
     /// Pairs of our own endpoints matched for intra-process delivery.
     local: local::LocalMatches,
+    /// Pairs of our endpoints and peers' matched over shared memory.
+    shm: shm::ShmMatches,
     /// Group coherent sets waiting for the parts of all their writers.
     group_sets: group::GroupSets,
 }
@@ -189,6 +192,7 @@ impl Participant {
             ignored: control::Ignored::new(),
             type_lookup: type_lookup::TypeLookupService::new(config.guid_prefix),
             local: Default::default(),
+            shm: Default::default(),
             group_sets: group::GroupSets::default(),
             config,
         };
@@ -435,6 +439,7 @@ impl Participant {
             Vec::new(),
         );
         self.forget_endpoint::<ReaderQos>(guid);
+        self.forget_shm_endpoint(id);
         self.events.push_back(Event::ReaderDeleted { reader: id });
         self.service(now);
     }
@@ -460,6 +465,7 @@ impl Participant {
             Vec::new(),
         );
         self.forget_endpoint::<WriterQos>(guid);
+        self.forget_shm_endpoint(id);
         self.events.push_back(Event::WriterDeleted { writer: id });
     }
 
@@ -499,6 +505,7 @@ impl Participant {
             .into_iter()
             .flatten()
             .chain(local.map(|r| Guid::new(prefix, *r)))
+            .chain(self.shm_readers(writer).iter().copied())
             .collect()
     }
 
@@ -527,6 +534,7 @@ impl Participant {
             .into_iter()
             .flatten()
             .chain(local)
+            .chain(self.shm_writers_of(reader))
             .collect()
     }
 

@@ -282,7 +282,7 @@ impl Publisher {
         let ids: Vec<EntityId> = self.writers()?.into_iter().map(|w| w.id).collect();
         let driver = self.participant.driver();
         let deadline = Instant::now().checked_add(timeout);
-        let done = || driver.with_core(|c, _| ids.iter().all(|id| c.is_acknowledged(*id)));
+        let done = || ids.iter().all(|id| driver.is_acknowledged(*id));
         if driver.wait_progress(deadline, done) {
             Ok(())
         } else {

@@ -23,7 +23,8 @@ impl Participant {
     /// [`Participant::write`] of a change that the content filters of the `rejected` readers refused (as
     /// evaluated by the caller on the sample, see [`Participant::writer_reader_filters`]): the change goes
     /// to the other readers as DATA and to the rejecting reliable ones as GAP, now and on repair.
-    /// Readers of this participant matched for intra-process delivery get it as an event.
+    /// Readers of this participant matched for intra-process delivery get it as an event; readers of peers
+    /// matched over shared memory get it through the writer's channel (all of them: they filter it).
     pub fn write_filtered(
         &mut self,
         now: Instant,
@@ -31,11 +32,15 @@ impl Participant {
         change: WriteChange,
         rejected: Vec<Guid>,
     ) -> Result<SequenceNumber, WriteError> {
-        if self.local_readers(writer).is_empty() {
+        let shm = self.has_shm_readers(writer);
+        if self.local_readers(writer).is_empty() && !shm {
             return self.write_wire(now, writer, change, rejected);
         }
         let (local, local_rejected) = (change.clone(), rejected.clone());
         let sn = self.write_wire(now, writer, change, rejected)?;
+        if shm {
+            self.deliver_shm(writer, sn, &local);
+        }
         self.deliver_local(now, writer, sn, local, &local_rejected);
         Ok(sn)
     }

@@ -81,5 +81,6 @@ impl Participant {
         if let Some(w) = self.writers.get_mut(&writer) {
             w.send_liveliness(&mut self.out);
         }
+        self.assert_liveliness_shm(writer);
     }
 }

@@ -15,6 +15,7 @@ use super::discovery::Local;
 use super::Participant;
 use crate::qos::{Durability, History, Reliability};
 use crate::rtps::api::{Event, ReceivedSample, WriteChange};
+use crate::rtps::discovery::{ReaderData, WriterData};
 use crate::rtps::types::{EntityId, Guid, GuidPrefix, SequenceNumber};
 
 /// The local pairs matched for intra-process delivery. Each side records its own match, as each side of a
@@ -54,6 +55,18 @@ impl LocalMatches {
     }
 }
 
+/// Whether a writer and a reader may be matched without wire state (intra-process or over shared memory):
+/// not when the writer's publisher has coherent access (coherent sets are assembled by the RTPS reader),
+/// nor when the reader is reliable KEEP_ALL with `max_samples` (its back-pressure is the RTPS reader's
+/// delivery credit).
+pub(super) fn pair_qualifies(wd: &WriterData, rd: &ReaderData) -> bool {
+    let rq = &rd.qos.reader;
+    let credit = matches!(rq.reliability, Reliability::Reliable { .. })
+        && matches!(rq.history, History::KeepAll)
+        && rq.resource_limits.max_samples.is_some();
+    !wd.qos.presentation.coherent_access && !credit
+}
+
 /// The (writer, reader) entity ids of `local` and `remote`, when `remote` is an endpoint of this participant.
 fn pair(own: GuidPrefix, local: Local, remote: Guid) -> Option<(EntityId, EntityId)> {
     if remote.prefix != own {
@@ -71,9 +84,12 @@ impl Participant {
     }
 
     /// Whether `local` and `remote` are matched for intra-process delivery.
+    /// (Or, with a peer's endpoint, over shared memory: see `shm.rs`.)
     pub(super) fn has_local_match(&self, local: Local, remote: Guid) -> bool {
-        pair(self.config.guid_prefix, local, remote)
-            .is_some_and(|(w, r)| self.local.has(local, w, r))
+        match pair(self.config.guid_prefix, local, remote) {
+            Some((w, r)) => self.local.has(local, w, r),
+            None => self.has_shm_match(local, remote),
+        }
     }
 
     /// Whether this pair of user endpoints of ours is delivered intra-process (see the module doc).
@@ -90,18 +106,15 @@ impl Participant {
         ) else {
             return false;
         };
-        let rq = &rd.qos.reader;
-        let credit = matches!(rq.reliability, Reliability::Reliable { .. })
-            && matches!(rq.history, History::KeepAll)
-            && rq.resource_limits.max_samples.is_some();
-        !wd.qos.presentation.coherent_access && !credit
+        pair_qualifies(wd, rd)
     }
 
     /// Matches `local` with `remote` for intra-process delivery when both are ours and the pair qualifies;
-    /// a durable reader of a durable writer gets the writer's history at once. False: use a proxy.
+    /// a durable reader of a durable writer gets the writer's history at once. A peer's endpoint may match
+    /// over shared memory instead (`shm.rs`). False: use a proxy.
     pub(super) fn add_local_match(&mut self, now: Instant, local: Local, remote: Guid) -> bool {
         let Some((w, r)) = pair(self.config.guid_prefix, local, remote) else {
-            return false;
+            return self.add_shm_match(now, local, remote);
         };
         if !self.delivers_locally(w, r) {
             return false;
@@ -128,10 +141,10 @@ impl Participant {
         true
     }
 
-    /// Unmatches an intra-process pair; whether it was one.
+    /// Unmatches an intra-process (or shared-memory) pair; whether it was one.
     pub(super) fn remove_local_match(&mut self, local: Local, remote: Guid) -> bool {
         let Some((w, r)) = pair(self.config.guid_prefix, local, remote) else {
-            return false;
+            return self.remove_shm_match(local, remote);
         };
         if !self.local.remove(local, w, r) {
             return false;

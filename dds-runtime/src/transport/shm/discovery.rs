@@ -2,8 +2,7 @@
 //! identity in SPDP (`PID_PROPERTY_LIST`, property [`SHM_HOST_PROPERTY`]); a peer that announced the same
 //! identity runs on this host, with this feature. Every other peer is reached over UDP.
 
-/// The SPDP property holding the announcing host's identity (its kernel boot id).
-pub const SHM_HOST_PROPERTY: &str = "dds.shm.host";
+pub use crate::rtps::shm::SHM_HOST_PROPERTY;
 
 /// This host's identity for shared memory: the kernel's boot id (the same in every network namespace of
 /// one boot of one machine); `None` where the kernel does not provide it.

@@ -11,21 +11,26 @@
 //! releases what it held. Nothing a dead process wrote half-way is ever delivered: only sent samples reach
 //! subscribers.
 //!
-//! Discovery says which peers can use it ([`peer_can_use_shm`]: same host, same feature). Not wired into
-//! the DCPS writers and readers yet (see `docs/performance.md`, "Shared memory").
+//! Discovery says which peers can use it ([`peer_can_use_shm`]: same host, same feature). DCPS uses one
+//! channel per writer ([`crate::rtps::shm`] for the frames and the pairs, `dcps::shm` for the wiring; see
+//! `docs/performance.md`, "Shared memory").
 //!
 //! [iceoryx2]: https://docs.rs/iceoryx2
 
 mod discovery;
 
 use std::ops::{Deref, DerefMut};
+use std::time::Duration;
 
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::port::{BackpressureAction, BackpressureInfo};
 use iceoryx2::prelude::*;
 use iceoryx2::sample::Sample;
 use iceoryx2::sample_mut::SampleMut;
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
+use iceoryx2::service::port_factory::PortFactory as _;
 
 pub use discovery::{host_id, peer_can_use_shm, SHM_HOST_PROPERTY};
 
@@ -59,6 +64,14 @@ pub struct ShmChannelConfig {
     pub max_loans: usize,
     /// Most subscribers (readers on other processes) of one channel.
     pub max_subscribers: usize,
+    /// How long a send waits for a subscriber whose queue is full before that subscriber misses the
+    /// sample (`None`: it waits as long as it takes).
+    pub delivery_timeout: Option<Duration>,
+    /// Most publishers of one channel.
+    pub max_publishers: usize,
+    /// A full subscriber queue drops its oldest sample instead of making the publisher wait (for
+    /// messages where only the latest matters, such as cumulative acknowledgements).
+    pub latest_only: bool,
 }
 
 impl Default for ShmChannelConfig {
@@ -68,14 +81,20 @@ impl Default for ShmChannelConfig {
             queue_depth: 16,
             max_loans: 4,
             max_subscribers: 16,
+            delivery_timeout: None,
+            max_publishers: 2,
+            latest_only: false,
         }
     }
 }
 
 /// One process's (or participant's) presence in shared memory: channels are opened through it.
 pub struct ShmNode {
-    node: Node<ipc::Service>,
+    node: Node<ipc_threadsafe::Service>,
 }
+
+/// A channel's service.
+type Service = PortFactory<ipc_threadsafe::Service, [u8], ()>;
 
 impl std::fmt::Debug for ShmNode {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -87,7 +106,7 @@ impl std::fmt::Debug for ShmNode {
 /// they held); returns how many dead nodes were removed.
 pub fn remove_dead_nodes() -> usize {
     let mut dead = Vec::new();
-    let listed = Node::<ipc::Service>::list(Config::global_config(), |state| {
+    let listed = Node::<ipc_threadsafe::Service>::list(Config::global_config(), |state| {
         if let NodeState::Dead(view) = state {
             dead.push(view);
         }
@@ -107,6 +126,26 @@ pub fn remove_dead_nodes() -> usize {
         .count()
 }
 
+/// Whether the node `id` ([`ShmNode::id`]) is still listed in shared memory, alive or dead (false once a
+/// dead node's resources were removed).
+pub fn node_listed(id: &str) -> bool {
+    use iceoryx2::node::NodeView;
+    let mut found = false;
+    let listed = Node::<ipc_threadsafe::Service>::list(Config::global_config(), |state| {
+        let nid = match &state {
+            NodeState::Alive(v) => *v.id(),
+            NodeState::Dead(v) => *v.id(),
+            NodeState::Inaccessible(n) | NodeState::Undefined(n) => *n,
+        };
+        found |= nid.to_string() == id;
+        CallbackProgression::Continue
+    });
+    if let Err(e) = listed {
+        tracing::warn!(error = ?e, "cannot list shared-memory nodes");
+    }
+    found
+}
+
 impl ShmNode {
     /// Creates this process's node (removing dead nodes first).
     pub fn new() -> Result<Self, ShmError> {
@@ -116,27 +155,26 @@ impl ShmNode {
         }
         let node = NodeBuilder::new()
             .signal_handling_mode(SignalHandlingMode::Disabled)
-            .create::<ipc::Service>()
+            .create::<ipc_threadsafe::Service>()
             .map_err(setup)?;
         Ok(ShmNode { node })
     }
 
-    fn service(
-        &self,
-        channel: &str,
-        c: &ShmChannelConfig,
-    ) -> Result<
-        iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, [u8], ()>,
-        ShmError,
-    > {
+    /// This node's identity (hexadecimal), as [`ShmPublisher::subscriber_nodes`] gives it.
+    pub fn id(&self) -> String {
+        self.node.id().to_string()
+    }
+
+    fn service(&self, channel: &str, c: &ShmChannelConfig) -> Result<Service, ShmError> {
         let name: ServiceName = channel.try_into().map_err(setup)?;
         self.node
             .service_builder(&name)
             .publish_subscribe::<[u8]>()
-            .enable_safe_overflow(false)
+            .enable_safe_overflow(c.latest_only)
             .subscriber_max_buffer_size(c.queue_depth)
             .subscriber_max_borrowed_samples(c.queue_depth)
             .max_subscribers(c.max_subscribers)
+            .max_publishers(c.max_publishers)
             .history_size(0)
             .open_or_create()
             .map_err(setup)
@@ -144,16 +182,19 @@ impl ShmNode {
 
     /// A publisher on `channel`.
     pub fn publisher(&self, channel: &str, c: &ShmChannelConfig) -> Result<ShmPublisher, ShmError> {
-        let publisher = self
-            .service(channel, c)?
+        let service = self.service(channel, c)?;
+        let builder = service
             .publisher_builder()
             .initial_max_slice_len(c.initial_max_sample)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
             .max_loaned_samples(c.max_loans)
-            .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
-            .create()
-            .map_err(setup)?;
-        Ok(ShmPublisher { publisher })
+            .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered);
+        let builder = match c.delivery_timeout {
+            Some(limit) => builder.set_backpressure_handler(give_up_after(limit)),
+            None => builder,
+        };
+        let publisher = builder.create().map_err(setup)?;
+        Ok(ShmPublisher { publisher, service })
     }
 
     /// A subscriber on `channel`.
@@ -171,9 +212,38 @@ impl ShmNode {
     }
 }
 
+/// A back-pressure handler that retries delivery to a full subscriber for `limit`, then skips it. It keeps
+/// its own clock: the time iceoryx2 reports can be unavailable (`Duration::MAX`), which would skip at once.
+fn give_up_after(limit: Duration) -> impl Fn(&BackpressureInfo) -> BackpressureAction + Send {
+    let since = std::sync::Mutex::new(std::time::Instant::now());
+    move |info: &BackpressureInfo| {
+        let mut since = since
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if info.retries == 0 {
+            *since = std::time::Instant::now();
+        }
+        if since.elapsed() < limit {
+            // iceoryx2 yields between retries (10 000 times before it sleeps): past the first few,
+            // sleep instead, so that a waiting writer leaves the processor to the reader it waits for.
+            if info.retries > 64 {
+                std::thread::sleep(Duration::from_micros(50));
+            }
+            BackpressureAction::Retry
+        } else {
+            tracing::warn!(
+                ?limit,
+                "shared-memory subscriber full too long: it misses a sample"
+            );
+            BackpressureAction::DiscardData
+        }
+    }
+}
+
 /// Sends samples on one channel.
 pub struct ShmPublisher {
-    publisher: Publisher<ipc::Service, [u8], ()>,
+    publisher: Publisher<ipc_threadsafe::Service, [u8], ()>,
+    service: Service,
 }
 
 impl std::fmt::Debug for ShmPublisher {
@@ -196,6 +266,41 @@ impl ShmPublisher {
         })
     }
 
+    /// The nodes ([`ShmNode::id`]) of the channel's subscribers.
+    pub fn subscriber_nodes(&self) -> Vec<String> {
+        let mut nodes = Vec::new();
+        self.service.dynamic_config().list_subscribers(|d| {
+            nodes.push(d.node_id.to_string());
+            CallbackProgression::Continue
+        });
+        nodes
+    }
+
+    /// Sends `parts`, one after the other, as one sample: each is copied once into a loaned buffer, which
+    /// is not zeroed first. How many subscribers got it.
+    pub fn send_parts(&self, parts: &[&[u8]]) -> Result<usize, ShmError> {
+        let len = parts.iter().map(|p| p.len()).sum();
+        let mut sample = self
+            .publisher
+            .loan_slice_uninit(len)
+            .map_err(|e| ShmError::Loan(format!("{e:?}")))?;
+        let mut at = 0;
+        for p in parts {
+            let dst = &mut sample.payload_mut()[at..at + p.len()];
+            // SAFETY: `dst` and `p` have the same length and do not overlap (`dst` is a loaned buffer);
+            // `MaybeUninit<u8>` has the layout of `u8`.
+            unsafe {
+                std::ptr::copy_nonoverlapping(p.as_ptr(), dst.as_mut_ptr().cast::<u8>(), p.len())
+            };
+            at += p.len();
+        }
+        // SAFETY: the loop above wrote all `len` bytes of the payload.
+        let sample = unsafe { sample.assume_init() };
+        sample
+            .send()
+            .map_err(|e| ShmError::Transfer(format!("{e:?}")))
+    }
+
     /// Connects subscribers that appeared since the last send (sending does it too).
     pub fn update_connections(&self) -> Result<(), ShmError> {
         self.publisher
@@ -206,7 +311,7 @@ impl ShmPublisher {
 
 /// A buffer loaned from a publisher's segment, written in place.
 pub struct ShmLoan<'a> {
-    sample: SampleMut<ipc::Service, [u8], ()>,
+    sample: SampleMut<ipc_threadsafe::Service, [u8], ()>,
     _publisher: std::marker::PhantomData<&'a ShmPublisher>,
 }
 
@@ -234,7 +339,7 @@ impl DerefMut for ShmLoan<'_> {
 
 /// Receives samples on one channel.
 pub struct ShmSubscriber {
-    subscriber: Subscriber<ipc::Service, [u8], ()>,
+    subscriber: Subscriber<ipc_threadsafe::Service, [u8], ()>,
 }
 
 impl std::fmt::Debug for ShmSubscriber {
@@ -255,7 +360,7 @@ impl ShmSubscriber {
 
 /// A received sample, read in place in the publisher's shared memory; released when dropped.
 pub struct ShmSample {
-    sample: Sample<ipc::Service, [u8], ()>,
+    sample: Sample<ipc_threadsafe::Service, [u8], ()>,
 }
 
 impl Deref for ShmSample {
@@ -264,6 +369,18 @@ impl Deref for ShmSample {
         self.sample.payload()
     }
 }
+
+impl AsRef<[u8]> for ShmSample {
+    fn as_ref(&self) -> &[u8] {
+        self
+    }
+}
+
+// SAFETY: through `&ShmSample` only `Sample::payload` is reached (`Deref`, `AsRef`), which reads the sent
+// chunk: shared memory that nobody writes while the sample is held (a publisher only writes loaned chunks,
+// and a sent chunk is not loaned again before every holder released it). Releasing it (`Drop`) takes the
+// sample by value, so it happens once, on one thread. `Sample` is already `Send` for this service type.
+unsafe impl Sync for ShmSample {}
 
 impl std::fmt::Debug for ShmSample {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

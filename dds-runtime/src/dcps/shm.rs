@@ -1,0 +1,444 @@
+//! The participant's shared-memory link (feature `shm`): the I/O side of the core's shared-memory pairs
+//! (`rtps::shm`). One channel per writer: the driver sends each change the core queued for it
+//! ([`Participant::poll_shm`]) as one frame written into a loaned buffer, and reads the channels of the
+//! peers' writers its readers are matched with, giving each frame to the core in place
+//! ([`Participant::receive_shm`]).
+//!
+//! What holds for a pair on shared memory: every change the writer sent reaches the reader's participant,
+//! in order, unless that participant's queue stays full longer than [`DELIVERY_TIMEOUT`] (reliable
+//! writers; best-effort writers drop at once for a full queue), or its subscriber is not connected within
+//! [`CONNECT_TIMEOUT`] of the first change for it (changes wait for it meanwhile, in order). Nothing is
+//! repaired afterwards: iceoryx2's delivery replaces RTPS repair for these pairs. Acknowledgements: once
+//! a reader's participant has put a writer's changes into its readers' caches it says so on the writer's
+//! acknowledgement channel (cumulative sequence numbers, latest only), which `wait_for_acknowledgments`
+//! waits for like RTPS ACKNACKs.
+
+use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, Weak};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use foldhash::{HashMap, HashMapExt};
+
+use super::sync::lock;
+use crate::rtps::shm::{
+    decode_header, shm_channel_name, ShmChange, SHM_HOST_PROPERTY, SHM_NODE_PROPERTY,
+};
+use crate::rtps::{EntityId, Guid, GuidPrefix, Participant, Payload};
+use crate::transport::shm::{
+    host_id, ShmChannelConfig, ShmError, ShmNode, ShmPublisher, ShmSubscriber,
+};
+
+/// How long a writer's changes wait for the subscribers of its readers' participants to connect.
+pub(crate) const CONNECT_TIMEOUT: Duration = Duration::from_secs(2);
+
+/// How long a reliable writer's send waits for a subscriber whose queue is full.
+pub(crate) const DELIVERY_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Frames taken from one channel per pass (they stay borrowed until their readers decoded them).
+const BATCH: usize = 8;
+
+/// Longest sleep of the polling thread when no frame arrives.
+const MAX_IDLE: Duration = Duration::from_millis(1);
+
+/// What the link needs of the participant's driver (which owns the link; the link does not know it).
+pub(crate) trait ShmHost: Send + Sync + 'static {
+    /// The driver's link.
+    fn shm_link(&self) -> Option<&ShmLink>;
+    /// Runs `f` on the core; changes of our own writers it queued are left for another thread to send
+    /// (the shared-memory thread must never wait on a peer).
+    fn with_core_from_shm(&self, f: &mut dyn FnMut(&mut Participant, Instant));
+    /// Runs `f` on the core for a query.
+    fn query_shm(&self, f: &mut dyn FnMut(&Participant));
+}
+
+/// One writer's channel, the set of nodes last seen connected to it, and its acknowledgements.
+struct Outlet {
+    publisher: ShmPublisher,
+    connected: Option<Arc<[String]>>,
+    /// Since when a change waits for its nodes to connect.
+    waiting_since: Option<Instant>,
+    acks: ShmSubscriber,
+    /// By node: the highest sequence number sent while it was expected, and the highest it acknowledged.
+    owed: HashMap<String, (i64, i64)>,
+}
+
+/// One peer writer's channel that our readers read, and where we acknowledge what it sent.
+struct Inlet {
+    writer: Guid,
+    subscriber: ShmSubscriber,
+    acks: ShmPublisher,
+}
+
+/// The channels our readers read, and the core generation they were set up for.
+#[derive(Default)]
+struct Inlets {
+    generation: u64,
+    channels: Vec<Inlet>,
+}
+
+/// A participant's presence in shared memory.
+pub(crate) struct ShmLink {
+    node: ShmNode,
+    prefix: GuidPrefix,
+    /// Changes taken from the core (under its lock), in write order, to send.
+    pending: Mutex<VecDeque<ShmChange>>,
+    /// The writers' channels; held while sending, so that sends keep the order of `pending`.
+    outlets: Mutex<HashMap<EntityId, Outlet>>,
+    inlets: Mutex<Inlets>,
+    /// The core's `shm_generation`, as last seen under its lock.
+    generation: AtomicU64,
+    stopped: AtomicBool,
+    thread: Mutex<Option<JoinHandle<()>>>,
+}
+
+fn channel_config(reliable: bool) -> ShmChannelConfig {
+    ShmChannelConfig {
+        delivery_timeout: Some(if reliable {
+            DELIVERY_TIMEOUT
+        } else {
+            Duration::ZERO
+        }),
+        ..ShmChannelConfig::default()
+    }
+}
+
+/// A writer's acknowledgement channel: many publishers (one per reader participant), small messages,
+/// only the latest matters.
+fn ack_config() -> ShmChannelConfig {
+    let c = ShmChannelConfig::default();
+    ShmChannelConfig {
+        initial_max_sample: 64,
+        max_publishers: c.max_subscribers,
+        latest_only: true,
+        ..c
+    }
+}
+
+/// The acknowledgement channel of the writer whose data channel is `data`.
+fn ack_channel(data: &str) -> String {
+    format!("{data}/ack")
+}
+
+/// An acknowledgement: the sequence number, then the acknowledging node.
+fn encode_ack(sn: i64, node: &str, out: &mut [u8]) {
+    out[..8].copy_from_slice(&sn.to_le_bytes());
+    out[8..].copy_from_slice(node.as_bytes());
+}
+
+fn decode_ack(b: &[u8]) -> Option<(i64, &str)> {
+    let sn = i64::from_le_bytes(b.get(..8)?.try_into().ok()?);
+    Some((sn, std::str::from_utf8(&b[8..]).ok()?))
+}
+
+impl ShmLink {
+    /// The link of participant `prefix`, and the SPDP properties that tell peers on this host to use it;
+    /// `None` (every peer on UDP) when this host has no identity or shared memory cannot be set up.
+    pub(crate) fn new(prefix: GuidPrefix) -> Option<(ShmLink, Vec<(String, String)>)> {
+        let host = host_id()?;
+        let node = ShmNode::new()
+            .map_err(|e| tracing::warn!(error = %e, "no shared memory: every peer gets UDP"))
+            .ok()?;
+        let props = vec![
+            (SHM_HOST_PROPERTY.to_owned(), host),
+            (SHM_NODE_PROPERTY.to_owned(), node.id()),
+        ];
+        let link = ShmLink {
+            node,
+            prefix,
+            pending: Mutex::new(VecDeque::new()),
+            outlets: Mutex::new(HashMap::new()),
+            inlets: Mutex::new(Inlets::default()),
+            generation: AtomicU64::new(0),
+            stopped: AtomicBool::new(false),
+            thread: Mutex::new(None),
+        };
+        Some((link, props))
+    }
+
+    /// Starts the thread that reads the channels.
+    pub(crate) fn start<H: ShmHost>(&self, driver: Weak<H>) -> std::io::Result<()> {
+        let h = std::thread::Builder::new()
+            .name("dds-shm".into())
+            .spawn(move || poll_loop(driver))?;
+        *lock(&self.thread) = Some(h);
+        Ok(())
+    }
+
+    /// Under the core lock: takes what the core queued for the channels.
+    pub(crate) fn take_from(&self, core: &mut Participant) {
+        self.generation
+            .store(core.shm_generation(), Ordering::Release);
+        let mut pending = None;
+        while let Some(c) = core.poll_shm() {
+            pending
+                .get_or_insert_with(|| lock(&self.pending))
+                .push_back(c);
+        }
+    }
+
+    /// Sends what was taken, in order (without the core lock); may wait for a full reader queue.
+    pub(crate) fn flush(&self) {
+        if lock(&self.pending).is_empty() {
+            return;
+        }
+        self.flush_with(&mut lock(&self.outlets));
+    }
+
+    /// [`flush`](Self::flush) unless another thread is sending (it sends what is pending too).
+    fn try_flush(&self) {
+        if lock(&self.pending).is_empty() {
+            return;
+        }
+        let mut guard = match self.outlets.try_lock() {
+            Ok(g) => g,
+            Err(std::sync::TryLockError::Poisoned(p)) => p.into_inner(),
+            Err(std::sync::TryLockError::WouldBlock) => return,
+        };
+        self.flush_with(&mut guard);
+    }
+
+    fn flush_with(&self, outlets: &mut HashMap<EntityId, Outlet>) {
+        // Changes of a writer whose readers are not connected yet wait, with those that follow them.
+        let mut held = VecDeque::new();
+        let mut held_writers: Vec<EntityId> = Vec::new();
+        loop {
+            let Some(c) = lock(&self.pending).pop_front() else {
+                break;
+            };
+            if held_writers.contains(&c.writer) {
+                held.push_back(c);
+                continue;
+            }
+            match self.send(outlets, &c) {
+                Ok(true) => {}
+                Ok(false) => {
+                    held_writers.push(c.writer);
+                    held.push_back(c);
+                }
+                Err(e) => {
+                    tracing::warn!(writer = ?c.writer, error = %e, "shared-memory send failed")
+                }
+            }
+        }
+        if !held.is_empty() {
+            let mut pending = lock(&self.pending);
+            while let Some(c) = held.pop_back() {
+                pending.push_front(c);
+            }
+        }
+    }
+
+    fn open_outlet(&self, writer: EntityId, reliable: bool) -> Result<Outlet, ShmError> {
+        let name = shm_channel_name(&Guid::new(self.prefix, writer));
+        Ok(Outlet {
+            publisher: self.node.publisher(&name, &channel_config(reliable))?,
+            connected: None,
+            waiting_since: None,
+            acks: self.node.subscriber(&ack_channel(&name), &ack_config())?,
+            owed: HashMap::new(),
+        })
+    }
+
+    /// Sends `c`; `Ok(false)` when it must wait for its nodes to connect.
+    fn send(
+        &self,
+        outlets: &mut HashMap<EntityId, Outlet>,
+        c: &ShmChange,
+    ) -> Result<bool, ShmError> {
+        let out = match outlets.entry(c.writer) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(self.open_outlet(c.writer, c.reliable)?)
+            }
+        };
+        if !out
+            .connected
+            .as_ref()
+            .is_some_and(|n| Arc::ptr_eq(n, &c.nodes))
+        {
+            let subs = out.publisher.subscriber_nodes();
+            let missing = c.nodes.iter().filter(|n| !subs.contains(n)).count();
+            let since = *out.waiting_since.get_or_insert_with(Instant::now);
+            if missing > 0 && since.elapsed() < CONNECT_TIMEOUT {
+                return Ok(false);
+            }
+            if missing > 0 {
+                tracing::warn!(
+                    missing,
+                    "shared-memory readers not connected in time: they miss changes"
+                );
+            }
+            let _ = out.publisher.update_connections();
+            out.connected = Some(c.nodes.clone());
+            out.waiting_since = None;
+        }
+        let mut header = [0u8; ShmChange::HEADER_LEN];
+        c.write_header(&mut header);
+        out.publisher.send_parts(&[&header, &c.change.payload])?;
+        if !c.liveliness {
+            for n in c.nodes.iter() {
+                let owed = out.owed.entry(n.clone()).or_insert((0, 0));
+                owed.0 = owed.0.max(c.sequence.0);
+            }
+        }
+        Ok(true)
+    }
+
+    /// Whether every reader participant in `nodes` acknowledged all that `writer` sent it (true when
+    /// nothing was sent on shared memory).
+    pub(crate) fn acknowledged(&self, writer: EntityId, nodes: &[String]) -> bool {
+        if lock(&self.pending).iter().any(|c| c.writer == writer) {
+            return false;
+        }
+        let mut outlets = lock(&self.outlets);
+        let Some(out) = outlets.get_mut(&writer) else {
+            return true;
+        };
+        while let Ok(Some(ack)) = out.acks.receive() {
+            if let Some((sn, node)) = decode_ack(&ack) {
+                if let Some(owed) = out.owed.get_mut(node) {
+                    owed.1 = owed.1.max(sn);
+                }
+            }
+        }
+        nodes
+            .iter()
+            .all(|n| out.owed.get(n).is_none_or(|(sent, acked)| acked >= sent))
+    }
+
+    /// The writer was deleted: its channel closes (after what it sent).
+    pub(crate) fn close_writer(&self, writer: EntityId) {
+        self.flush();
+        lock(&self.outlets).remove(&writer);
+    }
+
+    /// Reads what arrived on the channels our readers read and gives it to the core; how many frames.
+    /// Also opens and closes channels as the core's pairs changed.
+    pub(crate) fn drain(&self, driver: &dyn ShmHost) -> usize {
+        let mut inlets = lock(&self.inlets);
+        let generation = self.generation.load(Ordering::Acquire);
+        if generation != inlets.generation {
+            inlets.generation = generation;
+            let mut wanted = Vec::new();
+            driver.query_shm(&mut |c| wanted = c.shm_subscriptions());
+            self.resubscribe(&mut inlets, &wanted);
+        }
+        if inlets.channels.is_empty() {
+            return 0;
+        }
+        let mut frames: Vec<(Guid, Payload)> = Vec::new();
+        let mut highest = vec![0i64; inlets.channels.len()];
+        for (i, inlet) in inlets.channels.iter().enumerate() {
+            for _ in 0..BATCH {
+                match inlet.subscriber.receive() {
+                    Ok(Some(s)) => {
+                        if let Some(h) = decode_header(&s) {
+                            highest[i] = highest[i].max(h.sequence.0);
+                        }
+                        frames.push((inlet.writer, Payload::from_owner(Arc::new(s))));
+                    }
+                    Ok(None) => break,
+                    Err(e) => {
+                        tracing::warn!(writer = ?inlet.writer, error = %e, "shared-memory receive failed");
+                        break;
+                    }
+                }
+            }
+        }
+        let n = frames.len();
+        if n > 0 {
+            // Still under the inlets lock: two threads draining keep the channels' order. Our own
+            // changes are not sent from here (see `poll_loop`).
+            let mut frames = Some(frames);
+            driver.with_core_from_shm(&mut |c, now| {
+                for (writer, frame) in frames.take().into_iter().flatten() {
+                    c.receive_shm(now, writer, frame);
+                }
+            });
+            // They are in the readers' caches now.
+            for (inlet, sn) in inlets.channels.iter().zip(highest) {
+                if sn > 0 {
+                    self.acknowledge(inlet, sn);
+                }
+            }
+        }
+        n
+    }
+
+    fn acknowledge(&self, inlet: &Inlet, sn: i64) {
+        let node = self.node.id();
+        let sent = inlet.acks.loan(8 + node.len()).and_then(|mut loan| {
+            encode_ack(sn, &node, &mut loan);
+            loan.send()
+        });
+        if let Err(e) = sent {
+            tracing::debug!(writer = ?inlet.writer, error = %e, "shared-memory acknowledgement not sent");
+        }
+    }
+
+    fn resubscribe(&self, inlets: &mut Inlets, wanted: &[Guid]) {
+        inlets.channels.retain(|i| wanted.contains(&i.writer));
+        for w in wanted {
+            if inlets.channels.iter().any(|i| i.writer == *w) {
+                continue;
+            }
+            let name = shm_channel_name(w);
+            let opened = self
+                .node
+                .subscriber(&name, &ShmChannelConfig::default())
+                .and_then(|subscriber| {
+                    Ok(Inlet {
+                        writer: *w,
+                        subscriber,
+                        acks: self.node.publisher(&ack_channel(&name), &ack_config())?,
+                    })
+                });
+            match opened {
+                Ok(i) => inlets.channels.push(i),
+                Err(e) => tracing::warn!(writer = ?w, error = %e, "cannot read a writer's channel"),
+            }
+        }
+    }
+
+    /// Stops the polling thread and closes every channel.
+    pub(crate) fn shutdown(&self) {
+        self.stopped.store(true, Ordering::Release);
+        if let Some(h) = lock(&self.thread).take() {
+            if h.thread().id() != std::thread::current().id() {
+                let _ = h.join();
+            }
+        }
+        lock(&self.outlets).clear();
+        lock(&self.inlets).channels.clear();
+    }
+}
+
+/// The polling thread: drains the channels, sleeping longer (up to [`MAX_IDLE`]) while nothing arrives.
+fn poll_loop<H: ShmHost>(driver: Weak<H>) {
+    let mut idle = Duration::from_micros(20);
+    loop {
+        let Some(d) = driver.upgrade() else {
+            return;
+        };
+        // The thread never waits to send (a peer's queue may be full while its own thread waits on
+        // ours): it only sends when no other thread is sending, changes held for connecting readers
+        // typically.
+        let (n, held) = match d.shm_link() {
+            Some(link) if !link.stopped.load(Ordering::Acquire) => {
+                let n = link.drain(&*d);
+                link.try_flush();
+                (n, !lock(&link.pending).is_empty())
+            }
+            _ => return,
+        };
+        drop(d);
+        if n > 0 || held {
+            idle = Duration::from_micros(20);
+            continue;
+        }
+        std::thread::sleep(idle);
+        idle = (idle * 2).min(MAX_IDLE);
+    }
+}

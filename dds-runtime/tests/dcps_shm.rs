@@ -1,0 +1,334 @@
+//! Shared memory through the DCPS API (feature `shm`, run inside `scripts/isolated`): a writer's readers in
+//! participants on this host that can use shared memory get its samples through the writer's channel, not
+//! as datagrams; a participant without it (shared memory off) gets the same writer's samples over UDP; a
+//! writer process killed with `SIGKILL` leaks nothing and a new writer works after it. The second process
+//! is this test binary run again with `DCPS_SHM_ROLE` set (see `child`).
+mod dcps_util;
+
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Child, ChildStdout, Command, Stdio};
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+use dcps_util::*;
+use dds_runtime::prelude::*;
+use dds_runtime::rtps::shm::SHM_NODE_PROPERTY;
+use dds_runtime::transport::shm::{node_listed, remove_dead_nodes};
+
+const KIB: usize = 1024;
+
+/// The byte at `i` of blob `id`.
+fn pattern(id: u32, i: usize) -> u8 {
+    (id as usize)
+        .wrapping_mul(31)
+        .wrapping_add(i.wrapping_mul(7)) as u8
+}
+
+fn blob(id: u32, len: usize) -> Blob {
+    Blob {
+        id,
+        data: (0..len).map(|i| pattern(id, i)).collect(),
+    }
+}
+
+fn intact(b: &Blob) -> bool {
+    b.data
+        .iter()
+        .enumerate()
+        .all(|(i, x)| *x == pattern(b.id, i))
+}
+
+/// Takes blobs until `n` arrived or `timeout` passed; panics on a damaged one. Their ids, in order.
+fn take_blobs(r: &DataReader<Blob>, n: usize, timeout: Duration) -> Vec<u32> {
+    let mut ids = Vec::new();
+    wait_until(timeout, || {
+        for s in r.take().unwrap() {
+            if let Some(b) = s.data {
+                assert!(intact(&b), "blob {} damaged", b.id);
+                ids.push(b.id);
+            }
+        }
+        ids.len() >= n
+    });
+    ids
+}
+
+fn sent(p: &DomainParticipant) -> u64 {
+    p.transport_stats().sent.load(Ordering::Relaxed)
+}
+
+fn no_shm() -> Config {
+    Config {
+        interface: dds_runtime::config::InterfaceSelection::Name("lo".into()),
+        shm: false,
+        ..Config::default()
+    }
+}
+
+fn with_shm() -> Config {
+    Config {
+        shm: true,
+        ..no_shm()
+    }
+}
+
+fn wait_matched<T: DdsType>(w: &DataWriter<T>, n: u32) {
+    assert!(
+        wait_until(MATCH_TIMEOUT, || w
+            .publication_matched_status()
+            .current_count
+            == n),
+        "writer matched {:?}, wanted {n}",
+        w.publication_matched_status()
+    );
+}
+
+#[test]
+fn peers_on_shared_memory_get_no_datagram_and_a_peer_without_it_gets_udp() {
+    let p = participant_with(111, with_shm());
+    let near = participant_with(111, with_shm());
+    let (wq, rq) = reliable_keep_all();
+    let (w, r) = matched::<Blob>(&p, &near, "ShmMixed", &wq, &rq);
+    let n = 200u32;
+    let before = sent(&p);
+    for id in 0..n {
+        w.write(&blob(id, 16 * KIB)).unwrap();
+    }
+    assert_eq!(
+        take_blobs(&r, n as usize, MATCH_TIMEOUT),
+        (0..n).collect::<Vec<_>>()
+    );
+    // 200 samples of 16 KiB would be about 2600 fragments over UDP; SPDP may send a few datagrams.
+    let during = sent(&p) - before;
+    assert!(
+        during < 20,
+        "{during} datagrams sent for {n} samples on shared memory"
+    );
+
+    // A participant without shared memory: the same writer reaches it over UDP, the other one still not.
+    let far = participant_with(111, no_shm());
+    let fr = reader::<Blob>(&far, "ShmMixed", &rq);
+    wait_matched(&w, 2);
+    let before = sent(&p);
+    for id in n..2 * n {
+        w.write(&blob(id, 16 * KIB)).unwrap();
+    }
+    let want: Vec<u32> = (n..2 * n).collect();
+    assert_eq!(take_blobs(&r, n as usize, MATCH_TIMEOUT), want);
+    assert_eq!(take_blobs(&fr, n as usize, MATCH_TIMEOUT), want);
+    let during = sent(&p) - before;
+    // Over UDP each 16 KiB sample takes at least one datagram (fragments are packed together).
+    assert!(
+        during >= u64::from(n),
+        "{during} datagrams: the UDP reader gets its samples over UDP"
+    );
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+}
+
+#[test]
+fn instance_states_history_and_late_joiners_over_shared_memory() {
+    let p = participant_with(112, with_shm());
+    let q = participant_with(112, with_shm());
+    let wq = DataWriterQos::builder()
+        .reliability(reliable())
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast(2))
+        .build();
+    let rq = DataReaderQos::builder()
+        .reliability(reliable())
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast(2))
+        .build();
+    let w = writer::<Blob>(&p, "ShmStates", &wq);
+    for id in 0..3 {
+        for v in 0..3 {
+            w.write(&Blob { id, data: vec![v] }).unwrap();
+        }
+    }
+    // A durable late joiner gets the writer's history (the last two of each instance).
+    let r = reader::<Blob>(&q, "ShmStates", &rq);
+    wait_matched(&w, 1);
+    let mut got = Vec::new();
+    wait_until(MATCH_TIMEOUT, || {
+        got.extend(r.read().unwrap());
+        got.len() >= 6
+    });
+    let mut vals: Vec<(u32, u8)> = got
+        .iter()
+        .filter_map(|s| s.data.as_ref().map(|b| (b.id, b.data[0])))
+        .collect();
+    vals.sort();
+    assert_eq!(vals, vec![(0, 1), (0, 2), (1, 1), (1, 2), (2, 1), (2, 2)]);
+    // Dispose reaches the reader's instance state.
+    w.dispose(&Blob {
+        id: 1,
+        data: vec![],
+    })
+    .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        r.read()
+            .unwrap()
+            .iter()
+            .any(|s| s.info.instance_state == InstanceState::NotAliveDisposed && !s.info.valid_data)
+    }));
+    // The readers of the writer are the one on shared memory.
+    assert_eq!(w.matched_subscription_guids().len(), 1);
+    assert_eq!(r.matched_publications().len(), 1);
+}
+
+/// Runs this binary's `child` test as a second process in `role`; `vars` go to its environment.
+fn spawn(role: &str, vars: &[(&str, String)]) -> (Child, BufReader<ChildStdout>) {
+    let mut cmd = Command::new(std::env::current_exe().unwrap());
+    cmd.args(["child", "--exact", "--nocapture", "--test-threads=1"])
+        .env("DCPS_SHM_ROLE", role)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped());
+    for (k, v) in vars {
+        cmd.env(k, v);
+    }
+    let mut child = cmd.spawn().unwrap();
+    let out = BufReader::new(child.stdout.take().unwrap());
+    (child, out)
+}
+
+/// The rest of the first line from the child that contains `want` (libtest may print before it).
+fn wait_line(out: &mut BufReader<ChildStdout>, want: &str) -> String {
+    let mut line = String::new();
+    loop {
+        line.clear();
+        assert!(
+            out.read_line(&mut line).unwrap() > 0,
+            "child ended before {want:?}"
+        );
+        if let Some(i) = line.find(want) {
+            return line[i + want.len()..].trim().to_owned();
+        }
+    }
+}
+
+fn env_num(name: &str) -> usize {
+    std::env::var(name).unwrap().parse().unwrap()
+}
+
+/// The second process. `reader`: takes COUNT blobs from the topic, checks them, prints "got" and their
+/// ids. `writer`: writes COUNT blobs of SIZE bytes from FIRST on (COUNT 0: until killed), prints
+/// "writing" after the first; waits for its stdin to close.
+#[test]
+fn child() {
+    let Ok(role) = std::env::var("DCPS_SHM_ROLE") else {
+        return;
+    };
+    let domain = env_num("DCPS_SHM_DOMAIN") as u32;
+    let topic = std::env::var("DCPS_SHM_TOPIC").unwrap();
+    let count = env_num("DCPS_SHM_COUNT");
+    let p = participant_with(domain, with_shm());
+    let (wq, rq) = reliable_keep_all();
+    if role == "reader" {
+        let r = reader::<Blob>(&p, &topic, &rq);
+        println!("ready");
+        let ids = take_blobs(&r, count, Duration::from_secs(30));
+        println!("got {ids:?}");
+        return;
+    }
+    let size = env_num("DCPS_SHM_SIZE");
+    let first = env_num("DCPS_SHM_FIRST") as u32;
+    let w = writer::<Blob>(&p, &topic, &wq);
+    wait_matched(&w, 1);
+    let mut id = first;
+    loop {
+        w.write(&blob(id, size)).unwrap();
+        if id == first {
+            println!("writing");
+            std::io::stdout().flush().unwrap();
+        }
+        id += 1;
+        if count > 0 && id as usize == first as usize + count {
+            break;
+        }
+    }
+    println!("written");
+    let mut s = String::new();
+    let _ = std::io::stdin().read_line(&mut s);
+}
+
+#[test]
+fn mixed_readers_in_two_processes_get_every_sample_intact_and_in_order() {
+    let p = participant_with(113, with_shm());
+    let far = participant_with(113, no_shm());
+    let (wq, rq) = reliable_keep_all();
+    let w = writer::<Blob>(&p, "ShmTwo", &wq);
+    let n = 40usize;
+    let vars = [
+        ("DCPS_SHM_DOMAIN", "113".to_owned()),
+        ("DCPS_SHM_TOPIC", "ShmTwo".to_owned()),
+        ("DCPS_SHM_COUNT", n.to_string()),
+    ];
+    let (mut child, mut out) = spawn("reader", &vars);
+    wait_line(&mut out, "ready");
+    let fr = reader::<Blob>(&far, "ShmTwo", &rq);
+    wait_matched(&w, 2);
+    // The child's reader is on shared memory: its participant announced a node, and matched ours.
+    for id in 0..n as u32 {
+        w.write(&blob(id, 256 * KIB)).unwrap();
+    }
+    let want: Vec<u32> = (0..n as u32).collect();
+    assert_eq!(take_blobs(&fr, n, MATCH_TIMEOUT), want);
+    assert_eq!(wait_line(&mut out, "got "), format!("{want:?}"));
+    assert!(child.wait().unwrap().success());
+}
+
+/// The shared-memory node a discovered participant announced.
+fn peer_node(p: &DomainParticipant, not: &[GuidPrefix]) -> Option<String> {
+    p.discovered_participants()
+        .into_iter()
+        .filter(|d| !not.contains(&d.guid_prefix))
+        .find_map(|d| {
+            p.get_discovered_participant_data(d.handle)
+                .ok()?
+                .property(SHM_NODE_PROPERTY)
+                .map(str::to_owned)
+        })
+}
+
+#[test]
+fn killed_writer_process_leaks_nothing_and_a_new_writer_works() {
+    let p = participant_with(114, with_shm());
+    let (_, rq) = reliable_keep_all();
+    let r = reader::<Blob>(&p, "ShmKill", &rq);
+    let vars = |first: u32, count: usize| {
+        [
+            ("DCPS_SHM_DOMAIN", "114".to_owned()),
+            ("DCPS_SHM_TOPIC", "ShmKill".to_owned()),
+            ("DCPS_SHM_COUNT", count.to_string()),
+            ("DCPS_SHM_SIZE", (1024 * KIB).to_string()),
+            ("DCPS_SHM_FIRST", first.to_string()),
+        ]
+    };
+    // A writer of 1 MiB samples, killed while it writes (it holds a loan for most of each write).
+    let (mut killed, mut out) = spawn("writer", &vars(0, 0));
+    wait_line(&mut out, "writing");
+    let ids = take_blobs(&r, 5, MATCH_TIMEOUT);
+    assert_eq!(ids, (0..ids.len() as u32).collect::<Vec<_>>());
+    let node = peer_node(&p, &[]).expect("the writer announced its node");
+    killed.kill().unwrap(); // SIGKILL
+    killed.wait().unwrap();
+    // What it had sent is intact (take_blobs checks every byte) and in order.
+    let rest = take_blobs(&r, usize::MAX, Duration::from_millis(500));
+    let last = rest.last().copied().unwrap_or(ids[ids.len() - 1]);
+    let all: Vec<u32> = ids.iter().chain(&rest).copied().collect();
+    assert_eq!(all, (0..=last).collect::<Vec<_>>());
+    // Its dead node is removed (by us or by whoever looked first), with its segments and loans.
+    let end = Instant::now() + MATCH_TIMEOUT;
+    while node_listed(&node) {
+        remove_dead_nodes();
+        assert!(Instant::now() < end, "dead node {node} still listed");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // A new writer process on the same topic works.
+    let (mut next, mut out) = spawn("writer", &vars(1000, 20));
+    wait_line(&mut out, "written");
+    let ids = take_blobs(&r, 20, MATCH_TIMEOUT);
+    assert_eq!(ids, (1000..1020).collect::<Vec<_>>());
+    drop(next.stdin.take());
+    assert!(next.wait().unwrap().success());
+}
