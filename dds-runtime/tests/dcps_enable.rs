@@ -227,6 +227,9 @@ fn immutable_policies_change_until_enabled() {
         w.write(&shape("RED", x)).unwrap();
     }
 
+    assert!(wait_until(MATCH_TIMEOUT, || !pr
+        .discovered_participants()
+        .is_empty()));
     let tr = pr
         .create_topic::<ShapeType>("Respecify", &TopicQos::default())
         .unwrap();

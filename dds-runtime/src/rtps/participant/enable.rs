@@ -12,7 +12,6 @@ use crate::rtps::api::{CoreError, ReaderSpec, WriterSpec};
 use crate::rtps::discovery::{ReaderData, WriterData};
 use crate::rtps::reader::Reader;
 use crate::rtps::types::{entity_kind, EntityId};
-use crate::rtps::writer::Writer;
 
 /// A local endpoint created disabled: what it will announce once enabled.
 #[derive(Debug)]
@@ -118,8 +117,9 @@ impl Participant {
     }
 
     /// Replaces every policy of a disabled writer, immutable ones included (DDS 1.4 §2.2.2.1.1.7: they may
-    /// change until the entity is enabled). Its protocol state is rebuilt from the new QoS (history, limits,
-    /// reliability, durability, lifespan); nothing was written or matched yet, so nothing is lost.
+    /// change until the entity is enabled). Its protocol state takes the new QoS (history, limits,
+    /// reliability, durability, lifespan; its group and coherent state stay); nothing was written or
+    /// matched yet, so nothing is lost.
     /// `BadParameter` once the writer is enabled, `UnknownEntity` for no local writer.
     pub fn respecify_disabled_writer(
         &mut self,
@@ -133,7 +133,9 @@ impl Participant {
         let keyed = id.kind() == entity_kind::USER_WRITER_WITH_KEY;
         let params = super::user_writer_params(&self.config, &qos.writer, keyed);
         d.qos = qos;
-        self.writers.insert(id, Writer::new(d.guid, params));
+        if let Some(w) = self.writers.get_mut(&id) {
+            w.respecify(params);
+        }
         Ok(())
     }
 

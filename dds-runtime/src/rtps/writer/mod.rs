@@ -121,6 +121,15 @@ impl Writer {
         }
     }
 
+    /// New parameters for a writer that has written nothing yet (a disabled writer whose QoS changed):
+    /// its history and flow-control window are made anew; its group, coherent state and readers' filters
+    /// stay.
+    pub(crate) fn respecify(&mut self, params: WriterParams) {
+        self.history = HistoryCache::new(params.history, params.limits);
+        self.window = flow::Window::new(params.high_watermark, params.low_watermark);
+        self.params = params;
+    }
+
     fn durable(&self) -> bool {
         self.params.durability >= Durability::TransientLocal
     }
