@@ -5,8 +5,9 @@ use std::time::Instant;
 use foldhash::HashMap;
 use tracing::{debug, trace};
 
+use super::interned::Interned;
 use super::{Participant, ProxyParticipant};
-use crate::qos::{Durability, QosPolicyId, ReaderQos, WriterQos};
+use crate::qos::{Durability, Interner, QosPolicyId, ReaderQos, WriterQos};
 use crate::rtps::api::{ChangeKind, Event, ReceivedSample, WriteChange};
 use crate::rtps::discovery::matching::{match_endpoints_with, MatchResult};
 use crate::rtps::discovery::{builtin, EndpointData, EndpointQos, ParticipantData};
@@ -232,14 +233,15 @@ impl Participant {
             Ok(d) if self.ignored.endpoint(&d.guid, &d.topic_name) => {
                 trace!(endpoint = ?d.guid, "ignored SEDP announcement dropped");
             }
-            Ok(d) if d.guid.prefix == s.writer.prefix => {
+            Ok(mut d) if d.guid.prefix == s.writer.prefix => {
+                self.interned.share(&mut d);
                 let known = Q::known(self);
                 let new = !known.contains_key(&d.guid);
                 if !new || known.len() < MAX_ENDPOINTS {
                     // New, or announced again with another QoS (`set_qos`): reported either way.
                     if known.get(&d.guid).map(Box::as_ref) != Some(&d) {
                         self.events.push_back(Q::discovered(d.clone()));
-                        self.want_announced_types(now, d.type_information.as_ref());
+                        self.want_announced_types(now, d.type_information.as_deref());
                     }
                     self.on_endpoint_known(now, d);
                 }
@@ -296,7 +298,8 @@ impl Participant {
     }
 
     /// Announces a new local endpoint in SEDP and matches it.
-    pub(super) fn publish_endpoint<Q: Direction>(&mut self, now: Instant, d: EndpointData<Q>) {
+    pub(super) fn publish_endpoint<Q: Direction>(&mut self, now: Instant, mut d: EndpointData<Q>) {
+        self.interned.share(&mut d);
         self.announce(now, Q::ANNOUNCER, d.guid, ChangeKind::Alive, d.encode());
         // Local endpoints are reported as remote ones are (the DCPS services watch both).
         self.events.push_back(Q::discovered(d.clone()));
@@ -561,6 +564,8 @@ pub(super) trait Direction: EndpointQos + Clone + PartialEq {
     fn discovered(d: EndpointData<Self>) -> Event;
     /// The event for an endpoint that is gone.
     fn removed(guid: Guid) -> Event;
+    /// The interner of this direction's QoS.
+    fn interner(i: &mut Interned) -> &mut Interner<Self>;
 }
 
 impl Direction for WriterQos {
@@ -587,6 +592,9 @@ impl Direction for WriterQos {
     fn removed(guid: Guid) -> Event {
         Event::PublicationRemoved { guid }
     }
+    fn interner(i: &mut Interned) -> &mut Interner<Self> {
+        &mut i.writer_qos
+    }
 }
 
 impl Direction for ReaderQos {
@@ -612,5 +620,8 @@ impl Direction for ReaderQos {
     }
     fn removed(guid: Guid) -> Event {
         Event::SubscriptionRemoved { guid }
+    }
+    fn interner(i: &mut Interned) -> &mut Interner<Self> {
+        &mut i.reader_qos
     }
 }

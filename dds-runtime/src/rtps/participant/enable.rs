@@ -93,7 +93,7 @@ impl Participant {
     ) -> Option<WriterQos> {
         match self.deferred.get_mut(&id) {
             Some(Deferred::Writer(d)) => {
-                d.qos = qos;
+                d.qos = qos.into();
                 None
             }
             _ => Some(qos),
@@ -108,7 +108,7 @@ impl Participant {
     ) -> Option<ReaderQos> {
         match self.deferred.get_mut(&id) {
             Some(Deferred::Reader(d)) => {
-                d.qos = qos;
+                d.qos = qos.into();
                 None
             }
             _ => Some(qos),

@@ -1,0 +1,26 @@
+//! What the participant shares among the endpoints it knows: the QoS and type information that nearly every
+//! endpoint announces alike are kept once per distinct value (see `docs/performance.md`, "Footprint").
+
+use crate::qos::{Interner, ReaderQos, WriterQos};
+use crate::rtps::discovery::EndpointData;
+use crate::xtypes::TypeInformation;
+
+use super::discovery::Direction;
+
+/// The participant's interners, one per kind of shared value.
+#[derive(Debug, Default)]
+pub(super) struct Interned {
+    pub(super) writer_qos: Interner<WriterQos>,
+    pub(super) reader_qos: Interner<ReaderQos>,
+    types: Interner<TypeInformation>,
+}
+
+impl Interned {
+    /// Replaces `d`'s QoS and type information by the shared copies of equal values.
+    pub(super) fn share<Q: Direction>(&mut self, d: &mut EndpointData<Q>) {
+        d.qos = Q::interner(self).intern(d.qos.clone());
+        if let Some(t) = d.type_information.take() {
+            d.type_information = Some(self.types.intern(t));
+        }
+    }
+}
