@@ -61,7 +61,8 @@ pub(crate) struct Writer {
     params: WriterParams,
     history: HistoryCache,
     next_sn: SequenceNumber,
-    proxies: BTreeMap<Guid, ReaderProxy>,
+    /// Boxed: a map node then holds pointers, not whole proxies (see `docs/performance.md`, "Footprint").
+    proxies: BTreeMap<Guid, Box<ReaderProxy>>,
     /// One locator per matched reader, deduplicated: where new data goes.
     data_dest: Vec<Locator>,
     /// `data_dest` split for key-only changes: readers that want them without serialized key
@@ -438,7 +439,7 @@ impl Writer {
         }
         let behind = proxy.reliable && proxy.acked < self.next_sn;
         self.repair_floor.lower(proxy.repair_due);
-        self.proxies.insert(proxy.guid, proxy);
+        self.proxies.insert(proxy.guid, Box::new(proxy));
         self.rebuild_dest();
         self.update_acked(ev);
         if behind {
