@@ -107,6 +107,7 @@ impl Participant {
             data.metatraffic_unicast.clone()
         };
         let bits = data.builtin_endpoints;
+        let group = self.shared_metatraffic_group(&data);
         self.events
             .push_back(Event::ParticipantDiscovered(Box::new(data.clone())));
         self.participants.insert(
@@ -119,7 +120,10 @@ impl Participant {
         for (ours, theirs, bit) in builtin::WRITER_PAIRS {
             if bits & bit != 0 {
                 if let Some(w) = self.writers.get_mut(&ours) {
-                    let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true);
+                    let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true)
+                        .with_multicast(
+                            group.filter(|_| !super::type_lookup::is_service_endpoint(ours)),
+                        );
                     w.add_proxy(now, proxy, true, &mut self.events);
                 }
             }
@@ -140,6 +144,17 @@ impl Participant {
         if !meta.is_empty() {
             self.send_spdp(Some(meta[..1].to_vec()));
         }
+    }
+
+    /// The metatraffic multicast group a discovered participant shares with us, if any. Our SEDP and
+    /// participant-message writers send new announcements and periodic heartbeats there once two or more
+    /// participants' readers share it (`Writer::choose_multicast`): one datagram instead of one per
+    /// participant, as SPDP itself does. Repairs stay unicast; TypeLookup, addressed to one participant, too.
+    fn shared_metatraffic_group(&self, data: &ParticipantData) -> Option<Locator> {
+        data.metatraffic_multicast
+            .iter()
+            .find(|l| l.is_multicast() && self.config.metatraffic_multicast.contains(l))
+            .copied()
     }
 
     pub(super) fn remove_participant(&mut self, prefix: GuidPrefix) {
