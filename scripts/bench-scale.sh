@@ -47,7 +47,9 @@ run() {
       "$@" >"$tmp/$i.log" 2>&1 &
     pids+=($!)
   done
-  for p in "${pids[@]}"; do wait "$p" || failed=$((failed + 1)); done
+  for i in "${!pids[@]}"; do
+    wait "${pids[$i]}" || { failed=$((failed + 1)); echo "node $((i + 1)) failed:" >&2; tail -3 "$tmp/$((i + 1)).log" >&2; }
+  done
   for i in $(seq "$nodes"); do
     read -r _ t _ c _ r < <(grep -h '^discovered' "$tmp/$i.log" || echo "x 0 x 0 x 0")
     slowest=$(awk -v a="$slowest" -v b="$t" 'BEGIN { print (b > a ? b : a) }')

@@ -581,17 +581,7 @@ impl Writer {
         }
         if self.hb_due.is_some_and(|t| t <= now) {
             if self.has_reliable_proxy() && !self.is_acknowledged() {
-                let dest: Vec<Locator> = {
-                    let mut d: Vec<Locator> = self
-                        .proxies
-                        .values()
-                        .filter(|p| p.reliable && p.acked < self.next_sn)
-                        .filter_map(|p| p.data_destination())
-                        .collect();
-                    d.sort();
-                    d.dedup();
-                    d
-                };
+                let dest = self.heartbeat_destinations();
                 let hb = self.heartbeat(EntityId::UNKNOWN, false);
                 self.bytes_since_nonfinal_hb = 0;
                 self.changes_since_nonfinal_hb = 0;
