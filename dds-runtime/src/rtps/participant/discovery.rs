@@ -5,9 +5,9 @@ use std::time::Instant;
 use foldhash::HashMap;
 use tracing::{debug, trace};
 
-use super::interned::Interned;
+use super::interned::SharedQos;
 use super::{Participant, ProxyParticipant};
-use crate::qos::{Durability, Interner, QosPolicyId, ReaderQos, WriterQos};
+use crate::qos::{Durability, QosPolicyId, ReaderQos, WriterQos};
 use crate::rtps::api::{ChangeKind, Event, ReceivedSample, WriteChange};
 use crate::rtps::discovery::matching::{match_endpoints_with, MatchResult};
 use crate::rtps::discovery::{builtin, EndpointData, EndpointQos, ParticipantData};
@@ -560,7 +560,7 @@ impl Local {
 }
 
 /// What the participant keeps apart for each SEDP direction (publications, subscriptions).
-pub(super) trait Direction: EndpointQos + Clone + PartialEq {
+pub(super) trait Direction: EndpointQos + SharedQos + Clone {
     /// For logs.
     const NAME: &'static str;
     /// Our SEDP writer that announces local endpoints of this direction.
@@ -579,8 +579,6 @@ pub(super) trait Direction: EndpointQos + Clone + PartialEq {
     fn discovered(d: EndpointData<Self>) -> Event;
     /// The event for an endpoint that is gone.
     fn removed(guid: Guid) -> Event;
-    /// The interner of this direction's QoS.
-    fn interner(i: &mut Interned) -> &mut Interner<Self>;
 }
 
 impl Direction for WriterQos {
@@ -607,9 +605,6 @@ impl Direction for WriterQos {
     fn removed(guid: Guid) -> Event {
         Event::PublicationRemoved { guid }
     }
-    fn interner(i: &mut Interned) -> &mut Interner<Self> {
-        &mut i.writer_qos
-    }
 }
 
 impl Direction for ReaderQos {
@@ -635,8 +630,5 @@ impl Direction for ReaderQos {
     }
     fn removed(guid: Guid) -> Event {
         Event::SubscriptionRemoved { guid }
-    }
-    fn interner(i: &mut Interned) -> &mut Interner<Self> {
-        &mut i.reader_qos
     }
 }
