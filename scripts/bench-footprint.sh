@@ -8,11 +8,12 @@
 # (scripts/footprint/bare.py: the binding's libddsc). Its VmRSS is sampled from /proc every 100 ms: before the load
 # (settled), the peak while the load is discovered, and the settled figure after. Reported: KB per entity
 # ((settled after - before) / N) and the peak above the settled figure. A benchmark, not a test; it runs inside
-# scripts/isolated (loopback only).
+# scripts/isolated (loopback only). BARE=path/to/dds-idle probes that binary instead of a fresh release build
+# (e.g. one built at an older commit, for a before/after comparison); STACKS="ours" or "cyclone" runs one side.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [[ -z ${DDS_ISOLATED:-} ]]; then
-  cargo build -q --release -p dds-examples --bin dds-idle
+  [[ -n ${BARE:-} ]] || cargo build -q --release -p dds-examples --bin dds-idle
   exec env DDS_ISOLATED=1 scripts/isolated "$0" "$@"
 fi
 kind=${1:-writers} n=${2:-2000}
@@ -70,5 +71,7 @@ probe() {
   rm -rf "$tmp"
 }
 
-probe ours 41 target/release/dds-idle -d 41
-probe cyclone-11 42 python3 scripts/footprint/bare.py 42
+stacks=${STACKS:-ours cyclone}
+[[ $stacks == *ours* ]] && probe ours 41 "${BARE:-target/release/dds-idle}" -d 41
+[[ $stacks == *cyclone* ]] && probe cyclone-11 42 python3 scripts/footprint/bare.py 42
+exit 0

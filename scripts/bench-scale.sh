@@ -7,12 +7,13 @@
 #   sudo scripts/bench-scale.sh [NODES=10] [PER=10] [TOPICS=10]      (default: 100 participants, 20 endpoints each)
 #
 # Ours: target/release/dds-scale. Cyclone 11: scripts/scale/node.py (PyPI binding). Needs root (ip netns). The
-# namespaces (ddsscale-*) are deleted on exit. A benchmark, not a test.
+# namespaces (ddsscale-*) are deleted on exit. A benchmark, not a test. STACKS="ours" or "cyclone" runs one side;
+# DDS_SCALE_BIN=path runs another dds-scale binary (e.g. one built at an older commit) without building.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 nodes=${1:-10} per=${2:-10} topics=${3:-10}
 total=$((nodes * per))
-cargo build -q --release -p dds-examples --bin dds-scale
+[[ -n ${DDS_SCALE_BIN:-} ]] || cargo build -q --release -p dds-examples --bin dds-scale
 hub=ddsscale-hub
 cleanup() {
   for i in $(seq "$nodes"); do ip netns del "ddsscale-$i" 2>/dev/null || true; done
@@ -46,7 +47,9 @@ run() {
       "$@" >"$tmp/$i.log" 2>&1 &
     pids+=($!)
   done
-  for p in "${pids[@]}"; do wait "$p" || failed=$((failed + 1)); done
+  for i in "${!pids[@]}"; do
+    wait "${pids[$i]}" || { failed=$((failed + 1)); echo "node $((i + 1)) failed:" >&2; tail -3 "$tmp/$((i + 1)).log" >&2; }
+  done
   for i in $(seq "$nodes"); do
     read -r _ t _ c _ r < <(grep -h '^discovered' "$tmp/$i.log" || echo "x 0 x 0 x 0")
     slowest=$(awk -v a="$slowest" -v b="$t" 'BEGIN { print (b > a ? b : a) }')
@@ -58,5 +61,7 @@ run() {
   rm -rf "$tmp"
 }
 
-run ours target/release/dds-scale -d 7 --participants "$per" --topics "$topics" --total "$total" --hold 15 --timeout 120
-run cyclone-11 python3 scripts/scale/node.py 8 "$per" "$topics" "$total" 15 120
+stacks=${STACKS:-ours cyclone}
+[[ $stacks == *ours* ]] && run ours "${DDS_SCALE_BIN:-target/release/dds-scale}" -d 7 --participants "$per" --topics "$topics" --total "$total" --hold 15 --timeout 120
+[[ $stacks == *cyclone* ]] && run cyclone-11 python3 scripts/scale/node.py 8 "$per" "$topics" "$total" 15 120
+exit 0

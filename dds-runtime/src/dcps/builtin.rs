@@ -74,8 +74,8 @@ impl<Q: Clone> From<&EndpointData<Q>> for EndpointBuiltinTopicData<Q> {
                 .or(Some(Guid::new(d.guid.prefix, EntityId::PARTICIPANT))),
             topic_name: d.topic_name.clone(),
             type_name: d.type_name.clone(),
-            qos: d.qos.clone(),
-            type_information: d.type_information.clone(),
+            qos: Q::clone(&d.qos),
+            type_information: d.type_information.as_deref().cloned(),
         }
     }
 }

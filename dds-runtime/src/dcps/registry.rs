@@ -14,8 +14,8 @@ use std::time::Instant;
 use foldhash::{HashMap, HashSet};
 
 use crate::qos::{
-    ChangeableQos, DataReaderQos, DataWriterQos, DomainParticipantQos, PublisherQos, SubscriberQos,
-    TopicQos,
+    ChangeableQos, DataReaderQos, DataWriterQos, DomainParticipantQos, Interner, PublisherQos,
+    SubscriberQos, TopicQos,
 };
 use crate::rtps::{EntityId, Event, Guid, GuidPrefix};
 
@@ -117,8 +117,10 @@ pub(crate) struct Entities {
     pub(crate) subscribers: Vec<Group<SubscriberQos, DataReaderQos>>,
     pub(crate) writers: Vec<EndpointEntry>,
     pub(crate) readers: Vec<EndpointEntry>,
-    /// Topic name → type name of remote endpoints (for `find_topic` and INCONSISTENT_TOPIC).
-    pub(crate) remote_topics: HashMap<String, String>,
+    /// Topic name → type name of remote endpoints (for `find_topic` and INCONSISTENT_TOPIC). The type names
+    /// are shared (`type_names`): one entry costs a topic name, not two strings.
+    pub(crate) remote_topics: HashMap<Box<str>, Arc<str>>,
+    type_names: Interner<str>,
     /// Remote topics (participant, topic name) already counted in an INCONSISTENT_TOPIC status: a remote
     /// participant's topic counts once, whether learnt from its SEDP topic announcement or from its readers
     /// and writers (announced again on QoS changes).
@@ -234,7 +236,7 @@ impl Registry {
         let handle = node.handle;
         let clash = self.with(|e| {
             let mut inconsistent = InconsistentTopicStatus::default();
-            let clash = e.remote_topics.get(name).is_some_and(|t| t != type_name);
+            let clash = e.remote_topics.get(name).is_some_and(|t| &**t != type_name);
             if clash {
                 inconsistent.record();
             }
@@ -292,8 +294,9 @@ impl Registry {
             _ => return Vec::new(),
         };
         let out = self.with(|e| {
-            if e.remote_topics.len() < MAX_REMOTE_TOPICS || e.remote_topics.contains_key(topic) {
-                e.remote_topics.insert(topic.clone(), type_name.clone());
+            if e.remote_topics.len() < MAX_REMOTE_TOPICS || e.remote_topics.contains_key(&**topic) {
+                let t = e.type_names.intern(Arc::from(type_name.as_str()));
+                e.remote_topics.insert(topic.as_str().into(), t);
             }
             let inconsistent = e
                 .topics

@@ -10,6 +10,7 @@ mod filtering;
 mod group;
 mod historical;
 mod internal;
+mod interned;
 mod liveliness;
 mod local;
 mod receive;
@@ -96,6 +97,8 @@ pub struct Participant {
     shm: shm::ShmMatches,
     /// Group coherent sets waiting for the parts of all their writers.
     group_sets: group::GroupSets,
+    /// The QoS and type information shared by the known endpoints.
+    interned: interned::Interned,
 }
 
 fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
@@ -194,6 +197,7 @@ impl Participant {
             local: Default::default(),
             shm: Default::default(),
             group_sets: group::GroupSets::default(),
+            interned: Default::default(),
             config,
         };
         let prefix = p.config.guid_prefix;
@@ -322,13 +326,13 @@ impl Participant {
             participant_guid: Some(Guid::new(guid.prefix, EntityId::PARTICIPANT)),
             topic_name: spec.topic_name,
             type_name: spec.type_name,
-            qos: spec.qos,
+            qos: spec.qos.into(),
             unicast_locators: Vec::new(),
             multicast_locators: Vec::new(),
             expects_inline_qos: false,
-            type_information: spec.type_information,
+            type_information: spec.type_information.map(Into::into),
             entity_name: spec.entity_name,
-            content_filter: spec.content_filter,
+            content_filter: spec.content_filter.map(Box::new),
         })
     }
 

@@ -82,7 +82,7 @@ pub(crate) struct Service {
 
 /// The stand-in QoS: the original writer's, with the service's history, limits and marker.
 fn stand_in_qos(w: &WriterData, cap: usize) -> WriterQos {
-    let mut q = w.qos.clone();
+    let mut q = WriterQos::clone(&w.qos);
     let ds = q.writer.durability_service;
     q.writer.history = ds.history;
     q.writer.resource_limits = ResourceLimits {
@@ -104,7 +104,7 @@ fn original_of(w: &WriterData, original: Guid) -> WriterData {
     let mut d = w.clone();
     d.guid = original;
     d.participant_guid = Some(Guid::new(original.prefix, EntityId::PARTICIPANT));
-    d.qos.writer.user_data = UserData::default();
+    std::sync::Arc::make_mut(&mut d.qos).writer.user_data = UserData::default();
     d.entity_name = None;
     d
 }
@@ -267,7 +267,7 @@ impl Service {
             w.guid.entity_id.is_keyed(),
             stand_in_qos(w, self.cap),
         );
-        spec.type_information = w.type_information.clone();
+        spec.type_information = w.type_information.as_deref().cloned();
         spec.entity_name = Some(format!("durability stand-in for {}", w.topic_name));
         spec.internal = true;
         let id = match driver.create_endpoint(sink, |c, now| c.create_writer(now, spec)) {

@@ -190,7 +190,7 @@ impl DomainParticipant {
                 e.remote_topics
                     .iter()
                     .find(|(n, t)| topic_key(n, t) == handle)
-                    .map(|(n, _)| n.clone())
+                    .map(|(n, _)| n.to_string())
             })
             .ok_or_else(|| DdsError::BadParameter(format!("no discovered topic {handle:?}")))?;
         self.ignore_topic(&name)
@@ -336,7 +336,7 @@ impl DomainParticipant {
         let mut v: Vec<(String, String)> = self.registry.with(|e| {
             e.remote_topics
                 .iter()
-                .map(|(n, t)| (n.clone(), t.clone()))
+                .map(|(n, t)| (n.to_string(), t.to_string()))
                 .collect()
         });
         v.sort();

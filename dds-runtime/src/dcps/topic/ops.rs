@@ -218,7 +218,7 @@ impl DomainParticipant {
                 .iter()
                 .find(|t| !t.deleted && t.name == name)
                 .map(|t| t.type_name.clone())
-                .or_else(|| e.remote_topics.get(name).cloned())
+                .or_else(|| e.remote_topics.get(name).map(|t| t.to_string()))
                 .map(Ok)
         });
         match found.transpose()? {

@@ -83,8 +83,8 @@ fn types_consistent(w: &WriterData, r: &ReaderData, types: &dyn TypeResolver) ->
         }
     };
     let (wid, rid) = (
-        minimal_id(w.type_information.as_ref()),
-        minimal_id(r.type_information.as_ref()),
+        minimal_id(w.type_information.as_deref()),
+        minimal_id(r.type_information.as_deref()),
     );
     let (Some(wid), Some(rid)) = (wid, rid) else {
         if tce.force_type_validation {
@@ -111,6 +111,7 @@ mod tests {
     use crate::qos::TypeConsistencyKind;
     use crate::xtypes::XTypesType;
     use crate::DdsType;
+    use std::sync::Arc;
 
     #[derive(DdsType)]
     #[dds(appendable, name = "V1")]
@@ -150,13 +151,13 @@ mod tests {
         let w = WriterData {
             topic_name: "T".into(),
             type_name: wname.into(),
-            type_information: wti,
+            type_information: wti.map(Into::into),
             ..Default::default()
         };
         let r = ReaderData {
             topic_name: "T".into(),
             type_name: rname.into(),
-            type_information: rti,
+            type_information: rti.map(Into::into),
             ..Default::default()
         };
         (w, r)
@@ -182,13 +183,15 @@ mod tests {
     #[test]
     fn disallow_type_coercion_needs_the_same_type() {
         let (w, mut r) = pair("V2", info::<V2>(), "V1", info::<V1>());
-        r.qos.reader.type_consistency.kind = TypeConsistencyKind::DisallowTypeCoercion;
+        Arc::make_mut(&mut r.qos).reader.type_consistency.kind =
+            TypeConsistencyKind::DisallowTypeCoercion;
         assert_eq!(
             match_endpoints(&w, &r),
             MatchResult::Incompatible(QosPolicyId::TypeConsistencyEnforcement)
         );
         let (w, mut r) = pair("V1", info::<V1>(), "V1", info::<V1>());
-        r.qos.reader.type_consistency.kind = TypeConsistencyKind::DisallowTypeCoercion;
+        Arc::make_mut(&mut r.qos).reader.type_consistency.kind =
+            TypeConsistencyKind::DisallowTypeCoercion;
         assert_eq!(match_endpoints(&w, &r), MatchResult::Match);
     }
 
@@ -199,7 +202,10 @@ mod tests {
         let (w, r) = pair("V1", info::<V1>(), "V2", None);
         assert_eq!(match_endpoints(&w, &r), MatchResult::Unrelated);
         let (w, mut r) = pair("V1", None, "V1", info::<V1>());
-        r.qos.reader.type_consistency.force_type_validation = true;
+        Arc::make_mut(&mut r.qos)
+            .reader
+            .type_consistency
+            .force_type_validation = true;
         assert_eq!(
             match_endpoints(&w, &r),
             MatchResult::Incompatible(QosPolicyId::TypeConsistencyEnforcement)

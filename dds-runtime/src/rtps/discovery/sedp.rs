@@ -1,5 +1,7 @@
 //! DiscoveredWriterData / DiscoveredReaderData (§8.5.4, §9.6.2.2) and their parameter-list form.
 
+use std::sync::Arc;
+
 use super::{pl_payload, ContentFilterProperty, PL_CDR_LE};
 use crate::qos::{ReaderQos, WriterQos};
 use crate::rtps::messages::parameter::{pid, ParameterWriter};
@@ -21,20 +23,21 @@ pub struct EndpointData<Q> {
     pub topic_name: String,
     /// The registered type name.
     pub type_name: String,
-    /// The QoS as announced: endpoint, group and topic parts.
-    pub qos: Q,
+    /// The QoS as announced: endpoint, group and topic parts. Shared: a participant keeps one copy of each
+    /// distinct QoS its peers announce (see `docs/performance.md`, "Footprint").
+    pub qos: Arc<Q>,
     /// Unicast locators of the endpoint; empty means its participant's default unicast locators.
     pub unicast_locators: Vec<Locator>,
     /// Multicast locators of the endpoint.
     pub multicast_locators: Vec<Locator>,
     /// The endpoint wants inline QoS with every DATA (announced by readers only; always `false` for writers).
     pub expects_inline_qos: bool,
-    /// XTypes TYPE_INFORMATION, kept opaque.
-    pub type_information: Option<TypeInformation>,
+    /// XTypes TYPE_INFORMATION, kept opaque. Shared like `qos`.
+    pub type_information: Option<Arc<TypeInformation>>,
     /// PID_ENTITY_NAME, if announced.
     pub entity_name: Option<String>,
-    /// PID_CONTENT_FILTER_PROPERTY: the reader's content filter (readers only).
-    pub content_filter: Option<ContentFilterProperty>,
+    /// PID_CONTENT_FILTER_PROPERTY: the reader's content filter (readers only; boxed, as it is rarely set).
+    pub content_filter: Option<Box<ContentFilterProperty>>,
 }
 
 /// A publication as announced in SEDP (DiscoveredWriterData).
@@ -98,7 +101,7 @@ impl<Q: EndpointQos> EndpointData<Q> {
                 continue;
             }
             let known = d.read_common(&pl, p.id, p.value)?
-                || d.data.qos.read_param(p.id, p.value, pl.little_endian)?;
+                || d.qos.read_param(p.id, p.value, pl.little_endian)?;
             if !known && p.id & pid::MUST_UNDERSTAND != 0 {
                 return Err(WireError::MustUnderstand(p.id));
             }
@@ -111,6 +114,7 @@ impl<Q: EndpointQos> EndpointData<Q> {
 #[derive(Default)]
 struct Decoded<Q> {
     data: EndpointData<Q>,
+    qos: Q,
     guid: Option<Guid>,
     topic_name: Option<String>,
     type_name: Option<String>,
@@ -134,10 +138,12 @@ impl<Q> Decoded<Q> {
             pid::UNICAST_LOCATOR => add_locator(&mut d.unicast_locators, cur.locator()?),
             pid::MULTICAST_LOCATOR => add_locator(&mut d.multicast_locators, cur.locator()?),
             pid::EXPECTS_INLINE_QOS => d.expects_inline_qos = cur.u8()? != 0,
-            pid::TYPE_INFORMATION => d.type_information = Some(TypeInformation(value.to_vec())),
+            pid::TYPE_INFORMATION => {
+                d.type_information = Some(Arc::new(TypeInformation(value.to_vec())))
+            }
             pid::ENTITY_NAME => d.entity_name = Some(cur.string()?.to_owned()),
             pid::CONTENT_FILTER_PROPERTY => {
-                d.content_filter = Some(ContentFilterProperty::read(&mut cur)?)
+                d.content_filter = Some(Box::new(ContentFilterProperty::read(&mut cur)?))
             }
             // Known and deliberately unused.
             pid::KEY_HASH
@@ -161,6 +167,7 @@ impl<Q> Decoded<Q> {
             type_name: self
                 .type_name
                 .ok_or(WireError::Invalid("SEDP without type name"))?,
+            qos: Arc::new(self.qos),
             ..self.data
         })
     }
@@ -238,10 +245,10 @@ mod tests {
             participant_guid: Some(Guid::new(GuidPrefix([2; 12]), EntityId::PARTICIPANT)),
             topic_name: "Square".into(),
             type_name: "ShapeType".into(),
-            qos: WriterQos::new(wq, &pubq, &tq),
+            qos: WriterQos::new(wq, &pubq, &tq).into(),
             unicast_locators: vec![Locator::udpv4([10, 0, 0, 1], 7411)],
             multicast_locators: vec![],
-            type_information: Some(TypeInformation(vec![1, 2, 3, 4])),
+            type_information: Some(TypeInformation(vec![1, 2, 3, 4]).into()),
             expects_inline_qos: false,
             entity_name: None,
             content_filter: None,
@@ -279,14 +286,14 @@ mod tests {
             guid: Guid::new(GuidPrefix([3; 12]), EntityId([0, 0, 1, 7])),
             topic_name: "Square".into(),
             type_name: "ShapeType".into(),
-            qos: ReaderQos::from(rq),
+            qos: ReaderQos::from(rq).into(),
             expects_inline_qos: true,
-            content_filter: Some(ContentFilterProperty::ddssql(
+            content_filter: Some(Box::new(ContentFilterProperty::ddssql(
                 "Square_f",
                 "Square",
                 "x < %0",
                 vec!["5".into()],
-            )),
+            ))),
             ..Default::default()
         };
         let back = ReaderData::decode(&r.encode()).unwrap();

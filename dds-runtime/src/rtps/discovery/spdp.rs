@@ -208,6 +208,15 @@ impl ParticipantData {
         if !have_guid {
             return Err(WireError::Invalid("SPDP without participant GUID"));
         }
+        // Kept as long as the participant is known: no spare capacity.
+        for v in [
+            &mut d.metatraffic_unicast,
+            &mut d.metatraffic_multicast,
+            &mut d.default_unicast,
+            &mut d.default_multicast,
+        ] {
+            v.shrink_to_fit();
+        }
         Ok(d)
     }
 }

@@ -158,7 +158,7 @@ impl Participant {
             return Err(CoreError::UnknownEntity(id));
         };
         self.timers_changed();
-        d.qos = qos;
+        d.qos = qos.into();
         self.publish_endpoint(now, *d);
         Ok(())
     }

@@ -5,6 +5,7 @@ use std::time::Instant;
 use foldhash::HashMap;
 use tracing::{debug, trace};
 
+use super::interned::SharedQos;
 use super::{Participant, ProxyParticipant};
 use crate::qos::{Durability, QosPolicyId, ReaderQos, WriterQos};
 use crate::rtps::api::{ChangeKind, Event, ReceivedSample, WriteChange};
@@ -106,6 +107,7 @@ impl Participant {
             data.metatraffic_unicast.clone()
         };
         let bits = data.builtin_endpoints;
+        let group = self.shared_metatraffic_group(&data);
         self.events
             .push_back(Event::ParticipantDiscovered(Box::new(data.clone())));
         self.participants.insert(
@@ -118,7 +120,10 @@ impl Participant {
         for (ours, theirs, bit) in builtin::WRITER_PAIRS {
             if bits & bit != 0 {
                 if let Some(w) = self.writers.get_mut(&ours) {
-                    let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true);
+                    let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true)
+                        .with_multicast(
+                            group.filter(|_| !super::type_lookup::is_service_endpoint(ours)),
+                        );
                     w.add_proxy(now, proxy, true, &mut self.events);
                 }
             }
@@ -139,6 +144,17 @@ impl Participant {
         if !meta.is_empty() {
             self.send_spdp(Some(meta[..1].to_vec()));
         }
+    }
+
+    /// The metatraffic multicast group a discovered participant shares with us, if any. Our SEDP and
+    /// participant-message writers send new announcements and periodic heartbeats there once two or more
+    /// participants' readers share it (`Writer::choose_multicast`): one datagram instead of one per
+    /// participant, as SPDP itself does. Repairs stay unicast; TypeLookup, addressed to one participant, too.
+    fn shared_metatraffic_group(&self, data: &ParticipantData) -> Option<Locator> {
+        data.metatraffic_multicast
+            .iter()
+            .find(|l| l.is_multicast() && self.config.metatraffic_multicast.contains(l))
+            .copied()
     }
 
     pub(super) fn remove_participant(&mut self, prefix: GuidPrefix) {
@@ -232,14 +248,15 @@ impl Participant {
             Ok(d) if self.ignored.endpoint(&d.guid, &d.topic_name) => {
                 trace!(endpoint = ?d.guid, "ignored SEDP announcement dropped");
             }
-            Ok(d) if d.guid.prefix == s.writer.prefix => {
+            Ok(mut d) if d.guid.prefix == s.writer.prefix => {
+                self.interned.share(&mut d);
                 let known = Q::known(self);
                 let new = !known.contains_key(&d.guid);
                 if !new || known.len() < MAX_ENDPOINTS {
                     // New, or announced again with another QoS (`set_qos`): reported either way.
                     if known.get(&d.guid).map(Box::as_ref) != Some(&d) {
                         self.events.push_back(Q::discovered(d.clone()));
-                        self.want_announced_types(now, d.type_information.as_ref());
+                        self.want_announced_types(now, d.type_information.as_deref());
                     }
                     self.on_endpoint_known(now, d);
                 }
@@ -296,7 +313,8 @@ impl Participant {
     }
 
     /// Announces a new local endpoint in SEDP and matches it.
-    pub(super) fn publish_endpoint<Q: Direction>(&mut self, now: Instant, d: EndpointData<Q>) {
+    pub(super) fn publish_endpoint<Q: Direction>(&mut self, now: Instant, mut d: EndpointData<Q>) {
+        self.interned.share(&mut d);
         self.announce(now, Q::ANNOUNCER, d.guid, ChangeKind::Alive, d.encode());
         // Local endpoints are reported as remote ones are (the DCPS services watch both).
         self.events.push_back(Q::discovered(d.clone()));
@@ -542,7 +560,7 @@ impl Local {
 }
 
 /// What the participant keeps apart for each SEDP direction (publications, subscriptions).
-pub(super) trait Direction: EndpointQos + Clone + PartialEq {
+pub(super) trait Direction: EndpointQos + SharedQos + Clone {
     /// For logs.
     const NAME: &'static str;
     /// Our SEDP writer that announces local endpoints of this direction.

@@ -94,7 +94,7 @@ impl Participant {
     ) -> Option<WriterQos> {
         match self.deferred.get_mut(&id) {
             Some(Deferred::Writer(d)) => {
-                d.qos = qos;
+                d.qos = qos.into();
                 None
             }
             _ => Some(qos),
@@ -109,7 +109,7 @@ impl Participant {
     ) -> Option<ReaderQos> {
         match self.deferred.get_mut(&id) {
             Some(Deferred::Reader(d)) => {
-                d.qos = qos;
+                d.qos = qos.into();
                 None
             }
             _ => Some(qos),

@@ -11,7 +11,7 @@ use crate::rtps::types::{EntityId, Guid, SequenceNumber};
 /// The filter of a discovered reader that a writer of its topic can apply: class `DDSSQL`, on this topic.
 pub(super) fn usable_filter(rd: &ReaderData) -> Option<ContentFilterProperty> {
     rd.content_filter
-        .as_ref()
+        .as_deref()
         .filter(|f| {
             f.filter_class_name == ContentFilterProperty::DDSSQL
                 && f.related_topic_name == rd.topic_name
@@ -98,7 +98,7 @@ impl Participant {
         let Some(mut d) = self.known_readers.get(&guid).cloned() else {
             return;
         };
-        d.content_filter = filter;
+        d.content_filter = filter.map(Box::new);
         self.publish_endpoint(now, *d);
     }
 

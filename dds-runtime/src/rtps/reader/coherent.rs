@@ -60,7 +60,8 @@ struct OpenSet {
 /// One matched writer's open coherent set.
 #[derive(Debug)]
 pub(crate) struct Assembler {
-    open: Option<OpenSet>,
+    /// Boxed: most writers never send a coherent set, and a proxy is kept per matched writer.
+    open: Option<Box<OpenSet>>,
     limits: SetLimits,
     /// The group set the closing marker named (taken by `close`).
     group: Option<GroupSetId>,
@@ -106,14 +107,16 @@ impl Assembler {
                 if self.open.as_ref().is_some_and(|o| o.set != m.set) {
                     self.close(sn, sample.reader, sample.writer, out);
                 }
-                let o = self.open.get_or_insert_with(|| OpenSet {
-                    set: m.set,
-                    last: SequenceNumber(m.set.0 - 1),
-                    whole: true,
-                    count: 0,
-                    bytes: 0,
-                    samples: Vec::new(),
-                    group_set: m.group_set,
+                let o = self.open.get_or_insert_with(|| {
+                    Box::new(OpenSet {
+                        set: m.set,
+                        last: SequenceNumber(m.set.0 - 1),
+                        whole: true,
+                        count: 0,
+                        bytes: 0,
+                        samples: Vec::new(),
+                        group_set: m.group_set,
+                    })
                 });
                 o.whole &= sn == o.last.next();
                 o.last = sn;

@@ -60,7 +60,8 @@ pub(crate) struct ReaderParams {
 pub(crate) struct Reader {
     pub guid: Guid,
     params: ReaderParams,
-    proxies: BTreeMap<Guid, WriterProxy>,
+    /// Boxed: a map node then holds pointers, not whole proxies (see `docs/performance.md`, "Footprint").
+    proxies: BTreeMap<Guid, Box<WriterProxy>>,
     /// Lower bound of the proxies' `acknack_due` and `nackfrag_due`.
     proxy_floor: DueFloor,
     /// Back-pressure: how many more changes reliable proxies may deliver (`None`: no limit). A change
@@ -125,7 +126,7 @@ impl Reader {
             proxy.acknack_due = Some(now);
         }
         self.proxy_floor.lower(proxy.acknack_due);
-        self.proxies.insert(proxy.guid, proxy);
+        self.proxies.insert(proxy.guid, Box::new(proxy));
     }
 
     pub(crate) fn remove_proxy(&mut self, g: &Guid) -> bool {

@@ -61,7 +61,8 @@ pub(crate) struct Writer {
     params: WriterParams,
     history: HistoryCache,
     next_sn: SequenceNumber,
-    proxies: BTreeMap<Guid, ReaderProxy>,
+    /// Boxed: a map node then holds pointers, not whole proxies (see `docs/performance.md`, "Footprint").
+    proxies: BTreeMap<Guid, Box<ReaderProxy>>,
     /// One locator per matched reader, deduplicated: where new data goes.
     data_dest: Vec<Locator>,
     /// `data_dest` split for key-only changes: readers that want them without serialized key
@@ -447,7 +448,7 @@ impl Writer {
         }
         let behind = proxy.reliable && proxy.acked < self.next_sn;
         self.repair_floor.lower(proxy.repair_due);
-        self.proxies.insert(proxy.guid, proxy);
+        self.proxies.insert(proxy.guid, Box::new(proxy));
         self.rebuild_dest();
         self.update_acked(ev);
         if behind {
@@ -589,17 +590,7 @@ impl Writer {
         }
         if self.hb_due.is_some_and(|t| t <= now) {
             if self.has_reliable_proxy() && !self.is_acknowledged() {
-                let dest: Vec<Locator> = {
-                    let mut d: Vec<Locator> = self
-                        .proxies
-                        .values()
-                        .filter(|p| p.reliable && p.acked < self.next_sn)
-                        .filter_map(|p| p.data_destination())
-                        .collect();
-                    d.sort();
-                    d.dedup();
-                    d
-                };
+                let dest = self.heartbeat_destinations();
                 let hb = self.heartbeat(EntityId::UNKNOWN, false);
                 self.bytes_since_nonfinal_hb = 0;
                 self.changes_since_nonfinal_hb = 0;

@@ -31,4 +31,34 @@ impl Writer {
             });
         }
     }
+
+    /// Where the periodic heartbeat goes: to every reliable reader that has not acknowledged everything; by
+    /// multicast only where two or more of those share the group. A heartbeat sent to the group asks every
+    /// reader there for an ACKNACK, so a group in which one reader lags (common once discovery among many
+    /// participants settles) is served by unicast to that reader alone.
+    pub(super) fn heartbeat_destinations(&self) -> Vec<Locator> {
+        let unacked = || {
+            self.proxies
+                .values()
+                .filter(|p| p.reliable && p.acked < self.next_sn)
+        };
+        let mut lagging: BTreeMap<Locator, usize> = BTreeMap::new();
+        for m in unacked()
+            .filter(|p| p.via_multicast)
+            .filter_map(|p| p.multicast)
+        {
+            *lagging.entry(m).or_default() += 1;
+        }
+        let mut d: Vec<Locator> = unacked()
+            .filter_map(|p| match p.data_destination() {
+                Some(m) if lagging.get(&m).is_some_and(|&n| n < 2) => {
+                    p.destination().first().copied().or(Some(m))
+                }
+                other => other,
+            })
+            .collect();
+        d.sort();
+        d.dedup();
+        d
+    }
 }

@@ -1,0 +1,113 @@
+//! Discovery among many participants through the simulated network: SEDP announcements go once to the shared
+//! metatraffic multicast group rather than once per participant (the cost that made full discovery of 100
+//! participants slower than Cyclone's in `scripts/bench-scale.sh`, see docs/performance.md, "Scale").
+
+mod rtps_support;
+
+use std::time::Duration;
+
+use dds_runtime::qos::*;
+use dds_runtime::rtps::messages::{MessageIter, Submessage};
+use dds_runtime::rtps::*;
+use rtps_support::*;
+
+const NODES: usize = 8;
+const TOPICS: usize = 3;
+
+/// Every node has a writer and a reliable reader on each topic.
+fn endpoints(sim: &mut Sim) -> Vec<(Vec<EntityId>, Vec<EntityId>)> {
+    let now = sim.now;
+    let rq = DataReaderQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .build();
+    (0..NODES)
+        .map(|i| {
+            let p = &mut sim.nodes[i].p;
+            let topics = 0..TOPICS;
+            let w = topics
+                .clone()
+                .map(|t| {
+                    let spec =
+                        WriterSpec::new(format!("T{t}"), "X", true, DataWriterQos::default());
+                    p.create_writer(now, spec).unwrap()
+                })
+                .collect();
+            let r = topics
+                .map(|t| {
+                    let spec = ReaderSpec::new(format!("T{t}"), "X", true, rq.clone());
+                    p.create_reader(now, spec).unwrap()
+                })
+                .collect();
+            (w, r)
+        })
+        .collect()
+}
+
+fn fully_matched(sim: &Sim, eps: &[(Vec<EntityId>, Vec<EntityId>)]) -> bool {
+    eps.iter().enumerate().all(|(i, (ws, rs))| {
+        let p = &sim.nodes[i].p;
+        ws.iter().all(|w| p.writer_matches(*w).len() == NODES)
+            && rs.iter().all(|r| p.reader_matches(*r).len() == NODES)
+    })
+}
+
+/// Destinations (locators) of the datagrams in `log` sent by `node` that carry a publication announcement.
+fn announcement_destinations(log: &[Sent], node: usize) -> Vec<Locator> {
+    log.iter()
+        .filter(|(from, _, payload)| *from == node && announces_publication(payload))
+        .flat_map(|(_, to, _)| to.iter().copied())
+        .collect()
+}
+
+fn announces_publication(msg: &[u8]) -> bool {
+    let Ok((_, it)) = MessageIter::parse(msg) else {
+        return false;
+    };
+    it.flatten().any(|s| {
+        matches!(s, Submessage::Data(d) if d.writer_id == EntityId::SEDP_PUBLICATIONS_WRITER
+            && d.payload.is_some())
+    })
+}
+
+#[test]
+fn many_participants_discover_fully_and_announce_by_multicast() {
+    let mut sim = Sim::with_participants(11, Faults::NONE, NODES);
+    let eps = endpoints(&mut sim);
+    assert!(
+        sim.run_until(Duration::from_secs(5), |s| fully_matched(s, &eps)),
+        "not fully matched after {:?}",
+        sim.elapsed()
+    );
+    let took = sim.elapsed();
+    assert!(
+        took < Duration::from_millis(300),
+        "full discovery took {took:?}"
+    );
+
+    // A writer created once everyone knows everyone: its announcement goes out once, to the group.
+    sim.trace = Some(Vec::new());
+    let now = sim.now;
+    let spec = WriterSpec::new("Late", "X", true, DataWriterQos::default());
+    sim.nodes[0].p.create_writer(now, spec).unwrap();
+    sim.run_for(Duration::from_millis(50));
+    let to = announcement_destinations(sim.trace.as_ref().unwrap(), 0);
+    let group = sim.nodes[0].p.config().metatraffic_multicast()[0];
+    assert_eq!(to, vec![group], "announced to {to:?}");
+    // Every other participant learnt it from that one datagram.
+    for i in 1..NODES {
+        assert!(sim.has_event(i, |e| matches!(e,
+            Event::PublicationDiscovered(d) if d.topic_name == "Late")));
+    }
+}
+
+#[test]
+fn repairs_of_lost_announcements_still_reach_each_participant() {
+    // With loss on discovery traffic, what the multicast copy missed is repaired by unicast.
+    let mut sim = Sim::with_participants(12, Faults::lossy(0.2), NODES);
+    let eps = endpoints(&mut sim);
+    assert!(
+        sim.run_until(Duration::from_secs(20), |s| fully_matched(s, &eps)),
+        "not fully matched after {:?}",
+        sim.elapsed()
+    );
+}
