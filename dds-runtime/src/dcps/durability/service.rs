@@ -375,7 +375,7 @@ impl Service {
             };
             s.key_hash =
                 self.key_types
-                    .key_hash(driver, s.writer, info.as_ref(), s.kind, &s.payload);
+                    .key_hash(driver, s.writer, info.as_deref(), s.kind, &s.payload);
         }
     }
 

@@ -132,7 +132,7 @@ impl Participant {
         };
         let keyed = id.kind() == entity_kind::USER_WRITER_WITH_KEY;
         let params = super::user_writer_params(&self.config, &qos.writer, keyed);
-        d.qos = qos;
+        d.qos = qos.into();
         if let Some(w) = self.writers.get_mut(&id) {
             w.respecify(params);
         }
@@ -151,7 +151,7 @@ impl Participant {
             return Err(self.not_deferred(id));
         };
         let params = super::reader_params(&self.config, qos.reader.reliability.is_reliable());
-        d.qos = qos;
+        d.qos = qos.into();
         self.readers.insert(id, Reader::new(d.guid, params));
         Ok(())
     }
