@@ -12,6 +12,16 @@ use dds_runtime::prelude::*;
 /// Long enough for discovery to have happened had anything been announced (SPDP every 200 ms).
 const QUIET: Duration = Duration::from_millis(1200);
 
+/// A subscriber whose readers are created disabled.
+fn subscriber_without_autoenable(p: &DomainParticipant) -> Subscriber {
+    p.create_subscriber(
+        &SubscriberQos::builder()
+            .autoenable_created_entities(false)
+            .build(),
+    )
+    .unwrap()
+}
+
 fn no_autoenable_participant() -> DomainParticipantQos {
     DomainParticipantQos::builder()
         .autoenable_created_entities(false)
@@ -120,13 +130,7 @@ fn disabled_reader_matches_once_enabled_and_deleting_it_announces_nothing() {
     let t = pr
         .create_topic::<ShapeType>("EnableR", &TopicQos::default())
         .unwrap();
-    let sub = pr
-        .create_subscriber(
-            &SubscriberQos::builder()
-                .autoenable_created_entities(false)
-                .build(),
-        )
-        .unwrap();
+    let sub = subscriber_without_autoenable(&pr);
     let gone = sub
         .create_datareader::<ShapeType, _>(&t, &DataReaderQos::default())
         .unwrap();
@@ -233,13 +237,7 @@ fn immutable_policies_change_until_enabled() {
     let tr = pr
         .create_topic::<ShapeType>("Respecify", &TopicQos::default())
         .unwrap();
-    let sub = pr
-        .create_subscriber(
-            &SubscriberQos::builder()
-                .autoenable_created_entities(false)
-                .build(),
-        )
-        .unwrap();
+    let sub = subscriber_without_autoenable(&pr);
     let r = sub
         .create_datareader::<ShapeType, _>(&tr, &DataReaderQos::default())
         .unwrap();

@@ -268,22 +268,9 @@ fn dynamic_writer_to_cyclone_reader() {
     w.dispose(&DynamicData::from_json(&ty, &serde_json::json!({"color": "RED"})).unwrap())
         .unwrap();
     w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
-    let out = BufReader::new(child.stdout.take().unwrap());
-    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
-    assert!(
-        child.wait().unwrap().success(),
-        "cyclone sub failed: {lines:?}"
-    );
-    let xs: Vec<i64> = lines
-        .iter()
-        .filter(|l| l.contains("\"RED\""))
-        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
-        .collect();
+    let (xs, disposed, lines) = cyclone_sub_result(&mut child);
     assert_eq!(xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
-    assert!(
-        lines.iter().any(|l| l.contains("\"disposed\": true")),
-        "no dispose seen by Cyclone: {lines:?}"
-    );
+    assert!(disposed, "no dispose seen by Cyclone: {lines:?}");
 }
 
 #[cfg(all(feature = "idl", feature = "json"))]

@@ -5,7 +5,6 @@
 //! `scripts/isolated cargo nextest run -p dds-runtime -F shm --profile interop --test dcps_interop_shm --run-ignored all`.
 mod dcps_util;
 
-use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::sync::atomic::Ordering;
 use std::time::Duration;
@@ -86,20 +85,7 @@ fn one_writer_to_a_shared_memory_reader_and_a_cyclone_udp_reader() {
     });
     assert_eq!(xs, (0..10).collect::<Vec<_>>());
     assert!(disposed, "our reader did not see the disposal");
-    let out = BufReader::new(cyclone.stdout.take().unwrap());
-    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
-    assert!(
-        cyclone.wait().unwrap().success(),
-        "cyclone sub failed: {lines:?}"
-    );
-    let xs: Vec<i64> = lines
-        .iter()
-        .filter(|l| l.contains("\"RED\""))
-        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
-        .collect();
+    let (xs, disposed, lines) = cyclone_sub_result(&mut cyclone);
     assert_eq!(xs, (0..10).collect::<Vec<_>>(), "cyclone got {lines:?}");
-    assert!(
-        lines.iter().any(|l| l.contains("\"disposed\": true")),
-        "{lines:?}"
-    );
+    assert!(disposed, "{lines:?}");
 }

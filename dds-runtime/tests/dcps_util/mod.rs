@@ -190,3 +190,22 @@ pub(crate) fn take_n(r: &DataReader<ShapeType>, n: usize) -> Vec<Sample<ShapeTyp
     });
     got
 }
+
+/// What the Cyclone subscriber of `cyclone_shapes.py` printed, once it exited successfully: the `x` of each
+/// RED sample in order, and whether it saw the instance disposed.
+pub(crate) fn cyclone_sub_result(child: &mut std::process::Child) -> (Vec<i64>, bool, Vec<String>) {
+    use std::io::{BufRead, BufReader};
+    let out = BufReader::new(child.stdout.take().expect("piped stdout"));
+    let lines: Vec<String> = out.lines().map_while(Result::ok).collect();
+    assert!(
+        child.wait().unwrap().success(),
+        "cyclone sub failed: {lines:?}"
+    );
+    let xs = lines
+        .iter()
+        .filter(|l| l.contains("\"RED\""))
+        .filter_map(|l| l.split("\"x\": ").nth(1)?.split(',').next()?.parse().ok())
+        .collect();
+    let disposed = lines.iter().any(|l| l.contains("\"disposed\": true"));
+    (xs, disposed, lines)
+}
