@@ -93,6 +93,18 @@ pub(crate) struct Selection {
     pub(crate) query: Option<SharedFilter>,
 }
 
+impl Selection {
+    /// The samples in these states: no limit, instance or query.
+    pub(crate) fn states(s: SampleStateMask, v: ViewStateMask, i: InstanceStateMask) -> Self {
+        Selection {
+            sample_states: s,
+            view_states: v,
+            instance_states: i,
+            ..Selection::default()
+        }
+    }
+}
+
 type Filter<T> = Box<dyn Fn(&T) -> bool + Send + Sync>;
 
 pub(crate) struct ReaderCache<T> {

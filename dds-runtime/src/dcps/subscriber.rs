@@ -1009,11 +1009,8 @@ impl<T: DdsType> ReadConditionSource for ReaderInner<T> {
         query: Option<&SharedFilter>,
     ) -> bool {
         let sel = Selection {
-            sample_states: s,
-            view_states: v,
-            instance_states: i,
             query: query.cloned(),
-            ..Selection::default()
+            ..Selection::states(s, v, i)
         };
         lock(&self.cache).cache.has_matching(&sel)
     }

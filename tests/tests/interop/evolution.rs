@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use dds_runtime::prelude::*;
 use dds_runtime::xtypes::XTypesType;
 
-use super::harness::{cyclone_peer, require_netns, Proc, Skip};
+use super::harness::{cyclone_peer, loopback_participant, require_netns, Proc, Skip};
 
 const URI: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface name="lo" multicast="true"/></Interfaces><AllowMulticast>true</AllowMulticast></General></Domain></CycloneDDS>"#;
 
@@ -214,15 +214,6 @@ fn read_all<R: DdsType + Clone>(r: &DataReader<R>, key: impl Fn(&R) -> i32) -> V
     got
 }
 
-fn participant(domain: u32) -> DomainParticipant {
-    DomainParticipant::builder()
-        .domain_id(domain)
-        .interface("lo")
-        .spdp_interval(Duration::from_millis(200))
-        .build()
-        .expect("participant")
-}
-
 fn topic<T: DdsType>(p: &DomainParticipant, name: &str) -> Topic<T> {
     p.create_topic::<T>(name, &TopicQos::default()).unwrap()
 }
@@ -285,7 +276,7 @@ fn evolution_against_cyclone() -> Result<(), Skip> {
     cyclone_peer()?;
     std::env::set_var(dds_runtime::xtypes::ANNOUNCE_ENV, "on");
     let domain = 143;
-    let p = participant(domain);
+    let p = loopback_participant(domain);
     let app = |x: i32, v2: bool| {
         (
             x,
@@ -362,7 +353,7 @@ fn evolution_against_cyclone() -> Result<(), Skip> {
     drop((_wa, _wm, ra, rm));
 
     // Cyclone's version-1 writers, our version-2 readers (defaults for what version 1 lacks).
-    let p2 = participant(domain);
+    let p2 = loopback_participant(domain);
     let (ra, rm) = (
         reader::<AppV2>(&p2, "EvoApp"),
         reader::<MutV2>(&p2, "EvoMut"),
@@ -436,7 +427,7 @@ fn evolution_ours_against_ours() -> Result<(), Skip> {
     require_netns()?;
     std::env::set_var(dds_runtime::xtypes::ANNOUNCE_ENV, "on");
     let domain = 144;
-    let (pw, pr) = (participant(domain), participant(domain));
+    let (pw, pr) = (loopback_participant(domain), loopback_participant(domain));
     let (w1, m1) = (
         writer::<AppV1>(&pw, "EvoApp"),
         writer::<MutV1>(&pw, "EvoMut"),

@@ -11,6 +11,16 @@ use std::sync::{Arc, Condvar, Mutex, OnceLock};
 use std::thread;
 use std::time::{Duration, Instant};
 
+/// A participant of ours on `lo`, announcing itself every 200 ms (for tests that use the library directly).
+pub fn loopback_participant(domain: u32) -> dds_runtime::prelude::DomainParticipant {
+    dds_runtime::prelude::DomainParticipant::builder()
+        .domain_id(domain)
+        .interface("lo")
+        .spdp_interval(Duration::from_millis(200))
+        .build()
+        .expect("participant")
+}
+
 /// The workspace root (`tests/..`).
 pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -12,7 +12,7 @@ use std::time::Duration;
 use dds_runtime::prelude::*;
 use dds_runtime::xtypes::typeobject::{from_bytes, TypeBody, TypeInformation, TypeObject};
 
-use super::harness::{cyclone_peer, require_netns, Proc, Skip};
+use super::harness::{cyclone_peer, loopback_participant, require_netns, Proc, Skip};
 
 const URI: &str = r#"<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface name="lo" multicast="true"/></Interfaces><AllowMulticast>true</AllowMulticast></General></Domain></CycloneDDS>"#;
 
@@ -62,16 +62,6 @@ fn cyclonedds_cli(secs: u32, args: &[&str]) -> Command {
     c
 }
 
-/// A participant of ours on loopback, announcing itself every 200 ms.
-fn participant(domain: u32) -> DomainParticipant {
-    DomainParticipant::builder()
-        .domain_id(domain)
-        .interface("lo")
-        .spdp_interval(Duration::from_millis(200))
-        .build()
-        .expect("participant")
-}
-
 /// A participant of ours writing `Outer` samples on `topic` every 100 ms until the flag drops.
 fn our_writer(
     domain: u32,
@@ -81,7 +71,7 @@ fn our_writer(
     Arc<AtomicBool>,
     std::thread::JoinHandle<()>,
 ) {
-    let p = participant(domain);
+    let p = loopback_participant(domain);
     let t = p
         .create_topic::<Outer>(topic, &TopicQos::default())
         .unwrap();
@@ -260,7 +250,7 @@ fn our_client_fetches_a_cyclone_python_type() -> Result<(), Skip> {
         .collect();
     let theirs: TypeInformation = from_bytes(&bytes).unwrap();
 
-    let p = participant(domain);
+    let p = loopback_participant(domain);
     let t = p
         .discovered_topic_type("PyTrack", Duration::from_secs(20))
         .unwrap_or_else(|e| panic!("type not resolved: {e}\n{}", writer.dump()));

@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 use dds_runtime::prelude::*;
 use dds_runtime::xtypes::XTypesType;
 
-use super::harness::{cyclone_peer, require_netns, Proc, Skip};
+use super::harness::{cyclone_peer, loopback_participant, require_netns, Proc, Skip};
 
 #[macro_use]
 #[path = "../../../dds-runtime/tests/xtypes_shapes/mod.rs"]
@@ -70,15 +70,6 @@ fn want_total() -> usize {
 
 fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
-}
-
-fn participant(domain: u32) -> DomainParticipant {
-    DomainParticipant::builder()
-        .domain_id(domain)
-        .interface("lo")
-        .spdp_interval(Duration::from_millis(200))
-        .build()
-        .expect("participant")
 }
 
 /// Reliable, KEEP_LAST 1, transient-local: a sample written before the match still arrives.
@@ -225,7 +216,7 @@ fn settle(mut settled: impl FnMut() -> bool) -> bool {
 
 /// Cyclone writes, our 625 readers read.
 fn cyclone_writes(domain: u32) -> BTreeMap<(usize, usize), Pair> {
-    let p = participant(domain);
+    let p = loopback_participant(domain);
     let sub = p.create_subscriber(&SubscriberQos::default()).unwrap();
     let rq = qos().1;
     let readers: Vec<_> = all_pairs()
@@ -263,7 +254,7 @@ fn cyclone_writes(domain: u32) -> BTreeMap<(usize, usize), Pair> {
 
 /// Our 625 writers write, Cyclone reads.
 fn ours_write(domain: u32) -> BTreeMap<(usize, usize), Pair> {
-    let p = participant(domain);
+    let p = loopback_participant(domain);
     let publisher = p.create_publisher(&PublisherQos::default()).unwrap();
     let wq = qos().0;
     let writers: Vec<_> = all_pairs()

@@ -173,13 +173,9 @@ impl<T: DdsType> Registered for ReaderInner<T> {
         i: InstanceStateMask,
         out: &mut Vec<u64>,
     ) {
-        let sel = Selection {
-            sample_states: s,
-            view_states: v,
-            instance_states: i,
-            ..Selection::default()
-        };
-        lock(&self.cache).cache.matching_order(&sel, out);
+        lock(&self.cache)
+            .cache
+            .matching_order(&Selection::states(s, v, i), out);
     }
     fn notify_data_available(self: Arc<Self>) {
         self.state
