@@ -422,3 +422,66 @@ fn group_ordered_access_lists_readers_in_sample_order() {
     assert_eq!(seen, writes);
     assert!(sub.get_datareaders(any.0, any.1, any.2).unwrap().is_empty());
 }
+
+/// GROUP coherent access: inside `begin_access` / `end_access` the subscriber's readers never show part of
+/// a group set. A writer thread ends 300 group sets of one sample per writer as fast as it can while this
+/// thread counts both readers' samples inside an access scope, over and over: the counts are always
+/// equal (one reader holding a set's part that the other does not yet hold is a split set).
+#[test]
+fn group_set_is_never_split_across_readers_inside_an_access_scope() {
+    const SETS: i32 = 300;
+    let (_ps, publ, sub, ws, rs) = group_pair(
+        209,
+        presentation(PresentationAccessScope::Group, true, false),
+    );
+    let writer = std::thread::spawn(move || {
+        for set in 0..SETS {
+            publ.begin_coherent_changes().unwrap();
+            ws[0].write(&shape("RED", set)).unwrap();
+            ws[1].write(&shape("RED", set)).unwrap();
+            publ.end_coherent_changes().unwrap();
+        }
+        (publ, ws)
+    });
+    let mut splits = Vec::new();
+    let deadline = std::time::Instant::now() + Duration::from_secs(30);
+    loop {
+        sub.begin_access().unwrap();
+        let counts = (rs[0].sample_count(), rs[1].sample_count());
+        sub.end_access().unwrap();
+        if counts.0 != counts.1 {
+            splits.push(counts);
+        }
+        if counts == (SETS as usize, SETS as usize) || std::time::Instant::now() > deadline {
+            break;
+        }
+    }
+    let _keep = writer.join().unwrap();
+    assert_eq!(
+        (rs[0].sample_count(), rs[1].sample_count()),
+        (SETS as usize, SETS as usize)
+    );
+    assert!(splits.is_empty(), "split sets seen: {splits:?}");
+}
+
+/// GROUP access scope: while `begin_access` is open the readers' contents do not change; what arrived
+/// meanwhile appears at `end_access`.
+#[test]
+fn access_scope_holds_back_changes_until_it_ends() {
+    let (_ps, publ, sub, ws, rs) = group_pair(
+        210,
+        presentation(PresentationAccessScope::Group, true, false),
+    );
+    sub.begin_access().unwrap();
+    publ.begin_coherent_changes().unwrap();
+    ws[0].write(&shape("RED", 1)).unwrap();
+    ws[1].write(&shape("RED", 1)).unwrap();
+    publ.end_coherent_changes().unwrap();
+    for w in &ws {
+        w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    }
+    std::thread::sleep(Duration::from_millis(100));
+    assert_eq!((rs[0].sample_count(), rs[1].sample_count()), (0, 0));
+    sub.end_access().unwrap();
+    assert_eq!((rs[0].sample_count(), rs[1].sample_count()), (1, 1));
+}

@@ -8,7 +8,7 @@
 //! change, and a group coherent set whose parts readers deliver together (`rtps::participant::group`).
 
 use std::sync::atomic::AtomicU64;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, Weak};
 use std::time::{Duration, Instant};
 
 use crate::qos::{Presentation, PresentationAccessScope};
@@ -40,9 +40,7 @@ impl CoherentGroup {
         let (open, group) = {
             let mut st = lock(&self.state);
             st.writers.push(id);
-            if p.access_scope == PresentationAccessScope::Group
-                && (p.coherent_access || p.ordered_access)
-            {
+            if group_scoped(p) {
                 st.group.get_or_insert_with(WriterGroup::default);
             }
             (st.depth > 0, st.group.clone())
@@ -150,12 +148,50 @@ fn end_one(driver: &Driver, w: EntityId, deadline: Option<Instant>) -> DdsResult
     }
 }
 
+/// A reader of a subscriber with GROUP access scope (coherent or ordered), as its [`AccessScope`] delivers
+/// to it: what the core queued for all the subscriber's readers is stored in one step, so that a group set
+/// is never seen in one reader and not yet in another.
+pub(crate) trait AccessMember: Send + Sync {
+    /// Under the core lock: sets aside what the core has queued for the reader so far.
+    fn stage(&self);
+    /// How many changes wait in the reader's queue (bounds what an open access scope holds back).
+    fn held(&self) -> usize;
+    /// Stores what was set aside (under the scope's gate).
+    fn commit(&self);
+    /// After the gate: raises the statuses and calls the listeners that the stores call for.
+    fn announce(self: Arc<Self>);
+}
+
+/// Most changes the readers of one subscriber hold back while an access scope stays open: beyond it they
+/// are stored anyway (memory stays bounded; the scope then sees changes arrive).
+const MAX_HELD: usize = 1 << 16;
+
+#[derive(Default)]
+struct Gate {
+    /// Nesting depth of `begin_access`.
+    depth: u32,
+    /// GROUP access scope: the subscriber's readers.
+    members: Vec<Weak<dyn AccessMember>>,
+}
+
 /// A subscriber's access scope: `begin_access` / `end_access` nesting, and the counter its readers number
 /// their samples from with GROUP ordered access (one order across the readers, for `get_datareaders`).
-#[derive(Debug, Default)]
+///
+/// With GROUP access scope the readers store what they receive through [`AccessScope::deliver`], all of
+/// them at once, and nothing while an access scope is open: inside `begin_access` / `end_access` the
+/// readers' contents do not change, and a group set is in all of its readers or in none.
+#[derive(Default)]
 pub(crate) struct AccessScope {
-    depth: Mutex<u32>,
+    gate: Mutex<Gate>,
     order: Arc<AtomicU64>,
+}
+
+impl std::fmt::Debug for AccessScope {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("AccessScope")
+            .field("depth", &lock(&self.gate).depth)
+            .finish()
+    }
 }
 
 impl AccessScope {
@@ -164,23 +200,65 @@ impl AccessScope {
         self.order.clone()
     }
 
-    pub(crate) fn begin(&self) {
-        *lock(&self.depth) += 1;
+    /// Adds a reader that stores through [`AccessScope::deliver`].
+    pub(crate) fn join(&self, member: Weak<dyn AccessMember>) {
+        let mut g = lock(&self.gate);
+        g.members.retain(|m| m.strong_count() > 0);
+        g.members.push(member);
     }
 
-    pub(crate) fn end(&self) -> DdsResult<()> {
-        let mut d = lock(&self.depth);
-        if *d == 0 {
-            return Err(DdsError::PreconditionNotMet(
-                "end_access without begin_access",
-            ));
+    pub(crate) fn begin(&self) {
+        lock(&self.gate).depth += 1;
+    }
+
+    /// Ends one level; the outermost delivers what the readers held back meanwhile.
+    pub(crate) fn end(&self, driver: &Driver) -> DdsResult<()> {
+        {
+            let mut g = lock(&self.gate);
+            if g.depth == 0 {
+                return Err(DdsError::PreconditionNotMet(
+                    "end_access without begin_access",
+                ));
+            }
+            g.depth -= 1;
+            if g.depth > 0 || g.members.is_empty() {
+                return Ok(());
+            }
         }
-        *d -= 1;
+        self.deliver(driver);
         Ok(())
     }
 
     pub(crate) fn is_open(&self) -> bool {
-        *lock(&self.depth) > 0
+        lock(&self.gate).depth > 0
+    }
+
+    /// Stores what the core queued for every reader of the subscriber, in one step: the queues are set
+    /// aside together under the core lock (the core queues all parts of a group set in one hold of it),
+    /// then stored under the gate, which `begin_access` also takes. Nothing is stored while an access scope
+    /// is open (up to [`MAX_HELD`] changes); `end_access` delivers. Listeners run after the gate is free.
+    pub(crate) fn deliver(&self, driver: &Driver) {
+        let members: Vec<Arc<dyn AccessMember>> = {
+            let g = lock(&self.gate);
+            let members: Vec<_> = g.members.iter().filter_map(Weak::upgrade).collect();
+            if g.depth > 0 {
+                let held: usize = members.iter().map(|m| m.held()).sum();
+                if held < MAX_HELD {
+                    return;
+                }
+                tracing::warn!(
+                    held,
+                    "access scope open too long: storing what its readers hold"
+                );
+            }
+            driver.query_core(|_| members.iter().for_each(|m| m.stage()));
+            members.iter().for_each(|m| m.commit());
+            members
+        };
+        let _batch = super::data_on_readers::DataOnReadersBatch::start();
+        for m in members {
+            m.announce();
+        }
     }
 }
 
@@ -188,6 +266,12 @@ impl AccessScope {
 /// in reception order across instances (the default, and what TOPIC and GROUP scope ask for).
 pub(crate) fn instance_ordered(p: &Presentation) -> bool {
     p.ordered_access && p.access_scope == PresentationAccessScope::Instance
+}
+
+/// Whether a subscriber's readers store through their [`AccessScope`] (GROUP access scope, coherent or
+/// ordered).
+pub(crate) fn group_scoped(p: &Presentation) -> bool {
+    p.access_scope == PresentationAccessScope::Group && (p.coherent_access || p.ordered_access)
 }
 
 /// Whether a subscriber's readers share one order (ordered access with GROUP scope): `get_datareaders`

@@ -25,7 +25,9 @@ use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
 use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
 use super::participant::DomainParticipant;
-use super::presentation::{group_ordered, instance_ordered, AccessScope};
+use super::presentation::{
+    group_ordered, group_scoped, instance_ordered, AccessMember, AccessScope,
+};
 use super::sample::{
     InstanceHandle, InstanceStateMask, Sample, SampleInfo, SampleStateMask, ViewStateMask,
 };
@@ -103,6 +105,11 @@ impl Subscriber {
     /// Starts an access scope (DDS 1.4 §2.2.2.5.2.8) for reading coherent or ordered data across this
     /// subscriber's readers. Calls nest. Coherent sets become visible only whole (each writer's part of a
     /// set is stored at once), so reads inside and outside a scope never see part of a set.
+    ///
+    /// With GROUP access scope (coherent or ordered), the readers store what arrives all at once, and
+    /// not at all while a scope is open: between `begin_access` and `end_access` their contents do not
+    /// change, and a group set spanning several readers is in all of them or in none. What arrived
+    /// meanwhile is stored by the outermost `end_access` (or, past 65 536 held changes, anyway).
     pub fn begin_access(&self) -> DdsResult<()> {
         self.participant.driver().check_alive()?;
         self.access.begin();
@@ -111,7 +118,7 @@ impl Subscriber {
 
     /// Ends the access scope started by [`Subscriber::begin_access`]; `PreconditionNotMet` without one.
     pub fn end_access(&self) -> DdsResult<()> {
-        self.access.end()
+        self.access.end(self.participant.driver())
     }
 
     /// Whether an access scope is open.
@@ -183,6 +190,9 @@ impl Subscriber {
             state: EndpointState::new(driver.clone()),
             pending: Mutex::new(VecDeque::new()),
             group_order: group_ordered(&self.qos.presentation).then(|| self.access.order()),
+            access: group_scoped(&self.qos.presentation).then(|| self.access.clone()),
+            staged: Mutex::new(VecDeque::new()),
+            committed: Mutex::default(),
             cache: Mutex::new(CacheState {
                 cache,
                 by_hash: HashMap::new(),
@@ -218,6 +228,10 @@ impl Subscriber {
             }
             Ok(id)
         })?;
+        if inner.access.is_some() {
+            let member: Arc<dyn AccessMember> = inner.clone();
+            self.access.join(Arc::downgrade(&member));
+        }
         ops::register_reader(self, &inner, t.name());
         let id = handle.id();
         topic.reader_created(id);
@@ -259,6 +273,12 @@ struct Pass {
     rx_time: SystemTime,
     /// Consecutive samples mostly come from one writer: its QoS is looked up once per run.
     writer_info: Option<(Guid, RemoteWriterInfo)>,
+    stored: Stored,
+}
+
+/// What storing a reader's queue did, for the statuses it raises.
+#[derive(Default)]
+struct Stored {
     /// Something was stored or changed state.
     any: bool,
     rejected: Vec<(super::status::SampleRejectedReason, InstanceHandle)>,
@@ -276,6 +296,12 @@ struct ReaderInner<T: DdsType> {
     pending: Mutex<VecDeque<(u64, Pending)>>,
     /// GROUP ordered access: the subscriber's counter, which places each change as the core delivers it.
     group_order: Option<Arc<AtomicU64>>,
+    /// GROUP access scope: the subscriber's scope, which stores the queues of all its readers at once.
+    access: Option<Arc<AccessScope>>,
+    /// What the access scope set aside from `pending` (see [`AccessMember`]).
+    staged: Mutex<VecDeque<(u64, Pending)>>,
+    /// What the access scope stored, for `announce`.
+    committed: Mutex<Stored>,
     cache: Mutex<CacheState<T>>,
     data_cv: Condvar,
     /// Threads in `wait_for_data`; registered under the cache lock so that `notify_data` (called after the
@@ -842,9 +868,64 @@ impl<T: DdsType> ReaderInner<T> {
             return;
         };
         match st.cache.insert(inc, pass.now) {
-            Outcome::Accepted { .. } => pass.any = true,
+            Outcome::Accepted { .. } => pass.stored.any = true,
             Outcome::Filtered => {}
-            Outcome::Rejected { reason, handle } => pass.rejected.push((reason, handle)),
+            Outcome::Rejected { reason, handle } => pass.stored.rejected.push((reason, handle)),
+        }
+    }
+
+    /// Stores the changes of `queue` (the core's queue, or what the access scope set aside).
+    fn store_queued(&self, queue: &Mutex<VecDeque<(u64, Pending)>>) -> Stored {
+        let mut pass = Pass {
+            now: Instant::now(),
+            rx_time: SystemTime::now(),
+            writer_info: None,
+            stored: Stored::default(),
+        };
+        let mut guard = lock(&self.cache);
+        let st = &mut *guard;
+        // Taking the queue under the cache lock keeps the core's order even with several receive threads.
+        let mut batch = std::mem::take(&mut st.batch);
+        std::mem::swap(&mut batch, &mut *lock(queue));
+        for (place, item) in batch.drain(..) {
+            st.cache.order_from(place);
+            match item {
+                Pending::Sample(s) => self.store(st, s, &mut pass),
+                // Under one lock hold: a read sees all of the set or none of it.
+                Pending::CoherentSet(set) => {
+                    for s in set {
+                        self.store(st, s, &mut pass);
+                    }
+                }
+                Pending::WriterGone(g) => pass.stored.any |= st.cache.writer_gone(g, pass.now),
+            }
+        }
+        st.batch = batch;
+        pass.stored
+    }
+
+    /// Raises SAMPLE_REJECTED and DATA_AVAILABLE for what [`ReaderInner::store_queued`] stored.
+    fn announce_stored(self: &Arc<Self>, stored: Stored) {
+        let Stored { any, rejected } = stored;
+        if !rejected.is_empty() {
+            tracing::debug!(
+                count = rejected.len(),
+                "samples rejected by resource limits"
+            );
+            self.state.signal(
+                StatusMask::SAMPLE_REJECTED,
+                |st| {
+                    for (reason, handle) in &rejected {
+                        st.sample_rejected.record(*reason, *handle);
+                    }
+                    &mut st.sample_rejected
+                },
+                self.reader(),
+                |l, r, s| l.on_sample_rejected(r, s),
+            );
+        }
+        if any {
+            self.notify_data();
         }
     }
 
@@ -878,55 +959,11 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
     }
 
     fn process(self: Arc<Self>) {
-        let mut pass = Pass {
-            now: Instant::now(),
-            rx_time: SystemTime::now(),
-            writer_info: None,
-            any: false,
-            rejected: Vec::new(),
-        };
-        {
-            let mut guard = lock(&self.cache);
-            let st = &mut *guard;
-            // Taking the queue under the cache lock keeps the core's order even with several receive threads.
-            let mut batch = std::mem::take(&mut st.batch);
-            std::mem::swap(&mut batch, &mut *lock(&self.pending));
-            for (place, item) in batch.drain(..) {
-                st.cache.order_from(place);
-                match item {
-                    Pending::Sample(s) => self.store(st, s, &mut pass),
-                    // Under one lock hold: a read sees all of the set or none of it.
-                    Pending::CoherentSet(set) => {
-                        for s in set {
-                            self.store(st, s, &mut pass);
-                        }
-                    }
-                    Pending::WriterGone(g) => pass.any |= st.cache.writer_gone(g, pass.now),
-                }
-            }
-            st.batch = batch;
+        if let Some(scope) = &self.access {
+            return scope.deliver(&self.state.driver);
         }
-        let Pass { any, rejected, .. } = pass;
-        if !rejected.is_empty() {
-            tracing::debug!(
-                count = rejected.len(),
-                "samples rejected by resource limits"
-            );
-            self.state.signal(
-                StatusMask::SAMPLE_REJECTED,
-                |st| {
-                    for (reason, handle) in &rejected {
-                        st.sample_rejected.record(*reason, *handle);
-                    }
-                    &mut st.sample_rejected
-                },
-                self.reader(),
-                |l, r, s| l.on_sample_rejected(r, s),
-            );
-        }
-        if any {
-            self.notify_data();
-        }
+        let stored = self.store_queued(&self.pending);
+        self.announce_stored(stored);
     }
 
     fn on_event(self: Arc<Self>, ev: &Event) {
@@ -997,6 +1034,29 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
             self.reader(),
             |l, r, s| l.on_requested_deadline_missed(r, s),
         );
+    }
+}
+
+impl<T: DdsType> AccessMember for ReaderInner<T> {
+    fn stage(&self) {
+        let mut queued = lock(&self.pending);
+        lock(&self.staged).append(&mut queued);
+    }
+
+    fn held(&self) -> usize {
+        lock(&self.pending).len()
+    }
+
+    fn commit(&self) {
+        let s = self.store_queued(&self.staged);
+        let mut c = lock(&self.committed);
+        c.any |= s.any;
+        c.rejected.extend(s.rejected);
+    }
+
+    fn announce(self: Arc<Self>) {
+        let stored = std::mem::take(&mut *lock(&self.committed));
+        self.announce_stored(stored);
     }
 }
 
