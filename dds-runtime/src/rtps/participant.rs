@@ -340,7 +340,7 @@ impl Participant {
     pub fn create_writer(&mut self, now: Instant, spec: WriterSpec) -> Result<EntityId, CoreError> {
         let data = self.add_writer(spec)?;
         let id = data.guid.entity_id;
-        self.own_leases.track(now, id, &data.qos.writer.liveliness);
+        self.track_own_lease(now, id, &data.qos.writer.liveliness);
         self.publish_endpoint(now, data);
         Ok(id)
     }

@@ -26,7 +26,7 @@ const WAIT: Duration = Duration::from_secs(20);
 
 /// The Cyclone side. `writer`: writes once, asserts every 200 ms for 3 s ("asserting"), is silent for 3 s
 /// ("silent"), asserts again for 3 s ("asserting again"). `reader`: prints each liveliness change as
-/// `liveliness alive=A not_alive=N`, for 15 s.
+/// `liveliness alive=A not_alive=N`, for 15 s. A third argument makes the liveliness AUTOMATIC.
 const PEER: &str = r#"
 import sys, time
 from dataclasses import dataclass
@@ -51,8 +51,8 @@ class ShapeType(IdlStruct, typename="ShapeType"):
     shapesize: int32
 
 mode, domain = sys.argv[1], int(sys.argv[2])
-qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)),
-          Policy.Liveliness.ManualByTopic(duration(seconds=1)))
+kind = Policy.Liveliness.Automatic if len(sys.argv) > 3 else Policy.Liveliness.ManualByTopic
+qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), kind(duration(seconds=1)))
 dp = DomainParticipant(domain)
 tp = Topic(dp, "Lively", ShapeType)
 if mode == "writer":
@@ -85,9 +85,14 @@ else:
 "#;
 
 fn peer(mode: &str, domain: u32) -> Result<Proc, Skip> {
+    peer_with(mode, domain, &[])
+}
+
+fn peer_with(mode: &str, domain: u32, extra: &[&str]) -> Result<Proc, Skip> {
     cyclone_peer()?;
     let mut c = Command::new("python3");
     c.args(["-u", "-c", PEER, mode, &domain.to_string()]);
+    c.args(extra);
     Ok(Proc::spawn(&format!("cyclone {mode}"), c))
 }
 
@@ -271,6 +276,68 @@ fn us_to_cyclone(domain: u32) -> Result<(), Skip> {
         w.liveliness_lost_status().total_count == base + 1,
         &[&rd],
         "our writer lost liveliness again after writing and asserting"
+    );
+    Ok(())
+}
+
+/// AUTOMATIC liveliness with a lease (1 s) shorter than our SPDP interval (3 s): the participant asserts
+/// often enough for it, so a Cyclone reader requesting the same lease keeps our idle writer alive.
+#[test]
+fn automatic_liveliness_with_a_short_lease_keeps_an_idle_writer_alive_at_cyclone() {
+    let _ = automatic_us_to_cyclone(214);
+}
+
+fn automatic_us_to_cyclone(domain: u32) -> Result<(), Skip> {
+    require_netns()?;
+    let rd = peer_with("reader", domain, &["automatic"])?;
+    check!(
+        rd.wait_line(WAIT, |l| l == "created").is_some(),
+        &[&rd],
+        "peer reader"
+    );
+    let p = participant(domain);
+    let t = p
+        .create_topic::<ShapeType>("Lively", &TopicQos::default())
+        .expect("topic");
+    let wq = DataWriterQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .liveliness(Liveliness {
+            kind: LivelinessKind::Automatic,
+            lease_duration: LEASE,
+        })
+        .build();
+    let w = p
+        .create_publisher(&PublisherQos::default())
+        .and_then(|s| s.create_datawriter(&t, &wq))
+        .expect("writer");
+    check!(
+        wait_until(WAIT, || w.publication_matched_status().current_count == 1),
+        &[&rd],
+        "no match"
+    );
+    w.write(&ShapeType {
+        color: "RED".into(),
+        ..Default::default()
+    })
+    .expect("write");
+    check!(
+        rd.wait_line(WAIT, |l| l == "liveliness alive=1 not_alive=0")
+            .is_some(),
+        &[&rd],
+        "never alive"
+    );
+    // Idle for six leases.
+    std::thread::sleep(6 * LEASE);
+    let lost = rd.grep(|l| l.starts_with("liveliness") && !l.ends_with("not_alive=0"));
+    check!(
+        lost.is_empty(),
+        &[&rd],
+        "idle AUTOMATIC writer lost: {lost:?}"
+    );
+    check!(
+        w.liveliness_lost_status().total_count == 0,
+        &[&rd],
+        "our writer reported LIVELINESS_LOST"
     );
     Ok(())
 }

@@ -78,7 +78,7 @@ impl Participant {
         match self.deferred.remove(&id) {
             Some(Deferred::Writer(d)) => {
                 // A writer's liveliness lease starts when it becomes visible.
-                self.own_leases.track(now, id, &d.qos.writer.liveliness);
+                self.track_own_lease(now, id, &d.qos.writer.liveliness);
                 self.publish_endpoint(now, d);
             }
             Some(Deferred::Reader(d)) => self.publish_endpoint(now, d),

@@ -1,7 +1,7 @@
 //! Liveliness in the participant: the leases of matched writers with manual liveliness (see
 //! [`crate::rtps::liveliness`]) fed by what arrives, and our own assertions on the wire.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use super::Participant;
 use crate::qos::Liveliness;
@@ -42,6 +42,30 @@ impl Participant {
     /// The local reader `reader` no longer matches `writer`.
     pub(super) fn untrack_liveliness(&mut self, writer: &Guid, reader: EntityId) {
         self.leases.untrack(writer, reader);
+    }
+
+    /// Our local writer `writer` became visible with `liveliness`: its lease starts now, and the automatic
+    /// assertion comes often enough for it.
+    pub(super) fn track_own_lease(
+        &mut self,
+        now: Instant,
+        writer: EntityId,
+        liveliness: &Liveliness,
+    ) {
+        self.own_leases.track(now, writer, liveliness);
+        self.pmd_due = self.pmd_due.min(now + self.automatic_interval());
+        self.timers_changed();
+    }
+
+    /// How often the participant asserts its automatic liveliness (ParticipantMessageData of kind
+    /// AUTOMATIC): every SPDP interval, or 2/5 of the shortest lease of an AUTOMATIC writer when that is
+    /// shorter, so that one late or lost assertion does not cost the writers their liveliness.
+    pub(super) fn automatic_interval(&self) -> Duration {
+        let floor = Duration::from_millis(1);
+        match self.own_leases.shortest_automatic() {
+            Some(lease) => self.config.spdp_interval.min(lease * 2 / 5).max(floor),
+            None => self.config.spdp_interval,
+        }
     }
 
     /// Leases that ran out.

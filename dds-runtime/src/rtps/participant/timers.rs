@@ -92,17 +92,19 @@ impl Participant {
         if !self.enabled || self.timer_floor.get().is_some_and(|floor| now < floor) {
             return;
         }
+        // Leases first: an AUTOMATIC writer whose assertion below comes too late has lost its liveliness.
+        self.expire_leases(now);
         if now >= self.spdp_due {
             self.send_spdp(None);
             self.spdp_due = now + self.config.spdp_interval;
         }
         if now >= self.pmd_due {
             // Automatic liveliness: one ParticipantMessageData per interval keeps our lease alive at peers that
-            // only count builtin liveliness traffic.
+            // only count builtin liveliness traffic, and renews our AUTOMATIC writers' leases.
             self.send_participant_message(now, builtin::PMD_KIND_AUTOMATIC);
-            self.pmd_due = now + self.config.spdp_interval;
+            self.own_leases.assert_automatic(now);
+            self.pmd_due = now + self.automatic_interval();
         }
-        self.expire_leases(now);
         self.type_lookup_timeout(now);
         let expired: Vec<GuidPrefix> = self
             .participants

@@ -33,12 +33,17 @@ impl Writer {
     }
 }
 
-/// The liveliness our own writers committed to (DDS 1.4 §2.2.3.11): one lease per local writer with
-/// MANUAL_BY_PARTICIPANT or MANUAL_BY_TOPIC liveliness and a finite lease duration. A write or
-/// `assert_liveliness` of the writer renews it (for MANUAL_BY_PARTICIPANT, those of every such writer of
-/// the participant, and the participant's `assert_liveliness`); a lease that runs out reports
-/// [`Event::LivelinessLost`] once, until the writer asserts again. AUTOMATIC writers live as long as their
-/// participant runs, so they are not tracked. Sans-I/O: time comes in as an argument.
+/// The liveliness our own writers committed to (DDS 1.4 §2.2.3.11): one lease per local writer with a
+/// finite lease duration.
+/// - MANUAL_BY_TOPIC: a write or `assert_liveliness` of the writer renews it.
+/// - MANUAL_BY_PARTICIPANT: those of every such writer of the participant, and the participant's
+///   `assert_liveliness`, renew it.
+/// - AUTOMATIC: the participant's own periodic assertion ([`OwnLeases::assert_automatic`], sent at a rate
+///   that fits the shortest such lease) and the writer's writes renew it, so it runs out only when the
+///   participant fails to assert in time (its timers ran late: a stalled process).
+///
+/// A lease that runs out reports [`Event::LivelinessLost`] once, until it is renewed. Sans-I/O: time comes
+/// in as an argument.
 #[derive(Debug, Default)]
 pub(crate) struct OwnLeases {
     writers: BTreeMap<EntityId, OwnLease>,
@@ -46,7 +51,7 @@ pub(crate) struct OwnLeases {
 
 #[derive(Debug)]
 struct OwnLease {
-    by_participant: bool,
+    kind: LivelinessKind,
     duration: Duration,
     deadline: Instant,
     lost: bool,
@@ -55,7 +60,7 @@ struct OwnLease {
 impl OwnLeases {
     /// The local writer `writer` was created with `liveliness`; its lease starts now.
     pub(crate) fn track(&mut self, now: Instant, writer: EntityId, liveliness: &Liveliness) {
-        if liveliness.kind == LivelinessKind::Automatic || liveliness.lease_duration >= INFINITE {
+        if liveliness.lease_duration >= INFINITE {
             return;
         }
         let Some(deadline) = now.checked_add(liveliness.lease_duration) else {
@@ -64,7 +69,7 @@ impl OwnLeases {
         self.writers.insert(
             writer,
             OwnLease {
-                by_participant: liveliness.kind == LivelinessKind::ManualByParticipant,
+                kind: liveliness.kind,
                 duration: liveliness.lease_duration,
                 deadline,
                 lost: false,
@@ -84,7 +89,9 @@ impl OwnLeases {
             return false;
         }
         match self.writers.get_mut(&writer) {
-            Some(l) if l.by_participant => self.assert_participant(now),
+            Some(l) if l.kind == LivelinessKind::ManualByParticipant => {
+                self.assert_participant(now)
+            }
             Some(l) => l.renew(now),
             None => false,
         }
@@ -93,11 +100,30 @@ impl OwnLeases {
     /// The participant asserted its liveliness: renews every MANUAL_BY_PARTICIPANT writer. Returns whether
     /// a lease that had run out was revived.
     pub(crate) fn assert_participant(&mut self, now: Instant) -> bool {
+        self.renew_kind(now, LivelinessKind::ManualByParticipant)
+    }
+
+    /// The participant sent its periodic automatic assertion: renews every AUTOMATIC writer. Returns
+    /// whether a lease that had run out was revived.
+    pub(crate) fn assert_automatic(&mut self, now: Instant) -> bool {
+        self.renew_kind(now, LivelinessKind::Automatic)
+    }
+
+    fn renew_kind(&mut self, now: Instant, kind: LivelinessKind) -> bool {
         let mut revived = false;
-        for l in self.writers.values_mut().filter(|l| l.by_participant) {
+        for l in self.writers.values_mut().filter(|l| l.kind == kind) {
             revived |= l.renew(now);
         }
         revived
+    }
+
+    /// The shortest lease of an AUTOMATIC writer: the participant asserts more often than that.
+    pub(crate) fn shortest_automatic(&self) -> Option<Duration> {
+        self.writers
+            .values()
+            .filter(|l| l.kind == LivelinessKind::Automatic)
+            .map(|l| l.duration)
+            .min()
     }
 
     /// Leases that ran out by `now`: [`Event::LivelinessLost`] for each writer that had not lost it yet.
@@ -190,5 +216,40 @@ mod tests {
         assert_eq!(lost(&mut out), vec![a, b]);
         assert!(l.assert_participant(t0 + ms(200)));
         assert_eq!(l.next_deadline(), Some(t0 + ms(300)));
+    }
+}
+
+#[cfg(test)]
+mod automatic_tests {
+    use super::*;
+
+    #[test]
+    fn automatic_writers_are_renewed_by_the_participants_assertion_and_by_writes() {
+        let t0 = Instant::now();
+        let ms = Duration::from_millis;
+        let (a, m) = (EntityId([0, 0, 1, 2]), EntityId([0, 0, 2, 2]));
+        let mut l = OwnLeases::default();
+        let mut out = VecDeque::new();
+        let lease = |kind| Liveliness {
+            kind,
+            lease_duration: ms(100),
+        };
+        l.track(t0, a, &lease(LivelinessKind::Automatic));
+        l.track(t0, m, &lease(LivelinessKind::ManualByParticipant));
+        assert_eq!(l.shortest_automatic(), Some(ms(100)));
+        assert!(!l.assert_automatic(t0 + ms(90)));
+        l.expire(t0 + ms(150), &mut out);
+        assert!(
+            out.iter()
+                .all(|e| matches!(e, Event::LivelinessLost { writer } if *writer == m)),
+            "the automatic assertion renews AUTOMATIC writers only: {out:?}"
+        );
+        out.clear();
+        assert!(!l.assert_writer(t0 + ms(180), a), "a write renews it too");
+        l.expire(t0 + ms(250), &mut out);
+        assert!(out.is_empty());
+        l.expire(t0 + ms(400), &mut out);
+        assert_eq!(out.len(), 1, "lost once when the assertion came late");
+        assert!(l.assert_automatic(t0 + ms(410)), "revived");
     }
 }
