@@ -10,6 +10,7 @@ use std::path::Path;
 use dds_fuzz::cdr::*;
 use dds_runtime::cdr::{serialize, serialize_key, ByteOrder, DdsType, XcdrVersion};
 use dds_runtime::rtps::messages::{Header, MessageBuilder};
+use dds_runtime::xtypes::XTypesType;
 
 const ENCODINGS: [(XcdrVersion, ByteOrder, &str); 4] = [
     (XcdrVersion::Xcdr1, ByteOrder::LittleEndian, "x1le"),
@@ -97,7 +98,57 @@ fn main() {
         fs::copy(&src, idl.join(f)).unwrap();
     }
     fs::write(idl.join("features.idl"), IDL_FEATURES).unwrap();
+
+    dynamic_seeds(&cdr, &root.join("dynamic_decode"));
+    let filter = root.join("filter_parse");
+    fs::create_dir_all(&filter).unwrap();
+    for (name, text) in FILTERS {
+        fs::write(filter.join(name), text).unwrap();
+    }
 }
+
+/// `dynamic_decode`: the `cdr_decode` seeds of selectors 0–4 (the same types), and for each type its type
+/// objects with a payload, as a peer announces them (selector 5).
+fn dynamic_seeds(cdr: &Path, dir: &Path) {
+    fs::create_dir_all(dir).unwrap();
+    for e in fs::read_dir(cdr).unwrap() {
+        let e = e.unwrap();
+        let bytes = fs::read(e.path()).unwrap();
+        if bytes.first().is_some_and(|&s| s < TYPE_COUNT - 1) {
+            fs::write(dir.join(e.file_name()), bytes).unwrap();
+        }
+    }
+    fn announced<T: DdsType + XTypesType>(dir: &Path, name: &str, v: &T) {
+        let s = T::type_support().expect("describable");
+        let mut out = vec![5u8];
+        for part in [&s.information_bytes, &s.mapping_bytes] {
+            out.extend_from_slice(&(part.len() as u16).to_le_bytes());
+            out.extend_from_slice(part);
+        }
+        serialize(v, XcdrVersion::Xcdr2, ByteOrder::LittleEndian, &mut out).unwrap();
+        fs::write(dir.join(format!("announced-{name}")), out).unwrap();
+    }
+    announced(dir, "shape", &ShapeType::default());
+    announced(
+        dir,
+        "inner",
+        &Inner {
+            n: 7,
+            tags: vec!["a".into()],
+        },
+    );
+    announced(dir, "either", &Either::Text("abc".into()));
+}
+
+/// `filter_parse`: expressions (first line) with parameters (the other lines) over `MutOpt`.
+const FILTERS: [(&str, &str); 6] = [
+    ("simple", "id > 10"),
+    ("params", "b = %0 AND id BETWEEN %1 AND %2\nRED\n1\n100"),
+    ("nested", "h.n = 7 OR h.tags[1] LIKE 'b%'"),
+    ("enum", "f = 'Gamma' AND NOT (a < -1)"),
+    ("union", "e.Text = 't' AND c >= 0"),
+    ("order", "id > 0 ORDER BY c, id"),
+];
 
 fn rtps_seeds(dir: &Path) {
     use dds_runtime::rtps::messages::{Data, Heartbeat, ParameterList, Submessage};

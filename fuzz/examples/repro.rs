@@ -8,6 +8,8 @@ fn main() {
         "rtps_decode" => dds_fuzz::rtps_one,
         "idl_parse" => dds_fuzz::idl_one,
         "typelookup_decode" => dds_fuzz::typelookup_one,
+        "dynamic_decode" => dds_fuzz::dynamic_one,
+        "filter_parse" => dds_fuzz::filter_one,
         t => panic!("unknown target {t}"),
     };
     for f in args {

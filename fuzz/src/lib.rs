@@ -1,11 +1,15 @@
 //! Shared code of the fuzz targets (`fuzz_targets/`) and the seed generator (`examples/gen_seeds.rs`).
 
 pub mod cdr;
+mod dynamic;
+mod filter;
 mod idl;
 mod rtps;
 mod typelookup;
 
 pub use cdr::cdr_one;
+pub use dynamic::dynamic_one;
+pub use filter::filter_one;
 pub use idl::idl_one;
 pub use rtps::rtps_one;
 pub use typelookup::typelookup_one;
