@@ -294,7 +294,9 @@ fn our_writer_sends_each_sample_once_to_two_cyclone_readers() {
         w.write(&shape("ORANGE", i)).unwrap();
     }
     // Acknowledgements from the Cyclone readers have taken 8–10 s on a loaded machine (see docs/network.md).
+    let t0 = std::time::Instant::now();
     w.wait_for_acknowledgments(Duration::from_secs(30)).unwrap();
+    eprintln!("acknowledged after {:?}", t0.elapsed());
     for s in subs {
         let (ok, lines) = s.finish();
         let xs: Vec<String> = lines
