@@ -183,6 +183,33 @@ fn cyclone_to_us(domain: u32) -> Result<(), Skip> {
     Ok(())
 }
 
+/// Our writer with `wq` on the test topic, matched with the Cyclone reader `rd`, after its first write.
+fn matched_writer(
+    domain: u32,
+    wq: &DataWriterQos,
+    rd: &Proc,
+) -> Result<(DomainParticipant, DataWriter<ShapeType>), Skip> {
+    let p = participant(domain);
+    let t = p
+        .create_topic::<ShapeType>("Lively", &TopicQos::default())
+        .expect("topic");
+    let w = p
+        .create_publisher(&PublisherQos::default())
+        .and_then(|s| s.create_datawriter(&t, wq))
+        .expect("writer");
+    check!(
+        wait_until(WAIT, || w.publication_matched_status().current_count == 1),
+        &[rd],
+        "no match"
+    );
+    w.write(&ShapeType {
+        color: "RED".into(),
+        ..Default::default()
+    })
+    .expect("write");
+    Ok((p, w))
+}
+
 #[test]
 fn manual_liveliness_lost_and_regained_us_to_cyclone() {
     let _ = us_to_cyclone(196);
@@ -196,24 +223,7 @@ fn us_to_cyclone(domain: u32) -> Result<(), Skip> {
         &[&rd],
         "peer reader"
     );
-    let p = participant(domain);
-    let t = p
-        .create_topic::<ShapeType>("Lively", &TopicQos::default())
-        .expect("topic");
-    let w = p
-        .create_publisher(&PublisherQos::default())
-        .and_then(|s| s.create_datawriter(&t, &qos().0))
-        .expect("writer");
-    check!(
-        wait_until(WAIT, || w.publication_matched_status().current_count == 1),
-        &[&rd],
-        "no match"
-    );
-    w.write(&ShapeType {
-        color: "RED".into(),
-        ..Default::default()
-    })
-    .expect("write");
+    let (_p, w) = matched_writer(domain, &qos().0, &rd)?;
     // Matching may take longer than the lease: count lapses from the first write on.
     let base = w.liveliness_lost_status().total_count;
     let assert_for = |d: Duration| {
@@ -295,10 +305,6 @@ fn automatic_us_to_cyclone(domain: u32) -> Result<(), Skip> {
         &[&rd],
         "peer reader"
     );
-    let p = participant(domain);
-    let t = p
-        .create_topic::<ShapeType>("Lively", &TopicQos::default())
-        .expect("topic");
     let wq = DataWriterQos::builder()
         .reliability(Reliability::RELIABLE)
         .liveliness(Liveliness {
@@ -306,20 +312,7 @@ fn automatic_us_to_cyclone(domain: u32) -> Result<(), Skip> {
             lease_duration: LEASE,
         })
         .build();
-    let w = p
-        .create_publisher(&PublisherQos::default())
-        .and_then(|s| s.create_datawriter(&t, &wq))
-        .expect("writer");
-    check!(
-        wait_until(WAIT, || w.publication_matched_status().current_count == 1),
-        &[&rd],
-        "no match"
-    );
-    w.write(&ShapeType {
-        color: "RED".into(),
-        ..Default::default()
-    })
-    .expect("write");
+    let (_p, w) = matched_writer(domain, &wq, &rd)?;
     check!(
         rd.wait_line(WAIT, |l| l == "liveliness alive=1 not_alive=0")
             .is_some(),
