@@ -1,6 +1,8 @@
 //! XCDR1/XCDR2 decoding into a [`Value`] by its [`DynamicType`]: bounded (lengths are checked against the bytes
 //! left before anything is allocated, nesting is limited), and hostile bytes are an error, never a panic.
 
+use std::collections::hash_map::{Entry, HashMap};
+
 use crate::cdr::members::{begin_decode, end_member, skip_member};
 use crate::cdr::{
     ByteOrder, CdrReader, CdrType, DecodeError, DecodeErrorKind, Extensibility, Layout, WString,
@@ -81,11 +83,20 @@ pub(super) fn decode(r: &mut CdrReader<'_>, ty: &DynamicType) -> Result<Value, D
                 None
             };
             let n = read_count(r, min_size(key) + min_size(value), *bound, "map length")?;
-            let mut entries = Vec::with_capacity(n.min(r.remaining()));
+            let mut entries: Vec<(Value, Value)> = Vec::with_capacity(n.min(r.remaining()));
+            // A key that comes again replaces the earlier entry's value (the later wins, as in a map and in
+            // the derived code's `BTreeMap`); the first position is kept.
+            let mut index: HashMap<String, usize> = HashMap::new();
             for _ in 0..n {
                 let k = decode(r, key)?;
                 let v = decode(r, value)?;
-                entries.push((k, v));
+                match index.entry(format!("{k:?}")) {
+                    Entry::Occupied(e) => entries[*e.get()].1 = v,
+                    Entry::Vacant(e) => {
+                        e.insert(entries.len());
+                        entries.push((k, v));
+                    }
+                }
             }
             if let Some(l) = limit {
                 r.end_limit(l);
