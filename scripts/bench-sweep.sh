@@ -27,7 +27,7 @@ sizes=${SIZES:-16 64 256 1k 4k 16k 64k 256k 1M 4M}
 lat_sizes=${LAT_SIZES:-16 1k 64k}
 stacks=${STACKS:-ours cy11 cy010}
 cy11_root=${CYCLONE11:-../shared/cyclonedds-11.0.1}
-ours=target/release/dds-perf
+ours=${OURS:-target/release/dds-perf}
 [[ -x $ours ]] || cargo build --release -p dds-examples --bin dds-perf
 out=$(mktemp -d)
 trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$out"' EXIT
