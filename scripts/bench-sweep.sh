@@ -7,6 +7,7 @@
 #   BENCH_SECONDS=10 BENCH_ROUNDS=5 scripts/bench-sweep.sh
 #   SIZES="16 1k 64k" LAT_SIZES="16" scripts/bench-sweep.sh # a subset
 #   STACKS="ours cy11" scripts/bench-sweep.sh               # leave a stack out
+#   BASE=/tmp/dds-perf-old STACKS="ours base cy11" scripts/bench-sweep.sh  # an older build of ours as "base"
 #
 # Throughput: reliable keep-all, two processes, `X sub` <- `X pub size S`; the figure is the mean of the
 #   subscriber's per-second "rate ... kS/s" lines after a 2 s warm-up. CPU: user+system seconds of both
@@ -35,6 +36,8 @@ trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$out"' EXIT
 source scripts/cyclone11.sh
 
 declare -A cmd=([ours]=$ours [cy010]=/usr/bin/ddsperf)
+# BASE=path: another build of dds-perf as stack "base" (before/after comparisons in one interleaved run).
+[[ -n ${BASE:-} ]] && cmd[base]=$BASE
 if [[ -x $cy11_root/bin/ddsperf ]]; then
   cmd[cy11]=$(cyclone11_ddsperf "$cy11_root" "$out")
 fi
