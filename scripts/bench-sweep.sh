@@ -7,6 +7,7 @@
 #   BENCH_SECONDS=10 BENCH_ROUNDS=5 scripts/bench-sweep.sh
 #   SIZES="16 1k 64k" LAT_SIZES="16" scripts/bench-sweep.sh # a subset
 #   STACKS="ours cy11" scripts/bench-sweep.sh               # leave a stack out
+#   BASE=/tmp/dds-perf-old STACKS="ours base cy11" scripts/bench-sweep.sh  # an older build of ours as "base"
 #
 # Throughput: reliable keep-all, two processes, `X sub` <- `X pub size S`; the figure is the mean of the
 #   subscriber's per-second "rate ... kS/s" lines after a 2 s warm-up. CPU: user+system seconds of both
@@ -27,7 +28,7 @@ sizes=${SIZES:-16 64 256 1k 4k 16k 64k 256k 1M 4M}
 lat_sizes=${LAT_SIZES:-16 1k 64k}
 stacks=${STACKS:-ours cy11 cy010}
 cy11_root=${CYCLONE11:-../shared/cyclonedds-11.0.1}
-ours=target/release/dds-perf
+ours=${OURS:-target/release/dds-perf}
 [[ -x $ours ]] || cargo build --release -p dds-examples --bin dds-perf
 out=$(mktemp -d)
 trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$out"' EXIT
@@ -35,6 +36,8 @@ trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$out"' EXIT
 source scripts/cyclone11.sh
 
 declare -A cmd=([ours]=$ours [cy010]=/usr/bin/ddsperf)
+# BASE=path: another build of dds-perf as stack "base" (before/after comparisons in one interleaved run).
+[[ -n ${BASE:-} ]] && cmd[base]=$BASE
 if [[ -x $cy11_root/bin/ddsperf ]]; then
   cmd[cy11]=$(cyclone11_ddsperf "$cy11_root" "$out")
 fi

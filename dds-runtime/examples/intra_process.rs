@@ -2,9 +2,12 @@
 //! exchange over loopback UDP. A benchmark, not a test; run it inside `scripts/isolated`:
 //!
 //! ```text
-//! scripts/isolated cargo run --release -p dds-runtime --example intra_process -- [SIZE] [COUNT] [local|udp]
+//! scripts/isolated cargo run --release -p dds-runtime --example intra_process -- [SIZE] [COUNT] [local|owned|udp]
 //! ```
 //!
+//! `local` writes one sample by reference (`write(&T)`: serialized, and decoded by the reader); `owned`
+//! builds a fresh sample per write and hands it over (`write_owned(T)`: the reader gets it itself, no
+//! serialization); `udp` is `local` with intra-process delivery off.
 //! Prints samples/s, ns/sample and MB/s from the first write to the last take (reliable, KEEP_ALL).
 
 use std::time::{Duration, Instant};
@@ -24,7 +27,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let size: usize = args.next().map_or(Ok(16), |s| s.parse())?;
     let count: u64 = args.next().map_or(Ok(200_000), |s| s.parse())?;
-    let local = args.next().is_none_or(|m| m != "udp");
+    let mode = args.next().unwrap_or_else(|| "local".into());
+    let local = mode != "udp";
+    let owned = mode == "owned";
     let c = Config {
         domain_id: 120,
         interface: InterfaceSelection::Name("lo".into()),
@@ -70,14 +75,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let start = Instant::now();
     for i in 0..count {
-        sample.seq = i;
-        w.write(&sample)?;
+        if owned {
+            w.write_owned(Payload {
+                seq: i,
+                data: vec![0x5a; size],
+            })?;
+        } else {
+            sample.seq = i;
+            w.write(&sample)?;
+        }
     }
     let (got, end) = reader.join().expect("reader thread")?;
     let secs = end.duration_since(start).as_secs_f64();
     println!(
         "{} size {size} B: {got}/{count} samples in {secs:.3} s: {:.0} samples/s, {:.0} ns/sample, {:.1} MB/s",
-        if local { "intra-process" } else { "loopback UDP" },
+        match (local, owned) {
+            (_, true) => "intra-process, write_owned",
+            (true, false) => "intra-process, write",
+            (false, _) => "loopback UDP",
+        },
         got as f64 / secs,
         secs * 1e9 / got.max(1) as f64,
         got as f64 * size as f64 / secs / 1e6

@@ -50,7 +50,14 @@ struct Fixed {
 
 /// Writes `n` samples while another thread takes them in batches; returns (allocations on the writing
 /// thread, on the taking thread, everywhere) per sample.
-fn run(w: &DataWriter<Fixed>, r: &DataReader<Fixed>, first: u64, n: u64) -> (f64, f64, f64) {
+/// With `owned`, each sample goes through `write_owned` (a hand-over, no serialization) instead of `write`.
+fn run(
+    w: &DataWriter<Fixed>,
+    r: &DataReader<Fixed>,
+    first: u64,
+    n: u64,
+    owned: bool,
+) -> (f64, f64, f64) {
     let total_before = TOTAL.load(Ordering::Relaxed);
     let taker = std::thread::scope(|s| {
         let t = s.spawn(|| {
@@ -75,7 +82,11 @@ fn run(w: &DataWriter<Fixed>, r: &DataReader<Fixed>, first: u64, n: u64) -> (f64
         let mut sample = Fixed::default();
         for seq in first..first + n {
             sample.seq = seq;
-            w.write(&sample).unwrap();
+            if owned {
+                w.write_owned(sample.clone()).unwrap();
+            } else {
+                w.write(&sample).unwrap();
+            }
         }
         let writer = MINE.with(Cell::get) - before;
         (writer, t.join().unwrap())
@@ -109,9 +120,9 @@ fn steady_state_allocations_per_sample() {
         assert!(r.wait_for_data(Duration::from_secs(5)).unwrap());
         got += r.take().unwrap().len() as u64;
     }
-    run(&w, &r, filled, 10_000);
+    run(&w, &r, filled, 10_000, false);
     let n = 20_000;
-    let (write, take, total) = run(&w, &r, filled + 10_000, n);
+    let (write, take, total) = run(&w, &r, filled + 10_000, n, false);
     eprintln!(
         "allocations per sample: write path {write:.3}, take {take:.3}, whole process {total:.3}"
     );
@@ -128,6 +139,33 @@ fn steady_state_allocations_per_sample() {
     assert!(take < 0.001, "take: {take:.4} allocations per sample");
     assert!(
         total < 0.05,
+        "whole process: {total:.3} allocations per sample"
+    );
+}
+
+/// `write_owned` to a reader of the same participant: the sample is handed over (moved into the reader's
+/// cache, no serialization, no decode, no datagram); the one allocation per sample is the hand-over box.
+#[test]
+fn intra_process_write_owned_allocations_per_sample() {
+    let p = participant(84);
+    let (mut wq, rq) = reliable_keep_all();
+    wq.reliability = Reliability::Reliable {
+        max_blocking_time: Duration::from_secs(10),
+    };
+    let (w, r) = matched::<Fixed>(&p, &p, "AllocLocal", &wq, &rq);
+    run(&w, &r, 0, 10_000, true);
+    let n = 20_000;
+    let (write, take, total) = run(&w, &r, 10_000, n, true);
+    eprintln!(
+        "write_owned, allocations per sample: write path {write:.3}, take {take:.3}, whole process {total:.3}"
+    );
+    assert!(
+        write < 1.02,
+        "write_owned path: {write:.3} allocations per sample"
+    );
+    assert!(take < 0.001, "take: {take:.4} allocations per sample");
+    assert!(
+        total < 1.05,
         "whole process: {total:.3} allocations per sample"
     );
 }

@@ -231,6 +231,50 @@ fn rust_writer_filters_for_our_reader_while_cyclone_gets_everything() {
     assert_eq!(ours, [0, 1, 2]);
 }
 
+/// `write_owned`: our reader in the writer's participant gets the samples themselves, Cyclone gets them
+/// serialized (the writer has a wire reader, so the bytes are made with the write).
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn typed_writes_reach_a_local_reader_and_cyclone() {
+    let p = participant(69);
+    let w = square_writer(&p);
+    let t = p
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let r = p
+        .create_subscriber(&SubscriberQos::default())
+        .unwrap()
+        .create_datareader(&t, &tl_reliable_reader())
+        .unwrap();
+    let mut child = python(69, &["sub", "Square", "10", "dispose"]);
+    assert!(
+        wait_until(Duration::from_secs(20), || w
+            .publication_matched_status()
+            .current_count
+            == 2),
+        "the writer did not match both readers"
+    );
+    for i in 0..10 {
+        w.write_owned(shape("RED", i)).unwrap();
+    }
+    w.dispose(&shape("RED", 0)).unwrap();
+    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
+    let (xs, disposed, lines) = cyclone_sub_result(&mut child);
+    assert_eq!(xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
+    assert!(disposed, "no dispose seen by Cyclone: {lines:?}");
+    let mut ours = Vec::new();
+    wait_until(Duration::from_secs(5), || {
+        ours.extend(
+            r.take()
+                .unwrap()
+                .into_iter()
+                .filter_map(|s| s.data.map(|d| d.x)),
+        );
+        ours.len() >= 10
+    });
+    assert_eq!(ours, (0..10).collect::<Vec<_>>());
+}
+
 /// The shapes type as a dynamic type, from IDL text (as `dds subscribe --idl` builds it).
 #[cfg(all(feature = "idl", feature = "json"))]
 fn dynamic_shape_type() -> dds_runtime::xtypes::dynamic::DynamicType {

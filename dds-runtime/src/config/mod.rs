@@ -19,6 +19,7 @@
 //! | `DDS_MAX_MESSAGE_SIZE` | largest RTPS message (datagram) we send | bytes, `512`..=`65500` | `14720` |
 //! | `DDS_SOCKET_BUFFER_SIZE` | requested SO_RCVBUF / SO_SNDBUF | bytes | `4194304` |
 //! | `DDS_INTRA_PROCESS` | deliver to readers of the same participant directly (no serialization for them, no socket) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
+//! | `DDS_GSO` | on Linux, a fragmented sample's datagrams to one destination leave in one `UDP_SEGMENT` send | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_SHM` | with the `shm` feature: shared memory with peers on this host (their readers get our writers' samples through it, not UDP) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_WRITE_BATCH` | write batching: samples share datagrams until full, flushed, or this delay has passed | `off`, `on` (1 ms), or a delay in microseconds | `off` |
 //!
@@ -334,6 +335,9 @@ pub struct Config {
     /// Intra-process delivery: a writer gives its samples to readers of the same participant directly,
     /// with no serialization for the reader and no socket (`DDS_INTRA_PROCESS`, default on).
     pub intra_process: bool,
+    /// Segmented sends (Linux `UDP_SEGMENT`, `DDS_GSO`, default on): a run of equal-sized datagrams to one
+    /// destination, as a fragmented sample makes, leaves in one system call. Ignored elsewhere.
+    pub gso: bool,
     /// Shared memory with peers on this host that can use it (`DDS_SHM`, default on; only with the `shm`
     /// feature, ignored without it): their readers get our writers' samples through shared memory, not
     /// UDP. Off, the participant does not announce it, and its peers use UDP with it.
@@ -358,6 +362,7 @@ impl Default for Config {
             socket_buffer_size: 4 << 20,
             write_batch_delay: None,
             intra_process: true,
+            gso: true,
             shm: true,
         }
     }
@@ -468,6 +473,9 @@ impl Config {
         }
         if let Some(v) = lookup("DDS_INTRA_PROCESS") {
             c.intra_process = parse_bool("DDS_INTRA_PROCESS", &v)?;
+        }
+        if let Some(v) = lookup("DDS_GSO") {
+            c.gso = parse_bool("DDS_GSO", &v)?;
         }
         if let Some(v) = lookup("DDS_SHM") {
             c.shm = parse_bool("DDS_SHM", &v)?;

@@ -6,7 +6,7 @@ use std::time::{Instant, SystemTime};
 use foldhash::HashMap;
 
 use crate::cdr::{self, DdsType};
-use crate::rtps::{ChangeKind, ReceivedSample};
+use crate::rtps::{ChangeKind, Payload, ReceivedSample};
 
 use super::cache::Incoming;
 use super::driver::RemoteWriterInfo;
@@ -19,11 +19,28 @@ fn system_time(t: Option<crate::rtps::Time>) -> Option<SystemTime> {
         .map(|d| SystemTime::UNIX_EPOCH + d)
 }
 
+/// The sample itself when the payload carries it (intra-process delivery of `write_owned`/`write_shared`:
+/// no serialization), else decoded from the bytes.
+fn local_or_deserialize<T: DdsType>(payload: &mut Payload) -> Result<T, cdr::DecodeError> {
+    if payload.is_local() {
+        let mut slot: Option<T> = None;
+        match std::mem::take(payload).take_local_into(&mut slot) {
+            Ok(()) => {
+                if let Some(d) = slot {
+                    return Ok(d);
+                }
+            }
+            Err(p) => *payload = p,
+        }
+    }
+    cdr::deserialize::<T>(payload)
+}
+
 /// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped to an
 /// instance. Instances are identified by `cdr::instance_key`; a key-only change without a decodable key
 /// payload is mapped through its key hash to an instance seen before with the same hash.
 pub(crate) fn decode_change<T: DdsType>(
-    s: ReceivedSample,
+    mut s: ReceivedSample,
     info: RemoteWriterInfo,
     by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
     mut key: Vec<u8>,
@@ -36,7 +53,7 @@ pub(crate) fn decode_change<T: DdsType>(
     let mut data = None;
     let mut key_holder = None;
     if kind == ChangeKind::Alive {
-        let d = match cdr::deserialize::<T>(&s.payload) {
+        let d = match local_or_deserialize::<T>(&mut s.payload) {
             Ok(d) => d,
             Err(e) => {
                 tracing::warn!(writer = ?s.writer, seq = s.sequence.0, error = %e, "dropping undecodable sample");

@@ -446,13 +446,27 @@ impl Driver {
         }
     }
 
+    /// Sends the datagrams in order; consecutive ones for the same destinations (a fragmented sample's)
+    /// go to each destination as one run, which the transport may send in one system call.
     fn send_batch(&self, batch: &[Transmit]) {
-        for t in batch {
-            for d in &t.destinations {
+        const RUN: usize = 16;
+        let mut rest = batch;
+        while let Some(first) = rest.first() {
+            let mut run: [&[u8]; RUN] = [&[]; RUN];
+            let mut n = 0;
+            for t in rest.iter().take(RUN) {
+                if t.destinations != first.destinations {
+                    break;
+                }
+                run[n] = &t.payload;
+                n += 1;
+            }
+            for d in &first.destinations {
                 if let Some(a) = to_socket(d) {
-                    self.transport.send_to(&t.payload, a);
+                    self.transport.send_run(&run[..n], a);
                 }
             }
+            rest = &rest[n..];
         }
     }
 

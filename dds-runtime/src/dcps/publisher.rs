@@ -1,6 +1,7 @@
 //! `Publisher` and `DataWriter<T>`.
 
 mod ops;
+mod shared;
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering as AtomicOrdering};
 use std::sync::{Arc, Mutex, RwLock};
@@ -14,7 +15,8 @@ use crate::qos::{
     XCDR2_DATA_REPRESENTATION,
 };
 use crate::rtps::{
-    ChangeKind, EntityId, Event, Guid, Payload, Time, WriteChange, WriteError, WriterSpec,
+    ChangeKind, EntityId, Event, Guid, Payload, SequenceNumber, Time, WriteChange, WriteError,
+    WriterSpec,
 };
 
 use super::condition::StatusCondition;
@@ -179,6 +181,7 @@ impl Publisher {
             instances: Mutex::new(WriterInstances::default()),
             filters: Mutex::new(WriterFilters::default()),
             payloads: Mutex::new(BufferPool::new(WRITER_POOL_BUFFERS, WRITER_POOL_BYTES)),
+            bytes_needed: AtomicBool::new(true),
         });
         let owner = WriterOwner {
             topic: topic.clone(),
@@ -292,6 +295,9 @@ struct WriterInner<T: DdsType> {
     filters: Mutex<WriterFilters>,
     /// Serialized samples' buffers, reused once the history has let go of them.
     payloads: Mutex<BufferPool>,
+    /// Whether the last typed write (`write_owned`, `write_shared`) needed the serialized form (readers
+    /// beyond this participant, or a durable history): the next one serializes before taking the lock.
+    bytes_needed: AtomicBool,
 }
 
 /// Writes samples of type `T`. Cheap to clone; the writer is deleted when the last clone is dropped (a
@@ -415,21 +421,43 @@ impl<T: DdsType> DataWriter<T> {
     /// Hands one change to the core, waiting up to max_blocking_time while flow control refuses it. With the
     /// `sample`, the matched readers' content filters are evaluated on it (writer-side filtering).
     fn submit(&self, change: WriteChange, sample: Option<&T>) -> DdsResult<()> {
+        let id = self.id();
+        let mut attempt = |c: &mut crate::rtps::Participant, now| {
+            let rejected = self.rejected_by_filters(c, sample);
+            Some(c.write_filtered(now, id, change.clone(), rejected))
+        };
+        self.submit_with(&mut attempt, || Ok(()))
+    }
+
+    /// The matched readers whose content filters reject `sample` (writer-side filtering).
+    fn rejected_by_filters(&self, c: &crate::rtps::Participant, sample: Option<&T>) -> Vec<Guid> {
+        sample
+            .map(|s| lock(&self.inner.filters).rejected(c, self.id(), s))
+            .unwrap_or_default()
+    }
+
+    /// [`submit`](Self::submit) with the write done under the core's lock by `attempt`; when it does not
+    /// write (`None`), `prepare` runs (lock released) and the write is tried again.
+    fn submit_with(
+        &self,
+        attempt: &mut impl FnMut(
+            &mut crate::rtps::Participant,
+            Instant,
+        ) -> Option<Result<SequenceNumber, WriteError>>,
+        mut prepare: impl FnMut() -> DdsResult<()>,
+    ) -> DdsResult<()> {
         let driver = &self.inner.state.driver;
         self.inner.state.check_enabled()?;
         let max_block = self.inner.fixed.max_block();
         // Only a refused write needs the clock.
         let mut deadline: Option<Option<Instant>> = None;
-        let id = self.id();
         loop {
             let seen = driver.progress_generation();
-            let write = |c: &mut crate::rtps::Participant, now| {
-                let rejected = sample
-                    .map(|s| lock(&self.inner.filters).rejected(c, id, s))
-                    .unwrap_or_default();
-                c.write_filtered(now, id, change.clone(), rejected)
+            let Some(written) = driver.with_core_writing(|c, now| attempt(c, now)) else {
+                prepare()?;
+                continue;
             };
-            match driver.with_core_writing(write) {
+            match written {
                 Ok(_) => return Ok(()),
                 Err(WriteError::WouldBlock) => {
                     let now = Instant::now();
@@ -468,13 +496,7 @@ impl<T: DdsType> DataWriter<T> {
     /// Publishes `sample` with the given source timestamp.
     pub fn write_w_timestamp(&self, sample: &T, timestamp: SystemTime) -> DdsResult<()> {
         let payload = self.serialize(sample)?;
-        // Keyed writes register the instance, so that deleting the writer can unregister it.
-        let key_hash = if T::IS_KEYED {
-            self.instance_of(sample, true, true)?.and_then(|(_, kh)| kh)
-        } else {
-            lock(&self.inner.instances).keyless_last_write = Some(Instant::now());
-            None
-        };
+        let key_hash = self.written_instance(sample)?;
         let change = WriteChange {
             kind: ChangeKind::Alive,
             payload,
@@ -483,6 +505,17 @@ impl<T: DdsType> DataWriter<T> {
         };
         tracing::trace!(writer = ?self.id(), "write");
         self.submit(change, Some(sample))
+    }
+
+    /// Records a write of `sample`'s instance and gives its key hash (keyed writes register the instance,
+    /// so that deleting the writer can unregister it).
+    fn written_instance(&self, sample: &T) -> DdsResult<Option<[u8; 16]>> {
+        if T::IS_KEYED {
+            Ok(self.instance_of(sample, true, true)?.and_then(|(_, kh)| kh))
+        } else {
+            lock(&self.inner.instances).keyless_last_write = Some(Instant::now());
+            Ok(None)
+        }
     }
 
     /// The instance of `sample` (by serialized key) and its key hash; registers it when `create`, and

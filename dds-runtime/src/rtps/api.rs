@@ -26,6 +26,9 @@ enum Buf {
     Slice(Arc<[u8]>),
     Vec(Arc<Vec<u8>>),
     Owned(Arc<dyn AsRef<[u8]> + Send + Sync>),
+    /// A typed sample handed to readers of its writer's participant as itself; serialized only when
+    /// something reads its bytes.
+    Local(Arc<dyn LocalSample>),
 }
 
 impl Buf {
@@ -34,8 +37,23 @@ impl Buf {
             Buf::Slice(b) => b,
             Buf::Vec(v) => v,
             Buf::Owned(o) => (**o).as_ref(),
+            Buf::Local(l) => l.bytes(),
         }
     }
+}
+
+/// A sample written as a typed value (`DataWriter::write_owned`, `write_shared`) that readers of the same
+/// participant receive as itself, with no serialization: the core carries it in a [`Payload`]
+/// ([`Payload::local`]) without looking inside.
+pub trait LocalSample: Send + Sync + 'static {
+    /// The serialized sample (with its encapsulation header), produced on the first call: for whatever
+    /// needs the bytes after all (a reader of another type, a durability service).
+    fn bytes(&self) -> &[u8];
+    /// Whether `slot` is an `Option` of the sample's type.
+    fn fits(&self, slot: &dyn std::any::Any) -> bool;
+    /// Puts the sample into `slot` when it [`fits`](Self::fits): moved out when this is the last
+    /// reference to it, else cloned.
+    fn take_into(self: Arc<Self>, slot: &mut dyn std::any::Any);
 }
 
 impl Payload {
@@ -68,6 +86,36 @@ impl Payload {
             end,
         }
     }
+    /// Carries a typed sample for intra-process delivery. `len` is what the writer accounts for: the
+    /// serialized length when the sample was serialized already, else 0 (it then must not be sent: only
+    /// readers of the same participant get it). Reading the payload's bytes serializes it.
+    pub fn local(sample: Arc<dyn LocalSample>, len: usize) -> Self {
+        Payload {
+            buf: Some(Buf::Local(sample)),
+            start: 0,
+            end: len,
+        }
+    }
+    /// Whether this payload carries a typed sample ([`Payload::local`]).
+    pub fn is_local(&self) -> bool {
+        matches!(self.buf, Some(Buf::Local(_)))
+    }
+    /// Puts the typed sample of a [`Payload::local`] into `slot`, an `Option` of its type (see
+    /// [`LocalSample::take_into`]); gives the payload back for serialized bytes or another type.
+    pub fn take_local_into(self, slot: &mut dyn std::any::Any) -> Result<(), Payload> {
+        if !matches!(&self.buf, Some(Buf::Local(l)) if l.fits(&*slot)) {
+            return Err(self);
+        }
+        if let Some(Buf::Local(l)) = self.buf {
+            l.take_into(slot);
+        }
+        Ok(())
+    }
+    /// The length the writer's history and flow control account for: the byte length, except for a
+    /// typed sample not serialized when written ([`Payload::local`] with 0), which reading does not change.
+    pub fn accounted_len(&self) -> usize {
+        self.end - self.start
+    }
     /// A copy of `b` in a buffer of its own.
     pub fn copy_from_slice(b: &[u8]) -> Self {
         Payload::new(Arc::<[u8]>::from(b))
@@ -87,6 +135,7 @@ impl Payload {
     /// keeping them does not keep the rest alive.
     pub fn compact(self) -> Payload {
         match &self.buf {
+            Some(Buf::Local(_)) => self,
             Some(b) if b.bytes().len() > self.len() => Payload::copy_from_slice(&self),
             _ => self,
         }
@@ -107,6 +156,8 @@ impl Deref for Payload {
     type Target = [u8];
     fn deref(&self) -> &[u8] {
         match &self.buf {
+            // Serialized on demand: the whole sample, whatever length was accounted for.
+            Some(Buf::Local(l)) => l.bytes(),
             Some(b) => &b.bytes()[self.start..self.end],
             None => &[],
         }
@@ -140,6 +191,13 @@ impl PartialEq for Payload {
 impl Eq for Payload {}
 impl fmt::Debug for Payload {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.is_local() {
+            return write!(
+                f,
+                "Payload(local sample, {} bytes accounted)",
+                self.accounted_len()
+            );
+        }
         write!(f, "Payload({} bytes)", self.len())
     }
 }

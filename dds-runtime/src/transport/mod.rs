@@ -22,10 +22,14 @@
 //!
 //! On Linux, receive threads read with `recvmmsg` (up to 8 datagrams per call) and hand the whole batch to
 //! the receiver, so the core's lock is taken once per batch; elsewhere, or with [`ReceivePath::OneByOne`],
-//! they read one datagram per `recv_from`. Sends are one `sendto` per datagram. Options that only Linux has
+//! they read one datagram per `recv_from`. Sends are one `sendto` per datagram, except that on Linux a run
+//! of equal-sized datagrams to one destination (a fragmented sample's) leaves in one `sendmsg` with
+//! `UDP_SEGMENT` ([`UdpTransport::send_run`]; `DDS_GSO=off` turns it off). Options that only Linux has
 //! (`SO_RCVBUFFORCE`, `IP_MULTICAST_ALL`) are set only there.
 
 mod datagram;
+#[cfg(target_os = "linux")]
+mod gso;
 pub mod iface;
 #[cfg(target_os = "linux")]
 mod mmsg;

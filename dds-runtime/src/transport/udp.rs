@@ -10,6 +10,8 @@ use std::time::Duration;
 use socket2::{SockRef, Socket};
 
 use super::datagram::{Channel, Receiver, TransportStats};
+#[cfg(target_os = "linux")]
+use super::gso::{self, GsoState};
 use super::iface::{self, Interface};
 use super::recv::{self, ReceivePath};
 use super::socket::{multicast_socket, unicast_socket};
@@ -33,6 +35,9 @@ pub struct UdpTransport {
     stop: Arc<AtomicBool>,
     threads: Mutex<Vec<JoinHandle<()>>>,
     stats: Arc<TransportStats>,
+    /// Which destinations take segmented sends (Linux `UDP_SEGMENT`).
+    #[cfg(target_os = "linux")]
+    gso: GsoState,
 }
 
 impl std::fmt::Debug for UdpTransport {
@@ -177,6 +182,8 @@ impl UdpTransport {
             stop: Arc::new(AtomicBool::new(false)),
             threads: Mutex::new(Vec::new()),
             stats: Arc::new(TransportStats::default()),
+            #[cfg(target_os = "linux")]
+            gso: GsoState::new(config.gso),
         };
         tracing::info!(transport = ?t, "transport bound");
         Ok(t)
@@ -232,6 +239,60 @@ impl UdpTransport {
                 tracing::debug!(%dest, len = payload.len(), error = %e, "send failed");
             }
         }
+    }
+
+    /// Sends `payloads` to `dest`, in order. On Linux a run of datagrams of one length (the last may be
+    /// shorter) leaves in one `UDP_SEGMENT` send, as a fragmented sample's do, where the kernel and the
+    /// path allow it; elsewhere, and after a refusal, one `sendto` per datagram.
+    pub fn send_run(&self, payloads: &[&[u8]], dest: impl Into<SocketAddr>) {
+        let dest = self.scoped(dest.into());
+        let mut rest = payloads;
+        while !rest.is_empty() {
+            let n = self.send_segmented(rest, dest);
+            if n == 0 {
+                self.send_to(rest[0], dest);
+                rest = &rest[1..];
+            } else {
+                rest = &rest[n..];
+            }
+        }
+    }
+
+    /// One segmented send of the run at the head of `payloads`: how many datagrams it took (0: not sent,
+    /// send the first one alone).
+    #[cfg(target_os = "linux")]
+    fn send_segmented(&self, payloads: &[&[u8]], dest: SocketAddr) -> usize {
+        let n = gso::run_len(payloads);
+        if n < 2
+            || (dest.ip().is_multicast() && !self.multicast)
+            || !self.family.contains(dest.ip())
+            || !self.gso.allows(dest)
+        {
+            return 0;
+        }
+        match gso::send_segments(&self.meta_uc, &payloads[..n], dest) {
+            Ok(()) => {
+                self.stats.sent.fetch_add(n as u64, Ordering::Relaxed);
+                tracing::trace!(%dest, datagrams = n, len = payloads[0].len(), "sent segmented");
+                n
+            }
+            Err(e) if gso::unsupported(&e) => {
+                self.gso.refused(dest, &e);
+                0
+            }
+            Err(e) => {
+                self.stats
+                    .send_errors
+                    .fetch_add(n as u64, Ordering::Relaxed);
+                tracing::debug!(%dest, datagrams = n, error = %e, "segmented send failed");
+                n
+            }
+        }
+    }
+
+    #[cfg(not(target_os = "linux"))]
+    fn send_segmented(&self, _: &[&[u8]], _: SocketAddr) -> usize {
+        0
     }
 
     /// Sends `payload` to each destination.

@@ -195,6 +195,21 @@ fn ours_ping_ddsperf_pong_run() -> Result<(), Skip> {
     Ok(())
 }
 
+/// 64 KiB samples both ways: each goes as DATA_FRAGs, ours in segmented sends (`UDP_SEGMENT`) where the
+/// kernel takes them, Cyclone's in its own datagrams.
+#[test]
+fn ours_ping_ddsperf_pong_fragmented() {
+    let _ = ours_ping_ddsperf_pong_fragmented_run();
+}
+
+fn ours_ping_ddsperf_pong_fragmented_run() -> Result<(), Skip> {
+    require_netns()?;
+    let mut pong = cyclone("pong", "-i 106 -D 8 pong")?;
+    let mut ping = ours("ping", "-i 106 -D 6 ping size 64k")?;
+    check_pingpong(&mut ping, &mut pong);
+    Ok(())
+}
+
 #[test]
 fn parsers_agree_on_the_formats() {
     assert_eq!(

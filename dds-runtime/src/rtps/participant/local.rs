@@ -202,6 +202,14 @@ impl Participant {
         self.local.readers.get(&writer).map_or(&[], Vec::as_slice)
     }
 
+    /// Whether a change `writer` writes now needs its serialized form: it has readers on the wire or on
+    /// shared memory, or keeps its history for late joiners (true for unknown writers). When false, a
+    /// typed sample may be written unserialized ([`Payload::local`](crate::rtps::Payload::local) with
+    /// length 0): only this participant's readers get it. Decide under the same lock as the write.
+    pub fn writer_needs_bytes(&self, writer: EntityId) -> bool {
+        self.has_shm_readers(writer) || self.writers.get(&writer).is_none_or(|w| w.needs_bytes())
+    }
+
     /// Gives a change just written as `sn` to the writer's intra-process readers, as events (the
     /// serialized form: for writes that do not come with a typed sample).
     pub(super) fn deliver_local(

@@ -129,7 +129,7 @@ impl HistoryCache {
     /// Adds a change (call [`make_room`](Self::make_room) first).
     pub(crate) fn add(&mut self, change: CacheChange) {
         let key = change.key_hash.unwrap_or_default();
-        self.bytes += change.payload.len();
+        self.bytes += change.payload.accounted_len();
         let spare = &mut self.spare_queue;
         self.instances
             .entry(key)
@@ -140,7 +140,7 @@ impl HistoryCache {
 
     pub(crate) fn remove(&mut self, sn: SequenceNumber) -> Option<CacheChange> {
         let c = self.changes.remove(sn)?;
-        self.bytes -= c.payload.len();
+        self.bytes -= c.payload.accounted_len();
         let key = c.key_hash.unwrap_or_default();
         if let Some(q) = self.instances.get_mut(&key) {
             if let Some(pos) = q.iter().position(|s| *s == sn) {
@@ -198,10 +198,17 @@ impl HistoryCache {
             return 0;
         }
         if sn.0 - first.0 <= last.0 - sn.0 {
-            let below: usize = self.changes.range_below(sn).map(|c| c.payload.len()).sum();
+            let below: usize = self
+                .changes
+                .range_below(sn)
+                .map(|c| c.payload.accounted_len())
+                .sum();
             self.bytes - below
         } else {
-            self.changes.range_from(sn).map(|c| c.payload.len()).sum()
+            self.changes
+                .range_from(sn)
+                .map(|c| c.payload.accounted_len())
+                .sum()
         }
     }
 
@@ -288,7 +295,7 @@ mod tests {
             let walk: usize = h
                 .changes
                 .range_from(SequenceNumber(sn))
-                .map(|c| c.payload.len())
+                .map(|c| c.payload.accounted_len())
                 .sum();
             assert_eq!(h.bytes_from(SequenceNumber(sn)), walk, "from {sn}");
         }

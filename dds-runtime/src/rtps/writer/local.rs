@@ -8,6 +8,12 @@ use super::Writer;
 use crate::rtps::types::{Guid, SequenceNumber};
 
 impl Writer {
+    /// Whether a change written now needs its serialized form here: the writer has readers on the wire
+    /// (proxies), or keeps its history for late joiners. Otherwise only intra-process readers get it.
+    pub(crate) fn needs_bytes(&self) -> bool {
+        self.durable() || !self.proxies.is_empty()
+    }
+
     /// Calls `f` on every change a durable `reader` that joins now gets from this writer's history, in
     /// order: none unless the writer is durable; expired changes and those `reader`'s filter rejected are
     /// skipped.

@@ -263,7 +263,7 @@ impl Writer {
         if self.params.keyed && change.key_hash.is_none() {
             return Err(WriteError::MissingKeyHash);
         }
-        let len = change.payload.len();
+        let len = change.payload.accounted_len();
         self.window.note(len);
         if self.has_reliable_proxy() {
             if self.blocked {

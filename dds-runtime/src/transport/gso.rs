@@ -1,0 +1,180 @@
+//! Linux UDP generic segmentation offload (`UDP_SEGMENT`): one `sendmsg` hands the kernel a run of
+//! datagrams of one size (the last may be shorter) for one destination, and the kernel cuts them apart.
+//! A fragmented sample is such a run: on loopback the receiver then finds all of its datagrams queued at
+//! once (one wake-up, one `recvmmsg`) instead of waking for each `sendto`.
+//!
+//! Kernels or devices that refuse (`EIO`, `EINVAL`, `ENOPROTOOPT`, `EOPNOTSUPP`) turn it off for the
+//! socket's lifetime; the caller then sends one datagram per call.
+
+use std::io;
+use std::net::{SocketAddr, UdpSocket};
+use std::os::fd::AsRawFd;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+
+use socket2::SockAddr;
+
+/// Destinations refused by `EINVAL` remembered before segmentation is turned off altogether.
+const MAX_REFUSED: usize = 64;
+
+/// Whether segmented sends are tried, and to which destinations. `EINVAL` is what a path whose MTU is
+/// below the datagram size gives (the kernel does not segment into IP fragments): that destination keeps
+/// one send per datagram. Any other refusal turns segmentation off.
+#[derive(Debug)]
+pub(super) struct GsoState {
+    on: AtomicBool,
+    refused: Mutex<Vec<SocketAddr>>,
+}
+
+impl GsoState {
+    pub(super) fn new(on: bool) -> Self {
+        GsoState {
+            on: AtomicBool::new(on),
+            refused: Mutex::new(Vec::new()),
+        }
+    }
+
+    pub(super) fn allows(&self, dest: SocketAddr) -> bool {
+        self.on.load(Ordering::Relaxed)
+            && !self
+                .refused
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .contains(&dest)
+    }
+
+    pub(super) fn refused(&self, dest: SocketAddr, e: &io::Error) {
+        let mut refused = self.refused.lock().unwrap_or_else(|e| e.into_inner());
+        if e.raw_os_error() == Some(libc::EINVAL) && refused.len() < MAX_REFUSED {
+            tracing::debug!(%dest, error = %e, "no segmented sends to this destination");
+            refused.push(dest);
+        } else {
+            tracing::info!(%dest, error = %e, "segmented sends (UDP_SEGMENT) turned off");
+            self.on.store(false, Ordering::Relaxed);
+        }
+    }
+}
+
+/// Most datagrams one `UDP_SEGMENT` send may carry (the kernel's `UDP_MAX_SEGMENTS` is 64 on older
+/// kernels, 128 on newer ones).
+pub(super) const MAX_SEGMENTS: usize = 64;
+
+/// Most payload bytes one send may carry: an IPv4 datagram's 65 535 bytes less its IP and UDP headers
+/// (IPv6 allows 8 more; the smaller bound serves both).
+pub(super) const MAX_BYTES: usize = 65_535 - 20 - 8;
+
+/// How many of `payloads` (from the first) one segmented send can carry: a run whose datagrams all have
+/// the first one's length, except that the run's last may be shorter, within [`MAX_SEGMENTS`] and
+/// [`MAX_BYTES`]. At least 1.
+pub(super) fn run_len(payloads: &[&[u8]]) -> usize {
+    let Some(first) = payloads.first() else {
+        return 0;
+    };
+    let size = first.len();
+    let mut total = 0;
+    let mut n = 0;
+    for p in payloads.iter().take(MAX_SEGMENTS) {
+        if p.len() > size || total + p.len() > MAX_BYTES || p.is_empty() {
+            break;
+        }
+        total += p.len();
+        n += 1;
+        if p.len() < size {
+            break;
+        }
+    }
+    n.max(1)
+}
+
+/// Sends `payloads` (a run as [`run_len`] chose, at least two) to `dest` in one `sendmsg` with
+/// `UDP_SEGMENT` set to the first one's length.
+pub(super) fn send_segments(
+    sock: &UdpSocket,
+    payloads: &[&[u8]],
+    dest: SocketAddr,
+) -> io::Result<()> {
+    debug_assert!(payloads.len() >= 2 && payloads.len() <= MAX_SEGMENTS);
+    let mut iovs = [libc::iovec {
+        iov_base: std::ptr::null_mut(),
+        iov_len: 0,
+    }; MAX_SEGMENTS];
+    for (iov, p) in iovs.iter_mut().zip(payloads) {
+        iov.iov_base = p.as_ptr().cast_mut().cast();
+        iov.iov_len = p.len();
+    }
+    let addr = SockAddr::from(dest);
+    let seg = payloads[0].len() as u16;
+    // Room for one cmsghdr with a u16, aligned as the kernel wants (u64 alignment).
+    let mut control = [0u64; 4];
+    // SAFETY: all-zero is a valid msghdr; every pointer set below outlives the call.
+    let mut msg: libc::msghdr = unsafe { std::mem::zeroed() };
+    msg.msg_name = addr.as_ptr().cast_mut().cast();
+    msg.msg_namelen = addr.len();
+    msg.msg_iov = iovs.as_mut_ptr();
+    msg.msg_iovlen = payloads.len() as _;
+    msg.msg_control = control.as_mut_ptr().cast();
+    // SAFETY: CMSG_SPACE only computes a size.
+    msg.msg_controllen = unsafe { libc::CMSG_SPACE(std::mem::size_of::<u16>() as u32) } as _;
+    // SAFETY: the control buffer holds CMSG_SPACE(2) bytes (32 available), so the first header and
+    // its data are inside it.
+    unsafe {
+        let c = libc::CMSG_FIRSTHDR(&msg);
+        (*c).cmsg_level = libc::SOL_UDP;
+        (*c).cmsg_type = libc::UDP_SEGMENT;
+        (*c).cmsg_len = libc::CMSG_LEN(std::mem::size_of::<u16>() as u32) as _;
+        std::ptr::write_unaligned(libc::CMSG_DATA(c).cast::<u16>(), seg);
+    }
+    // SAFETY: msg points at live iovecs, address and control data for the duration of the call.
+    let n = unsafe { libc::sendmsg(sock.as_raw_fd(), &msg, 0) };
+    if n < 0 {
+        Err(io::Error::last_os_error())
+    } else {
+        Ok(())
+    }
+}
+
+/// Whether an error of [`send_segments`] says the kernel or the device cannot segment (turn it off), as
+/// opposed to an ordinary send failure.
+pub(super) fn unsupported(e: &io::Error) -> bool {
+    matches!(
+        e.raw_os_error(),
+        Some(libc::EIO | libc::EINVAL | libc::ENOPROTOOPT | libc::EOPNOTSUPP)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_are_equal_sized_datagrams_with_a_shorter_last() {
+        let a = [0u8; 1000];
+        let b = [0u8; 400];
+        assert_eq!(run_len(&[&a, &a, &a, &b, &a]), 4);
+        assert_eq!(run_len(&[&a, &a]), 2);
+        assert_eq!(run_len(&[&b, &a]), 1);
+        assert_eq!(run_len(&[&a]), 1);
+        let big = [0u8; 14_720];
+        // 4 × 14 720 = 58 880 fits, a fifth would pass 65 507.
+        assert_eq!(run_len(&[&big, &big, &big, &big, &big]), 4);
+        let tiny = [0u8; 10];
+        let many: Vec<&[u8]> = (0..100).map(|_| &tiny[..]).collect();
+        assert_eq!(run_len(&many), MAX_SEGMENTS);
+    }
+
+    #[test]
+    fn a_segmented_send_arrives_as_separate_datagrams() {
+        let rx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let payloads: [&[u8]; 3] = [&[1; 1200], &[2; 1200], &[3; 500]];
+        match send_segments(&tx, &payloads, rx.local_addr().unwrap()) {
+            Err(e) if unsupported(&e) => return, // no GSO here: the fallback's case
+            r => r.unwrap(),
+        }
+        let mut buf = [0u8; 2000];
+        for p in payloads {
+            let n = rx.recv(&mut buf).unwrap();
+            assert_eq!(&buf[..n], p);
+        }
+    }
+}
