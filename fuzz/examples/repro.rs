@@ -8,6 +8,7 @@ fn main() {
         "rtps_decode" => dds_fuzz::rtps_one,
         "idl_parse" => dds_fuzz::idl_one,
         "typelookup_decode" => dds_fuzz::typelookup_one,
+        "durability_key" => dds_fuzz::durability_key_one,
         t => panic!("unknown target {t}"),
     };
     for f in args {
