@@ -154,6 +154,94 @@ fn late_joiner_gets_each_sample_once_while_the_writer_lives() {
     assert_eq!(take_all(&r, 6), expected(1, 3), "live samples once each");
 }
 
+/// What a late joiner holds per instance once everything arrived: the values of its samples and its
+/// instance state (each sample's info shows the instance's current state).
+fn by_instance(r: &DataReader<ShapeType>) -> Vec<(String, Vec<i32>, InstanceState)> {
+    assert!(wait_until(HISTORY_TIMEOUT, || r
+        .subscription_matched_status()
+        .current_count
+        >= 1));
+    assert!(r.wait_for_historical_data(HISTORY_TIMEOUT).unwrap());
+    std::thread::sleep(Duration::from_millis(500));
+    let mut out: Vec<(String, Vec<i32>, InstanceState)> = Vec::new();
+    for s in r.take().unwrap() {
+        let Some(d) = s.data else { continue };
+        match out.iter_mut().find(|(c, ..)| *c == d.color) {
+            Some(e) => {
+                e.1.push(d.x);
+                e.2 = s.info.instance_state;
+            }
+            None => out.push((d.color, vec![d.x], s.info.instance_state)),
+        }
+    }
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
+
+/// The service replays an instance's kept samples and then its final state, as a writer that stayed alive
+/// would: the unregistration and the dispose do not evict the samples DURABILITY_SERVICE keeps (KEEP_LAST 2).
+#[test]
+fn a_late_joiner_gets_the_kept_samples_then_the_final_state() {
+    let pw = participant(147);
+    let mut wq = durable_writer_qos(Durability::Transient, 2);
+    // RED, disposed and then without writer, stays for the delay (see the next test).
+    wq.durability_service.service_cleanup_delay = Duration::from_secs(60);
+    let w = writer::<ShapeType>(&pw, "Final", &wq);
+    for x in 1..=3 {
+        for color in ["BLUE", "GREEN", "RED"] {
+            w.write(&shape(color, x)).unwrap();
+        }
+    }
+    w.unregister_instance(&shape("BLUE", 0)).unwrap();
+    w.dispose(&shape("RED", 0)).unwrap();
+    // Deleting the writer unregisters GREEN (and RED, which stays disposed).
+    drop(w);
+    std::thread::sleep(Duration::from_millis(300));
+    let pr = participant(147);
+    let r = reader::<ShapeType>(&pr, "Final", &durable_reader_qos(Durability::Transient));
+    let no_writers = InstanceState::NotAliveNoWriters;
+    assert_eq!(
+        by_instance(&r),
+        vec![
+            ("BLUE".to_string(), vec![2, 3], no_writers),
+            ("GREEN".to_string(), vec![2, 3], no_writers),
+            (
+                "RED".to_string(),
+                vec![2, 3],
+                InstanceState::NotAliveDisposed
+            ),
+        ]
+    );
+}
+
+/// `service_cleanup_delay` applies per instance: an instance disposed and without live writers is purged
+/// after the delay, while the writer's other instances stay. (The writer is deleted first: a late joiner then
+/// gets the instances from the stand-in alone.)
+#[test]
+fn a_disposed_instance_is_purged_after_the_cleanup_delay() {
+    let pw = participant(140);
+    let mut wq = durable_writer_qos(Durability::Transient, 1);
+    wq.durability_service.service_cleanup_delay = Duration::from_secs(3);
+    let w = writer::<ShapeType>(&pw, "Purged", &wq);
+    write_rounds(&w, 1);
+    w.dispose(&shape("RED", 0)).unwrap();
+    drop(w);
+    let pr = participant(140);
+    let early = reader::<ShapeType>(&pr, "Purged", &durable_reader_qos(Durability::Transient));
+    let early = by_instance(&early);
+    std::thread::sleep(Duration::from_secs(4));
+    let late = reader::<ShapeType>(&pr, "Purged", &durable_reader_qos(Durability::Transient));
+    let late = by_instance(&late);
+    let blue = (
+        "BLUE".to_string(),
+        vec![1],
+        InstanceState::NotAliveNoWriters,
+    );
+    let red = ("RED".to_string(), vec![1], InstanceState::NotAliveDisposed);
+    assert_eq!(early, vec![blue.clone(), red], "before the delay");
+    assert_eq!(late, vec![blue], "after the delay");
+}
+
 /// Alignment: a domain-wide service started after the original writer is gone learns the writer's data
 /// from the stand-in of the service that kept it, and keeps serving it after that service is gone too.
 #[test]

@@ -31,6 +31,28 @@ fn cdr_seeds<T: DdsType>(dir: &Path, sel: u8, name: &str, v: &T) {
     }
 }
 
+/// `durability_key` seeds: the type objects of `T` with a sample and a key-only payload in each encoding.
+fn key_seeds<T: DdsType + XTypesType>(dir: &Path, name: &str, v: &T) {
+    let mapping = &T::type_support().expect("describable").mapping_bytes;
+    for (ver, order, tag) in ENCODINGS {
+        let mut sample = Vec::new();
+        serialize(v, ver, order, &mut sample).expect("seed encodes");
+        let input = dds_fuzz::durability_key_input(mapping, true, &sample);
+        assert_eq!(dds_fuzz::durability_key_hashes(&input), 2, "{name}-{tag}");
+        fs::write(dir.join(format!("{name}-{tag}")), input).unwrap();
+        let mut key = Vec::new();
+        if serialize_key(v, ver, order, &mut key).is_ok() {
+            let input = dds_fuzz::durability_key_input(mapping, false, &key);
+            assert_eq!(
+                dds_fuzz::durability_key_hashes(&input),
+                2,
+                "{name}-key-{tag}"
+            );
+            fs::write(dir.join(format!("{name}-key-{tag}")), input).unwrap();
+        }
+    }
+}
+
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("seeds");
     let cdr = root.join("cdr_decode");
@@ -86,6 +108,17 @@ fn main() {
     cdr_seeds(&cdr, 3, "outer", &outer);
     cdr_seeds(&cdr, 4, "either-num", &Either::Num(-1));
     cdr_seeds(&cdr, 4, "either-text", &Either::Text("abc".into()));
+
+    let key = root.join("durability_key");
+    fs::create_dir_all(&key).unwrap();
+    // Without the unit union case: the derive encodes nothing for it, but `xtypes::dynamic`, going by the
+    // derive's type objects, reads the default case's member there (FINDINGS.md).
+    let mut outer_key = outer.clone();
+    outer_key.nest.u.retain(|u| *u != SmallUnion::Nothing);
+    key_seeds(&key, "shape", &outer_key.shape);
+    key_seeds(&key, "mutopt", outer_key.m.as_ref().expect("set above"));
+    key_seeds(&key, "nest", &outer_key.nest);
+    key_seeds(&key, "outer", &outer_key);
 
     let rtps = root.join("rtps_decode");
     fs::create_dir_all(&rtps).unwrap();

@@ -10,6 +10,7 @@ fn main() {
         "typelookup_decode" => dds_fuzz::typelookup_one,
         "dynamic_decode" => dds_fuzz::dynamic_one,
         "filter_parse" => dds_fuzz::filter_one,
+        "durability_key" => dds_fuzz::durability_key_one,
         t => panic!("unknown target {t}"),
     };
     for f in args {

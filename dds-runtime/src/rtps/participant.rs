@@ -13,6 +13,7 @@ mod internal;
 mod interned;
 mod liveliness;
 mod local;
+mod managed;
 mod receive;
 mod shm;
 mod timers;

@@ -219,3 +219,111 @@ fn keyed_without_key_hash(domain: u32) -> Result<(), Skip> {
     let _ = r.interrupt(WAIT);
     Ok(())
 }
+
+/// The Cyclone shape peer's type (`tests/peers/cyclone_shape.py`), for a writer in this process.
+#[derive(dds_runtime::prelude::DdsType, Debug, Clone, PartialEq, Default)]
+#[dds(name = "ShapeType", appendable)]
+struct ShapeType {
+    #[dds(key)]
+    color: String,
+    x: i32,
+    y: i32,
+    shapesize: i32,
+    additional_payload_size: Vec<u8>,
+}
+
+/// A TRANSIENT writer in this process (its participant's own service keeps its data, KEEP_LAST 2, cleanup
+/// delay 60 s) writes three samples of BLUE, GREEN and RED on `Final`, unregisters BLUE, disposes RED and is
+/// deleted (which unregisters GREEN and RED). A late `shape_main` reader (`reader`, requesting `durability`)
+/// must print, per instance, the last two samples and then the final state: NOT_ALIVE_NO_WRITERS for BLUE
+/// and GREEN, NOT_ALIVE_DISPOSED for RED.
+fn final_states(reader: Prog, durability: char, domain: u32) -> Result<(), Skip> {
+    use dds_runtime::prelude::*;
+    require_netns()?;
+    let p = super::harness::loopback_participant(domain);
+    let qos = DataWriterQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .durability(Durability::Transient)
+        .data_representation(DataRepresentation::xcdr1())
+        .history(History::KeepLast(2))
+        .durability_service(DurabilityService {
+            history: History::KeepLast(2),
+            service_cleanup_delay: Duration::from_secs(60),
+            ..DurabilityService::default()
+        })
+        .writer_data_lifecycle(WriterDataLifecycle {
+            autodispose_unregistered_instances: false,
+        })
+        .build();
+    let topic = p
+        .create_topic::<ShapeType>("Final", &TopicQos::default())
+        .expect("topic");
+    let publisher = p
+        .create_publisher(&PublisherQos::default())
+        .expect("publisher");
+    let w = publisher.create_datawriter(&topic, &qos).expect("writer");
+    let shape = |color: &str, x: i32| ShapeType {
+        color: color.into(),
+        x,
+        y: 2 * x,
+        shapesize: 30,
+        additional_payload_size: Vec::new(),
+    };
+    for x in 1..=3 {
+        for color in ["BLUE", "GREEN", "RED"] {
+            w.write(&shape(color, x)).expect("write");
+        }
+    }
+    w.unregister_instance(&shape("BLUE", 0))
+        .expect("unregister");
+    w.dispose(&shape("RED", 0)).expect("dispose");
+    drop(w);
+    std::thread::sleep(Duration::from_millis(300));
+    let mut r = reader.spawn(
+        "reader",
+        &format!("-S -t Final -d {domain} -r -D {durability} -k 0"),
+    )?;
+    let state_line =
+        |c: &str, s: &str| format!("{:<10} {c:<10} NOT_ALIVE_{s}_INSTANCE_STATE", "Final");
+    let expected = [
+        ("BLUE", "NO_WRITERS"),
+        ("GREEN", "NO_WRITERS"),
+        ("RED", "DISPOSED"),
+    ];
+    let all = r.wait_lines(WAIT, 3, |l| l.contains("NOT_ALIVE")).is_some();
+    std::thread::sleep(Duration::from_secs(1));
+    for (color, state) in expected {
+        let prefix = format!("{:<10} {color:<10} ", "Final");
+        let lines = r.grep(|l| l.starts_with(&prefix));
+        let (states, data): (Vec<&String>, Vec<&String>) =
+            lines.iter().partition(|l| l.contains("NOT_ALIVE"));
+        let want = [
+            format!("{prefix}002 004 [30]"),
+            format!("{prefix}003 006 [30]"),
+        ];
+        // A reader prints the instance state with each sample it takes while the instance is not alive,
+        // and once more for the state change when it took the samples before.
+        check!(
+            all && data == want.iter().collect::<Vec<_>>()
+                && !states.is_empty()
+                && states.iter().all(|l| **l == state_line(color, state))
+                && lines.last() == states.last().copied(),
+            &[&r],
+            "{color}: expected {want:?} then {state}, got {lines:?}"
+        );
+    }
+    let _ = r.interrupt(WAIT);
+    Ok(())
+}
+
+/// Cyclone handles only TRANSIENT_LOCAL readers as durable on the wire: a TRANSIENT one starts at the
+/// writer's newest change (it expects a durability service of its own), so its late joiner is TRANSIENT_LOCAL.
+#[test]
+fn a_late_cyclone_reader_gets_the_kept_samples_then_the_final_state() {
+    let _ = final_states(Prog::Cyclone, 'l', 198);
+}
+
+#[test]
+fn a_late_reader_of_ours_gets_the_kept_samples_then_the_final_state() {
+    let _ = final_states(Prog::Ours, 't', 199);
+}

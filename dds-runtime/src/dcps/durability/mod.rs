@@ -19,6 +19,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+pub use key::peer_key_hash;
 #[cfg(feature = "persistence")]
 pub use store::StoreError;
 

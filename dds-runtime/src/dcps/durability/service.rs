@@ -21,7 +21,7 @@ use crate::qos::{
 };
 use crate::rtps::discovery::WriterData;
 use crate::rtps::{
-    ChangeKind, EntityId, Event, Guid, GuidPrefix, ReaderSpec, ReceivedSample, WriteChange,
+    EntityId, Event, Guid, GuidPrefix, ReaderSpec, ReceivedSample, SequenceNumber, WriteChange,
     WriteError, WriterSpec,
 };
 
@@ -46,6 +46,8 @@ struct Kept {
     stand_in: Option<EntityId>,
     /// When the original writer was seen to go (or, after a restart, when the service loaded it).
     gone_since: Option<Instant>,
+    /// The stand-in's sequence number of each kept change it republished (by the original's).
+    published: HashMap<i64, SequenceNumber>,
 }
 
 impl Kept {
@@ -80,15 +82,15 @@ pub(crate) struct Service {
     me: Weak<Service>,
 }
 
-/// The stand-in QoS: the original writer's, with the service's history, limits and marker.
+/// The stand-in QoS: the original writer's, with the service's marker. Its history mirrors the service's
+/// (`Participant::manage_history`): KEEP_ALL, bounded by the service's cap as a safety net.
 fn stand_in_qos(w: &WriterData, cap: usize) -> WriterQos {
     let mut q = WriterQos::clone(&w.qos);
-    let ds = q.writer.durability_service;
-    q.writer.history = ds.history;
+    q.writer.history = History::KeepAll;
     q.writer.resource_limits = ResourceLimits {
-        max_samples: Some(ds.max_samples.unwrap_or(u32::MAX).min(cap as u32)),
-        max_instances: ds.max_instances,
-        max_samples_per_instance: ds.max_samples_per_instance,
+        max_samples: Some(u32::try_from(cap.saturating_add(1)).unwrap_or(u32::MAX)),
+        max_instances: None,
+        max_samples_per_instance: None,
     };
     q.writer.reliability = Reliability::Reliable {
         max_blocking_time: Duration::from_millis(100),
@@ -196,8 +198,9 @@ impl Service {
             }
             let mut history =
                 WriterHistory::new(Limits::new(&w.qos.writer.durability_service, self.cap));
+            let now = Instant::now();
             for c in changes {
-                history.insert(c);
+                history.insert(c, now);
             }
             st.kept.insert(
                 w.guid,
@@ -206,6 +209,7 @@ impl Service {
                     history,
                     stand_in: None,
                     gone_since: gone.then(Instant::now),
+                    published: HashMap::new(),
                 },
             );
         }
@@ -270,24 +274,53 @@ impl Service {
         spec.type_information = w.type_information.as_deref().cloned();
         spec.entity_name = Some(format!("durability stand-in for {}", w.topic_name));
         spec.internal = true;
-        let id = match driver.create_endpoint(sink, |c, now| c.create_writer(now, spec)) {
+        let create = |c: &mut crate::rtps::Participant, now| {
+            let id = c.create_writer(now, spec)?;
+            c.manage_history(id);
+            Ok(id)
+        };
+        let id = match driver.create_endpoint(sink, create) {
             Ok(id) => id,
             Err(e) => {
                 tracing::warn!(error = %e, topic = %w.topic_name, "durability: no stand-in");
                 return;
             }
         };
-        let backlog: Vec<WriteChange> = {
+        let backlog: Vec<Republish> = {
             let mut st = lock(&self.state);
             let Some(k) = st.kept.get_mut(&w.guid) else {
                 return;
             };
             k.stand_in = Some(id);
             let keyed = k.keyed();
-            k.history.changes().map(|c| c.to_write(keyed)).collect()
+            let write = |c: &StoredChange| Republish::Write(id, c.seq, c.to_write(keyed));
+            k.history.changes().map(write).collect()
         };
-        for ch in backlog {
-            write_change(driver, id, ch);
+        self.republish(driver, w.guid, backlog);
+    }
+
+    /// Mirrors changes of `original`'s kept history on its stand-in, in order.
+    fn republish(&self, driver: &Driver, original: Guid, ops: Vec<Republish>) {
+        for op in ops {
+            match op {
+                Republish::Write(id, seq, ch) => {
+                    let Some(sn) = write_change(driver, id, ch) else {
+                        continue;
+                    };
+                    if let Some(k) = lock(&self.state).kept.get_mut(&original) {
+                        k.published.insert(seq, sn);
+                    }
+                }
+                Republish::Remove(seq) => {
+                    let found = lock(&self.state)
+                        .kept
+                        .get_mut(&original)
+                        .and_then(|k| Some((k.stand_in?, k.published.remove(&seq)?)));
+                    if let Some((id, sn)) = found {
+                        driver.with_core(|c, _| c.remove_change(id, sn));
+                    }
+                }
+            }
         }
     }
 
@@ -297,16 +330,13 @@ impl Service {
             return;
         };
         self.fill_key_hashes(&driver, &mut samples);
-        let mut out: Vec<(EntityId, WriteChange)> = Vec::new();
+        let mut out: Vec<(Guid, Vec<Republish>)> = Vec::new();
         #[cfg(feature = "persistence")]
         let mut batch = Batch::default();
+        let now = Instant::now();
         {
             let mut st = lock(&self.state);
             for s in samples {
-                // Unregistrations are not kept: the service keeps the instance for late joiners.
-                if s.kind == ChangeKind::Unregister {
-                    continue;
-                }
                 // A change from another service's stand-in is the original writer's, numbered here.
                 let original = st.sources.get(&s.writer).copied();
                 let Some(k) = st.kept.get_mut(&original.unwrap_or(s.writer)) else {
@@ -323,33 +353,41 @@ impl Service {
                     timestamp: s.source_timestamp,
                     payload: s.payload.compact(),
                 };
-                let ins = k.history.insert(c.clone());
-                if !ins.kept {
-                    continue;
+                let ins = k.history.insert(c.clone(), now);
+                let mut ops: Vec<Republish> = ins
+                    .evicted
+                    .iter()
+                    .map(|seq| Republish::Remove(*seq))
+                    .collect();
+                if let (Some(id), true) = (k.stand_in, ins.kept) {
+                    ops.push(Republish::Write(id, c.seq, c.to_write(keyed)));
                 }
-                if let Some(id) = k.stand_in {
-                    out.push((id, c.to_write(keyed)));
-                }
+                let g = k.data.guid;
                 #[cfg(feature = "persistence")]
                 if k.persistent() {
-                    let g = k.data.guid;
                     batch
                         .evicted
                         .extend(ins.evicted.iter().map(|seq| (g, *seq)));
-                    batch.put.push((g, c));
+                    if ins.kept {
+                        batch.put.push((g, c));
+                    }
                 }
+                out.push((g, ops));
             }
         }
         #[cfg(feature = "persistence")]
-        if let Some(store) = &self.store {
-            if !batch.is_empty() {
-                if let Err(e) = store.apply(&batch) {
-                    tracing::warn!(error = %e, "durability: changes not stored");
-                }
-            }
+        self.store_batch(&batch);
+        for (g, ops) in out {
+            self.republish(&driver, g, ops);
         }
-        for (id, ch) in out {
-            write_change(&driver, id, ch);
+    }
+
+    #[cfg(feature = "persistence")]
+    fn store_batch(&self, batch: &Batch) {
+        if let (Some(store), false) = (&self.store, batch.is_empty()) {
+            if let Err(e) = store.apply(batch) {
+                tracing::warn!(error = %e, "durability: changes not stored");
+            }
         }
     }
 
@@ -379,21 +417,46 @@ impl Service {
         }
     }
 
-    /// Forgets `original` once it has been gone for its `service_cleanup_delay` and each of its instances is
-    /// disposed (DDS 1.4 §2.2.3.5).
+    /// Purges `original`'s instances that have been disposed, with no live writer, for its
+    /// `service_cleanup_delay` (DDS 1.4 §2.2.3.5), and forgets `original` once it is gone and nothing of it
+    /// is left.
     fn cleanup(&self, original: &Guid, now: Instant) {
-        let stand_in = {
+        let (purged, stand_in, forget, persistent) = {
             let mut st = lock(&self.state);
-            let Some(k) = st.kept.get(original) else {
+            let Some(k) = st.kept.get_mut(original) else {
                 return;
             };
             let delay = k.data.qos.writer.durability_service.service_cleanup_delay;
-            let due = k.gone_since.is_some_and(|t| now >= t + delay);
-            if !due || !k.history.all_disposed() {
-                return;
+            let purged = k.history.purge(now, k.gone_since, delay);
+            let forget = k.history.is_empty()
+                && k.gone_since
+                    .is_some_and(|t| t.checked_add(delay).is_some_and(|d| now >= d));
+            let (stand_in, persistent) = (k.stand_in, k.persistent());
+            if forget {
+                st.kept.remove(original);
             }
-            st.kept.remove(original).and_then(|k| k.stand_in)
+            (purged, stand_in, forget, persistent)
         };
+        if !purged.is_empty() {
+            tracing::debug!(writer = ?original, changes = purged.len(), "durability: instances purged");
+            #[cfg(feature = "persistence")]
+            if persistent {
+                self.store_batch(&Batch {
+                    evicted: purged.iter().map(|seq| (*original, *seq)).collect(),
+                    ..Batch::default()
+                });
+            }
+        }
+        #[cfg(not(feature = "persistence"))]
+        let _ = persistent;
+        let Some(driver) = self.driver.upgrade() else {
+            return;
+        };
+        if !forget {
+            let ops = purged.into_iter().map(Republish::Remove).collect();
+            self.republish(&driver, *original, ops);
+            return;
+        }
         self.key_types.forget(original);
         tracing::info!(writer = ?original, "durability: cleaned up");
         #[cfg(feature = "persistence")]
@@ -402,7 +465,7 @@ impl Service {
                 tracing::warn!(error = %e, "durability: writer not removed from the store");
             }
         }
-        if let (Some(id), Some(driver)) = (stand_in, self.driver.upgrade()) {
+        if let Some(id) = stand_in {
             driver.delete_endpoint(id);
         }
     }
@@ -439,8 +502,17 @@ impl Service {
     }
 }
 
-/// Writes a change to a stand-in, waiting (at most 2 s) while flow control holds it back.
-fn write_change(driver: &Driver, id: EntityId, ch: WriteChange) {
+/// A change to mirror on a stand-in.
+enum Republish {
+    /// Write the kept change with this (original) sequence number to the stand-in.
+    Write(EntityId, i64, WriteChange),
+    /// Remove the kept change with this sequence number from the stand-in's history.
+    Remove(i64),
+}
+
+/// Writes a change to a stand-in, waiting (at most 2 s) while flow control holds it back; its sequence
+/// number on the stand-in, unless it could not be written.
+fn write_change(driver: &Driver, id: EntityId, ch: WriteChange) -> Option<SequenceNumber> {
     let deadline = Instant::now() + Duration::from_secs(2);
     loop {
         match driver.with_core(|core, now| core.write(now, id, ch.clone())) {
@@ -450,9 +522,9 @@ fn write_change(driver: &Driver, id: EntityId, ch: WriteChange) {
             }
             Err(e) => {
                 tracing::warn!(error = %e, "durability: change not republished");
-                return;
+                return None;
             }
-            Ok(_) => return,
+            Ok(sn) => return Some(sn),
         }
     }
 }

@@ -92,6 +92,8 @@ pub(crate) struct Writer {
     pub group: Option<WriterGroup>,
     /// The content filters of the matched readers that announced one.
     pub filters: ReaderFilters,
+    /// The owner decides what the history keeps (see [`Writer::manage_history`]).
+    managed: bool,
 }
 
 impl Writer {
@@ -119,7 +121,24 @@ impl Writer {
             coherent: CoherentState::Off,
             group: None,
             filters: ReaderFilters::default(),
+            managed: false,
         }
+    }
+
+    /// Hands the history over to the writer's owner (a durability service's stand-in, which mirrors the
+    /// history the service keeps): unregistered instances are no longer pruned once acknowledged, and the
+    /// owner drops changes with [`Writer::remove_change`].
+    pub(crate) fn manage_history(&mut self) {
+        self.managed = true;
+    }
+
+    /// Drops change `sn` from the history; readers that still miss it get a GAP. Whether it was there.
+    pub(crate) fn remove_change(&mut self, sn: SequenceNumber, ev: &mut VecDeque<Event>) -> bool {
+        let removed = self.history.remove(sn).is_some();
+        if removed {
+            self.update_acked(ev);
+        }
+        removed
     }
 
     /// New parameters for a writer that has written nothing yet (a disabled writer whose QoS changed):
@@ -219,7 +238,7 @@ impl Writer {
         let floor = self.acked_floor();
         if !self.durable() {
             self.history.remove_below(floor);
-        } else {
+        } else if !self.managed {
             self.history.prune_unregistered(floor);
         }
         self.unacked_bytes = if self.has_reliable_proxy() {
