@@ -17,20 +17,12 @@ mod gen {
     include!(concat!(env!("OUT_DIR"), "/own/typedefs.rs"));
 }
 
-use std::collections::BTreeSet;
-use std::path::PathBuf;
+#[path = "golden/cyclone_idlc.rs"]
+mod cyclone_idlc;
 
 use dds_runtime::cdr::{self, BoundedString, ByteOrder, DdsType, XcdrVersion};
 use dds_runtime::xtypes::dynamic::types_from_idl;
-use dds_runtime::xtypes::typeobject::{from_bytes, TypeInformation, TypeMapping};
 use gen::m;
-
-fn fixture() -> serde_json::Value {
-    let path =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/cyclone-idlc/typedefs.json");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    serde_json::from_str(&text).expect("json")
-}
 
 fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
@@ -46,56 +38,13 @@ fn dynamic_mapping(name: &str) -> String {
         .mapping_bytes)
 }
 
-/// The items of a list as a set (Cyclone's idlc orders dependencies and mapping pairs its own way, and its
-/// complete list drops repeats; the binding, whose order the builder follows, keeps them).
-fn set<T: std::fmt::Debug>(items: &[T]) -> BTreeSet<String> {
-    items.iter().map(|i| format!("{i:?}")).collect()
-}
-
-/// `T`'s objects are Cyclone idlc's: the same topic type identifiers and sizes, dependencies and identifier →
-/// object pairs; the dynamic type read from the same IDL has the same bytes as `T`.
+/// `T`'s objects are Cyclone idlc's (see [`cyclone_idlc::same_objects`]); the dynamic type read from the same
+/// IDL has the same bytes as `T`.
 fn same_as_cyclone<T: DdsType>(name: &str) {
-    let fx = fixture();
-    let want = &fx["types"][name];
+    let fx = cyclone_idlc::fixture("typedefs");
     let (info, map) = (T::type_information(), T::type_mapping());
     let (info, map) = (info.expect("type information"), map.expect("type mapping"));
-    let unhex = |k: &str| -> Vec<u8> {
-        let s = want[k].as_str().expect("fixture");
-        (0..s.len())
-            .step_by(2)
-            .map(|i| u8::from_str_radix(&s[i..i + 2], 16).expect("hex"))
-            .collect()
-    };
-    let ours: TypeInformation = from_bytes(info).expect("ours decodes");
-    let theirs: TypeInformation = from_bytes(&unhex("type_information")).expect("theirs decodes");
-    for (o, t) in [
-        (&ours.minimal, &theirs.minimal),
-        (&ours.complete, &theirs.complete),
-    ] {
-        assert_eq!(o.typeid_with_size, t.typeid_with_size, "{name}: topic type");
-        assert_eq!(
-            set(&o.dependent_typeids),
-            set(&t.dependent_typeids),
-            "{name}: dependencies"
-        );
-    }
-    let ours: TypeMapping = from_bytes(map).expect("ours decodes");
-    let theirs: TypeMapping = from_bytes(&unhex("type_mapping")).expect("theirs decodes");
-    assert_eq!(
-        set(&ours.identifier_object_pair_minimal),
-        set(&theirs.identifier_object_pair_minimal),
-        "{name}: minimal objects"
-    );
-    assert_eq!(
-        set(&ours.identifier_object_pair_complete),
-        set(&theirs.identifier_object_pair_complete),
-        "{name}: complete objects"
-    );
-    assert_eq!(
-        set(&ours.identifier_complete_minimal),
-        set(&theirs.identifier_complete_minimal),
-        "{name}: complete to minimal"
-    );
+    cyclone_idlc::same_objects(name, info, map, &fx["types"][name]);
     assert_eq!(
         dynamic_mapping(name),
         hex(map),
@@ -117,7 +66,7 @@ fn a_union_with_typedef_cases() {
     assert_eq!(ours, dynamic_mapping("M::U"));
     assert_ne!(
         ours,
-        fixture()["types"]["M::U"]["type_mapping"]
+        cyclone_idlc::fixture("typedefs")["types"]["M::U"]["type_mapping"]
             .as_str()
             .expect("fixture")
     );
