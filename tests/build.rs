@@ -93,6 +93,21 @@ fn compile(corpus: &Path, out: &Path, (root, file): (&str, &str), key: &str, fin
     }
 }
 
+/// Our own IDL (`tests/idl/`), always compiled, into `$OUT_DIR/own/` (`tests/idlc_typedefs.rs`).
+fn own_idl() {
+    let dir =
+        PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it")).join("idl");
+    let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR")).join("own");
+    println!("cargo::rerun-if-changed={}", dir.display());
+    let _ = std::fs::create_dir_all(&out);
+    if let Err(e) = idlc::Builder::new()
+        .out_dir(&out)
+        .compile(&[dir.join("typedefs.idl")])
+    {
+        panic!("idlc rejects tests/idl/typedefs.idl: {e}");
+    }
+}
+
 fn main() {
     let keys: Vec<String> = FILES
         .iter()
@@ -111,6 +126,7 @@ fn main() {
     );
     println!("cargo::rerun-if-env-changed=DDS_IDL_CORPUS");
     println!("cargo::rerun-if-changed=build.rs");
+    own_idl();
 
     let corpus = corpus_dir();
     println!("cargo::rerun-if-changed={}", corpus.display());

@@ -67,6 +67,8 @@ pub(crate) struct FieldAttrs {
     pub(crate) recursive: bool,
     /// `u8` is IDL `octet` here (`TK_BYTE` in the type objects), not `uint8`.
     pub(crate) octet: bool,
+    /// `xtypes = T`: the member is described as `T` (typedef markers, `Octet`, `Bounded`), not as its type.
+    pub(crate) xtypes: Option<Type>,
 }
 
 /// Enum variant attributes (enumerators and union cases).
@@ -224,6 +226,8 @@ fn field_item(cx: &mut Ctxt, f: &mut FieldAttrs, m: &ParseNestedMeta) -> Result<
         f.default = Some(m.value()?.parse::<Expr>()?);
     } else if p.is_ident("bound") {
         f.bound = Some(m.value()?.parse::<Expr>()?);
+    } else if p.is_ident("xtypes") {
+        f.xtypes = Some(m.value()?.parse::<Type>()?);
     } else {
         return Ok(false);
     }

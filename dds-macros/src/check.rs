@@ -158,7 +158,7 @@ fn check_union(cx: &mut Ctxt, c: &Container, u: &Union) {
             if fa.key.is_some() || fa.optional || fa.base || fa.non_serialized || fa.id.is_some() {
                 cx.error_spanned_by(
                     p.field,
-                    "a union case accepts only `bound`, `octet`, `external`, `name`, `must_understand` and `recursive`",
+                    "a union case accepts only `bound`, `octet`, `xtypes`, `external`, `name`, `must_understand` and `recursive`",
                 );
             }
         }

@@ -72,6 +72,69 @@ def is_octet(t):
             return t is byte or t == byte
 
 
+def has_typedef(t):
+    """Whether `t` goes through a typedef (then its member says so with `#[dds(xtypes = ...)]`)."""
+    if isinstance(t, WrapOpt):
+        return has_typedef(t.inner)
+    if isinstance(t, typedef):
+        return True
+    if isinstance(t, (sequence, array)):
+        return has_typedef(t.subtype)
+    return False
+
+
+def typedef_marker(t):
+    return t.name.split("::")[-1] + "Typedef"
+
+
+def xtypes_type(t):
+    """The spelling of `t` in `#[dds(xtypes = ...)]`: typedefs by their markers, octets and bounds in the type."""
+    if isinstance(t, WrapOpt):
+        return xtypes_type(t.inner)
+    if isinstance(t, typedef):
+        return typedef_marker(t)
+    if t is byte or t == byte:
+        return "dds_runtime::xtypes::Octet"
+    if isinstance(t, sequence):
+        inner = xtypes_type(t.subtype)
+        return f"BoundedSeq<{inner}, {t.max_length}>" if t.max_length else f"Vec<{inner}>"
+    if isinstance(t, array):
+        return f"[{xtypes_type(t.subtype)}; {t.length}]"
+    return rust_type(t, True)
+
+
+def emit_typedef(t):
+    """A typedef's marker, dependencies first (`typedef!`)."""
+    return "\n".join([
+        "dds_runtime::typedef!(",
+        f"    /// IDL typedef `{t.name}`.",
+        f'    pub {typedef_marker(t)} = "{t.name}" => {xtypes_type(t.subtype)}',
+        ");",
+    ])
+
+
+def collect_typedefs(types):
+    """Every typedef the named types' members go through, dependencies first."""
+    order = []
+
+    def visit(t):
+        if isinstance(t, WrapOpt):
+            return visit(t.inner)
+        if isinstance(t, (sequence, array, case, default)):
+            return visit(t.subtype)
+        if isinstance(t, typedef):
+            visit(t.subtype)
+            if t.name not in [o.name for o in order]:
+                order.append(t)
+        elif isclass(t) and issubclass(t, (IdlStruct, IdlUnion)):
+            for v in get_extended_type_hints(t).values():
+                visit(v)
+
+    for t in types:
+        visit(t)
+    return order
+
+
 def bound_of(t):
     if isinstance(t, WrapOpt):
         return bound_of(t.inner)
@@ -157,6 +220,8 @@ def emit_type(t):
                 labels = ", ".join(f"case = {rust_value(disc, lab)}" for lab in ct.labels)
                 out.append(f"    #[dds({labels}{rename})]")
             octet = "#[dds(octet)] " if is_octet(ct.subtype) else ""
+            if has_typedef(ct.subtype):
+                octet += f"#[dds(xtypes = {xtypes_type(ct.subtype)})] "
             out.append(f"    {camel(mname)}({octet}{rust_type(ct.subtype, True)}),")
         out.append("}")
     else:
@@ -192,6 +257,8 @@ def emit_type(t):
                 a.append(f"bound = {b}")
             if is_octet(ft):
                 a.append("octet")
+            if has_typedef(ft):
+                a.append(f"xtypes = {xtypes_type(ft)}")
             rt = rust_type(ft, False)
             if fa.get("external"):
                 rt = f"Option<Box<{rt[7:-1]}>>" if rt.startswith("Option<") else f"Box<{rt}>"
@@ -302,7 +369,11 @@ def write(path, corpus):
         "use dds_runtime::DdsType;",
         "",
     ]
-    for t in collect([c for c, _ in corpus]):
+    named = collect([c for c, _ in corpus])
+    for t in collect_typedefs(named):
+        lines.append(emit_typedef(t))
+        lines.append("")
+    for t in named:
         lines.append(emit_type(t))
         lines.append("")
     for cls, samples in corpus:

@@ -211,9 +211,6 @@ mod check {
         ("test_struct_keys", "holds a union: the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
         ("InnerStructureHelperChildChild", "the binding's subclass inherits @nested from its base class; the IDL does not mark the derived struct @nested"),
         ("test_struct_inherit_mutable_keys", "the binding's subclass inherits @nested from its base class; the IDL does not mark the derived struct @nested"),
-        ("NoCommon_Module.My_Structure", "idlc writes IDL typedefs as Rust type aliases, so there are no alias type objects"),
-        ("sensor_msgs.msg.Imu", "idlc writes IDL typedefs as Rust type aliases, so there are no alias type objects"),
-        ("sensor_msgs.msg.Imu.final", "idlc writes IDL typedefs as Rust type aliases, so there are no alias type objects"),
     ];
 
     /// Our TypeInformation and TypeMapping against Cyclone's for the same IDL type

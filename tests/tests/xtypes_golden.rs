@@ -22,7 +22,6 @@ use dds_runtime::xtypes::XTypesType;
 
 /// Types whose Rust mirror cannot say what the Python type says, so the bytes differ for a stated reason.
 const KNOWN: &[(&str, &str)] = &[
-    ("Typedefs", "the Rust mirror writes typedefs as their aliased types: no alias type objects"),
     ("UnionAppendable", "the binding numbers union members from 0; libddsc's wire and the derive from 1 (the discriminator is member 0 of a mutable union)"),
     ("UnionHolder", "holds unions, whose members the binding numbers from 0; libddsc's wire and the derive from 1"),
     ("UnionHolderAppendable", "holds unions, whose members the binding numbers from 0; libddsc's wire and the derive from 1"),

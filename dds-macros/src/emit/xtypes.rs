@@ -56,6 +56,18 @@ pub(super) fn xtypes_impl(c: &Container) -> TokenStream {
     }
 }
 
+/// The description function of a member: the type its `#[dds(xtypes = T)]` names (which says all of it:
+/// typedefs, bounds, octets), else its own type with its bound and `octet` mark.
+fn member_ref(c: &Container, ty: &Type, a: &FieldAttrs) -> TokenStream {
+    match &a.xtypes {
+        Some(t) => {
+            let rt = c.runtime();
+            quote!(#rt::xtypes::TypeRef(<#t as #rt::xtypes::XTypesType>::xtypes_desc))
+        }
+        None => type_ref(c, ty, a.bound.as_ref(), a.octet),
+    }
+}
+
 /// The description function of a member type, with its bound and `octet` mark.
 fn type_ref(c: &Container, ty: &Type, bound: Option<&Expr>, octet: bool) -> TokenStream {
     let x = {
@@ -109,7 +121,7 @@ fn struct_def(c: &Container, s: &Struct) -> TokenStream {
             let name = &f.wire_name;
             let id = member_id(c, s, f.id);
             let flags = member_flags(c, &f.attrs, f.key(), f.optional);
-            let ty = type_ref(c, f.inner, f.attrs.bound.as_ref(), f.attrs.octet);
+            let ty = member_ref(c, f.inner, &f.attrs);
             let hash_id = match &f.attrs.hashid {
                 HashId::Unset => quote!(::core::option::Option::None),
                 HashId::OfName => quote!(::core::option::Option::Some("")),
@@ -163,7 +175,7 @@ fn union_def(c: &Container, u: &Union) -> TokenStream {
             .map(|l| quote!((#l) as i32));
         let (ty, external) = match &k.payload {
             Some(p) => {
-                let r = type_ref(c, p.ty, p.attrs.bound.as_ref(), p.attrs.octet);
+                let r = member_ref(c, p.ty, &p.attrs);
                 (quote!(::core::option::Option::Some(#r)), p.attrs.external)
             }
             None => (quote!(::core::option::Option::None), false),

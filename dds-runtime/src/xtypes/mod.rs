@@ -62,6 +62,7 @@ impl TypeInformation {
     }
 }
 
+mod alias;
 mod build;
 mod compat;
 mod describe;
@@ -70,6 +71,7 @@ mod objects;
 mod octet;
 mod shape;
 
+pub use alias::{Bounded, Octet};
 pub use build::TypeSupport;
 pub use describe::{
     bounded_desc, BitmaskDef, CaseDef, EnumDef, MemberDef, NamedRef, StructDef, TypeDef, TypeDesc,

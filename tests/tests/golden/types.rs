@@ -10,6 +10,16 @@
 use dds_runtime::cdr::{BoundedSeq, BoundedString, WChar};
 use dds_runtime::DdsType;
 
+dds_runtime::typedef!(
+    /// IDL typedef `Golden::MyLong`.
+    pub MyLongTypedef = "Golden::MyLong" => i32
+);
+
+dds_runtime::typedef!(
+    /// IDL typedef `Golden::Names`.
+    pub NamesTypedef = "Golden::Names" => Vec<String>
+);
+
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::Primitives", final)]
 pub struct Primitives {
@@ -904,9 +914,11 @@ pub struct MutableNested {
 #[derive(DdsType, Debug, Clone, PartialEq)]
 #[dds(name = "Golden::Typedefs", appendable)]
 pub struct Typedefs {
-    #[dds(key)]
+    #[dds(key, xtypes = MyLongTypedef)]
     pub id: i32,
+    #[dds(xtypes = NamesTypedef)]
     pub names: Vec<String>,
+    #[dds(xtypes = Vec<MyLongTypedef>)]
     pub more: Vec<i32>,
 }
 

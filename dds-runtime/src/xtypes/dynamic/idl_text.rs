@@ -154,18 +154,54 @@ fn collect(t: &DynamicType, order: &mut Vec<DynamicType>, depth: u32) {
             }
         }
         TypeKind::Alias { target, .. } => collect(target, order, depth + 1),
-        TypeKind::Sequence { element, .. } | TypeKind::Array { element, .. } => {
-            collect(element, order, depth + 1)
-        }
+        TypeKind::Array { element, .. } => collect(element, order, depth + 1),
+        TypeKind::Sequence { element, .. } => collect_element(element, order, depth + 1),
         TypeKind::Map { key, value, .. } => {
-            collect(key, order, depth + 1);
-            collect(value, order, depth + 1);
+            collect_element(key, order, depth + 1);
+            collect_element(value, order, depth + 1);
         }
         _ => {}
     }
     if is_named(t) {
         order.push(t.clone());
     }
+}
+
+/// A sequence's element or a map's key or value: an anonymous array there has no IDL spelling, so it gets a
+/// generated typedef ([`array_typedef_name`]), declared before its first use.
+fn collect_element(t: &DynamicType, order: &mut Vec<DynamicType>, depth: u32) {
+    collect(t, order, depth);
+    if matches!(t.kind(), TypeKind::Array { .. }) {
+        collect(
+            &DynamicType::alias(array_typedef_name(t), t.clone()),
+            order,
+            depth,
+        );
+    }
+}
+
+/// The name of the typedef [`to_idl`](DynamicType::to_idl) writes for an anonymous array where IDL allows
+/// none (`sequence<long[2]>` becomes `typedef long long_array_2[2];` and `sequence<long_array_2>`): the
+/// element's spelling and the dimensions, as one identifier, at the outermost scope.
+fn array_typedef_name(t: &DynamicType) -> String {
+    let TypeKind::Array { element, dims } = t.kind() else {
+        return t.name();
+    };
+    let mut name: String = spelling(element)
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    name.push_str("_array");
+    for d in dims {
+        let _ = write!(name, "_{d}");
+    }
+    let mut squeezed = String::with_capacity(name.len());
+    for c in name.chars() {
+        if !(c == '_' && squeezed.ends_with('_')) {
+            squeezed.push(c);
+        }
+    }
+    squeezed.trim_matches('_').to_string()
 }
 
 /// How a member of type `t` named `name` is declared (arrays put their dimensions after the name).
@@ -190,6 +226,7 @@ fn spelling(t: &DynamicType) -> String {
             Some(b) => format!("map<{}, {}, {b}>", spelling(key), spelling(value)),
             None => format!("map<{}, {}>", spelling(key), spelling(value)),
         },
+        TypeKind::Array { .. } => array_typedef_name(t),
         _ if is_named(t) => scoped(&t.name()),
         _ => t.name(),
     }
@@ -366,5 +403,36 @@ fn label(disc: &DynamicType, v: i64) -> String {
         }
         TypeKind::Primitive(super::Primitive::Char8) => format!("'{}'", char::from(v as u8)),
         _ => v.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::builder::StructBuilder;
+    use super::super::types::Primitive;
+    use super::*;
+
+    #[test]
+    fn anonymous_arrays_in_sequences_and_maps_get_one_typedef_each() {
+        let long3 = DynamicType::array(DynamicType::primitive(Primitive::Int32), vec![3]).unwrap();
+        let t = StructBuilder::new("M::S")
+            .member("a", DynamicType::sequence(long3.clone(), Some(4)))
+            .member(
+                "b",
+                DynamicType::map(DynamicType::string(None), long3.clone(), None),
+            )
+            .member("c", long3)
+            .build()
+            .unwrap();
+        let idl = t.to_idl();
+        assert_eq!(
+            idl.matches("typedef long long_array_3[3];").count(),
+            1,
+            "{idl}"
+        );
+        assert!(idl.contains("sequence<long_array_3, 4> a;"), "{idl}");
+        assert!(idl.contains("map<string, long_array_3> b;"), "{idl}");
+        assert!(idl.contains("long c[3];"), "{idl}");
+        assert!(idl.find("typedef").unwrap() < idl.find("struct S").unwrap());
     }
 }

@@ -1,18 +1,52 @@
 //! [`DynamicType`]: a type described at run time (XTypes 1.3 §7.5.2), shared cheaply through an `Arc`.
 
+use std::cell::RefCell;
+use std::collections::HashSet;
 use std::sync::Arc;
 
 use crate::cdr::Extensibility;
 
 use super::error::DynamicError;
 
-/// A type known at run time. Cloning shares the description; equality is structural (clones compare in O(1)).
+/// A type known at run time. Cloning shares the description; equality is structural (clones compare in O(1),
+/// and each pair of shared sub-types is compared once per comparison, so separately built types that share
+/// sub-types, however deeply, compare in time linear in their pairs of nodes).
 #[derive(Clone)]
 pub struct DynamicType(pub(super) Arc<TypeKind>);
 
+thread_local! {
+    /// Within one outermost comparison (depth > 0): the pairs of nodes (by address) found equal so far.
+    static EQUAL_PAIRS: RefCell<(u32, HashSet<(usize, usize)>)> = RefCell::new((0, HashSet::new()));
+}
+
 impl PartialEq for DynamicType {
     fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0) || self.0 == other.0
+        if Arc::ptr_eq(&self.0, &other.0) {
+            return true;
+        }
+        // Both trees are borrowed for the whole outermost comparison, so addresses stay unique until the
+        // memo is cleared at its end.
+        let pair = (
+            Arc::as_ptr(&self.0) as usize,
+            Arc::as_ptr(&other.0) as usize,
+        );
+        let known = EQUAL_PAIRS.with(|m| {
+            let mut m = m.borrow_mut();
+            m.0 += 1;
+            m.1.contains(&pair)
+        });
+        let same = known || self.0 == other.0;
+        EQUAL_PAIRS.with(|m| {
+            let mut m = m.borrow_mut();
+            if same {
+                m.1.insert(pair);
+            }
+            m.0 -= 1;
+            if m.0 == 0 {
+                m.1 = HashSet::new();
+            }
+        });
+        same
     }
 }
 
@@ -531,5 +565,37 @@ impl DynamicType {
     /// (its `disc_key` is kept for the type's description only).
     pub fn is_keyed(&self) -> bool {
         self.as_struct().is_some_and(StructType::has_keys)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::builder::StructBuilder;
+    use super::*;
+
+    /// `L0 { long a; }`, `Ln { Ln-1 a; Ln-1 b; }`: 2^n paths, n + 1 distinct nodes.
+    fn lattice(depth: usize) -> DynamicType {
+        let mut t = StructBuilder::new("L0")
+            .member("a", DynamicType::primitive(Primitive::Int32))
+            .build()
+            .unwrap();
+        for i in 1..=depth {
+            t = StructBuilder::new(format!("L{i}"))
+                .member("a", t.clone())
+                .member("b", t)
+                .build()
+                .unwrap();
+        }
+        t
+    }
+
+    #[test]
+    fn separately_built_deep_lattices_compare_in_linear_time() {
+        // Without the memo this is 2^60 comparisons.
+        let (a, b) = (lattice(60), lattice(60));
+        let start = std::time::Instant::now();
+        assert_eq!(a, b);
+        assert_ne!(a, lattice(59));
+        assert!(start.elapsed() < std::time::Duration::from_secs(1));
     }
 }

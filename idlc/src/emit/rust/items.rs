@@ -184,7 +184,10 @@ impl Emitter<'_> {
         if let Some(b) = self.field_bound(&f.ty) {
             a.push(format!("bound = {b}"));
         }
-        if self.is_octet(&f.ty) {
+        // `xtypes` describes the member whole, octets included.
+        if self.has_typedef(&f.ty) {
+            a.push(format!("xtypes = {}", self.xtypes_type(&f.ty)));
+        } else if self.is_octet(&f.ty) {
             a.push("octet".into());
         }
         a
@@ -244,7 +247,9 @@ impl Emitter<'_> {
             if c.external {
                 ty = format!("{}<{ty}>", self.std("Box"));
             }
-            if self.is_octet(&c.ty) {
+            if self.has_typedef(&c.ty) {
+                ty = format!("#[dds(xtypes = {})] {ty}", self.xtypes_type(&c.ty));
+            } else if self.is_octet(&c.ty) {
                 ty = format!("#[dds(octet)] {ty}");
             }
             variants.push(Member {
@@ -326,6 +331,29 @@ impl Emitter<'_> {
         self.item_head(id, &doc, w);
         let rust = self.rust_type(ty, Pos::Field);
         w.assign(&format!("pub type {}", self.names[id]), &rust, ";");
+        self.typedef_marker(id, ty, w);
+    }
+
+    /// The typedef's XTypes marker, which `#[dds(xtypes = ...)]` of the members of this type name, so that
+    /// their type objects go through the typedef (`TK_ALIAS`) as Cyclone DDS's do.
+    fn typedef_marker(&self, id: DeclId, ty: &Type, w: &mut Writer) {
+        let marker = &self.typedef_markers[id];
+        if marker.is_empty() {
+            return;
+        }
+        let d = &self.model.decls[id];
+        w.item();
+        w.open(&format!("{}::typedef!", self.opts.runtime_crate));
+        w.docs(&[format!(
+            "The XTypes description of typedef `{}` (for `#[dds(xtypes = ...)]`).",
+            self.names[id]
+        )]);
+        w.line(&format!(
+            "pub {marker} = {} => {}",
+            lit_str(&d.scoped_name()),
+            self.xtypes_type(ty)
+        ));
+        w.close("");
     }
 
     pub(super) fn const_item(&mut self, id: DeclId, c: &Const, w: &mut Writer) {

@@ -52,6 +52,8 @@ struct Emitter<'a> {
     opts: &'a RustOptions,
     /// Rust identifier of each declaration.
     names: Vec<String>,
+    /// Rust identifier of each typedef's XTypes marker (`typedef!`), empty for other declarations.
+    typedef_markers: Vec<String>,
     /// Rust module path of each declaration.
     mods: Vec<Vec<String>>,
     /// Rust module path being written.
@@ -70,6 +72,7 @@ pub fn emit(model: &Model, opts: &RustOptions, diags: &mut Diagnostics) -> Strin
         model,
         opts,
         names: vec![String::new(); model.decls.len()],
+        typedef_markers: vec![String::new(); model.decls.len()],
         mods: vec![vec![]; model.decls.len()],
         cur: vec![],
         shadowed: HashSet::new(),
@@ -77,6 +80,7 @@ pub fn emit(model: &Model, opts: &RustOptions, diags: &mut Diagnostics) -> Strin
         diags: vec![],
     };
     e.assign_names(&model.root, &[]);
+    e.drop_undescribable_markers();
     let src = opts
         .source_name
         .as_deref()
@@ -150,6 +154,12 @@ impl Emitter<'_> {
             self.names[id] = name;
             self.mods[id] = path.to_vec();
         }
+        // Typedef markers come last, so that they never take a declaration's name.
+        for &id in &m.decls {
+            if matches!(self.model.decls[id].kind, DeclKind::Alias { .. }) {
+                self.typedef_markers[id] = types.take(format!("{}Typedef", bare(&self.names[id])));
+            }
+        }
         for sub in &m.modules {
             let mut p = path.to_vec();
             p.push(ident(&snake(&sub.name)));
@@ -157,8 +167,24 @@ impl Emitter<'_> {
         }
     }
 
+    /// Typedefs of `any` (and the like) have no XTypes description, so no marker.
+    fn drop_undescribable_markers(&mut self) {
+        for id in 0..self.model.decls.len() {
+            if let DeclKind::Alias { ty } = &self.model.decls[id].kind {
+                if !self.describable(ty) {
+                    self.typedef_markers[id].clear();
+                }
+            }
+        }
+    }
+
     /// Path of a declaration relative to the current module.
     fn path_to(&self, id: DeclId) -> String {
+        self.path_in(id, &self.names[id])
+    }
+
+    /// Path of `name`, declared in the module of declaration `id`, relative to the current module.
+    fn path_in(&self, id: DeclId, name: &str) -> String {
         let target = &self.mods[id];
         let common = self
             .cur
@@ -168,7 +194,7 @@ impl Emitter<'_> {
             .count();
         let mut parts: Vec<String> = vec!["super".into(); self.cur.len() - common];
         parts.extend(target[common..].iter().cloned());
-        parts.push(self.names[id].clone());
+        parts.push(name.to_string());
         parts.join("::")
     }
 

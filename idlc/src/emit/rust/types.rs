@@ -111,6 +111,75 @@ impl Emitter<'_> {
         }
     }
 
+    /// Whether `t` goes through a typedef that has an XTypes marker (then the member says so with
+    /// `#[dds(xtypes = ...)]`, see [`Self::xtypes_type`]).
+    pub(super) fn has_typedef(&self, t: &Type) -> bool {
+        match t {
+            Type::Named { decl, .. } => !self.typedef_markers[*decl].is_empty(),
+            Type::Sequence { elem, .. } | Type::Array { elem, .. } => self.has_typedef(elem),
+            Type::Map { key, value, .. } => self.has_typedef(key) || self.has_typedef(value),
+            _ => false,
+        }
+    }
+
+    /// Whether `t` has an XTypes description (`any`, `Object` and failed references have none).
+    pub(super) fn describable(&self, t: &Type) -> bool {
+        match t {
+            Type::Prim { prim } => !matches!(prim, Prim::Any | Prim::Object),
+            Type::Error => false,
+            Type::Sequence { elem, .. } | Type::Array { elem, .. } => self.describable(elem),
+            Type::Map { key, value, .. } => self.describable(key) && self.describable(value),
+            Type::Named { decl, .. } => match &self.model.decls[*decl].kind {
+                DeclKind::Alias { ty } => self.describable(ty),
+                _ => true,
+            },
+            _ => true,
+        }
+    }
+
+    /// The spelling of `t` in `#[dds(xtypes = ...)]` and in a typedef marker: typedefs by their markers,
+    /// `octet` as `Octet`, every bound in the type.
+    pub(super) fn xtypes_type(&self, t: &Type) -> String {
+        let rt = &self.opts.runtime_crate;
+        match t {
+            Type::Prim { prim: Prim::Octet } => format!("{rt}::xtypes::Octet"),
+            Type::String {
+                wide: true,
+                bound: Some(b),
+            } => format!("{rt}::xtypes::Bounded<{rt}::cdr::WString, {b}>"),
+            Type::Sequence { elem, bound } => {
+                let e = self.xtypes_type(elem);
+                match bound {
+                    Some(b) => format!("{rt}::cdr::BoundedSeq<{e}, {b}>"),
+                    None => format!("{}<{e}>", self.std("Vec")),
+                }
+            }
+            Type::Map { key, value, bound } => {
+                let m = format!(
+                    "::std::collections::BTreeMap<{}, {}>",
+                    self.xtypes_type(key),
+                    self.xtypes_type(value)
+                );
+                match bound {
+                    Some(b) => format!("{rt}::xtypes::Bounded<{m}, {b}>"),
+                    None => m,
+                }
+            }
+            Type::Array { elem, dims } => {
+                let mut s = self.xtypes_type(elem);
+                for d in dims.iter().rev() {
+                    s = format!("[{s}; {d}]");
+                }
+                s
+            }
+            Type::Named { decl, .. } if !self.typedef_markers[*decl].is_empty() => {
+                self.path_in(*decl, &self.typedef_markers[*decl])
+            }
+            Type::Named { decl, .. } => self.path_to(*decl),
+            _ => self.rust_type(t, Pos::Nested),
+        }
+    }
+
     /// Whether `t` is IDL `octet` or a sequence or array (of sequences or arrays) of it, through typedefs:
     /// such a member carries `#[dds(octet)]`, so that its `u8` is described as `octet` (`TK_BYTE`), not
     /// `uint8`.
