@@ -1,5 +1,7 @@
 //! `Publisher` and `DataWriter<T>`.
 
+#[cfg(feature = "shm")]
+mod loan;
 mod ops;
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering as AtomicOrdering};
@@ -33,6 +35,8 @@ use super::topic::Topic;
 use super::writer_filter::WriterFilters;
 use crate::rtps::pool::BufferPool;
 
+#[cfg(feature = "shm")]
+pub use loan::{LoanError, SampleLoan};
 pub use ops::PublisherListener;
 
 /// Callbacks of a [`DataWriter`] (see [`crate::dcps::listener`]). Every method has an empty default.
@@ -415,6 +419,23 @@ impl<T: DdsType> DataWriter<T> {
     /// Hands one change to the core, waiting up to max_blocking_time while flow control refuses it. With the
     /// `sample`, the matched readers' content filters are evaluated on it (writer-side filtering).
     fn submit(&self, change: WriteChange, sample: Option<&T>) -> DdsResult<()> {
+        let id = self.id();
+        self.submit_with(sample, |c, now, rejected| {
+            c.write_filtered(now, id, change.clone(), rejected)
+        })
+        .map(drop)
+    }
+
+    /// [`submit`](Self::submit) through `write`, which gets the readers whose filters rejected `sample`.
+    fn submit_with<R>(
+        &self,
+        sample: Option<&T>,
+        mut write: impl FnMut(
+            &mut crate::rtps::Participant,
+            Instant,
+            Vec<Guid>,
+        ) -> Result<R, WriteError>,
+    ) -> DdsResult<R> {
         let driver = &self.inner.state.driver;
         self.inner.state.check_enabled()?;
         let max_block = self.inner.fixed.max_block();
@@ -423,14 +444,14 @@ impl<T: DdsType> DataWriter<T> {
         let id = self.id();
         loop {
             let seen = driver.progress_generation();
-            let write = |c: &mut crate::rtps::Participant, now| {
+            let attempt = |c: &mut crate::rtps::Participant, now| {
                 let rejected = sample
                     .map(|s| lock(&self.inner.filters).rejected(c, id, s))
                     .unwrap_or_default();
-                c.write_filtered(now, id, change.clone(), rejected)
+                write(c, now, rejected)
             };
-            match driver.with_core_writing(write) {
-                Ok(_) => return Ok(()),
+            match driver.with_core_writing(attempt) {
+                Ok(r) => return Ok(r),
                 Err(WriteError::WouldBlock) => {
                     let now = Instant::now();
                     let deadline = *deadline.get_or_insert_with(|| now.checked_add(max_block));
@@ -468,13 +489,7 @@ impl<T: DdsType> DataWriter<T> {
     /// Publishes `sample` with the given source timestamp.
     pub fn write_w_timestamp(&self, sample: &T, timestamp: SystemTime) -> DdsResult<()> {
         let payload = self.serialize(sample)?;
-        // Keyed writes register the instance, so that deleting the writer can unregister it.
-        let key_hash = if T::IS_KEYED {
-            self.instance_of(sample, true, true)?.and_then(|(_, kh)| kh)
-        } else {
-            lock(&self.inner.instances).keyless_last_write = Some(Instant::now());
-            None
-        };
+        let key_hash = self.written_key_hash(sample)?;
         let change = WriteChange {
             kind: ChangeKind::Alive,
             payload,
@@ -483,6 +498,17 @@ impl<T: DdsType> DataWriter<T> {
         };
         tracing::trace!(writer = ?self.id(), "write");
         self.submit(change, Some(sample))
+    }
+
+    /// The key hash of `sample`, about to be written. Keyed writes register the instance, so that deleting
+    /// the writer can unregister it.
+    fn written_key_hash(&self, sample: &T) -> DdsResult<Option<[u8; 16]>> {
+        if T::IS_KEYED {
+            Ok(self.instance_of(sample, true, true)?.and_then(|(_, kh)| kh))
+        } else {
+            lock(&self.inner.instances).keyless_last_write = Some(Instant::now());
+            Ok(None)
+        }
     }
 
     /// The instance of `sample` (by serialized key) and its key hash; registers it when `create`, and
