@@ -8,6 +8,7 @@ fn main() {
         "rtps_decode" => dds_fuzz::rtps_one,
         "idl_parse" => dds_fuzz::idl_one,
         "typelookup_decode" => dds_fuzz::typelookup_one,
+        "shm_header" => dds_fuzz::shm_one,
         t => panic!("unknown target {t}"),
     };
     for f in args {

@@ -3,9 +3,11 @@
 pub mod cdr;
 mod idl;
 mod rtps;
+mod shm;
 mod typelookup;
 
 pub use cdr::cdr_one;
 pub use idl::idl_one;
 pub use rtps::rtps_one;
+pub use shm::shm_one;
 pub use typelookup::typelookup_one;

@@ -146,8 +146,9 @@ impl ShmChange {
     /// alignment).
     pub const HEADER_LEN: usize = 64;
 
-    /// A change for the channel of `writer`, to every reader of `nodes`.
-    pub(crate) fn new(
+    /// A change for the channel of `writer`, to every reader of `nodes` (no target, not a liveliness
+    /// assertion, not the end of a history, not loaned: set those fields after).
+    pub fn new(
         writer: EntityId,
         sequence: SequenceNumber,
         change: WriteChange,
