@@ -44,6 +44,13 @@ const BATCH: usize = 8;
 /// signal the reader participants they sent to, see [`wake_channel`]).
 const MAX_IDLE: Duration = Duration::from_millis(100);
 
+/// Stack of the reading thread, which decodes samples into their readers' caches: plain-data samples
+/// (`DataWriter::loan`) are large arrays decoded by value (reserved, not committed, until used).
+const READER_STACK: usize = 64 << 20;
+
+/// Longest wait of a receive thread for the reading thread ([`ShmLink::drain_first`]).
+const DRAIN_WAIT: Duration = Duration::from_millis(100);
+
 /// How often changes held for readers that are not connected yet are retried.
 const HELD_RETRY: Duration = Duration::from_millis(1);
 
@@ -120,6 +127,9 @@ pub(crate) struct ShmLink {
     notifiers: Mutex<HashMap<String, ShmNotifier>>,
     /// Loaned changes the core queued, until their turn.
     parked: Mutex<Vec<Parked>>,
+    /// Drain passes of the reading thread, for [`drain_first`](ShmLink::drain_first).
+    passes: Mutex<u64>,
+    passed: std::sync::Condvar,
 }
 
 fn channel_config(reliable: bool) -> ShmChannelConfig {
@@ -192,6 +202,8 @@ impl ShmLink {
             wake_self,
             notifiers: Mutex::new(HashMap::new()),
             parked: Mutex::new(Vec::new()),
+            passes: Mutex::new(0),
+            passed: std::sync::Condvar::new(),
         };
         Some((link, props))
     }
@@ -200,6 +212,7 @@ impl ShmLink {
     pub(crate) fn start<H: ShmHost>(&self, driver: Weak<H>) -> std::io::Result<()> {
         let h = std::thread::Builder::new()
             .name("dds-shm".into())
+            .stack_size(READER_STACK)
             .spawn(move || poll_loop(driver))?;
         *lock(&self.thread) = Some(h);
         Ok(())
@@ -502,6 +515,47 @@ impl ShmLink {
         n
     }
 
+    /// Before a receive thread handles datagrams: what arrived on the channels before them reaches the
+    /// readers first (a writer's last changes before the announcement of its deletion, typically). The
+    /// reading thread drains them (it decodes samples on its large stack; plain-data samples can be
+    /// large arrays decoded by value) while this thread waits, at most [`DRAIN_WAIT`]. Free when nothing
+    /// is queued. Without a reading-thread wake-up, drains here.
+    pub(crate) fn drain_first(&self, driver: &dyn ShmHost) {
+        let queued = lock(&self.inlets)
+            .channels
+            .iter()
+            .any(|i| i.subscriber.has_samples());
+        if !queued || self.stopped.load(Ordering::Acquire) {
+            return;
+        }
+        if self.listener.is_none() {
+            self.drain(driver);
+            return;
+        }
+        let mut passes = lock(&self.passes);
+        // A pass already under way may have read the channels before the frames came.
+        let target = *passes + 2;
+        self.wake();
+        let deadline = Instant::now() + DRAIN_WAIT;
+        while *passes < target {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() || self.stopped.load(Ordering::Acquire) {
+                break;
+            }
+            passes = self
+                .passed
+                .wait_timeout(passes, left)
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .0;
+        }
+    }
+
+    /// The reading thread finished a drain pass.
+    fn count_pass(&self) {
+        *lock(&self.passes) += 1;
+        self.passed.notify_all();
+    }
+
     fn acknowledge(&self, inlet: &Inlet, sn: i64) {
         let node = self.node.id();
         let sent = inlet.acks.loan(8 + node.len()).and_then(|mut loan| {
@@ -568,6 +622,7 @@ fn poll_loop<H: ShmHost>(driver: Weak<H>) {
         let (n, held, listener) = match d.shm_link() {
             Some(link) if !link.stopped.load(Ordering::Acquire) => {
                 let n = link.drain(&*d);
+                link.count_pass();
                 link.try_flush();
                 let held = !lock(&link.pending).is_empty();
                 (n, held, link.listener.clone())

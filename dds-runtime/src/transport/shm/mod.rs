@@ -155,6 +155,10 @@ pub fn node_listed(id: &str) -> bool {
 impl ShmNode {
     /// Creates this process's node (removing dead nodes first).
     pub fn new() -> Result<Self, ShmError> {
+        // iceoryx2 warns on stderr of what is expected here (no config file, a wake-up signal that finds
+        // the listener's queue full: it wakes anyway); `IOX2_LOG_LEVEL` still overrides.
+        static QUIET: std::sync::Once = std::sync::Once::new();
+        QUIET.call_once(|| set_log_level_from_env_or(LogLevel::Error));
         let removed = remove_dead_nodes();
         if removed > 0 {
             tracing::info!(removed, "removed dead shared-memory nodes");
@@ -391,6 +395,11 @@ impl std::fmt::Debug for ShmSubscriber {
 }
 
 impl ShmSubscriber {
+    /// Whether a sample is queued.
+    pub fn has_samples(&self) -> bool {
+        self.subscriber.has_samples().unwrap_or(false)
+    }
+
     /// The next sample, if one is queued (never blocks).
     pub fn receive(&self) -> Result<Option<ShmSample>, ShmError> {
         self.subscriber
