@@ -184,10 +184,14 @@ impl ShmLink {
             (SHM_NODE_PROPERTY.to_owned(), node.id()),
         ];
         let wake = wake_channel(&node.id());
-        let listener = node
-            .listener(&wake)
+        // `DDS_SHM_WAKE=poll`: the reading thread polls (diagnostic: the behaviour before wake-ups).
+        let poll = std::env::var("DDS_SHM_WAKE").is_ok_and(|v| v == "poll");
+        let listener = (!poll)
+            .then(|| node.listener(&wake))
+            .transpose()
             .map_err(|e| tracing::warn!(error = %e, "no shared-memory wake-up: the reader polls"))
-            .ok();
+            .ok()
+            .flatten();
         let wake_self = listener.as_ref().and_then(|_| node.notifier(&wake).ok());
         let link = ShmLink {
             node,
