@@ -9,8 +9,11 @@
 //!
 //! Each measurement: this program runs itself again as the subscriber (a second process), both with
 //! `Config::shm` on or off; the publisher writes samples of SIZE bytes (reliable, KEEP_ALL) for SECONDS;
-//! the subscriber takes them (each is decoded into a `Vec<u8>`) and reports samples/s from its first to
-//! its last sample.
+//! the subscriber takes them and reports samples/s from its first to its last sample. Three modes per
+//! round, interleaved: `loan` (shared memory, a plain-data sample of SIZE bytes written in place through
+//! `DataWriter::loan`; SIZE 1048576 or 4194304 only), `shm` (shared memory, a `{seq, Vec<u8>}` sample
+//! serialized and copied into the channel) and `udp` (the `Vec<u8>` sample over loopback UDP). Each line
+//! also gives the load average at its start (`/proc/loadavg`).
 
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
@@ -29,6 +32,108 @@ struct Payload {
 
 /// Marks the end of a measurement.
 const LAST: u64 = u64::MAX;
+
+/// A plain-data sample of 1 MiB: its encoding is its memory image, so it can be loaned.
+#[derive(DdsType, Clone, Copy)]
+#[dds(name = "bench::Plain1M", final)]
+#[repr(C)]
+struct Plain1M {
+    seq: u64,
+    data: [u8; (1 << 20) - 8],
+}
+
+/// A plain-data sample of 4 MiB.
+#[derive(DdsType, Clone, Copy)]
+#[dds(name = "bench::Plain4M", final)]
+#[repr(C)]
+struct Plain4M {
+    seq: u64,
+    data: [u8; (4 << 20) - 8],
+}
+
+// SAFETY: `repr(C)`: a `u64` then bytes, a multiple of 8 long: no padding; every bit pattern is valid.
+unsafe impl bytemuck::Zeroable for Plain1M {}
+// SAFETY: as above.
+unsafe impl bytemuck::Pod for Plain1M {}
+// SAFETY: as above.
+unsafe impl bytemuck::Zeroable for Plain4M {}
+// SAFETY: as above.
+unsafe impl bytemuck::Pod for Plain4M {}
+
+/// What the benchmark needs of a sample type.
+trait Bench: DdsType {
+    fn seq(&self) -> u64;
+}
+
+impl Bench for Payload {
+    fn seq(&self) -> u64 {
+        self.seq
+    }
+}
+
+impl Bench for Plain1M {
+    fn seq(&self) -> u64 {
+        self.seq
+    }
+}
+
+impl Bench for Plain4M {
+    fn seq(&self) -> u64 {
+        self.seq
+    }
+}
+
+/// A plain sample type that can be loaned.
+trait Loanable: Bench + bytemuck::Pod {
+    fn fill(&mut self, seq: u64);
+}
+
+impl Loanable for Plain1M {
+    fn fill(&mut self, seq: u64) {
+        self.seq = seq;
+        self.data.fill(seq as u8);
+    }
+}
+
+impl Loanable for Plain4M {
+    fn fill(&mut self, seq: u64) {
+        self.seq = seq;
+        self.data.fill(seq as u8);
+    }
+}
+
+/// How a measurement sends its samples.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Mode {
+    Loan,
+    Shm,
+    Udp,
+}
+
+impl Mode {
+    fn name(self) -> &'static str {
+        match self {
+            Mode::Loan => "loan",
+            Mode::Shm => "shm",
+            Mode::Udp => "udp",
+        }
+    }
+
+    fn parse(s: &str) -> Mode {
+        match s {
+            "loan" => Mode::Loan,
+            "shm" => Mode::Shm,
+            _ => Mode::Udp,
+        }
+    }
+}
+
+fn loadavg() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_owned))
+        .unwrap_or_default()
+}
 
 fn participant(domain: u32, shm: bool) -> DdsResult<DomainParticipant> {
     let c = Config {
@@ -57,9 +162,9 @@ fn qos() -> (DataWriterQos, DataReaderQos) {
 }
 
 /// The subscriber process: prints "ready", then "N SECONDS" once the end marker arrived.
-fn subscriber(domain: u32, shm: bool) -> Result<(), Box<dyn std::error::Error>> {
+fn subscriber<T: Bench>(domain: u32, shm: bool) -> Result<(), Box<dyn std::error::Error>> {
     let p = participant(domain, shm)?;
-    let topic = p.create_topic::<Payload>("ShmBench", &TopicQos::default())?;
+    let topic = p.create_topic::<T>("ShmBench", &TopicQos::default())?;
     let r = p
         .create_subscriber(&SubscriberQos::default())?
         .create_datareader(&topic, &qos().1)?;
@@ -72,7 +177,7 @@ fn subscriber(domain: u32, shm: bool) -> Result<(), Box<dyn std::error::Error>> 
         let mut end = false;
         for s in r.take()? {
             let Some(d) = s.data else { continue };
-            if d.seq == LAST {
+            if d.seq() == LAST {
                 end = true;
                 continue;
             }
@@ -89,40 +194,84 @@ fn subscriber(domain: u32, shm: bool) -> Result<(), Box<dyn std::error::Error>> 
     Ok(())
 }
 
-/// One measurement: samples/s seen by the subscriber.
-fn measure(
-    domain: u32,
-    shm: bool,
-    size: usize,
-    secs: f64,
-) -> Result<f64, Box<dyn std::error::Error>> {
-    let mut child = Command::new(std::env::current_exe()?)
-        .args(["sub", &domain.to_string(), if shm { "shm" } else { "udp" }])
-        .stdout(Stdio::piped())
-        .spawn()?;
-    let mut out = BufReader::new(child.stdout.take().ok_or("no stdout")?);
-    let mut line = String::new();
-    out.read_line(&mut line)?;
-    let p = participant(domain, shm)?;
-    let topic = p.create_topic::<Payload>("ShmBench", &TopicQos::default())?;
+/// A matched writer of `T` in a participant with shared memory on or off.
+fn matched_writer<T: DdsType>(
+    p: &DomainParticipant,
+) -> Result<DataWriter<T>, Box<dyn std::error::Error>> {
+    let topic = p.create_topic::<T>("ShmBench", &TopicQos::default())?;
     let w = p
         .create_publisher(&PublisherQos::default())?
         .create_datawriter(&topic, &qos().0)?;
     while w.publication_matched_status().current_count == 0 {
         std::thread::sleep(Duration::from_millis(10));
     }
+    Ok(w)
+}
+
+/// Writes `{seq, Vec<u8>}` samples of `size` bytes until `end`, then the end marker.
+fn write_vec(w: &DataWriter<Payload>, size: usize, end: Instant) -> DdsResult<()> {
     let mut sample = Payload {
         seq: 0,
         data: vec![0x5a; size],
     };
-    let end = Instant::now() + Duration::from_secs_f64(secs);
     while Instant::now() < end {
         w.write(&sample)?;
         sample.seq += 1;
     }
     sample.seq = LAST;
     sample.data.clear();
-    w.write(&sample)?;
+    w.write(&sample)
+}
+
+/// Loans, fills and writes plain samples until `end`, then the end marker.
+fn write_loaned<T: Loanable>(
+    w: &DataWriter<T>,
+    end: Instant,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut seq = 0;
+    while Instant::now() < end {
+        let mut loan = w.loan()?;
+        loan.fill(seq);
+        loan.write()?;
+        seq += 1;
+    }
+    let mut loan = w.loan()?;
+    loan.fill(LAST);
+    loan.write()?;
+    Ok(())
+}
+
+/// One measurement: samples/s seen by the subscriber.
+fn measure(
+    domain: u32,
+    mode: Mode,
+    size: usize,
+    secs: f64,
+) -> Result<f64, Box<dyn std::error::Error>> {
+    let mut child = Command::new(std::env::current_exe()?)
+        .args(["sub", &domain.to_string(), mode.name(), &size.to_string()])
+        .stdout(Stdio::piped())
+        .spawn()?;
+    let mut out = BufReader::new(child.stdout.take().ok_or("no stdout")?);
+    let mut line = String::new();
+    out.read_line(&mut line)?;
+    let p = participant(domain, mode != Mode::Udp)?;
+    let end = |_| Instant::now() + Duration::from_secs_f64(secs);
+    match (mode, size) {
+        (Mode::Loan, 1048576) => {
+            let w = matched_writer::<Plain1M>(&p)?;
+            write_loaned(&w, end(()))?;
+        }
+        (Mode::Loan, 4194304) => {
+            let w = matched_writer::<Plain4M>(&p)?;
+            write_loaned(&w, end(()))?;
+        }
+        (Mode::Loan, _) => return Err("loan mode: SIZE 1048576 or 4194304".into()),
+        _ => {
+            let w = matched_writer::<Payload>(&p)?;
+            write_vec(&w, size, end(()))?;
+        }
+    }
     line.clear();
     out.read_line(&mut line)?;
     child.wait()?;
@@ -133,36 +282,72 @@ fn measure(
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    if std::env::var_os("RUST_LOG").is_some() {
+        tracing_subscriber::fmt()
+            .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
+            .with_writer(std::io::stderr)
+            .init();
+    }
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.first().map(String::as_str) == Some("sub") {
-        return subscriber(args[1].parse()?, args[2] == "shm");
+        let (domain, mode, size): (u32, Mode, usize) =
+            (args[1].parse()?, Mode::parse(&args[2]), args[3].parse()?);
+        // Plain samples are decoded by value: a stack for a few copies of 4 MiB.
+        let sub = std::thread::Builder::new().stack_size(256 << 20).spawn(
+            move || -> Result<(), String> {
+                let shm = mode != Mode::Udp;
+                let r = match (mode, size) {
+                    (Mode::Loan, 1048576) => subscriber::<Plain1M>(domain, shm),
+                    (Mode::Loan, _) => subscriber::<Plain4M>(domain, shm),
+                    _ => subscriber::<Payload>(domain, shm),
+                };
+                r.map_err(|e| e.to_string())
+            },
+        )?;
+        return sub
+            .join()
+            .map_err(|_| "subscriber panicked")?
+            .map_err(Into::into);
     }
     let size: usize = args.first().map_or(Ok(1 << 20), |s| s.parse())?;
     let secs: f64 = args.get(1).map_or(Ok(5.0), |s| s.parse())?;
     let rounds: u32 = args.get(2).map_or(Ok(2), |s| s.parse())?;
-    let (mut shm_rates, mut udp_rates) = (Vec::new(), Vec::new());
+    let modes: Vec<Mode> = match args.get(3) {
+        Some(m) => m.split(',').map(Mode::parse).collect(),
+        None if matches!(size, 1048576 | 4194304) => vec![Mode::Loan, Mode::Shm, Mode::Udp],
+        None => vec![Mode::Shm, Mode::Udp],
+    };
+    let mut rates: Vec<Vec<f64>> = vec![Vec::new(); modes.len()];
     for round in 0..rounds {
-        for shm in [true, false] {
-            let domain = 130 + round * 2 + u32::from(shm);
-            let rate = measure(domain, shm, size, secs)?;
+        for (i, mode) in modes.iter().enumerate() {
+            let domain = 130 + round * 3 + i as u32;
+            let load = loadavg();
+            let rate = measure(domain, *mode, size, secs)?;
             let mbps = rate * size as f64 * 8.0 / 1e9;
             println!(
-                "round {round} {:>13} size {size} B: {rate:.0} samples/s ({mbps:.2} Gb/s)",
-                if shm { "shared memory" } else { "loopback UDP" }
+                "round {round} {:>4} size {size} B: {rate:.0} samples/s ({mbps:.2} Gb/s), load {load}",
+                mode.name()
             );
-            if shm {
-                shm_rates.push(rate);
-            } else {
-                udp_rates.push(rate);
-            }
+            rates[i].push(rate);
         }
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-    println!(
-        "size {size} B: shared memory {:.0} samples/s, loopback UDP {:.0} samples/s, ratio {:.1}x",
-        mean(&shm_rates),
-        mean(&udp_rates),
-        mean(&shm_rates) / mean(&udp_rates).max(f64::MIN_POSITIVE)
-    );
+    let udp = modes.iter().position(|m| *m == Mode::Udp);
+    for (mode, r) in modes.iter().zip(&rates) {
+        let ratio = udp.map_or(String::new(), |u| {
+            let per_round: Vec<String> = r
+                .iter()
+                .zip(&rates[u])
+                .map(|(x, y)| format!("{:.1}", x / y.max(f64::MIN_POSITIVE)))
+                .collect();
+            let ratio = mean(r) / mean(&rates[u]).max(f64::MIN_POSITIVE);
+            format!(", {ratio:.1}x UDP (per round {})", per_round.join(" / "))
+        });
+        println!(
+            "size {size} B {:>4}: mean {:.0} samples/s{ratio}",
+            mode.name(),
+            mean(r)
+        );
+    }
     Ok(())
 }

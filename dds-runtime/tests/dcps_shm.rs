@@ -2,15 +2,19 @@
 //! participants on this host that can use shared memory get its samples through the writer's channel, not
 //! as datagrams; a participant without it (shared memory off) gets the same writer's samples over UDP; a
 //! writer process killed with `SIGKILL` leaks nothing and a new writer works after it. The second process
-//! is this test binary run again with `DCPS_SHM_ROLE` set (see `child`).
+//! is this test binary run again with `DCPS_SHM_ROLE` set (see `child`). Plain-data samples written in
+//! place through `DataWriter::loan`; a durable reader that joins a writer whose channel its participant
+//! already reads gets the history before the live samples.
 mod dcps_util;
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, ChildStdout, Command, Stdio};
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use dcps_util::*;
+use dds_runtime::dcps::LoanError;
 use dds_runtime::prelude::*;
 use dds_runtime::rtps::shm::SHM_NODE_PROPERTY;
 use dds_runtime::transport::shm::{node_listed, remove_dead_nodes};
@@ -331,4 +335,186 @@ fn killed_writer_process_leaks_nothing_and_a_new_writer_works() {
     assert_eq!(ids, (1000..1020).collect::<Vec<_>>());
     drop(next.stdin.take());
     assert!(next.wait().unwrap().success());
+}
+
+/// A plain-data sample: its XCDR1 encoding is its memory image, so it can be loaned.
+#[derive(DdsType, Debug, Clone, Copy, PartialEq)]
+#[dds(name = "test::Plain", final)]
+#[repr(C)]
+struct Plain {
+    #[dds(key)]
+    id: u32,
+    seq: u32,
+    data: [u8; 4088],
+}
+
+// SAFETY: `repr(C)`, fields of plain integers with no padding between or after them (4 + 4 + 4088 bytes,
+// alignment 4); every bit pattern is valid.
+unsafe impl bytemuck::Zeroable for Plain {}
+// SAFETY: as above.
+unsafe impl bytemuck::Pod for Plain {}
+
+/// Plain data, but a mutable type: its encoding (a parameter list) is not its memory image.
+#[derive(DdsType, Debug, Clone, Copy, PartialEq)]
+#[dds(name = "test::PlainMutable", mutable)]
+#[repr(C)]
+struct PlainMutable {
+    a: u32,
+    b: u32,
+}
+
+// SAFETY: `repr(C)`, two `u32`, no padding.
+unsafe impl bytemuck::Zeroable for PlainMutable {}
+// SAFETY: as above.
+unsafe impl bytemuck::Pod for PlainMutable {}
+
+fn fill_plain(p: &mut Plain, id: u32, seq: u32) {
+    p.id = id;
+    p.seq = seq;
+    for (i, b) in p.data.iter_mut().enumerate() {
+        *b = pattern(seq, i);
+    }
+}
+
+/// Takes plain samples until `n` arrived or `timeout` passed; panics on a damaged one. Their `seq`s.
+fn take_plain(r: &DataReader<Plain>, n: usize, timeout: Duration) -> Vec<u32> {
+    let mut seqs = Vec::new();
+    wait_until(timeout, || {
+        for s in r.take().unwrap() {
+            if let Some(p) = s.data {
+                let ok = p
+                    .data
+                    .iter()
+                    .enumerate()
+                    .all(|(i, x)| *x == pattern(p.seq, i));
+                assert!(ok, "plain sample {} damaged", p.seq);
+                seqs.push(p.seq);
+            }
+        }
+        seqs.len() >= n
+    });
+    seqs
+}
+
+#[test]
+fn loaned_samples_reach_shared_memory_readers_in_place_and_udp_readers_from_a_copy() {
+    let p = participant_with(115, with_shm());
+    let near = participant_with(115, with_shm());
+    let off = participant_with(115, no_shm());
+    let (wq, rq) = reliable_keep_all();
+    let w = writer::<Plain>(&p, "ShmLoan", &wq);
+    // Typed errors, for which the caller writes as usual.
+    assert!(matches!(w.loan(), Err(LoanError::NoSharedMemoryReader)));
+    let ow = writer::<Plain>(&off, "ShmLoanOff", &wq);
+    assert!(matches!(ow.loan(), Err(LoanError::SharedMemoryOff)));
+    let mw = writer::<PlainMutable>(&p, "ShmLoanMutable", &wq);
+    assert!(matches!(mw.loan(), Err(LoanError::NotPlain)));
+
+    let r = reader::<Plain>(&near, "ShmLoan", &rq);
+    wait_matched(&w, 1);
+    let n = 100u32;
+    let before = sent(&p);
+    for seq in 0..n {
+        let mut loan = w.loan().unwrap();
+        fill_plain(&mut loan, seq % 3, seq);
+        if seq == 7 {
+            // Dropped unwritten: the buffer goes back, nothing is published.
+            drop(loan);
+            loan = w.loan().unwrap();
+            fill_plain(&mut loan, seq % 3, seq);
+        }
+        loan.write().unwrap();
+    }
+    assert_eq!(
+        take_plain(&r, n as usize, MATCH_TIMEOUT),
+        (0..n).collect::<Vec<_>>()
+    );
+    let during = sent(&p) - before;
+    assert!(
+        during < 20,
+        "{during} datagrams sent for {n} loaned samples"
+    );
+
+    // A reader on UDP as well: it gets the loaned samples from a copy, the other still in place.
+    let fr = reader::<Plain>(&off, "ShmLoan", &rq);
+    wait_matched(&w, 2);
+    let before = sent(&p);
+    for seq in n..2 * n {
+        let mut loan = w.loan().unwrap();
+        fill_plain(&mut loan, seq % 3, seq);
+        loan.write().unwrap();
+    }
+    let want: Vec<u32> = (n..2 * n).collect();
+    assert_eq!(take_plain(&r, n as usize, MATCH_TIMEOUT), want);
+    assert_eq!(take_plain(&fr, n as usize, MATCH_TIMEOUT), want);
+    assert!(
+        sent(&p) - before >= u64::from(n),
+        "the UDP reader gets datagrams"
+    );
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    // The keyed instances were registered by the loaned writes.
+    assert!(w
+        .lookup_instance(&Plain {
+            id: 2,
+            seq: 0,
+            data: [0; 4088]
+        })
+        .unwrap()
+        .is_some());
+}
+
+/// A durable reader whose participant already reads the writer's channel (for another reader) gets the
+/// writer's history first, then the live samples: none of the history is skipped because live samples
+/// came first.
+#[test]
+fn a_durable_reader_joining_a_channel_already_read_gets_the_history_first() {
+    let p = participant_with(116, with_shm());
+    let q = participant_with(116, with_shm());
+    let wq = DataWriterQos::builder()
+        .reliability(reliable())
+        .durability(Durability::TransientLocal)
+        .history(History::KeepAll)
+        .build();
+    let live_q = DataReaderQos::builder()
+        .reliability(reliable())
+        .history(History::KeepAll)
+        .build();
+    let durable_q = DataReaderQos::builder()
+        .reliability(reliable())
+        .durability(Durability::TransientLocal)
+        .history(History::KeepAll)
+        .build();
+    let w = writer::<Blob>(&p, "ShmDurableOrder", &wq);
+    let _live = reader::<Blob>(&q, "ShmDurableOrder", &live_q);
+    wait_matched(&w, 1);
+    // The writer keeps writing while the durable reader joins.
+    let written = Arc::new(AtomicU32::new(0));
+    let stop = Arc::new(AtomicBool::new(false));
+    let writing = {
+        let (w, written, stop) = (w.clone(), written.clone(), stop.clone());
+        std::thread::spawn(move || {
+            let mut id = 0;
+            while !stop.load(Ordering::Acquire) {
+                w.write(&blob(id, 64)).unwrap();
+                id += 1;
+                written.store(id, Ordering::Release);
+                std::thread::sleep(Duration::from_micros(200));
+            }
+            id
+        })
+    };
+    wait_until(MATCH_TIMEOUT, || written.load(Ordering::Acquire) >= 50);
+    let joined_at = written.load(Ordering::Acquire);
+    let durable = reader::<Blob>(&q, "ShmDurableOrder", &durable_q);
+    wait_matched(&w, 2);
+    std::thread::sleep(Duration::from_millis(100));
+    stop.store(true, Ordering::Release);
+    let total = writing.join().unwrap();
+    // One instance per id: every id from the first of the history to the last, each once, in order.
+    let ids = take_blobs(&durable, total as usize, MATCH_TIMEOUT);
+    assert_eq!(
+        ids,
+        (0..total).collect::<Vec<_>>(),
+        "the durable reader (joined after {joined_at}) got the history, then the live samples"
+    );
 }

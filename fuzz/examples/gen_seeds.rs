@@ -138,6 +138,67 @@ fn main() {
     for (name, text) in FILTERS {
         fs::write(filter.join(name), text).unwrap();
     }
+    let shm = root.join("shm_header");
+    fs::create_dir_all(&shm).unwrap();
+    shm_seeds(&shm);
+}
+
+/// Frames as a writer's channel carries them: a sample, a loaned sample (payload range), a change for one
+/// reader, the end of a history, a liveliness assertion.
+fn shm_seeds(dir: &Path) {
+    use std::sync::Arc;
+
+    use dds_runtime::rtps::shm::ShmChange;
+    use dds_runtime::rtps::{
+        ChangeKind, EntityId, Guid, GuidPrefix, Payload, SequenceNumber, Time, WriteChange,
+    };
+
+    let change = |kind, payload: &[u8]| WriteChange {
+        kind,
+        payload: Payload::copy_from_slice(payload),
+        key_hash: Some([7; 16]),
+        source_timestamp: Some(Time {
+            seconds: 1_700_000_000,
+            fraction: 42,
+        }),
+    };
+    let sample = [0, 1, 0, 0, 5, 0, 0, 0, 1, 2, 3, 4];
+    let w = EntityId([0, 0, 1, 0x02]);
+    let c = |kind, sn| {
+        ShmChange::new(
+            w,
+            SequenceNumber(sn),
+            change(kind, &sample),
+            Arc::from(Vec::new()),
+            true,
+        )
+    };
+    let frame = |c: &ShmChange| {
+        let mut f = vec![0; c.frame_len()];
+        c.write_frame(&mut f);
+        f
+    };
+    fs::write(dir.join("alive"), frame(&c(ChangeKind::Alive, 1))).unwrap();
+    fs::write(
+        dir.join("dispose"),
+        frame(&c(ChangeKind::DisposeUnregister, 9)),
+    )
+    .unwrap();
+    let mut loaned = vec![0; 96];
+    loaned[68..80].copy_from_slice(&sample);
+    c(ChangeKind::Alive, 2).write_header_with(&mut loaned, Some(68..80));
+    fs::write(dir.join("loaned"), loaned).unwrap();
+    let mut targeted = c(ChangeKind::Alive, 3);
+    targeted.target = Some(Guid::new(GuidPrefix([3; 12]), EntityId([0, 0, 2, 0x07])));
+    fs::write(dir.join("targeted"), frame(&targeted)).unwrap();
+    let mut end = targeted.clone();
+    end.change.payload = Payload::default();
+    end.history_end = true;
+    fs::write(dir.join("history_end"), frame(&end)).unwrap();
+    let mut alive = c(ChangeKind::Alive, 0);
+    alive.change.payload = Payload::default();
+    alive.liveliness = true;
+    fs::write(dir.join("liveliness"), frame(&alive)).unwrap();
 }
 
 /// `dynamic_decode`: the `cdr_decode` seeds of selectors 0–4 (the same types), and for each type its type

@@ -11,6 +11,7 @@ fn main() {
         "dynamic_decode" => dds_fuzz::dynamic_one,
         "filter_parse" => dds_fuzz::filter_one,
         "durability_key" => dds_fuzz::durability_key_one,
+        "shm_header" => dds_fuzz::shm_one,
         t => panic!("unknown target {t}"),
     };
     for f in args {

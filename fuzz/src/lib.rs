@@ -6,6 +6,7 @@ mod dynamic;
 mod filter;
 mod idl;
 mod rtps;
+mod shm;
 mod typelookup;
 
 pub use cdr::cdr_one;
@@ -14,4 +15,5 @@ pub use dynamic::dynamic_one;
 pub use filter::filter_one;
 pub use idl::idl_one;
 pub use rtps::rtps_one;
+pub use shm::shm_one;
 pub use typelookup::typelookup_one;

@@ -313,7 +313,7 @@ impl Driver {
         // before the announcement of its deletion, typically).
         #[cfg(feature = "shm")]
         if let Some(link) = &self.shm {
-            link.drain(self);
+            link.drain_first(self);
         }
         // A datagram with DATA is copied once out of the reusable receive buffers, and its samples share
         // the copy; fragments are copied straight into their reassembly buffers.

@@ -82,6 +82,8 @@ pub use participant::{
     DomainParticipantFactory, WriteBatching,
 };
 pub use publisher::{DataWriter, Publisher};
+#[cfg(feature = "shm")]
+pub use publisher::{LoanError, SampleLoan};
 pub use sample::{
     InstanceHandle, InstanceState, InstanceStateMask, Sample, SampleInfo, SampleState,
     SampleStateMask, ViewState, ViewStateMask,

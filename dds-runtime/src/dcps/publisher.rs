@@ -1,5 +1,7 @@
 //! `Publisher` and `DataWriter<T>`.
 
+#[cfg(feature = "shm")]
+mod loan;
 mod ops;
 mod shared;
 
@@ -15,8 +17,7 @@ use crate::qos::{
     XCDR2_DATA_REPRESENTATION,
 };
 use crate::rtps::{
-    ChangeKind, EntityId, Event, Guid, Payload, SequenceNumber, Time, WriteChange, WriteError,
-    WriterSpec,
+    ChangeKind, EntityId, Event, Guid, Payload, Time, WriteChange, WriteError, WriterSpec,
 };
 
 use super::condition::StatusCondition;
@@ -35,6 +36,8 @@ use super::topic::Topic;
 use super::writer_filter::WriterFilters;
 use crate::rtps::pool::BufferPool;
 
+#[cfg(feature = "shm")]
+pub use loan::{LoanError, SampleLoan};
 pub use ops::PublisherListener;
 
 /// Callbacks of a [`DataWriter`] (see [`crate::dcps::listener`]). Every method has an empty default.
@@ -426,7 +429,7 @@ impl<T: DdsType> DataWriter<T> {
             let rejected = self.rejected_by_filters(c, sample);
             Some(c.write_filtered(now, id, change.clone(), rejected))
         };
-        self.submit_with(&mut attempt, || Ok(()))
+        self.submit_with(&mut attempt, || Ok(())).map(drop)
     }
 
     /// The matched readers whose content filters reject `sample` (writer-side filtering).
@@ -438,14 +441,14 @@ impl<T: DdsType> DataWriter<T> {
 
     /// [`submit`](Self::submit) with the write done under the core's lock by `attempt`; when it does not
     /// write (`None`), `prepare` runs (lock released) and the write is tried again.
-    fn submit_with(
+    fn submit_with<R>(
         &self,
         attempt: &mut impl FnMut(
             &mut crate::rtps::Participant,
             Instant,
-        ) -> Option<Result<SequenceNumber, WriteError>>,
+        ) -> Option<Result<R, WriteError>>,
         mut prepare: impl FnMut() -> DdsResult<()>,
-    ) -> DdsResult<()> {
+    ) -> DdsResult<R> {
         let driver = &self.inner.state.driver;
         self.inner.state.check_enabled()?;
         let max_block = self.inner.fixed.max_block();
@@ -458,7 +461,7 @@ impl<T: DdsType> DataWriter<T> {
                 continue;
             };
             match written {
-                Ok(_) => return Ok(()),
+                Ok(r) => return Ok(r),
                 Err(WriteError::WouldBlock) => {
                     let now = Instant::now();
                     let deadline = *deadline.get_or_insert_with(|| now.checked_add(max_block));

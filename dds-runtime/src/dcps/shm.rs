@@ -27,7 +27,8 @@ use crate::rtps::shm::{
 };
 use crate::rtps::{EntityId, Guid, GuidPrefix, Participant, Payload};
 use crate::transport::shm::{
-    host_id, ShmChannelConfig, ShmError, ShmNode, ShmPublisher, ShmSubscriber,
+    host_id, ShmChannelConfig, ShmError, ShmListener, ShmLoan, ShmNode, ShmNotifier, ShmPublisher,
+    ShmSubscriber,
 };
 
 /// How long a writer's changes wait for the subscribers of its readers' participants to connect.
@@ -39,8 +40,35 @@ pub(crate) const DELIVERY_TIMEOUT: Duration = Duration::from_secs(10);
 /// Frames taken from one channel per pass (they stay borrowed until their readers decoded them).
 const BATCH: usize = 8;
 
-/// Longest sleep of the polling thread when no frame arrives.
-const MAX_IDLE: Duration = Duration::from_millis(1);
+/// Longest sleep of the reading thread when no frame arrives and no writer signals (a safety net: writers
+/// signal the reader participants they sent to, see [`wake_channel`]).
+const MAX_IDLE: Duration = Duration::from_millis(100);
+
+/// Stack of the reading thread, which decodes samples into their readers' caches: plain-data samples
+/// (`DataWriter::loan`) are large arrays decoded by value (reserved, not committed, until used).
+const READER_STACK: usize = 64 << 20;
+
+/// Longest wait of a receive thread for the reading thread ([`ShmLink::drain_first`]).
+const DRAIN_WAIT: Duration = Duration::from_millis(100);
+
+/// How often changes held for readers that are not connected yet are retried.
+const HELD_RETRY: Duration = Duration::from_millis(1);
+
+/// The event channel that wakes the reading thread of the participant whose node is `node`: writers
+/// signal it after sending frames to that participant, and the participant itself when the channels it
+/// reads change.
+fn wake_channel(node: &str) -> String {
+    format!("dds/n/{node}")
+}
+
+/// A change written in a loaned buffer (`DataWriter::loan`), waiting for its turn in the channel.
+struct Parked {
+    writer: EntityId,
+    sequence: i64,
+    loan: ShmLoan,
+    /// Where the serialized sample is in the buffer.
+    payload: std::ops::Range<usize>,
+}
 
 /// What the link needs of the participant's driver (which owns the link; the link does not know it).
 pub(crate) trait ShmHost: Send + Sync + 'static {
@@ -91,6 +119,17 @@ pub(crate) struct ShmLink {
     generation: AtomicU64,
     stopped: AtomicBool,
     thread: Mutex<Option<JoinHandle<()>>>,
+    /// Where the reading thread sleeps (`None`: it polls).
+    listener: Option<Arc<ShmListener>>,
+    /// Wakes our own reading thread.
+    wake_self: Option<ShmNotifier>,
+    /// Wakes the reading threads of the participants we send to, by node.
+    notifiers: Mutex<HashMap<String, ShmNotifier>>,
+    /// Loaned changes the core queued, until their turn.
+    parked: Mutex<Vec<Parked>>,
+    /// Drain passes of the reading thread, for [`drain_first`](ShmLink::drain_first).
+    passes: Mutex<u64>,
+    passed: std::sync::Condvar,
 }
 
 fn channel_config(reliable: bool) -> ShmChannelConfig {
@@ -144,6 +183,16 @@ impl ShmLink {
             (SHM_HOST_PROPERTY.to_owned(), host),
             (SHM_NODE_PROPERTY.to_owned(), node.id()),
         ];
+        let wake = wake_channel(&node.id());
+        // `DDS_SHM_WAKE=poll`: the reading thread polls (diagnostic: the behaviour before wake-ups).
+        let poll = std::env::var("DDS_SHM_WAKE").is_ok_and(|v| v == "poll");
+        let listener = (!poll)
+            .then(|| node.listener(&wake))
+            .transpose()
+            .map_err(|e| tracing::warn!(error = %e, "no shared-memory wake-up: the reader polls"))
+            .ok()
+            .flatten();
+        let wake_self = listener.as_ref().and_then(|_| node.notifier(&wake).ok());
         let link = ShmLink {
             node,
             prefix,
@@ -153,6 +202,12 @@ impl ShmLink {
             generation: AtomicU64::new(0),
             stopped: AtomicBool::new(false),
             thread: Mutex::new(None),
+            listener: listener.map(Arc::new),
+            wake_self,
+            notifiers: Mutex::new(HashMap::new()),
+            parked: Mutex::new(Vec::new()),
+            passes: Mutex::new(0),
+            passed: std::sync::Condvar::new(),
         };
         Some((link, props))
     }
@@ -161,6 +216,7 @@ impl ShmLink {
     pub(crate) fn start<H: ShmHost>(&self, driver: Weak<H>) -> std::io::Result<()> {
         let h = std::thread::Builder::new()
             .name("dds-shm".into())
+            .stack_size(READER_STACK)
             .spawn(move || poll_loop(driver))?;
         *lock(&self.thread) = Some(h);
         Ok(())
@@ -168,8 +224,11 @@ impl ShmLink {
 
     /// Under the core lock: takes what the core queued for the channels.
     pub(crate) fn take_from(&self, core: &mut Participant) {
-        self.generation
-            .store(core.shm_generation(), Ordering::Release);
+        let generation = core.shm_generation();
+        if self.generation.swap(generation, Ordering::AcqRel) != generation {
+            // The channels to read changed: the reading thread (re)subscribes now.
+            self.wake();
+        }
         let mut pending = None;
         while let Some(c) = core.poll_shm() {
             pending
@@ -203,6 +262,7 @@ impl ShmLink {
         // Changes of a writer whose readers are not connected yet wait, with those that follow them.
         let mut held = VecDeque::new();
         let mut held_writers: Vec<EntityId> = Vec::new();
+        let mut woken: Vec<Arc<[String]>> = Vec::new();
         loop {
             let Some(c) = lock(&self.pending).pop_front() else {
                 break;
@@ -212,7 +272,11 @@ impl ShmLink {
                 continue;
             }
             match self.send(outlets, &c) {
-                Ok(true) => {}
+                Ok(true) => {
+                    if !woken.iter().any(|n| Arc::ptr_eq(n, &c.nodes)) {
+                        woken.push(c.nodes.clone());
+                    }
+                }
                 Ok(false) => {
                     held_writers.push(c.writer);
                     held.push_back(c);
@@ -222,12 +286,85 @@ impl ShmLink {
                 }
             }
         }
+        self.wake_readers(&woken);
         if !held.is_empty() {
             let mut pending = lock(&self.pending);
             while let Some(c) = held.pop_back() {
                 pending.push_front(c);
             }
         }
+    }
+
+    /// Signals the reading threads of the participants of `nodes` (each once).
+    fn wake_readers(&self, nodes: &[Arc<[String]>]) {
+        if nodes.is_empty() {
+            return;
+        }
+        let mut notifiers = lock(&self.notifiers);
+        let mut done: Vec<&str> = Vec::new();
+        for n in nodes.iter().flat_map(|n| n.iter()) {
+            if done.contains(&n.as_str()) {
+                continue;
+            }
+            done.push(n);
+            if !notifiers.contains_key(n) {
+                match self.node.notifier(&wake_channel(n)) {
+                    Ok(x) => {
+                        notifiers.insert(n.clone(), x);
+                    }
+                    Err(e) => {
+                        tracing::debug!(node = n, error = %e, "no wake-up for a reader participant");
+                        continue;
+                    }
+                }
+            }
+            if let Some(Err(e)) = notifiers.get(n).map(ShmNotifier::notify) {
+                tracing::debug!(node = n, error = %e, "reader participant not woken");
+                notifiers.remove(n);
+            }
+        }
+    }
+
+    /// Wakes our own reading thread.
+    fn wake(&self) {
+        if let Some(w) = &self.wake_self {
+            let _ = w.notify();
+        }
+    }
+
+    /// A buffer of `len` bytes from the channel of `writer` (reliable or not), for a sample written in
+    /// place: [`park`](Self::park) it once the core has queued the change.
+    pub(crate) fn loan(
+        &self,
+        writer: EntityId,
+        reliable: bool,
+        len: usize,
+    ) -> Result<ShmLoan, ShmError> {
+        let mut outlets = lock(&self.outlets);
+        let out = match outlets.entry(writer) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(self.open_outlet(writer, reliable)?)
+            }
+        };
+        out.publisher.loan(len)
+    }
+
+    /// Under the core lock, right after `Participant::write_loaned` queued change `sequence` of `writer`:
+    /// the buffer that holds its sample (at `payload`), sent in the change's turn.
+    pub(crate) fn park(
+        &self,
+        writer: EntityId,
+        sequence: i64,
+        loan: ShmLoan,
+        payload: std::ops::Range<usize>,
+    ) {
+        lock(&self.parked).push(Parked {
+            writer,
+            sequence,
+            loan,
+            payload,
+        });
     }
 
     fn open_outlet(&self, writer: EntityId, reliable: bool) -> Result<Outlet, ShmError> {
@@ -241,7 +378,7 @@ impl ShmLink {
         })
     }
 
-    /// Sends `c`; `Ok(false)` when it must wait for its nodes to connect.
+    /// Sends `c`; `Ok(false)` when it must wait for its nodes to connect, or for its loaned buffer.
     fn send(
         &self,
         outlets: &mut HashMap<EntityId, Outlet>,
@@ -274,9 +411,23 @@ impl ShmLink {
             out.connected = Some(c.nodes.clone());
             out.waiting_since = None;
         }
-        let mut header = [0u8; ShmChange::HEADER_LEN];
-        c.write_header(&mut header);
-        out.publisher.send_parts(&[&header, &c.change.payload])?;
+        if c.loaned {
+            let mut parked = lock(&self.parked);
+            let at = parked
+                .iter()
+                .position(|p| p.writer == c.writer && p.sequence == c.sequence.0);
+            // The core queues the change before its writer parks the buffer: until then it waits.
+            let Some(mut p) = at.map(|i| parked.swap_remove(i)) else {
+                return Ok(false);
+            };
+            drop(parked);
+            c.write_header_with(&mut p.loan[..], Some(p.payload));
+            p.loan.send()?;
+        } else {
+            let mut header = [0u8; ShmChange::HEADER_LEN];
+            c.write_header(&mut header);
+            out.publisher.send_parts(&[&header, &c.change.payload])?;
+        }
         if !c.liveliness {
             for n in c.nodes.iter() {
                 let owed = out.owed.entry(n.clone()).or_insert((0, 0));
@@ -311,6 +462,7 @@ impl ShmLink {
     /// The writer was deleted: its channel closes (after what it sent).
     pub(crate) fn close_writer(&self, writer: EntityId) {
         self.flush();
+        lock(&self.parked).retain(|p| p.writer != writer);
         lock(&self.outlets).remove(&writer);
     }
 
@@ -334,7 +486,7 @@ impl ShmLink {
             for _ in 0..BATCH {
                 match inlet.subscriber.receive() {
                     Ok(Some(s)) => {
-                        if let Some(h) = decode_header(&s) {
+                        if let Ok(h) = decode_header(&s) {
                             highest[i] = highest[i].max(h.sequence.0);
                         }
                         frames.push((inlet.writer, Payload::from_owner(Arc::new(s))));
@@ -365,6 +517,47 @@ impl ShmLink {
             }
         }
         n
+    }
+
+    /// Before a receive thread handles datagrams: what arrived on the channels before them reaches the
+    /// readers first (a writer's last changes before the announcement of its deletion, typically). The
+    /// reading thread drains them (it decodes samples on its large stack; plain-data samples can be
+    /// large arrays decoded by value) while this thread waits, at most [`DRAIN_WAIT`]. Free when nothing
+    /// is queued. Without a reading-thread wake-up, drains here.
+    pub(crate) fn drain_first(&self, driver: &dyn ShmHost) {
+        let queued = lock(&self.inlets)
+            .channels
+            .iter()
+            .any(|i| i.subscriber.has_samples());
+        if !queued || self.stopped.load(Ordering::Acquire) {
+            return;
+        }
+        if self.listener.is_none() {
+            self.drain(driver);
+            return;
+        }
+        let mut passes = lock(&self.passes);
+        // A pass already under way may have read the channels before the frames came.
+        let target = *passes + 2;
+        self.wake();
+        let deadline = Instant::now() + DRAIN_WAIT;
+        while *passes < target {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() || self.stopped.load(Ordering::Acquire) {
+                break;
+            }
+            passes = self
+                .passed
+                .wait_timeout(passes, left)
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .0;
+        }
+    }
+
+    /// The reading thread finished a drain pass.
+    fn count_pass(&self) {
+        *lock(&self.passes) += 1;
+        self.passed.notify_all();
     }
 
     fn acknowledge(&self, inlet: &Inlet, sn: i64) {
@@ -405,17 +598,22 @@ impl ShmLink {
     /// Stops the polling thread and closes every channel.
     pub(crate) fn shutdown(&self) {
         self.stopped.store(true, Ordering::Release);
+        self.wake();
         if let Some(h) = lock(&self.thread).take() {
             if h.thread().id() != std::thread::current().id() {
                 let _ = h.join();
             }
         }
+        lock(&self.parked).clear();
         lock(&self.outlets).clear();
         lock(&self.inlets).channels.clear();
+        lock(&self.notifiers).clear();
     }
 }
 
-/// The polling thread: drains the channels, sleeping longer (up to [`MAX_IDLE`]) while nothing arrives.
+/// The reading thread: drains the channels, then sleeps until a writer signals that it sent frames to
+/// this participant (or the channels to read changed), at most [`MAX_IDLE`]; without an event channel it
+/// polls, sleeping longer (up to 1 ms) while nothing arrives.
 fn poll_loop<H: ShmHost>(driver: Weak<H>) {
     let mut idle = Duration::from_micros(20);
     loop {
@@ -425,20 +623,36 @@ fn poll_loop<H: ShmHost>(driver: Weak<H>) {
         // The thread never waits to send (a peer's queue may be full while its own thread waits on
         // ours): it only sends when no other thread is sending, changes held for connecting readers
         // typically.
-        let (n, held) = match d.shm_link() {
+        let (n, held, listener) = match d.shm_link() {
             Some(link) if !link.stopped.load(Ordering::Acquire) => {
                 let n = link.drain(&*d);
+                link.count_pass();
                 link.try_flush();
-                (n, !lock(&link.pending).is_empty())
+                let held = !lock(&link.pending).is_empty();
+                (n, held, link.listener.clone())
             }
             _ => return,
         };
         drop(d);
-        if n > 0 || held {
+        if n > 0 {
             idle = Duration::from_micros(20);
             continue;
         }
-        std::thread::sleep(idle);
-        idle = (idle * 2).min(MAX_IDLE);
+        match listener {
+            Some(l) => {
+                let timeout = if held { HELD_RETRY } else { MAX_IDLE };
+                if let Err(e) = l.wait(timeout) {
+                    tracing::debug!(error = %e, "shared-memory wait failed");
+                    std::thread::sleep(HELD_RETRY);
+                }
+            }
+            None => {
+                if held {
+                    idle = Duration::from_micros(20);
+                }
+                std::thread::sleep(idle);
+                idle = (idle * 2).min(HELD_RETRY);
+            }
+        }
     }
 }

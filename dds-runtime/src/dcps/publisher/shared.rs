@@ -143,7 +143,7 @@ impl<T: DdsType + Clone> DataWriter<T> {
             Some(h) => self.serialize_into(h),
             None => Ok(()),
         };
-        self.submit_with(&mut attempt, prepare)
+        self.submit_with(&mut attempt, prepare).map(drop)
     }
 
     /// Serializes the hand-over's sample into a buffer of the writer's pool (errors reported here, as

@@ -32,6 +32,19 @@ impl Participant {
         change: WriteChange,
         rejected: Vec<Guid>,
     ) -> Result<SequenceNumber, WriteError> {
+        self.write_delivering(now, writer, change, rejected, false)
+    }
+
+    /// [`write_filtered`](Self::write_filtered); `loaned`: the sample is in a buffer of the writer's
+    /// shared-memory channel (see `Participant::write_loaned`).
+    pub(super) fn write_delivering(
+        &mut self,
+        now: Instant,
+        writer: EntityId,
+        change: WriteChange,
+        rejected: Vec<Guid>,
+        loaned: bool,
+    ) -> Result<SequenceNumber, WriteError> {
         let shm = self.has_shm_readers(writer);
         if self.local_readers(writer).is_empty() && !shm {
             return self.write_wire(now, writer, change, rejected);
@@ -39,7 +52,7 @@ impl Participant {
         let (local, local_rejected) = (change.clone(), rejected.clone());
         let sn = self.write_wire(now, writer, change, rejected)?;
         if shm {
-            self.deliver_shm(writer, sn, &local);
+            self.deliver_shm(writer, sn, &local, loaned);
         }
         self.deliver_local(now, writer, sn, local, &local_rejected);
         Ok(sn)

@@ -20,7 +20,7 @@ use super::discovery::Local;
 use super::local::pair_qualifies;
 use super::Participant;
 use crate::qos::Durability;
-use crate::rtps::api::{Event, Payload, ReceivedSample, WriteChange};
+use crate::rtps::api::{Event, Payload, ReceivedSample, WriteChange, WriteError};
 use crate::rtps::shm::{decode_header, shm_node, shm_peers, ShmChange};
 use crate::rtps::types::{EntityId, Guid, SequenceNumber};
 
@@ -35,15 +35,37 @@ pub(super) struct ShmMatches {
     /// Writer side: our writer → the shared-memory nodes of those readers' participants, and whether the
     /// writer is reliable.
     nodes: HashMap<EntityId, (Arc<[String]>, bool)>,
-    /// Reader side: (peer's writer, our reader) → the highest sequence number delivered.
-    reader_side: HashMap<(Guid, EntityId), SequenceNumber>,
+    /// Reader side: (peer's writer, our reader) → what the reader got.
+    reader_side: HashMap<(Guid, EntityId), ReaderSide>,
     /// Changes for the writers' channels, in write order.
     out: VecDeque<ShmChange>,
     /// Changes whenever the set of channels our readers read changes.
     generation: u64,
 }
 
+/// A reader's side of a pair: what it got from the writer's channel.
+#[derive(Debug, Clone, Copy)]
+struct ReaderSide {
+    /// The highest sequence number delivered.
+    last: SequenceNumber,
+    /// A durable reader of a durable writer waits for the history the writer replays to it (ended by a
+    /// `history_end` frame): until then, changes for every reader are older than that end, and come again
+    /// in the history (or are gone from it, as for any late joiner). Since when it waits.
+    awaiting_history: Option<Instant>,
+}
+
+/// How long a reader waits for the history of a writer before taking its changes as they come.
+const HISTORY_WAIT: std::time::Duration = std::time::Duration::from_secs(15);
+
 impl Participant {
+    /// Whether a durable reader of `writer` gets `writer`'s history: both durable, as both sides see it.
+    fn shm_replays(&self, writer: &Guid, reader: &Guid) -> bool {
+        let wd = self.known_writers.get(writer);
+        let rd = self.known_readers.get(reader);
+        wd.is_some_and(|w| w.qos.writer.durability >= Durability::TransientLocal)
+            && rd.is_some_and(|r| r.qos.reader.durability >= Durability::TransientLocal)
+    }
+
     /// Whether `local` (ours) and `remote` (a peer's) qualify for a shared-memory pair.
     fn shm_qualifies(&self, local: Local, remote: Guid) -> bool {
         let (id, ours) = match local {
@@ -94,7 +116,12 @@ impl Participant {
         }
         match local {
             Local::Reader(r) => {
-                self.shm.reader_side.insert((remote, r), SequenceNumber(0));
+                let own = Guid::new(self.config.guid_prefix, r);
+                let side = ReaderSide {
+                    last: SequenceNumber(0),
+                    awaiting_history: self.shm_replays(&remote, &own).then_some(now),
+                };
+                self.shm.reader_side.insert((remote, r), side);
                 self.shm.generation += 1;
                 if let Some(wd) = self.known_writers.get(&remote) {
                     let liveliness = wd.qos.writer.liveliness;
@@ -104,11 +131,8 @@ impl Participant {
             Local::Writer(w) => {
                 self.shm.readers.entry(w).or_default().push(remote);
                 self.refresh_shm_nodes(w);
-                let durable = self
-                    .known_readers
-                    .get(&remote)
-                    .is_some_and(|rd| rd.qos.reader.durability >= Durability::TransientLocal);
-                if durable {
+                let own = Guid::new(self.config.guid_prefix, w);
+                if self.shm_replays(&own, &remote) {
                     self.replay_history_shm(now, w, remote);
                 }
             }
@@ -193,7 +217,7 @@ impl Participant {
     }
 
     /// A durable reader `reader` that joins durable writer `w` gets its history through the channel,
-    /// addressed to it alone.
+    /// addressed to it alone, then a `history_end` frame (also when the history is empty).
     fn replay_history_shm(&mut self, now: Instant, w: EntityId, reader: Guid) {
         let Some((nodes, reliable)) = self.shm.nodes.get(&w).cloned() else {
             return;
@@ -202,30 +226,40 @@ impl Participant {
             return;
         };
         let out = &mut self.shm.out;
+        let mut end = SequenceNumber(0);
         wr.for_each_historical(now, &reader, |c| {
-            out.push_back(ShmChange {
-                writer: w,
-                sequence: c.sn,
-                change: WriteChange {
-                    kind: c.kind,
-                    payload: c.payload.clone(),
-                    key_hash: c.key_hash,
-                    source_timestamp: c.source_timestamp,
-                },
-                target: Some(reader),
-                nodes: nodes.clone(),
-                reliable,
-                liveliness: false,
-            });
+            let change = WriteChange {
+                kind: c.kind,
+                payload: c.payload.clone(),
+                key_hash: c.key_hash,
+                source_timestamp: c.source_timestamp,
+            };
+            let mut sc = ShmChange::new(w, c.sn, change, nodes.clone(), reliable);
+            sc.target = Some(reader);
+            end = end.max(c.sn);
+            out.push_back(sc);
         });
+        let mut sc = ShmChange::new(
+            w,
+            end,
+            WriteChange::alive(Payload::default()),
+            nodes,
+            reliable,
+        );
+        sc.target = Some(reader);
+        sc.history_end = true;
+        out.push_back(sc);
     }
 
-    /// Queues a change just written as `sn` for the writer's channel, when it has readers there.
+    /// Queues a change just written as `sn` for the writer's channel, when it has readers there
+    /// (`loaned`: the sample is in a buffer of the channel that the driver holds, see
+    /// [`ShmChange::loaned`]).
     pub(super) fn deliver_shm(
         &mut self,
         writer: EntityId,
         sn: SequenceNumber,
         change: &WriteChange,
+        loaned: bool,
     ) {
         let Some((nodes, reliable)) = self.shm.nodes.get(&writer) else {
             return;
@@ -234,15 +268,9 @@ impl Participant {
             tracing::warn!(?writer, "shared-memory queue full: change dropped");
             return;
         }
-        self.shm.out.push_back(ShmChange {
-            writer,
-            sequence: sn,
-            change: change.clone(),
-            target: None,
-            nodes: nodes.clone(),
-            reliable: *reliable,
-            liveliness: false,
-        });
+        let mut c = ShmChange::new(writer, sn, change.clone(), nodes.clone(), *reliable);
+        c.loaned = loaned;
+        self.shm.out.push_back(c);
     }
 
     /// `DataWriter::assert_liveliness` of `writer`: its readers over shared memory are told through its
@@ -251,15 +279,15 @@ impl Participant {
         let Some((nodes, reliable)) = self.shm.nodes.get(&writer) else {
             return;
         };
-        self.shm.out.push_back(ShmChange {
+        let mut c = ShmChange::new(
             writer,
-            sequence: SequenceNumber(0),
-            change: WriteChange::alive(Payload::default()),
-            target: None,
-            nodes: nodes.clone(),
-            reliable: *reliable,
-            liveliness: true,
-        });
+            SequenceNumber(0),
+            WriteChange::alive(Payload::default()),
+            nodes.clone(),
+            *reliable,
+        );
+        c.liveliness = true;
+        self.shm.out.push_back(c);
     }
 
     /// The shared-memory nodes (participants) of `writer`'s readers over shared memory.
@@ -308,30 +336,80 @@ impl Participant {
             .map(|(w, _)| *w)
     }
 
+    /// Whether a change of `writer` written in a buffer of its channel (`DataWriter::loan`) must also be
+    /// given to the core with its payload: when the writer has no readers on shared memory, or another
+    /// use for it (a reader on the wire or in this participant, a durable history). Otherwise the core
+    /// gets an empty payload and the sample goes in the loaned buffer alone.
+    pub fn loan_needs_payload(&self, writer: EntityId) -> bool {
+        let durable = self
+            .known_writers
+            .get(&Guid::new(self.config.guid_prefix, writer))
+            .is_none_or(|d| d.qos.writer.durability >= Durability::TransientLocal);
+        !self.has_shm_readers(writer)
+            || durable
+            || !self.local_readers(writer).is_empty()
+            || self
+                .writers
+                .get(&writer)
+                .is_none_or(|w| w.matched().next().is_some())
+    }
+
+    /// [`Participant::write_filtered`] of a change written in a buffer loaned from the writer's channel:
+    /// when the writer has readers on shared memory the driver sends that buffer (its sequence number is
+    /// the one returned; whether it was queued for the channel is the `bool`). Give the change its payload
+    /// when [`loan_needs_payload`](Self::loan_needs_payload) says so.
+    pub fn write_loaned(
+        &mut self,
+        now: Instant,
+        writer: EntityId,
+        change: WriteChange,
+        rejected: Vec<Guid>,
+    ) -> Result<(SequenceNumber, bool), WriteError> {
+        if !self.has_shm_readers(writer) {
+            return self
+                .write_filtered(now, writer, change, rejected)
+                .map(|sn| (sn, false));
+        }
+        self.write_delivering(now, writer, change, rejected, true)
+            .map(|sn| (sn, true))
+    }
+
     /// A frame read from `writer`'s channel (shared, typically read in place): each of our readers matched
     /// with it over shared memory gets the change as an event, once (a change addressed to one reader
-    /// reaches only that one; one at or below what a reader already got is skipped). Anything that is not
-    /// a frame is dropped.
+    /// reaches only that one; one at or below what a reader already got is skipped; a durable reader
+    /// waiting for the writer's history takes only that history until its end). Anything that is not a
+    /// frame is dropped.
     pub fn receive_shm(&mut self, now: Instant, writer: Guid, frame: Payload) {
-        let Some(h) = decode_header(&frame) else {
-            tracing::debug!(?writer, len = frame.len(), "not a shared-memory frame");
-            return;
+        let h = match decode_header(&frame) {
+            Ok(h) => h,
+            Err(e) => {
+                tracing::debug!(?writer, error = %e, "not a shared-memory frame");
+                return;
+            }
         };
         if h.liveliness {
             self.writer_asserted(now, writer);
             return;
         }
-        let payload = frame.slice(ShmChange::HEADER_LEN..frame.len());
+        let payload = frame.slice(h.payload.clone());
         let own = self.config.guid_prefix;
         let mut any = false;
-        for ((w, r), last) in self.shm.reader_side.iter_mut() {
-            if *w != writer
-                || h.target.is_some_and(|t| t != Guid::new(own, *r))
-                || h.sequence <= *last
-            {
+        for ((w, r), side) in self.shm.reader_side.iter_mut() {
+            if *w != writer || h.target.is_some_and(|t| t != Guid::new(own, *r)) {
                 continue;
             }
-            *last = h.sequence;
+            if h.history_end {
+                side.awaiting_history = None;
+                side.last = side.last.max(h.sequence);
+                continue;
+            }
+            let waiting = side
+                .awaiting_history
+                .is_some_and(|since| now.saturating_duration_since(since) < HISTORY_WAIT);
+            if (waiting && h.target.is_none()) || h.sequence <= side.last {
+                continue;
+            }
+            side.last = h.sequence;
             any = true;
             self.events.push_back(Event::Sample(ReceivedSample {
                 reader: *r,

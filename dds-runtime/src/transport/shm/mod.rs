@@ -96,6 +96,12 @@ pub struct ShmNode {
 /// A channel's service.
 type Service = PortFactory<ipc_threadsafe::Service, [u8], ()>;
 
+/// An event channel's service.
+type EventService = iceoryx2::service::port_factory::event::PortFactory<ipc_threadsafe::Service>;
+
+/// Most notifiers of one event channel (processes that wake one listener).
+const MAX_NOTIFIERS: usize = 64;
+
 impl std::fmt::Debug for ShmNode {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("ShmNode").finish_non_exhaustive()
@@ -149,6 +155,10 @@ pub fn node_listed(id: &str) -> bool {
 impl ShmNode {
     /// Creates this process's node (removing dead nodes first).
     pub fn new() -> Result<Self, ShmError> {
+        // iceoryx2 warns on stderr of what is expected here (no config file, a wake-up signal that finds
+        // the listener's queue full: it wakes anyway); `IOX2_LOG_LEVEL` still overrides.
+        static QUIET: std::sync::Once = std::sync::Once::new();
+        QUIET.call_once(|| set_log_level_from_env_or(LogLevel::Error));
         let removed = remove_dead_nodes();
         if removed > 0 {
             tracing::info!(removed, "removed dead shared-memory nodes");
@@ -195,6 +205,38 @@ impl ShmNode {
         };
         let publisher = builder.create().map_err(setup)?;
         Ok(ShmPublisher { publisher, service })
+    }
+
+    fn event_service(&self, name: &str) -> Result<EventService, ShmError> {
+        let name: ServiceName = name.try_into().map_err(setup)?;
+        self.node
+            .service_builder(&name)
+            .event()
+            .max_notifiers(MAX_NOTIFIERS)
+            .max_listeners(1)
+            .open_or_create()
+            .map_err(setup)
+    }
+
+    /// The listener of event channel `name` (one per channel): it wakes when a notifier of the channel
+    /// signals.
+    pub fn listener(&self, name: &str) -> Result<ShmListener, ShmError> {
+        let service = self.event_service(name)?;
+        let listener = service.listener_builder().create().map_err(setup)?;
+        Ok(ShmListener {
+            listener,
+            _service: service,
+        })
+    }
+
+    /// A notifier on event channel `name`.
+    pub fn notifier(&self, name: &str) -> Result<ShmNotifier, ShmError> {
+        let service = self.event_service(name)?;
+        let notifier = service.notifier_builder().create().map_err(setup)?;
+        Ok(ShmNotifier {
+            notifier,
+            _service: service,
+        })
     }
 
     /// A subscriber on `channel`.
@@ -254,16 +296,14 @@ impl std::fmt::Debug for ShmPublisher {
 
 impl ShmPublisher {
     /// Loans a zeroed buffer of `len` bytes in shared memory: write the sample into it, then
-    /// [`ShmLoan::send`] it. Dropping the loan gives it back unsent.
-    pub fn loan(&self, len: usize) -> Result<ShmLoan<'_>, ShmError> {
+    /// [`ShmLoan::send`] it. Dropping the loan gives it back unsent. The loan keeps what it needs of the
+    /// publisher alive: it may outlive this handle (it can then only be dropped or sent to nobody).
+    pub fn loan(&self, len: usize) -> Result<ShmLoan, ShmError> {
         let sample = self
             .publisher
             .loan_slice(len)
             .map_err(|e| ShmError::Loan(format!("{e:?}")))?;
-        Ok(ShmLoan {
-            sample,
-            _publisher: std::marker::PhantomData,
-        })
+        Ok(ShmLoan { sample })
     }
 
     /// The nodes ([`ShmNode::id`]) of the channel's subscribers.
@@ -309,13 +349,19 @@ impl ShmPublisher {
     }
 }
 
-/// A buffer loaned from a publisher's segment, written in place.
-pub struct ShmLoan<'a> {
+/// A buffer loaned from a publisher's segment, written in place. `Send`: it may be written on one thread
+/// and sent from another.
+pub struct ShmLoan {
     sample: SampleMut<ipc_threadsafe::Service, [u8], ()>,
-    _publisher: std::marker::PhantomData<&'a ShmPublisher>,
 }
 
-impl ShmLoan<'_> {
+impl std::fmt::Debug for ShmLoan {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ShmLoan({} bytes)", self.len())
+    }
+}
+
+impl ShmLoan {
     /// Sends the buffer to every subscriber; how many got it.
     pub fn send(self) -> Result<usize, ShmError> {
         self.sample
@@ -324,14 +370,14 @@ impl ShmLoan<'_> {
     }
 }
 
-impl Deref for ShmLoan<'_> {
+impl Deref for ShmLoan {
     type Target = [u8];
     fn deref(&self) -> &[u8] {
         self.sample.payload()
     }
 }
 
-impl DerefMut for ShmLoan<'_> {
+impl DerefMut for ShmLoan {
     fn deref_mut(&mut self) -> &mut [u8] {
         self.sample.payload_mut()
     }
@@ -349,6 +395,11 @@ impl std::fmt::Debug for ShmSubscriber {
 }
 
 impl ShmSubscriber {
+    /// Whether a sample is queued.
+    pub fn has_samples(&self) -> bool {
+        self.subscriber.has_samples().unwrap_or(false)
+    }
+
     /// The next sample, if one is queued (never blocks).
     pub fn receive(&self) -> Result<Option<ShmSample>, ShmError> {
         self.subscriber
@@ -385,5 +436,51 @@ unsafe impl Sync for ShmSample {}
 impl std::fmt::Debug for ShmSample {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "ShmSample({} bytes)", self.len())
+    }
+}
+
+/// Waits for signals on an event channel ([`ShmNode::listener`]): a thread sleeps in
+/// [`wait`](Self::wait) instead of polling.
+pub struct ShmListener {
+    listener: iceoryx2::port::listener::Listener<ipc_threadsafe::Service>,
+    _service: EventService,
+}
+
+impl std::fmt::Debug for ShmListener {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShmListener").finish_non_exhaustive()
+    }
+}
+
+impl ShmListener {
+    /// Waits until a notifier signals or `timeout` passes; whether it was signalled. Signals sent since
+    /// the last wait are kept, so a signal sent before the wait starts is not missed.
+    pub fn wait(&self, timeout: Duration) -> Result<bool, ShmError> {
+        let mut woken = false;
+        self.listener
+            .timed_wait_all(|_| woken = true, timeout)
+            .map_err(|e| ShmError::Transfer(format!("{e:?}")))?;
+        Ok(woken)
+    }
+}
+
+/// Signals the listener of an event channel ([`ShmNode::notifier`]).
+pub struct ShmNotifier {
+    notifier: iceoryx2::port::notifier::Notifier<ipc_threadsafe::Service>,
+    _service: EventService,
+}
+
+impl std::fmt::Debug for ShmNotifier {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShmNotifier").finish_non_exhaustive()
+    }
+}
+
+impl ShmNotifier {
+    /// Wakes the channel's listener; how many listeners were signalled (0 when none exists yet).
+    pub fn notify(&self) -> Result<usize, ShmError> {
+        self.notifier
+            .notify()
+            .map_err(|e| ShmError::Transfer(format!("{e:?}")))
     }
 }
