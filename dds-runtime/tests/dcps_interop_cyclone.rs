@@ -211,24 +211,25 @@ fn rust_writer_filters_for_our_reader_while_cyclone_gets_everything() {
     );
     let (cyclone_xs, lines) = write_red_to_cyclone(&w, child);
     assert_eq!(cyclone_xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
-    let mut ours = Vec::new();
+    let mut ours = take_xs_until(&r, 3);
+    std::thread::sleep(Duration::from_millis(200));
+    ours.extend(take_xs_until(&r, 0));
+    assert_eq!(ours, [0, 1, 2]);
+}
+
+/// The `x` of the valid samples `r` holds, taken until there are at least `n` (or 5 s passed).
+fn take_xs_until(r: &DataReader<ShapeType>, n: usize) -> Vec<i32> {
+    let mut xs = Vec::new();
     wait_until(Duration::from_secs(5), || {
-        ours.extend(
+        xs.extend(
             r.take()
                 .unwrap()
                 .into_iter()
                 .filter_map(|s| s.data.map(|d| d.x)),
         );
-        ours.len() >= 3
+        xs.len() >= n
     });
-    std::thread::sleep(Duration::from_millis(200));
-    ours.extend(
-        r.take()
-            .unwrap()
-            .into_iter()
-            .filter_map(|s| s.data.map(|d| d.x)),
-    );
-    assert_eq!(ours, [0, 1, 2]);
+    xs
 }
 
 /// `write_owned`: our reader in the writer's participant gets the samples themselves, Cyclone gets them
@@ -262,17 +263,7 @@ fn typed_writes_reach_a_local_reader_and_cyclone() {
     let (xs, disposed, lines) = cyclone_sub_result(&mut child);
     assert_eq!(xs, (0..10).collect::<Vec<_>>(), "{lines:?}");
     assert!(disposed, "no dispose seen by Cyclone: {lines:?}");
-    let mut ours = Vec::new();
-    wait_until(Duration::from_secs(5), || {
-        ours.extend(
-            r.take()
-                .unwrap()
-                .into_iter()
-                .filter_map(|s| s.data.map(|d| d.x)),
-        );
-        ours.len() >= 10
-    });
-    assert_eq!(ours, (0..10).collect::<Vec<_>>());
+    assert_eq!(take_xs_until(&r, 10), (0..10).collect::<Vec<_>>());
 }
 
 /// The shapes type as a dynamic type, from IDL text (as `dds subscribe --idl` builds it).
