@@ -241,15 +241,18 @@ fn immutable_policies_change_until_enabled() {
     let r = sub
         .create_datareader::<ShapeType, _>(&tr, &DataReaderQos::default())
         .unwrap();
+    // Reliable as well: a best-effort late joiner gets the history once, with no repair, and loses it when
+    // the history arrives before the reader has matched the writer (about one run in three).
     let late_joiner = DataReaderQos {
         durability: Durability::TransientLocal,
         history: History::KeepAll,
+        reliability: Reliability::RELIABLE,
         ..r.get_qos().unwrap()
     };
     r.set_qos(&late_joiner).unwrap();
     r.enable().unwrap();
     // The writer's history kept the last 5 of the 8 (KEEP_LAST 5, not the default 1), and the reader,
-    // TRANSIENT_LOCAL and KEEP_ALL by now, gets all of them.
+    // TRANSIENT_LOCAL, reliable and KEEP_ALL by now, gets all of them.
     let got = take_n(&r, 5);
     let xs: Vec<i32> = got
         .iter()
