@@ -30,7 +30,7 @@ const ENCODINGS: [(XcdrVersion, ByteOrder); 4] = [
 ];
 
 /// The dynamic type of a derived type, from the type objects it announces.
-fn dynamic_of<T: XTypesType>() -> DynamicType {
+pub(crate) fn dynamic_of<T: XTypesType>() -> DynamicType {
     let s = T::type_support().expect("describable");
     let info: TypeInformation = from_bytes(&s.information_bytes).expect("own information");
     let mapping: TypeMapping = from_bytes(&s.mapping_bytes).expect("own mapping");

@@ -10,11 +10,10 @@ use std::sync::OnceLock;
 
 use dds_runtime::cdr::{self, ByteOrder, XcdrVersion};
 use dds_runtime::filter::ContentFilter;
-use dds_runtime::xtypes::dynamic::{DynamicData, DynamicType};
-use dds_runtime::xtypes::typeobject::{from_bytes, TypeInformation, TypeMapping};
-use dds_runtime::xtypes::XTypesType;
+use dds_runtime::xtypes::dynamic::DynamicData;
 
 use crate::cdr::{Either, Inner, Kind, MutOpt};
+use crate::dynamic::dynamic_of;
 
 fn samples() -> &'static (Vec<MutOpt>, Vec<DynamicData>) {
     static S: OnceLock<(Vec<MutOpt>, Vec<DynamicData>)> = OnceLock::new();
@@ -45,10 +44,7 @@ fn samples() -> &'static (Vec<MutOpt>, Vec<DynamicData>) {
             h: None,
         };
         let typed = vec![empty, full];
-        let s = MutOpt::type_support().expect("describable");
-        let info: TypeInformation = from_bytes(&s.information_bytes).expect("own information");
-        let mapping: TypeMapping = from_bytes(&s.mapping_bytes).expect("own mapping");
-        let ty = DynamicType::from_type_mapping(&info, &mapping).expect("dynamic type");
+        let ty = dynamic_of::<MutOpt>();
         let dynamic = typed
             .iter()
             .map(|v| {
