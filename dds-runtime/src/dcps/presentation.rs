@@ -241,8 +241,13 @@ impl AccessScope {
         let members: Vec<Arc<dyn AccessMember>> = {
             let g = lock(&self.gate);
             let members: Vec<_> = g.members.iter().filter_map(Weak::upgrade).collect();
+            let held: usize = members.iter().map(|m| m.held()).sum();
+            // Nothing queued: whatever is queued later comes with its own call (each reader the core
+            // queues for is processed after), so the other readers of one batch cost no core lock here.
+            if held == 0 {
+                return;
+            }
             if g.depth > 0 {
-                let held: usize = members.iter().map(|m| m.held()).sum();
                 if held < MAX_HELD {
                     return;
                 }
