@@ -97,8 +97,12 @@ fn multicast_off_binds_no_group_socket() {
 
 /// Sends `n` numbered datagrams to a transport reading its sockets `path`'s way; each arrives once, whole,
 /// from the sender's address.
-fn receives_every_datagram(path: ReceivePath, domain: u32) {
-    let rx = UdpTransport::bind(&cfg(domain, ParticipantIndex::None)).unwrap();
+fn receives_every_datagram(path: ReceivePath, domain: u32, spin: Duration) {
+    let rx = UdpTransport::bind(&Config {
+        receive_spin: spin,
+        ..cfg(domain, ParticipantIndex::None)
+    })
+    .unwrap();
     let tx = UdpTransport::bind(&cfg(domain, ParticipantIndex::None)).unwrap();
     let got = Arc::new(Mutex::new(Vec::new()));
     let g = got.clone();
@@ -143,11 +147,21 @@ fn receives_every_datagram(path: ReceivePath, domain: u32) {
 fn portable_receive_path_delivers_every_datagram() {
     require_netns();
     assert_eq!(ReceivePath::OneByOne.effective(), ReceivePath::OneByOne);
-    receives_every_datagram(ReceivePath::OneByOne, 53);
+    receives_every_datagram(ReceivePath::OneByOne, 53, Duration::ZERO);
 }
 
 #[test]
 fn batched_receive_path_delivers_every_datagram() {
     require_netns();
-    receives_every_datagram(ReceivePath::Batched, 54);
+    receives_every_datagram(ReceivePath::Batched, 54, Duration::ZERO);
+}
+
+/// With busy polling on, the receive thread polls between bursts (they follow each other within the
+/// window) and still hands over every datagram once; and the portable path, which cannot poll, too.
+#[test]
+fn polling_receive_paths_deliver_every_datagram() {
+    require_netns();
+    let spin = Duration::from_millis(20);
+    receives_every_datagram(ReceivePath::Batched, 55, spin);
+    receives_every_datagram(ReceivePath::OneByOne, 56, spin);
 }

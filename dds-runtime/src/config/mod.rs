@@ -20,6 +20,7 @@
 //! | `DDS_SOCKET_BUFFER_SIZE` | requested SO_RCVBUF / SO_SNDBUF | bytes | `4194304` |
 //! | `DDS_INTRA_PROCESS` | deliver to readers of the same participant directly (no serialization for them, no socket) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_GSO` | on Linux, a fragmented sample's datagrams to one destination leave in one `UDP_SEGMENT` send | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
+//! | `DDS_RECEIVE_SPIN_US` | adaptive busy polling: while datagrams arrive less than this apart, a receive thread polls its socket this long after each batch instead of sleeping (saves a wake-up per datagram; pays only with a core to spare) | microseconds, `0` = off | `0` |
 //! | `DDS_SHM` | with the `shm` feature: shared memory with peers on this host (their readers get our writers' samples through it, not UDP) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_WRITE_BATCH` | write batching: samples share datagrams until full, flushed, or this delay has passed | `off`, `on` (1 ms), or a delay in microseconds | `off` |
 //!
@@ -338,6 +339,12 @@ pub struct Config {
     /// Segmented sends (Linux `UDP_SEGMENT`, `DDS_GSO`, default on): a run of equal-sized datagrams to one
     /// destination, as a fragmented sample makes, leaves in one system call. Ignored elsewhere.
     pub gso: bool,
+    /// Adaptive busy polling of the receive sockets (`DDS_RECEIVE_SPIN_US`, default 0: off). While datagrams
+    /// arrive less than this apart, a receive thread polls its socket for up to this long after each batch
+    /// instead of sleeping, which saves a thread wake-up per datagram on a request/reply or a fast stream.
+    /// Sparse traffic never polls, and the polling thread yields between polls. It pays only with a core to
+    /// spare: on a loaded machine the polling threads delay the very threads they wait for.
+    pub receive_spin: Duration,
     /// Shared memory with peers on this host that can use it (`DDS_SHM`, default on; only with the `shm`
     /// feature, ignored without it): their readers get our writers' samples through shared memory, not
     /// UDP. Off, the participant does not announce it, and its peers use UDP with it.
@@ -363,6 +370,7 @@ impl Default for Config {
             write_batch_delay: None,
             intra_process: true,
             gso: true,
+            receive_spin: Duration::ZERO,
             shm: true,
         }
     }
@@ -477,6 +485,9 @@ impl Config {
         if let Some(v) = lookup("DDS_GSO") {
             c.gso = parse_bool("DDS_GSO", &v)?;
         }
+        if let Some(v) = lookup("DDS_RECEIVE_SPIN_US") {
+            c.receive_spin = Duration::from_micros(parse_num("DDS_RECEIVE_SPIN_US", &v)?);
+        }
         if let Some(v) = lookup("DDS_SHM") {
             c.shm = parse_bool("DDS_SHM", &v)?;
         }
@@ -580,8 +591,10 @@ mod tests {
             ("DDS_PARTICIPANT_INDEX", "none"),
             ("DDS_SPDP_INTERVAL_MS", "250"),
             ("DDS_FRAGMENT_SIZE", "8000"),
+            ("DDS_RECEIVE_SPIN_US", "40"),
         ])
         .unwrap();
+        assert_eq!(c.receive_spin, Duration::from_micros(40));
         assert_eq!(c.domain_id, 7);
         assert_eq!(c.interface, InterfaceSelection::Name("lo".into()));
         assert!(!c.multicast);

@@ -53,6 +53,11 @@ pub(super) const RECV_BUFFER: usize = 65536;
 pub(super) trait RecvBatch {
     /// Blocks for the first datagram, then takes what else the implementation can; returns how many arrived.
     fn recv(&mut self, sock: &UdpSocket) -> io::Result<usize>;
+    /// Takes what is queued without blocking (`WouldBlock` when nothing is). Only paths that can poll are
+    /// ever asked; the others keep this default.
+    fn try_recv(&mut self, _sock: &UdpSocket) -> io::Result<usize> {
+        Err(io::ErrorKind::Unsupported.into())
+    }
     /// The `i`th datagram of the last batch; `None` when its sender is neither IPv4 nor IPv6.
     fn datagram(&self, i: usize) -> Option<Datagram<'_>>;
 }

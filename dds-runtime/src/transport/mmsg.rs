@@ -58,6 +58,26 @@ impl MmsgBatch {
 
 impl RecvBatch for MmsgBatch {
     fn recv(&mut self, sock: &UdpSocket) -> io::Result<usize> {
+        self.read(sock, libc::MSG_WAITFORONE)
+    }
+
+    fn try_recv(&mut self, sock: &UdpSocket) -> io::Result<usize> {
+        self.read(sock, libc::MSG_DONTWAIT)
+    }
+
+    fn datagram(&self, i: usize) -> Option<Datagram<'_>> {
+        let len = (self.hdrs[i].msg_len as usize).min(self.bufs[i].len());
+        let from = sockaddr(&self.addrs[i])?;
+        Some(Datagram {
+            data: &self.bufs[i][..len],
+            from,
+        })
+    }
+}
+
+impl MmsgBatch {
+    /// One `recvmmsg` with these flags.
+    fn read(&mut self, sock: &UdpSocket, flags: libc::c_int) -> io::Result<usize> {
         for h in &mut self.hdrs {
             h.msg_hdr.msg_namelen =
                 std::mem::size_of::<libc::sockaddr_storage>() as libc::socklen_t;
@@ -69,7 +89,7 @@ impl RecvBatch for MmsgBatch {
                 sock.as_raw_fd(),
                 self.hdrs.as_mut_ptr(),
                 RECV_BATCH as libc::c_uint,
-                libc::MSG_WAITFORONE,
+                flags,
                 std::ptr::null_mut(),
             )
         };
@@ -78,15 +98,6 @@ impl RecvBatch for MmsgBatch {
         } else {
             Ok(n as usize)
         }
-    }
-
-    fn datagram(&self, i: usize) -> Option<Datagram<'_>> {
-        let len = (self.hdrs[i].msg_len as usize).min(self.bufs[i].len());
-        let from = sockaddr(&self.addrs[i])?;
-        Some(Datagram {
-            data: &self.bufs[i][..len],
-            from,
-        })
     }
 }
 

@@ -4,6 +4,7 @@
 use std::io;
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use super::datagram::{
     Channel, Datagram, Receiver, RecvBatch, TransportStats, MAX_BATCH, RECV_BUFFER,
@@ -75,63 +76,98 @@ impl RecvBatch for SingleRecv {
     }
 }
 
-/// Reads `sock` the chosen way until `stop` is set.
+/// Reads `sock` the chosen way until `stop` is set. The batched path polls for up to `spin` after a batch
+/// that followed the one before it within `spin` (see [`Spin`]).
 pub(super) fn run(
     path: ReceivePath,
+    spin: Duration,
     ch: Channel,
     sock: &UdpSocket,
     stop: &AtomicBool,
     rx: &Receiver,
     stats: &TransportStats,
 ) {
+    let io = Io {
+        ch,
+        sock,
+        stop,
+        rx,
+        stats,
+    };
     match path.effective() {
         #[cfg(target_os = "linux")]
-        ReceivePath::Batched => recv_loop(
-            &mut super::mmsg::MmsgBatch::new(),
-            ch,
-            sock,
-            stop,
-            rx,
-            stats,
-        ),
-        _ => recv_loop(&mut SingleRecv::new(), ch, sock, stop, rx, stats),
+        ReceivePath::Batched => recv_loop(&mut super::mmsg::MmsgBatch::new(), Spin::new(spin), &io),
+        // The portable path cannot poll: it always waits.
+        _ => recv_loop(&mut SingleRecv::new(), Spin::new(Duration::ZERO), &io),
     }
 }
 
-fn recv_loop(
-    batch: &mut impl RecvBatch,
+/// What a receive thread reads from and hands its datagrams to.
+struct Io<'a> {
     ch: Channel,
-    sock: &UdpSocket,
-    stop: &AtomicBool,
-    rx: &Receiver,
-    stats: &TransportStats,
-) {
-    while !stop.load(Ordering::Relaxed) {
-        match batch.recv(sock) {
-            Ok(n) => {
-                if stop.load(Ordering::Relaxed) {
+    sock: &'a UdpSocket,
+    stop: &'a AtomicBool,
+    rx: &'a Receiver,
+    stats: &'a TransportStats,
+}
+
+/// Adaptive busy polling. While datagrams come closer together than `max` (a ping/pong, a fast stream),
+/// the thread polls the socket for up to `max` after each batch instead of sleeping in the kernel, so the
+/// next datagram is handled without a wake-up. Sparse traffic (discovery, a slow stream) never polls, and
+/// the thread yields between polls, so a busy core loses little to it.
+struct Spin {
+    max: Duration,
+    last: Option<Instant>,
+    until: Option<Instant>,
+}
+
+impl Spin {
+    fn new(max: Duration) -> Self {
+        Spin {
+            max,
+            last: None,
+            until: None,
+        }
+    }
+
+    /// A batch was just handled.
+    fn arrived(&mut self) {
+        if self.max.is_zero() {
+            return;
+        }
+        let now = Instant::now();
+        let dense = self.last.is_some_and(|t| now - t <= self.max);
+        self.until = dense.then_some(now + self.max);
+        self.last = Some(now);
+    }
+
+    /// The next batch: polled for while the window is open, then waited for.
+    fn next(&mut self, batch: &mut impl RecvBatch, io: &Io<'_>) -> io::Result<usize> {
+        if let Some(until) = self.until.take() {
+            loop {
+                match batch.try_recv(io.sock) {
+                    Err(e) if e.kind() == io::ErrorKind::WouldBlock => {}
+                    r => return r,
+                }
+                if io.stop.load(Ordering::Relaxed) || Instant::now() >= until {
                     break;
                 }
-                // On the stack: no allocation per batch.
-                let mut grams = [NO_DATAGRAM; MAX_BATCH];
-                let mut k = 0;
-                for d in (0..n.min(MAX_BATCH)).filter_map(|i| batch.datagram(i)) {
-                    if !d.data.is_empty() {
-                        grams[k] = d;
-                        k += 1;
-                    }
+                std::thread::yield_now();
+            }
+        }
+        batch.recv(io.sock)
+    }
+}
+
+fn recv_loop(batch: &mut impl RecvBatch, mut spin: Spin, io: &Io<'_>) {
+    while !io.stop.load(Ordering::Relaxed) {
+        match spin.next(batch, io) {
+            Ok(n) => {
+                if io.stop.load(Ordering::Relaxed) {
+                    break;
                 }
-                let grams = &grams[..k];
-                if grams.is_empty() {
-                    continue;
-                }
-                stats
-                    .received
-                    .fetch_add(grams.len() as u64, Ordering::Relaxed);
-                for d in grams {
-                    tracing::trace!(channel = ?ch, from = %d.from, len = d.data.len(), "received");
-                }
-                rx(ch, grams);
+                deliver(batch, n, io);
+                spin.arrived();
             }
             Err(e)
                 if matches!(
@@ -141,12 +177,36 @@ fn recv_loop(
                         | io::ErrorKind::Interrupted
                 ) => {}
             Err(e) => {
-                if stop.load(Ordering::Relaxed) {
+                if io.stop.load(Ordering::Relaxed) {
                     break;
                 }
                 // ICMP port-unreachable from an earlier send shows up here as ConnectionRefused.
-                tracing::debug!(channel = ?ch, error = %e, "recv error");
+                tracing::debug!(channel = ?io.ch, error = %e, "recv error");
             }
         }
     }
+}
+
+/// Hands the `n` datagrams of the last read to the receiver.
+fn deliver(batch: &impl RecvBatch, n: usize, io: &Io<'_>) {
+    // On the stack: no allocation per batch.
+    let mut grams = [NO_DATAGRAM; MAX_BATCH];
+    let mut k = 0;
+    for d in (0..n.min(MAX_BATCH)).filter_map(|i| batch.datagram(i)) {
+        if !d.data.is_empty() {
+            grams[k] = d;
+            k += 1;
+        }
+    }
+    let grams = &grams[..k];
+    if grams.is_empty() {
+        return;
+    }
+    io.stats
+        .received
+        .fetch_add(grams.len() as u64, Ordering::Relaxed);
+    for d in grams {
+        tracing::trace!(channel = ?io.ch, from = %d.from, len = d.data.len(), "received");
+    }
+    (io.rx)(io.ch, grams);
 }

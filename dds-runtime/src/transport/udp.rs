@@ -38,6 +38,8 @@ pub struct UdpTransport {
     /// Which destinations take segmented sends (Linux `UDP_SEGMENT`).
     #[cfg(target_os = "linux")]
     gso: GsoState,
+    /// How long receive threads poll after a batch (`Config::receive_spin`).
+    spin: Duration,
 }
 
 impl std::fmt::Debug for UdpTransport {
@@ -184,6 +186,7 @@ impl UdpTransport {
             stats: Arc::new(TransportStats::default()),
             #[cfg(target_os = "linux")]
             gso: GsoState::new(config.gso),
+            spin: config.receive_spin,
         };
         tracing::info!(transport = ?t, "transport bound");
         Ok(t)
@@ -214,9 +217,10 @@ impl UdpTransport {
             let stop = self.stop.clone();
             let rx = rx.clone();
             let stats = self.stats.clone();
+            let spin = self.spin;
             let h = std::thread::Builder::new()
                 .name(format!("dds-rx-{ch:?}"))
-                .spawn(move || recv::run(path, ch, &sock, &stop, &rx, &stats))?;
+                .spawn(move || recv::run(path, spin, ch, &sock, &stop, &rx, &stats))?;
             threads.push(h);
         }
         Ok(())
