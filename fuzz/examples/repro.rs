@@ -12,6 +12,7 @@ fn main() {
         "filter_parse" => dds_fuzz::filter_one,
         "durability_key" => dds_fuzz::durability_key_one,
         "shm_header" => dds_fuzz::shm_one,
+        "rtps_participant" => dds_fuzz::participant_one,
         t => panic!("unknown target {t}"),
     };
     for f in args {

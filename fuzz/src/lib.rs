@@ -5,6 +5,7 @@ mod durability;
 mod dynamic;
 mod filter;
 mod idl;
+mod participant;
 mod rtps;
 mod shm;
 mod typelookup;
@@ -14,6 +15,7 @@ pub use durability::{durability_key_hashes, durability_key_input, durability_key
 pub use dynamic::dynamic_one;
 pub use filter::filter_one;
 pub use idl::idl_one;
+pub use participant::participant_one;
 pub use rtps::rtps_one;
 pub use shm::shm_one;
 pub use typelookup::typelookup_one;
