@@ -1,5 +1,6 @@
 //! `Subscriber` and `DataReader<T>`.
 
+mod builtin;
 mod ops;
 
 use std::collections::VecDeque;
@@ -39,6 +40,7 @@ use super::sync::{lock, recover};
 use super::topic::{Topic, TopicDescription};
 use crate::filter::ContentFilter;
 
+pub(crate) use builtin::{BuiltinGroup, BuiltinReader};
 pub use ops::SubscriberListener;
 
 /// Callbacks of a [`DataReader`] (see [`crate::dcps::listener`]). Every method has an empty default.
@@ -186,24 +188,13 @@ impl Subscriber {
         cache.set_filter(topic.sample_filter());
         cache.set_instance_order(instance_ordered(&self.qos.presentation));
 
-        let inner = Arc::new(ReaderInner::<T> {
-            state: EndpointState::new(driver.clone()),
-            pending: Mutex::new(VecDeque::new()),
-            group_order: group_ordered(&self.qos.presentation).then(|| self.access.order()),
-            access: group_scoped(&self.qos.presentation).then(|| self.access.clone()),
-            staged: Mutex::new(VecDeque::new()),
-            committed: Mutex::default(),
-            cache: Mutex::new(CacheState {
-                cache,
-                by_hash: HashMap::new(),
-                batch: VecDeque::new(),
-            }),
-            data_cv: Condvar::new(),
-            data_waiters: AtomicUsize::new(0),
-            wakers: Mutex::new(Vec::new()),
-            data_signal: Signal::default(),
-            credit_limit: AtomicUsize::new(credit_limit.unwrap_or(NO_CREDIT_LIMIT)),
-        });
+        let inner = Arc::new(ReaderInner::<T>::new(
+            driver.clone(),
+            cache,
+            group_ordered(&self.qos.presentation).then(|| self.access.order()),
+            group_scoped(&self.qos.presentation).then(|| self.access.clone()),
+            credit_limit,
+        ));
         let owner = ReaderOwner {
             topic: t.clone(),
             subscriber: self.clone(),
@@ -811,6 +802,34 @@ impl<T: DdsType> DataReader<T> {
 }
 
 impl<T: DdsType> ReaderInner<T> {
+    /// The state of a new reader with `cache`, not yet created in the core.
+    fn new(
+        driver: Arc<super::driver::Driver>,
+        cache: ReaderCache<T>,
+        group_order: Option<Arc<AtomicU64>>,
+        access: Option<Arc<AccessScope>>,
+        credit_limit: Option<usize>,
+    ) -> Self {
+        ReaderInner {
+            state: EndpointState::new(driver),
+            pending: Mutex::new(VecDeque::new()),
+            group_order,
+            access,
+            staged: Mutex::new(VecDeque::new()),
+            committed: Mutex::default(),
+            cache: Mutex::new(CacheState {
+                cache,
+                by_hash: HashMap::new(),
+                batch: VecDeque::new(),
+            }),
+            data_cv: Condvar::new(),
+            data_waiters: AtomicUsize::new(0),
+            wakers: Mutex::new(Vec::new()),
+            data_signal: Signal::default(),
+            credit_limit: AtomicUsize::new(credit_limit.unwrap_or(NO_CREDIT_LIMIT)),
+        }
+    }
+
     /// The public reader, for listeners.
     fn reader(
         self: &Arc<Self>,
