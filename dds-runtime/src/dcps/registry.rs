@@ -476,11 +476,15 @@ impl Registry {
         ptr: *const (),
         qos: &Q,
     ) -> DdsResult<Vec<Weak<dyn Registered>>> {
+        // A disabled group takes every policy (DDS 1.4 §2.2.2.1.1.7); its readers or writers (disabled
+        // too) announce the new ones when enabled.
+        let enabled = self.is_enabled(self.with_group::<Q, _>(ptr, |g| g.node.handle)?);
         let (handle, changed) = self.with_group::<Q, _>(ptr, |g| {
-            if let Some(p) = g.qos.immutable_change(qos) {
+            let immutable = g.qos.immutable_change(qos);
+            if let (Some(p), true) = (immutable, enabled) {
                 return Err(DdsError::ImmutablePolicy(p));
             }
-            let changed = g.qos.announced_change(qos);
+            let changed = g.qos.announced_change(qos) || immutable.is_some();
             g.qos = qos.clone();
             Ok((g.node.handle, changed))
         })??;

@@ -164,6 +164,8 @@ impl Subscriber {
             .participant
             .registry()
             .group_creates_enabled::<SubscriberQos>(Arc::as_ptr(&self.qos) as *const ())?;
+        // The QoS in effect: a disabled subscriber may have changed any policy since its creation.
+        let group_qos = self.get_qos()?;
         let mut rq = qos.clone();
         if rq.data_representation.ids().is_empty() {
             rq.data_representation = DataRepresentation::accept_both();
@@ -174,7 +176,7 @@ impl Subscriber {
             topic_name: t.name().to_string(),
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
-            qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
+            qos: ReaderQos::new(rq.clone(), &group_qos, &t.get_qos()?),
             type_information: crate::xtypes::announced_type_information_for(
                 T::type_information(),
                 T::type_mapping(),
@@ -186,13 +188,13 @@ impl Subscriber {
         let credit_limit = credit_limit(&rq);
         let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
         cache.set_filter(topic.sample_filter());
-        cache.set_instance_order(instance_ordered(&self.qos.presentation));
+        cache.set_instance_order(instance_ordered(&group_qos.presentation));
 
         let inner = Arc::new(ReaderInner::<T>::new(
             driver.clone(),
             cache,
-            group_ordered(&self.qos.presentation).then(|| self.access.order()),
-            group_scoped(&self.qos.presentation).then(|| self.access.clone()),
+            group_ordered(&group_qos.presentation).then(|| self.access.order()),
+            group_scoped(&group_qos.presentation).then(|| self.access.clone()),
             credit_limit,
         ));
         let owner = ReaderOwner {

@@ -364,7 +364,7 @@ impl Subscriber {
         let prefix = self.participant.driver().guid_prefix;
         let handle = |id| InstanceHandle::from_guid(crate::rtps::Guid::new(prefix, id));
         let readers = self.readers()?;
-        if group_ordered(&self.qos.presentation) {
+        if group_ordered(&self.get_qos()?.presentation) {
             return Ok(group_order(&readers, samples, views, instances)
                 .into_iter()
                 .map(handle)

@@ -105,10 +105,11 @@ impl<T: DdsType> Topic<T> {
 
     /// Changes the QoS (`set_qos`): TOPIC_DATA, DEADLINE, LATENCY_BUDGET, TRANSPORT_PRIORITY and LIFESPAN
     /// may change (a new TOPIC_DATA is announced again by the topic's readers and writers); the others
-    /// cannot (`ImmutablePolicy`).
+    /// cannot (`ImmutablePolicy`) once the topic is enabled. A disabled topic takes every policy.
     pub fn set_qos(&self, qos: &TopicQos) -> DdsResult<()> {
+        let enabled = self.is_enabled();
         let announce = self.with_entry(|t| {
-            if let Some(p) = t.qos.immutable_change(qos) {
+            if let (Some(p), true) = (t.qos.immutable_change(qos), enabled) {
                 return Err(DdsError::ImmutablePolicy(p));
             }
             let changed = t.qos.topic_data != qos.topic_data;
