@@ -20,8 +20,8 @@ fn alive<T>(samples: &[Sample<T>]) -> Vec<&T> {
 
 struct Count(Arc<AtomicU32>);
 
-impl<T> BuiltinDataReaderListener<T> for Count {
-    fn on_data_available(&self, _r: &BuiltinDataReader<T>) {
+impl<T: DdsType> DataReaderListener<T> for Count {
+    fn on_data_available(&self, _r: &DataReader<T>) {
         self.0.fetch_add(1, Ordering::SeqCst);
     }
 }
@@ -36,7 +36,7 @@ fn builtin_readers_see_entities_come_and_go() {
     let pubs = builtin.publication_reader();
     let subs = builtin.subscription_reader();
     let topics = builtin.topic_reader();
-    assert_eq!(parts.topic_name(), "DCPSParticipant");
+    assert_eq!(parts.topic().name(), "DCPSParticipant");
     // Our own participant is there from the start.
     let own = parts.read().unwrap();
     assert!(alive(&own).iter().any(|d| d.key == p.guid_prefix()));
@@ -122,8 +122,10 @@ fn builtin_readers_see_entities_come_and_go() {
                 .is_some_and(|s| s.info.instance_state == InstanceState::NotAliveDisposed)
         })
     }));
+    // The data read before, then the dispose as a sample without data (as for any reader).
     let taken = subs.take_instance(rh).unwrap();
-    assert_eq!(taken.len(), 1);
+    let last = taken.last().expect("samples of the disposed reader");
+    assert!(!last.info.valid_data && taken.len() <= 2);
     assert!(
         subs.read_instance(rh).is_err(),
         "a taken, disposed instance is forgotten"
@@ -243,4 +245,137 @@ fn topics_are_announced_in_sedp() {
                     .any(|s| s.info.instance_state == InstanceState::NotAliveDisposed)
             })
     }));
+}
+
+struct OnReaders(Arc<AtomicU32>);
+
+impl SubscriberListener for OnReaders {
+    fn on_data_on_readers(&self, _s: &Subscriber) {
+        self.0.fetch_add(1, Ordering::SeqCst);
+    }
+}
+
+/// The built-in readers are `DataReader`s of the built-in subscriber: `lookup_datareader` finds them by
+/// topic name, `get_datareaders` lists them, DATA_ON_READERS reaches the subscriber's listener, a query
+/// condition filters on their members, and a remote participant that leaves is read by instance state.
+#[test]
+fn builtin_readers_are_datareaders_of_the_builtin_subscriber() {
+    let p = participant(224);
+    let builtin = p.get_builtin_subscriber().unwrap();
+    let parts = builtin
+        .lookup_datareader::<ParticipantBuiltinTopicData>("DCPSParticipant")
+        .unwrap()
+        .expect("DCPSParticipant reader");
+    let pubs = builtin
+        .lookup_datareader::<PublicationBuiltinTopicData>("DCPSPublication")
+        .unwrap()
+        .expect("DCPSPublication reader");
+    assert!(builtin
+        .lookup_datareader::<SubscriptionBuiltinTopicData>("DCPSSubscription")
+        .unwrap()
+        .is_some());
+    assert!(builtin
+        .lookup_datareader::<TopicBuiltinTopicData>("DCPSTopic")
+        .unwrap()
+        .is_some());
+    assert_eq!(
+        parts.instance_handle(),
+        builtin.participant_reader().instance_handle()
+    );
+    assert_eq!(pubs.topic().type_name(), "DDS::PublicationBuiltinTopicData");
+    let sub_handle = builtin.instance_handle().unwrap();
+    assert_eq!(pubs.subscriber().instance_handle().unwrap(), sub_handle);
+    // Our own participant: unread, so DCPSParticipant is listed (DCPSPublication is empty).
+    let listed = builtin
+        .get_datareaders(
+            SampleStateMask::NOT_READ,
+            ViewStateMask::ANY,
+            InstanceStateMask::ANY,
+        )
+        .unwrap();
+    assert!(listed.contains(&parts.instance_handle()));
+    // The participant's own instance handle is its DCPSParticipant instance.
+    let own = parts.read_instance(p.instance_handle()).unwrap();
+    assert_eq!(own.len(), 1);
+    assert_eq!(own[0].data.as_ref().unwrap().key, p.guid_prefix());
+
+    let calls = Arc::new(AtomicU32::new(0));
+    builtin
+        .set_listener(
+            Box::new(OnReaders(calls.clone())),
+            StatusMask::DATA_ON_READERS,
+        )
+        .unwrap();
+    let q = pubs
+        .create_querycondition(
+            SampleStateMask::ANY,
+            ViewStateMask::ANY,
+            InstanceStateMask::ALIVE,
+            "topic_name = %0",
+            &["Wanted"],
+        )
+        .unwrap();
+    let ws = WaitSet::new();
+    ws.attach_condition(q.clone());
+
+    let other = participant(224);
+    let _skip = writer::<ShapeType>(&other, "Unwanted", &DataWriterQos::default());
+    let w = writer::<ShapeType>(&other, "Wanted", &DataWriterQos::default());
+    assert!(!ws.wait(MATCH_TIMEOUT).unwrap().is_empty());
+    let got = pubs.read_w_condition(&q).unwrap();
+    assert_eq!(got.len(), 1, "only the writer on Wanted passes the query");
+    assert_eq!(got[0].data.as_ref().unwrap().key, w.guid());
+    assert!(calls.load(Ordering::SeqCst) >= 1, "on_data_on_readers");
+
+    // The other participant leaves: NOT_ALIVE_DISPOSED, read by instance state.
+    let other_prefix = other.guid_prefix();
+    let gone = InstanceHandle::from_guid(Guid::new(
+        other_prefix,
+        dds_runtime::rtps::EntityId::PARTICIPANT,
+    ));
+    drop((w, _skip, other));
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        parts
+            .select()
+            .instance_state(InstanceStateMask::NOT_ALIVE)
+            .read()
+            .unwrap()
+            .iter()
+            .any(|s| s.info.instance_handle == gone)
+    }));
+    assert!(parts
+        .select()
+        .instance_state(InstanceStateMask::ALIVE)
+        .read()
+        .unwrap()
+        .iter()
+        .all(|s| s.info.instance_handle != gone));
+    assert_eq!(parts.get_key_value(gone).unwrap().key, other_prefix);
+}
+
+/// The built-in subscriber and its topics are not entities the participant contains: it can be deleted
+/// after asking for them. Readers dropped by the application come back on the next call, with their data.
+#[test]
+fn builtin_subscriber_is_not_a_contained_entity() {
+    let f = DomainParticipantFactory::get_instance();
+    let p = participant(224);
+    let b = p.get_builtin_subscriber().unwrap();
+    assert!(p
+        .lookup_topicdescription::<ParticipantBuiltinTopicData>("DCPSParticipant")
+        .is_some());
+    let h = b.participant_reader().instance_handle();
+    drop(b);
+    let again = p.get_builtin_subscriber().unwrap();
+    assert_eq!(again.participant_reader().instance_handle(), h);
+    assert!(
+        again
+            .participant_reader()
+            .read_instance(p.instance_handle())
+            .is_ok(),
+        "our own participant, still there"
+    );
+    p.delete_contained_entities().unwrap();
+    assert!(again.participant_reader().read().is_ok());
+    drop(again);
+    f.delete_participant(&p).unwrap();
 }

@@ -268,3 +268,95 @@ fn immutable_policies_change_until_enabled() {
         Err(DdsError::ImmutablePolicy(QosPolicyId::Durability))
     ));
 }
+
+/// Topics, publishers and subscribers created disabled take every policy, immutable ones included, until
+/// enabled; then those give `ImmutablePolicy`. What was set before `enable()` is what the readers and
+/// writers announce and match with: a PRESENTATION changed on a disabled publisher lets its writers (one
+/// created before the change, one after) match a reader requesting coherent TOPIC access, and one changed
+/// on a disabled subscriber makes its reader refuse a writer that offers less.
+#[test]
+fn group_and_topic_policies_change_until_enabled() {
+    let pw = participant(225);
+    let pr = participant(225);
+    pw.set_qos(&no_autoenable_participant()).unwrap();
+    let coherent = Presentation {
+        access_scope: PresentationAccessScope::Topic,
+        coherent_access: true,
+        ordered_access: false,
+    };
+    // The topic.
+    let topic = pw
+        .create_topic::<ShapeType>("GroupBeforeEnable", &TopicQos::default())
+        .unwrap();
+    assert!(!topic.is_enabled());
+    let durable = TopicQos::builder()
+        .durability(Durability::TransientLocal)
+        .build();
+    topic.set_qos(&durable).unwrap();
+    assert_eq!(topic.get_qos().unwrap(), durable);
+    topic.enable().unwrap();
+    assert!(matches!(
+        topic.set_qos(&TopicQos::default()),
+        Err(DdsError::ImmutablePolicy(QosPolicyId::Durability))
+    ));
+    // The publisher: one writer before the change, one after.
+    let publisher = pw.create_publisher(&PublisherQos::default()).unwrap();
+    assert!(!publisher.is_enabled());
+    let early = publisher
+        .create_datawriter(&topic, &DataWriterQos::default())
+        .unwrap();
+    let pq = PublisherQos::builder().presentation(coherent).build();
+    publisher.set_qos(&pq).unwrap();
+    assert_eq!(publisher.get_qos().unwrap().presentation, coherent);
+    let late = publisher
+        .create_datawriter(&topic, &DataWriterQos::default())
+        .unwrap();
+    publisher.enable().unwrap();
+    assert!(early.is_enabled() && late.is_enabled());
+    assert!(matches!(
+        publisher.set_qos(&PublisherQos::default()),
+        Err(DdsError::ImmutablePolicy(QosPolicyId::Presentation))
+    ));
+    // The subscriber.
+    let subscriber = pw.create_subscriber(&SubscriberQos::default()).unwrap();
+    subscriber
+        .set_qos(&SubscriberQos::builder().presentation(coherent).build())
+        .unwrap();
+    let strict = subscriber
+        .create_datareader::<ShapeType, _>(&topic, &DataReaderQos::default())
+        .unwrap();
+    subscriber.enable().unwrap();
+    assert!(matches!(
+        subscriber.set_qos(&SubscriberQos::default()),
+        Err(DdsError::ImmutablePolicy(QosPolicyId::Presentation))
+    ));
+
+    // The other participant: a reader requesting coherent TOPIC access, a writer offering the default.
+    let tr = pr
+        .create_topic::<ShapeType>("GroupBeforeEnable", &TopicQos::default())
+        .unwrap();
+    let wants = pr
+        .create_subscriber(&SubscriberQos::builder().presentation(coherent).build())
+        .unwrap()
+        .create_datareader::<ShapeType, _>(&tr, &DataReaderQos::default())
+        .unwrap();
+    let plain = writer_on::<ShapeType>(&pr, &tr);
+    assert!(
+        wait_until(MATCH_TIMEOUT, || wants.matched_publications().len() == 2),
+        "both writers of the changed publisher match: {:?}",
+        wants.requested_incompatible_qos_status()
+    );
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        strict.requested_incompatible_qos_status().total_count >= 1
+    }));
+    assert!(!strict.matched_publication_guids().contains(&plain.guid()));
+    assert!(!wants.matched_publication_guids().contains(&plain.guid()));
+    assert!(wants.matched_publication_guids().contains(&early.guid()));
+}
+
+fn writer_on<T: DdsType>(p: &DomainParticipant, t: &Topic<T>) -> DataWriter<T> {
+    p.create_publisher(&PublisherQos::default())
+        .unwrap()
+        .create_datawriter(t, &DataWriterQos::default())
+        .unwrap()
+}

@@ -1,6 +1,8 @@
-//! The built-in subscriber (`get_builtin_subscriber`, DDS 1.4 §2.2.5): its four readers, seeded with what
-//! discovery knows when it is first asked for, then fed by the core's discovery events.
+//! The built-in subscriber (`get_builtin_subscriber`, DDS 1.4 §2.2.5): a [`Subscriber`] with four
+//! `DataReader`s, seeded with what discovery knows when it is first asked for, then fed by the core's
+//! discovery events.
 
+use std::any::Any;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
@@ -8,60 +10,171 @@ use super::builtin::{
     topic_key, ParticipantBuiltinTopicData, PublicationBuiltinTopicData,
     SubscriptionBuiltinTopicData, TopicBuiltinTopicData,
 };
-use super::builtin_reader::BuiltinDataReader;
-use super::driver::{CoreObserver, Driver};
+use super::builtin_cdr::{guid_key_handle, topic_key_handle};
+use super::data_on_readers::DataOnReadersBatch;
+use super::driver::CoreObserver;
+use super::error::DdsResult;
+use super::participant::DomainParticipant;
+use super::registry::BuiltinReaders;
 use super::sample::InstanceHandle;
+use super::subscriber::{BuiltinGroup, BuiltinReader, DataReader, Subscriber};
 use super::sync::lock;
 use crate::rtps::discovery::{EndpointData, ParticipantData, TopicData};
 use crate::rtps::{EntityId, Event, Guid, GuidPrefix};
 
-/// The built-in subscriber of a participant: one reader per built-in topic. Cheap to clone; every call of
-/// `get_builtin_subscriber` returns the same readers.
+/// The built-in subscriber of a participant: a [`Subscriber`] (it derefs to one: `lookup_datareader`,
+/// `get_datareaders`, `set_listener` with DATA_ON_READERS, ...) holding one `DataReader` per built-in
+/// topic. Every call of `get_builtin_subscriber` returns the same subscriber and readers.
 #[derive(Clone, Debug)]
 pub struct BuiltinSubscriber {
-    /// Our participant's prefix (local endpoints that are deleted leave as remote ones do).
-    prefix: GuidPrefix,
-    /// The DCPSTopic instance of each topic announced in SEDP, by the announcement's GUID.
-    topic_guids: Arc<Mutex<HashMap<Guid, InstanceHandle>>>,
-    participants: BuiltinDataReader<ParticipantBuiltinTopicData>,
-    publications: BuiltinDataReader<PublicationBuiltinTopicData>,
-    subscriptions: BuiltinDataReader<SubscriptionBuiltinTopicData>,
-    topics: BuiltinDataReader<TopicBuiltinTopicData>,
+    subscriber: Subscriber,
+    participants: DataReader<ParticipantBuiltinTopicData>,
+    publications: DataReader<PublicationBuiltinTopicData>,
+    subscriptions: DataReader<SubscriptionBuiltinTopicData>,
+    topics: DataReader<TopicBuiltinTopicData>,
+}
+
+impl std::ops::Deref for BuiltinSubscriber {
+    type Target = Subscriber;
+
+    fn deref(&self) -> &Subscriber {
+        &self.subscriber
+    }
 }
 
 impl BuiltinSubscriber {
     /// The `DCPSParticipant` reader: the participants discovered through SPDP, and this one.
-    pub fn participant_reader(&self) -> BuiltinDataReader<ParticipantBuiltinTopicData> {
+    pub fn participant_reader(&self) -> DataReader<ParticipantBuiltinTopicData> {
         self.participants.clone()
     }
 
     /// The `DCPSPublication` reader: the writers discovered through SEDP, and this participant's.
-    pub fn publication_reader(&self) -> BuiltinDataReader<PublicationBuiltinTopicData> {
+    pub fn publication_reader(&self) -> DataReader<PublicationBuiltinTopicData> {
         self.publications.clone()
     }
 
     /// The `DCPSSubscription` reader: the readers discovered through SEDP, and this participant's.
-    pub fn subscription_reader(&self) -> BuiltinDataReader<SubscriptionBuiltinTopicData> {
+    pub fn subscription_reader(&self) -> DataReader<SubscriptionBuiltinTopicData> {
         self.subscriptions.clone()
     }
 
-    /// The `DCPSTopic` reader: the topics of the readers and writers discovered (see docs/dcps-api.md).
-    pub fn topic_reader(&self) -> BuiltinDataReader<TopicBuiltinTopicData> {
+    /// The `DCPSTopic` reader: the topics announced in SEDP and those of the readers and writers
+    /// discovered (see docs/dcps-api.md).
+    pub fn topic_reader(&self) -> DataReader<TopicBuiltinTopicData> {
         self.topics.clone()
     }
 
-    /// Creates the readers, seeds them from the core and subscribes them to its discovery events.
-    pub(crate) fn start(driver: &Driver) -> Self {
-        let s = BuiltinSubscriber {
-            prefix: driver.guid_prefix,
-            topic_guids: Arc::default(),
-            participants: BuiltinDataReader::new("DCPSParticipant"),
-            publications: BuiltinDataReader::new("DCPSPublication"),
-            subscriptions: BuiltinDataReader::new("DCPSSubscription"),
-            topics: BuiltinDataReader::new("DCPSTopic"),
+    /// The subscriber itself.
+    pub fn subscriber(&self) -> &Subscriber {
+        &self.subscriber
+    }
+}
+
+impl DomainParticipant {
+    /// The built-in subscriber (`get_builtin_subscriber`): readers of `DCPSParticipant`,
+    /// `DCPSPublication`, `DCPSSubscription` and `DCPSTopic`. Created on the first call with what
+    /// discovery knows by then; every call returns the same subscriber and readers.
+    pub fn get_builtin_subscriber(&self) -> DdsResult<BuiltinSubscriber> {
+        self.driver().check_alive()?;
+        let feed = {
+            let mut slot = lock(&self.registry().builtin);
+            match slot.clone().map(|f| f.as_any().downcast::<BuiltinFeed>()) {
+                Some(Ok(feed)) => feed,
+                _ => {
+                    let (feed, s) = BuiltinFeed::start(self)?;
+                    *slot = Some(feed);
+                    return Ok(s);
+                }
+            }
         };
+        // Outside the lock: making a reader's handle again runs the core, whose events may reach
+        // listeners that ask for the built-in subscriber.
+        feed.subscriber(self)
+    }
+}
+
+/// What the participant keeps of its built-in subscriber: the readers' feeding side, which discovery
+/// events go to (it holds nothing that keeps the participant alive).
+pub(crate) struct BuiltinFeed {
+    group: BuiltinGroup,
+    /// Our participant's prefix (local endpoints that are deleted leave as remote ones do).
+    prefix: GuidPrefix,
+    /// The DCPSTopic key of each topic announced in SEDP, by the announcement's GUID.
+    topic_guids: Mutex<HashMap<Guid, Vec<u8>>>,
+    participants: BuiltinReader<ParticipantBuiltinTopicData>,
+    publications: BuiltinReader<PublicationBuiltinTopicData>,
+    subscriptions: BuiltinReader<SubscriptionBuiltinTopicData>,
+    topics: BuiltinReader<TopicBuiltinTopicData>,
+}
+
+impl BuiltinReaders for BuiltinFeed {
+    /// The handle of the built-in subscriber (not one of the participant's contained entities).
+    fn group_handle(&self) -> InstanceHandle {
+        self.group.handle()
+    }
+
+    fn as_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync> {
+        self
+    }
+}
+
+impl BuiltinFeed {
+    fn subscriber(&self, p: &DomainParticipant) -> DdsResult<BuiltinSubscriber> {
+        let s = self.group.subscriber(p);
+        Ok(BuiltinSubscriber {
+            participants: self.participants.reader(&s)?,
+            publications: self.publications.reader(&s)?,
+            subscriptions: self.subscriptions.reader(&s)?,
+            topics: self.topics.reader(&s)?,
+            subscriber: s,
+        })
+    }
+
+    /// Creates the readers, seeds them from the core and subscribes them to its discovery events.
+    fn start(p: &DomainParticipant) -> DdsResult<(Arc<Self>, BuiltinSubscriber)> {
+        let (group, s) = BuiltinGroup::new(p);
+        let (participants, pr) = BuiltinReader::create(
+            &s,
+            "DCPSParticipant",
+            (EntityId::SPDP_READER, EntityId::SPDP_WRITER),
+            guid_key_handle,
+        )?;
+        let (publications, wr) = BuiltinReader::create(
+            &s,
+            "DCPSPublication",
+            (
+                EntityId::SEDP_PUBLICATIONS_READER,
+                EntityId::SEDP_PUBLICATIONS_WRITER,
+            ),
+            guid_key_handle,
+        )?;
+        let (subscriptions, rr) = BuiltinReader::create(
+            &s,
+            "DCPSSubscription",
+            (
+                EntityId::SEDP_SUBSCRIPTIONS_READER,
+                EntityId::SEDP_SUBSCRIPTIONS_WRITER,
+            ),
+            guid_key_handle,
+        )?;
+        let (topics, tr) = BuiltinReader::create(
+            &s,
+            "DCPSTopic",
+            (EntityId::SEDP_TOPICS_READER, EntityId::SEDP_TOPICS_WRITER),
+            topic_key_handle,
+        )?;
+        let feed = Arc::new(BuiltinFeed {
+            group,
+            prefix: p.guid_prefix(),
+            topic_guids: Mutex::default(),
+            participants,
+            publications,
+            subscriptions,
+            topics,
+        });
+        let driver = p.driver();
         // Events from now on; what came before is seeded below (a repeat is only an update).
-        driver.add_observer(Arc::new(s.clone()));
+        driver.add_observer(feed.clone());
         let (participants, writers, readers, topics) = driver.query_core(|c| {
             let mut ps: Vec<ParticipantData> = c.discovered_participants().cloned().collect();
             ps.push(c.participant_data());
@@ -71,87 +184,92 @@ impl BuiltinSubscriber {
             (ps, ws, rs, ts)
         });
         for t in topics {
-            s.on_event(&Event::TopicDiscovered(Box::new(t)));
+            feed.on_event(&Event::TopicDiscovered(Box::new(t)));
         }
         for p in &participants {
-            s.participant(p);
+            feed.participant(p);
         }
         for w in &writers {
-            s.publication(w);
+            feed.publication(w);
         }
         for r in &readers {
-            s.subscription(r);
+            feed.subscription(r);
         }
-        s
+        let s = BuiltinSubscriber {
+            subscriber: s,
+            participants: pr,
+            publications: wr,
+            subscriptions: rr,
+            topics: tr,
+        };
+        Ok((feed, s))
     }
 
     fn participant(&self, p: &ParticipantData) {
-        self.participants
-            .upsert(participant_handle(p.guid_prefix), p.into());
+        self.participants.upsert(p.into());
     }
 
     fn publication(&self, w: &EndpointData<crate::qos::WriterQos>) {
         self.topic(&w.topic_name, &w.type_name, &w.qos.topic_data.0);
-        self.publications
-            .upsert(InstanceHandle::from_guid(w.guid), w.into());
+        self.publications.upsert(w.into());
     }
 
     fn subscription(&self, r: &EndpointData<crate::qos::ReaderQos>) {
         self.topic(&r.topic_name, &r.type_name, &r.qos.topic_data.0);
-        self.subscriptions
-            .upsert(InstanceHandle::from_guid(r.guid), r.into());
+        self.subscriptions.upsert(r.into());
     }
 
     /// A topic seen for the first time becomes an instance of DCPSTopic (later endpoints change nothing).
     fn topic(&self, name: &str, type_name: &str, topic_data: &[u8]) {
-        let key = topic_key(name, type_name);
-        if !self.topics.has_alive_instance(key) {
-            self.topics.upsert(
-                key,
-                TopicBuiltinTopicData::new(name, type_name, topic_data.to_vec()),
-            );
+        if !self.topics.is_alive(&topic_key_bytes(name, type_name)) {
+            let data = TopicBuiltinTopicData::new(name, type_name, topic_data.to_vec());
+            self.topics.upsert(data);
         }
+    }
+
+    /// The local or remote writer `g` is gone.
+    fn writer_gone(&self, g: Guid) {
+        self.publications.dispose(g.to_bytes().to_vec());
+    }
+
+    /// The local or remote reader `g` is gone.
+    fn reader_gone(&self, g: Guid) {
+        self.subscriptions.dispose(g.to_bytes().to_vec());
     }
 }
 
-fn participant_handle(p: GuidPrefix) -> InstanceHandle {
-    InstanceHandle::from_guid(Guid::new(p, EntityId::PARTICIPANT))
+/// The serialized key of the DCPSTopic instance of `name` with `type_name`.
+fn topic_key_bytes(name: &str, type_name: &str) -> Vec<u8> {
+    topic_key(name, type_name).0.to_be_bytes().to_vec()
 }
 
-impl CoreObserver for BuiltinSubscriber {
+impl CoreObserver for BuiltinFeed {
     fn on_event(&self, ev: &Event) {
+        // DATA_ON_READERS once for what one event changed in several readers.
+        let _batch = DataOnReadersBatch::start();
         match ev {
             Event::ParticipantDiscovered(p) => self.participant(p),
             Event::ParticipantLost { guid_prefix } => {
-                self.participants.dispose(participant_handle(*guid_prefix));
+                let g = Guid::new(*guid_prefix, EntityId::PARTICIPANT);
+                self.participants.dispose(g.to_bytes().to_vec());
             }
             Event::PublicationDiscovered(w) => self.publication(w),
-            Event::PublicationRemoved { guid } => {
-                self.publications.dispose(InstanceHandle::from_guid(*guid));
-            }
             Event::SubscriptionDiscovered(r) => self.subscription(r),
-            Event::SubscriptionRemoved { guid } => {
-                self.subscriptions.dispose(InstanceHandle::from_guid(*guid));
-            }
-            Event::WriterDeleted { writer } => {
-                let g = Guid::new(self.prefix, *writer);
-                self.publications.dispose(InstanceHandle::from_guid(g));
-            }
+            Event::PublicationRemoved { guid } => self.writer_gone(*guid),
+            Event::SubscriptionRemoved { guid } => self.reader_gone(*guid),
+            Event::WriterDeleted { writer } => self.writer_gone(Guid::new(self.prefix, *writer)),
+            Event::ReaderDeleted { reader } => self.reader_gone(Guid::new(self.prefix, *reader)),
             Event::TopicDiscovered(t) => {
-                let key = topic_key(&t.topic_name, &t.type_name);
+                let key = topic_key_bytes(&t.topic_name, &t.type_name);
                 lock(&self.topic_guids).insert(t.guid, key);
                 let data =
                     TopicBuiltinTopicData::new(&t.topic_name, &t.type_name, t.topic_data.clone());
-                self.topics.upsert(key, data);
+                self.topics.upsert(data);
             }
             Event::TopicRemoved { guid } => {
                 if let Some(key) = lock(&self.topic_guids).remove(guid) {
                     self.topics.dispose(key);
                 }
-            }
-            Event::ReaderDeleted { reader } => {
-                let g = Guid::new(self.prefix, *reader);
-                self.subscriptions.dispose(InstanceHandle::from_guid(g));
             }
             _ => {}
         }

@@ -122,6 +122,8 @@ pub(crate) struct ReaderCache<T> {
     instance_order: bool,
     /// Makes the key holder of a new instance from its first data (`get_key_value`).
     key_of: Option<fn(&T) -> Option<T>>,
+    /// Derives an instance's handle from its key (the built-in readers: the entity's handle); else counted.
+    handle_of: Option<fn(&[u8]) -> InstanceHandle>,
     /// `collect_with`'s working vectors, kept (empty) between calls so that a take allocates nothing.
     collect_scratch: (Vec<Touched>, Vec<(u64, usize, usize)>),
 }
@@ -160,7 +162,14 @@ impl<T: FilterFields> ReaderCache<T> {
             instance_order: false,
             collect_scratch: (Vec::new(), Vec::new()),
             key_of: None,
+            handle_of: None,
         }
+    }
+
+    /// Instance handles from now on derive from the key with `f` (a handle in use, or NIL, falls back to
+    /// the counter).
+    pub(crate) fn set_handle_fn(&mut self, f: fn(&[u8]) -> InstanceHandle) {
+        self.handle_of = Some(f);
     }
 
     pub(crate) fn set_filter(&mut self, f: Option<Filter<T>>) {
@@ -204,8 +213,13 @@ impl<T: FilterFields> ReaderCache<T> {
                 return None;
             }
         }
-        let h = InstanceHandle(self.next_handle);
-        self.next_handle += 1;
+        let h = match self.handle_of.map(|f| f(&key)) {
+            Some(h) if h != InstanceHandle::NIL && !self.instances.contains_key(&h) => h,
+            _ => {
+                self.next_handle += 1;
+                InstanceHandle(self.next_handle - 1)
+            }
+        };
         self.by_key.insert(key.clone(), h);
         self.instances.insert(
             h,

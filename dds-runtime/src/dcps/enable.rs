@@ -115,7 +115,12 @@ impl Registry {
         let todo: Vec<(InstanceHandle, String, String, Vec<u8>)> = self.with(|e| {
             e.topics
                 .iter()
-                .filter(|t| !t.deleted && t.wire.is_none() && !e.disabled.contains(&t.node.handle))
+                .filter(|t| {
+                    !t.deleted
+                        && !t.builtin
+                        && t.wire.is_none()
+                        && !e.disabled.contains(&t.node.handle)
+                })
                 .map(|t| {
                     let data = t.qos.topic_data.0.clone();
                     (t.node.handle, t.name.clone(), t.type_name.clone(), data)

@@ -28,7 +28,7 @@
 //! key hash when a sample of that instance carrying the same hash was seen before.
 
 pub mod builtin;
-mod builtin_reader;
+mod builtin_cdr;
 mod builtin_subscriber;
 mod cache;
 mod chain;
@@ -63,7 +63,6 @@ pub use builtin::{
     EndpointBuiltinTopicData, ParticipantBuiltinTopicData, PublicationBuiltinTopicData,
     SubscriptionBuiltinTopicData, TopicBuiltinTopicData,
 };
-pub use builtin_reader::{BuiltinDataReader, BuiltinDataReaderListener};
 pub use builtin_subscriber::BuiltinSubscriber;
 pub use chain::StatusChange;
 pub use condition::{

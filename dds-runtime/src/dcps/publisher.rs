@@ -160,6 +160,8 @@ impl Publisher {
             .participant
             .registry()
             .group_creates_enabled::<PublisherQos>(Arc::as_ptr(&self.qos) as *const ())?;
+        // The QoS in effect: a disabled publisher may have changed any policy since its creation.
+        let group_qos = self.get_qos()?;
         let (version, rep) = writer_version::<T>(&qos.data_representation);
         let mut wq = qos.clone();
         wq.data_representation = rep;
@@ -168,7 +170,7 @@ impl Publisher {
             topic_name: topic.name().to_string(),
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
-            qos: WriterQos::new(wq.clone(), &self.qos, topic.qos()),
+            qos: WriterQos::new(wq.clone(), &group_qos, &topic.get_qos()?),
             type_information: crate::xtypes::announced_type_information_for(
                 T::type_information(),
                 T::type_mapping(),
@@ -208,7 +210,7 @@ impl Publisher {
         })?;
         ops::register_writer(self, &inner, topic.name());
         let id = handle.id();
-        self.group.add_writer(&driver, id, &self.qos.presentation);
+        self.group.add_writer(&driver, id, &group_qos.presentation);
         tracing::info!(
             topic = topic.name(),
             type_name = T::TYPE_NAME,

@@ -58,6 +58,9 @@ pub(crate) struct TopicEntry {
     pub(crate) deleted: bool,
     /// The GUID of its SEDP announcement (DCPSTopic), once announced.
     pub(crate) wire: Option<Guid>,
+    /// A topic of the built-in subscriber (DCPSParticipant, ...): never announced, not counted among the
+    /// participant's entities.
+    pub(crate) builtin: bool,
 }
 
 /// A reader or writer.
@@ -70,6 +73,14 @@ pub(crate) struct EndpointEntry {
     pub(crate) deleted: Weak<AtomicBool>,
     /// The entity itself (its inner state), for the typed lookups and group QoS changes.
     pub(crate) entity: Weak<dyn Registered>,
+}
+
+/// The built-in subscriber's readers, as the registry keeps them (`dcps::builtin_subscriber`).
+pub(crate) trait BuiltinReaders: Send + Sync {
+    /// The handle of the built-in subscriber.
+    fn group_handle(&self) -> InstanceHandle;
+    /// The readers, for a downcast to their type.
+    fn as_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync>;
 }
 
 /// A reader or writer as the registry sees it.
@@ -158,8 +169,8 @@ pub(crate) struct Registry {
     entities: Mutex<Entities>,
     /// Notified when a remote topic is discovered (`find_topic` waits on it).
     discovered: Condvar,
-    /// The built-in subscriber, created when first asked for.
-    pub(crate) builtin: std::sync::OnceLock<super::builtin_subscriber::BuiltinSubscriber>,
+    /// The built-in subscriber's readers, created when first asked for.
+    pub(crate) builtin: Mutex<Option<Arc<dyn BuiltinReaders>>>,
 }
 
 impl Registry {
@@ -179,7 +190,7 @@ impl Registry {
                 ..Entities::default()
             }),
             discovered: Condvar::new(),
-            builtin: std::sync::OnceLock::new(),
+            builtin: Mutex::new(None),
         }
     }
 
@@ -231,6 +242,7 @@ impl Registry {
         name: &str,
         type_name: &str,
         qos: TopicQos,
+        builtin: bool,
     ) -> InstanceHandle {
         let node = self.group_node(KIND_TOPIC);
         let handle = node.handle;
@@ -249,6 +261,7 @@ impl Registry {
                 inconsistent,
                 deleted: false,
                 wire: None,
+                builtin,
             });
             clash
         });
@@ -463,11 +476,15 @@ impl Registry {
         ptr: *const (),
         qos: &Q,
     ) -> DdsResult<Vec<Weak<dyn Registered>>> {
+        // A disabled group takes every policy (DDS 1.4 §2.2.2.1.1.7); its readers or writers (disabled
+        // too) announce the new ones when enabled.
+        let enabled = self.is_enabled(self.with_group::<Q, _>(ptr, |g| g.node.handle)?);
         let (handle, changed) = self.with_group::<Q, _>(ptr, |g| {
-            if let Some(p) = g.qos.immutable_change(qos) {
+            let immutable = g.qos.immutable_change(qos);
+            if let (Some(p), true) = (immutable, enabled) {
                 return Err(DdsError::ImmutablePolicy(p));
             }
-            let changed = g.qos.announced_change(qos);
+            let changed = g.qos.announced_change(qos) || immutable.is_some();
             g.qos = qos.clone();
             Ok((g.node.handle, changed))
         })??;

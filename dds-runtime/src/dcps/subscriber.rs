@@ -1,5 +1,6 @@
 //! `Subscriber` and `DataReader<T>`.
 
+mod builtin;
 mod ops;
 
 use std::collections::VecDeque;
@@ -39,6 +40,7 @@ use super::sync::{lock, recover};
 use super::topic::{Topic, TopicDescription};
 use crate::filter::ContentFilter;
 
+pub(crate) use builtin::{BuiltinGroup, BuiltinReader};
 pub use ops::SubscriberListener;
 
 /// Callbacks of a [`DataReader`] (see [`crate::dcps::listener`]). Every method has an empty default.
@@ -162,6 +164,8 @@ impl Subscriber {
             .participant
             .registry()
             .group_creates_enabled::<SubscriberQos>(Arc::as_ptr(&self.qos) as *const ())?;
+        // The QoS in effect: a disabled subscriber may have changed any policy since its creation.
+        let group_qos = self.get_qos()?;
         let mut rq = qos.clone();
         if rq.data_representation.ids().is_empty() {
             rq.data_representation = DataRepresentation::accept_both();
@@ -172,7 +176,7 @@ impl Subscriber {
             topic_name: t.name().to_string(),
             type_name: T::TYPE_NAME.to_string(),
             keyed: T::IS_KEYED,
-            qos: ReaderQos::new(rq.clone(), &self.qos, t.qos()),
+            qos: ReaderQos::new(rq.clone(), &group_qos, &t.get_qos()?),
             type_information: crate::xtypes::announced_type_information_for(
                 T::type_information(),
                 T::type_mapping(),
@@ -184,26 +188,15 @@ impl Subscriber {
         let credit_limit = credit_limit(&rq);
         let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
         cache.set_filter(topic.sample_filter());
-        cache.set_instance_order(instance_ordered(&self.qos.presentation));
+        cache.set_instance_order(instance_ordered(&group_qos.presentation));
 
-        let inner = Arc::new(ReaderInner::<T> {
-            state: EndpointState::new(driver.clone()),
-            pending: Mutex::new(VecDeque::new()),
-            group_order: group_ordered(&self.qos.presentation).then(|| self.access.order()),
-            access: group_scoped(&self.qos.presentation).then(|| self.access.clone()),
-            staged: Mutex::new(VecDeque::new()),
-            committed: Mutex::default(),
-            cache: Mutex::new(CacheState {
-                cache,
-                by_hash: HashMap::new(),
-                batch: VecDeque::new(),
-            }),
-            data_cv: Condvar::new(),
-            data_waiters: AtomicUsize::new(0),
-            wakers: Mutex::new(Vec::new()),
-            data_signal: Signal::default(),
-            credit_limit: AtomicUsize::new(credit_limit.unwrap_or(NO_CREDIT_LIMIT)),
-        });
+        let inner = Arc::new(ReaderInner::<T>::new(
+            driver.clone(),
+            cache,
+            group_ordered(&group_qos.presentation).then(|| self.access.order()),
+            group_scoped(&group_qos.presentation).then(|| self.access.clone()),
+            credit_limit,
+        ));
         let owner = ReaderOwner {
             topic: t.clone(),
             subscriber: self.clone(),
@@ -811,6 +804,34 @@ impl<T: DdsType> DataReader<T> {
 }
 
 impl<T: DdsType> ReaderInner<T> {
+    /// The state of a new reader with `cache`, not yet created in the core.
+    fn new(
+        driver: Arc<super::driver::Driver>,
+        cache: ReaderCache<T>,
+        group_order: Option<Arc<AtomicU64>>,
+        access: Option<Arc<AccessScope>>,
+        credit_limit: Option<usize>,
+    ) -> Self {
+        ReaderInner {
+            state: EndpointState::new(driver),
+            pending: Mutex::new(VecDeque::new()),
+            group_order,
+            access,
+            staged: Mutex::new(VecDeque::new()),
+            committed: Mutex::default(),
+            cache: Mutex::new(CacheState {
+                cache,
+                by_hash: HashMap::new(),
+                batch: VecDeque::new(),
+            }),
+            data_cv: Condvar::new(),
+            data_waiters: AtomicUsize::new(0),
+            wakers: Mutex::new(Vec::new()),
+            data_signal: Signal::default(),
+            credit_limit: AtomicUsize::new(credit_limit.unwrap_or(NO_CREDIT_LIMIT)),
+        }
+    }
+
     /// The public reader, for listeners.
     fn reader(
         self: &Arc<Self>,

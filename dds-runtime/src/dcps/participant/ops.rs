@@ -19,6 +19,7 @@ use super::super::error::{DdsError, DdsResult};
 use super::super::registry::Registry;
 use super::super::sample::InstanceHandle;
 use super::super::status::*;
+use super::super::sync::lock;
 use super::DomainParticipant;
 
 /// Callbacks of a [`DomainParticipant`] for the statuses of every entity it contains that no more specific
@@ -247,13 +248,27 @@ impl DomainParticipant {
     }
 
     /// Whether a topic, publisher, subscriber, reader or writer of this participant still exists.
+    /// The built-in subscriber and its readers and topics are not among them.
     pub(super) fn has_contained_entities(&self) -> bool {
+        let builtin = self.builtin_subscriber_handle();
         self.registry.with(|e| {
-            e.topics.iter().any(|t| !t.deleted)
+            e.topics.iter().any(|t| !t.deleted && !t.builtin)
                 || e.publishers.iter().any(|g| !g.deleted)
-                || e.subscribers.iter().any(|g| !g.deleted)
-                || e.writers.iter().chain(e.readers.iter()).any(|w| w.alive())
+                || e.subscribers
+                    .iter()
+                    .any(|g| !g.deleted && Some(g.node.handle) != builtin)
+                || e.writers
+                    .iter()
+                    .chain(e.readers.iter())
+                    .any(|w| w.alive() && Some(w.group) != builtin)
         })
+    }
+
+    /// The handle of the built-in subscriber, once created.
+    fn builtin_subscriber_handle(&self) -> Option<InstanceHandle> {
+        lock(&self.registry.builtin)
+            .as_ref()
+            .map(|f| f.group_handle())
     }
 
     /// Deletes every reader, writer, publisher, subscriber and topic of the participant
@@ -261,13 +276,21 @@ impl DomainParticipant {
     /// SEDP; handles still held return `AlreadyDeleted` from then on.
     pub fn delete_contained_entities(&self) -> DdsResult<()> {
         self.driver.check_alive()?;
+        let builtin = self.builtin_subscriber_handle();
         let ids: Vec<EntityId> = self.registry.with(|e| {
             e.publishers.iter_mut().for_each(|g| g.deleted = true);
-            e.subscribers.iter_mut().for_each(|g| g.deleted = true);
-            e.topics.iter_mut().for_each(|t| t.deleted = true);
+            e.subscribers
+                .iter_mut()
+                .filter(|g| Some(g.node.handle) != builtin)
+                .for_each(|g| g.deleted = true);
+            e.topics
+                .iter_mut()
+                .filter(|t| !t.builtin)
+                .for_each(|t| t.deleted = true);
             e.writers
                 .iter()
                 .chain(e.readers.iter())
+                .filter(|w| Some(w.group) != builtin)
                 .map(|w| w.guid.entity_id)
                 .collect()
         });

@@ -10,7 +10,6 @@ use crate::cdr::{self, DdsType};
 use crate::qos::{ChangeableQos, DataReaderQos, ReaderQos, SubscriberQos, TopicQos};
 
 use super::super::builtin::PublicationBuiltinTopicData;
-use super::super::builtin_subscriber::BuiltinSubscriber;
 use super::super::cache::Selection;
 use super::super::chain::{ListenerNode, ParentListener, StatusChange};
 use super::super::condition::{ReadCondition, ReadConditionSource, StatusCondition};
@@ -199,19 +198,6 @@ impl DomainParticipant {
         self.registry()
             .delete_group::<SubscriberQos>(Arc::as_ptr(&subscriber.qos) as *const ())
     }
-
-    /// The built-in subscriber (`get_builtin_subscriber`): readers of `DCPSParticipant`,
-    /// `DCPSPublication`, `DCPSSubscription` and `DCPSTopic`. Created on the first call with what
-    /// discovery knows by then; every call returns the same readers.
-    pub fn get_builtin_subscriber(&self) -> DdsResult<BuiltinSubscriber> {
-        self.driver().check_alive()?;
-        let driver = self.driver();
-        Ok(self
-            .registry()
-            .builtin
-            .get_or_init(|| BuiltinSubscriber::start(driver))
-            .clone())
-    }
 }
 
 impl Subscriber {
@@ -378,7 +364,7 @@ impl Subscriber {
         let prefix = self.participant.driver().guid_prefix;
         let handle = |id| InstanceHandle::from_guid(crate::rtps::Guid::new(prefix, id));
         let readers = self.readers()?;
-        if group_ordered(&self.qos.presentation) {
+        if group_ordered(&self.get_qos()?.presentation) {
             return Ok(group_order(&readers, samples, views, instances)
                 .into_iter()
                 .map(handle)

@@ -39,9 +39,39 @@ impl ParentListener for TopicLevel {
 pub(super) fn register_topic<T: DdsType>(t: &Topic<T>) {
     let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&t.inner) as Weak<TopicInner>;
     let registry = t.inner.participant.registry();
-    let handle = registry.add_topic(identity, &t.inner.name, T::TYPE_NAME, t.inner.qos.clone());
+    let handle = registry.add_topic(
+        identity,
+        &t.inner.name,
+        T::TYPE_NAME,
+        t.inner.qos.clone(),
+        false,
+    );
     registry.created_by_participant(handle);
     registry.announce_topics(t.inner.participant.driver());
+}
+
+impl DomainParticipant {
+    /// The topic `name` of a built-in reader (DCPSParticipant, ...): the local one while it exists, else a
+    /// new one, enabled, never announced in SEDP and not counted among the participant's entities.
+    pub(crate) fn builtin_topic<T: DdsType>(&self, name: &str) -> DdsResult<Topic<T>> {
+        self.driver().check_alive()?;
+        if let Some(t) = self.lookup_topicdescription::<T>(name) {
+            return Ok(t);
+        }
+        let topic = Topic {
+            inner: Arc::new(TopicInner {
+                participant: self.clone(),
+                name: name.to_string(),
+                qos: TopicQos::default(),
+            }),
+            _t: std::marker::PhantomData,
+        };
+        let identity: Weak<dyn Any + Send + Sync> =
+            Arc::downgrade(&topic.inner) as Weak<TopicInner>;
+        self.registry()
+            .add_topic(identity, name, T::TYPE_NAME, TopicQos::default(), true);
+        Ok(topic)
+    }
 }
 
 impl<T: DdsType> Topic<T> {
@@ -75,10 +105,11 @@ impl<T: DdsType> Topic<T> {
 
     /// Changes the QoS (`set_qos`): TOPIC_DATA, DEADLINE, LATENCY_BUDGET, TRANSPORT_PRIORITY and LIFESPAN
     /// may change (a new TOPIC_DATA is announced again by the topic's readers and writers); the others
-    /// cannot (`ImmutablePolicy`).
+    /// cannot (`ImmutablePolicy`) once the topic is enabled. A disabled topic takes every policy.
     pub fn set_qos(&self, qos: &TopicQos) -> DdsResult<()> {
+        let enabled = self.is_enabled();
         let announce = self.with_entry(|t| {
-            if let Some(p) = t.qos.immutable_change(qos) {
+            if let (Some(p), true) = (t.qos.immutable_change(qos), enabled) {
                 return Err(DdsError::ImmutablePolicy(p));
             }
             let changed = t.qos.topic_data != qos.topic_data;

@@ -1,0 +1,198 @@
+//! The readers of the built-in subscriber (DDS 1.4 §2.2.5) as ordinary `DataReader<T>`s: the typed reader's
+//! cache, states, conditions, listeners and subscriber, with no RTPS reader behind them. Discovery feeds
+//! them ([`BuiltinReader::upsert`], [`BuiltinReader::dispose`]); their QoS is the one DDS sets for them
+//! (RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1).
+
+use std::any::Any;
+use std::sync::{Arc, Weak};
+use std::time::{Instant, SystemTime};
+
+use crate::cdr::{self, DdsType};
+use crate::qos::{DataReaderQos, Durability, History, Reliability, ResourceLimits, SubscriberQos};
+use crate::rtps::{ChangeKind, EntityId, Guid};
+
+use super::super::cache::{Incoming, Outcome, ReaderCache};
+use super::super::driver::Endpoint;
+use super::super::error::DdsResult;
+use super::super::participant::DomainParticipant;
+use super::super::presentation::AccessScope;
+use super::super::sample::{InstanceHandle, InstanceState};
+use super::super::sync::lock;
+use super::{ops, DataReader, ReaderInner, ReaderOwner, Stored, Subscriber};
+
+/// Most instances one built-in reader keeps, so that hostile discovery data cannot grow it without bound
+/// (beyond, new entities are rejected: SAMPLE_REJECTED).
+const MAX_INSTANCES: u32 = 16 * 1024;
+
+/// The QoS of the built-in readers (DDS 1.4 §2.2.5).
+fn builtin_qos() -> DataReaderQos {
+    DataReaderQos::builder()
+        .reliability(Reliability::Reliable {
+            max_blocking_time: std::time::Duration::from_millis(100),
+        })
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast(1))
+        .resource_limits(ResourceLimits {
+            max_instances: Some(MAX_INSTANCES),
+            ..ResourceLimits::default()
+        })
+        .build()
+}
+
+/// The built-in subscriber's identity, kept by the participant: not a `Subscriber` (which would keep the
+/// participant alive), but what makes one.
+pub(crate) struct BuiltinGroup {
+    qos: Arc<SubscriberQos>,
+    access: Arc<AccessScope>,
+    handle: InstanceHandle,
+}
+
+impl BuiltinGroup {
+    /// Registers the built-in subscriber of `p` (enabled, not counted among its entities).
+    pub(crate) fn new(p: &DomainParticipant) -> (Self, Subscriber) {
+        let s = Subscriber {
+            participant: p.clone(),
+            qos: Arc::new(SubscriberQos::default()),
+            access: Arc::default(),
+        };
+        let identity: Weak<dyn Any + Send + Sync> = Arc::downgrade(&s.qos) as Weak<SubscriberQos>;
+        let node = p.registry().add_group(identity, (*s.qos).clone());
+        let g = BuiltinGroup {
+            qos: s.qos.clone(),
+            access: s.access.clone(),
+            handle: node.handle,
+        };
+        (g, s)
+    }
+
+    /// The built-in subscriber of `p`.
+    pub(crate) fn subscriber(&self, p: &DomainParticipant) -> Subscriber {
+        Subscriber {
+            participant: p.clone(),
+            qos: self.qos.clone(),
+            access: self.access.clone(),
+        }
+    }
+
+    /// Its instance handle.
+    pub(crate) fn handle(&self) -> InstanceHandle {
+        self.handle
+    }
+}
+
+/// The feeding side of one built-in reader. Holds the reader's state, not its handle: the handle (and
+/// through it the participant) lives as long as the application holds the reader, and is made again
+/// when it asks for the reader after dropping it.
+pub(crate) struct BuiltinReader<T: DdsType> {
+    inner: Arc<ReaderInner<T>>,
+    /// The reader's entity id: the participant's built-in reader of the topic.
+    id: EntityId,
+    topic_name: &'static str,
+    /// The writer the reader's changes come from: the participant's built-in writer of the topic.
+    writer: Guid,
+}
+
+impl<T: DdsType> BuiltinReader<T> {
+    /// Creates the reader of `topic_name` in the built-in subscriber `s`, with entity id `id`; changes
+    /// come from the writer `writer` of this participant, instance handles from `handle_of` (the key).
+    pub(crate) fn create(
+        s: &Subscriber,
+        topic_name: &'static str,
+        (id, writer): (EntityId, EntityId),
+        handle_of: fn(&[u8]) -> InstanceHandle,
+    ) -> DdsResult<(Self, DataReader<T>)> {
+        let p = &s.participant;
+        let mut cache = ReaderCache::new(builtin_qos(), true);
+        cache.set_handle_fn(handle_of);
+        let inner = Arc::new(ReaderInner::new(
+            p.driver().clone(),
+            cache,
+            None,
+            None,
+            None,
+        ));
+        let topic = p.builtin_topic::<T>(topic_name)?;
+        inner.state.set_parent(ops::reader_parent(s, &topic)?);
+        let r = BuiltinReader {
+            inner,
+            id,
+            topic_name,
+            writer: Guid::new(p.driver().guid_prefix, writer),
+        };
+        let reader = r.attach(s, topic)?;
+        ops::register_reader(s, &r.inner, topic_name);
+        Ok((r, reader))
+    }
+
+    /// A new handle of the reader, owning `topic` and `s`.
+    fn attach(&self, s: &Subscriber, topic: super::Topic<T>) -> DdsResult<DataReader<T>> {
+        let sink: Arc<dyn Endpoint> = self.inner.clone();
+        let owner = ReaderOwner {
+            topic,
+            subscriber: s.clone(),
+        };
+        let id = self.id;
+        let handle = self.inner.state.create(sink, owner, move |_, _| Ok(id))?;
+        Ok(DataReader {
+            inner: self.inner.clone(),
+            handle,
+        })
+    }
+
+    /// The reader, in the built-in subscriber `s`.
+    pub(crate) fn reader(&self, s: &Subscriber) -> DdsResult<DataReader<T>> {
+        if let Some(handle) = self.inner.state.handle() {
+            return Ok(DataReader {
+                inner: self.inner.clone(),
+                handle,
+            });
+        }
+        let topic = s.participant.builtin_topic::<T>(self.topic_name)?;
+        self.attach(s, topic)
+    }
+
+    /// Discovery learnt new or changed data of an entity.
+    pub(crate) fn upsert(&self, data: T) {
+        let mut key = Vec::new();
+        match cdr::instance_key(&data, &mut key) {
+            Ok(()) => self.apply(ChangeKind::Alive, Some(data), key),
+            Err(e) => tracing::debug!(error = %e, "built-in sample without a key"),
+        }
+    }
+
+    /// The entity whose serialized key is `key` left: its instance is disposed.
+    pub(crate) fn dispose(&self, key: Vec<u8>) {
+        self.apply(ChangeKind::DisposeUnregister, None, key);
+    }
+
+    /// Whether the instance of serialized key `key` is known and alive.
+    pub(crate) fn is_alive(&self, key: &[u8]) -> bool {
+        let st = lock(&self.inner.cache);
+        st.cache
+            .lookup(key)
+            .and_then(|h| st.cache.instance_state(h))
+            == Some(InstanceState::Alive)
+    }
+
+    fn apply(&self, kind: ChangeKind, data: Option<T>, key: Vec<u8>) {
+        let now = SystemTime::now();
+        let inc = Incoming {
+            writer: self.writer,
+            kind,
+            data,
+            key,
+            key_holder: None,
+            source_timestamp: now,
+            reception_timestamp: now,
+            strength: 0,
+            expires: None,
+        };
+        let mut stored = Stored::default();
+        match lock(&self.inner.cache).cache.insert(inc, Instant::now()) {
+            Outcome::Accepted { .. } => stored.any = true,
+            Outcome::Filtered => {}
+            Outcome::Rejected { reason, handle } => stored.rejected.push((reason, handle)),
+        }
+        self.inner.announce_stored(stored);
+    }
+}
