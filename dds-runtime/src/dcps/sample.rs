@@ -19,14 +19,22 @@ impl InstanceHandle {
         self.0 == 0
     }
 
-    /// The handle for an RTPS GUID: FNV-1a of its 16 bytes, never NIL.
+    /// The handle for an RTPS GUID, never NIL: its two 8-byte halves mixed by the 64-bit finaliser of
+    /// MurmurHash3 (a bijection, so two GUIDs that differ in one half never share a handle). Computed for
+    /// every received sample (its publication handle), so it costs a few multiplications, not a loop.
     pub fn from_guid(g: Guid) -> Self {
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        for x in g.to_bytes() {
-            h ^= u64::from(x);
-            h = h.wrapping_mul(0x0100_0000_01b3);
+        fn mix(mut h: u64) -> u64 {
+            h ^= h >> 33;
+            h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+            h ^= h >> 33;
+            h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+            h ^ (h >> 33)
         }
-        InstanceHandle(h.max(1))
+        let b = g.to_bytes();
+        let (lo, hi) = b.split_at(8);
+        let lo = u64::from_le_bytes(lo.try_into().unwrap_or_default());
+        let hi = u64::from_le_bytes(hi.try_into().unwrap_or_default());
+        InstanceHandle(mix(lo ^ mix(hi)).max(1))
     }
 }
 
