@@ -69,7 +69,8 @@ pub struct Participant {
     user_readers: BTreeSet<EntityId>,
     /// Service-internal endpoints (`internal.rs`).
     internal: BTreeSet<EntityId>,
-    participants: HashMap<GuidPrefix, ProxyParticipant>,
+    /// Boxed: the table keeps spare slots (see `docs/performance.md`, "Footprint").
+    participants: HashMap<GuidPrefix, Box<ProxyParticipant>>,
     /// Every known publication and subscription, remote and local (local ones match locally too).
     /// Every known endpoint, local and remote. Boxed: a table slot is then a pointer, not a whole
     /// announcement, which halves the memory per remote endpoint (the table keeps spare slots).
