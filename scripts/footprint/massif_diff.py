@@ -2,7 +2,7 @@
 
 usage: massif_diff.py MASSIF_OUT N [DEPTH]
 
-Compares two detailed snapshots of scripts/footprint/massif.sh's profile: the last one before the first SPDP
+Compares two detailed snapshots of scripts/footprint/massif.sh's profile: the one before the first SPDP
 sample from the load was processed (nothing allocated under `on_spdp` yet), and the last one still near the
 peak (before the participant is stopped and frees everything). Each allocation site is named by its first
 DEPTH frames (default 2) outside the standard library and hashbrown; printed: bytes, bytes per entity, site.
@@ -51,7 +51,7 @@ def main():
     depth = int(sys.argv[3]) if len(sys.argv) > 3 else 2
     snaps = snapshots(path)
     loaded = [any("on_spdp" in f for s in t for f in s) for _, t in snaps]
-    before = max(i for i, x in enumerate(loaded) if not x) if not all(loaded) else 0
+    before = max(loaded.index(True) - 1, 0) if any(loaded) else 0
     top = max(h for h, _ in snaps)
     after = max(i for i, (h, _) in enumerate(snaps) if h >= 0.85 * top)
     growth = Counter()
