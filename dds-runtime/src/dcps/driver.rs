@@ -392,6 +392,8 @@ impl Driver {
         }
         BATCH.with(|b| *b.borrow_mut() = batch);
         self.after_unlock(&mut deferred, &mut touched, next_timeout, progress);
+        // Only non-sample events are deferred: a discovery burst must not pin its room for good.
+        deferred.shrink_to(crate::rtps::KEPT_QUEUE_ROOM);
         ROUTED.with(|b| *b.borrow_mut() = (deferred, touched));
         r
     }

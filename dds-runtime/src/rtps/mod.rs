@@ -20,5 +20,6 @@ mod api;
 
 pub use api::*;
 pub use participant::Participant;
+pub(crate) use participant::KEPT_QUEUE_ROOM;
 pub use types::*;
 pub use writer::WriterGroup;

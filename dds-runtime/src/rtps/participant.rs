@@ -17,6 +17,7 @@ mod managed;
 mod receive;
 mod shm;
 mod timers;
+pub(crate) use timers::KEPT_QUEUE_ROOM;
 mod topics;
 mod type_lookup;
 
@@ -69,7 +70,8 @@ pub struct Participant {
     user_readers: BTreeSet<EntityId>,
     /// Service-internal endpoints (`internal.rs`).
     internal: BTreeSet<EntityId>,
-    participants: HashMap<GuidPrefix, ProxyParticipant>,
+    /// Boxed: the table keeps spare slots (see `docs/performance.md`, "Footprint").
+    participants: HashMap<GuidPrefix, Box<ProxyParticipant>>,
     /// Every known publication and subscription, remote and local (local ones match locally too).
     /// Every known endpoint, local and remote. Boxed: a table slot is then a pointer, not a whole
     /// announcement, which halves the memory per remote endpoint (the table keeps spare slots).

@@ -1,5 +1,6 @@
 //! SPDP and SEDP processing, builtin endpoint wiring, and matching of user endpoints.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use foldhash::HashMap;
@@ -101,10 +102,11 @@ impl Participant {
         }
         let prefix = data.guid_prefix;
         debug!(participant = ?prefix, vendor = ?data.vendor_id, "participant discovered");
-        let meta: Vec<Locator> = if data.metatraffic_unicast.is_empty() {
-            data.metatraffic_multicast.clone()
+        // One list for all the proxies of its builtin endpoints.
+        let meta: Arc<[Locator]> = if data.metatraffic_unicast.is_empty() {
+            data.metatraffic_multicast.as_slice().into()
         } else {
-            data.metatraffic_unicast.clone()
+            data.metatraffic_unicast.as_slice().into()
         };
         let bits = data.builtin_endpoints;
         let group = self.shared_metatraffic_group(&data);
@@ -112,10 +114,10 @@ impl Participant {
             .push_back(Event::ParticipantDiscovered(Box::new(data.clone())));
         self.participants.insert(
             prefix,
-            ProxyParticipant {
+            Box::new(ProxyParticipant {
                 data,
                 lease_deadline,
-            },
+            }),
         );
         for (ours, theirs, bit) in builtin::WRITER_PAIRS {
             if bits & bit != 0 {

@@ -10,6 +10,8 @@ use tracing::{debug, trace};
 use super::timers::lower_floor;
 use super::Participant;
 use crate::rtps::api::{Event, Payload};
+use crate::rtps::discovery::builtin;
+use crate::rtps::discovery::topics::TOPIC_READER_PAIR;
 use crate::rtps::messages::{id, MessageIter, Submessage};
 use crate::rtps::reader::Reader;
 use crate::rtps::types::*;
@@ -244,6 +246,16 @@ fn for_readers(
         }
         return;
     }
+    if let Some(id) = builtin_reader_of(writer.entity_id) {
+        // A builtin writer has one reader of ours: no index entry per remote builtin writer (about ten per
+        // discovered participant).
+        if let Some(r) = readers.get_mut(&id) {
+            if r.has_proxy(&writer) {
+                f(r);
+            }
+        }
+        return;
+    }
     let ids = match index.entry(writer) {
         Entry::Occupied(e) => e.into_mut(),
         Entry::Vacant(e) => {
@@ -265,6 +277,18 @@ fn for_readers(
             }
         }
     }
+}
+
+/// Our builtin reader that listens to the remote builtin writer `writer`, if it is one.
+fn builtin_reader_of(writer: EntityId) -> Option<EntityId> {
+    if !writer.is_builtin() {
+        return None;
+    }
+    builtin::READER_PAIRS
+        .iter()
+        .chain([&TOPIC_READER_PAIR])
+        .find(|(_, theirs, _)| *theirs == writer)
+        .map(|(ours, _, _)| *ours)
 }
 
 #[cfg(test)]

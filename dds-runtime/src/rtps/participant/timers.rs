@@ -18,6 +18,9 @@ use crate::rtps::types::*;
 const FULL_SCAN_INTERVAL: Duration = Duration::from_millis(100);
 
 /// Lowers a known timer floor to `t`; an unknown floor stays unknown (it is rescanned anyway).
+/// The room (in events) the participant's queues keep after a burst; see `Participant::trim_queues`.
+pub(crate) const KEPT_QUEUE_ROOM: usize = 256;
+
 pub(super) fn lower_floor(floor: &Cell<Option<Instant>>, t: Option<Instant>) {
     if let (Some(f), Some(t)) = (floor.get(), t) {
         if t < f {
@@ -97,6 +100,7 @@ impl Participant {
         if now >= self.spdp_due {
             self.send_spdp(None);
             self.spdp_due = now + self.config.spdp_interval;
+            self.trim_queues();
         }
         if now >= self.pmd_due {
             // Automatic liveliness: one ParticipantMessageData per interval keeps our lease alive at peers that
@@ -143,6 +147,14 @@ impl Participant {
     }
 
     /// Sends our SPDP announcement to the SPDP multicast locators and initial peers, or to `to` only.
+    /// Gives back the room a burst left in the event queues (thousands of SEDP samples arrive in one pass
+    /// when a peer with many endpoints appears): done once per SPDP period, so a steady stream does not
+    /// shrink and regrow them.
+    fn trim_queues(&mut self) {
+        self.scratch.shrink_to(KEPT_QUEUE_ROOM);
+        self.events.shrink_to(KEPT_QUEUE_ROOM);
+    }
+
     pub(super) fn send_spdp(&mut self, to: Option<Vec<Locator>>) {
         let dest = to.unwrap_or_else(|| {
             let mut d = self.config.metatraffic_multicast.clone();

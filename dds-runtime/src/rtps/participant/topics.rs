@@ -91,12 +91,12 @@ impl Participant {
         now: Instant,
         prefix: GuidPrefix,
         bits: u32,
-        meta: &[Locator],
+        meta: &std::sync::Arc<[Locator]>,
     ) {
         let (ours, theirs, bit) = TOPIC_WRITER_PAIR;
         if bits & bit != 0 {
             if let Some(w) = self.writers.get_mut(&ours) {
-                let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.to_vec(), true);
+                let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true);
                 w.add_proxy(now, proxy, true, &mut self.events);
             }
         }
@@ -105,7 +105,7 @@ impl Participant {
             if let Some(r) = self.readers.get_mut(&ours) {
                 r.add_proxy(
                     now,
-                    WriterProxy::new(Guid::new(prefix, theirs), meta.to_vec(), true),
+                    WriterProxy::new(Guid::new(prefix, theirs), meta.clone(), true),
                 );
                 self.readers_by_writer.clear();
             }

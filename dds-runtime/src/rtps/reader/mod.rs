@@ -22,13 +22,6 @@ use crate::rtps::types::*;
 use coherent::{group_set, Assembler, SetLimits, SetMark};
 use defrag::Defrag;
 
-fn slot_size(s: &Slot) -> usize {
-    match s {
-        Slot::Change(c) => c.payload.len(),
-        Slot::Irrelevant => 0,
-    }
-}
-
 /// Whether every must-understand inline QoS parameter is one we know.
 fn inline_qos_understood(q: Option<&crate::rtps::messages::ParameterList<'_>>) -> bool {
     use crate::rtps::messages::parameter::pid;
@@ -164,18 +157,15 @@ impl Reader {
         credit: &std::cell::Cell<Option<usize>>,
         out: &mut Vec<Event>,
     ) {
-        while let Some(e) = p.reorder.first_entry() {
-            if *e.key() > p.next_expected {
+        loop {
+            let next = p.next_expected;
+            let Some((sn, slot)) = p.take_first_if(|sn, slot| {
+                sn < next
+                    || (sn == next
+                        && (!matches!(slot, Slot::Change(_)) || Self::take_credit(credit)))
+            }) else {
                 break;
-            }
-            if *e.key() == p.next_expected
-                && matches!(e.get(), Slot::Change(_))
-                && !Self::take_credit(credit)
-            {
-                break;
-            }
-            let (sn, slot) = e.remove_entry();
-            p.reorder_bytes -= slot_size(&slot);
+            };
             if sn == p.next_expected {
                 Self::deliver(reader, p, sn, slot, out);
                 p.next_expected = sn.next();
@@ -200,11 +190,9 @@ impl Reader {
                 p.next_expected = sn.next();
                 Self::drain(rid, p, &self.credit, out);
             } else {
-                let size = slot_size(&slot);
-                if p.reorder.len() < self.params.reorder_max_samples
-                    && p.reorder_bytes + size <= self.params.reorder_max_bytes
+                if p.held() < self.params.reorder_max_samples
+                    && p.held_bytes() + slot.size() <= self.params.reorder_max_bytes
                 {
-                    p.reorder_bytes += size;
                     // Held for a while: it must not pin the whole datagram it arrived in.
                     let slot = match slot {
                         Slot::Change(mut c) => {
@@ -213,7 +201,7 @@ impl Reader {
                         }
                         other => other,
                     };
-                    p.reorder.insert(sn, slot);
+                    p.hold(sn, slot);
                 }
             }
         } else {
@@ -346,35 +334,37 @@ impl Reader {
             self.accept(p, sn, Slot::Irrelevant, out);
             return;
         }
-        if !p.defrag.contains_key(&sn) {
-            if p.defrag.len() >= self.params.defrag_max_samples {
+        let reliable = p.reliable;
+        let b = p.backlog_mut();
+        if !b.defrag.contains_key(&sn) {
+            if b.defrag.len() >= self.params.defrag_max_samples {
                 // Reliable: keep the oldest (they unblock delivery); best effort: keep the newest.
-                let victim = if p.reliable {
-                    p.defrag.last_key_value()
+                let victim = if reliable {
+                    b.defrag.last_key_value()
                 } else {
-                    p.defrag.first_key_value()
+                    b.defrag.first_key_value()
                 };
                 let Some((&v, _)) = victim else { return };
-                if p.reliable && v < sn {
+                if reliable && v < sn {
                     return;
                 }
-                if let Some(old) = p.defrag.remove(&v) {
-                    p.defrag_bytes -= old.bytes;
+                if let Some(old) = b.defrag.remove(&v) {
+                    b.defrag_bytes -= old.bytes;
                 }
             }
             let cost = defrag::cost(d.sample_size, d.fragment_size);
-            if p.defrag_bytes + cost > self.params.defrag_max_bytes {
+            if b.defrag_bytes + cost > self.params.defrag_max_bytes {
                 return;
             }
             let mut df = Defrag::new(d.sample_size, d.fragment_size, pool.take());
-            p.defrag_bytes += df.bytes;
+            b.defrag_bytes += df.bytes;
             df.status_info = d.inline_qos.and_then(|q| q.status_info());
             df.key_hash = d.inline_qos.and_then(|q| q.key_hash());
             df.key_flag = d.key_flag;
             df.coherent_set = d.inline_qos.and_then(|q| q.coherent_set());
-            p.defrag.insert(sn, df);
+            b.defrag.insert(sn, df);
         }
-        let Some(df) = p.defrag.get_mut(&sn) else {
+        let Some(df) = b.defrag.get_mut(&sn) else {
             return;
         };
         if df.sample_size != d.sample_size || df.fragment_size != d.fragment_size {
@@ -388,10 +378,10 @@ impl Reader {
             df.add(d.fragment_starting_num.saturating_add(i as u32), chunk);
         }
         if df.is_complete() {
-            let Some(df) = p.defrag.remove(&sn) else {
+            let Some(df) = b.defrag.remove(&sn) else {
                 return;
             };
-            p.defrag_bytes -= df.bytes;
+            b.defrag_bytes -= df.bytes;
             let kind = df
                 .status_info
                 .map_or(ChangeKind::Alive, ChangeKind::from_status_info);
@@ -428,25 +418,20 @@ impl Reader {
         if g.gap_start <= p.next_expected && base > p.next_expected {
             // Nothing below base will come any more. What we already hold of it was published and is delivered
             // in order; the rest is irrelevant (not lost).
-            while let Some(e) = p.reorder.first_entry() {
-                if *e.key() >= base {
-                    break;
-                }
-                let (sn, slot) = e.remove_entry();
-                p.reorder_bytes -= slot_size(&slot);
+            while let Some((sn, slot)) = p.take_first_if(|sn, _| sn < base) {
                 Self::deliver(rid, p, sn, slot, out);
             }
             p.next_expected = base;
         } else if g.gap_start > p.next_expected && base.0 - g.gap_start.0 <= 256 {
             let mut sn = g.gap_start;
-            while sn < base && p.reorder.len() < cap {
-                p.reorder.entry(sn).or_insert(Slot::Irrelevant);
+            while sn < base && p.held() < cap {
+                p.hold_irrelevant(sn);
                 sn = sn.next();
             }
         }
         for sn in g.gap_list.iter() {
-            if sn >= p.next_expected && p.reorder.len() < cap {
-                p.reorder.entry(sn).or_insert(Slot::Irrelevant);
+            if sn >= p.next_expected && p.held() < cap {
+                p.hold_irrelevant(sn);
             }
         }
         Self::drain(rid, p, &self.credit, out);
@@ -479,12 +464,7 @@ impl Reader {
             // The writer no longer has [next_expected, first): deliver what we hold of it, count the rest lost.
             let mut lost = 0u64;
             let mut sn = p.next_expected;
-            while let Some(e) = p.reorder.first_entry() {
-                if *e.key() >= hb.first_sn {
-                    break;
-                }
-                let (k, slot) = e.remove_entry();
-                p.reorder_bytes -= slot_size(&slot);
+            while let Some((k, slot)) = p.take_first_if(|k, _| k < hb.first_sn) {
                 if matches!(slot, Slot::Change(_)) {
                     lost += (k.0 - sn.0) as u64;
                     Self::deliver(rid, p, k, slot, out);
@@ -522,29 +502,32 @@ impl Reader {
             return;
         };
         if !p.reliable
-            || p.last_hbfrag_count
+            || p.backlog()
+                .and_then(|b| b.last_hbfrag_count)
                 .is_some_and(|c| hf.count.wrapping_sub(c) <= 0)
         {
             return;
         }
-        p.last_hbfrag_count = Some(hf.count);
         let sn = hf.writer_sn;
-        if p.has(sn) || hf.last_fragment_num == 0 {
+        let known = p.has(sn);
+        let b = p.backlog_mut();
+        b.last_hbfrag_count = Some(hf.count);
+        if known || hf.last_fragment_num == 0 {
             return;
         }
-        let Some(d) = p.defrag.get(&sn) else {
+        let Some(d) = b.defrag.get(&sn) else {
             return;
         };
         if d.missing(hf.last_fragment_num).is_empty()
-            || (p.nackfrag_req.len() >= self.params.defrag_max_samples.max(1)
-                && !p.nackfrag_req.contains_key(&sn))
+            || (b.nackfrag_req.len() >= self.params.defrag_max_samples.max(1)
+                && !b.nackfrag_req.contains_key(&sn))
         {
             return;
         }
-        let last = p.nackfrag_req.entry(sn).or_insert(0);
+        let last = b.nackfrag_req.entry(sn).or_insert(0);
         *last = (*last).max(hf.last_fragment_num);
-        p.nackfrag_due.get_or_insert(now + delay);
-        self.proxy_floor.lower(p.nackfrag_due);
+        b.nackfrag_due.get_or_insert(now + delay);
+        self.proxy_floor.lower(b.nackfrag_due);
     }
 
     pub(crate) fn next_timeout(&self) -> Option<Instant> {
@@ -563,11 +546,11 @@ impl Reader {
             if p.acknack_due.is_some_and(|t| t <= now) {
                 Self::send_acknack(rid, p, out);
             }
-            if p.nackfrag_due.is_some_and(|t| t <= now) {
+            if p.nackfrag_due().is_some_and(|t| t <= now) {
                 Self::send_requested_nackfrags(rid, p, out);
             }
             exact.lower(p.acknack_due);
-            exact.lower(p.nackfrag_due);
+            exact.lower(p.nackfrag_due());
         }
         self.proxy_floor = exact;
     }
@@ -580,7 +563,7 @@ impl Reader {
         let upper = p.hb_last.min(base + 255);
         let mut sn = base;
         while sn <= upper {
-            if !p.reorder.contains_key(&sn) && !p.defrag.contains_key(&sn) {
+            if !p.holds_any_of(sn) {
                 set.insert(sn);
             }
             sn = sn.next();
@@ -596,14 +579,18 @@ impl Reader {
             final_flag: set.num_bits == 0 && p.synced,
         });
         out.push(&dest, dst, Ts::Any, &ack);
-        for (sn, d) in p.defrag.range(base..) {
-            if *sn > p.hb_last {
+        let (writer, hb_last) = (p.guid, p.hb_last);
+        let Some(b) = p.backlog_if_used_mut() else {
+            return;
+        };
+        for (sn, d) in b.defrag.range(base..) {
+            if *sn > hb_last {
                 break;
             }
             let Some(nf) = nack_frag(
                 rid,
-                p.guid,
-                &mut p.nackfrag_count,
+                writer,
+                &mut b.nackfrag_count,
                 *sn,
                 &d.missing(d.total()),
             ) else {
@@ -611,22 +598,23 @@ impl Reader {
             };
             out.push(&dest, dst, Ts::Any, &nf);
             // Already asked for all it lacks: a pending HEARTBEAT_FRAG answer for it is redundant.
-            p.nackfrag_req.remove(sn);
+            b.nackfrag_req.remove(sn);
         }
     }
 
     /// One NACK_FRAG per sample a HEARTBEAT_FRAG asked about and still partly received: the fragments we lack
     /// up to the last one the writer has.
     fn send_requested_nackfrags(rid: EntityId, p: &mut WriterProxy, out: &mut Outbox) {
-        p.nackfrag_due = None;
-        let req = std::mem::take(&mut p.nackfrag_req);
         let dest = p.destination().to_vec();
-        let dst = Some(p.guid.prefix);
+        let (writer, dst) = (p.guid, Some(p.guid.prefix));
+        let b = p.backlog_mut();
+        b.nackfrag_due = None;
+        let req = std::mem::take(&mut b.nackfrag_req);
         for (sn, last) in req {
-            let Some(d) = p.defrag.get(&sn) else {
+            let Some(d) = b.defrag.get(&sn) else {
                 continue;
             };
-            if let Some(nf) = nack_frag(rid, p.guid, &mut p.nackfrag_count, sn, &d.missing(last)) {
+            if let Some(nf) = nack_frag(rid, writer, &mut b.nackfrag_count, sn, &d.missing(last)) {
                 out.push(&dest, dst, Ts::Any, &nf);
             }
         }

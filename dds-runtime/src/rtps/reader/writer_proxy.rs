@@ -1,6 +1,12 @@
 //! What a reader knows about one matched writer (§8.4.10.4): ordering, gaps, fragments, acknowledgement.
+//!
+//! Slim by design: a participant keeps one proxy per remote builtin writer of every discovered participant
+//! (see `docs/performance.md`, "Footprint"), and most of them never see a change out of order or in
+//! fragments. What only those need (the reorder buffer, reassembly, NACK_FRAG state) is in a [`Backlog`]
+//! allocated the first time it is needed, and the locators are shared with the participant's other proxies.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 use super::coherent::{Assembler, SetMark};
@@ -13,6 +19,16 @@ use crate::rtps::types::*;
 pub(crate) enum Slot {
     Change(PendingChange),
     Irrelevant,
+}
+
+impl Slot {
+    /// Payload bytes the slot holds.
+    pub(crate) fn size(&self) -> usize {
+        match self {
+            Slot::Change(c) => c.payload.len(),
+            Slot::Irrelevant => 0,
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -28,53 +44,55 @@ pub(crate) struct PendingChange {
 #[derive(Debug)]
 pub(crate) struct WriterProxy {
     pub guid: Guid,
-    pub locators: Vec<Locator>,
+    /// Shared with the other proxies made from the same announcement (one list per remote participant for
+    /// its builtin writers).
+    pub locators: Arc<[Locator]>,
     /// Reliable protocol with this writer (both sides reliable).
     pub reliable: bool,
-    /// Every sequence number below this was delivered or skipped.
-    pub next_expected: SequenceNumber,
     /// Something (data, gap or heartbeat) was received from this writer.
     pub synced: bool,
+    /// Every sequence number below this was delivered or skipped.
+    pub next_expected: SequenceNumber,
+    pub hb_last: SequenceNumber,
+    pub last_hb_count: Option<i32>,
+    pub acknack_due: Option<Instant>,
+    pub acknack_count: i32,
+    /// Changes held out of order and fragments: `None` until the first one arrives.
+    backlog: Option<Box<Backlog>>,
+    /// The writer's coherent set being assembled.
+    pub coherent: Assembler,
+}
+
+/// The part of a [`WriterProxy`] only used once changes arrive out of order or in fragments.
+#[derive(Debug, Default)]
+pub(crate) struct Backlog {
     pub reorder: BTreeMap<SequenceNumber, Slot>,
     /// Payload bytes held in `reorder`.
     pub reorder_bytes: usize,
-    pub hb_last: SequenceNumber,
-    pub last_hb_count: Option<i32>,
     pub last_hbfrag_count: Option<i32>,
-    pub acknack_due: Option<Instant>,
     /// Partly received samples a HEARTBEAT_FRAG asked about: sequence number -> last fragment the writer
     /// has. Answered with NACK_FRAG at `nackfrag_due` (bounded: samples held in `defrag`, at most
     /// `defrag_max_samples`).
     pub nackfrag_req: BTreeMap<SequenceNumber, u32>,
     pub nackfrag_due: Option<Instant>,
-    pub acknack_count: i32,
     pub nackfrag_count: i32,
     pub defrag: BTreeMap<SequenceNumber, Defrag>,
     pub defrag_bytes: usize,
-    /// The writer's coherent set being assembled.
-    pub coherent: Assembler,
 }
 
 impl WriterProxy {
-    pub(crate) fn new(guid: Guid, locators: Vec<Locator>, reliable: bool) -> Self {
+    pub(crate) fn new(guid: Guid, locators: impl Into<Arc<[Locator]>>, reliable: bool) -> Self {
         WriterProxy {
             guid,
-            locators,
+            locators: locators.into(),
             reliable,
-            next_expected: SequenceNumber(1),
             synced: false,
-            reorder: BTreeMap::new(),
-            reorder_bytes: 0,
+            next_expected: SequenceNumber(1),
             hb_last: SequenceNumber(0),
             last_hb_count: None,
-            last_hbfrag_count: None,
             acknack_due: None,
-            nackfrag_req: BTreeMap::new(),
-            nackfrag_due: None,
             acknack_count: 0,
-            nackfrag_count: 0,
-            defrag: BTreeMap::new(),
-            defrag_bytes: 0,
+            backlog: None,
             coherent: Assembler::default(),
         }
     }
@@ -83,16 +101,89 @@ impl WriterProxy {
         &self.locators[..self.locators.len().min(1)]
     }
 
-    /// Drops defragmentation state below `next_expected`.
-    pub(crate) fn drop_stale_defrag(&mut self) {
-        let keep = self.defrag.split_off(&self.next_expected);
-        for d in self.defrag.values() {
-            self.defrag_bytes -= d.bytes;
-        }
-        self.defrag = keep;
+    /// The backlog, if anything ever needed one.
+    pub(crate) fn backlog(&self) -> Option<&Backlog> {
+        self.backlog.as_deref()
     }
 
+    /// The backlog for changes, if anything ever needed one.
+    pub(crate) fn backlog_if_used_mut(&mut self) -> Option<&mut Backlog> {
+        self.backlog.as_deref_mut()
+    }
+
+    /// The backlog, made on first use.
+    pub(crate) fn backlog_mut(&mut self) -> &mut Backlog {
+        self.backlog.get_or_insert_with(Box::default)
+    }
+
+    /// Changes held out of order.
+    pub(crate) fn held(&self) -> usize {
+        self.backlog().map_or(0, |b| b.reorder.len())
+    }
+
+    /// Payload bytes held out of order.
+    pub(crate) fn held_bytes(&self) -> usize {
+        self.backlog().map_or(0, |b| b.reorder_bytes)
+    }
+
+    /// Holds `slot` for `sn` until its turn.
+    pub(crate) fn hold(&mut self, sn: SequenceNumber, slot: Slot) {
+        let b = self.backlog_mut();
+        b.reorder_bytes += slot.size();
+        if let Some(old) = b.reorder.insert(sn, slot) {
+            b.reorder_bytes -= old.size();
+        }
+    }
+
+    /// Marks `sn` irrelevant unless something is held for it already.
+    pub(crate) fn hold_irrelevant(&mut self, sn: SequenceNumber) {
+        self.backlog_mut()
+            .reorder
+            .entry(sn)
+            .or_insert(Slot::Irrelevant);
+    }
+
+    /// Takes the first held change when `take(sn, slot)` says so.
+    pub(crate) fn take_first_if(
+        &mut self,
+        take: impl FnOnce(SequenceNumber, &Slot) -> bool,
+    ) -> Option<(SequenceNumber, Slot)> {
+        let b = self.backlog.as_deref_mut()?;
+        let e = b.reorder.first_entry()?;
+        if !take(*e.key(), e.get()) {
+            return None;
+        }
+        let (sn, slot) = e.remove_entry();
+        b.reorder_bytes -= slot.size();
+        Some((sn, slot))
+    }
+
+    /// The time the next NACK_FRAG answering a HEARTBEAT_FRAG is due.
+    pub(crate) fn nackfrag_due(&self) -> Option<Instant> {
+        self.backlog().and_then(|b| b.nackfrag_due)
+    }
+
+    /// Drops defragmentation state below `next_expected`.
+    pub(crate) fn drop_stale_defrag(&mut self) {
+        let next = self.next_expected;
+        let Some(b) = self.backlog.as_deref_mut() else {
+            return;
+        };
+        let keep = b.defrag.split_off(&next);
+        for d in b.defrag.values() {
+            b.defrag_bytes -= d.bytes;
+        }
+        b.defrag = keep;
+    }
+
+    /// Whether `sn` was delivered, skipped or is held (whole).
     pub(crate) fn has(&self, sn: SequenceNumber) -> bool {
-        sn < self.next_expected || self.reorder.contains_key(&sn)
+        sn < self.next_expected || self.backlog().is_some_and(|b| b.reorder.contains_key(&sn))
+    }
+
+    /// Whether `sn` is held whole or partly (fragments).
+    pub(crate) fn holds_any_of(&self, sn: SequenceNumber) -> bool {
+        self.backlog()
+            .is_some_and(|b| b.reorder.contains_key(&sn) || b.defrag.contains_key(&sn))
     }
 }

@@ -204,7 +204,11 @@ impl Writer {
             d.sort_by_key(|&(own, l)| (l, own));
             d.dedup_by_key(|(_, l)| *l);
             d.sort_by_key(|&(own, _)| own);
-            d.into_iter().map(|(_, l)| l).collect::<Vec<Locator>>()
+            // Collected in place (the pairs' allocation is reused): kept as long as the readers are, so
+            // without the spare room.
+            let mut d: Vec<Locator> = d.into_iter().map(|(_, l)| l).collect();
+            d.shrink_to_fit();
+            d
         };
         self.data_dest = dest(None);
         self.key_hash_dest = dest(Some(true));

@@ -1,6 +1,7 @@
 //! What a writer knows about one matched reader (§8.4.7.5).
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::Arc;
 use std::time::Instant;
 
 use crate::rtps::types::*;
@@ -12,8 +13,9 @@ pub(crate) const MAX_REQUESTED_FRAG_SAMPLES: usize = 64;
 #[derive(Debug, Clone)]
 pub(crate) struct ReaderProxy {
     pub guid: Guid,
-    /// Where to send; the first is used.
-    pub locators: Vec<Locator>,
+    /// Where to send; the first is used. Shared with the other proxies made from the same announcement (one
+    /// list per remote participant for its builtin readers).
+    pub locators: Arc<[Locator]>,
     /// A multicast locator the reader listens on, when multicast user data is on (see
     /// `ParticipantConfig::multicast_data`).
     pub multicast: Option<Locator>,
@@ -39,10 +41,10 @@ pub(crate) struct ReaderProxy {
 }
 
 impl ReaderProxy {
-    pub(crate) fn new(guid: Guid, locators: Vec<Locator>, reliable: bool) -> Self {
+    pub(crate) fn new(guid: Guid, locators: impl Into<Arc<[Locator]>>, reliable: bool) -> Self {
         ReaderProxy {
             guid,
-            locators,
+            locators: locators.into(),
             multicast: None,
             via_multicast: false,
             reliable,
