@@ -124,6 +124,9 @@ pub(crate) struct ReaderCache<T> {
     key_of: Option<fn(&T) -> Option<T>>,
     /// Derives an instance's handle from its key (the built-in readers: the entity's handle); else counted.
     handle_of: Option<fn(&[u8]) -> InstanceHandle>,
+    /// At `max_instances`, a new instance evicts the instance longest not alive instead of being refused
+    /// (the built-in readers: entities keep coming and going for the life of the participant).
+    evict_not_alive: bool,
     /// `collect_with`'s working vectors, kept (empty) between calls so that a take allocates nothing.
     collect_scratch: (Vec<Touched>, Vec<(u64, usize, usize)>),
 }
@@ -163,7 +166,31 @@ impl<T: FilterFields> ReaderCache<T> {
             collect_scratch: (Vec::new(), Vec::new()),
             key_of: None,
             handle_of: None,
+            evict_not_alive: false,
         }
+    }
+
+    /// At `max_instances`, make room by evicting the instance longest not alive (see `evict_not_alive`).
+    pub(crate) fn set_evict_not_alive(&mut self, on: bool) {
+        self.evict_not_alive = on;
+    }
+
+    /// Forgets the instance that has been not alive the longest, with its samples; false when every
+    /// instance is alive.
+    fn evict_oldest_not_alive(&mut self) -> bool {
+        let oldest = self
+            .instances
+            .iter()
+            .filter_map(|(h, i)| i.not_alive_since.map(|t| (t, *h)))
+            .min();
+        let Some((_, h)) = oldest else {
+            return false;
+        };
+        if let Some(i) = self.instances.remove(&h) {
+            self.total -= i.samples.len();
+            self.by_key.remove(&i.key);
+        }
+        true
     }
 
     /// Instance handles from now on derive from the key with `f` (a handle in use, or NIL, falls back to
@@ -209,7 +236,9 @@ impl<T: FilterFields> ReaderCache<T> {
         now: Instant,
     ) -> Option<InstanceHandle> {
         if let Some(max) = self.qos.resource_limits.max_instances {
-            if self.instances.len() >= max as usize {
+            if self.instances.len() >= max as usize
+                && !(self.evict_not_alive && self.evict_oldest_not_alive())
+            {
                 return None;
             }
         }
@@ -939,6 +968,47 @@ mod tests {
             c.insert(inc(2, ChangeKind::Alive, 1, 6), ms(245)),
             Outcome::Accepted { .. }
         ));
+    }
+
+    #[test]
+    fn at_the_instance_limit_the_instance_longest_not_alive_makes_room() {
+        let qos = DataReaderQos {
+            resource_limits: ResourceLimits {
+                max_samples: None,
+                max_instances: Some(2),
+                max_samples_per_instance: None,
+            },
+            ..Default::default()
+        };
+        let mut c = ReaderCache::new(qos, true);
+        c.set_evict_not_alive(true);
+        let t = Instant::now();
+        let ms = |n| t + Duration::from_millis(n);
+        c.insert(inc(1, ChangeKind::Alive, 1, 1), ms(0));
+        c.insert(inc(1, ChangeKind::Alive, 2, 2), ms(0));
+        // Every instance alive: a third is refused.
+        assert!(matches!(
+            c.insert(inc(1, ChangeKind::Alive, 3, 3), ms(1)),
+            Outcome::Rejected {
+                reason: SampleRejectedReason::ByInstancesLimit,
+                ..
+            }
+        ));
+        // Key 2 disposed, then key 1: key 2 has been gone longer and makes room for key 3.
+        c.insert(inc(1, ChangeKind::Dispose, 2, 0), ms(2));
+        c.insert(inc(1, ChangeKind::Dispose, 1, 0), ms(3));
+        assert!(matches!(
+            c.insert(inc(1, ChangeKind::Alive, 3, 3), ms(4)),
+            Outcome::Accepted { .. }
+        ));
+        assert_eq!(c.instance_count(), 2);
+        assert!(c.lookup(&[2]).is_none());
+        assert!(c.lookup(&[1]).is_some() && c.lookup(&[3]).is_some());
+        assert_eq!(
+            c.len(),
+            2,
+            "key 1's sample and key 3's; key 2's went with it"
+        );
     }
 
     #[test]

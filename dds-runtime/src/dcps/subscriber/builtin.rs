@@ -20,8 +20,9 @@ use super::super::sample::{InstanceHandle, InstanceState};
 use super::super::sync::lock;
 use super::{ops, DataReader, ReaderInner, ReaderOwner, Stored, Subscriber};
 
-/// Most instances one built-in reader keeps, so that hostile discovery data cannot grow it without bound
-/// (beyond, new entities are rejected: SAMPLE_REJECTED).
+/// Most instances one built-in reader keeps, so that hostile discovery data cannot grow it without bound.
+/// At the limit a new entity evicts the one gone longest; only when every kept entity is alive is it
+/// rejected (SAMPLE_REJECTED).
 const MAX_INSTANCES: u32 = 16 * 1024;
 
 /// The QoS of the built-in readers (DDS 1.4 §2.2.5).
@@ -104,6 +105,7 @@ impl<T: DdsType> BuiltinReader<T> {
         let p = &s.participant;
         let mut cache = ReaderCache::new(builtin_qos(), true);
         cache.set_handle_fn(handle_of);
+        cache.set_evict_not_alive(true);
         let inner = Arc::new(ReaderInner::new(
             p.driver().clone(),
             cache,
