@@ -4,8 +4,8 @@
 //! tests prove the endpoints still match (TypeLookup, then assignability, which for unions goes by labels) and
 //! exchange samples both ways.
 //! Ignored by default (needs python3 + cyclonedds): run with
-//! `scripts/isolated cargo nextest run -p dds-runtime --features idl --test dcps_dynamic_cyclone
-//! --run-ignored ignored-only`. Domains 215 and 216.
+//! `scripts/isolated cargo nextest run -p dds-runtime --features idl,json --test dcps_dynamic_cyclone
+//! --run-ignored ignored-only`. Domains 215, 216 and 217.
 mod dcps_util;
 
 use std::io::{BufRead, BufReader};
@@ -167,4 +167,94 @@ fn cyclone_union_writer_to_typed_reader() {
             (4, InstanceState::Alive),
         ]
     );
+}
+
+/// The same Cyclone writer to a dynamic reader (type from IDL text): the dynamic reader keeps instances with
+/// the typed reader's cache, so it sees the union values, disposed and unregistered instances, sample states
+/// (read, then not read again) and reads by instance.
+#[cfg(all(feature = "idl", feature = "json"))]
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn cyclone_union_writer_to_dynamic_reader_instance_states() {
+    use dds_runtime::xtypes::dynamic::{types_from_idl, DynamicData, Value};
+    require_netns();
+    let idl =
+        "module xu { @final union Choice switch (long) { case 1: long a; case 2: string b; }; \
+               @final struct Holder { @key long id; Choice c; }; };";
+    let ty = types_from_idl("u.idl", idl)
+        .unwrap()
+        .remove("xu::Holder")
+        .unwrap();
+    let p = participant(217);
+    let t = p
+        .create_dynamic_topic("UnionTopic", ty.clone(), &TopicQos::default())
+        .unwrap();
+    let r = p
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| s.create_dynamic_reader(&t, &tl_reader_qos()))
+        .unwrap();
+    let mut child = python(217, &["pub"]);
+    let key = |id: i32| {
+        let mut d = DynamicData::new(ty.clone());
+        d.set("id", Value::Int32(id)).unwrap();
+        d
+    };
+    let settled = wait_until(Duration::from_secs(25), || {
+        r.wait_for_data(Duration::from_millis(100));
+        let states: Vec<_> = (1..=4)
+            .map(|id| {
+                r.lookup_instance(&key(id))
+                    .and_then(|h| r.instance_state(h))
+            })
+            .collect();
+        states
+            == [
+                Some(InstanceState::Alive),
+                Some(InstanceState::NotAliveDisposed),
+                Some(InstanceState::NotAliveNoWriters),
+                Some(InstanceState::Alive),
+            ]
+    });
+    drop(child.stdin.take());
+    let _ = child.wait();
+    assert!(settled, "instance states never settled");
+    assert_eq!(r.instance_count(), 4);
+    let any = (
+        SampleStateMask::ANY,
+        ViewStateMask::ANY,
+        InstanceStateMask::ANY,
+    );
+    let first = r.read_states(SampleStateMask::NOT_READ, any.1, any.2);
+    let values: Vec<String> = first
+        .iter()
+        .filter_map(|s| s.data.as_ref())
+        .map(|d| d.to_json().to_string())
+        .collect();
+    assert_eq!(
+        values,
+        [
+            r#"{"c":{"a":10,"discriminator":1},"id":1}"#,
+            r#"{"c":{"b":"s2","discriminator":2},"id":2}"#,
+            r#"{"c":{"a":30,"discriminator":1},"id":3}"#,
+            r#"{"c":{"b":"s4","discriminator":2},"id":4}"#,
+        ]
+    );
+    assert!(r
+        .read_states(SampleStateMask::NOT_READ, any.1, any.2)
+        .is_empty());
+    let only_disposed = InstanceStateMask {
+        alive: false,
+        disposed: true,
+        no_writers: false,
+    };
+    let disposed = r.read_states(any.0, any.1, only_disposed);
+    assert!(!disposed.is_empty());
+    assert!(disposed
+        .iter()
+        .all(|s| s.info.instance_state == InstanceState::NotAliveDisposed));
+    let h4 = r.lookup_instance(&key(4)).unwrap();
+    let taken = r.take_instance(h4);
+    assert_eq!(taken.len(), 1);
+    assert_eq!(taken[0].info.instance_handle, h4);
+    assert!(r.read_instance(h4).is_empty());
 }
