@@ -292,3 +292,76 @@ fn dynamic_writers_match_typed_readers_by_assignability() {
         })
     );
 }
+
+/// The dynamic reader's read and query conditions (the typed reader's `ReadCondition`/`QueryCondition` over its
+/// cache): a waitset wakes for them, and read/take with a condition return what it selects, in its ORDER BY.
+#[test]
+fn dynamic_reader_read_and_query_conditions() {
+    let ty = shape_from_builder();
+    let (p1, p2) = (participant(215), participant(215));
+    let (wq, rq) = reliable_keep_all();
+    let w = writer::<ShapeType>(&p1, "DynCond", &wq);
+    let topic = p2
+        .create_dynamic_topic("DynCond", ty.clone(), &TopicQos::default())
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| s.create_dynamic_reader(&topic, &rq))
+        .unwrap();
+    let unread = r.create_readcondition(
+        SampleStateMask::NOT_READ,
+        ViewStateMask::ANY,
+        InstanceStateMask::ANY,
+    );
+    let q = r
+        .create_querycondition(
+            SampleStateMask::ANY,
+            ViewStateMask::ANY,
+            InstanceStateMask::ANY,
+            "x >= %0 ORDER BY y",
+            &["2"],
+        )
+        .unwrap();
+    let ws = WaitSet::new();
+    ws.attach_condition(unread.clone());
+    assert!(!unread.trigger_value());
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    for (color, x) in [("RED", 1), ("BLUE", 3), ("GREEN", 2), ("RED", 4)] {
+        w.write(&shape(color, x)).unwrap();
+    }
+    let woke = ws.wait(Duration::from_secs(5)).expect("the waitset wakes");
+    assert!(matches!(&woke[..], [Condition::Read(_)]));
+    assert!(wait_until(Duration::from_secs(5), || r
+        .read_states(
+            SampleStateMask::ANY,
+            ViewStateMask::ANY,
+            InstanceStateMask::ANY
+        )
+        .len()
+        == 4));
+    assert!(!unread.trigger_value(), "everything was read");
+    let xs = |v: Vec<Sample<DynamicData>>| -> Vec<i32> {
+        v.iter()
+            .filter_map(|s| match s.data.as_ref()?.get("x")? {
+                Value::Int32(x) => Some(*x),
+                _ => None,
+            })
+            .collect()
+    };
+    assert!(q.trigger_value());
+    assert_eq!(xs(r.read_w_condition(&q)), [2, 3, 4]);
+    assert_eq!(xs(r.take_w_condition(&q)), [2, 3, 4]);
+    assert_eq!(
+        xs(r.take_states(
+            SampleStateMask::ANY,
+            ViewStateMask::ANY,
+            InstanceStateMask::ANY
+        )),
+        [1],
+        "the query took only its samples"
+    );
+    assert!(!q.trigger_value());
+}

@@ -14,7 +14,8 @@ use crate::qos::{DataReaderQos, DataRepresentation, ReaderQos};
 use crate::rtps::{ChangeKind, Event, Guid, Payload, ReaderSpec, ReceivedSample};
 use crate::xtypes::dynamic::{DynamicData, DynamicType};
 
-use super::super::cache::{to_sample, ReaderCache, Selection};
+use super::super::cache::{to_sample, ReaderCache, Selection, SharedFilter};
+use super::super::condition::{QueryCondition, ReadCondition, ReadConditionSource, Signal};
 use super::super::decode::{decode_change_with, SampleCodec};
 use super::super::driver::{Driver, Endpoint, EndpointHandle, Pending};
 use super::super::error::DdsResult;
@@ -97,6 +98,8 @@ struct Inner {
     pending: Mutex<VecDeque<Pending>>,
     cache: Mutex<CacheState>,
     data_cv: Condvar,
+    /// Wakes the waitsets of this reader's read and query conditions.
+    data_signal: Signal,
     matched: Mutex<Vec<Guid>>,
     incompatible: Mutex<IncompatibleQosStatus>,
 }
@@ -122,6 +125,12 @@ impl Inner {
         any
     }
 
+    /// Wakes `wait_for_data` and the waitsets of the reader's conditions.
+    fn notify_data(&self) {
+        self.data_cv.notify_all();
+        self.data_signal.notify();
+    }
+
     fn store(&self, st: &mut CacheState, s: ReceivedSample, now: Instant, rx: SystemTime) -> bool {
         let info = self.driver.remote_writer(&s.writer);
         let key = st.cache.take_key_buffer();
@@ -135,6 +144,25 @@ impl Inner {
     }
 }
 
+impl ReadConditionSource for Inner {
+    fn has_matching(
+        &self,
+        s: SampleStateMask,
+        v: ViewStateMask,
+        i: InstanceStateMask,
+        query: Option<&SharedFilter>,
+    ) -> bool {
+        let sel = Selection {
+            query: query.cloned(),
+            ..Selection::states(s, v, i)
+        };
+        lock(&self.cache).cache.has_matching(&sel)
+    }
+    fn data_signal(&self) -> &Signal {
+        &self.data_signal
+    }
+}
+
 impl Endpoint for Inner {
     fn enqueue(&self, item: Pending) {
         lock(&self.pending).push_back(item);
@@ -142,7 +170,7 @@ impl Endpoint for Inner {
 
     fn process(self: Arc<Self>) {
         if self.store_pending() {
-            self.data_cv.notify_all();
+            self.notify_data();
         }
     }
 
@@ -158,9 +186,7 @@ impl Endpoint for Inner {
                 writer,
                 alive: false,
                 ..
-            } if lock(&self.cache).cache.writer_gone(*writer, Instant::now()) => {
-                self.data_cv.notify_all()
-            }
+            } if lock(&self.cache).cache.writer_gone(*writer, Instant::now()) => self.notify_data(),
             _ => {}
         }
     }
@@ -220,6 +246,7 @@ impl Subscriber {
             }),
             ty,
             data_cv: Condvar::new(),
+            data_signal: Signal::default(),
             matched: Mutex::new(Vec::new()),
             incompatible: Mutex::new(IncompatibleQosStatus::default()),
         });
@@ -334,6 +361,54 @@ impl DynamicReader {
         let mut key = Vec::new();
         key_sample.instance_key(&mut key).ok()?;
         lock(&self.inner.cache).cache.lookup(&key)
+    }
+
+    /// A read condition on this reader (for a [`WaitSet`](crate::dcps::WaitSet)): triggers while it holds a
+    /// sample in these states.
+    pub fn create_readcondition(
+        &self,
+        sample_states: SampleStateMask,
+        view_states: ViewStateMask,
+        instance_states: InstanceStateMask,
+    ) -> ReadCondition {
+        ReadCondition::on(
+            self.inner.clone(),
+            sample_states,
+            view_states,
+            instance_states,
+        )
+    }
+
+    /// A query condition on this reader: a read condition whose samples must also satisfy `expression` (the
+    /// Annex B subset, optionally ending in `ORDER BY`), with `%n` bound to `params[n]`.
+    pub fn create_querycondition<S: AsRef<str>>(
+        &self,
+        sample_states: SampleStateMask,
+        view_states: ViewStateMask,
+        instance_states: InstanceStateMask,
+        expression: &str,
+        params: &[S],
+    ) -> DdsResult<QueryCondition> {
+        let query = crate::filter::ContentFilter::query(expression, params)?;
+        let read = self.create_readcondition(sample_states, view_states, instance_states);
+        Ok(QueryCondition::new(read, query))
+    }
+
+    /// Reads with a read condition's states (and a query condition's query and ORDER BY).
+    pub fn read_w_condition(&self, c: &ReadCondition) -> Vec<Sample<DynamicData>> {
+        self.collect(&Self::of_condition(c), false)
+    }
+
+    /// Takes with a read condition's states (and a query condition's query and ORDER BY).
+    pub fn take_w_condition(&self, c: &ReadCondition) -> Vec<Sample<DynamicData>> {
+        self.collect(&Self::of_condition(c), true)
+    }
+
+    fn of_condition(c: &ReadCondition) -> Selection {
+        Selection {
+            query: c.query.clone(),
+            ..Selection::states(c.sample_states, c.view_states, c.instance_states)
+        }
     }
 
     /// The state of an instance the reader knows.
