@@ -100,11 +100,13 @@ fn own_idl() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR")).join("own");
     println!("cargo::rerun-if-changed={}", dir.display());
     let _ = std::fs::create_dir_all(&out);
-    if let Err(e) = idlc::Builder::new()
-        .out_dir(&out)
-        .compile(&[dir.join("typedefs.idl")])
-    {
-        panic!("idlc rejects tests/idl/typedefs.idl: {e}");
+    for stem in ["typedefs", "nested_base", "no-peer/bitsets"] {
+        if let Err(e) = idlc::Builder::new()
+            .out_dir(&out)
+            .compile(&[dir.join(format!("{stem}.idl"))])
+        {
+            panic!("idlc rejects tests/idl/{stem}.idl: {e}");
+        }
     }
 }
 

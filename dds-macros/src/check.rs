@@ -166,4 +166,25 @@ fn check_union(cx: &mut Ctxt, c: &Container, u: &Union) {
     if u.default_value_case().is_none() {
         cx.error_spanned_by(c.ident(), "a union needs a variant that is not recursive");
     }
+    check_unit_cases(cx, u);
+}
+
+/// XTypes has no member-less case: the type objects leave a unit variant out, so its labels fall to the
+/// default case, whose member a peer would then read. Refused when a default case carries a member.
+fn check_unit_cases(cx: &mut Ctxt, u: &Union) {
+    let default_has_member = u
+        .cases
+        .iter()
+        .any(|c| c.attrs.default && c.payload.is_some());
+    if !default_has_member {
+        return;
+    }
+    for case in u.cases.iter().filter(|c| c.payload.is_none()) {
+        cx.error_spanned_by(
+            case.variant,
+            "a unit variant cannot sit beside a `default` variant with a member: XTypes has no member-less \
+             case, so peers decoding by the type objects would read the default member for its labels; \
+             give it a member or drop the default",
+        );
+    }
 }

@@ -462,7 +462,9 @@ impl<'a> Union<'a> {
             syn::parse_quote!(i32)
         });
         let disc_is_wchar = matches!(&disc, Type::Path(p) if p.path.segments.last().is_some_and(|s| s.ident == "WChar"));
-        let mut next_id: u32 = 1;
+        // dds_runtime's `UnionType::first_member_id` (the same rule, written down there): from 0 as Cyclone
+        // DDS 11 numbers them, from 1 in mutable unions (the discriminator is member 0 on the wire).
+        let mut next_id: u32 = u32::from(matches!(ta.ext, Some(Ext::Mutable)));
         let mut cases = Vec::new();
         for v in &data.variants {
             let attrs = parse_variant_attrs(cx, &v.attrs);

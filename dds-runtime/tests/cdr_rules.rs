@@ -524,8 +524,9 @@ enum ByBool {
 #[derive(DdsType, Debug, PartialEq)]
 #[dds(final, discriminator = u8)]
 enum ByOctet {
+    // A unit variant would have no type object beside the default case (the derive refuses it).
     #[dds(case = 0)]
-    Zero,
+    Zero(u8),
     #[dds(case = 1, case = 2)]
     Small(u16),
     #[dds(default)]
@@ -562,7 +563,7 @@ fn union_discriminators_and_defaults() {
     }
     let v = All {
         b: ByBool::No(5),
-        o: ByOctet::Zero,
+        o: ByOctet::Zero(7),
         o2: ByOctet::Other(-1),
         c: ByChar::Other(1),
     };
@@ -571,12 +572,12 @@ fn union_discriminators_and_defaults() {
         &v,
         Xcdr2,
         LE,
-        "00 07 00 02 00 00 05 00 00 03 00 00 ff ff ff ff 00 01 00 00",
+        "00 07 00 02 00 00 05 00 00 07 03 00 ff ff ff ff 00 01 00 00",
     );
     let v = All {
         b: ByBool::Yes(1),
         o: ByOctet::Small(2),
-        o2: ByOctet::Zero,
+        o2: ByOctet::Zero(0),
         c: ByChar::A(2),
     };
     roundtrip_all(&v);

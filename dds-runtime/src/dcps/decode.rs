@@ -36,10 +36,61 @@ fn local_or_deserialize<T: DdsType>(payload: &mut Payload) -> Result<T, cdr::Dec
     cdr::deserialize::<T>(payload)
 }
 
-/// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped to an
-/// instance. Instances are identified by `cdr::instance_key`; a key-only change without a decodable key
-/// payload is mapped through its key hash to an instance seen before with the same hash.
+/// What a reader needs to know of its sample type `T` to decode changes and identify instances: derived
+/// types know it statically ([`Derived`]), dynamic ones through their `DynamicType`. One decoding step
+/// ([`decode_change_with`]) and one cache serve both.
+pub(crate) trait SampleCodec<T> {
+    /// The type has key members.
+    fn keyed(&self) -> bool;
+    /// A sample from its payload.
+    fn decode(&self, payload: &mut Payload) -> Result<T, cdr::DecodeError>;
+    /// A sample holding the key values, from a key payload.
+    fn decode_key(&self, payload: &[u8]) -> Result<T, cdr::DecodeError>;
+    /// The serialized key that identifies the sample's instance.
+    fn instance_key(&self, v: &T, out: &mut Vec<u8>) -> Result<(), cdr::EncodeError>;
+    /// The key hash a writer using `version` sends.
+    fn key_hash(&self, v: &T, version: cdr::XcdrVersion) -> Result<[u8; 16], cdr::EncodeError>;
+}
+
+/// [`SampleCodec`] of a `#[derive(DdsType)]` type.
+pub(crate) struct Derived;
+
+impl<T: DdsType> SampleCodec<T> for Derived {
+    fn keyed(&self) -> bool {
+        T::IS_KEYED
+    }
+    fn decode(&self, payload: &mut Payload) -> Result<T, cdr::DecodeError> {
+        local_or_deserialize::<T>(payload)
+    }
+    fn decode_key(&self, payload: &[u8]) -> Result<T, cdr::DecodeError> {
+        cdr::deserialize_key::<T>(payload)
+    }
+    fn instance_key(&self, v: &T, out: &mut Vec<u8>) -> Result<(), cdr::EncodeError> {
+        cdr::instance_key(v, out)
+    }
+    fn key_hash(&self, v: &T, version: cdr::XcdrVersion) -> Result<[u8; 16], cdr::EncodeError> {
+        cdr::key_hash(v, version)
+    }
+}
+
+/// [`decode_change_with`] for a derived type.
 pub(crate) fn decode_change<T: DdsType>(
+    s: ReceivedSample,
+    info: RemoteWriterInfo,
+    by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
+    key: Vec<u8>,
+    now: Instant,
+    rx_time: SystemTime,
+) -> Option<Incoming<T>> {
+    decode_change_with(&Derived, s, info, by_hash, key, now, rx_time)
+}
+
+/// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped to an
+/// instance. Instances are identified by their serialized key ([`SampleCodec::instance_key`]); a key-only
+/// change without a decodable key payload is mapped through its key hash to an instance seen before with the
+/// same hash.
+pub(crate) fn decode_change_with<T, C: SampleCodec<T>>(
+    codec: &C,
     mut s: ReceivedSample,
     info: RemoteWriterInfo,
     by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
@@ -53,15 +104,15 @@ pub(crate) fn decode_change<T: DdsType>(
     let mut data = None;
     let mut key_holder = None;
     if kind == ChangeKind::Alive {
-        let d = match local_or_deserialize::<T>(&mut s.payload) {
+        let d = match codec.decode(&mut s.payload) {
             Ok(d) => d,
             Err(e) => {
                 tracing::warn!(writer = ?s.writer, seq = s.sequence.0, error = %e, "dropping undecodable sample");
                 return None;
             }
         };
-        if T::IS_KEYED {
-            if let Err(e) = cdr::instance_key(&d, &mut key) {
+        if codec.keyed() {
+            if let Err(e) = codec.instance_key(&d, &mut key) {
                 tracing::warn!(error = %e, "cannot compute the instance key");
                 return None;
             }
@@ -70,8 +121,8 @@ pub(crate) fn decode_change<T: DdsType>(
             let hashes = match s.key_hash {
                 Some(kh) => [Some(kh), None],
                 None => [
-                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr1).ok(),
-                    cdr::key_hash(&d, cdr::XcdrVersion::Xcdr2).ok(),
+                    codec.key_hash(&d, cdr::XcdrVersion::Xcdr1).ok(),
+                    codec.key_hash(&d, cdr::XcdrVersion::Xcdr2).ok(),
                 ],
             };
             for kh in hashes.into_iter().flatten() {
@@ -82,11 +133,11 @@ pub(crate) fn decode_change<T: DdsType>(
             }
         }
         data = Some(d);
-    } else if T::IS_KEYED {
+    } else if codec.keyed() {
         if !s.payload.is_empty() {
-            match cdr::deserialize_key::<T>(&s.payload) {
+            match codec.decode_key(&s.payload) {
                 Ok(k) => {
-                    if let Err(e) = cdr::instance_key(&k, &mut key) {
+                    if let Err(e) = codec.instance_key(&k, &mut key) {
                         tracing::warn!(error = %e, "cannot compute the instance key");
                         return None;
                     }

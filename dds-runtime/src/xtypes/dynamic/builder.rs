@@ -221,7 +221,8 @@ pub struct UnionBuilder {
     discriminator: DynamicType,
     disc_key: bool,
     nested: bool,
-    cases: Vec<UnionCase>,
+    /// The cases, each with its explicit id (the others are numbered in `build`, by the extensibility).
+    cases: Vec<(UnionCase, Option<u32>)>,
 }
 
 impl UnionBuilder {
@@ -255,7 +256,7 @@ impl UnionBuilder {
         self
     }
 
-    /// Adds a case with its labels; ids are numbered from 1, as libddsc does.
+    /// Adds a case with its labels; ids are numbered as [`UnionType::first_member_id`] says.
     pub fn case(self, name: impl Into<String>, ty: DynamicType, labels: Vec<i64>) -> Self {
         self.case_with(name, ty, labels, false, None)
     }
@@ -274,15 +275,15 @@ impl UnionBuilder {
         is_default: bool,
         id: Option<u32>,
     ) -> Self {
-        let id = id.unwrap_or_else(|| self.cases.last().map_or(1, |c| c.id + 1));
-        self.cases.push(UnionCase {
+        let case = UnionCase {
             name: name.into(),
-            id,
+            id: 0,
             ty,
             labels,
             is_default,
             external: false,
-        });
+        };
+        self.cases.push((case, id));
         self
     }
 
@@ -303,7 +304,7 @@ impl UnionBuilder {
                 self.discriminator.name()
             )));
         }
-        if self.cases.iter().filter(|c| c.is_default).count() > 1 {
+        if self.cases.iter().filter(|(c, _)| c.is_default).count() > 1 {
             return Err(DynamicError::Invalid(format!(
                 "{}: two default cases",
                 self.name
@@ -314,10 +315,24 @@ impl UnionBuilder {
             extensibility: self.extensibility,
             discriminator: self.discriminator,
             disc_key: self.disc_key,
-            cases: self.cases,
+            cases: number_cases(self.cases, self.extensibility),
             nested: self.nested,
         })))
     }
+}
+
+/// Gives the cases without an explicit id the next one: from [`UnionType::first_member_id`], and after an
+/// explicit id from that id.
+fn number_cases(cases: Vec<(UnionCase, Option<u32>)>, ext: Extensibility) -> Vec<UnionCase> {
+    let mut next = UnionType::first_member_id(ext);
+    cases
+        .into_iter()
+        .map(|(mut c, id)| {
+            c.id = id.unwrap_or(next);
+            next = c.id.wrapping_add(1);
+            c
+        })
+        .collect()
 }
 
 /// Builds an [`EnumType`].

@@ -73,7 +73,7 @@ fn convert(mut c: Compilation) -> Result<BTreeMap<String, DynamicType>, IdlError
         if !convertible {
             continue;
         }
-        // A declaration that cannot be converted (bitsets, `fixed`, `any`) is left out; using it is an error.
+        // A declaration that cannot be converted (`fixed`, `any`) is left out; using it is an error.
         if let Ok(t) = conv.decl(id, 0) {
             out.insert(d.scoped_name(), t);
         }
@@ -185,6 +185,7 @@ impl Converter<'_> {
                 }
                 b.build()?
             }
+            DeclKind::Bitset(b) => DynamicType::primitive(bitset_storage(b.bits)),
             _ => return Err(unsupported(&name)),
         };
         self.done.insert(id, t.clone());
@@ -277,5 +278,17 @@ impl Converter<'_> {
             },
             _ => return Err(unsupported("a label")),
         })
+    }
+}
+
+/// A bitset is the unsigned integer that holds its bits, as idlc's generated code (a `#[dds(transparent)]`
+/// newtype over `u8`..`u64`) is on the wire and in the type objects: its fields are accessors, not members, so
+/// the dynamic type (and its `to_idl`) has the integer, not the fields.
+fn bitset_storage(bits: u32) -> Primitive {
+    match bits {
+        0..=8 => Primitive::UInt8,
+        9..=16 => Primitive::UInt16,
+        17..=32 => Primitive::UInt32,
+        _ => Primitive::UInt64,
     }
 }

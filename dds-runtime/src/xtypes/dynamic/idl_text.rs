@@ -334,9 +334,9 @@ fn declare_union(u: &UnionType, local: &str, ind: &str, out: &mut String) {
         type_annotations(u.nested, false),
         spelling(&u.discriminator)
     );
-    let mut next_id = 1;
+    let mut next_id = UnionType::first_member_id(u.extensibility);
     for c in &u.cases {
-        // Ids are written where they are not the default numbering (from 1).
+        // Ids are written where they are not the default numbering.
         let mut a = if c.id == next_id {
             String::new()
         } else {

@@ -387,6 +387,20 @@ pub struct UnionType {
 }
 
 impl UnionType {
+    /// The id of the first case when none is given, then numbered on (`@id` continues from its value).
+    ///
+    /// Cyclone DDS 11 (its idlc and Python binding) numbers union members from 0 in the type objects, and its
+    /// endpoints match ours only if the ids agree, so final and appendable unions follow it. XTypes 1.3 gives
+    /// the discriminator id 0 and the members 1, 2, ... (Cyclone after 11.0.1 does too); a mutable union
+    /// puts the discriminator in member 0 on the wire, so its cases must start at 1. Cyclone 11 has no
+    /// mutable unions, so for them the spec applies. The derive (dds-macros `model.rs`) applies the same rule.
+    pub fn first_member_id(extensibility: Extensibility) -> u32 {
+        match extensibility {
+            Extensibility::Mutable => 1,
+            Extensibility::Final | Extensibility::Appendable => 0,
+        }
+    }
+
     /// The case a discriminator value selects: a labelled case, else the default case.
     pub fn case_for(&self, disc: i64) -> Option<usize> {
         self.cases
