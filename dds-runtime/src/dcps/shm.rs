@@ -14,7 +14,7 @@
 //! waits for like RTPS ACKNACKs.
 
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -28,7 +28,7 @@ use crate::rtps::shm::{
 use crate::rtps::{EntityId, Guid, GuidPrefix, Participant, Payload};
 use crate::transport::shm::{
     host_id, ShmChannelConfig, ShmError, ShmListener, ShmLoan, ShmNode, ShmNotifier, ShmPublisher,
-    ShmSubscriber,
+    ShmSample, ShmSubscriber,
 };
 
 /// How long a writer's changes wait for the subscribers of its readers' participants to connect.
@@ -97,6 +97,43 @@ struct Inlet {
     writer: Guid,
     subscriber: ShmSubscriber,
     acks: ShmPublisher,
+    /// Frames of this channel still held (decoding, or kept in place by readers, `dcps::InPlace`).
+    held: Arc<AtomicUsize>,
+}
+
+/// Most frames of one channel held at once; past it, frames are copied out of shared memory and given
+/// back at once. iceoryx2 lends a subscriber at most the channel's queue depth of frames: readers that
+/// keep samples in place must not take them all, or the channel would stall.
+const MAX_HELD: usize = 12;
+
+/// A frame read from a channel, counted while it is held.
+struct HeldFrame {
+    frame: ShmSample,
+    held: Arc<AtomicUsize>,
+}
+
+impl AsRef<[u8]> for HeldFrame {
+    fn as_ref(&self) -> &[u8] {
+        &self.frame
+    }
+}
+
+impl Drop for HeldFrame {
+    fn drop(&mut self) {
+        self.held.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+impl Inlet {
+    /// The frame as a payload: shared in place, or copied when too many frames are held already.
+    fn payload(&self, frame: ShmSample) -> Payload {
+        if self.held.fetch_add(1, Ordering::AcqRel) >= MAX_HELD {
+            self.held.fetch_sub(1, Ordering::AcqRel);
+            return Payload::copy_from_slice(&frame);
+        }
+        let held = self.held.clone();
+        Payload::from_owner(Arc::new(HeldFrame { frame, held }))
+    }
 }
 
 /// The channels our readers read, and the core generation they were set up for.
@@ -489,7 +526,7 @@ impl ShmLink {
                         if let Ok(h) = decode_header(&s) {
                             highest[i] = highest[i].max(h.sequence.0);
                         }
-                        frames.push((inlet.writer, Payload::from_owner(Arc::new(s))));
+                        frames.push((inlet.writer, inlet.payload(s)));
                     }
                     Ok(None) => break,
                     Err(e) => {
@@ -586,6 +623,7 @@ impl ShmLink {
                         writer: *w,
                         subscriber,
                         acks: self.node.publisher(&ack_channel(&name), &ack_config())?,
+                        held: Arc::new(AtomicUsize::new(0)),
                     })
                 });
             match opened {
