@@ -37,6 +37,9 @@ pub(crate) const CONNECT_TIMEOUT: Duration = Duration::from_secs(2);
 /// How long a reliable writer's send waits for a subscriber whose queue is full.
 pub(crate) const DELIVERY_TIMEOUT: Duration = Duration::from_secs(10);
 
+/// A long flush wakes its reader participants after this many frames (and at its end): half a queue.
+const WAKE_EVERY: usize = 8;
+
 /// Frames taken from one channel per pass (they stay borrowed until their readers decoded them).
 const BATCH: usize = 8;
 
@@ -90,6 +93,25 @@ struct Outlet {
     acks: ShmSubscriber,
     /// By node: the highest sequence number sent while it was expected, and the highest it acknowledged.
     owed: HashMap<String, (i64, i64)>,
+    /// The nodes that said (on the acknowledgement channel) that they are connected to the channel.
+    greeted: Vec<String>,
+}
+
+impl Outlet {
+    /// Takes the acknowledgements that arrived: what each node acknowledged, and that it is connected.
+    fn read_acks(&mut self) {
+        while let Ok(Some(ack)) = self.acks.receive() {
+            let Some((sn, node)) = decode_ack(&ack) else {
+                continue;
+            };
+            if let Some(owed) = self.owed.get_mut(node) {
+                owed.1 = owed.1.max(sn);
+            }
+            if !self.greeted.iter().any(|g| g == node) {
+                self.greeted.push(node.to_owned());
+            }
+        }
+    }
 }
 
 /// One peer writer's channel that our readers read, and where we acknowledge what it sent.
@@ -97,6 +119,10 @@ struct Inlet {
     writer: Guid,
     subscriber: ShmSubscriber,
     acks: ShmPublisher,
+    /// Until its first frame: since when it tells the writer, on the acknowledgement channel, that it is
+    /// connected (an acknowledgement of 0) once it is. A writer sends nothing before that: iceoryx2
+    /// skips a subscriber that is not connected yet once its queue is full, and the samples would be lost.
+    greeting_since: Option<Instant>,
     /// Frames of this channel still held (decoding, or kept in place by readers, `dcps::InPlace`).
     held: Arc<AtomicUsize>,
 }
@@ -164,6 +190,9 @@ pub(crate) struct ShmLink {
     notifiers: Mutex<HashMap<String, ShmNotifier>>,
     /// Loaned changes the core queued, until their turn.
     parked: Mutex<Vec<Parked>>,
+    /// Whether a channel we read waits for its first frame and greets its writer (the reading thread
+    /// then polls quickly: the writer waits for the greeting).
+    greeting: AtomicBool,
     /// Drain passes of the reading thread, for [`drain_first`](ShmLink::drain_first).
     passes: Mutex<u64>,
     passed: std::sync::Condvar,
@@ -243,6 +272,7 @@ impl ShmLink {
             wake_self,
             notifiers: Mutex::new(HashMap::new()),
             parked: Mutex::new(Vec::new()),
+            greeting: AtomicBool::new(false),
             passes: Mutex::new(0),
             passed: std::sync::Condvar::new(),
         };
@@ -300,6 +330,7 @@ impl ShmLink {
         let mut held = VecDeque::new();
         let mut held_writers: Vec<EntityId> = Vec::new();
         let mut woken: Vec<Arc<[String]>> = Vec::new();
+        let mut sent = 0usize;
         loop {
             let Some(c) = lock(&self.pending).pop_front() else {
                 break;
@@ -312,6 +343,12 @@ impl ShmLink {
                 Ok(true) => {
                     if !woken.iter().any(|n| Arc::ptr_eq(n, &c.nodes)) {
                         woken.push(c.nodes.clone());
+                    }
+                    // Readers drain while more is sent: a full queue would wait for them.
+                    sent += 1;
+                    if sent.is_multiple_of(WAKE_EVERY) {
+                        self.wake_readers(&woken);
+                        woken.clear();
                     }
                 }
                 Ok(false) => {
@@ -412,6 +449,7 @@ impl ShmLink {
             waiting_since: None,
             acks: self.node.subscriber(&ack_channel(&name), &ack_config())?,
             owed: HashMap::new(),
+            greeted: Vec::new(),
         })
     }
 
@@ -432,8 +470,8 @@ impl ShmLink {
             .as_ref()
             .is_some_and(|n| Arc::ptr_eq(n, &c.nodes))
         {
-            let subs = out.publisher.subscriber_nodes();
-            let missing = c.nodes.iter().filter(|n| !subs.contains(n)).count();
+            out.read_acks();
+            let missing = c.nodes.iter().filter(|n| !out.greeted.contains(n)).count();
             let since = *out.waiting_since.get_or_insert_with(Instant::now);
             if missing > 0 && since.elapsed() < CONNECT_TIMEOUT {
                 return Ok(false);
@@ -484,13 +522,7 @@ impl ShmLink {
         let Some(out) = outlets.get_mut(&writer) else {
             return true;
         };
-        while let Ok(Some(ack)) = out.acks.receive() {
-            if let Some((sn, node)) = decode_ack(&ack) {
-                if let Some(owed) = out.owed.get_mut(node) {
-                    owed.1 = owed.1.max(sn);
-                }
-            }
-        }
+        out.read_acks();
         nodes
             .iter()
             .all(|n| out.owed.get(n).is_none_or(|(sent, acked)| acked >= sent))
@@ -519,7 +551,16 @@ impl ShmLink {
         }
         let mut frames: Vec<(Guid, Payload)> = Vec::new();
         let mut highest = vec![0i64; inlets.channels.len()];
-        for (i, inlet) in inlets.channels.iter().enumerate() {
+        let mut greeting = false;
+        for (i, inlet) in inlets.channels.iter_mut().enumerate() {
+            if let Some(since) = inlet.greeting_since {
+                if inlet.subscriber.has_samples() {
+                    inlet.greeting_since = None;
+                } else if inlet.subscriber.connect() {
+                    self.acknowledge(inlet, 0);
+                }
+                greeting |= since.elapsed() < CONNECT_TIMEOUT;
+            }
             for _ in 0..BATCH {
                 match inlet.subscriber.receive() {
                     Ok(Some(s)) => {
@@ -536,6 +577,7 @@ impl ShmLink {
                 }
             }
         }
+        self.greeting.store(greeting, Ordering::Release);
         let n = frames.len();
         if n > 0 {
             // Still under the inlets lock: two threads draining keep the channels' order. Our own
@@ -623,6 +665,7 @@ impl ShmLink {
                         writer: *w,
                         subscriber,
                         acks: self.node.publisher(&ack_channel(&name), &ack_config())?,
+                        greeting_since: Some(Instant::now()),
                         held: Arc::new(AtomicUsize::new(0)),
                     })
                 });
@@ -666,7 +709,7 @@ fn poll_loop<H: ShmHost>(driver: Weak<H>) {
                 let n = link.drain(&*d);
                 link.count_pass();
                 link.try_flush();
-                let held = !lock(&link.pending).is_empty();
+                let held = !lock(&link.pending).is_empty() || link.greeting.load(Ordering::Acquire);
                 (n, held, link.listener.clone())
             }
             _ => return,
