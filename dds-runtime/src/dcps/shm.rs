@@ -557,6 +557,7 @@ impl ShmLink {
                 if inlet.subscriber.has_samples() {
                     inlet.greeting_since = None;
                 } else if inlet.subscriber.connect() {
+                    tracing::trace!(writer = ?inlet.writer, "connected to a writer's channel: greeting it");
                     self.acknowledge(inlet, 0);
                 }
                 greeting |= since.elapsed() < CONNECT_TIMEOUT;
