@@ -296,6 +296,7 @@ impl Driver {
         let d2 = driver.clone();
         let h = std::thread::Builder::new()
             .name("dds-timer".into())
+            .stack_size(crate::transport::DELIVERY_STACK)
             .spawn(move || d2.timer_loop())?;
         *lock(&driver.timer_thread) = Some(h);
         // The first SPDP announcement goes out now rather than at the first timeout.

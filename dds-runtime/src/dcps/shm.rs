@@ -47,10 +47,6 @@ const BATCH: usize = 8;
 /// signal the reader participants they sent to, see [`wake_channel`]).
 const MAX_IDLE: Duration = Duration::from_millis(100);
 
-/// Stack of the reading thread, which decodes samples into their readers' caches: plain-data samples
-/// (`DataWriter::loan`) are large arrays decoded by value (reserved, not committed, until used).
-const READER_STACK: usize = 64 << 20;
-
 /// Longest wait of a receive thread for the reading thread ([`ShmLink::drain_first`]).
 const DRAIN_WAIT: Duration = Duration::from_millis(100);
 
@@ -283,7 +279,7 @@ impl ShmLink {
     pub(crate) fn start<H: ShmHost>(&self, driver: Weak<H>) -> std::io::Result<()> {
         let h = std::thread::Builder::new()
             .name("dds-shm".into())
-            .stack_size(READER_STACK)
+            .stack_size(crate::transport::DELIVERY_STACK)
             .spawn(move || poll_loop(driver))?;
         *lock(&self.thread) = Some(h);
         Ok(())

@@ -216,6 +216,7 @@ impl UdpTransport {
             let stats = self.stats.clone();
             let h = std::thread::Builder::new()
                 .name(format!("dds-rx-{ch:?}"))
+                .stack_size(super::DELIVERY_STACK)
                 .spawn(move || recv::run(path, ch, &sock, &stop, &rx, &stats))?;
             threads.push(h);
         }
