@@ -34,6 +34,9 @@ use crate::transport::shm::{
 /// How long a writer's changes wait for the subscribers of its readers' participants to connect.
 pub(crate) const CONNECT_TIMEOUT: Duration = Duration::from_secs(2);
 
+/// Longest wait of a writer's deletion for its reader participants' acknowledgements ([`ShmLink::linger`]).
+const LINGER: Duration = Duration::from_secs(2);
+
 /// How long a reliable writer's send waits for a subscriber whose queue is full.
 pub(crate) const DELIVERY_TIMEOUT: Duration = Duration::from_secs(10);
 
@@ -524,6 +527,28 @@ impl ShmLink {
             .all(|n| out.owed.get(n).is_none_or(|(sent, acked)| acked >= sent))
     }
 
+    /// Before `writer` is deleted: sends what is pending, then waits (at most [`LINGER`]) until the
+    /// reader participants in `nodes` acknowledged it. The deletion's SEDP announcement unmatches the
+    /// writer's readers, and a reader participant closes the channel then, with what it has not drained
+    /// yet: the writer's last changes (a benchmark's end marker, under load) were lost that way.
+    pub(crate) fn linger(&self, writer: EntityId, nodes: &[String]) {
+        if nodes.is_empty() {
+            return;
+        }
+        self.flush();
+        let deadline = Instant::now() + LINGER;
+        while !self.acknowledged(writer, nodes) {
+            if Instant::now() >= deadline {
+                tracing::debug!(
+                    ?writer,
+                    "shared-memory readers did not acknowledge before deletion"
+                );
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+
     /// The writer was deleted: its channel closes (after what it sent).
     pub(crate) fn close_writer(&self, writer: EntityId) {
         self.flush();
@@ -577,6 +602,7 @@ impl ShmLink {
         self.greeting.store(greeting, Ordering::Release);
         let n = frames.len();
         if n > 0 {
+            tracing::trace!(frames = n, "shared-memory frames drained");
             // Still under the inlets lock: two threads draining keep the channels' order. Our own
             // changes are not sent from here (see `poll_loop`).
             let mut frames = Some(frames);

@@ -423,6 +423,12 @@ impl Participant {
         }
         if any {
             self.writer_asserted(now, writer);
+        } else {
+            tracing::trace!(
+                ?writer,
+                sequence = h.sequence.0,
+                "shared-memory frame for no reader"
+            );
         }
     }
 }
