@@ -20,6 +20,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use dds_runtime::config::InterfaceSelection;
+use dds_runtime::dcps::InPlace;
 use dds_runtime::prelude::*;
 
 /// A keyless sample with a payload of SIZE bytes.
@@ -83,6 +84,12 @@ impl Bench for Plain4M {
     }
 }
 
+impl<T: Bench + bytemuck::Pod> Bench for InPlace<T> {
+    fn seq(&self) -> u64 {
+        (**self).seq()
+    }
+}
+
 /// A plain sample type that can be loaned.
 trait Loanable: Bench + bytemuck::Pod {
     fn fill(&mut self, seq: u64);
@@ -105,7 +112,10 @@ impl Loanable for Plain4M {
 /// How a measurement sends its samples.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum Mode {
+    /// Loaned and written in place; the reader reads in place (`InPlace<T>`).
     Loan,
+    /// Loaned and written in place; the reader decodes each sample by value (a copy of `T`).
+    LoanCopy,
     Shm,
     Udp,
 }
@@ -114,6 +124,7 @@ impl Mode {
     fn name(self) -> &'static str {
         match self {
             Mode::Loan => "loan",
+            Mode::LoanCopy => "loanv",
             Mode::Shm => "shm",
             Mode::Udp => "udp",
         }
@@ -122,6 +133,7 @@ impl Mode {
     fn parse(s: &str) -> Mode {
         match s {
             "loan" => Mode::Loan,
+            "loanv" => Mode::LoanCopy,
             "shm" => Mode::Shm,
             _ => Mode::Udp,
         }
@@ -258,15 +270,17 @@ fn measure(
     let p = participant(domain, mode != Mode::Udp)?;
     let end = |_| Instant::now() + Duration::from_secs_f64(secs);
     match (mode, size) {
-        (Mode::Loan, 1048576) => {
+        (Mode::Loan | Mode::LoanCopy, 1048576) => {
             let w = matched_writer::<Plain1M>(&p)?;
             write_loaned(&w, end(()))?;
         }
-        (Mode::Loan, 4194304) => {
+        (Mode::Loan | Mode::LoanCopy, 4194304) => {
             let w = matched_writer::<Plain4M>(&p)?;
             write_loaned(&w, end(()))?;
         }
-        (Mode::Loan, _) => return Err("loan mode: SIZE 1048576 or 4194304".into()),
+        (Mode::Loan | Mode::LoanCopy, _) => {
+            return Err("loan modes: SIZE 1048576 or 4194304".into())
+        }
         _ => {
             let w = matched_writer::<Payload>(&p)?;
             write_vec(&w, size, end(()))?;
@@ -292,13 +306,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if args.first().map(String::as_str) == Some("sub") {
         let (domain, mode, size): (u32, Mode, usize) =
             (args[1].parse()?, Mode::parse(&args[2]), args[3].parse()?);
-        // Plain samples are decoded by value: a stack for a few copies of 4 MiB.
+        // `loanv` decodes plain samples by value: a stack for a few copies of 4 MiB.
         let sub = std::thread::Builder::new().stack_size(256 << 20).spawn(
             move || -> Result<(), String> {
                 let shm = mode != Mode::Udp;
                 let r = match (mode, size) {
-                    (Mode::Loan, 1048576) => subscriber::<Plain1M>(domain, shm),
-                    (Mode::Loan, _) => subscriber::<Plain4M>(domain, shm),
+                    (Mode::Loan, 1048576) => subscriber::<InPlace<Plain1M>>(domain, shm),
+                    (Mode::Loan, _) => subscriber::<InPlace<Plain4M>>(domain, shm),
+                    (Mode::LoanCopy, 1048576) => subscriber::<Plain1M>(domain, shm),
+                    (Mode::LoanCopy, _) => subscriber::<Plain4M>(domain, shm),
                     _ => subscriber::<Payload>(domain, shm),
                 };
                 r.map_err(|e| e.to_string())
@@ -320,7 +336,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut rates: Vec<Vec<f64>> = vec![Vec::new(); modes.len()];
     for round in 0..rounds {
         for (i, mode) in modes.iter().enumerate() {
-            let domain = 130 + round * 3 + i as u32;
+            let domain = 130 + round * modes.len() as u32 + i as u32;
             let load = loadavg();
             let rate = measure(domain, *mode, size, secs)?;
             let mbps = rate * size as f64 * 8.0 / 1e9;

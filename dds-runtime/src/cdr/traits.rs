@@ -223,4 +223,13 @@ pub trait DdsType: CdrType + crate::filter::FilterFields + Send + Sync + 'static
     fn type_mapping() -> Option<&'static [u8]> {
         None
     }
+
+    /// A sample that reads a received payload where it is, without decoding it; `shared` is the
+    /// payload with the owner of its bytes (`rtps::Payload`). `None` (the default): the payload is
+    /// decoded. Implemented by `dcps::InPlace` (plain-data samples read in shared memory).
+    #[doc(hidden)]
+    fn decode_shared(shared: &dyn std::any::Any) -> Option<Self> {
+        let _ = shared;
+        None
+    }
 }

@@ -20,7 +20,7 @@ fn system_time(t: Option<crate::rtps::Time>) -> Option<SystemTime> {
 }
 
 /// The sample itself when the payload carries it (intra-process delivery of `write_owned`/`write_shared`:
-/// no serialization), else decoded from the bytes.
+/// no serialization), else read in place when the type can (`dcps::InPlace`), else decoded from the bytes.
 fn local_or_deserialize<T: DdsType>(payload: &mut Payload) -> Result<T, cdr::DecodeError> {
     if payload.is_local() {
         let mut slot: Option<T> = None;
@@ -32,6 +32,9 @@ fn local_or_deserialize<T: DdsType>(payload: &mut Payload) -> Result<T, cdr::Dec
             }
             Err(p) => *payload = p,
         }
+    }
+    if let Some(d) = T::decode_shared(&*payload) {
+        return Ok(d);
     }
     cdr::deserialize::<T>(payload)
 }

@@ -296,6 +296,7 @@ impl Driver {
         let d2 = driver.clone();
         let h = std::thread::Builder::new()
             .name("dds-timer".into())
+            .stack_size(crate::transport::DELIVERY_STACK)
             .spawn(move || d2.timer_loop())?;
         *lock(&driver.timer_thread) = Some(h);
         // The first SPDP announcement goes out now rather than at the first timeout.
@@ -445,6 +446,8 @@ impl Driver {
             if !touched.iter().any(|(id, _)| *id == reader) {
                 touched.push((reader, r));
             }
+        } else {
+            tracing::trace!(?reader, "event for an endpoint not registered: dropped");
         }
     }
 
@@ -635,6 +638,13 @@ impl Driver {
                     tracing::debug!(error = %e, "farewell change not sent");
                 }
             }
+        });
+        // Readers on shared memory get what it sent before they learn of its deletion.
+        #[cfg(feature = "shm")]
+        if let (Some(link), true) = (&self.shm, id.is_writer()) {
+            link.linger(id, &self.query_core(|c| c.shm_nodes(id)));
+        }
+        self.with_core(|c, now| {
             if id.is_writer() {
                 c.delete_writer(now, id);
             } else {

@@ -44,6 +44,8 @@ mod error;
 pub mod filter;
 pub mod listener;
 mod participant;
+#[cfg(feature = "shm")]
+mod plain;
 mod presentation;
 mod process_info;
 mod publisher;
@@ -80,6 +82,8 @@ pub use participant::{
     DiscoveredParticipant, DiscoveredType, DomainParticipant, DomainParticipantBuilder,
     DomainParticipantFactory, WriteBatching,
 };
+#[cfg(feature = "shm")]
+pub use plain::InPlace;
 pub use publisher::{DataWriter, Publisher};
 #[cfg(feature = "shm")]
 pub use publisher::{LoanError, SampleLoan};

@@ -14,7 +14,7 @@
 //! waits for like RTPS ACKNACKs.
 
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -28,14 +28,20 @@ use crate::rtps::shm::{
 use crate::rtps::{EntityId, Guid, GuidPrefix, Participant, Payload};
 use crate::transport::shm::{
     host_id, ShmChannelConfig, ShmError, ShmListener, ShmLoan, ShmNode, ShmNotifier, ShmPublisher,
-    ShmSubscriber,
+    ShmSample, ShmSubscriber,
 };
 
 /// How long a writer's changes wait for the subscribers of its readers' participants to connect.
 pub(crate) const CONNECT_TIMEOUT: Duration = Duration::from_secs(2);
 
+/// Longest wait of a writer's deletion for its reader participants' acknowledgements ([`ShmLink::linger`]).
+const LINGER: Duration = Duration::from_secs(2);
+
 /// How long a reliable writer's send waits for a subscriber whose queue is full.
 pub(crate) const DELIVERY_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// A long flush wakes its reader participants after this many frames (and at its end): half a queue.
+const WAKE_EVERY: usize = 8;
 
 /// Frames taken from one channel per pass (they stay borrowed until their readers decoded them).
 const BATCH: usize = 8;
@@ -43,10 +49,6 @@ const BATCH: usize = 8;
 /// Longest sleep of the reading thread when no frame arrives and no writer signals (a safety net: writers
 /// signal the reader participants they sent to, see [`wake_channel`]).
 const MAX_IDLE: Duration = Duration::from_millis(100);
-
-/// Stack of the reading thread, which decodes samples into their readers' caches: plain-data samples
-/// (`DataWriter::loan`) are large arrays decoded by value (reserved, not committed, until used).
-const READER_STACK: usize = 64 << 20;
 
 /// Longest wait of a receive thread for the reading thread ([`ShmLink::drain_first`]).
 const DRAIN_WAIT: Duration = Duration::from_millis(100);
@@ -90,6 +92,25 @@ struct Outlet {
     acks: ShmSubscriber,
     /// By node: the highest sequence number sent while it was expected, and the highest it acknowledged.
     owed: HashMap<String, (i64, i64)>,
+    /// The nodes that said (on the acknowledgement channel) that they are connected to the channel.
+    greeted: Vec<String>,
+}
+
+impl Outlet {
+    /// Takes the acknowledgements that arrived: what each node acknowledged, and that it is connected.
+    fn read_acks(&mut self) {
+        while let Ok(Some(ack)) = self.acks.receive() {
+            let Some((sn, node)) = decode_ack(&ack) else {
+                continue;
+            };
+            if let Some(owed) = self.owed.get_mut(node) {
+                owed.1 = owed.1.max(sn);
+            }
+            if !self.greeted.iter().any(|g| g == node) {
+                self.greeted.push(node.to_owned());
+            }
+        }
+    }
 }
 
 /// One peer writer's channel that our readers read, and where we acknowledge what it sent.
@@ -97,6 +118,47 @@ struct Inlet {
     writer: Guid,
     subscriber: ShmSubscriber,
     acks: ShmPublisher,
+    /// Until its first frame: since when it tells the writer, on the acknowledgement channel, that it is
+    /// connected (an acknowledgement of 0) once it is. A writer sends nothing before that: iceoryx2
+    /// skips a subscriber that is not connected yet once its queue is full, and the samples would be lost.
+    greeting_since: Option<Instant>,
+    /// Frames of this channel still held (decoding, or kept in place by readers, `dcps::InPlace`).
+    held: Arc<AtomicUsize>,
+}
+
+/// Most frames of one channel held at once; past it, frames are copied out of shared memory and given
+/// back at once. iceoryx2 lends a subscriber at most the channel's queue depth of frames: readers that
+/// keep samples in place must not take them all, or the channel would stall.
+const MAX_HELD: usize = 12;
+
+/// A frame read from a channel, counted while it is held.
+struct HeldFrame {
+    frame: ShmSample,
+    held: Arc<AtomicUsize>,
+}
+
+impl AsRef<[u8]> for HeldFrame {
+    fn as_ref(&self) -> &[u8] {
+        &self.frame
+    }
+}
+
+impl Drop for HeldFrame {
+    fn drop(&mut self) {
+        self.held.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+impl Inlet {
+    /// The frame as a payload: shared in place, or copied when too many frames are held already.
+    fn payload(&self, frame: ShmSample) -> Payload {
+        if self.held.fetch_add(1, Ordering::AcqRel) >= MAX_HELD {
+            self.held.fetch_sub(1, Ordering::AcqRel);
+            return Payload::copy_from_slice(&frame);
+        }
+        let held = self.held.clone();
+        Payload::from_owner(Arc::new(HeldFrame { frame, held }))
+    }
 }
 
 /// The channels our readers read, and the core generation they were set up for.
@@ -127,6 +189,9 @@ pub(crate) struct ShmLink {
     notifiers: Mutex<HashMap<String, ShmNotifier>>,
     /// Loaned changes the core queued, until their turn.
     parked: Mutex<Vec<Parked>>,
+    /// Whether a channel we read waits for its first frame and greets its writer (the reading thread
+    /// then polls quickly: the writer waits for the greeting).
+    greeting: AtomicBool,
     /// Drain passes of the reading thread, for [`drain_first`](ShmLink::drain_first).
     passes: Mutex<u64>,
     passed: std::sync::Condvar,
@@ -206,6 +271,7 @@ impl ShmLink {
             wake_self,
             notifiers: Mutex::new(HashMap::new()),
             parked: Mutex::new(Vec::new()),
+            greeting: AtomicBool::new(false),
             passes: Mutex::new(0),
             passed: std::sync::Condvar::new(),
         };
@@ -216,7 +282,7 @@ impl ShmLink {
     pub(crate) fn start<H: ShmHost>(&self, driver: Weak<H>) -> std::io::Result<()> {
         let h = std::thread::Builder::new()
             .name("dds-shm".into())
-            .stack_size(READER_STACK)
+            .stack_size(crate::transport::DELIVERY_STACK)
             .spawn(move || poll_loop(driver))?;
         *lock(&self.thread) = Some(h);
         Ok(())
@@ -263,6 +329,7 @@ impl ShmLink {
         let mut held = VecDeque::new();
         let mut held_writers: Vec<EntityId> = Vec::new();
         let mut woken: Vec<Arc<[String]>> = Vec::new();
+        let mut sent = 0usize;
         loop {
             let Some(c) = lock(&self.pending).pop_front() else {
                 break;
@@ -275,6 +342,12 @@ impl ShmLink {
                 Ok(true) => {
                     if !woken.iter().any(|n| Arc::ptr_eq(n, &c.nodes)) {
                         woken.push(c.nodes.clone());
+                    }
+                    // Readers drain while more is sent: a full queue would wait for them.
+                    sent += 1;
+                    if sent.is_multiple_of(WAKE_EVERY) {
+                        self.wake_readers(&woken);
+                        woken.clear();
                     }
                 }
                 Ok(false) => {
@@ -375,6 +448,7 @@ impl ShmLink {
             waiting_since: None,
             acks: self.node.subscriber(&ack_channel(&name), &ack_config())?,
             owed: HashMap::new(),
+            greeted: Vec::new(),
         })
     }
 
@@ -395,8 +469,8 @@ impl ShmLink {
             .as_ref()
             .is_some_and(|n| Arc::ptr_eq(n, &c.nodes))
         {
-            let subs = out.publisher.subscriber_nodes();
-            let missing = c.nodes.iter().filter(|n| !subs.contains(n)).count();
+            out.read_acks();
+            let missing = c.nodes.iter().filter(|n| !out.greeted.contains(n)).count();
             let since = *out.waiting_since.get_or_insert_with(Instant::now);
             if missing > 0 && since.elapsed() < CONNECT_TIMEOUT {
                 return Ok(false);
@@ -447,16 +521,32 @@ impl ShmLink {
         let Some(out) = outlets.get_mut(&writer) else {
             return true;
         };
-        while let Ok(Some(ack)) = out.acks.receive() {
-            if let Some((sn, node)) = decode_ack(&ack) {
-                if let Some(owed) = out.owed.get_mut(node) {
-                    owed.1 = owed.1.max(sn);
-                }
-            }
-        }
+        out.read_acks();
         nodes
             .iter()
             .all(|n| out.owed.get(n).is_none_or(|(sent, acked)| acked >= sent))
+    }
+
+    /// Before `writer` is deleted: sends what is pending, then waits (at most [`LINGER`]) until the
+    /// reader participants in `nodes` acknowledged it. The deletion's SEDP announcement unmatches the
+    /// writer's readers, and a reader participant closes the channel then, with what it has not drained
+    /// yet: the writer's last changes (a benchmark's end marker, under load) were lost that way.
+    pub(crate) fn linger(&self, writer: EntityId, nodes: &[String]) {
+        if nodes.is_empty() {
+            return;
+        }
+        self.flush();
+        let deadline = Instant::now() + LINGER;
+        while !self.acknowledged(writer, nodes) {
+            if Instant::now() >= deadline {
+                tracing::debug!(
+                    ?writer,
+                    "shared-memory readers did not acknowledge before deletion"
+                );
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
     }
 
     /// The writer was deleted: its channel closes (after what it sent).
@@ -482,14 +572,24 @@ impl ShmLink {
         }
         let mut frames: Vec<(Guid, Payload)> = Vec::new();
         let mut highest = vec![0i64; inlets.channels.len()];
-        for (i, inlet) in inlets.channels.iter().enumerate() {
+        let mut greeting = false;
+        for (i, inlet) in inlets.channels.iter_mut().enumerate() {
+            if let Some(since) = inlet.greeting_since {
+                if inlet.subscriber.has_samples() {
+                    inlet.greeting_since = None;
+                } else if inlet.subscriber.connect() {
+                    tracing::trace!(writer = ?inlet.writer, "connected to a writer's channel: greeting it");
+                    self.acknowledge(inlet, 0);
+                }
+                greeting |= since.elapsed() < CONNECT_TIMEOUT;
+            }
             for _ in 0..BATCH {
                 match inlet.subscriber.receive() {
                     Ok(Some(s)) => {
                         if let Ok(h) = decode_header(&s) {
                             highest[i] = highest[i].max(h.sequence.0);
                         }
-                        frames.push((inlet.writer, Payload::from_owner(Arc::new(s))));
+                        frames.push((inlet.writer, inlet.payload(s)));
                     }
                     Ok(None) => break,
                     Err(e) => {
@@ -499,8 +599,10 @@ impl ShmLink {
                 }
             }
         }
+        self.greeting.store(greeting, Ordering::Release);
         let n = frames.len();
         if n > 0 {
+            tracing::trace!(frames = n, "shared-memory frames drained");
             // Still under the inlets lock: two threads draining keep the channels' order. Our own
             // changes are not sent from here (see `poll_loop`).
             let mut frames = Some(frames);
@@ -586,6 +688,8 @@ impl ShmLink {
                         writer: *w,
                         subscriber,
                         acks: self.node.publisher(&ack_channel(&name), &ack_config())?,
+                        greeting_since: Some(Instant::now()),
+                        held: Arc::new(AtomicUsize::new(0)),
                     })
                 });
             match opened {
@@ -628,7 +732,7 @@ fn poll_loop<H: ShmHost>(driver: Weak<H>) {
                 let n = link.drain(&*d);
                 link.count_pass();
                 link.try_flush();
-                let held = !lock(&link.pending).is_empty();
+                let held = !lock(&link.pending).is_empty() || link.greeting.load(Ordering::Acquire);
                 (n, held, link.listener.clone())
             }
             _ => return,

@@ -96,6 +96,11 @@ impl Payload {
             end: len,
         }
     }
+    /// Whether the bytes are kept by another owner ([`Payload::from_owner`]: a sample read in place in
+    /// shared memory).
+    pub fn is_from_owner(&self) -> bool {
+        matches!(self.buf, Some(Buf::Owned(_)))
+    }
     /// Whether this payload carries a typed sample ([`Payload::local`]).
     pub fn is_local(&self) -> bool {
         matches!(self.buf, Some(Buf::Local(_)))

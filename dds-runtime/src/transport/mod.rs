@@ -39,6 +39,11 @@ pub mod shm;
 mod socket;
 mod udp;
 
+/// Stack of the threads that deliver samples to readers (receive, timer and shared-memory threads): a
+/// `DataReader<T>` of a large plain type (a 4 MiB array) decodes it by value on them. Reserved, not
+/// committed: only what is used takes memory.
+pub(crate) const DELIVERY_STACK: usize = 64 << 20;
+
 pub use datagram::{Channel, Datagram, Receiver, TransportStats};
 pub use iface::Interface;
 pub use recv::ReceivePath;

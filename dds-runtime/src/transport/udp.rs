@@ -220,6 +220,7 @@ impl UdpTransport {
             let spin = self.spin;
             let h = std::thread::Builder::new()
                 .name(format!("dds-rx-{ch:?}"))
+                .stack_size(super::DELIVERY_STACK)
                 .spawn(move || recv::run(path, spin, ch, &sock, &stop, &rx, &stats))?;
             threads.push(h);
         }

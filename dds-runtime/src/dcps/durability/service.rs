@@ -417,10 +417,27 @@ impl Service {
         }
     }
 
+    /// Whether `original` was learnt from another service's stand-in that is still discovered: its
+    /// history may be on its way (over shared memory, it comes once the channel is connected), so an
+    /// empty history does not mean that nothing is left.
+    fn aligning(&self, original: &Guid) -> bool {
+        let sources: Vec<Guid> = lock(&self.state)
+            .sources
+            .iter()
+            .filter(|(_, o)| *o == original)
+            .map(|(s, _)| *s)
+            .collect();
+        !sources.is_empty()
+            && self.driver.upgrade().is_some_and(|d| {
+                d.query_core(|c| c.publications().any(|w| sources.contains(&w.guid)))
+            })
+    }
+
     /// Purges `original`'s instances that have been disposed, with no live writer, for its
     /// `service_cleanup_delay` (DDS 1.4 §2.2.3.5), and forgets `original` once it is gone and nothing of it
     /// is left.
     fn cleanup(&self, original: &Guid, now: Instant) {
+        let aligning = self.aligning(original);
         let (purged, stand_in, forget, persistent) = {
             let mut st = lock(&self.state);
             let Some(k) = st.kept.get_mut(original) else {
@@ -428,7 +445,8 @@ impl Service {
             };
             let delay = k.data.qos.writer.durability_service.service_cleanup_delay;
             let purged = k.history.purge(now, k.gone_since, delay);
-            let forget = k.history.is_empty()
+            let forget = !aligning
+                && k.history.is_empty()
                 && k.gone_since
                     .is_some_and(|t| t.checked_add(delay).is_some_and(|d| now >= d));
             let (stand_in, persistent) = (k.stand_in, k.persistent());

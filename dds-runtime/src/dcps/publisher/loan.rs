@@ -9,17 +9,15 @@
 //! A writer with other readers too (on the wire, in its own participant) or a durable history gives the
 //! core a copy of the sample for them; the readers on shared memory still get the loaned buffer.
 
-use std::any::TypeId;
 use std::ops::{Deref, DerefMut, Range};
-use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant, SystemTime};
 
 use bytemuck::Pod;
-use foldhash::{HashMap, HashMapExt};
 
 use super::{wire_time, DataWriter};
-use crate::cdr::{self, ByteOrder, DdsType, XcdrVersion};
+use crate::cdr::DdsType;
 use crate::dcps::error::DdsError;
+use crate::dcps::plain::plain_layout_cached;
 use crate::dcps::shm::ShmHost;
 use crate::dcps::sync::lock;
 use crate::rtps::shm::ShmChange;
@@ -71,44 +69,6 @@ impl<T: DdsType + Pod> std::fmt::Debug for SampleLoan<T> {
             .field("bytes", &self.payload.len())
             .finish()
     }
-}
-
-/// The encapsulation header and padding of a plain type's samples, or `None`.
-type Plain = Option<([u8; 4], usize)>;
-
-/// [`plain_layout`] once per type and version.
-fn plain_layout_cached<T: DdsType + Pod>(version: XcdrVersion) -> Plain {
-    static CACHE: OnceLock<Mutex<HashMap<(TypeId, bool), Plain>>> = OnceLock::new();
-    let key = (TypeId::of::<T>(), version == XcdrVersion::Xcdr2);
-    let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-    if let Some(p) = lock(cache).get(&key) {
-        return *p;
-    }
-    let p = plain_layout::<T>(version);
-    lock(cache).insert(key, p);
-    p
-}
-
-/// Whether `T`'s encoding in `version` (native byte order) is its memory image: a probe whose bytes
-/// follow a sequence without short periods is encoded, and its body must equal the probe's bytes, with
-/// only zero padding after them. Any padding, reordering or byte swapping the encoding does would shift
-/// or permute the sequence. The encapsulation header and the padding length are returned.
-fn plain_layout<T: DdsType + Pod>(version: XcdrVersion) -> Plain {
-    let mut probe: Box<T> = bytemuck::allocation::zeroed_box();
-    let mut x: u32 = 0x9e37_79b9;
-    for b in bytemuck::bytes_of_mut(&mut *probe) {
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
-        *b = (x >> 24) as u8;
-    }
-    let mut out = Vec::new();
-    cdr::serialize(&*probe, version, ByteOrder::NATIVE, &mut out).ok()?;
-    let size = std::mem::size_of::<T>();
-    let (head, rest) = out.split_at_checked(4)?;
-    let (body, pad) = rest.split_at_checked(size)?;
-    let plain = body == bytemuck::bytes_of(&*probe) && pad.len() < 4 && pad.iter().all(|b| *b == 0);
-    plain.then(|| (head.try_into().unwrap_or_default(), pad.len()))
 }
 
 impl<T: DdsType + Pod> DataWriter<T> {

@@ -8,7 +8,8 @@
 //! Both sides decide from the same discovery data (both participants' SPDP properties, both endpoints'
 //! SEDP QoS), so a pair is on shared memory on both sides or on neither. A pair keeps the wire when the
 //! writer's publisher has coherent access or the reader is reliable KEEP_ALL with `max_samples` (the same
-//! rule as intra-process pairs, [`pair_qualifies`]); builtin endpoints keep it too.
+//! rule as intra-process pairs, [`pair_qualifies`]), or when the publisher has GROUP-ordered access;
+//! builtin endpoints keep it too.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -93,7 +94,13 @@ impl Participant {
                 self.known_readers.get(&own),
             ),
         };
-        matches!((wd, rd), (Some(wd), Some(rd)) if pair_qualifies(wd, rd))
+        // GROUP-ordered access orders the changes of the publisher's writers among themselves: one
+        // channel per writer, drained channel by channel, would not keep that order.
+        let group_ordered = |p: &crate::qos::Presentation| {
+            p.ordered_access && p.access_scope == crate::qos::PresentationAccessScope::Group
+        };
+        matches!((wd, rd), (Some(wd), Some(rd))
+            if pair_qualifies(wd, rd) && !group_ordered(&wd.qos.presentation))
     }
 
     /// Whether `local` and `remote` are matched over shared memory.
@@ -423,6 +430,12 @@ impl Participant {
         }
         if any {
             self.writer_asserted(now, writer);
+        } else {
+            tracing::trace!(
+                ?writer,
+                sequence = h.sequence.0,
+                "shared-memory frame for no reader"
+            );
         }
     }
 }

@@ -245,12 +245,12 @@ impl ShmNode {
         channel: &str,
         c: &ShmChannelConfig,
     ) -> Result<ShmSubscriber, ShmError> {
-        let subscriber = self
-            .service(channel, c)?
-            .subscriber_builder()
-            .create()
-            .map_err(setup)?;
-        Ok(ShmSubscriber { subscriber })
+        let service = self.service(channel, c)?;
+        let subscriber = service.subscriber_builder().create().map_err(setup)?;
+        Ok(ShmSubscriber {
+            subscriber,
+            service,
+        })
     }
 }
 
@@ -386,6 +386,7 @@ impl DerefMut for ShmLoan {
 /// Receives samples on one channel.
 pub struct ShmSubscriber {
     subscriber: Subscriber<ipc_threadsafe::Service, [u8], ()>,
+    service: Service,
 }
 
 impl std::fmt::Debug for ShmSubscriber {
@@ -398,6 +399,16 @@ impl ShmSubscriber {
     /// Whether a sample is queued.
     pub fn has_samples(&self) -> bool {
         self.subscriber.has_samples().unwrap_or(false)
+    }
+
+    /// Connects to the channel's publishers, and whether it has any: samples they send from now on reach
+    /// this subscriber. (A publisher that fills a subscriber's queue before the subscriber connected to
+    /// it skips that subscriber, so a sender should learn of the connection before sending much.)
+    pub fn connect(&self) -> bool {
+        // Listed first, then connected: every publisher counted is connected.
+        let listed = self.service.dynamic_config().number_of_publishers() > 0;
+        let connected = self.subscriber.update_connections().is_ok();
+        listed && connected
     }
 
     /// The next sample, if one is queued (never blocks).
