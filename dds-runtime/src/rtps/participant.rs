@@ -41,6 +41,8 @@ use crate::qos::{DataWriterQos, Durability, History, ReaderQos, ResourceLimits, 
 struct ProxyParticipant {
     data: ParticipantData,
     lease_deadline: Instant,
+    /// Its TypeLookup endpoints are matched with ours (done when a request or reply is first exchanged).
+    type_lookup_matched: bool,
 }
 
 /// A sans-I/O RTPS participant. See `docs/rtps-core.md`.
