@@ -103,7 +103,7 @@ impl Participant {
         let prefix = data.guid_prefix;
         debug!(participant = ?prefix, vendor = ?data.vendor_id, "participant discovered");
         // One list for all the proxies of its builtin endpoints.
-        let meta = metatraffic(&data);
+        let meta = super::metatraffic(&data);
         let bits = data.builtin_endpoints;
         let group = self.shared_metatraffic_group(&data);
         self.events
@@ -643,14 +643,5 @@ impl Direction for ReaderQos {
     }
     fn removed(guid: Guid) -> Event {
         Event::SubscriptionRemoved { guid }
-    }
-}
-
-/// Where a discovered participant's builtin endpoints listen: one list for all their proxies.
-pub(super) fn metatraffic(data: &ParticipantData) -> Arc<[Locator]> {
-    if data.metatraffic_unicast.is_empty() {
-        data.metatraffic_multicast.as_slice().into()
-    } else {
-        data.metatraffic_unicast.as_slice().into()
     }
 }

@@ -146,7 +146,7 @@ impl Participant {
         }
         p.type_lookup_matched = true;
         let bits = p.data.builtin_endpoints;
-        let meta = super::discovery::metatraffic(&p.data);
+        let meta = super::metatraffic(&p.data);
         trace!(participant = ?prefix, "TypeLookup endpoints matched");
         // Addressed to one participant: never via a shared multicast group.
         self.match_builtin_pairs(now, prefix, bits, &meta, None, is_service_endpoint);
