@@ -88,6 +88,29 @@ fn types_are_fetched_over_a_lossy_network() {
     }
 }
 
+/// The service endpoints are matched per peer on the first exchange (not at discovery): two participants
+/// fetch from one owner at about the same time (whichever is matched second may find the owner's reply
+/// writer past its first sequence numbers) and both learn the type, also with loss; a later request still
+/// goes through.
+#[test]
+fn several_participants_fetch_from_one_owner() {
+    for (seed, faults) in [(5, Faults::NONE), (6, Faults::lossy(0.3))] {
+        let mut sim = Sim::with_participants(seed, faults, 3);
+        let info = owner_writes_top(&mut sim);
+        assert!(
+            sim.run_until(Duration::from_secs(20), |s| {
+                learnt_everything(s, 1, &info) && learnt_everything(s, 2, &info)
+            }),
+            "seed {seed}"
+        );
+        let nobody = TypeIdentifier::Complete([0x5b; 14]);
+        let now = sim.now;
+        sim.nodes[2].p.request_types(now, [nobody]);
+        sim.run_until(Duration::from_secs(1), |_| false);
+        assert_eq!(sim.nodes[2].p.type_store().len(), 6, "seed {seed}");
+    }
+}
+
 #[test]
 fn a_type_nobody_has_is_asked_for_and_given_up() {
     let mut sim = Sim::with_participants(3, Faults::NONE, 2);

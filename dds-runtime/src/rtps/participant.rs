@@ -41,6 +41,17 @@ use crate::qos::{DataWriterQos, Durability, History, ReaderQos, ResourceLimits, 
 struct ProxyParticipant {
     data: ParticipantData,
     lease_deadline: Instant,
+    /// Its TypeLookup endpoints are matched with ours (done when a request or reply is first exchanged).
+    type_lookup_matched: bool,
+}
+
+/// Where a discovered participant's builtin endpoints listen: one list for all their proxies.
+fn metatraffic(data: &ParticipantData) -> std::sync::Arc<[Locator]> {
+    if data.metatraffic_unicast.is_empty() {
+        data.metatraffic_multicast.as_slice().into()
+    } else {
+        data.metatraffic_unicast.as_slice().into()
+    }
 }
 
 /// A sans-I/O RTPS participant. See `docs/rtps-core.md`.

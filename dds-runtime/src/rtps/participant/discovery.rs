@@ -103,11 +103,7 @@ impl Participant {
         let prefix = data.guid_prefix;
         debug!(participant = ?prefix, vendor = ?data.vendor_id, "participant discovered");
         // One list for all the proxies of its builtin endpoints.
-        let meta: Arc<[Locator]> = if data.metatraffic_unicast.is_empty() {
-            data.metatraffic_multicast.as_slice().into()
-        } else {
-            data.metatraffic_unicast.as_slice().into()
-        };
+        let meta = super::metatraffic(&data);
         let bits = data.builtin_endpoints;
         let group = self.shared_metatraffic_group(&data);
         self.events
@@ -117,21 +113,41 @@ impl Participant {
             Box::new(ProxyParticipant {
                 data,
                 lease_deadline,
+                type_lookup_matched: false,
             }),
         );
+        // The TypeLookup endpoints are matched when a request or reply is first exchanged with it.
+        let pairs = |ours: EntityId| !super::type_lookup::is_service_endpoint(ours);
+        self.match_builtin_pairs(now, prefix, bits, &meta, group, pairs);
+        self.match_topic_builtins(now, prefix, bits, &meta);
+        // Answer directly so the newcomer need not wait for our next periodic announcement.
+        if !meta.is_empty() {
+            self.send_spdp(Some(meta[..1].to_vec()));
+        }
+    }
+
+    /// Matches those builtin endpoints of ours that `which` selects with the ones the participant `prefix`
+    /// announces in `bits`. `group`: see [`Self::shared_metatraffic_group`].
+    pub(super) fn match_builtin_pairs(
+        &mut self,
+        now: Instant,
+        prefix: GuidPrefix,
+        bits: u32,
+        meta: &Arc<[Locator]>,
+        group: Option<Locator>,
+        which: impl Fn(EntityId) -> bool,
+    ) {
         for (ours, theirs, bit) in builtin::WRITER_PAIRS {
-            if bits & bit != 0 {
+            if bits & bit != 0 && which(ours) {
                 if let Some(w) = self.writers.get_mut(&ours) {
                     let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true)
-                        .with_multicast(
-                            group.filter(|_| !super::type_lookup::is_service_endpoint(ours)),
-                        );
+                        .with_multicast(group);
                     w.add_proxy(now, proxy, true, &mut self.events);
                 }
             }
         }
         for (ours, theirs, bit) in builtin::READER_PAIRS {
-            if bits & bit != 0 {
+            if bits & bit != 0 && which(ours) {
                 if let Some(r) = self.readers.get_mut(&ours) {
                     r.add_proxy(
                         now,
@@ -140,11 +156,6 @@ impl Participant {
                     self.readers_by_writer.clear();
                 }
             }
-        }
-        self.match_topic_builtins(now, prefix, bits, &meta);
-        // Answer directly so the newcomer need not wait for our next periodic announcement.
-        if !meta.is_empty() {
-            self.send_spdp(Some(meta[..1].to_vec()));
         }
     }
 

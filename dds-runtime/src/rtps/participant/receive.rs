@@ -112,6 +112,7 @@ impl Participant {
                         self.on_spdp(now, src, &d);
                         self.timers_changed();
                     } else {
+                        self.service_traffic(now, wguid);
                         let scratch = &mut self.scratch;
                         for_readers(
                             &mut self.readers,
@@ -125,6 +126,7 @@ impl Participant {
                 }
                 Submessage::DataFrag(d) => {
                     let wguid = Guid::new(src, d.writer_id);
+                    self.service_traffic(now, wguid);
                     let scratch = &mut self.scratch;
                     let pool = &mut self.rx_pools.samples;
                     for_readers(
@@ -138,6 +140,10 @@ impl Participant {
                 }
                 Submessage::Heartbeat(h) => {
                     let wguid = Guid::new(src, h.writer_id);
+                    if h.last_sn >= h.first_sn {
+                        // Changes we may have lost: a request or reply.
+                        self.service_traffic(now, wguid);
+                    }
                     self.for_readers_arming(h.reader_id, wguid, |r, scratch| {
                         r.on_heartbeat(now, wguid, &h, scratch)
                     });

@@ -50,6 +50,14 @@ pub(super) fn is_service_endpoint(id: EntityId) -> bool {
     )
 }
 
+/// Whether `id` is one of the service's two writers.
+fn is_service_writer(id: EntityId) -> bool {
+    matches!(
+        id,
+        EntityId::TYPELOOKUP_REQUEST_WRITER | EntityId::TYPELOOKUP_REPLY_WRITER
+    )
+}
+
 /// The service writers: reliable, volatile, keyless, KEEP_LAST [`HISTORY_DEPTH`] (as Cyclone's are reliable
 /// and volatile).
 pub(super) fn writer_params(base: WriterParams) -> WriterParams {
@@ -126,9 +134,53 @@ impl Participant {
         self.send_type_requests(now);
     }
 
+    /// Matches our service endpoints with those of the participant `prefix`, unless done already. A
+    /// participant's four service proxies are made when a request or reply is first exchanged with it (most
+    /// peers never exchange one): see `docs/performance.md`, "Footprint".
+    pub(super) fn match_type_lookup(&mut self, now: Instant, prefix: GuidPrefix) {
+        let Some(p) = self.participants.get_mut(&prefix) else {
+            return;
+        };
+        if p.type_lookup_matched {
+            return;
+        }
+        p.type_lookup_matched = true;
+        let bits = p.data.builtin_endpoints;
+        let meta = super::metatraffic(&p.data);
+        trace!(participant = ?prefix, "TypeLookup endpoints matched");
+        // Addressed to one participant: never via a shared multicast group.
+        self.match_builtin_pairs(now, prefix, bits, &meta, None, is_service_endpoint);
+    }
+
+    /// A submessage from `writer` arrived: if it is a remote service writer's and may carry (or announce) a
+    /// request or reply, its participant's service endpoints are matched before it is handled.
+    pub(super) fn service_traffic(&mut self, now: Instant, writer: Guid) {
+        if is_service_writer(writer.entity_id) {
+            self.match_type_lookup(now, writer.prefix);
+        }
+    }
+
+    /// Matches the service endpoints of every discovered participant: our requests go to all of them.
+    fn match_type_lookup_all(&mut self, now: Instant) {
+        let pending: Vec<GuidPrefix> = self
+            .participants
+            .iter()
+            .filter(|(_, p)| !p.type_lookup_matched)
+            .map(|(prefix, _)| *prefix)
+            .collect();
+        for prefix in pending {
+            self.match_type_lookup(now, prefix);
+        }
+    }
+
     /// Writes the client's queued requests on the request writer.
     fn send_type_requests(&mut self, now: Instant) {
+        let mut matched = false;
         while let Some(req) = self.type_lookup.client.poll_request(now) {
+            if !matched {
+                self.match_type_lookup_all(now);
+                matched = true;
+            }
             match typelookup::encode_request(&req) {
                 Ok(bytes) => self.write_service(now, EntityId::TYPELOOKUP_REQUEST_WRITER, bytes),
                 Err(e) => debug!(error = %e, "TypeLookup request not encodable"),

@@ -32,7 +32,7 @@ use crate::rtps::messages::{
 };
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
-use reader_proxy::{MAX_REQUESTED, MAX_REQUESTED_FRAG_SAMPLES};
+use reader_proxy::MAX_REQUESTED_FRAG_SAMPLES;
 
 /// Protocol parameters of one writer.
 #[derive(Debug, Clone, Copy)]
@@ -460,12 +460,11 @@ impl Writer {
                 proxy.repair_due = Some(now);
             } else {
                 // Best effort: push the history once.
-                proxy.requested = self
-                    .history
-                    .range(SequenceNumber(1))
-                    .map(|c| c.sn)
-                    .take(MAX_REQUESTED)
-                    .collect();
+                for c in self.history.range(SequenceNumber(1)) {
+                    if !proxy.request(c.sn) {
+                        break;
+                    }
+                }
                 proxy.repair_due = Some(now);
             }
         }
@@ -518,16 +517,14 @@ impl Writer {
             p.acked = base;
         }
         for sn in ack.reader_sn_state.iter() {
-            if sn >= p.acked && sn < next_sn && p.requested.len() < MAX_REQUESTED {
-                p.requested.insert(sn);
+            if sn >= p.acked && sn < next_sn && !p.request(sn) {
+                break;
             }
         }
         request_past_bitmap(p, &ack.reader_sn_state, next_sn);
-        let acked = p.acked;
-        p.requested = p.requested.split_off(&acked);
-        p.requested_frags = p.requested_frags.split_off(&acked);
+        p.drop_requests_below(p.acked);
         // A request, or a reader that is behind without knowing it (e.g. a pre-emptive ACKNACK): answer soon.
-        if !p.requested.is_empty()
+        if p.has_requested()
             || (ack.reader_sn_state.num_bits == 0 && base < next_sn && !ack.final_flag)
         {
             p.repair_due.get_or_insert(now + delay);
@@ -566,16 +563,15 @@ impl Writer {
         }
         p.last_nackfrag = Some(nf.count);
         if in_history {
-            if p.requested_frags.len() < MAX_REQUESTED_FRAG_SAMPLES
-                || p.requested_frags.contains_key(&nf.writer_sn)
-            {
-                p.requested_frags
+            let frags = &mut p.repairs_mut().requested_frags;
+            if frags.len() < MAX_REQUESTED_FRAG_SAMPLES || frags.contains_key(&nf.writer_sn) {
+                frags
                     .entry(nf.writer_sn)
                     .or_default()
                     .extend(nf.fragment_number_state.iter());
             }
-        } else if p.requested.len() < MAX_REQUESTED {
-            p.requested.insert(nf.writer_sn);
+        } else {
+            p.request(nf.writer_sn);
         }
         p.repair_due.get_or_insert(now + delay);
         self.repair_floor.lower(p.repair_due);
@@ -659,10 +655,9 @@ impl Writer {
             }
         };
         while budget > 0 {
-            let Some(sn) = p.requested.pop_first() else {
+            let Some(sn) = p.pop_requested() else {
                 break;
             };
-            p.requested_frags.remove(&sn);
             match self.history.get(sn) {
                 Some(c) if sn >= p.floor && c.rejected.binary_search(&g).is_err() => {
                     resend(c, None);
@@ -672,7 +667,7 @@ impl Writer {
             }
         }
         while budget > 0 {
-            let Some((sn, frags)) = p.requested_frags.pop_first() else {
+            let Some((sn, frags)) = p.pop_requested_frags() else {
                 break;
             };
             if let Some(c) = self.history.get(sn) {
@@ -694,7 +689,8 @@ impl Writer {
             }
         }
         send_gaps(out, &dest, dst, g.entity_id, wid, &gaps);
-        let more = !p.requested.is_empty() || !p.requested_frags.is_empty();
+        let more = p.has_requests();
+        p.release_if_served();
         let reliable = p.reliable;
         if more {
             p.repair_due = Some(now + self.params.nack_response_delay);
@@ -723,8 +719,7 @@ fn request_past_bitmap(p: &mut ReaderProxy, set: &SequenceNumberSet, next_sn: Se
         return;
     }
     let mut sn = set.base + i64::from(BITMAP_BITS);
-    while sn < next_sn && p.requested.len() < MAX_REQUESTED {
-        p.requested.insert(sn);
+    while sn < next_sn && p.request(sn) {
         sn = sn.next();
     }
 }
