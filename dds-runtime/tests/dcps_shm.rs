@@ -378,22 +378,37 @@ fn fill_plain(p: &mut Plain, id: u32, seq: u32) {
 
 /// Takes plain samples until `n` arrived or `timeout` passed; panics on a damaged one. Their `seq`s.
 fn take_plain(r: &DataReader<Plain>, n: usize, timeout: Duration) -> Vec<u32> {
-    let mut seqs = Vec::new();
+    take_checked(r, n, timeout, |p| p)
+        .iter()
+        .map(|p| p.seq)
+        .collect()
+}
+
+/// Takes samples of `r` until `n` arrived or `timeout` passed, checking each one's pattern (`plain` views it
+/// as a `Plain`); panics on a damaged one.
+fn take_checked<S: DdsType>(
+    r: &DataReader<S>,
+    n: usize,
+    timeout: Duration,
+    plain: fn(&S) -> &Plain,
+) -> Vec<S> {
+    let mut got = Vec::new();
     wait_until(timeout, || {
         for s in r.take().unwrap() {
-            if let Some(p) = s.data {
+            if let Some(d) = s.data {
+                let p = plain(&d);
                 let ok = p
                     .data
                     .iter()
                     .enumerate()
                     .all(|(i, x)| *x == pattern(p.seq, i));
                 assert!(ok, "plain sample {} damaged", p.seq);
-                seqs.push(p.seq);
+                got.push(d);
             }
         }
-        seqs.len() >= n
+        got.len() >= n
     });
-    seqs
+    got
 }
 
 #[test]
@@ -439,11 +454,7 @@ fn loaned_samples_reach_shared_memory_readers_in_place_and_udp_readers_from_a_co
     let fr = reader::<Plain>(&off, "ShmLoan", &rq);
     wait_matched(&w, 2);
     let before = sent(&p);
-    for seq in n..2 * n {
-        let mut loan = w.loan().unwrap();
-        fill_plain(&mut loan, seq % 3, seq);
-        loan.write().unwrap();
-    }
+    loan_write(&w, n..2 * n);
     let want: Vec<u32> = (n..2 * n).collect();
     assert_eq!(take_plain(&r, n as usize, MATCH_TIMEOUT), want);
     assert_eq!(take_plain(&fr, n as usize, MATCH_TIMEOUT), want);
@@ -470,22 +481,7 @@ fn take_in_place(
     n: usize,
     timeout: Duration,
 ) -> Vec<InPlace<Plain>> {
-    let mut got = Vec::new();
-    wait_until(timeout, || {
-        for s in r.take().unwrap() {
-            if let Some(p) = s.data {
-                let ok = p
-                    .data
-                    .iter()
-                    .enumerate()
-                    .all(|(i, x)| *x == pattern(p.seq, i));
-                assert!(ok, "plain sample {} damaged", p.seq);
-                got.push(p);
-            }
-        }
-        got.len() >= n
-    });
-    got
+    take_checked(r, n, timeout, |p| p)
 }
 
 fn loan_write(w: &DataWriter<Plain>, seqs: std::ops::Range<u32>) {

@@ -20,6 +20,7 @@ mod api;
 
 pub use api::*;
 pub use participant::Participant;
+#[cfg(feature = "net")]
 pub(crate) use participant::KEPT_QUEUE_ROOM;
 pub use types::*;
 pub use writer::WriterGroup;

@@ -17,6 +17,7 @@ mod managed;
 mod receive;
 mod shm;
 mod timers;
+#[cfg(feature = "net")]
 pub(crate) use timers::KEPT_QUEUE_ROOM;
 mod topics;
 mod type_lookup;
