@@ -19,18 +19,11 @@ mod explain;
 /// Includes one generated file as a module, when idlc accepted it.
 macro_rules! idl {
     ($m:ident, $stem:literal) => {
-        #[cfg(idlc_ok = $stem)]
-        #[allow(
-            clippy::all,
-            clippy::pedantic,
-            non_camel_case_types,
-            non_snake_case,
-            dead_code,
-            unused_imports
-        )]
-        mod $m {
-            include!(concat!(env!("OUT_DIR"), "/", $stem, ".rs"));
-        }
+        dds_tests::generated!(
+            #[cfg(idlc_ok = $stem)]
+            $m,
+            $stem
+        );
     };
 }
 

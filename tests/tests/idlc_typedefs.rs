@@ -5,43 +5,19 @@
 //! binding (whose bytes the other golden tests hold, and whose order we follow) disagree on it. The same IDL
 //! read as dynamic types gives the same bytes, and the typedefs change the type objects only, not the encoding.
 
-#[allow(
-    clippy::all,
-    clippy::pedantic,
-    non_camel_case_types,
-    non_snake_case,
-    dead_code,
-    unused_imports
-)]
-mod gen {
-    include!(concat!(env!("OUT_DIR"), "/own/typedefs.rs"));
-}
+dds_tests::generated!(gen, "own/typedefs");
 
-/// `tests/idl/nested_base.idl`: structs deriving from `@nested` structs.
-#[allow(
-    clippy::all,
-    clippy::pedantic,
-    non_camel_case_types,
-    non_snake_case,
-    dead_code,
-    unused_imports
-)]
-mod gen_nested {
-    include!(concat!(env!("OUT_DIR"), "/own/nested_base.rs"));
-}
+dds_tests::generated!(
+    /// `tests/idl/nested_base.idl`: structs deriving from `@nested` structs.
+    gen_nested,
+    "own/nested_base"
+);
 
-/// `tests/idl/no-peer/bitsets.idl`: bitsets (no peer reference).
-#[allow(
-    clippy::all,
-    clippy::pedantic,
-    non_camel_case_types,
-    non_snake_case,
-    dead_code,
-    unused_imports
-)]
-mod gen_bitsets {
-    include!(concat!(env!("OUT_DIR"), "/own/bitsets.rs"));
-}
+dds_tests::generated!(
+    /// `tests/idl/no-peer/bitsets.idl`: bitsets (no peer reference).
+    gen_bitsets,
+    "own/bitsets"
+);
 
 #[path = "golden/cyclone_idlc.rs"]
 mod cyclone_idlc;
