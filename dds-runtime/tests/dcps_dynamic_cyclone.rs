@@ -1,8 +1,8 @@
 //! Unions and instance states against a real Cyclone DDS 11 peer (python `cyclonedds`,
-//! `dcps_util/cyclone_union.py`), typed and dynamic endpoints. Cyclone 11 numbers union members from 0 in its
-//! type objects, we (XTypes 1.3, and Cyclone after 11.0.1) from 1, so the type identifiers differ: these
-//! tests prove the endpoints still match (TypeLookup, then assignability, which for unions goes by labels) and
-//! exchange samples both ways.
+//! `dcps_util/cyclone_union.py`), typed and dynamic endpoints. Cyclone 11 numbers the members of non-mutable
+//! unions from 0 in its type objects, where XTypes 1.3 (and Cyclone after 11.0.1) starts at 1; we follow
+//! Cyclone 11 (docs/xtypes.md). With ids from 1 these endpoints never matched; these tests prove they match
+//! and exchange samples both ways.
 //! Ignored by default (needs python3 + cyclonedds): run with
 //! `scripts/isolated cargo nextest run -p dds-runtime --features idl,json --test dcps_dynamic_cyclone
 //! --run-ignored ignored-only`. Domains 215, 216 and 217.
