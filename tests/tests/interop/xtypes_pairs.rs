@@ -141,11 +141,14 @@ fn peer_count(peer: &Proc, what: &str) -> Option<usize> {
         .and_then(|l| l[what.len()..].trim().parse().ok())
 }
 
-/// Whether the peer has decided every pair as expected: its matched and its incompatible totals.
+/// Whether the peer has decided every pair: its matched total, and at least as many incompatible reports as
+/// there are unmatched pairs. A Cyclone writer end now and then reports one refused pair twice (539 for 538;
+/// seen against Cyclone itself, docs/xtypes.md): its per-pair results, not this total, are what the tests
+/// compare.
 fn peer_decided(peer: &Proc) -> bool {
     let want = want_total();
     peer_count(peer, "MATCHED ") == Some(want)
-        && peer_count(peer, "INCOMPATIBLE ") == Some(625 - want)
+        && peer_count(peer, "INCOMPATIBLE ").is_some_and(|n| n >= 625 - want)
 }
 
 /// Whether our end of pair (`w`, `r`) decided as expected: matched, or reported incompatible.
