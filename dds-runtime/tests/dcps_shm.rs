@@ -17,7 +17,7 @@ use dcps_util::*;
 use dds_runtime::dcps::{InPlace, LoanError};
 use dds_runtime::prelude::*;
 use dds_runtime::rtps::shm::SHM_NODE_PROPERTY;
-use dds_runtime::transport::shm::{node_listed, remove_dead_nodes};
+use dds_runtime::transport::shm::{node_status, remove_dead_nodes, NodeStatus};
 
 const KIB: usize = 1024;
 
@@ -215,7 +215,7 @@ fn env_num(name: &str) -> usize {
 }
 
 /// The second process. `reader`: takes COUNT blobs from the topic, checks them, prints "got" and their
-/// ids. `writer`: writes COUNT blobs of SIZE bytes from FIRST on (COUNT 0: until killed), prints
+/// ids, and waits for its stdin to close. `writer`: writes COUNT blobs of SIZE bytes from FIRST on (COUNT 0: until killed), prints
 /// "writing" after the first; waits for its stdin to close.
 #[test]
 fn child() {
@@ -232,6 +232,9 @@ fn child() {
         println!("ready");
         let ids = take_blobs(&r, count, Duration::from_secs(30));
         println!("got {ids:?}");
+        std::io::stdout().flush().unwrap();
+        let mut s = String::new();
+        let _ = std::io::stdin().read_line(&mut s);
         return;
     }
     let size = env_num("DCPS_SHM_SIZE");
@@ -278,6 +281,7 @@ fn mixed_readers_in_two_processes_get_every_sample_intact_and_in_order() {
     let want: Vec<u32> = (0..n as u32).collect();
     assert_eq!(take_blobs(&fr, n, MATCH_TIMEOUT), want);
     assert_eq!(wait_line(&mut out, "got "), format!("{want:?}"));
+    drop(child.stdin.take());
     assert!(child.wait().unwrap().success());
 }
 
@@ -323,7 +327,7 @@ fn killed_writer_process_leaks_nothing_and_a_new_writer_works() {
     assert_eq!(all, (0..=last).collect::<Vec<_>>());
     // Its dead node is removed (by us or by whoever looked first), with its segments and loans.
     let end = Instant::now() + MATCH_TIMEOUT;
-    while node_listed(&node) {
+    while node_status(&node) != NodeStatus::Absent {
         remove_dead_nodes();
         assert!(Instant::now() < end, "dead node {node} still listed");
         std::thread::sleep(Duration::from_millis(50));
@@ -335,6 +339,59 @@ fn killed_writer_process_leaks_nothing_and_a_new_writer_works() {
     assert_eq!(ids, (1000..1020).collect::<Vec<_>>());
     drop(next.stdin.take());
     assert!(next.wait().unwrap().success());
+}
+
+/// Deleting a writer waits for its shared-memory readers to acknowledge what it sent, but not for a
+/// reader whose process was killed (its node is dead): with `connected`, the reader was killed after it
+/// had taken a sample (the deletion's wait for acknowledgements), else right after matching (the first
+/// send's wait for the reader to connect).
+fn delete_writer_after_its_reader_is_killed(domain: u32, topic: &str, connected: bool) {
+    let p = participant_with(domain, with_shm());
+    let (wq, _) = reliable_keep_all();
+    let w = writer::<Blob>(&p, topic, &wq);
+    let taken = if connected { 1 } else { 1000 };
+    let vars = [
+        ("DCPS_SHM_DOMAIN", domain.to_string()),
+        ("DCPS_SHM_TOPIC", topic.to_owned()),
+        ("DCPS_SHM_COUNT", taken.to_string()),
+    ];
+    let (mut child, mut out) = spawn("reader", &vars);
+    wait_line(&mut out, "ready");
+    wait_matched(&w, 1);
+    let node = peer_node(&p, &[]).expect("the reader announced its node");
+    w.write(&blob(0, 4 * KIB)).unwrap();
+    if connected {
+        assert_eq!(wait_line(&mut out, "got "), "[0]");
+    }
+    child.kill().unwrap(); // SIGKILL: the reader acknowledges nothing that follows
+    child.wait().unwrap();
+    // Dead, or already removed by a cleanup in a test beside this one.
+    assert!(matches!(
+        node_status(&node),
+        NodeStatus::Dead | NodeStatus::Absent
+    ));
+    // Still matched (its participant's lease has not expired): these go to its channel.
+    for id in 1..4 {
+        w.write(&blob(id, 4 * KIB)).unwrap();
+    }
+    let start = Instant::now();
+    w.publisher().delete_datawriter(&w).unwrap();
+    let took = start.elapsed();
+    assert!(
+        took < Duration::from_millis(1000),
+        "deletion waited {took:?} for a dead reader"
+    );
+    remove_dead_nodes();
+}
+
+#[test]
+fn deleting_a_writer_does_not_wait_for_a_killed_reader_to_acknowledge() {
+    delete_writer_after_its_reader_is_killed(117, "ShmDeadAcks", true);
+}
+
+#[test]
+fn deleting_a_writer_does_not_wait_for_a_killed_reader_to_connect() {
+    delete_writer_after_its_reader_is_killed(118, "ShmDeadConnect", false);
 }
 
 /// A plain-data sample: its XCDR1 encoding is its memory image, so it can be loaned.

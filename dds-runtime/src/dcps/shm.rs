@@ -27,8 +27,8 @@ use crate::rtps::shm::{
 };
 use crate::rtps::{EntityId, Guid, GuidPrefix, Participant, Payload};
 use crate::transport::shm::{
-    host_id, ShmChannelConfig, ShmError, ShmListener, ShmLoan, ShmNode, ShmNotifier, ShmPublisher,
-    ShmSample, ShmSubscriber,
+    host_id, node_status, NodeStatus, ShmChannelConfig, ShmError, ShmListener, ShmLoan, ShmNode,
+    ShmNotifier, ShmPublisher, ShmSample, ShmSubscriber,
 };
 
 /// How long a writer's changes wait for the subscribers of its readers' participants to connect.
@@ -36,6 +36,9 @@ pub(crate) const CONNECT_TIMEOUT: Duration = Duration::from_secs(2);
 
 /// Longest wait of a writer's deletion for its reader participants' acknowledgements ([`ShmLink::linger`]).
 const LINGER: Duration = Duration::from_secs(2);
+
+/// How often a lingering deletion looks for reader participants that died ([`ShmLink::linger`]).
+const LIVENESS_CHECK: Duration = Duration::from_millis(20);
 
 /// How long a reliable writer's send waits for a subscriber whose queue is full.
 pub(crate) const DELIVERY_TIMEOUT: Duration = Duration::from_secs(10);
@@ -218,6 +221,12 @@ fn ack_config() -> ShmChannelConfig {
         latest_only: true,
         ..c
     }
+}
+
+/// Whether the reader participant of node `n` is gone: its process died (its node is listed dead, or
+/// already removed by whoever cleaned up first), so it will never connect or acknowledge.
+fn node_gone(n: &str) -> bool {
+    matches!(node_status(n), NodeStatus::Dead | NodeStatus::Absent)
 }
 
 /// The acknowledgement channel of the writer whose data channel is `data`.
@@ -470,9 +479,18 @@ impl ShmLink {
             .is_some_and(|n| Arc::ptr_eq(n, &c.nodes))
         {
             out.read_acks();
-            let missing = c.nodes.iter().filter(|n| !out.greeted.contains(n)).count();
+            let mut missing = c.nodes.iter().filter(|n| !out.greeted.contains(n)).count();
             let since = *out.waiting_since.get_or_insert_with(Instant::now);
-            if missing > 0 && since.elapsed() < CONNECT_TIMEOUT {
+            let waited = since.elapsed();
+            if missing > 0 && waited >= LIVENESS_CHECK {
+                // A reader participant that died never connects: do not wait for it.
+                missing = c
+                    .nodes
+                    .iter()
+                    .filter(|n| !out.greeted.contains(n) && !node_gone(n))
+                    .count();
+            }
+            if missing > 0 && waited < CONNECT_TIMEOUT {
                 return Ok(false);
             }
             if missing > 0 {
@@ -530,22 +548,32 @@ impl ShmLink {
     /// Before `writer` is deleted: sends what is pending, then waits (at most [`LINGER`]) until the
     /// reader participants in `nodes` acknowledged it. The deletion's SEDP announcement unmatches the
     /// writer's readers, and a reader participant closes the channel then, with what it has not drained
-    /// yet: the writer's last changes (a benchmark's end marker, under load) were lost that way.
+    /// yet: the writer's last changes (a benchmark's end marker, under load) were lost that way. A reader
+    /// participant whose process died is not waited for ([`node_gone`]).
     pub(crate) fn linger(&self, writer: EntityId, nodes: &[String]) {
         if nodes.is_empty() {
             return;
         }
         self.flush();
-        let deadline = Instant::now() + LINGER;
-        while !self.acknowledged(writer, nodes) {
-            if Instant::now() >= deadline {
+        let mut waiting = nodes.to_vec();
+        let start = Instant::now();
+        let mut next_check = start;
+        while !self.acknowledged(writer, &waiting) {
+            let now = Instant::now();
+            if now >= start + LINGER {
                 tracing::debug!(
                     ?writer,
                     "shared-memory readers did not acknowledge before deletion"
                 );
                 return;
             }
+            if now >= next_check {
+                waiting.retain(|n| !node_gone(n));
+                next_check = now + LIVENESS_CHECK;
+            }
             std::thread::sleep(Duration::from_millis(1));
+            // Changes held for a reader that turned out dead go now.
+            self.flush();
         }
     }
 

@@ -132,24 +132,41 @@ pub fn remove_dead_nodes() -> usize {
         .count()
 }
 
-/// Whether the node `id` ([`ShmNode::id`]) is still listed in shared memory, alive or dead (false once a
-/// dead node's resources were removed).
-pub fn node_listed(id: &str) -> bool {
+/// What shared memory lists of a node ([`node_status`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum NodeStatus {
+    /// Its process runs.
+    Alive,
+    /// Its process died; its resources are still listed until [`remove_dead_nodes`] frees them.
+    Dead,
+    /// Listed, but its state cannot be read (no permission, or the node is being created or removed).
+    Unknown,
+    /// Not listed: never created here, or removed.
+    Absent,
+}
+
+/// What shared memory lists of the node `id` ([`ShmNode::id`]).
+pub fn node_status(id: &str) -> NodeStatus {
     use iceoryx2::node::NodeView;
-    let mut found = false;
+    let mut status = NodeStatus::Absent;
     let listed = Node::<ipc_threadsafe::Service>::list(Config::global_config(), |state| {
-        let nid = match &state {
-            NodeState::Alive(v) => *v.id(),
-            NodeState::Dead(v) => *v.id(),
-            NodeState::Inaccessible(n) | NodeState::Undefined(n) => *n,
+        let (nid, s) = match &state {
+            NodeState::Alive(v) => (*v.id(), NodeStatus::Alive),
+            NodeState::Dead(v) => (*v.id(), NodeStatus::Dead),
+            NodeState::Inaccessible(n) | NodeState::Undefined(n) => (*n, NodeStatus::Unknown),
         };
-        found |= nid.to_string() == id;
+        if nid.to_string() == id {
+            status = s;
+            return CallbackProgression::Stop;
+        }
         CallbackProgression::Continue
     });
     if let Err(e) = listed {
         tracing::warn!(error = ?e, "cannot list shared-memory nodes");
+        return NodeStatus::Unknown;
     }
-    found
+    status
 }
 
 impl ShmNode {
