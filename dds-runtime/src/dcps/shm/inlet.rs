@@ -1,0 +1,204 @@
+//! The reader side of the link: the channels of peers' writers our readers read, the frames they hold,
+//! and our acknowledgements to those writers.
+
+use super::*;
+
+/// One peer writer's channel that our readers read, and where we acknowledge what it sent.
+pub(super) struct Inlet {
+    writer: Guid,
+    subscriber: ShmSubscriber,
+    acks: ShmPublisher,
+    /// Until its first frame: since when it tells the writer, on the acknowledgement channel, that it is
+    /// connected (an acknowledgement of 0) once it is. A writer sends nothing before that: iceoryx2
+    /// skips a subscriber that is not connected yet once its queue is full, and the samples would be lost.
+    greeting_since: Option<Instant>,
+    /// Frames of this channel still held (decoding, or kept in place by readers, `dcps::InPlace`).
+    held: Arc<AtomicUsize>,
+}
+
+/// Most frames of one channel held at once; past it, frames are copied out of shared memory and given
+/// back at once. iceoryx2 lends a subscriber at most the channel's queue depth of frames: readers that
+/// keep samples in place must not take them all, or the channel would stall.
+const MAX_HELD: usize = 12;
+
+/// A frame read from a channel, counted while it is held.
+pub(super) struct HeldFrame {
+    frame: ShmSample,
+    held: Arc<AtomicUsize>,
+}
+
+impl AsRef<[u8]> for HeldFrame {
+    fn as_ref(&self) -> &[u8] {
+        &self.frame
+    }
+}
+
+impl Drop for HeldFrame {
+    fn drop(&mut self) {
+        self.held.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+impl Inlet {
+    /// The frame as a payload: shared in place, or copied when too many frames are held already.
+    fn payload(&self, frame: ShmSample) -> Payload {
+        if self.held.fetch_add(1, Ordering::AcqRel) >= MAX_HELD {
+            self.held.fetch_sub(1, Ordering::AcqRel);
+            return Payload::copy_from_slice(&frame);
+        }
+        let held = self.held.clone();
+        Payload::from_owner(Arc::new(HeldFrame { frame, held }))
+    }
+}
+
+/// The channels our readers read, and the core generation they were set up for.
+#[derive(Default)]
+pub(super) struct Inlets {
+    generation: u64,
+    pub(super) channels: Vec<Inlet>,
+}
+
+impl ShmLink {
+    /// Reads what arrived on the channels our readers read and gives it to the core; how many frames.
+    /// Also opens and closes channels as the core's pairs changed.
+    pub(crate) fn drain(&self, driver: &dyn ShmHost) -> usize {
+        let mut inlets = lock(&self.inlets);
+        let generation = self.generation.load(Ordering::Acquire);
+        if generation != inlets.generation {
+            inlets.generation = generation;
+            let mut wanted = Vec::new();
+            driver.query_shm(&mut |c| wanted = c.shm_subscriptions());
+            self.resubscribe(&mut inlets, &wanted);
+        }
+        if inlets.channels.is_empty() {
+            return 0;
+        }
+        let mut frames: Vec<(Guid, Payload)> = Vec::new();
+        let mut highest = vec![0i64; inlets.channels.len()];
+        let mut greeting = false;
+        for (i, inlet) in inlets.channels.iter_mut().enumerate() {
+            if let Some(since) = inlet.greeting_since {
+                if inlet.subscriber.has_samples() {
+                    inlet.greeting_since = None;
+                } else if inlet.subscriber.connect() {
+                    tracing::trace!(writer = ?inlet.writer, "connected to a writer's channel: greeting it");
+                    self.acknowledge(inlet, 0);
+                }
+                greeting |= since.elapsed() < CONNECT_TIMEOUT;
+            }
+            for _ in 0..BATCH {
+                match inlet.subscriber.receive() {
+                    Ok(Some(s)) => {
+                        if let Ok(h) = decode_header(&s) {
+                            highest[i] = highest[i].max(h.sequence.0);
+                        }
+                        frames.push((inlet.writer, inlet.payload(s)));
+                    }
+                    Ok(None) => break,
+                    Err(e) => {
+                        tracing::warn!(writer = ?inlet.writer, error = %e, "shared-memory receive failed");
+                        break;
+                    }
+                }
+            }
+        }
+        self.greeting.store(greeting, Ordering::Release);
+        let n = frames.len();
+        if n > 0 {
+            tracing::trace!(frames = n, "shared-memory frames drained");
+            // Still under the inlets lock: two threads draining keep the channels' order. Our own
+            // changes are not sent from here (see `poll_loop`).
+            let mut frames = Some(frames);
+            driver.with_core_from_shm(&mut |c, now| {
+                for (writer, frame) in frames.take().into_iter().flatten() {
+                    c.receive_shm(now, writer, frame);
+                }
+            });
+            // They are in the readers' caches now.
+            for (inlet, sn) in inlets.channels.iter().zip(highest) {
+                if sn > 0 {
+                    self.acknowledge(inlet, sn);
+                }
+            }
+        }
+        n
+    }
+
+    /// Before a receive thread handles datagrams: what arrived on the channels before them reaches the
+    /// readers first (a writer's last changes before the announcement of its deletion, typically). The
+    /// reading thread drains them (it decodes samples on its large stack; plain-data samples can be
+    /// large arrays decoded by value) while this thread waits, at most [`DRAIN_WAIT`]. Free when nothing
+    /// is queued. Without a reading-thread wake-up, drains here.
+    pub(crate) fn drain_first(&self, driver: &dyn ShmHost) {
+        let queued = lock(&self.inlets)
+            .channels
+            .iter()
+            .any(|i| i.subscriber.has_samples());
+        if !queued || self.stopped.load(Ordering::Acquire) {
+            return;
+        }
+        if self.listener.is_none() {
+            self.drain(driver);
+            return;
+        }
+        let mut passes = lock(&self.passes);
+        // A pass already under way may have read the channels before the frames came.
+        let target = *passes + 2;
+        self.wake();
+        let deadline = Instant::now() + DRAIN_WAIT;
+        while *passes < target {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() || self.stopped.load(Ordering::Acquire) {
+                break;
+            }
+            passes = self
+                .passed
+                .wait_timeout(passes, left)
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .0;
+        }
+    }
+
+    /// The reading thread finished a drain pass.
+    pub(super) fn count_pass(&self) {
+        *lock(&self.passes) += 1;
+        self.passed.notify_all();
+    }
+
+    fn acknowledge(&self, inlet: &Inlet, sn: i64) {
+        let node = self.node.id();
+        let sent = inlet.acks.loan(8 + node.len()).and_then(|mut loan| {
+            encode_ack(sn, &node, &mut loan);
+            loan.send()
+        });
+        if let Err(e) = sent {
+            tracing::debug!(writer = ?inlet.writer, error = %e, "shared-memory acknowledgement not sent");
+        }
+    }
+
+    fn resubscribe(&self, inlets: &mut Inlets, wanted: &[Guid]) {
+        inlets.channels.retain(|i| wanted.contains(&i.writer));
+        for w in wanted {
+            if inlets.channels.iter().any(|i| i.writer == *w) {
+                continue;
+            }
+            let name = shm_channel_name(w);
+            let opened = self
+                .node
+                .subscriber(&name, &ShmChannelConfig::default())
+                .and_then(|subscriber| {
+                    Ok(Inlet {
+                        writer: *w,
+                        subscriber,
+                        acks: self.node.publisher(&ack_channel(&name), &ack_config())?,
+                        greeting_since: Some(Instant::now()),
+                        held: Arc::new(AtomicUsize::new(0)),
+                    })
+                });
+            match opened {
+                Ok(i) => inlets.channels.push(i),
+                Err(e) => tracing::warn!(writer = ?w, error = %e, "cannot read a writer's channel"),
+            }
+        }
+    }
+}

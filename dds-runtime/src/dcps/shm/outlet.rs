@@ -1,0 +1,325 @@
+//! The writer side of the link: our writers' channels, the changes queued for them, and the
+//! acknowledgements their reader participants send back.
+
+use super::*;
+
+/// A change written in a loaned buffer (`DataWriter::loan`), waiting for its turn in the channel.
+pub(super) struct Parked {
+    writer: EntityId,
+    sequence: i64,
+    loan: ShmLoan,
+    /// Where the serialized sample is in the buffer.
+    payload: std::ops::Range<usize>,
+}
+
+/// One writer's channel, the set of nodes last seen connected to it, and its acknowledgements.
+pub(super) struct Outlet {
+    publisher: ShmPublisher,
+    connected: Option<Arc<[String]>>,
+    /// Since when a change waits for its nodes to connect.
+    waiting_since: Option<Instant>,
+    acks: ShmSubscriber,
+    /// By node: the highest sequence number sent while it was expected, and the highest it acknowledged.
+    owed: HashMap<String, (i64, i64)>,
+    /// The nodes that said (on the acknowledgement channel) that they are connected to the channel.
+    greeted: Vec<String>,
+}
+
+impl Outlet {
+    /// Takes the acknowledgements that arrived: what each node acknowledged, and that it is connected.
+    fn read_acks(&mut self) {
+        while let Ok(Some(ack)) = self.acks.receive() {
+            let Some((sn, node)) = decode_ack(&ack) else {
+                continue;
+            };
+            if let Some(owed) = self.owed.get_mut(node) {
+                owed.1 = owed.1.max(sn);
+            }
+            if !self.greeted.iter().any(|g| g == node) {
+                self.greeted.push(node.to_owned());
+            }
+        }
+    }
+}
+
+impl ShmLink {
+    /// Under the core lock: takes what the core queued for the channels.
+    pub(crate) fn take_from(&self, core: &mut Participant) {
+        let generation = core.shm_generation();
+        if self.generation.swap(generation, Ordering::AcqRel) != generation {
+            // The channels to read changed: the reading thread (re)subscribes now.
+            self.wake();
+        }
+        let mut pending = None;
+        while let Some(c) = core.poll_shm() {
+            pending
+                .get_or_insert_with(|| lock(&self.pending))
+                .push_back(c);
+        }
+    }
+
+    /// Sends what was taken, in order (without the core lock); may wait for a full reader queue.
+    pub(crate) fn flush(&self) {
+        if lock(&self.pending).is_empty() {
+            return;
+        }
+        self.flush_with(&mut lock(&self.outlets));
+    }
+
+    /// [`flush`](Self::flush) unless another thread is sending (it sends what is pending too).
+    pub(super) fn try_flush(&self) {
+        if lock(&self.pending).is_empty() {
+            return;
+        }
+        let mut guard = match self.outlets.try_lock() {
+            Ok(g) => g,
+            Err(std::sync::TryLockError::Poisoned(p)) => p.into_inner(),
+            Err(std::sync::TryLockError::WouldBlock) => return,
+        };
+        self.flush_with(&mut guard);
+    }
+
+    fn flush_with(&self, outlets: &mut HashMap<EntityId, Outlet>) {
+        // Changes of a writer whose readers are not connected yet wait, with those that follow them.
+        let mut held = VecDeque::new();
+        let mut held_writers: Vec<EntityId> = Vec::new();
+        let mut woken: Vec<Arc<[String]>> = Vec::new();
+        let mut sent = 0usize;
+        loop {
+            let Some(c) = lock(&self.pending).pop_front() else {
+                break;
+            };
+            if held_writers.contains(&c.writer) {
+                held.push_back(c);
+                continue;
+            }
+            match self.send(outlets, &c) {
+                Ok(true) => {
+                    if !woken.iter().any(|n| Arc::ptr_eq(n, &c.nodes)) {
+                        woken.push(c.nodes.clone());
+                    }
+                    // Readers drain while more is sent: a full queue would wait for them.
+                    sent += 1;
+                    if sent.is_multiple_of(WAKE_EVERY) {
+                        self.wake_readers(&woken);
+                        woken.clear();
+                    }
+                }
+                Ok(false) => {
+                    held_writers.push(c.writer);
+                    held.push_back(c);
+                }
+                Err(e) => {
+                    tracing::warn!(writer = ?c.writer, error = %e, "shared-memory send failed")
+                }
+            }
+        }
+        self.wake_readers(&woken);
+        if !held.is_empty() {
+            let mut pending = lock(&self.pending);
+            while let Some(c) = held.pop_back() {
+                pending.push_front(c);
+            }
+        }
+    }
+
+    /// Signals the reading threads of the participants of `nodes` (each once).
+    fn wake_readers(&self, nodes: &[Arc<[String]>]) {
+        if nodes.is_empty() {
+            return;
+        }
+        let mut notifiers = lock(&self.notifiers);
+        let mut done: Vec<&str> = Vec::new();
+        for n in nodes.iter().flat_map(|n| n.iter()) {
+            if done.contains(&n.as_str()) {
+                continue;
+            }
+            done.push(n);
+            if !notifiers.contains_key(n) {
+                match self.node.notifier(&wake_channel(n)) {
+                    Ok(x) => {
+                        notifiers.insert(n.clone(), x);
+                    }
+                    Err(e) => {
+                        tracing::debug!(node = n, error = %e, "no wake-up for a reader participant");
+                        continue;
+                    }
+                }
+            }
+            if let Some(Err(e)) = notifiers.get(n).map(ShmNotifier::notify) {
+                tracing::debug!(node = n, error = %e, "reader participant not woken");
+                notifiers.remove(n);
+            }
+        }
+    }
+
+    /// A buffer of `len` bytes from the channel of `writer` (reliable or not), for a sample written in
+    /// place: [`park`](Self::park) it once the core has queued the change.
+    pub(crate) fn loan(
+        &self,
+        writer: EntityId,
+        reliable: bool,
+        len: usize,
+    ) -> Result<ShmLoan, ShmError> {
+        let mut outlets = lock(&self.outlets);
+        let out = match outlets.entry(writer) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(self.open_outlet(writer, reliable)?)
+            }
+        };
+        out.publisher.loan(len)
+    }
+
+    /// Under the core lock, right after `Participant::write_loaned` queued change `sequence` of `writer`:
+    /// the buffer that holds its sample (at `payload`), sent in the change's turn.
+    pub(crate) fn park(
+        &self,
+        writer: EntityId,
+        sequence: i64,
+        loan: ShmLoan,
+        payload: std::ops::Range<usize>,
+    ) {
+        lock(&self.parked).push(Parked {
+            writer,
+            sequence,
+            loan,
+            payload,
+        });
+    }
+
+    fn open_outlet(&self, writer: EntityId, reliable: bool) -> Result<Outlet, ShmError> {
+        let name = shm_channel_name(&Guid::new(self.prefix, writer));
+        Ok(Outlet {
+            publisher: self.node.publisher(&name, &channel_config(reliable))?,
+            connected: None,
+            waiting_since: None,
+            acks: self.node.subscriber(&ack_channel(&name), &ack_config())?,
+            owed: HashMap::new(),
+            greeted: Vec::new(),
+        })
+    }
+
+    /// Sends `c`; `Ok(false)` when it must wait for its nodes to connect, or for its loaned buffer.
+    fn send(
+        &self,
+        outlets: &mut HashMap<EntityId, Outlet>,
+        c: &ShmChange,
+    ) -> Result<bool, ShmError> {
+        let out = match outlets.entry(c.writer) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(self.open_outlet(c.writer, c.reliable)?)
+            }
+        };
+        if !out
+            .connected
+            .as_ref()
+            .is_some_and(|n| Arc::ptr_eq(n, &c.nodes))
+        {
+            out.read_acks();
+            let mut missing = c.nodes.iter().filter(|n| !out.greeted.contains(n)).count();
+            let since = *out.waiting_since.get_or_insert_with(Instant::now);
+            let waited = since.elapsed();
+            if missing > 0 && waited >= LIVENESS_CHECK {
+                // A reader participant that died never connects: do not wait for it.
+                missing = c
+                    .nodes
+                    .iter()
+                    .filter(|n| !out.greeted.contains(n) && !node_gone(n))
+                    .count();
+            }
+            if missing > 0 && waited < CONNECT_TIMEOUT {
+                return Ok(false);
+            }
+            if missing > 0 {
+                tracing::warn!(
+                    missing,
+                    "shared-memory readers not connected in time: they miss changes"
+                );
+            }
+            let _ = out.publisher.update_connections();
+            out.connected = Some(c.nodes.clone());
+            out.waiting_since = None;
+        }
+        if c.loaned {
+            let mut parked = lock(&self.parked);
+            let at = parked
+                .iter()
+                .position(|p| p.writer == c.writer && p.sequence == c.sequence.0);
+            // The core queues the change before its writer parks the buffer: until then it waits.
+            let Some(mut p) = at.map(|i| parked.swap_remove(i)) else {
+                return Ok(false);
+            };
+            drop(parked);
+            c.write_header_with(&mut p.loan[..], Some(p.payload));
+            p.loan.send()?;
+        } else {
+            let mut header = [0u8; ShmChange::HEADER_LEN];
+            c.write_header(&mut header);
+            out.publisher.send_parts(&[&header, &c.change.payload])?;
+        }
+        if !c.liveliness {
+            for n in c.nodes.iter() {
+                let owed = out.owed.entry(n.clone()).or_insert((0, 0));
+                owed.0 = owed.0.max(c.sequence.0);
+            }
+        }
+        Ok(true)
+    }
+
+    /// Whether every reader participant in `nodes` acknowledged all that `writer` sent it (true when
+    /// nothing was sent on shared memory).
+    pub(crate) fn acknowledged(&self, writer: EntityId, nodes: &[String]) -> bool {
+        if lock(&self.pending).iter().any(|c| c.writer == writer) {
+            return false;
+        }
+        let mut outlets = lock(&self.outlets);
+        let Some(out) = outlets.get_mut(&writer) else {
+            return true;
+        };
+        out.read_acks();
+        nodes
+            .iter()
+            .all(|n| out.owed.get(n).is_none_or(|(sent, acked)| acked >= sent))
+    }
+
+    /// Before `writer` is deleted: sends what is pending, then waits (at most [`LINGER`]) until the
+    /// reader participants in `nodes` acknowledged it. The deletion's SEDP announcement unmatches the
+    /// writer's readers, and a reader participant closes the channel then, with what it has not drained
+    /// yet: the writer's last changes (a benchmark's end marker, under load) were lost that way. A reader
+    /// participant whose process died is not waited for ([`node_gone`]).
+    pub(crate) fn linger(&self, writer: EntityId, nodes: &[String]) {
+        if nodes.is_empty() {
+            return;
+        }
+        self.flush();
+        let mut waiting = nodes.to_vec();
+        let start = Instant::now();
+        let mut next_check = start;
+        while !self.acknowledged(writer, &waiting) {
+            let now = Instant::now();
+            if now >= start + LINGER {
+                tracing::debug!(
+                    ?writer,
+                    "shared-memory readers did not acknowledge before deletion"
+                );
+                return;
+            }
+            if now >= next_check {
+                waiting.retain(|n| !node_gone(n));
+                next_check = now + LIVENESS_CHECK;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+            // Changes held for a reader that turned out dead go now.
+            self.flush();
+        }
+    }
+
+    /// The writer was deleted: its channel closes (after what it sent).
+    pub(crate) fn close_writer(&self, writer: EntityId) {
+        self.flush();
+        lock(&self.parked).retain(|p| p.writer != writer);
+        lock(&self.outlets).remove(&writer);
+    }
+}
