@@ -455,11 +455,12 @@ impl Writer {
             proxy.floor = self.next_sn;
             proxy.acked = self.next_sn;
         } else if !self.history.is_empty() {
-            if proxy.reliable {
+            if proxy.reliable && !self.history_fits_one_push() {
                 // Announce the history; the reader asks for what it lacks.
                 proxy.repair_due = Some(now);
             } else {
-                // Best effort: push the history once.
+                // Best effort, or a reliable reader that would ask for all of it: push the history once
+                // (followed by a heartbeat), which saves the HEARTBEAT/ACKNACK round that would ask for it.
                 for c in self.history.range(SequenceNumber(1)) {
                     if !proxy.request(c.sn) {
                         break;
@@ -478,6 +479,18 @@ impl Writer {
             self.hb_due
                 .get_or_insert(now + self.params.heartbeat_period);
         }
+    }
+
+    /// Whether a new reliable reader gets the history pushed at matching rather than announced: when it
+    /// holds every change from 1 on (so a reader that has nothing would ask for all of it, and no GAP is
+    /// needed) and fits in one repair round. A matched SEDP writer's announcements usually do; the cost
+    /// of a reader that had them already (matched again) is one repair round, as for a NACK of everything.
+    fn history_fits_one_push(&self) -> bool {
+        self.history.first_sn() == Some(SequenceNumber(1))
+            && self.history.len() as i64 == self.next_sn.0 - 1
+            && self.history.len() <= reader_proxy::MAX_REQUESTED
+            && self.history.bytes_from(SequenceNumber(1)) + 64 * self.history.len()
+                <= self.params.max_repair_bytes
     }
 
     pub(crate) fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
@@ -692,6 +705,7 @@ impl Writer {
                 out.push(&dest, dst, Ts::Any, &hf);
             }
         }
+        let idle = budget == self.params.max_repair_bytes as isize && gaps.is_empty();
         send_gaps(out, &dest, dst, g.entity_id, wid, &gaps);
         let more = p.has_requests();
         p.release_if_served();
@@ -700,7 +714,8 @@ impl Writer {
             p.repair_due = Some(now + self.params.nack_response_delay);
             self.repair_queue.arm(p.repair_due, g);
         }
-        if reliable {
+        // A reader that acknowledged everything meanwhile (its ACKNACK crossed our push) needs no heartbeat.
+        if reliable && !(idle && p.acked >= self.next_sn) {
             let hb = self.heartbeat(g.entity_id, false);
             out.push(&dest, dst, Ts::Any, &hb);
         }
