@@ -219,3 +219,57 @@ fn discovery_takes_a_bounded_number_of_datagrams() {
     // Each new reader of an SEDP writer gets the announcements pushed, so none is asked for.
     assert_eq!(discovery.count("NACK"), 0);
 }
+
+/// Whether `msg` holds a submessage that `f` selects.
+fn carries(msg: &[u8], f: impl Fn(&Submessage<'_>) -> bool) -> bool {
+    MessageIter::parse(msg).is_ok_and(|(_, it)| it.flatten().any(|s| f(&s)))
+}
+
+/// Two of eight participants stop answering after a new announcement: the writer's periodic heartbeats go to
+/// those two alone, not to the group, where the five that are up to date would answer each one.
+#[test]
+fn heartbeats_for_a_few_laggards_go_to_them_alone() {
+    let mut sim = Sim::with_participants(14, Faults::NONE, NODES);
+    let eps = endpoints(&mut sim);
+    assert!(sim.run_until(Duration::from_secs(5), |s| fully_matched(s, &eps)));
+    sim.run_for(Duration::from_secs(1));
+    sim.nodes[6].up = false;
+    sim.nodes[7].up = false;
+    sim.trace = Some(Vec::new());
+    let now = sim.now;
+    let spec = WriterSpec::new("Late", "X", true, DataWriterQos::default());
+    sim.nodes[0].p.create_writer(now, spec).unwrap();
+    // About five heartbeat periods (100 ms).
+    sim.run_for(Duration::from_millis(500));
+    let log = sim.trace.take().unwrap();
+    let group = sim.nodes[0].p.config().metatraffic_multicast()[0];
+    let periodic = |s: &Submessage<'_>| {
+        matches!(s, Submessage::Heartbeat(h)
+            if h.writer_id == EntityId::SEDP_PUBLICATIONS_WRITER && !h.final_flag)
+    };
+    let to_group = log
+        .iter()
+        .filter(|(from, to, m)| *from == 0 && to.contains(&group) && carries(m, periodic))
+        .count();
+    let to_laggards = log
+        .iter()
+        .filter(|(from, to, m)| *from == 0 && !to.contains(&group) && carries(m, periodic))
+        .count();
+    // One to the group: nobody had acknowledged the announcement (its piggy-backed heartbeat is final).
+    assert_eq!(to_group, 1, "heartbeats to the group");
+    assert!(to_laggards >= 3, "{to_laggards} heartbeats to the laggards");
+    let acks = log
+        .iter()
+        .filter(|(from, _, m)| {
+            (1..6).contains(from)
+                && carries(m, |s| {
+                    matches!(s, Submessage::AckNack(a)
+                        if a.writer_id == EntityId::SEDP_PUBLICATIONS_WRITER)
+                })
+        })
+        .count();
+    assert_eq!(
+        acks, 5,
+        "ACKNACKs from the participants that are up to date"
+    );
+}
