@@ -9,6 +9,8 @@
 # Ours: target/release/dds-scale. Cyclone 11: scripts/scale/node.py (PyPI binding). Needs root (ip netns). The
 # namespaces (ddsscale-*) are deleted on exit. A benchmark, not a test. STACKS="ours" or "cyclone" runs one side;
 # DDS_SCALE_BIN=path runs another dds-scale binary (e.g. one built at an older commit) without building.
+# CAPTURE=dir records every frame the nodes send (tshark on the bridge ports) to dir/NAME.pcap and prints the
+# datagrams, bytes and RTPS submessages each stack sent, by kind (scripts/scale/pcap-summary.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 nodes=${1:-10} per=${2:-10} topics=${3:-10}
@@ -40,6 +42,15 @@ run() {
   local name=$1; shift
   local tmp pids=() slowest=0 cpu=0 rss=0 failed=0
   tmp=$(mktemp -d)
+  local cap=
+  if [[ -n ${CAPTURE:-} ]]; then
+    mkdir -p "$CAPTURE"
+    local ifs=()
+    for i in $(seq "$nodes"); do ifs+=(-i "p$i"); done
+    ip netns exec "$hub" tshark -q "${ifs[@]}" -f udp -w "$CAPTURE/$name.pcapng" 2>"$tmp/tshark.log" &
+    cap=$!
+    sleep 2
+  fi
   for i in $(seq "$nodes"); do
     IFACE=v$i
     ip netns exec "ddsscale-$i" env DDS_INTERFACE="$IFACE" \
@@ -56,6 +67,12 @@ run() {
     cpu=$(awk -v a="$cpu" -v b="$c" 'BEGIN { print a + b }')
     rss=$((rss + r))
   done
+  if [[ -n $cap ]]; then
+    sleep 1
+    kill "$cap"
+    wait "$cap" || true
+    scripts/scale/pcap-summary.sh "$CAPTURE/$name.pcapng" "$nodes"
+  fi
   printf '%-12s %3d participants x %2d endpoints: full discovery %6.2f s  cpu %7.2f s  peak rss %7d KB (sum)  %d node(s) failed\n' \
     "$name" "$total" "$((2 * topics))" "$slowest" "$cpu" "$rss" "$failed"
   rm -rf "$tmp"

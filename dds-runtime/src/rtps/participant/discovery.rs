@@ -119,7 +119,7 @@ impl Participant {
         // The TypeLookup endpoints are matched when a request or reply is first exchanged with it.
         let pairs = |ours: EntityId| !super::type_lookup::is_service_endpoint(ours);
         self.match_builtin_pairs(now, prefix, bits, &meta, group, pairs);
-        self.match_topic_builtins(now, prefix, bits, &meta);
+        self.match_topic_builtins(now, prefix, bits, &meta, group);
         // Answer directly so the newcomer need not wait for our next periodic announcement.
         if !meta.is_empty() {
             self.send_spdp(Some(meta[..1].to_vec()));
@@ -159,10 +159,11 @@ impl Participant {
         }
     }
 
-    /// The metatraffic multicast group a discovered participant shares with us, if any. Our SEDP and
-    /// participant-message writers send new announcements and periodic heartbeats there once two or more
-    /// participants' readers share it (`Writer::choose_multicast`): one datagram instead of one per
-    /// participant, as SPDP itself does. Repairs stay unicast; TypeLookup, addressed to one participant, too.
+    /// The metatraffic multicast group a discovered participant shares with us, if any. Our SEDP (topics,
+    /// publications, subscriptions) and participant-message writers send new announcements and periodic
+    /// heartbeats there once two or more participants' readers share it (`Writer::choose_multicast`): one
+    /// datagram instead of one per participant, as SPDP itself does. Repairs stay unicast; TypeLookup,
+    /// addressed to one participant, too.
     fn shared_metatraffic_group(&self, data: &ParticipantData) -> Option<Locator> {
         data.metatraffic_multicast
             .iter()

@@ -103,9 +103,14 @@ impl Participant {
             self.trim_queues();
         }
         if now >= self.pmd_due {
-            // Automatic liveliness: one ParticipantMessageData per interval keeps our lease alive at peers that
-            // only count builtin liveliness traffic, and renews our AUTOMATIC writers' leases.
-            self.send_participant_message(now, builtin::PMD_KIND_AUTOMATIC);
+            // Automatic liveliness: one ParticipantMessageData per interval renews our AUTOMATIC writers'
+            // leases at peers that track them by these messages (Fast DDS). Only writers with a finite lease
+            // need it: the participant's own lease is kept by SPDP, sent as often. Without such a writer
+            // nothing is sent, as Cyclone does: each message costs an ACKNACK from every matched peer
+            // (docs/performance.md, "Scale").
+            if self.own_leases.shortest_automatic().is_some() {
+                self.send_participant_message(now, builtin::PMD_KIND_AUTOMATIC);
+            }
             self.own_leases.assert_automatic(now);
             self.pmd_due = now + self.automatic_interval();
         }

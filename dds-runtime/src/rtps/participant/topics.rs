@@ -92,11 +92,13 @@ impl Participant {
         prefix: GuidPrefix,
         bits: u32,
         meta: &std::sync::Arc<[Locator]>,
+        group: Option<Locator>,
     ) {
         let (ours, theirs, bit) = TOPIC_WRITER_PAIR;
         if bits & bit != 0 {
             if let Some(w) = self.writers.get_mut(&ours) {
-                let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true);
+                let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true)
+                    .with_multicast(group);
                 w.add_proxy(now, proxy, true, &mut self.events);
             }
         }

@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use crate::rtps::api::{ChangeKind, Event, Payload, ReceivedSample};
-use crate::rtps::due::DueFloor;
+use crate::rtps::due::DueQueue;
 use crate::rtps::messages::{
     AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, NackFrag, Submessage,
 };
@@ -55,8 +55,8 @@ pub(crate) struct Reader {
     params: ReaderParams,
     /// Boxed: a map node then holds pointers, not whole proxies (see `docs/performance.md`, "Footprint").
     proxies: BTreeMap<Guid, Box<WriterProxy>>,
-    /// Lower bound of the proxies' `acknack_due` and `nackfrag_due`.
-    proxy_floor: DueFloor,
+    /// The proxies whose `acknack_due` or `nackfrag_due` is armed, in deadline order.
+    due: DueQueue,
     /// Back-pressure: how many more changes reliable proxies may deliver (`None`: no limit). A change
     /// refused for lack of credit is not stored, so it stays missing and is NACKed, never acknowledged.
     credit: std::cell::Cell<Option<usize>>,
@@ -68,7 +68,7 @@ impl Reader {
             guid,
             params,
             proxies: BTreeMap::new(),
-            proxy_floor: DueFloor::default(),
+            due: DueQueue::default(),
             credit: std::cell::Cell::new(None),
         }
     }
@@ -118,12 +118,16 @@ impl Reader {
             // Pre-emptive ACKNACK: prompts the writer to tell us what it has.
             proxy.acknack_due = Some(now);
         }
-        self.proxy_floor.lower(proxy.acknack_due);
+        self.due.arm(proxy.acknack_due, proxy.guid);
         self.proxies.insert(proxy.guid, Box::new(proxy));
     }
 
     pub(crate) fn remove_proxy(&mut self, g: &Guid) -> bool {
-        self.proxies.remove(g).is_some()
+        let had = self.proxies.remove(g).is_some();
+        if self.proxies.is_empty() {
+            self.due.clear();
+        }
+        had
     }
 
     fn deliver(
@@ -485,10 +489,10 @@ impl Reader {
         }
         p.synced = true;
         let missing = p.hb_last >= p.next_expected;
-        if !hb.final_flag || missing {
-            p.acknack_due.get_or_insert(now + delay);
+        if (!hb.final_flag || missing) && p.acknack_due.is_none() {
+            p.acknack_due = Some(now + delay);
+            self.due.arm(p.acknack_due, writer);
         }
-        self.proxy_floor.lower(p.acknack_due);
     }
 
     /// HEARTBEAT_FRAG (§8.3.7.6): the writer has fragments 1..=last of one sample. Answered with a NACK_FRAG
@@ -526,33 +530,33 @@ impl Reader {
         }
         let last = b.nackfrag_req.entry(sn).or_insert(0);
         *last = (*last).max(hf.last_fragment_num);
-        b.nackfrag_due.get_or_insert(now + delay);
-        self.proxy_floor.lower(b.nackfrag_due);
+        if b.nackfrag_due.is_none() {
+            b.nackfrag_due = Some(now + delay);
+            self.due.arm(b.nackfrag_due, writer);
+        }
     }
 
     pub(crate) fn next_timeout(&self) -> Option<Instant> {
-        self.proxy_floor.get()
+        self.due.next()
     }
 
     /// Sends due ACKNACKs (and NACK_FRAGs for partly received samples), and NACK_FRAGs answering
     /// HEARTBEAT_FRAGs.
+    /// Only the proxies whose timer is due are visited (in deadline order), not every proxy.
     pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
-        if !self.proxy_floor.reached(now) {
-            return;
-        }
         let rid = self.guid.entity_id;
-        let mut exact = DueFloor::default();
-        for p in self.proxies.values_mut() {
+        while let Some(g) = self.due.pop_due(now) {
+            // A stale entry (timer cleared, proxy gone) finds nothing due.
+            let Some(p) = self.proxies.get_mut(&g) else {
+                continue;
+            };
             if p.acknack_due.is_some_and(|t| t <= now) {
                 Self::send_acknack(rid, p, out);
             }
             if p.nackfrag_due().is_some_and(|t| t <= now) {
                 Self::send_requested_nackfrags(rid, p, out);
             }
-            exact.lower(p.acknack_due);
-            exact.lower(p.nackfrag_due());
         }
-        self.proxy_floor = exact;
     }
 
     /// An ACKNACK for what is missing up to the last heartbeat, and a NACK_FRAG per partly received sample.

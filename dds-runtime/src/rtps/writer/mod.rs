@@ -25,7 +25,7 @@ use std::time::{Duration, Instant};
 
 use crate::qos::{Durability, History, ResourceLimits};
 use crate::rtps::api::{ChangeKind, Event, WriteChange, WriteError};
-use crate::rtps::due::DueFloor;
+use crate::rtps::due::DueQueue;
 use crate::rtps::messages::parameter::pid;
 use crate::rtps::messages::{
     Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, ParameterList, Submessage,
@@ -73,8 +73,8 @@ pub(crate) struct Writer {
     /// HEARTBEAT_FRAG count: its own sequence, separate from HEARTBEAT's (§8.3.7.6).
     hbfrag_count: i32,
     hb_due: Option<Instant>,
-    /// Lower bound of the proxies' `repair_due`.
-    repair_floor: DueFloor,
+    /// The proxies whose `repair_due` is armed, in deadline order.
+    repair_queue: DueQueue,
     bytes_since_nonfinal_hb: usize,
     /// Changes written since the last non-final heartbeat: with a sample limit on the history, small
     /// samples fill it long before the bytes reach the watermark.
@@ -110,7 +110,7 @@ impl Writer {
             hb_count: 0,
             hbfrag_count: 0,
             hb_due: None,
-            repair_floor: DueFloor::default(),
+            repair_queue: DueQueue::default(),
             bytes_since_nonfinal_hb: 0,
             changes_since_nonfinal_hb: 0,
             bytes_since_hb: 0,
@@ -455,11 +455,12 @@ impl Writer {
             proxy.floor = self.next_sn;
             proxy.acked = self.next_sn;
         } else if !self.history.is_empty() {
-            if proxy.reliable {
+            if proxy.reliable && !self.history_fits_one_push() {
                 // Announce the history; the reader asks for what it lacks.
                 proxy.repair_due = Some(now);
             } else {
-                // Best effort: push the history once.
+                // Best effort, or a reliable reader that would ask for all of it: push the history once
+                // (followed by a heartbeat), which saves the HEARTBEAT/ACKNACK round that would ask for it.
                 for c in self.history.range(SequenceNumber(1)) {
                     if !proxy.request(c.sn) {
                         break;
@@ -469,7 +470,7 @@ impl Writer {
             }
         }
         let behind = proxy.reliable && proxy.acked < self.next_sn;
-        self.repair_floor.lower(proxy.repair_due);
+        self.repair_queue.arm(proxy.repair_due, proxy.guid);
         self.proxies.insert(proxy.guid, Box::new(proxy));
         self.rebuild_dest();
         self.update_acked(ev);
@@ -480,9 +481,24 @@ impl Writer {
         }
     }
 
+    /// Whether a new reliable reader gets the history pushed at matching rather than announced: when it
+    /// holds every change from 1 on (so a reader that has nothing would ask for all of it, and no GAP is
+    /// needed) and fits in one repair round. A matched SEDP writer's announcements usually do; the cost
+    /// of a reader that had them already (matched again) is one repair round, as for a NACK of everything.
+    fn history_fits_one_push(&self) -> bool {
+        self.history.first_sn() == Some(SequenceNumber(1))
+            && self.history.len() as i64 == self.next_sn.0 - 1
+            && self.history.len() <= reader_proxy::MAX_REQUESTED
+            && self.history.bytes_from(SequenceNumber(1)) + 64 * self.history.len()
+                <= self.params.max_repair_bytes
+    }
+
     pub(crate) fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
         self.filters.set(*guid, None);
         let had = self.proxies.remove(guid).is_some();
+        if self.proxies.is_empty() {
+            self.repair_queue.clear();
+        }
         if had {
             self.rebuild_dest();
             self.update_acked(ev);
@@ -524,12 +540,13 @@ impl Writer {
         request_past_bitmap(p, &ack.reader_sn_state, next_sn);
         p.drop_requests_below(p.acked);
         // A request, or a reader that is behind without knowing it (e.g. a pre-emptive ACKNACK): answer soon.
-        if p.has_requested()
-            || (ack.reader_sn_state.num_bits == 0 && base < next_sn && !ack.final_flag)
+        if (p.has_requested()
+            || (ack.reader_sn_state.num_bits == 0 && base < next_sn && !ack.final_flag))
+            && p.repair_due.is_none()
         {
-            p.repair_due.get_or_insert(now + delay);
+            p.repair_due = Some(now + delay);
+            self.repair_queue.arm(p.repair_due, reader);
         }
-        self.repair_floor.lower(p.repair_due);
         if progressed {
             self.update_acked(ev);
             if self.is_acknowledged() {
@@ -573,12 +590,14 @@ impl Writer {
         } else {
             p.request(nf.writer_sn);
         }
-        p.repair_due.get_or_insert(now + delay);
-        self.repair_floor.lower(p.repair_due);
+        if p.repair_due.is_none() {
+            p.repair_due = Some(now + delay);
+            self.repair_queue.arm(p.repair_due, reader);
+        }
     }
 
     pub(crate) fn next_timeout(&self) -> Option<Instant> {
-        match (self.repair_floor.get(), self.hb_due) {
+        match (self.repair_queue.next(), self.hb_due) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         }
@@ -594,18 +613,16 @@ impl Writer {
 
     pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
         self.expire(now);
-        if self.repair_floor.reached(now) {
-            let due: Vec<Guid> = self
+        // Only the proxies whose repair is due are visited, earliest first; a stale entry (repair done
+        // already, proxy gone) finds nothing due.
+        while let Some(g) = self.repair_queue.pop_due(now) {
+            if self
                 .proxies
-                .values()
-                .filter(|p| p.repair_due.is_some_and(|t| t <= now))
-                .map(|p| p.guid)
-                .collect();
-            for g in due {
+                .get(&g)
+                .is_some_and(|p| p.repair_due.is_some_and(|t| t <= now))
+            {
                 self.repair(now, g, out);
             }
-            let exact = self.proxies.values().filter_map(|p| p.repair_due).min();
-            self.repair_floor.set_exact(exact);
         }
         if self.hb_due.is_some_and(|t| t <= now) {
             if self.has_reliable_proxy() && !self.is_acknowledged() {
@@ -688,14 +705,17 @@ impl Writer {
                 out.push(&dest, dst, Ts::Any, &hf);
             }
         }
+        let idle = budget == self.params.max_repair_bytes as isize && gaps.is_empty();
         send_gaps(out, &dest, dst, g.entity_id, wid, &gaps);
         let more = p.has_requests();
         p.release_if_served();
         let reliable = p.reliable;
         if more {
             p.repair_due = Some(now + self.params.nack_response_delay);
+            self.repair_queue.arm(p.repair_due, g);
         }
-        if reliable {
+        // A reader that acknowledged everything meanwhile (its ACKNACK crossed our push) needs no heartbeat.
+        if reliable && !(idle && p.acked >= self.next_sn) {
             let hb = self.heartbeat(g.entity_id, false);
             out.push(&dest, dst, Ts::Any, &hb);
         }
