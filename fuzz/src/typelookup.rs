@@ -50,7 +50,10 @@ pub fn typelookup_one(data: &[u8]) {
     if sel == 0xff {
         if let Ok(o) = from_bytes::<TypeObject>(payload) {
             let bytes = to_bytes(&o).expect("a decoded type object encodes");
-            assert_eq!(from_bytes::<TypeObject>(&bytes).expect("re-encoded object"), o);
+            assert_eq!(
+                from_bytes::<TypeObject>(&bytes).expect("re-encoded object"),
+                o
+            );
         }
     } else if sel % 2 == 0 {
         let Ok(req) = decode_request(payload) else {
