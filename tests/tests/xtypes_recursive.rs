@@ -224,3 +224,81 @@ fn hostile_nesting_stops_at_the_depth_limit() {
         "the encoder refuses to write past the depth limit too"
     );
 }
+
+/// Typed endpoints of a recursive type announce component identifiers in their type information; a writer
+/// and a reader of `Holder` (two components inside) in two participants over loopback still match (the
+/// identifiers are equal) and exchange a sample. Needs a network namespace (`scripts/isolated`).
+#[test]
+fn recursive_typed_endpoints_match_and_exchange_data() {
+    use dds_runtime::prelude::*;
+    use std::time::{Duration, Instant};
+    assert_eq!(
+        std::env::var("DDS_IN_NETNS").as_deref(),
+        Ok("1"),
+        "socket tests must run inside scripts/isolated (loopback-only network namespace)"
+    );
+    let part = || {
+        DomainParticipant::builder()
+            .domain_id(219)
+            .interface("lo")
+            .spdp_interval(Duration::from_millis(200))
+            .build()
+            .expect("participant")
+    };
+    let (p1, p2) = (part(), part());
+    let qos_w = DataWriterQos::builder()
+        .reliability(Reliability::Reliable {
+            max_blocking_time: Duration::from_secs(1),
+        })
+        .durability(Durability::TransientLocal)
+        .build();
+    let qos_r = DataReaderQos::builder()
+        .reliability(Reliability::Reliable {
+            max_blocking_time: Duration::from_secs(1),
+        })
+        .durability(Durability::TransientLocal)
+        .build();
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .and_then(|p| {
+            p.create_datawriter(
+                &p1.create_topic::<Holder>("RecTopic", &TopicQos::default())?,
+                &qos_w,
+            )
+        })
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| {
+            s.create_datareader(
+                &p2.create_topic::<Holder>("RecTopic", &TopicQos::default())?,
+                &qos_r,
+            )
+        })
+        .unwrap();
+    let sample = Holder {
+        id: 7,
+        root: Node {
+            value: 1,
+            children: vec![Node::default()],
+        },
+        a: A {
+            x: 2,
+            bs: vec![B { y: 3, as_: vec![] }],
+        },
+    };
+    w.write(&sample).unwrap();
+    let end = Instant::now() + Duration::from_secs(10);
+    let mut got = Vec::new();
+    while got.is_empty() && Instant::now() < end {
+        let _ = r.wait_for_data(Duration::from_millis(100));
+        got.extend(r.take().unwrap().into_iter().filter_map(|s| s.data));
+    }
+    assert_eq!(
+        got,
+        [sample],
+        "matched: {:?}",
+        r.matched_publication_guids()
+    );
+    assert_eq!(r.requested_incompatible_qos_status().total_count, 0);
+}
