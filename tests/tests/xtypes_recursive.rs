@@ -239,7 +239,7 @@ fn recursive_typed_endpoints_match_and_exchange_data() {
     );
     let part = || {
         DomainParticipant::builder()
-            .domain_id(219)
+            .domain_id(220)
             .interface("lo")
             .spdp_interval(Duration::from_millis(200))
             .build()
