@@ -365,3 +365,119 @@ fn dynamic_reader_read_and_query_conditions() {
     );
     assert!(!q.trigger_value());
 }
+
+/// Records each listener call of a dynamic reader by name.
+struct Calls(std::sync::Arc<std::sync::Mutex<Vec<&'static str>>>);
+
+impl DynamicReaderListener for Calls {
+    fn on_data_available(&self, _: &DynamicReader) {
+        self.0.lock().unwrap().push("data");
+    }
+    fn on_subscription_matched(&self, _: &DynamicReader, _: SubscriptionMatchedStatus) {
+        self.0.lock().unwrap().push("matched");
+    }
+    fn on_requested_deadline_missed(&self, _: &DynamicReader, _: DeadlineMissedStatus) {
+        self.0.lock().unwrap().push("deadline");
+    }
+    fn on_requested_incompatible_qos(&self, _: &DynamicReader, _: IncompatibleQosStatus) {
+        self.0.lock().unwrap().push("incompatible");
+    }
+    fn on_sample_rejected(&self, _: &DynamicReader, _: SampleRejectedStatus) {
+        self.0.lock().unwrap().push("rejected");
+    }
+}
+
+/// A dynamic reader's listener and status condition, against typed writers: matched, data available and
+/// deadline missed (a writer that stops), requested incompatible QoS (a best-effort writer), sample rejected
+/// (KEEP_ALL with max_samples_per_instance 2); `get_*_status` reset the counts and clear the condition.
+#[test]
+fn dynamic_reader_listener_and_status_condition() {
+    let ty = shape_from_builder();
+    let (p1, p2) = (participant(219), participant(219));
+    let publ = p1.create_publisher(&PublisherQos::default()).unwrap();
+    let t1 = p1
+        .create_topic::<ShapeType>("Square", &TopicQos::default())
+        .unwrap();
+    let w = publ
+        .create_datawriter(
+            &t1,
+            &DataWriterQos::builder()
+                .reliability(reliable())
+                .deadline(Duration::from_millis(100))
+                .history(History::KeepAll)
+                .build(),
+        )
+        .unwrap();
+    let topic = p2
+        .create_dynamic_topic("Square", ty, &TopicQos::default())
+        .unwrap();
+    let calls = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let rq = DataReaderQos::builder()
+        .reliability(reliable())
+        .deadline(Duration::from_millis(200))
+        .history(History::KeepAll)
+        .resource_limits(ResourceLimits {
+            max_samples_per_instance: Some(2),
+            ..ResourceLimits::default()
+        })
+        .build();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| {
+            s.create_dynamic_reader_with_listener(
+                &topic,
+                &rq,
+                Box::new(Calls(calls.clone())),
+                StatusMask::all(),
+            )
+        })
+        .unwrap();
+    let cond = r.status_condition();
+    cond.set_enabled_statuses(StatusMask::SUBSCRIPTION_MATCHED);
+    let ws = WaitSet::new();
+    ws.attach_condition(cond.clone());
+    assert!(!ws.wait(MATCH_TIMEOUT).unwrap().is_empty(), "no match");
+    assert_eq!(r.subscription_matched_status().current_count, 1);
+    assert!(!cond.trigger_value(), "reading the status clears it");
+    // Volatile: the writer must have matched the reader too, or the sample goes nowhere.
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    w.write(&shape("RED", 0)).unwrap();
+    cond.set_enabled_statuses(StatusMask::REQUESTED_DEADLINE_MISSED);
+    assert!(
+        !ws.wait(Duration::from_secs(5)).unwrap().is_empty(),
+        "no deadline"
+    );
+    assert!(r.requested_deadline_missed_status().total_count >= 1);
+    // Reliable KEEP_ALL: the third sample of the instance is rejected (and repaired later).
+    for x in 1..3 {
+        w.write(&shape("RED", x)).unwrap();
+    }
+    let best_effort = publ
+        .create_datawriter(
+            &t1,
+            &DataWriterQos::builder()
+                .reliability(Reliability::BestEffort)
+                .build(),
+        )
+        .unwrap();
+    cond.set_enabled_statuses(StatusMask::REQUESTED_INCOMPATIBLE_QOS);
+    assert!(
+        !ws.wait(MATCH_TIMEOUT).unwrap().is_empty(),
+        "no incompatible QoS"
+    );
+    assert_eq!(r.requested_incompatible_qos_status().total_count, 1);
+    drop(best_effort);
+    // The status condition is raised just before the listener is called: wait for the calls.
+    let all = ["matched", "data", "deadline", "incompatible", "rejected"];
+    let seen_all = || all.iter().all(|w| calls.lock().unwrap().contains(w));
+    assert!(
+        wait_until(Duration::from_secs(5), seen_all),
+        "listener calls: {:?}",
+        calls.lock().unwrap()
+    );
+    assert!(r.sample_rejected_status().total_count >= 1);
+    assert_eq!(r.take().len(), 2, "max_samples_per_instance");
+}

@@ -5,7 +5,7 @@
 //! and exchange samples both ways.
 //! Ignored by default (needs python3 + cyclonedds): run with
 //! `scripts/isolated cargo nextest run -p dds-runtime --features idl,json --test dcps_dynamic_cyclone
-//! --run-ignored ignored-only`. Domains 215, 216 and 217.
+//! --run-ignored ignored-only`. Domains 215, 216, 217 and 218.
 mod dcps_util;
 
 use std::io::{BufRead, BufReader};
@@ -257,4 +257,165 @@ fn cyclone_union_writer_to_dynamic_reader_instance_states() {
     assert_eq!(taken.len(), 1);
     assert_eq!(taken[0].info.instance_handle, h4);
     assert!(r.read_instance(h4).is_empty());
+}
+
+/// What a dynamic reader saw of its statuses: one line per status change.
+#[cfg(feature = "idl")]
+#[derive(Default)]
+struct Seen(std::sync::Mutex<Vec<String>>);
+
+#[cfg(feature = "idl")]
+impl Seen {
+    fn push(&self, what: String) {
+        self.0.lock().unwrap().push(what);
+    }
+    fn has(&self, prefix: &str) -> bool {
+        self.0.lock().unwrap().iter().any(|l| l.starts_with(prefix))
+    }
+    fn all(&self) -> Vec<String> {
+        self.0.lock().unwrap().clone()
+    }
+}
+
+#[cfg(feature = "idl")]
+struct Recorder(std::sync::Arc<Seen>);
+
+#[cfg(feature = "idl")]
+impl DynamicReaderListener for Recorder {
+    fn on_data_available(&self, r: &DynamicReader) {
+        let n = r.read_states(
+            SampleStateMask::NOT_READ,
+            ViewStateMask::ANY,
+            InstanceStateMask::ANY,
+        );
+        self.0.push(format!("data {}", n.len()));
+    }
+    fn on_subscription_matched(&self, _: &DynamicReader, s: SubscriptionMatchedStatus) {
+        self.0.push(format!("matched {}", s.current_count));
+    }
+    fn on_requested_deadline_missed(&self, _: &DynamicReader, s: DeadlineMissedStatus) {
+        self.0.push(format!("deadline {}", s.total_count));
+    }
+    fn on_liveliness_changed(&self, _: &DynamicReader, s: LivelinessChangedStatus) {
+        self.0.push(format!(
+            "liveliness {} {}",
+            s.alive_count, s.not_alive_count
+        ));
+    }
+}
+
+/// The statuses a WaitSet on a dynamic reader's status condition reports, each read (and so reset) once
+/// seen, in the `Seen` notation.
+#[cfg(feature = "idl")]
+fn waitset_round(r: &DynamicReader, ws: &WaitSet, seen: &Seen) {
+    let Ok(triggered) = ws.wait(Duration::from_millis(200)) else {
+        return;
+    };
+    if triggered.is_empty() {
+        return;
+    }
+    let changed = r.status_condition().changed_statuses();
+    if changed.contains(StatusMask::SUBSCRIPTION_MATCHED) {
+        seen.push(format!(
+            "matched {}",
+            r.subscription_matched_status().current_count
+        ));
+    }
+    if changed.contains(StatusMask::DATA_AVAILABLE) {
+        seen.push(format!("data {}", r.take().len()));
+    }
+    if changed.contains(StatusMask::REQUESTED_DEADLINE_MISSED) {
+        let s = r.requested_deadline_missed_status();
+        seen.push(format!("deadline {}", s.total_count));
+    }
+    if changed.contains(StatusMask::LIVELINESS_CHANGED) {
+        let s = r.liveliness_changed_status();
+        seen.push(format!(
+            "liveliness {} {}",
+            s.alive_count, s.not_alive_count
+        ));
+    }
+}
+
+/// A Cyclone writer (offered deadline 300 ms, MANUAL_BY_TOPIC liveliness with a 600 ms lease) writes five
+/// samples, then falls silent. Two dynamic readers of its type: one with a listener, one watched through a
+/// WaitSet on its status condition. Both see the match, the data, the missed deadline and the lost
+/// liveliness (a status change with no alive writer and one not alive).
+#[cfg(feature = "idl")]
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn dynamic_reader_statuses_from_a_cyclone_writer() {
+    use dds_runtime::xtypes::dynamic::types_from_idl;
+    use std::sync::Arc;
+    require_netns();
+    let ty = types_from_idl(
+        "b.idl",
+        "module xs { @final struct Beat { @key long id; long n; }; };",
+    )
+    .unwrap()
+    .remove("xs::Beat")
+    .unwrap();
+    let p = participant(218);
+    let t = p
+        .create_dynamic_topic("BeatTopic", ty, &TopicQos::default())
+        .unwrap();
+    let qos = DataReaderQos::builder()
+        .reliability(reliable())
+        .history(History::KeepLast(1))
+        .deadline(Duration::from_millis(300))
+        .build();
+    let s = p.create_subscriber(&SubscriberQos::default()).unwrap();
+    let by_listener = Arc::new(Seen::default());
+    let _listened = s
+        .create_dynamic_reader_with_listener(
+            &t,
+            &qos,
+            Box::new(Recorder(by_listener.clone())),
+            StatusMask::all(),
+        )
+        .unwrap();
+    let watched = s.create_dynamic_reader(&t, &qos).unwrap();
+    let cond = watched.status_condition();
+    cond.set_enabled_statuses(
+        StatusMask::SUBSCRIPTION_MATCHED
+            | StatusMask::DATA_AVAILABLE
+            | StatusMask::REQUESTED_DEADLINE_MISSED
+            | StatusMask::LIVELINESS_CHANGED,
+    );
+    let ws = WaitSet::new();
+    ws.attach_condition(cond);
+    let by_waitset = Seen::default();
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/dcps_util/cyclone_status.py"
+    );
+    let mut child = Command::new("python3")
+        .arg(script)
+        .env("CYCLONEDDS_URI", CYCLONE_URI)
+        .env("DDS_DOMAIN_ID", "218")
+        .stdin(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("python3 with cyclonedds");
+    let wanted = ["matched 1", "data ", "deadline ", "liveliness 0 1"];
+    let done = wait_until(Duration::from_secs(25), || {
+        waitset_round(&watched, &ws, &by_waitset);
+        wanted
+            .iter()
+            .all(|w| by_waitset.has(w) && by_listener.has(w))
+    });
+    drop(child.stdin.take());
+    let _ = child.wait();
+    assert!(
+        done,
+        "listener saw {:?}, waitset saw {:?}",
+        by_listener.all(),
+        by_waitset.all()
+    );
+    eprintln!(
+        "listener saw {:?}\nwaitset saw {:?}",
+        by_listener.all(),
+        by_waitset.all()
+    );
+    assert!(by_listener.has("liveliness 1 0") && by_waitset.has("liveliness 1 0"));
 }

@@ -1,13 +1,17 @@
 //! The TypeLookup request/reply decoder (`dds_runtime::xtypes::typelookup`). Whatever decodes must re-encode
 //! to bytes that decode to the same message; a decoded request goes through the server (with a store holding
 //! a few types), a decoded reply through a client with requests in flight (objects are stored only if their
-//! hash checks out). Nothing may panic or allocate beyond the input's size.
+//! hash checks out). Nothing may panic or allocate beyond the input's size. A first byte of 0xff makes the rest
+//! a bare type object (as replies carry them; seeds `bitset_*`: `TK_BITSET` objects), which must re-encode to
+//! bytes that decode to the same object.
 
 use std::time::Instant;
 
 use dds_runtime::xtypes::store::{StoreLimits, TypeStore};
 use dds_runtime::xtypes::typelookup::*;
-use dds_runtime::xtypes::typeobject::{from_bytes, TypeIdentifier, TypeInformation, TypeMapping};
+use dds_runtime::xtypes::typeobject::{
+    from_bytes, to_bytes, TypeIdentifier, TypeInformation, TypeMapping, TypeObject,
+};
 use dds_runtime::xtypes::XTypesType;
 
 #[derive(dds_runtime::DdsType, Debug, Clone, PartialEq, Default)]
@@ -43,7 +47,15 @@ pub fn typelookup_one(data: &[u8]) {
         return;
     };
     let now = Instant::now();
-    if sel % 2 == 0 {
+    if sel == 0xff {
+        if let Ok(o) = from_bytes::<TypeObject>(payload) {
+            let bytes = to_bytes(&o).expect("a decoded type object encodes");
+            assert_eq!(
+                from_bytes::<TypeObject>(&bytes).expect("re-encoded object"),
+                o
+            );
+        }
+    } else if sel % 2 == 0 {
         let Ok(req) = decode_request(payload) else {
             return;
         };

@@ -77,6 +77,7 @@ impl<T: DdsType> SampleCodec<T> for Derived {
 }
 
 /// [`decode_change_with`] for a derived type.
+#[cfg(test)]
 pub(crate) fn decode_change<T: DdsType>(
     s: ReceivedSample,
     info: RemoteWriterInfo,

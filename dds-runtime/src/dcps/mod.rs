@@ -71,7 +71,9 @@ pub use condition::{
     Condition, GuardCondition, QueryCondition, ReadCondition, StatusCondition, WaitSet,
 };
 pub use durability::{DurabilityServiceConfig, DurabilityServiceMode};
-pub use dynamic::{DynamicReader, DynamicSample, DynamicTopic, DynamicWriter};
+pub use dynamic::{
+    DynamicReader, DynamicReaderListener, DynamicSample, DynamicTopic, DynamicWriter,
+};
 pub use error::{DdsError, DdsResult};
 pub use filter::{ContentFilter, FieldValue, FilterError, FilterFields};
 pub use listener::{

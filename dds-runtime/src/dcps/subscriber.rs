@@ -1,6 +1,7 @@
 //! `Subscriber` and `DataReader<T>`.
 
 mod builtin;
+mod kind;
 mod ops;
 
 use std::collections::VecDeque;
@@ -21,7 +22,7 @@ use super::cache::{to_sample, Outcome, ReaderCache, Selection};
 use super::condition::{
     QueryCondition, ReadCondition, ReadConditionSource, Signal, StatusCondition,
 };
-use super::decode::decode_change;
+use super::decode::decode_change_with;
 use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
 use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
@@ -41,6 +42,7 @@ use super::topic::{Topic, TopicDescription};
 use crate::filter::ContentFilter;
 
 pub(crate) use builtin::{BuiltinGroup, BuiltinReader};
+pub(crate) use kind::{reader_callbacks, ReaderCallbacks, ReaderKind, Typed};
 pub use ops::SubscriberListener;
 
 /// Callbacks of a [`DataReader`] (see [`crate::dcps::listener`]). Every method has an empty default.
@@ -190,7 +192,8 @@ impl Subscriber {
         cache.set_filter(topic.sample_filter());
         cache.set_instance_order(instance_ordered(&group_qos.presentation));
 
-        let inner = Arc::new(ReaderInner::<T>::new(
+        let inner = Arc::new(ReaderInner::<Typed<T>>::new(
+            super::decode::Derived,
             driver.clone(),
             cache,
             group_ordered(&group_qos.presentation).then(|| self.access.order()),
@@ -243,7 +246,7 @@ const NO_CREDIT_LIMIT: usize = usize::MAX;
 
 /// The credit a reader gives the core: reliable KEEP_ALL with `max_samples` delivers (and acknowledges)
 /// only what fits in the cache.
-fn credit_limit(q: &DataReaderQos) -> Option<usize> {
+pub(crate) fn credit_limit(q: &DataReaderQos) -> Option<usize> {
     match (&q.reliability, &q.history, q.resource_limits.max_samples) {
         (crate::qos::Reliability::Reliable { .. }, crate::qos::History::KeepAll, Some(m)) => {
             Some(m as usize)
@@ -252,8 +255,8 @@ fn credit_limit(q: &DataReaderQos) -> Option<usize> {
     }
 }
 
-struct CacheState<T> {
-    cache: ReaderCache<T>,
+pub(crate) struct CacheState<T> {
+    pub(crate) cache: ReaderCache<T>,
     /// Key hash → serialized key, learnt from samples that carried both (for key-hash-only disposes).
     by_hash: HashMap<[u8; 16], Vec<u8>>,
     /// The queue being processed, swapped with `pending` (one lock round per batch, buffers reused).
@@ -277,14 +280,17 @@ struct Stored {
     rejected: Vec<(super::status::SampleRejectedReason, InstanceHandle)>,
 }
 
-/// What a reader's handle keeps alive.
-struct ReaderOwner<T> {
+/// What a typed reader's handle keeps alive.
+pub(crate) struct ReaderOwner<T> {
     topic: Topic<T>,
     subscriber: Subscriber,
 }
 
-struct ReaderInner<T: DdsType> {
-    state: EndpointState<ReaderStatuses, dyn DataReaderListener<T>, ReaderOwner<T>>,
+/// A reader's state behind its public handle, typed or dynamic ([`ReaderKind`]).
+pub(crate) struct ReaderInner<K: ReaderKind> {
+    /// Decodes the samples.
+    codec: K::Codec,
+    pub(crate) state: EndpointState<ReaderStatuses, K::Listener, K::Owner>,
     /// Queued changes, each with its place in the subscriber's order (GROUP ordered access; else 0).
     pending: Mutex<VecDeque<(u64, Pending)>>,
     /// GROUP ordered access: the subscriber's counter, which places each change as the core delivers it.
@@ -295,7 +301,7 @@ struct ReaderInner<T: DdsType> {
     staged: Mutex<VecDeque<(u64, Pending)>>,
     /// What the access scope stored, for `announce`.
     committed: Mutex<Stored>,
-    cache: Mutex<CacheState<T>>,
+    pub(crate) cache: Mutex<CacheState<K::Data>>,
     data_cv: Condvar,
     /// Threads in `wait_for_data`; registered under the cache lock so that `notify_data` (called after the
     /// change was made under that lock) skips the futex wake only when nobody can be sleeping.
@@ -319,7 +325,7 @@ struct ReaderInner<T: DdsType> {
 /// Coherent sets are stored whole or not at all; ordered access with INSTANCE scope groups reads by
 /// instance; with GROUP scope the subscriber's readers share one order (see `Subscriber::get_datareaders`).
 pub struct DataReader<T: DdsType> {
-    inner: Arc<ReaderInner<T>>,
+    inner: Arc<ReaderInner<Typed<T>>>,
     handle: Arc<EndpointHandle<ReaderOwner<T>>>,
 }
 
@@ -412,48 +418,15 @@ impl<'a, T: DdsType> Selector<'a, T> {
 }
 
 impl<T: DdsType> DataReader<T> {
-    /// Core of read and take: calls `emit` with each selected sample's data slot and info (with `take` the
-    /// samples leave the cache), then updates DATA_AVAILABLE, the read conditions and the reader's credit.
+    /// See [`ReaderInner::visit`].
     fn visit(
         &self,
-        mut sel: Selection,
+        sel: Selection,
         next_after: Option<InstanceHandle>,
         take: bool,
-        mut emit: impl FnMut(&mut Option<T>, SampleInfo),
+        emit: impl FnMut(&mut Option<T>, SampleInfo),
     ) -> DdsResult<usize> {
-        self.inner.state.check_enabled()?;
-        self.inner.state.data_read();
-        let mut n = 0;
-        {
-            let mut st = lock(&self.inner.cache);
-            if let Some(prev) = next_after {
-                sel.instance = None;
-                match st.cache.next_instance(prev, &sel) {
-                    Some(h) => sel.instance = Some(h),
-                    None => return Ok(0),
-                }
-            }
-            st.cache.collect_with(&sel, take, |slot, info| {
-                n += 1;
-                emit(slot, info);
-            });
-            let unread = Selection {
-                sample_states: SampleStateMask::NOT_READ,
-                ..Selection::default()
-            };
-            if !st.cache.has_matching(&unread) {
-                self.inner
-                    .state
-                    .status_core()
-                    .clear(StatusMask::DATA_AVAILABLE);
-            }
-        }
-        if take && n > 0 {
-            self.inner.refresh_credit();
-        }
-        // Read conditions may have stopped triggering.
-        self.inner.data_signal.notify();
-        Ok(n)
+        self.inner.visit(sel, next_after, take, emit)
     }
 
     /// Zero-copy read of all samples, see [`Selector::read_with`].
@@ -621,34 +594,7 @@ impl<T: DdsType> DataReader<T> {
 
     /// Blocks until a not-read sample is available (`Ok(true)`) or `timeout` passes (`Ok(false)`).
     pub fn wait_for_data(&self, timeout: Duration) -> DdsResult<bool> {
-        self.inner.state.check_enabled()?;
-        let deadline = Instant::now().checked_add(timeout);
-        let unread = Selection {
-            sample_states: SampleStateMask::NOT_READ,
-            ..Selection::default()
-        };
-        let mut st = lock(&self.inner.cache);
-        loop {
-            if st.cache.has_matching(&unread) {
-                return Ok(true);
-            }
-            self.inner.state.driver.check_alive()?;
-            let left = match deadline {
-                Some(d) => match d.checked_duration_since(Instant::now()) {
-                    Some(l) if !l.is_zero() => l,
-                    _ => return Ok(false),
-                },
-                None => Duration::from_secs(1),
-            };
-            self.inner.data_waiters.fetch_add(1, AtomicOrdering::SeqCst);
-            st = recover(
-                self.inner
-                    .data_cv
-                    .wait_timeout(st, left.min(Duration::from_secs(1))),
-            )
-            .0;
-            self.inner.data_waiters.fetch_sub(1, AtomicOrdering::SeqCst);
-        }
+        self.inner.wait_for_data(timeout)
     }
 
     /// Blocks until every matched reliable writer's announced data (the history of TRANSIENT_LOCAL writers
@@ -803,16 +749,18 @@ impl<T: DdsType> DataReader<T> {
     }
 }
 
-impl<T: DdsType> ReaderInner<T> {
+impl<K: ReaderKind> ReaderInner<K> {
     /// The state of a new reader with `cache`, not yet created in the core.
-    fn new(
+    pub(crate) fn new(
+        codec: K::Codec,
         driver: Arc<super::driver::Driver>,
-        cache: ReaderCache<T>,
+        cache: ReaderCache<K::Data>,
         group_order: Option<Arc<AtomicU64>>,
         access: Option<Arc<AccessScope>>,
         credit_limit: Option<usize>,
     ) -> Self {
         ReaderInner {
+            codec,
             state: EndpointState::new(driver),
             pending: Mutex::new(VecDeque::new()),
             group_order,
@@ -833,11 +781,81 @@ impl<T: DdsType> ReaderInner<T> {
     }
 
     /// The public reader, for listeners.
-    fn reader(
-        self: &Arc<Self>,
-    ) -> impl FnOnce(Arc<EndpointHandle<ReaderOwner<T>>>) -> DataReader<T> {
+    fn reader(self: &Arc<Self>) -> impl FnOnce(Arc<EndpointHandle<K::Owner>>) -> K::Reader {
         let inner = self.clone();
-        move |handle| DataReader { inner, handle }
+        move |handle| K::reader(inner, handle)
+    }
+
+    /// Core of read and take: calls `emit` with each selected sample's data slot and info (with `take` the
+    /// samples leave the cache), then updates DATA_AVAILABLE, the read conditions and the reader's credit.
+    pub(crate) fn visit(
+        &self,
+        mut sel: Selection,
+        next_after: Option<InstanceHandle>,
+        take: bool,
+        mut emit: impl FnMut(&mut Option<K::Data>, SampleInfo),
+    ) -> DdsResult<usize> {
+        self.state.check_enabled()?;
+        self.state.data_read();
+        let mut n = 0;
+        {
+            let mut st = lock(&self.cache);
+            if let Some(prev) = next_after {
+                sel.instance = None;
+                match st.cache.next_instance(prev, &sel) {
+                    Some(h) => sel.instance = Some(h),
+                    None => return Ok(0),
+                }
+            }
+            st.cache.collect_with(&sel, take, |slot, info| {
+                n += 1;
+                emit(slot, info);
+            });
+            let unread = Selection {
+                sample_states: SampleStateMask::NOT_READ,
+                ..Selection::default()
+            };
+            if !st.cache.has_matching(&unread) {
+                self.state.status_core().clear(StatusMask::DATA_AVAILABLE);
+            }
+        }
+        if take && n > 0 {
+            self.refresh_credit();
+        }
+        // Read conditions may have stopped triggering.
+        self.data_signal.notify();
+        Ok(n)
+    }
+
+    /// Blocks until a not-read sample is available (`Ok(true)`) or `timeout` passes (`Ok(false)`).
+    pub(crate) fn wait_for_data(&self, timeout: Duration) -> DdsResult<bool> {
+        self.state.check_enabled()?;
+        let deadline = Instant::now().checked_add(timeout);
+        let unread = Selection {
+            sample_states: SampleStateMask::NOT_READ,
+            ..Selection::default()
+        };
+        let mut st = lock(&self.cache);
+        loop {
+            if st.cache.has_matching(&unread) {
+                return Ok(true);
+            }
+            self.state.driver.check_alive()?;
+            let left = match deadline {
+                Some(d) => match d.checked_duration_since(Instant::now()) {
+                    Some(l) if !l.is_zero() => l,
+                    _ => return Ok(false),
+                },
+                None => Duration::from_secs(1),
+            };
+            self.data_waiters.fetch_add(1, AtomicOrdering::SeqCst);
+            st = recover(
+                self.data_cv
+                    .wait_timeout(st, left.min(Duration::from_secs(1))),
+            )
+            .0;
+            self.data_waiters.fetch_sub(1, AtomicOrdering::SeqCst);
+        }
     }
 
     /// `writer` became alive (`Some(true)`), not alive (`Some(false)`) or unmatched (`None`): LIVELINESS_CHANGED
@@ -855,7 +873,7 @@ impl<T: DdsType> ReaderInner<T> {
                     .then_some(&mut st.liveliness_changed)
             },
             self.reader(),
-            |l, r, s| l.on_liveliness_changed(r, s),
+            |l, r, s| l.liveliness_changed(r, s),
         );
     }
 
@@ -874,7 +892,7 @@ impl<T: DdsType> ReaderInner<T> {
     }
 
     /// Decodes one received change and stores it in the cache.
-    fn store(&self, st: &mut CacheState<T>, s: ReceivedSample, pass: &mut Pass) {
+    fn store(&self, st: &mut CacheState<K::Data>, s: ReceivedSample, pass: &mut Pass) {
         let info = match pass.writer_info {
             Some((g, info)) if g == s.writer => info,
             _ => {
@@ -884,8 +902,15 @@ impl<T: DdsType> ReaderInner<T> {
             }
         };
         let key = st.cache.take_key_buffer();
-        let Some(inc) = decode_change::<T>(s, info, &mut st.by_hash, key, pass.now, pass.rx_time)
-        else {
+        let Some(inc) = decode_change_with(
+            &self.codec,
+            s,
+            info,
+            &mut st.by_hash,
+            key,
+            pass.now,
+            pass.rx_time,
+        ) else {
             return;
         };
         match st.cache.insert(inc, pass.now) {
@@ -942,7 +967,7 @@ impl<T: DdsType> ReaderInner<T> {
                     &mut st.sample_rejected
                 },
                 self.reader(),
-                |l, r, s| l.on_sample_rejected(r, s),
+                |l, r, s| l.sample_rejected(r, s),
             );
         }
         if any {
@@ -961,11 +986,11 @@ impl<T: DdsType> ReaderInner<T> {
         self.state.status_core().raise(StatusMask::DATA_AVAILABLE);
         self.data_signal.notify();
         self.state
-            .call_listener(self.reader(), |l, r| l.on_data_available(r));
+            .call_listener(self.reader(), |l, r| l.data_available(r));
     }
 }
 
-impl<T: DdsType> Endpoint for ReaderInner<T> {
+impl<K: ReaderKind> Endpoint for ReaderInner<K> {
     fn enqueue(&self, item: Pending) {
         // Numbered here, under the core lock, in the core's order across the subscriber's readers (they
         // store their queues one after the other).
@@ -999,7 +1024,7 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                     |st| &mut st.subscription_matched,
                     (*writer, *matched),
                     self.reader(),
-                    |l, r, s| l.on_subscription_matched(r, s),
+                    |l, r, s| l.subscription_matched(r, s),
                 );
                 // A writer matched is alive until its lease says otherwise; an unmatched one is no longer
                 // counted.
@@ -1014,7 +1039,7 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                         &mut st.requested_incompatible_qos
                     },
                     self.reader(),
-                    |l, r, s| l.on_requested_incompatible_qos(r, s),
+                    |l, r, s| l.requested_incompatible_qos(r, s),
                 );
             }
             Event::LivelinessChanged { writer, alive, .. } => {
@@ -1034,7 +1059,7 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                         &mut st.sample_lost
                     },
                     self.reader(),
-                    |l, r, s| l.on_sample_lost(r, s),
+                    |l, r, s| l.sample_lost(r, s),
                 );
             }
             _ => {}
@@ -1053,12 +1078,12 @@ impl<T: DdsType> Endpoint for ReaderInner<T> {
                 &mut st.requested_deadline_missed
             },
             self.reader(),
-            |l, r, s| l.on_requested_deadline_missed(r, s),
+            |l, r, s| l.requested_deadline_missed(r, s),
         );
     }
 }
 
-impl<T: DdsType> AccessMember for ReaderInner<T> {
+impl<K: ReaderKind> AccessMember for ReaderInner<K> {
     fn stage(&self) {
         let mut queued = lock(&self.pending);
         lock(&self.staged).append(&mut queued);
@@ -1081,7 +1106,7 @@ impl<T: DdsType> AccessMember for ReaderInner<T> {
     }
 }
 
-impl<T: DdsType> ReadConditionSource for ReaderInner<T> {
+impl<K: ReaderKind> ReadConditionSource for ReaderInner<K> {
     fn has_matching(
         &self,
         s: SampleStateMask,

@@ -6,11 +6,20 @@
 //! - the dependent types are those without dependencies of their own (in discovery order), then the others
 //!   in post-order; the complete list keeps repeats, the minimal one drops them;
 //! - the mapping holds the types with dependencies (topic type first), then those without.
+//!
+//! Recursive types (XTypes 1.3 §7.3.4.9) as the binding builds them: the types of a strongly connected
+//! component (`super::scc`: more than one type, or one that depends on itself) are sorted by name and numbered
+//! from 1; their objects are made with `StronglyConnectedComponentId`s of a zero hash for each other, the
+//! sequence of those objects (XCDR2, as a `@final` struct holding `sequence<TypeObject>`) is hashed, and each
+//! type's identifier is the component id with that hash and its number; its objects then carry the hash too.
+//! In dependency lists a component stands as a whole (number 0, the size of that sequence), after the
+//! components it depends on; the mapping lists each of its types.
 
 use std::collections::HashMap;
 
 use super::describe::TypeRef;
 use super::error::BuildError;
+use super::scc::Components;
 use super::shape::{Def, Described, Shape};
 use super::typeobject::*;
 
@@ -40,23 +49,42 @@ impl TypeSupport {
             described: d,
             done: HashMap::new(),
             busy: Vec::new(),
+            placeholders: HashMap::new(),
         };
+        let (inner, leaves): (Vec<usize>, Vec<usize>) =
+            (0..graph.nodes.len()).partition(|&i| !graph.edges[i].is_empty());
+        let comps = Components::find(&graph.edges, &inner);
+        let mut post = Vec::new();
+        if !inner.is_empty() {
+            comps.post_order(0, &mut post);
+        }
+        // Recursive components first, those they depend on before them.
+        let mut wholes = vec![None; comps.members.len()];
+        for &c in &post {
+            if comps.recursive[c] && wholes[c].is_none() {
+                let names: Vec<&str> = comps.members[c].iter().map(|&i| graph.nodes[i]).collect();
+                wholes[c] = Some(b.component(names)?);
+            }
+        }
         let nodes: Vec<Built> = graph
             .nodes
             .iter()
             .map(|&n| b.named(n))
             .collect::<Result<_, _>>()?;
-        let (inner, leaves): (Vec<usize>, Vec<usize>) =
-            (0..nodes.len()).partition(|&i| !graph.edges[i].is_empty());
-        let mut deps: Vec<usize> = Vec::new();
+        let mut deps: Vec<[TypeIdentifierWithSize; 2]> = Vec::new();
         if !inner.is_empty() {
-            deps.extend(&leaves);
-            graph.check_acyclic(&inner)?;
-            let mut post = Vec::new();
-            graph.post_order(0, &inner, &mut post);
-            deps.extend(post.into_iter().filter(|&i| i != 0));
+            deps.extend(leaves.iter().map(|&i| both_with_size(&nodes[i])));
+            for c in post {
+                match &wholes[c] {
+                    Some(whole) => deps.push(whole.clone()),
+                    None if comps.members[c] != [0] => {
+                        deps.push(both_with_size(&nodes[comps.members[c][0]]))
+                    }
+                    None => {}
+                }
+            }
         }
-        let information = information(&nodes, &deps);
+        let information = information(&nodes[0], &deps);
         let order: Vec<usize> = if inner.is_empty() {
             vec![0]
         } else {
@@ -96,24 +124,29 @@ fn with_size(n: &Built, complete: bool) -> TypeIdentifierWithSize {
     }
 }
 
-/// The `TypeInformation` of node 0 with these dependencies (repeats dropped from the minimal list only).
-fn information(nodes: &[Built], deps: &[usize]) -> TypeInformation {
+/// A type's minimal and complete identifiers with their objects' sizes.
+fn both_with_size(n: &Built) -> [TypeIdentifierWithSize; 2] {
+    [with_size(n, false), with_size(n, true)]
+}
+
+/// The `TypeInformation` of `top` with these dependencies, minimal and complete (repeats dropped from the
+/// minimal list only).
+fn information(top: &Built, deps: &[[TypeIdentifierWithSize; 2]]) -> TypeInformation {
     let mut minimal_deps: Vec<TypeIdentifierWithSize> = Vec::new();
-    for &d in deps {
-        let t = with_size(&nodes[d], false);
-        if !minimal_deps.contains(&t) {
-            minimal_deps.push(t);
+    for [t, _] in deps {
+        if !minimal_deps.contains(t) {
+            minimal_deps.push(t.clone());
         }
     }
-    let complete_deps: Vec<_> = deps.iter().map(|&d| with_size(&nodes[d], true)).collect();
+    let complete_deps: Vec<_> = deps.iter().map(|[_, t]| t.clone()).collect();
     TypeInformation {
         minimal: TypeIdentifierWithDependencies {
-            typeid_with_size: with_size(&nodes[0], false),
+            typeid_with_size: with_size(top, false),
             dependent_typeid_count: minimal_deps.len() as i32,
             dependent_typeids: minimal_deps,
         },
         complete: TypeIdentifierWithDependencies {
-            typeid_with_size: with_size(&nodes[0], true),
+            typeid_with_size: with_size(top, true),
             dependent_typeid_count: complete_deps.len() as i32,
             dependent_typeids: complete_deps,
         },
@@ -186,44 +219,6 @@ impl<'a> Graph<'a> {
         }
         g
     }
-
-    fn check_acyclic(&self, inner: &[usize]) -> Result<(), BuildError> {
-        // Colour-marking depth-first search over the types with dependencies.
-        fn visit(g: &Graph, i: usize, state: &mut [u8]) -> Result<(), BuildError> {
-            state[i] = 1;
-            for &j in &g.edges[i] {
-                match state[j] {
-                    1 => return Err(BuildError::Recursive(g.nodes[j].to_owned())),
-                    0 => visit(g, j, state)?,
-                    _ => {}
-                }
-            }
-            state[i] = 2;
-            Ok(())
-        }
-        let mut state = vec![0u8; self.nodes.len()];
-        inner.iter().try_for_each(|&i| {
-            if state[i] == 0 {
-                visit(self, i, &mut state)
-            } else {
-                Ok(())
-            }
-        })
-    }
-
-    /// Post-order over the types with dependencies, children in discovery order (repeats kept).
-    fn post_order(&self, i: usize, inner: &[usize], out: &mut Vec<usize>) {
-        let mut children: Vec<usize> = self.edges[i]
-            .iter()
-            .copied()
-            .filter(|j| inner.contains(j))
-            .collect();
-        children.sort_unstable();
-        for j in children {
-            self.post_order(j, inner, out);
-        }
-        out.push(i);
-    }
 }
 
 /// The named types a definition refers to, in Cyclone's gathering order.
@@ -281,9 +276,111 @@ struct Builder<'a> {
     described: &'a Described,
     done: HashMap<&'a str, Built>,
     busy: Vec<&'a str>,
+    /// While a recursive component is built: the identifiers its types have for each other (minimal,
+    /// complete).
+    placeholders: HashMap<&'a str, [TypeIdentifier; 2]>,
+}
+
+/// The identifiers of the `index`th type (from 1; 0: the whole) of a component of `len` types whose objects
+/// hash to `hashes` (minimal, complete).
+fn component_ids(hashes: [EquivalenceHash; 2], len: usize, index: usize) -> [TypeIdentifier; 2] {
+    let id = |kind, hash| {
+        TypeIdentifier::StronglyConnected(StronglyConnectedComponentId {
+            kind,
+            hash,
+            scc_length: len as i32,
+            scc_index: index as i32,
+        })
+    };
+    [
+        id(EquivalenceKind::Minimal, hashes[0]),
+        id(EquivalenceKind::Complete, hashes[1]),
+    ]
+}
+
+/// A component's objects as the binding hashes them: a `@final` struct holding `sequence<TypeObject>`, XCDR2
+/// little endian without encapsulation header (DHEADER, count, each object 4-aligned).
+fn component_bytes(objects: &[TypeObject]) -> Result<Vec<u8>, BuildError> {
+    let mut body = Vec::new();
+    for o in objects {
+        body.resize(body.len().next_multiple_of(4), 0);
+        body.extend(to_bytes(o)?);
+    }
+    let mut out = Vec::with_capacity(body.len() + 8);
+    out.extend(((body.len() + 4) as u32).to_le_bytes());
+    out.extend((objects.len() as u32).to_le_bytes());
+    out.extend(body);
+    Ok(out)
 }
 
 impl<'a> Builder<'a> {
+    /// Builds the types of a recursive component (see the module documentation); returns the identifiers
+    /// and sizes of the component as a whole (minimal, complete).
+    fn component(
+        &mut self,
+        mut names: Vec<&'a str>,
+    ) -> Result<[TypeIdentifierWithSize; 2], BuildError> {
+        names.sort_unstable();
+        let len = names.len();
+        let mut hashes = [[0u8; 14]; 2];
+        let mut sizes = [0usize; 2];
+        // Twice: with zero hashes for the hash, then with the hash for the objects.
+        for pass in 0..2 {
+            for (k, &n) in names.iter().enumerate() {
+                self.placeholders
+                    .insert(n, component_ids(hashes, len, k + 1));
+            }
+            let mut objects: [Vec<TypeObject>; 2] = [Vec::new(), Vec::new()];
+            for &n in &names {
+                let def = self.described.def(n);
+                objects[0].push(TypeObject::Minimal(MinimalTypeObject(
+                    self.body(n, def, false)?,
+                )));
+                objects[1].push(TypeObject::Complete(CompleteTypeObject(
+                    self.body(n, def, true)?,
+                )));
+            }
+            if pass == 0 {
+                for e in 0..2 {
+                    let bytes = component_bytes(&objects[e])?;
+                    sizes[e] = bytes.len();
+                    hashes[e] = equivalence_hash(&bytes);
+                }
+                continue;
+            }
+            let [minimal, complete] = objects;
+            for (k, (m, c)) in minimal.into_iter().zip(complete).enumerate() {
+                let (TypeObject::Minimal(minimal), TypeObject::Complete(complete)) = (m, c) else {
+                    unreachable!("built as minimal and complete")
+                };
+                let [minimal_id, complete_id] = component_ids(hashes, len, k + 1);
+                let built = Built {
+                    minimal_len: to_bytes(&TypeObject::Minimal(minimal.clone()))?.len(),
+                    complete_len: to_bytes(&TypeObject::Complete(complete.clone()))?.len(),
+                    minimal,
+                    complete,
+                    minimal_id,
+                    complete_id,
+                };
+                self.done.insert(names[k], built);
+            }
+        }
+        for n in &names {
+            self.placeholders.remove(n);
+        }
+        let [m, c] = component_ids(hashes, len, 0);
+        Ok([
+            TypeIdentifierWithSize {
+                type_id: m,
+                typeobject_serialized_size: sizes[0] as u32,
+            },
+            TypeIdentifierWithSize {
+                type_id: c,
+                typeobject_serialized_size: sizes[1] as u32,
+            },
+        ])
+    }
+
     fn named(&mut self, name: &'a str) -> Result<Built, BuildError> {
         if let Some(b) = self.done.get(name) {
             return Ok(b.clone());
@@ -361,6 +458,9 @@ impl<'a> Builder<'a> {
                     key_flags: MemberFlag::empty(),
                     key: Box::new(key),
                 }
+            }
+            Shape::Named(n) if self.placeholders.contains_key(n.as_str()) => {
+                self.placeholders[n.as_str()][usize::from(complete)].clone()
             }
             Shape::Named(n) => {
                 let b = self.named(n)?;

@@ -69,6 +69,7 @@ mod describe;
 mod error;
 mod objects;
 mod octet;
+mod scc;
 mod shape;
 
 pub use alias::{Bounded, Octet};

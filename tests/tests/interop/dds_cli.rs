@@ -1,7 +1,9 @@
 //! The `dds` command line against Cyclone DDS 11 (Python binding): `dds ls --json` lists a Cyclone writer
 //! and reader with their topic and type names, `dds ps` shows the Cyclone process, `dds subscribe --idl`
 //! prints what the Cyclone writer writes, `dds publish --idl` reaches the Cyclone reader, and `dds typeof`
-//! without `--idl` says why the discovered type cannot be used yet.
+//! without `--idl` says why the discovered type cannot be used yet. `dds subscribe` shows the disposes of a
+//! Cyclone writer that writes and at once disposes each instance (the dispose then usually only marks the
+//! sample still held, as the reader cache does, instead of arriving as a sample of its own).
 
 use std::process::Command;
 use std::time::Duration;
@@ -260,6 +262,97 @@ fn dds_publish_idl_reaches_cyclone_reader() {
         "GREEN: {got:?}"
     );
     let _ = p.interrupt(WAIT);
+}
+
+/// A Cyclone writer on "Flash" that, once matched, writes and at once disposes three instances.
+const DISPOSER: &str = r#"
+import sys, time
+from dataclasses import dataclass
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.topic import Topic
+from cyclonedds.pub import DataWriter
+from cyclonedds.idl import IdlStruct
+from cyclonedds.idl.types import int32
+from cyclonedds.idl.annotations import key
+from cyclonedds.core import Qos, Policy
+from cyclonedds.util import duration
+
+@dataclass
+class ShapeType(IdlStruct, typename="ShapeType"):
+    color: str
+    key("color")
+    x: int32
+    y: int32
+    shapesize: int32
+
+dp = DomainParticipant(int(sys.argv[1]))
+w = DataWriter(dp, Topic(dp, "Flash", ShapeType), qos=Qos(Policy.Reliability.Reliable(duration(seconds=1))))
+end = time.time() + 20
+while w.get_publication_matched_status().current_count == 0 and time.time() < end:
+    time.sleep(0.05)
+print("matched", flush=True)
+for i, c in enumerate(["RED", "GREEN", "BLUE"]):
+    s = ShapeType(color=c, x=i, y=i, shapesize=30)
+    w.write(s)
+    w.dispose(s)
+    time.sleep(0.3)
+w.wait_for_acks(duration(seconds=5))
+print("done", flush=True)
+time.sleep(3)
+"#;
+
+#[test]
+fn dds_subscribe_shows_disposes_that_marked_held_samples() {
+    if require_netns().is_err() || cyclone_peer().is_err() {
+        return;
+    }
+    let Ok(bin) = our_bin("dds") else { return };
+    let idl = idl_file();
+    let mut sub = Command::new(bin);
+    sub.args(["subscribe", "Flash", "--ndjson", "--reliable", "-n", "6"])
+        .args(["--timeout", "25"])
+        .arg("--idl")
+        .arg(&idl)
+        .args(["--domain", &DOMAIN.to_string()]);
+    let mut sub = Proc::spawn("dds subscribe", sub);
+    let mut c = Command::new("python3");
+    c.arg("-u").arg("-c").arg(DISPOSER).arg(DOMAIN.to_string());
+    let mut peer = Proc::spawn("cyclone disposer", c);
+    let exit = sub.wait_exit(Duration::from_secs(30));
+    let rows = ndjson_rows(&sub.lines().join("\n"));
+    let _ = peer.interrupt(WAIT);
+    check!(
+        exit.is_some(),
+        &[&sub, &peer],
+        "dds subscribe did not finish"
+    );
+    let shown: Vec<(String, String)> = rows
+        .iter()
+        .map(|r| match r.get("kind") {
+            Some(k) => (
+                k.as_str().unwrap_or("?").to_string(),
+                r["key"]["color"].as_str().unwrap_or("?").to_string(),
+            ),
+            None => (
+                "Alive".to_string(),
+                r["color"].as_str().unwrap_or("?").to_string(),
+            ),
+        })
+        .collect();
+    let want: Vec<(String, String)> = ["RED", "GREEN", "BLUE"]
+        .iter()
+        .flat_map(|c| {
+            [
+                ("Alive".to_string(), c.to_string()),
+                ("Dispose".to_string(), c.to_string()),
+            ]
+        })
+        .collect();
+    check!(
+        shown == want,
+        &[&sub, &peer],
+        "dds subscribe showed {shown:?}"
+    );
 }
 
 /// The JSON documents of `dds subscribe --ndjson` output, one per line (other lines skipped).

@@ -5,8 +5,9 @@
 //! ([`DynamicType::type_support`], the derive's builder), so that they match peers by assignability and the
 //! TypeLookup service serves their type objects ([`DynamicTopic::with_type_information`] announces other
 //! bytes instead). Samples are [`DynamicData`], byte-identical on the wire to the
-//! derived code for the same type. Listeners, conditions, instances and read/take by state are left to the
-//! typed API: a dynamic writer writes and disposes, a dynamic reader takes what arrived.
+//! derived code for the same type. A dynamic reader runs on the typed reader's machinery: instances, read/take
+//! by state, read and query conditions, statuses, a listener ([`DynamicReaderListener`]) and a status
+//! condition. A dynamic writer writes and disposes.
 
 mod reader;
 mod writer;
@@ -21,7 +22,7 @@ use super::participant::DomainParticipant;
 use super::sync::lock;
 use crate::rtps::Guid;
 
-pub use reader::{DynamicReader, DynamicSample};
+pub use reader::{DynamicReader, DynamicReaderListener, DynamicSample};
 pub use writer::DynamicWriter;
 
 struct TopicInner {

@@ -1,29 +1,32 @@
-//! [`DynamicReader`]: the typed reader's cache (`dcps/cache.rs`) and decoding step (`dcps/decode.rs`) over
-//! [`DynamicData`] samples, so instance states, sample and view states and read/take by state and instance
-//! are the typed reader's.
+//! [`DynamicReader`]: the typed reader's machinery (`dcps/subscriber.rs`: queue, decoding step, cache,
+//! statuses, listener and status condition) over [`DynamicData`] samples, so instance states, sample and view
+//! states, read/take by state and instance, listeners and status conditions are the typed reader's.
 
-use std::collections::VecDeque;
-use std::sync::{Arc, Condvar, Mutex};
-use std::time::{Duration, Instant, SystemTime};
-
-use foldhash::{HashMap, HashMapExt};
+use std::sync::Arc;
+use std::time::{Duration, SystemTime};
 
 use crate::cdr::{DecodeError, EncodeError, XcdrVersion};
-use crate::dcps::IncompatibleQosStatus;
 use crate::qos::{DataReaderQos, DataRepresentation, ReaderQos};
-use crate::rtps::{ChangeKind, Event, Guid, Payload, ReaderSpec, ReceivedSample};
+use crate::rtps::{ChangeKind, Guid, Payload, ReaderSpec};
 use crate::xtypes::dynamic::{DynamicData, DynamicType};
 
-use super::super::cache::{to_sample, ReaderCache, Selection, SharedFilter};
-use super::super::condition::{QueryCondition, ReadCondition, ReadConditionSource, Signal};
-use super::super::decode::{decode_change_with, SampleCodec};
-use super::super::driver::{Driver, Endpoint, EndpointHandle, Pending};
+use super::super::cache::{to_sample, ReaderCache, Selection};
+use super::super::condition::{QueryCondition, ReadCondition, StatusCondition};
+use super::super::decode::SampleCodec;
+use super::super::driver::{Endpoint, EndpointHandle};
+use super::super::endpoint::check_history;
 use super::super::error::DdsResult;
 use super::super::sample::{
     InstanceHandle, InstanceState, InstanceStateMask, Sample, SampleInfo, SampleStateMask,
     ViewStateMask,
 };
-use super::super::subscriber::Subscriber;
+use super::super::status::{
+    DeadlineMissedStatus, IncompatibleQosStatus, LivelinessChangedStatus, SampleLostStatus,
+    SampleRejectedStatus, StatusMask, SubscriptionMatchedStatus,
+};
+use super::super::subscriber::{
+    credit_limit, reader_callbacks, ReaderInner, ReaderKind, Subscriber,
+};
 use super::super::sync::lock;
 use super::DynamicTopic;
 
@@ -80,126 +83,61 @@ impl SampleCodec<DynamicData> for DynamicType {
     }
 }
 
-struct Owner {
+/// Callbacks of a [`DynamicReader`], as [`DataReaderListener`](crate::dcps::DataReaderListener) is for a
+/// typed reader (see [`crate::dcps::listener`]). Every method has an empty default.
+#[allow(unused_variables)]
+pub trait DynamicReaderListener: Send + Sync {
+    /// New samples (or instance state changes) are available.
+    fn on_data_available(&self, reader: &DynamicReader) {}
+    /// A writer matched or unmatched.
+    fn on_subscription_matched(&self, reader: &DynamicReader, status: SubscriptionMatchedStatus) {}
+    /// A writer was found with incompatible QoS (or a type not assignable to the reader's).
+    fn on_requested_incompatible_qos(&self, reader: &DynamicReader, status: IncompatibleQosStatus) {
+    }
+    /// Samples were lost.
+    fn on_sample_lost(&self, reader: &DynamicReader, status: SampleLostStatus) {}
+    /// A sample was rejected by a resource limit.
+    fn on_sample_rejected(&self, reader: &DynamicReader, status: SampleRejectedStatus) {}
+    /// A matched writer's liveliness changed.
+    fn on_liveliness_changed(&self, reader: &DynamicReader, status: LivelinessChangedStatus) {}
+    /// An instance missed its deadline.
+    fn on_requested_deadline_missed(&self, reader: &DynamicReader, status: DeadlineMissedStatus) {}
+}
+
+reader_callbacks!(dyn DynamicReaderListener, DynamicReader);
+
+/// What a dynamic reader's handle keeps alive.
+pub(crate) struct Owner {
     topic: DynamicTopic,
     _subscriber: Subscriber,
 }
 
-/// The cache and the key hashes seen (for key-hash-only disposes), under one lock.
-struct CacheState {
-    cache: ReaderCache<DynamicData>,
-    by_hash: HashMap<[u8; 16], Vec<u8>>,
-}
+/// The dynamic flavour of the reader machinery: [`DynamicData`] samples decoded by their [`DynamicType`].
+pub(crate) struct Dynamic;
 
-struct Inner {
-    ty: DynamicType,
-    driver: Arc<Driver>,
-    /// Changes queued under the core lock, decoded and stored by `process`.
-    pending: Mutex<VecDeque<Pending>>,
-    cache: Mutex<CacheState>,
-    data_cv: Condvar,
-    /// Wakes the waitsets of this reader's read and query conditions.
-    data_signal: Signal,
-    matched: Mutex<Vec<Guid>>,
-    incompatible: Mutex<IncompatibleQosStatus>,
-}
-
-impl Inner {
-    /// Decodes and stores the queued changes; whether any changed the cache.
-    fn store_pending(&self) -> bool {
-        let queued: Vec<Pending> = lock(&self.pending).drain(..).collect();
-        let (now, rx_time) = (Instant::now(), SystemTime::now());
-        let mut st = lock(&self.cache);
-        let mut any = false;
-        for item in queued {
-            match item {
-                Pending::Sample(s) => any |= self.store(&mut st, s, now, rx_time),
-                Pending::CoherentSet(set) => {
-                    for s in set {
-                        any |= self.store(&mut st, s, now, rx_time);
-                    }
-                }
-                Pending::WriterGone(g) => any |= st.cache.writer_gone(g, now),
-            }
-        }
-        any
-    }
-
-    /// Wakes `wait_for_data` and the waitsets of the reader's conditions.
-    fn notify_data(&self) {
-        self.data_cv.notify_all();
-        self.data_signal.notify();
-    }
-
-    fn store(&self, st: &mut CacheState, s: ReceivedSample, now: Instant, rx: SystemTime) -> bool {
-        let info = self.driver.remote_writer(&s.writer);
-        let key = st.cache.take_key_buffer();
-        let Some(inc) = decode_change_with(&self.ty, s, info, &mut st.by_hash, key, now, rx) else {
-            return false;
-        };
-        matches!(
-            st.cache.insert(inc, now),
-            super::super::cache::Outcome::Accepted { .. }
-        )
-    }
-}
-
-impl ReadConditionSource for Inner {
-    fn has_matching(
-        &self,
-        s: SampleStateMask,
-        v: ViewStateMask,
-        i: InstanceStateMask,
-        query: Option<&SharedFilter>,
-    ) -> bool {
-        let sel = Selection {
-            query: query.cloned(),
-            ..Selection::states(s, v, i)
-        };
-        lock(&self.cache).cache.has_matching(&sel)
-    }
-    fn data_signal(&self) -> &Signal {
-        &self.data_signal
-    }
-}
-
-impl Endpoint for Inner {
-    fn enqueue(&self, item: Pending) {
-        lock(&self.pending).push_back(item);
-    }
-
-    fn process(self: Arc<Self>) {
-        if self.store_pending() {
-            self.notify_data();
-        }
-    }
-
-    fn on_event(self: Arc<Self>, ev: &Event) {
-        match ev {
-            Event::SubscriptionMatched {
-                writer, matched, ..
-            } => super::record_match(&self.matched, *writer, *matched),
-            Event::RequestedIncompatibleQos { policy, .. } => {
-                lock(&self.incompatible).record(*policy)
-            }
-            Event::LivelinessChanged {
-                writer,
-                alive: false,
-                ..
-            } if lock(&self.cache).cache.writer_gone(*writer, Instant::now()) => self.notify_data(),
-            _ => {}
-        }
-    }
-
-    fn tick(self: Arc<Self>, now: Instant) {
-        lock(&self.cache).cache.tick(now);
+impl ReaderKind for Dynamic {
+    type Data = DynamicData;
+    type Codec = DynamicType;
+    type Listener = dyn DynamicReaderListener;
+    type Owner = Owner;
+    type Reader = DynamicReader;
+    fn reader(
+        inner: Arc<ReaderInner<Dynamic>>,
+        handle: Arc<EndpointHandle<Owner>>,
+    ) -> DynamicReader {
+        DynamicReader { inner, handle }
     }
 }
 
 /// Takes [`DynamicData`] samples of a [`DynamicTopic`]. Cheap to clone; deleted with its last clone.
+///
+/// It runs on the typed reader's machinery (queue, decoding, cache, statuses, listener, status condition):
+/// what [`DataReader`](crate::dcps::DataReader) documents of its QoS holds here too. Not supported (yet):
+/// the subscriber's and participant's listeners (statuses go to the reader's own listener and status
+/// condition only), GROUP presentation, and the subscriber's `get_datareaders`.
 #[derive(Clone)]
 pub struct DynamicReader {
-    inner: Arc<Inner>,
+    inner: Arc<ReaderInner<Dynamic>>,
     handle: Arc<EndpointHandle<Owner>>,
 }
 
@@ -220,12 +158,34 @@ impl Subscriber {
         topic: &DynamicTopic,
         qos: &DataReaderQos,
     ) -> DdsResult<DynamicReader> {
+        self.create_dynamic(topic, qos, None)
+    }
+
+    /// Creates a reader of a dynamic topic with its listener installed first, enabled for the statuses in
+    /// `mask`: the listener sees every status of the reader from its creation on.
+    pub fn create_dynamic_reader_with_listener(
+        &self,
+        topic: &DynamicTopic,
+        qos: &DataReaderQos,
+        listener: Box<dyn DynamicReaderListener>,
+        mask: StatusMask,
+    ) -> DdsResult<DynamicReader> {
+        self.create_dynamic(topic, qos, Some((Arc::from(listener), mask)))
+    }
+
+    fn create_dynamic(
+        &self,
+        topic: &DynamicTopic,
+        qos: &DataReaderQos,
+        listener: Option<(Arc<dyn DynamicReaderListener>, StatusMask)>,
+    ) -> DdsResult<DynamicReader> {
         let driver = self.participant().driver().clone();
+        driver.check_alive()?;
         let mut rq = qos.clone();
         if rq.data_representation.ids().is_empty() {
             rq.data_representation = DataRepresentation::accept_both();
         }
-        super::super::endpoint::check_history(&rq.history)?;
+        check_history(&rq.history)?;
         let ty = topic.dynamic_type().clone();
         let spec = ReaderSpec {
             topic_name: topic.name().to_string(),
@@ -237,33 +197,29 @@ impl Subscriber {
             content_filter: None,
             internal: false,
         };
-        let inner = Arc::new(Inner {
-            driver: driver.clone(),
-            pending: Mutex::new(VecDeque::new()),
-            cache: Mutex::new(CacheState {
-                cache: ReaderCache::new(rq, ty.is_keyed()),
-                by_hash: HashMap::new(),
-            }),
-            ty,
-            data_cv: Condvar::new(),
-            data_signal: Signal::default(),
-            matched: Mutex::new(Vec::new()),
-            incompatible: Mutex::new(IncompatibleQosStatus::default()),
-        });
-        let sink: Arc<dyn Endpoint> = inner.clone();
-        let id = driver.create_endpoint(sink, |c, now| {
-            topic.register_types(c);
-            c.create_reader(now, spec)
-        })?;
+        let credit = credit_limit(&rq);
+        let cache = ReaderCache::new(rq, ty.is_keyed());
+        let inner = Arc::new(ReaderInner::<Dynamic>::new(
+            ty, driver, cache, None, None, credit,
+        ));
+        if let Some((l, mask)) = listener {
+            inner.state.set_listener_with_mask(Some(l), mask);
+        }
         let owner = Owner {
             topic: topic.clone(),
             _subscriber: self.clone(),
         };
-        tracing::info!(topic = topic.name(), type_name = %topic.type_name(), ?id, "dynamic reader created");
-        Ok(DynamicReader {
-            inner,
-            handle: Arc::new(EndpointHandle::new(driver, id, owner)),
-        })
+        let sink: Arc<dyn Endpoint> = inner.clone();
+        let handle = inner.state.create(sink, owner, |c, now| {
+            topic.register_types(c);
+            let id = c.create_reader(now, spec)?;
+            if credit.is_some() {
+                c.set_reader_credit(id, credit);
+            }
+            Ok(id)
+        })?;
+        tracing::info!(topic = topic.name(), type_name = %topic.type_name(), id = ?handle.id(), "dynamic reader created");
+        Ok(DynamicReader { inner, handle })
     }
 }
 
@@ -273,6 +229,11 @@ impl DynamicReader {
         self.handle.guid()
     }
 
+    /// The reader's handle (as writers see it in their matched subscriptions).
+    pub fn instance_handle(&self) -> InstanceHandle {
+        InstanceHandle::from_guid(self.guid())
+    }
+
     /// The topic.
     pub fn topic(&self) -> &DynamicTopic {
         &self.handle.owner().topic
@@ -280,36 +241,92 @@ impl DynamicReader {
 
     /// The writers matched now.
     pub fn matched_writers(&self) -> Vec<Guid> {
-        lock(&self.inner.matched).clone()
+        self.inner.state.matched()
+    }
+
+    /// The reader's status condition (for a [`WaitSet`](crate::dcps::WaitSet)).
+    pub fn status_condition(&self) -> StatusCondition {
+        StatusCondition {
+            core: self.inner.state.status_core().clone(),
+        }
+    }
+
+    /// Installs a listener for every status (replacing any previous one).
+    pub fn set_listener(&self, listener: Box<dyn DynamicReaderListener>) {
+        self.inner.state.set_listener(Some(Arc::from(listener)));
+    }
+
+    /// Installs a listener enabled for the statuses in `mask` only (replacing any previous one).
+    pub fn set_listener_with_mask(
+        &self,
+        listener: Box<dyn DynamicReaderListener>,
+        mask: StatusMask,
+    ) {
+        self.inner
+            .state
+            .set_listener_with_mask(Some(Arc::from(listener)), mask);
+    }
+
+    /// Removes the listener.
+    pub fn clear_listener(&self) {
+        self.inner.state.set_listener(None);
+    }
+
+    /// SUBSCRIPTION_MATCHED (resets the change counts).
+    pub fn subscription_matched_status(&self) -> SubscriptionMatchedStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::SUBSCRIPTION_MATCHED, |s| {
+                &mut s.subscription_matched
+            })
     }
 
     /// REQUESTED_INCOMPATIBLE_QOS: writers on the topic not matched for a policy (`TypeConsistencyEnforcement`
     /// for a type not assignable to the reader's). Resets the change count.
     pub fn requested_incompatible_qos_status(&self) -> IncompatibleQosStatus {
-        super::take_incompatible(&self.inner.incompatible)
+        self.inner
+            .state
+            .take_status(StatusMask::REQUESTED_INCOMPATIBLE_QOS, |s| {
+                &mut s.requested_incompatible_qos
+            })
     }
 
-    /// Waits until a sample (or an instance state change) not read yet is in the cache; `false` on timeout.
+    /// SAMPLE_LOST (resets the change count).
+    pub fn sample_lost_status(&self) -> SampleLostStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::SAMPLE_LOST, |s| &mut s.sample_lost)
+    }
+
+    /// SAMPLE_REJECTED (resets the change count).
+    pub fn sample_rejected_status(&self) -> SampleRejectedStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::SAMPLE_REJECTED, |s| &mut s.sample_rejected)
+    }
+
+    /// LIVELINESS_CHANGED (resets the change counts).
+    pub fn liveliness_changed_status(&self) -> LivelinessChangedStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::LIVELINESS_CHANGED, |s| {
+                &mut s.liveliness_changed
+            })
+    }
+
+    /// REQUESTED_DEADLINE_MISSED (resets the change count).
+    pub fn requested_deadline_missed_status(&self) -> DeadlineMissedStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::REQUESTED_DEADLINE_MISSED, |s| {
+                &mut s.requested_deadline_missed
+            })
+    }
+
+    /// Waits until a sample (or an instance state change) not read yet is in the cache; `false` on timeout
+    /// (or once the participant is gone).
     pub fn wait_for_data(&self, timeout: Duration) -> bool {
-        let end = Instant::now() + timeout;
-        let unread = Selection::states(
-            SampleStateMask::NOT_READ,
-            ViewStateMask::ANY,
-            InstanceStateMask::ANY,
-        );
-        let mut st = lock(&self.inner.cache);
-        while !st.cache.has_matching(&unread) {
-            let left = end.saturating_duration_since(Instant::now());
-            if left.is_zero() {
-                return false;
-            }
-            st = self
-                .inner
-                .data_cv
-                .wait_timeout(st, left)
-                .map_or_else(|e| e.into_inner().0, |r| r.0);
-        }
-        true
+        self.inner.wait_for_data(timeout).unwrap_or(false)
     }
 
     /// Takes every sample in the cache, oldest first, with the change each made to its instance. A payload
@@ -320,7 +337,7 @@ impl DynamicReader {
             ViewStateMask::ANY,
             InstanceStateMask::ANY,
         );
-        self.collect(&any, true)
+        self.collect(any, true)
             .into_iter()
             .map(DynamicSample::from)
             .collect()
@@ -333,7 +350,7 @@ impl DynamicReader {
         view: ViewStateMask,
         instance: InstanceStateMask,
     ) -> Vec<Sample<DynamicData>> {
-        self.collect(&Selection::states(sample, view, instance), false)
+        self.collect(Selection::states(sample, view, instance), false)
     }
 
     /// Takes (removes from the cache) the samples in these states.
@@ -343,17 +360,17 @@ impl DynamicReader {
         view: ViewStateMask,
         instance: InstanceStateMask,
     ) -> Vec<Sample<DynamicData>> {
-        self.collect(&Selection::states(sample, view, instance), true)
+        self.collect(Selection::states(sample, view, instance), true)
     }
 
     /// Reads the samples of one instance.
     pub fn read_instance(&self, h: InstanceHandle) -> Vec<Sample<DynamicData>> {
-        self.collect(&Self::of_instance(h), false)
+        self.collect(Self::of_instance(h), false)
     }
 
     /// Takes the samples of one instance.
     pub fn take_instance(&self, h: InstanceHandle) -> Vec<Sample<DynamicData>> {
-        self.collect(&Self::of_instance(h), true)
+        self.collect(Self::of_instance(h), true)
     }
 
     /// The handle of the instance whose key `key_sample` holds, if the reader knows it.
@@ -396,12 +413,12 @@ impl DynamicReader {
 
     /// Reads with a read condition's states (and a query condition's query and ORDER BY).
     pub fn read_w_condition(&self, c: &ReadCondition) -> Vec<Sample<DynamicData>> {
-        self.collect(&Self::of_condition(c), false)
+        self.collect(Self::of_condition(c), false)
     }
 
     /// Takes with a read condition's states (and a query condition's query and ORDER BY).
     pub fn take_w_condition(&self, c: &ReadCondition) -> Vec<Sample<DynamicData>> {
-        self.collect(&Self::of_condition(c), true)
+        self.collect(Self::of_condition(c), true)
     }
 
     fn of_condition(c: &ReadCondition) -> Selection {
@@ -433,14 +450,16 @@ impl DynamicReader {
     }
 
     /// The selected samples; those without data (dispose, unregister) carry the instance's key values when
-    /// the reader knows them.
-    fn collect(&self, sel: &Selection, take: bool) -> Vec<Sample<DynamicData>> {
-        self.inner.store_pending();
+    /// the reader knows them. Empty once the participant is gone.
+    fn collect(&self, sel: Selection, take: bool) -> Vec<Sample<DynamicData>> {
         let mut out = Vec::new();
-        let mut st = lock(&self.inner.cache);
-        st.cache.collect_with(sel, take, |slot, info| {
+        let visited = self.inner.visit(sel, None, take, |slot, info| {
             out.push(to_sample(slot, info, take, Some(DynamicData::clone)));
         });
+        if visited.is_err() {
+            return Vec::new();
+        }
+        let st = lock(&self.inner.cache);
         for s in out.iter_mut().filter(|s| s.data.is_none()) {
             s.data = st.cache.key_holder(s.info.instance_handle).cloned();
         }

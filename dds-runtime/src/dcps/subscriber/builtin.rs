@@ -18,7 +18,7 @@ use super::super::participant::DomainParticipant;
 use super::super::presentation::AccessScope;
 use super::super::sample::{InstanceHandle, InstanceState};
 use super::super::sync::lock;
-use super::{ops, DataReader, ReaderInner, ReaderOwner, Stored, Subscriber};
+use super::{ops, DataReader, ReaderInner, ReaderOwner, Stored, Subscriber, Typed};
 
 /// Most instances one built-in reader keeps, so that hostile discovery data cannot grow it without bound.
 /// At the limit a new entity evicts the one gone longest; only when every kept entity is alive is it
@@ -85,7 +85,7 @@ impl BuiltinGroup {
 /// through it the participant) lives as long as the application holds the reader, and is made again
 /// when it asks for the reader after dropping it.
 pub(crate) struct BuiltinReader<T: DdsType> {
-    inner: Arc<ReaderInner<T>>,
+    inner: Arc<ReaderInner<Typed<T>>>,
     /// The reader's entity id: the participant's built-in reader of the topic.
     id: EntityId,
     topic_name: &'static str,
@@ -107,6 +107,7 @@ impl<T: DdsType> BuiltinReader<T> {
         cache.set_handle_fn(handle_of);
         cache.set_evict_not_alive(true);
         let inner = Arc::new(ReaderInner::new(
+            super::super::decode::Derived,
             p.driver().clone(),
             cache,
             None,

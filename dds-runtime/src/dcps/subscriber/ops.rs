@@ -22,7 +22,7 @@ use super::super::sample::{InstanceHandle, InstanceStateMask, SampleStateMask, V
 use super::super::status::*;
 use super::super::sync::lock;
 use super::super::topic::Topic;
-use super::{DataReader, DataReaderListener, ReaderInner, Subscriber};
+use super::{DataReader, DataReaderListener, ReaderInner, Subscriber, Typed};
 use crate::rtps::EntityId;
 
 /// Callbacks of a [`Subscriber`] for its readers' statuses that have no listener of their own enabled for
@@ -108,7 +108,7 @@ pub(super) fn reader_parent<T: DdsType>(
 /// Registers a new reader in its participant.
 pub(super) fn register_reader<T: DdsType>(
     s: &Subscriber,
-    inner: &Arc<ReaderInner<T>>,
+    inner: &Arc<ReaderInner<Typed<T>>>,
     topic: &str,
 ) {
     let Ok(group) = s.with_group(|g| g.node.handle) else {
@@ -117,7 +117,7 @@ pub(super) fn register_reader<T: DdsType>(
     if T::IS_KEYED {
         lock(&inner.cache).cache.set_key_holder_fn(key_holder::<T>);
     }
-    let entity: Weak<dyn Registered> = Arc::downgrade(inner) as Weak<ReaderInner<T>>;
+    let entity: Weak<dyn Registered> = Arc::downgrade(inner) as Weak<ReaderInner<Typed<T>>>;
     s.participant.registry().add_endpoint(
         false,
         EndpointEntry {
@@ -146,7 +146,7 @@ fn key_holder<T: DdsType>(data: &T) -> Option<T> {
     cdr::deserialize_key(&buf).ok()
 }
 
-impl<T: DdsType> Registered for ReaderInner<T> {
+impl<T: DdsType> Registered for ReaderInner<Typed<T>> {
     fn as_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync> {
         self
     }
@@ -333,7 +333,7 @@ impl Subscriber {
         let inner = self
             .participant
             .registry()
-            .find_child::<SubscriberQos, ReaderInner<T>>(handle, topic_name);
+            .find_child::<SubscriberQos, ReaderInner<Typed<T>>>(handle, topic_name);
         Ok(inner.and_then(|inner| {
             let handle = inner.state.handle()?;
             Some(DataReader { inner, handle })

@@ -267,6 +267,20 @@ impl Resolver<'_> {
                     })
                     .collect(),
             })),
+            // A bitset is the unsigned integer that holds its bits, as the derive and `types_from_idl` make it.
+            TypeBody::Bitset { fields, .. } => {
+                let bits = fields
+                    .iter()
+                    .map(|f| u32::from(f.position) + u32::from(f.bitcount))
+                    .max()
+                    .unwrap_or(0);
+                DynamicType::primitive(match bits {
+                    0..=8 => Primitive::UInt8,
+                    9..=16 => Primitive::UInt16,
+                    17..=32 => Primitive::UInt32,
+                    _ => Primitive::UInt64,
+                })
+            }
             TypeBody::Bitmask {
                 flags,
                 bit_bound,

@@ -374,6 +374,23 @@ impl BodyWriter {
                     })
                 })
             }),
+            TypeBody::Bitset {
+                flags,
+                detail,
+                fields,
+            } => appendable(w, |w| {
+                w.write_u16(flags.bits());
+                appendable(w, |w| self.type_detail(w, detail))?;
+                seq(w, fields, |w, f| {
+                    appendable(w, |w| {
+                        w.write_u16(f.position);
+                        w.write_u16(f.flags.bits());
+                        w.write_u8(f.bitcount);
+                        w.write_u8(f.holder_type);
+                        self.member_detail(w, &f.detail)
+                    })
+                })
+            }),
             TypeBody::Sequence {
                 flags,
                 bound,

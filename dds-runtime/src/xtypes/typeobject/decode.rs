@@ -248,6 +248,24 @@ impl BodyReader {
         })
     }
 
+    /// A bit field: at most 64 bits, ending at bit 64 at the latest.
+    fn bitfield(&self, r: R<'_, '_>) -> Result<Bitfield, DecodeError> {
+        let position = r.read_u16("bit position")?;
+        let flags = MemberFlag::from_bits_retain(r.read_u16("member flags")?);
+        let bitcount = r.read_u8("bit count")?;
+        if bitcount == 0 || u32::from(position) + u32::from(bitcount) > 64 {
+            return Err(invalid(r, "bit field within 64 bits", u64::from(bitcount)));
+        }
+        let holder_type = r.read_u8("bit field holder type")?;
+        Ok(Bitfield {
+            position,
+            flags,
+            bitcount,
+            holder_type,
+            detail: self.member_detail(r)?,
+        })
+    }
+
     fn element(&self, r: R<'_, '_>) -> Result<CollectionElement, DecodeError> {
         appendable(r, "collection element", |r| {
             let flags = MemberFlag::from_bits_retain(r.read_u16("element flags")?);
@@ -425,6 +443,18 @@ impl BodyReader {
                     bit_bound,
                     detail,
                     bitflags,
+                })
+            })?,
+            TK_BITSET => appendable(r, "bitset", |r| {
+                let flags = tflags(r)?;
+                let detail = appendable(r, "bitset header", |r| self.type_detail(r))?;
+                let fields = seq(r, "bitfields", 8, |r| {
+                    appendable(r, "bitfield", |r| self.bitfield(r))
+                })?;
+                Ok(TypeBody::Bitset {
+                    flags,
+                    detail,
+                    fields,
                 })
             })?,
             TK_SEQUENCE => {

@@ -28,9 +28,9 @@ pub use info::{
 };
 pub use object::{
     AnnotationParameterValue, AppliedAnnotation, AppliedAnnotationParameter,
-    AppliedBuiltinMemberAnnotations, AppliedVerbatimAnnotation, Bitflag, CollectionElement,
-    CompleteTypeObject, EnumeratedLiteral, MemberDetail, MemberName, MinimalTypeObject,
-    StructMember, TypeBody, TypeDetail, TypeObject, UnionMember,
+    AppliedBuiltinMemberAnnotations, AppliedVerbatimAnnotation, Bitfield, Bitflag,
+    CollectionElement, CompleteTypeObject, EnumeratedLiteral, MemberDetail, MemberName,
+    MinimalTypeObject, StructMember, TypeBody, TypeDetail, TypeObject, UnionMember,
 };
 
 /// Type kinds (`TK_*`, XTypes 1.3 §7.3.4.1): the discriminators of fully descriptive identifiers and of type

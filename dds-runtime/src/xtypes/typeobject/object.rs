@@ -89,6 +89,17 @@ pub enum TypeBody {
         /// Flags, sorted by position.
         bitflags: Vec<Bitflag>,
     },
+    /// `TK_BITSET`: bit fields packed in an integer (no peer makes these objects from IDL: Cyclone 11's idlc
+    /// rejects `bitset`; the layout is that of Cyclone's type-object IDL, whose `MinimalBitfield` is
+    /// appendable where XTypes 1.3 makes it final).
+    Bitset {
+        /// Bitset flags (unused, 0).
+        flags: TypeFlag,
+        /// Type detail (complete).
+        detail: TypeDetail,
+        /// The bit fields, in declaration order.
+        fields: Vec<Bitfield>,
+    },
     /// `TK_SEQUENCE` (a sequence whose identifier is not plain).
     Sequence {
         /// Collection flags (unused, 0).
@@ -136,6 +147,7 @@ impl TypeBody {
             TypeBody::Union { .. } => TK_UNION,
             TypeBody::Enum { .. } => TK_ENUM,
             TypeBody::Bitmask { .. } => TK_BITMASK,
+            TypeBody::Bitset { .. } => TK_BITSET,
             TypeBody::Sequence { .. } => TK_SEQUENCE,
             TypeBody::Array { .. } => TK_ARRAY,
             TypeBody::Map { .. } => TK_MAP,
@@ -150,6 +162,7 @@ impl TypeBody {
             | TypeBody::Union { detail, .. }
             | TypeBody::Enum { detail, .. }
             | TypeBody::Bitmask { detail, .. }
+            | TypeBody::Bitset { detail, .. }
             | TypeBody::Array { detail, .. } => &detail.type_name,
             TypeBody::Sequence { detail, .. } | TypeBody::Map { detail, .. } => {
                 detail.as_ref().map_or("", |d| d.type_name.as_str())
@@ -256,6 +269,21 @@ pub struct Bitflag {
     pub position: u16,
     /// Flags (unused, 0).
     pub flags: MemberFlag,
+    /// Name.
+    pub detail: MemberDetail,
+}
+
+/// A bit field of a bitset (`CommonBitfield` + detail).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Bitfield {
+    /// Position of its lowest bit.
+    pub position: u16,
+    /// Flags (unused, 0).
+    pub flags: MemberFlag,
+    /// Number of bits (1..=64).
+    pub bitcount: u8,
+    /// `TK_*` of the integer (or boolean) type the field's value is read as.
+    pub holder_type: u8,
     /// Name.
     pub detail: MemberDetail,
 }

@@ -1,0 +1,62 @@
+#!/usr/bin/env python3
+"""Cyclone DDS 11 (python cyclonedds) writer for the status tests of dcps_dynamic_cyclone.rs: a keyed
+`xs::Beat`, offered deadline 300 ms and MANUAL_BY_TOPIC liveliness with a 600 ms lease.
+
+  cyclone_status.py pub   -- waits up to 20 s for a match, writes id 1 five times 100 ms apart (each write
+                             asserts liveliness), then writes nothing more: the reader's deadline is missed
+                             and the writer's liveliness lost. Exits when stdin closes.
+Reliable, volatile, keep-last 1.
+"""
+import os
+import sys
+import time
+from dataclasses import dataclass
+
+from cyclonedds.core import Policy, Qos
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.idl import IdlStruct
+from cyclonedds.idl.annotations import final, key
+from cyclonedds.idl.types import int32
+from cyclonedds.pub import DataWriter
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+
+
+@dataclass
+@final
+class Beat(IdlStruct, typename="xs::Beat"):
+    id: int32
+    key("id")
+    n: int32
+
+
+def log(*a):
+    print(*a, file=sys.stderr, flush=True)
+
+
+def main():
+    dp = DomainParticipant(int(os.environ.get("DDS_DOMAIN_ID", "0")))
+    tp = Topic(dp, "BeatTopic", Beat)
+    qos = Qos(
+        Policy.Reliability.Reliable(duration(seconds=1)),
+        Policy.History.KeepLast(1),
+        Policy.Deadline(duration(milliseconds=300)),
+        Policy.Liveliness.ManualByTopic(duration(milliseconds=600)),
+    )
+    w = DataWriter(dp, tp, qos=qos)
+    deadline = time.time() + 20
+    while w.get_publication_matched_status().current_count == 0:
+        if time.time() > deadline:
+            log("pub: no match")
+            sys.exit(2)
+        time.sleep(0.05)
+    log("pub: matched")
+    for n in range(5):
+        w.write(Beat(id=1, n=n))
+        time.sleep(0.1)
+    log("pub: silent")
+    sys.stdin.read()
+
+
+if __name__ == "__main__":
+    main()
