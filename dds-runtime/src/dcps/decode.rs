@@ -204,6 +204,7 @@ mod tests {
             payload: Payload::from(payload),
             key_hash,
             source_timestamp: None,
+            group_sequence: None,
         }
     }
 
