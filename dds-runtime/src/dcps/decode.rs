@@ -163,6 +163,7 @@ pub(crate) fn decode_change_with<T, C: SampleCodec<T>>(
     }
     Some(Incoming {
         writer: s.writer,
+        attributed: info.original,
         kind,
         data,
         key,

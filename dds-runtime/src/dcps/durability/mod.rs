@@ -20,6 +20,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 pub use key::peer_key_hash;
+pub(crate) use marker::stand_in_for;
 #[cfg(feature = "persistence")]
 pub use store::StoreError;
 
