@@ -848,7 +848,7 @@ fn remote_writer_info(w: &crate::rtps::discovery::WriterData) -> (Guid, RemoteWr
         RemoteWriterInfo {
             strength: q.ownership_strength.0,
             lifespan,
-            original: super::durability::stand_in_for(&q.user_data.0),
+            original: super::stand_in::stand_in_for(&q.user_data.0),
         },
     )
 }

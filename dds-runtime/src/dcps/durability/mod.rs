@@ -10,7 +10,7 @@
 mod dedup;
 mod history;
 mod key;
-mod marker;
+use super::stand_in as marker;
 mod service;
 #[cfg(feature = "persistence")]
 mod store;
@@ -20,7 +20,6 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 pub use key::peer_key_hash;
-pub(crate) use marker::stand_in_for;
 #[cfg(feature = "persistence")]
 pub use store::StoreError;
 
