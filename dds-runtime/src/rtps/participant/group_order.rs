@@ -158,7 +158,10 @@ impl Participant {
         let Event::Sample(s) = &ev else {
             return Some(ev);
         };
-        let (Some(gsn), Some(group)) = (s.group_sequence, self.writer_group(&s.writer)) else {
+        let Some(gsn) = s.group_sequence else {
+            return Some(ev);
+        };
+        let Some(group) = self.writer_group(&s.writer) else {
             return Some(ev);
         };
         if !self.group_ordered_reader(s.reader) {
