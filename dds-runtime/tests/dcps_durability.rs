@@ -135,6 +135,54 @@ fn disposed_data_is_cleaned_up() {
 }
 
 #[test]
+fn replayed_samples_name_the_original_writer() {
+    // The late reader gets the samples from the stand-in only (the writer is gone), yet each names the
+    // writer that wrote it, as `publication_handle` and `publication_guid`.
+    let pw = participant(219);
+    let w = writer::<ShapeType>(
+        &pw,
+        "Attributed",
+        &durable_writer_qos(Durability::Transient, 2),
+    );
+    let (handle, guid) = (w.instance_handle(), w.guid());
+    write_rounds(&w, 2);
+    drop(w);
+    std::thread::sleep(Duration::from_millis(300));
+    let pr = participant(219);
+    let r = reader::<ShapeType>(
+        &pr,
+        "Attributed",
+        &durable_reader_qos(Durability::Transient),
+    );
+    assert!(wait_until(HISTORY_TIMEOUT, || r
+        .subscription_matched_status()
+        .current_count
+        >= 1));
+    assert!(r.wait_for_historical_data(HISTORY_TIMEOUT).unwrap());
+    let mut infos = Vec::new();
+    wait_until(HISTORY_TIMEOUT, || {
+        infos.extend(
+            r.take()
+                .unwrap()
+                .into_iter()
+                .filter(|s| s.data.is_some())
+                .map(|s| (s.info.publication_handle, s.info.publication_guid)),
+        );
+        infos.len() >= 4
+    });
+    assert_eq!(infos.len(), 4, "the four kept samples");
+    assert!(
+        infos.iter().all(|i| *i == (handle, guid)),
+        "each names the original writer {guid:?}: {infos:?}"
+    );
+    let standin = r.matched_publications();
+    assert!(
+        !standin.contains(&handle),
+        "the only matched writer is the stand-in"
+    );
+}
+
+#[test]
 fn late_joiner_gets_each_sample_once_while_the_writer_lives() {
     let pw = participant(142);
     let w = writer::<ShapeType>(&pw, "Both", &durable_writer_qos(Durability::Transient, 3));

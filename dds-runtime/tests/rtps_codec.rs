@@ -52,6 +52,23 @@ fn all_submessages<'a>(
             count: 4,
             final_flag: false,
             liveliness_flag: true,
+            group_info: None,
+        }),
+        Submessage::Heartbeat(Heartbeat {
+            reader_id: EntityId::UNKNOWN,
+            writer_id: w,
+            first_sn: SequenceNumber(3),
+            last_sn: SequenceNumber(9),
+            count: 5,
+            final_flag: true,
+            liveliness_flag: false,
+            group_info: Some(HeartbeatGroupInfo {
+                current_gsn: SequenceNumber(40),
+                first_gsn: SequenceNumber(11),
+                last_gsn: SequenceNumber((1 << 32) + 38),
+                writer_set: [1, 2, 3, 4],
+                secure_writer_set: [0; 4],
+            }),
         }),
         Submessage::Gap(Gap {
             reader_id: r,

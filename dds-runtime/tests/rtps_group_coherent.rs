@@ -39,7 +39,7 @@ fn setup(seed: u64, faults: Faults, reliable: bool) -> Setup {
             .p
             .create_writer(now, WriterSpec::new(topic, "M::T", false, wq.clone()))
             .unwrap();
-        sim.nodes[0].p.join_writer_group(w[k], &group).unwrap();
+        sim.nodes[0].p.join_writer_group(now, w[k], &group).unwrap();
         r[k] = sim.nodes[1]
             .p
             .create_reader(now, ReaderSpec::new(topic, "M::T", false, rq.clone()))
@@ -258,7 +258,7 @@ fn group_set_with_a_writer_no_reader_matches_completes() {
         .create_writer(now, WriterSpec::new("C", "M::T", false, wq))
         .unwrap();
     let g = s.group.clone();
-    s.sim.nodes[0].p.join_writer_group(c, &g).unwrap();
+    s.sim.nodes[0].p.join_writer_group(now, c, &g).unwrap();
     s.sim.run_for(Duration::from_millis(500));
     s.sim.nodes[0].p.begin_group_set(&g);
     for w in [s.w[0], s.w[1], c] {

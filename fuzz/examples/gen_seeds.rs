@@ -280,6 +280,7 @@ fn rtps_seeds(dir: &Path) {
         count: 3,
         final_flag: false,
         liveliness_flag: false,
+        group_info: None,
     });
     for (name, subs) in [
         ("data", vec![data]),

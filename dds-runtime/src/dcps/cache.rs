@@ -25,6 +25,8 @@ pub(crate) use query::SharedFilter;
 /// One decoded change arriving from a writer.
 pub(crate) struct Incoming<T> {
     pub(crate) writer: Guid,
+    /// The writer `SampleInfo` names when it is not `writer`: a durability stand-in's original.
+    pub(crate) attributed: Option<Guid>,
     pub(crate) kind: ChangeKind,
     pub(crate) data: Option<T>,
     /// Serialized key (`cdr::instance_key`), or the 16-byte key hash when nothing better is known.
@@ -414,7 +416,7 @@ impl<T: FilterFields> ReaderCache<T> {
                 read: false,
                 source_timestamp: inc.source_timestamp,
                 reception_timestamp: inc.reception_timestamp,
-                writer: inc.writer,
+                writer: inc.attributed.unwrap_or(inc.writer),
                 disposed_gen: inst.disposed_gen,
                 no_writers_gen: inst.no_writers_gen,
                 seq,
@@ -462,7 +464,7 @@ impl<T: FilterFields> ReaderCache<T> {
                 read: false,
                 source_timestamp: inc.source_timestamp,
                 reception_timestamp: inc.reception_timestamp,
-                writer: inc.writer,
+                writer: inc.attributed.unwrap_or(inc.writer),
                 disposed_gen: inst.disposed_gen,
                 no_writers_gen: inst.no_writers_gen,
                 seq,
@@ -490,6 +492,7 @@ impl<T: FilterFields> ReaderCache<T> {
             let key = inst.key.clone();
             let inc = Incoming {
                 writer,
+                attributed: None,
                 kind: ChangeKind::Unregister,
                 data: None,
                 key,
@@ -809,6 +812,7 @@ mod tests {
     fn inc(w: u8, kind: ChangeKind, key: u8, v: i32) -> Incoming<i32> {
         Incoming {
             writer: Guid::from_bytes([w; 16]),
+            attributed: None,
             kind,
             data: (kind == ChangeKind::Alive).then_some(v),
             key: vec![key],

@@ -164,6 +164,7 @@ pub(crate) fn decode_change_with<T, C: SampleCodec<T>>(
     }
     Some(Incoming {
         writer: s.writer,
+        attributed: info.original,
         kind,
         data,
         key,
@@ -205,6 +206,7 @@ mod tests {
             payload: Payload::from(payload),
             key_hash,
             source_timestamp: None,
+            group_sequence: None,
         }
     }
 

@@ -71,6 +71,9 @@ pub(crate) struct RemoteWriterInfo {
     pub(crate) strength: i32,
     /// Its lifespan, when finite.
     pub(crate) lifespan: Option<Duration>,
+    /// A durability stand-in: the writer it replays (named in its USER_DATA), which our readers report
+    /// as the changes' publication.
+    pub(crate) original: Option<Guid>,
 }
 
 /// Drives one participant: the core, its sockets, its timer thread and the registry of endpoints.
@@ -845,6 +848,7 @@ fn remote_writer_info(w: &crate::rtps::discovery::WriterData) -> (Guid, RemoteWr
         RemoteWriterInfo {
             strength: q.ownership_strength.0,
             lifespan,
+            original: super::stand_in::stand_in_for(&q.user_data.0),
         },
     )
 }

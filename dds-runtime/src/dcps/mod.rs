@@ -53,6 +53,7 @@ mod registry;
 pub mod sample;
 #[cfg(feature = "shm")]
 mod shm;
+mod stand_in;
 pub mod status;
 mod subscriber;
 mod sync;

@@ -45,9 +45,9 @@ impl CoherentGroup {
             }
             (st.depth > 0, st.group.clone())
         };
-        let _ = driver.with_core(|c, _| {
+        let _ = driver.with_core(|c, now| {
             if let Some(g) = &group {
-                c.join_writer_group(id, g)?;
+                c.join_writer_group(now, id, g)?;
             }
             if open {
                 c.begin_coherent_set(id)?;

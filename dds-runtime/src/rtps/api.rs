@@ -592,6 +592,9 @@ pub struct ReceivedSample {
     pub key_hash: Option<[u8; 16]>,
     /// The writer's INFO_TS, if any.
     pub source_timestamp: Option<Time>,
+    /// PID_GROUP_SEQ_NUM: the change's number among all changes of its writer's publisher, from
+    /// publishers with GROUP access scope.
+    pub group_sequence: Option<SequenceNumber>,
 }
 
 /// Names a group coherent set (RTPS 2.5 §8.7.6): the group sequence number of its first change and the

@@ -8,6 +8,7 @@ mod discovery;
 mod enable;
 mod filtering;
 mod group;
+mod group_order;
 mod historical;
 mod internal;
 mod interned;
@@ -112,6 +113,8 @@ pub struct Participant {
     shm: shm::ShmMatches,
     /// Group coherent sets waiting for the parts of all their writers.
     group_sets: group::GroupSets,
+    /// GROUP ordered access: changes held until their group sequence number is next.
+    group_order: group_order::GroupOrder,
     /// The QoS and type information shared by the known endpoints.
     interned: interned::Interned,
 }
@@ -212,6 +215,7 @@ impl Participant {
             local: Default::default(),
             shm: Default::default(),
             group_sets: group::GroupSets::default(),
+            group_order: group_order::GroupOrder::default(),
             interned: Default::default(),
             config,
         };
@@ -348,6 +352,7 @@ impl Participant {
             type_information: spec.type_information.map(Into::into),
             entity_name: spec.entity_name,
             content_filter: spec.content_filter.map(Box::new),
+            group: None,
         })
     }
 
@@ -536,7 +541,7 @@ impl Participant {
         if let Some(r) = self.readers.get_mut(&reader) {
             let mut out = Vec::new();
             r.set_credit(credit, &mut out);
-            self.events.extend(out);
+            out.into_iter().for_each(|e| self.push_delivery(e));
         }
     }
 

@@ -44,6 +44,8 @@ pub mod entity_kind {
     pub const USER_READER_NO_KEY: u8 = 0x04;
     /// A user reader of a keyed topic.
     pub const USER_READER_WITH_KEY: u8 = 0x07;
+    /// A user-defined writer group (a publisher).
+    pub const USER_WRITER_GROUP: u8 = 0x08;
     /// A builtin participant.
     pub const BUILTIN_PARTICIPANT: u8 = 0xc1;
     /// A builtin writer of a keyed topic.

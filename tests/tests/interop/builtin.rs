@@ -71,7 +71,8 @@ fn builtin_readers_see_cyclone_entities_come_and_go() {
     let _ = run(216);
 }
 
-fn run(domain: u32) -> Result<(), Skip> {
+/// A participant in `domain` (with a Cyclone peer available) and its built-in subscriber.
+fn builtin_subscriber(domain: u32) -> Result<(DomainParticipant, BuiltinSubscriber), Skip> {
     require_netns()?;
     cyclone_peer()?;
     let p = DomainParticipant::builder()
@@ -79,6 +80,11 @@ fn run(domain: u32) -> Result<(), Skip> {
         .build()
         .expect("participant");
     let b = p.get_builtin_subscriber().expect("builtin subscriber");
+    Ok((p, b))
+}
+
+fn run(domain: u32) -> Result<(), Skip> {
+    let (_p, b) = builtin_subscriber(domain)?;
     let (parts, pubs, subs, topics) = (
         b.participant_reader(),
         b.publication_reader(),
@@ -227,13 +233,7 @@ fn builtin_datareaders_wait_for_cyclone_and_see_it_exit() {
 }
 
 fn run_exit(domain: u32) -> Result<(), Skip> {
-    require_netns()?;
-    cyclone_peer()?;
-    let p = DomainParticipant::builder()
-        .domain_id(domain)
-        .build()
-        .expect("participant");
-    let b = p.get_builtin_subscriber().expect("builtin subscriber");
+    let (_p, b) = builtin_subscriber(domain)?;
     let parts = b
         .lookup_datareader::<ParticipantBuiltinTopicData>("DCPSParticipant")
         .unwrap()

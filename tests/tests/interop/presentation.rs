@@ -314,6 +314,44 @@ fn group_coherent_sets_ours_to_cyclone_reader_on_the_wire() -> Result<(), Skip> 
             &ids[..ids.len().min(2000)]
         );
     }
+    // Our heartbeats carry GroupInfo (flag G, 0x08), and Cyclone, which does not know it, still
+    // acknowledges: its ACKNACKs to our writers move past the first change.
+    let fields = |filter: &str, field: &str| {
+        let out = Command::new("tshark")
+            .args(["-r", &cap_s, "-Y", filter, "-T", "fields", "-e", field])
+            .output()
+            .expect("tshark -r");
+        String::from_utf8_lossy(&out.stdout).to_string()
+    };
+    let hb_flags = fields(
+        "rtps.vendorId == 0x01dd && rtps.sm.id == 0x07 && (rtps.sm.wrEntityId.entityKind == 2 || rtps.sm.wrEntityId.entityKind == 3)",
+        "rtps.sm.flags",
+    );
+    let g_flag = hb_flags
+        .split([',', '\n'])
+        .filter_map(|f| u8::from_str_radix(f.trim().trim_start_matches("0x"), 16).ok())
+        .any(|f| f & 0x08 != 0);
+    check!(
+        g_flag,
+        &[&t],
+        "a HEARTBEAT with flag G from our writers: {}",
+        &hb_flags[..hb_flags.len().min(500)]
+    );
+    let acks = fields(
+        "rtps.vendorId == 0x0110 && rtps.sm.id == 0x06 && (rtps.sm.wrEntityId.entityKind == 2 || rtps.sm.wrEntityId.entityKind == 3)",
+        "rtps.sm.seqNumber",
+    );
+    let acked = acks
+        .split([',', '\n'])
+        .filter_map(|n| n.trim().parse::<i64>().ok())
+        .max()
+        .unwrap_or(0);
+    check!(
+        acked > 10,
+        &[&t],
+        "Cyclone acknowledges our group writers (highest ACKNACK base {acked}): {}",
+        &acks[..acks.len().min(500)]
+    );
     let _ = std::fs::remove_file(&cap_s);
     Ok(())
 }

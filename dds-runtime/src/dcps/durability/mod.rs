@@ -10,7 +10,7 @@
 mod dedup;
 mod history;
 mod key;
-mod marker;
+use super::stand_in as marker;
 mod service;
 #[cfg(feature = "persistence")]
 mod store;

@@ -181,6 +181,7 @@ impl<T: DdsType> BuiltinReader<T> {
         let now = SystemTime::now();
         let inc = Incoming {
             writer: self.writer,
+            attributed: None,
             kind,
             data,
             key,

@@ -38,6 +38,10 @@ pub struct EndpointData<Q> {
     pub entity_name: Option<String>,
     /// PID_CONTENT_FILTER_PROPERTY: the reader's content filter (readers only; boxed, as it is rarely set).
     pub content_filter: Option<Box<ContentFilterProperty>>,
+    /// The endpoint's publisher or subscriber, if announced (PID_GROUP_ENTITYID with the endpoint's
+    /// prefix, or PID_GROUP_GUID). Ours announce it for members of a group with GROUP access scope: the
+    /// writers that share group sequence numbers.
+    pub group: Option<Guid>,
 }
 
 /// A publication as announced in SEDP (DiscoveredWriterData).
@@ -86,6 +90,9 @@ impl<Q: EndpointQos> EndpointData<Q> {
         if let Some(f) = &self.content_filter {
             f.write(&mut w);
         }
+        if let Some(g) = &self.group {
+            w.raw(pid::GROUP_ENTITYID, &g.entity_id.0);
+        }
         self.qos.write_params(&mut w);
         w.finish();
         out
@@ -118,6 +125,7 @@ struct Decoded<Q> {
     guid: Option<Guid>,
     topic_name: Option<String>,
     type_name: Option<String>,
+    group_entity: Option<EntityId>,
 }
 
 impl<Q> Decoded<Q> {
@@ -145,9 +153,10 @@ impl<Q> Decoded<Q> {
             pid::CONTENT_FILTER_PROPERTY => {
                 d.content_filter = Some(Box::new(ContentFilterProperty::read(&mut cur)?))
             }
+            pid::GROUP_GUID => d.group = Some(cur.guid()?),
+            pid::GROUP_ENTITYID => self.group_entity = Some(cur.entity_id()?),
             // Known and deliberately unused.
             pid::KEY_HASH
-            | pid::GROUP_GUID
             | pid::TYPE_MAX_SIZE_SERIALIZED
             | pid::PROTOCOL_VERSION
             | pid::VENDORID => {}
@@ -157,10 +166,16 @@ impl<Q> Decoded<Q> {
     }
 
     fn finish(self) -> Result<EndpointData<Q>, WireError> {
+        let guid = self
+            .guid
+            .ok_or(WireError::Invalid("SEDP without endpoint GUID"))?;
+        let group = self
+            .group_entity
+            .map(|e| Guid::new(guid.prefix, e))
+            .or(self.data.group);
         Ok(EndpointData {
-            guid: self
-                .guid
-                .ok_or(WireError::Invalid("SEDP without endpoint GUID"))?,
+            guid,
+            group,
             topic_name: self
                 .topic_name
                 .ok_or(WireError::Invalid("SEDP without topic name"))?,
@@ -252,9 +267,11 @@ mod tests {
             expects_inline_qos: false,
             entity_name: None,
             content_filter: None,
+            group: Some(Guid::new(GuidPrefix([2; 12]), EntityId([0, 0, 3, 8]))),
         };
         let enc = w.encode();
         let back = WriterData::decode(&enc).unwrap();
+        assert_eq!(back.group, w.group);
         // Durations pass through 2^-32 fractions; compare after one more round trip.
         assert_eq!(WriterData::decode(&back.encode()).unwrap(), back);
         assert_eq!(back.topic_name, "Square");

@@ -22,6 +22,8 @@ bitflags! {
         const FINAL = 0x02;
         /// L: the heartbeat also asserts the writer's liveliness.
         const LIVELINESS = 0x04;
+        /// G: GroupInfo (current, first and last group sequence numbers, writer set) follows the count.
+        const GROUP_INFO = 0x08;
     }
 
     /// Flags of INFO_TS (§9.4.5.9).

@@ -80,6 +80,8 @@ pub mod pid {
     pub const PARTICIPANT_GUID: u16 = 0x0050;
     /// The publisher's or subscriber's GUID.
     pub const GROUP_GUID: u16 = 0x0052;
+    /// The entity id of the endpoint's publisher or subscriber (RTPS 2.5 `remoteGroupEntityId`).
+    pub const GROUP_ENTITYID: u16 = 0x0053;
     /// SPDP: the builtin endpoint set bits.
     pub const BUILTIN_ENDPOINT_SET: u16 = 0x0058;
     /// PID_COHERENT_SET (inline QoS): the sequence number of the first change of the coherent set.
@@ -215,6 +217,11 @@ impl<'a> ParameterList<'a> {
     /// Inline QoS: PID_COHERENT_SET, the first sequence number of the change's coherent set.
     pub fn coherent_set(&self) -> Option<SequenceNumber> {
         self.sequence_number(pid::COHERENT_SET)
+    }
+
+    /// Inline QoS: PID_GROUP_SEQ_NUM, the change's number within its publisher's group.
+    pub fn group_seq_num(&self) -> Option<SequenceNumber> {
+        self.sequence_number(pid::GROUP_SEQ_NUM)
     }
 
     /// Inline QoS: PID_GROUP_COHERENT_SET, the group sequence number of the first change of the group

@@ -40,6 +40,24 @@ pub struct Heartbeat {
     pub final_flag: bool,
     /// L: the heartbeat asserts liveliness.
     pub liveliness_flag: bool,
+    /// G: the writer belongs to a group (GROUP access scope) and says where the group stands.
+    pub group_info: Option<HeartbeatGroupInfo>,
+}
+
+/// The group part of a HEARTBEAT (flag G, RTPS 2.5 §8.3.7.5, §9.4.5.6), sent by writers of a publisher with
+/// GROUP access scope.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HeartbeatGroupInfo {
+    /// The last group sequence number any writer of the group had written when the heartbeat was sent.
+    pub current_gsn: SequenceNumber,
+    /// The group sequence number of the change `first_sn`.
+    pub first_gsn: SequenceNumber,
+    /// The group sequence number of the change `last_sn`.
+    pub last_gsn: SequenceNumber,
+    /// The digest of the group's writers when `current_gsn` was written (`GroupDigest_t`).
+    pub writer_set: [u8; 4],
+    /// Reserved for DDS-Security (`GroupDigest_t`; zero here).
+    pub secure_writer_set: [u8; 4],
 }
 
 /// GAP (§9.4.5.5): sequence numbers that will never be sent to the reader.
@@ -273,6 +291,17 @@ impl<'a> Submessage<'a> {
                     return Err(WireError::Invalid("HEARTBEAT sequence numbers"));
                 }
                 let f = HeartbeatFlags::from_bits_retain(flags);
+                let group_info = if f.contains(HeartbeatFlags::GROUP_INFO) {
+                    Some(HeartbeatGroupInfo {
+                        current_gsn: c.sequence_number()?,
+                        first_gsn: c.sequence_number()?,
+                        last_gsn: c.sequence_number()?,
+                        writer_set: c.array()?,
+                        secure_writer_set: c.array()?,
+                    })
+                } else {
+                    None
+                };
                 Submessage::Heartbeat(Heartbeat {
                     reader_id,
                     writer_id,
@@ -281,6 +310,7 @@ impl<'a> Submessage<'a> {
                     count,
                     final_flag: f.contains(HeartbeatFlags::FINAL),
                     liveliness_flag: f.contains(HeartbeatFlags::LIVELINESS),
+                    group_info,
                 })
             }
             id::GAP => {
@@ -401,6 +431,7 @@ impl<'a> Submessage<'a> {
                 let mut f = HeartbeatFlags::empty();
                 f.set(HeartbeatFlags::FINAL, h.final_flag);
                 f.set(HeartbeatFlags::LIVELINESS, h.liveliness_flag);
+                f.set(HeartbeatFlags::GROUP_INFO, h.group_info.is_some());
                 (id::HEARTBEAT, f.bits())
             }
             Submessage::Gap(_) => (id::GAP, 0),
@@ -469,6 +500,13 @@ impl<'a> Submessage<'a> {
                 p.sequence_number(h.first_sn);
                 p.sequence_number(h.last_sn);
                 p.i32(h.count);
+                if let Some(g) = &h.group_info {
+                    p.sequence_number(g.current_gsn);
+                    p.sequence_number(g.first_gsn);
+                    p.sequence_number(g.last_gsn);
+                    p.bytes(&g.writer_set);
+                    p.bytes(&g.secure_writer_set);
+                }
             }
             Submessage::Gap(g) => {
                 p.bytes(&g.reader_id.0);

@@ -4,9 +4,10 @@
 
 use std::time::Instant;
 
+use super::enable::Deferred;
 use super::{timers, Participant};
 use crate::rtps::api::WriteError;
-use crate::rtps::types::{EntityId, SequenceNumber};
+use crate::rtps::types::{entity_kind, EntityId, Guid, SequenceNumber};
 use crate::rtps::writer::{Writer, WriterGroup};
 
 impl Participant {
@@ -40,13 +41,41 @@ impl Participant {
     /// Makes a user writer a member of a publisher's group (GROUP access scope): from now on its changes
     /// carry `PID_GROUP_SEQ_NUM` from the group's counter, and while the group has a coherent set open
     /// ([`Participant::begin_group_set`]) `PID_GROUP_COHERENT_SET`; its end-of-set markers then carry
-    /// `PID_WRITER_GROUP_INFO`, the digest of the writers of the set.
+    /// `PID_WRITER_GROUP_INFO`, the digest of the writers of the set. Its heartbeats carry GroupInfo, and
+    /// its SEDP announcement (sent again now when it was sent already) names the group
+    /// (`PID_GROUP_ENTITYID`), so that readers can order the group's changes by group sequence number.
     pub fn join_writer_group(
         &mut self,
+        now: Instant,
         writer: EntityId,
         group: &WriterGroup,
     ) -> Result<(), WriteError> {
+        self.user_writer(writer)?;
+        let fresh = match group.entity() {
+            Some(_) => None,
+            None => self.alloc_entity(entity_kind::USER_WRITER_GROUP).ok(),
+        };
+        let entity = group.join(writer, fresh);
         self.user_writer(writer)?.group = Some(group.clone());
+        let Some(entity) = entity else {
+            return Ok(());
+        };
+        let guid = Guid::new(self.config.guid_prefix, entity);
+        if let Some(Deferred::Writer(d)) = self.deferred.get_mut(&writer) {
+            d.group = Some(guid);
+            return Ok(());
+        }
+        let me = Guid::new(self.config.guid_prefix, writer);
+        if let Some(d) = self
+            .known_writers
+            .get(&me)
+            .filter(|d| d.group != Some(guid))
+        {
+            let mut d = (**d).clone();
+            d.group = Some(guid);
+            self.timers_changed();
+            self.publish_endpoint(now, d);
+        }
         Ok(())
     }
 

@@ -178,6 +178,7 @@ impl Participant {
         self.readers_by_writer.retain(|w, _| w.prefix != prefix);
         self.forget_topics_of(prefix);
         self.forget_group_sets(&prefix);
+        self.forget_group_order(&prefix);
         for (ours, theirs, _) in builtin::WRITER_PAIRS {
             if let Some(w) = self.writers.get_mut(&ours) {
                 w.remove_proxy(&Guid::new(prefix, theirs), &mut self.events);

@@ -209,6 +209,9 @@ fn discard_parts(parts: Vec<Event>, out: &mut VecDeque<Event>) {
 impl Participant {
     /// Routes an event for the application: a part of a group coherent set waits for the rest of its set.
     pub(super) fn push_delivery(&mut self, ev: Event) {
+        let Some(ev) = self.order_by_group(ev) else {
+            return;
+        };
         let Event::CoherentSet {
             reader,
             writer,
@@ -246,6 +249,9 @@ impl Participant {
                 .collect();
             self.group_sets
                 .writer_gone(*writer, &unmatched, &mut self.events);
+            if let Some(now) = self.group_order_clock() {
+                self.group_order_timeout(now);
+            }
         }
     }
 

@@ -184,6 +184,7 @@ impl Participant {
                 payload: c.payload.clone(),
                 key_hash: c.key_hash,
                 source_timestamp: c.source_timestamp,
+                group_sequence: None,
             }));
         });
     }
@@ -236,6 +237,7 @@ impl Participant {
                 payload: change.payload.clone(),
                 key_hash: change.key_hash,
                 source_timestamp: change.source_timestamp,
+                group_sequence: None,
             }));
         }
         self.writer_asserted(now, wguid);

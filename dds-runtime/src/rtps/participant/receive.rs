@@ -147,6 +147,8 @@ impl Participant {
                     self.for_readers_arming(h.reader_id, wguid, |r, scratch| {
                         r.on_heartbeat(now, wguid, &h, scratch)
                     });
+                    self.route_deliveries(now);
+                    self.on_group_heartbeat(wguid, &h);
                     if h.liveliness_flag {
                         self.writer_asserted(now, wguid);
                     }
@@ -219,6 +221,7 @@ impl Participant {
         if self.scratch.is_empty() {
             return;
         }
+        self.group_order.tick(now);
         let mut batch = std::mem::take(&mut self.scratch);
         for ev in batch.drain(..) {
             match ev {

@@ -426,6 +426,7 @@ impl Participant {
                 payload: payload.clone(),
                 key_hash: h.key_hash,
                 source_timestamp: h.source_timestamp,
+                group_sequence: None,
             }));
         }
         if any {

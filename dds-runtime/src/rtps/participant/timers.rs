@@ -82,6 +82,9 @@ impl Participant {
                 t = t.min(x);
             }
         }
+        if let Some(x) = self.group_order.deadline() {
+            t = t.min(x);
+        }
         t
     }
 
@@ -115,6 +118,7 @@ impl Participant {
             self.pmd_due = now + self.automatic_interval();
         }
         self.type_lookup_timeout(now);
+        self.group_order_timeout(now);
         let expired: Vec<GuidPrefix> = self
             .participants
             .iter()

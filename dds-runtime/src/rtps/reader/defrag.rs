@@ -32,6 +32,7 @@ pub(crate) struct Defrag {
     pub key_flag: bool,
     /// `PID_COHERENT_SET` of the sample, if it is in a coherent set.
     pub coherent_set: Option<SequenceNumber>,
+    pub group_seq: Option<SequenceNumber>,
     /// Source timestamp in force for the first fragment that carried one.
     pub source_timestamp: Option<crate::rtps::types::Time>,
 }
@@ -66,6 +67,7 @@ impl Defrag {
             key_hash: None,
             key_flag: false,
             coherent_set: None,
+            group_seq: None,
             source_timestamp: None,
         }
     }

@@ -108,6 +108,21 @@ impl Reader {
         self.proxies.contains_key(g)
     }
 
+    /// Asks `writer` to say soon where it stands: the next ACKNACK, due now, is not final.
+    pub(crate) fn solicit_heartbeat(&mut self, now: Instant, writer: &Guid) {
+        if let Some(p) = self.proxies.get_mut(writer).filter(|p| p.reliable) {
+            p.want_heartbeat = true;
+            p.acknack_due.get_or_insert(now);
+            self.proxy_floor.lower(p.acknack_due);
+        }
+    }
+
+    /// A reliable proxy's in-order point: every change of `writer` up to the result reached this reader.
+    pub(crate) fn delivered_through(&self, writer: &Guid) -> Option<SequenceNumber> {
+        let p = self.proxies.get(writer).filter(|p| p.reliable)?;
+        Some(SequenceNumber(p.next_expected.0 - 1))
+    }
+
     pub(crate) fn add_proxy(&mut self, now: Instant, mut proxy: WriterProxy) {
         proxy.reliable &= self.params.reliable;
         proxy.coherent = Assembler::new(SetLimits {
@@ -146,6 +161,7 @@ impl Reader {
                 payload: c.payload,
                 key_hash: c.key_hash,
                 source_timestamp: c.source_timestamp,
+                group_sequence: c.group_seq,
             };
             if c.coherent.is_none() && !p.coherent.is_open() {
                 out.push(Event::Sample(s));
@@ -293,6 +309,7 @@ impl Reader {
                 key_hash,
                 source_timestamp: ts,
                 coherent,
+                group_seq: d.inline_qos.and_then(|q| q.group_seq_num()),
             }),
         };
         self.accept(p, d.writer_sn, slot, out);
@@ -366,6 +383,7 @@ impl Reader {
             df.key_hash = d.inline_qos.and_then(|q| q.key_hash());
             df.key_flag = d.key_flag;
             df.coherent_set = d.inline_qos.and_then(|q| q.coherent_set());
+            df.group_seq = d.inline_qos.and_then(|q| q.group_seq_num());
             b.defrag.insert(sn, df);
         }
         let Some(df) = b.defrag.get_mut(&sn) else {
@@ -391,6 +409,7 @@ impl Reader {
                 .map_or(ChangeKind::Alive, ChangeKind::from_status_info);
             let key_hash = df.key_hash;
             let source_timestamp = df.source_timestamp;
+            let group_seq = df.group_seq;
             let coherent = df.coherent_set.map(|set| SetMark {
                 set,
                 end: false,
@@ -406,6 +425,7 @@ impl Reader {
                 key_hash,
                 source_timestamp,
                 coherent,
+                group_seq,
             });
             self.accept(p, sn, slot, out);
         }
@@ -580,7 +600,7 @@ impl Reader {
             writer_id: p.guid.entity_id,
             reader_sn_state: set,
             count: p.acknack_count,
-            final_flag: set.num_bits == 0 && p.synced,
+            final_flag: set.num_bits == 0 && p.synced && !std::mem::take(&mut p.want_heartbeat),
         });
         out.push(&dest, dst, Ts::Any, &ack);
         let (writer, hb_last) = (p.guid, p.hb_last);

@@ -39,6 +39,8 @@ pub(crate) struct PendingChange {
     pub source_timestamp: Option<Time>,
     /// Membership in a coherent set (`PID_COHERENT_SET`).
     pub coherent: Option<SetMark>,
+    /// `PID_GROUP_SEQ_NUM`, from members of a GROUP-scope publisher.
+    pub group_seq: Option<SequenceNumber>,
 }
 
 #[derive(Debug)]
@@ -56,6 +58,8 @@ pub(crate) struct WriterProxy {
     pub hb_last: SequenceNumber,
     pub last_hb_count: Option<i32>,
     pub acknack_due: Option<Instant>,
+    /// The next ACKNACK asks for an answer even when nothing is missing (GROUP ordering waits to hear).
+    pub want_heartbeat: bool,
     pub acknack_count: i32,
     /// Changes held out of order and fragments: `None` until the first one arrives.
     backlog: Option<Box<Backlog>>,
@@ -91,6 +95,7 @@ impl WriterProxy {
             hb_last: SequenceNumber(0),
             last_hb_count: None,
             acknack_due: None,
+            want_heartbeat: false,
             acknack_count: 0,
             backlog: None,
             coherent: Assembler::default(),

@@ -7,13 +7,22 @@
 //! writer's end-of-set marker repeats `PID_GROUP_COHERENT_SET` and adds `PID_WRITER_GROUP_INFO`, the digest
 //! of the writers that took part in the set ([`writer_set_digest`]), so that a reader knows when it holds
 //! every writer's part. Markers take no group sequence number of their own.
+//!
+//! Every HEARTBEAT of a member carries GroupInfo (flag G): the group's last group sequence number
+//! (`currentGSN`), those of the writer's first and last change, and the digest of the group's members. A
+//! reader that holds all of the writer's changes up to the heartbeat's `lastSN` then knows that the writer
+//! has no change it lacks numbered up to `currentGSN` (`rtps::participant::group_order`). The group has an
+//! entity id of its own (kind 0x08, user-defined writer group), which its members announce in SEDP as
+//! `PID_GROUP_ENTITYID`, so that readers know which writers share the numbering.
 
 use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex, PoisonError};
 
 use md5::{Digest, Md5};
 
+use super::Writer;
 use crate::rtps::messages::parameter::pid;
+use crate::rtps::messages::HeartbeatGroupInfo;
 use crate::rtps::types::{EntityId, SequenceNumber};
 
 /// The digest of a set of writers (`GroupDigest_t`, 4 octets): the first four octets of the MD5 hash of
@@ -76,6 +85,10 @@ struct GroupSeq {
     open: Option<Option<SequenceNumber>>,
     /// The writers that wrote in the open set.
     writers: BTreeSet<EntityId>,
+    /// Every writer that joined the group.
+    members: BTreeSet<EntityId>,
+    /// The group's entity id, once a participant gave it one.
+    entity: Option<EntityId>,
 }
 
 /// The state the writers of one publisher with GROUP access scope share: the group sequence number and
@@ -90,6 +103,8 @@ impl Default for WriterGroup {
             next_gsn: 1,
             open: None,
             writers: BTreeSet::new(),
+            members: BTreeSet::new(),
+            entity: None,
         })))
     }
 }
@@ -97,6 +112,32 @@ impl Default for WriterGroup {
 impl WriterGroup {
     fn with<R>(&self, f: impl FnOnce(&mut GroupSeq) -> R) -> R {
         f(&mut self.0.lock().unwrap_or_else(PoisonError::into_inner))
+    }
+
+    /// The group's entity id, if it has one.
+    pub(crate) fn entity(&self) -> Option<EntityId> {
+        self.with(|g| g.entity)
+    }
+
+    /// Adds a member; gives the group the entity id `entity` when it has none. Returns the group's id.
+    pub(crate) fn join(&self, writer: EntityId, entity: Option<EntityId>) -> Option<EntityId> {
+        self.with(|g| {
+            g.members.insert(writer);
+            if g.entity.is_none() {
+                g.entity = entity;
+            }
+            g.entity
+        })
+    }
+
+    /// The last group sequence number written (0: none yet).
+    pub(crate) fn current_gsn(&self) -> SequenceNumber {
+        self.with(|g| SequenceNumber(g.next_gsn - 1))
+    }
+
+    /// The digest of the group's members.
+    fn member_digest(&self) -> [u8; 4] {
+        self.with(|g| writer_set_digest(&g.members))
     }
 
     /// Opens a group coherent set (nothing when one is open).
@@ -139,6 +180,30 @@ impl WriterGroup {
                 set,
                 writers: None,
             }
+        })
+    }
+}
+
+impl Writer {
+    /// The GroupInfo of this writer's HEARTBEAT announcing `first..=last`, when it is a group member.
+    pub(crate) fn group_info(
+        &self,
+        first: SequenceNumber,
+        last: SequenceNumber,
+    ) -> Option<HeartbeatGroupInfo> {
+        let group = self.group.as_ref()?;
+        let current_gsn = group.current_gsn();
+        let gsn = |sn| self.history.get(sn).and_then(|c| c.marks.group?.gsn);
+        let last_gsn = gsn(last).unwrap_or(current_gsn);
+        let first_gsn = gsn(first)
+            .unwrap_or(SequenceNumber(last_gsn.0 + 1))
+            .min(SequenceNumber(last_gsn.0 + 1));
+        Some(HeartbeatGroupInfo {
+            current_gsn,
+            first_gsn: first_gsn.max(SequenceNumber(1)),
+            last_gsn,
+            writer_set: group.member_digest(),
+            secure_writer_set: [0; 4],
         })
     }
 }

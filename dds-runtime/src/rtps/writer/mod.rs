@@ -430,14 +430,19 @@ impl Writer {
 
     fn heartbeat(&mut self, reader_id: EntityId, final_flag: bool) -> Submessage<'static> {
         self.hb_count = self.hb_count.wrapping_add(1);
+        let (first_sn, last_sn) = (
+            self.history.first_sn().unwrap_or(self.next_sn),
+            self.last_sn(),
+        );
         Submessage::Heartbeat(Heartbeat {
             reader_id,
             writer_id: self.guid.entity_id,
-            first_sn: self.history.first_sn().unwrap_or(self.next_sn),
-            last_sn: self.last_sn(),
+            first_sn,
+            last_sn,
             count: self.hb_count,
             final_flag,
             liveliness_flag: false,
+            group_info: self.group_info(first_sn, last_sn),
         })
     }
 
@@ -515,6 +520,7 @@ impl Writer {
     ) {
         let next_sn = self.next_sn;
         let delay = self.params.nack_response_delay;
+        let grouped = self.group.is_some();
         let Some(p) = self.proxies.get_mut(&reader) else {
             return;
         };
@@ -540,8 +546,9 @@ impl Writer {
         request_past_bitmap(p, &ack.reader_sn_state, next_sn);
         p.drop_requests_below(p.acked);
         // A request, or a reader that is behind without knowing it (e.g. a pre-emptive ACKNACK): answer soon.
+        // A group member answers every non-final ACKNACK: its heartbeat tells where the group stands.
         if (p.has_requested()
-            || (ack.reader_sn_state.num_bits == 0 && base < next_sn && !ack.final_flag))
+            || (ack.reader_sn_state.num_bits == 0 && (base < next_sn || grouped) && !ack.final_flag))
             && p.repair_due.is_none()
         {
             p.repair_due = Some(now + delay);
@@ -714,8 +721,11 @@ impl Writer {
             p.repair_due = Some(now + self.params.nack_response_delay);
             self.repair_queue.arm(p.repair_due, g);
         }
-        // A reader that acknowledged everything meanwhile (its ACKNACK crossed our push) needs no heartbeat.
-        if reliable && !(idle && p.acked >= self.next_sn) {
+        // A reader that acknowledged everything meanwhile (its ACKNACK crossed our push) needs no heartbeat,
+        // unless the writer is a group member: its heartbeat's GroupInfo tells the reader where the group
+        // stands (an ordered reader asks for it while it holds changes back).
+        let caught_up = idle && p.acked >= self.next_sn;
+        if reliable && (!caught_up || self.group.is_some()) {
             let hb = self.heartbeat(g.entity_id, false);
             out.push(&dest, dst, Ts::Any, &hb);
         }

@@ -1,6 +1,7 @@
 //! How a durability service's stand-in writer says whom it stands for: its USER_DATA is this prefix
 //! followed by the 16-byte GUID of the original writer. Other services skip such writers (no service
-//! replays another's replay) and readers use it to drop repeats (see [`super::dedup`]).
+//! replays another's replay), readers use it to drop repeats (`durability/dedup.rs`) and report the
+//! original writer as the changes' publication (`RemoteWriterInfo::original` in `driver.rs`).
 
 use crate::rtps::Guid;
 
