@@ -393,7 +393,7 @@ impl DynamicReaderListener for Calls {
 #[test]
 fn dynamic_reader_listener_and_status_condition() {
     let ty = shape_from_builder();
-    let (p1, p2) = (participant(219), participant(219));
+    let (p1, p2) = (participant(17), participant(17));
     let publ = p1.create_publisher(&PublisherQos::default()).unwrap();
     let t1 = p1
         .create_topic::<ShapeType>("Square", &TopicQos::default())
