@@ -112,8 +112,9 @@ impl Reader {
     pub(crate) fn solicit_heartbeat(&mut self, now: Instant, writer: &Guid) {
         if let Some(p) = self.proxies.get_mut(writer).filter(|p| p.reliable) {
             p.want_heartbeat = true;
-            p.acknack_due.get_or_insert(now);
-            self.proxy_floor.lower(p.acknack_due);
+            let due = p.acknack_due.map_or(now, |d| d.min(now));
+            p.acknack_due = Some(due);
+            self.due.arm(p.acknack_due, *writer);
         }
     }
 
