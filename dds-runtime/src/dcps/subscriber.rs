@@ -700,56 +700,74 @@ impl<T: DdsType> DataReader<T> {
 
     /// SUBSCRIPTION_MATCHED (resets the change counts).
     pub fn subscription_matched_status(&self) -> SubscriptionMatchedStatus {
-        self.inner
-            .state
+        self.inner.subscription_matched_status()
+    }
+
+    /// REQUESTED_INCOMPATIBLE_QOS (resets the change count).
+    pub fn requested_incompatible_qos_status(&self) -> IncompatibleQosStatus {
+        self.inner.requested_incompatible_qos_status()
+    }
+
+    /// SAMPLE_LOST (resets the change count).
+    pub fn sample_lost_status(&self) -> SampleLostStatus {
+        self.inner.sample_lost_status()
+    }
+
+    /// SAMPLE_REJECTED (resets the change count).
+    pub fn sample_rejected_status(&self) -> SampleRejectedStatus {
+        self.inner.sample_rejected_status()
+    }
+
+    /// LIVELINESS_CHANGED (resets the change counts).
+    pub fn liveliness_changed_status(&self) -> LivelinessChangedStatus {
+        self.inner.liveliness_changed_status()
+    }
+
+    /// REQUESTED_DEADLINE_MISSED (resets the change count).
+    pub fn requested_deadline_missed_status(&self) -> DeadlineMissedStatus {
+        self.inner.requested_deadline_missed_status()
+    }
+}
+
+impl<K: ReaderKind> ReaderInner<K> {
+    // The reader's statuses, read by the application (each resets its change counts), for both kinds.
+    pub(crate) fn subscription_matched_status(&self) -> SubscriptionMatchedStatus {
+        self.state
             .take_status(StatusMask::SUBSCRIPTION_MATCHED, |s| {
                 &mut s.subscription_matched
             })
     }
 
-    /// REQUESTED_INCOMPATIBLE_QOS (resets the change count).
-    pub fn requested_incompatible_qos_status(&self) -> IncompatibleQosStatus {
-        self.inner
-            .state
+    pub(crate) fn requested_incompatible_qos_status(&self) -> IncompatibleQosStatus {
+        self.state
             .take_status(StatusMask::REQUESTED_INCOMPATIBLE_QOS, |s| {
                 &mut s.requested_incompatible_qos
             })
     }
 
-    /// SAMPLE_LOST (resets the change count).
-    pub fn sample_lost_status(&self) -> SampleLostStatus {
-        self.inner
-            .state
+    pub(crate) fn sample_lost_status(&self) -> SampleLostStatus {
+        self.state
             .take_status(StatusMask::SAMPLE_LOST, |s| &mut s.sample_lost)
     }
 
-    /// SAMPLE_REJECTED (resets the change count).
-    pub fn sample_rejected_status(&self) -> SampleRejectedStatus {
-        self.inner
-            .state
+    pub(crate) fn sample_rejected_status(&self) -> SampleRejectedStatus {
+        self.state
             .take_status(StatusMask::SAMPLE_REJECTED, |s| &mut s.sample_rejected)
     }
 
-    /// LIVELINESS_CHANGED (resets the change counts).
-    pub fn liveliness_changed_status(&self) -> LivelinessChangedStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::LIVELINESS_CHANGED, |s| {
-                &mut s.liveliness_changed
-            })
+    pub(crate) fn liveliness_changed_status(&self) -> LivelinessChangedStatus {
+        self.state.take_status(StatusMask::LIVELINESS_CHANGED, |s| {
+            &mut s.liveliness_changed
+        })
     }
 
-    /// REQUESTED_DEADLINE_MISSED (resets the change count).
-    pub fn requested_deadline_missed_status(&self) -> DeadlineMissedStatus {
-        self.inner
-            .state
+    pub(crate) fn requested_deadline_missed_status(&self) -> DeadlineMissedStatus {
+        self.state
             .take_status(StatusMask::REQUESTED_DEADLINE_MISSED, |s| {
                 &mut s.requested_deadline_missed
             })
     }
-}
 
-impl<K: ReaderKind> ReaderInner<K> {
     /// The state of a new reader with `cache`, not yet created in the core.
     pub(crate) fn new(
         codec: K::Codec,

@@ -274,53 +274,33 @@ impl DynamicReader {
 
     /// SUBSCRIPTION_MATCHED (resets the change counts).
     pub fn subscription_matched_status(&self) -> SubscriptionMatchedStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::SUBSCRIPTION_MATCHED, |s| {
-                &mut s.subscription_matched
-            })
+        self.inner.subscription_matched_status()
     }
 
     /// REQUESTED_INCOMPATIBLE_QOS: writers on the topic not matched for a policy (`TypeConsistencyEnforcement`
     /// for a type not assignable to the reader's). Resets the change count.
     pub fn requested_incompatible_qos_status(&self) -> IncompatibleQosStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::REQUESTED_INCOMPATIBLE_QOS, |s| {
-                &mut s.requested_incompatible_qos
-            })
+        self.inner.requested_incompatible_qos_status()
     }
 
     /// SAMPLE_LOST (resets the change count).
     pub fn sample_lost_status(&self) -> SampleLostStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::SAMPLE_LOST, |s| &mut s.sample_lost)
+        self.inner.sample_lost_status()
     }
 
     /// SAMPLE_REJECTED (resets the change count).
     pub fn sample_rejected_status(&self) -> SampleRejectedStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::SAMPLE_REJECTED, |s| &mut s.sample_rejected)
+        self.inner.sample_rejected_status()
     }
 
     /// LIVELINESS_CHANGED (resets the change counts).
     pub fn liveliness_changed_status(&self) -> LivelinessChangedStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::LIVELINESS_CHANGED, |s| {
-                &mut s.liveliness_changed
-            })
+        self.inner.liveliness_changed_status()
     }
 
     /// REQUESTED_DEADLINE_MISSED (resets the change count).
     pub fn requested_deadline_missed_status(&self) -> DeadlineMissedStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::REQUESTED_DEADLINE_MISSED, |s| {
-                &mut s.requested_deadline_missed
-            })
+        self.inner.requested_deadline_missed_status()
     }
 
     /// Waits until a sample (or an instance state change) not read yet is in the cache; `false` on timeout

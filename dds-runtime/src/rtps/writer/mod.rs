@@ -548,7 +548,9 @@ impl Writer {
         // A request, or a reader that is behind without knowing it (e.g. a pre-emptive ACKNACK): answer soon.
         // A group member answers every non-final ACKNACK: its heartbeat tells where the group stands.
         if (p.has_requested()
-            || (ack.reader_sn_state.num_bits == 0 && (base < next_sn || grouped) && !ack.final_flag))
+            || (ack.reader_sn_state.num_bits == 0
+                && (base < next_sn || grouped)
+                && !ack.final_flag))
             && p.repair_due.is_none()
         {
             p.repair_due = Some(now + delay);
