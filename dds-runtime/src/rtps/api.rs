@@ -67,6 +67,12 @@ impl Payload {
             end,
         }
     }
+    /// Brings the shared buffer's reference counts into the cache ahead of a clone or drop (a hint).
+    pub(crate) fn prefetch(&self) {
+        if let Some(Buf::Vec(v)) = &self.buf {
+            super::pool::prefetch_arc(v);
+        }
+    }
     /// Shares the bytes of a pooled buffer whole.
     pub(crate) fn from_shared_vec(v: Arc<Vec<u8>>) -> Self {
         let end = v.len();

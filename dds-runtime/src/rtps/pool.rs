@@ -40,12 +40,20 @@ impl BufferPool {
 
     /// An empty buffer referenced by nobody else: a free one from the pool, else a new one (with the
     /// capacity of the last buffer shared, so that filling it does not regrow it step by step).
+    ///
+    /// The next buffer in line is prefetched: a writer with thousands of samples in flight reuses a buffer
+    /// long after it last touched it, and reading its reference counts cold was a tenth of a 64-byte
+    /// publisher's time.
     pub(crate) fn take(&mut self) -> Arc<Vec<u8>> {
         if let Some(front) = self.bufs.front_mut() {
             if let Some(v) = Arc::get_mut(front) {
                 v.clear();
                 self.bytes -= v.capacity();
-                return self.bufs.pop_front().unwrap_or_default();
+                let b = self.bufs.pop_front().unwrap_or_default();
+                if let Some(next) = self.bufs.front() {
+                    prefetch_arc(next);
+                }
+                return b;
             }
         }
         Arc::new(Vec::with_capacity(self.last_len))
@@ -80,6 +88,26 @@ impl BufferPool {
         self.bufs.push_back(b);
         p
     }
+}
+
+/// Asks the CPU to bring `a`'s reference counts and value into the cache ahead of use (a hint: no effect
+/// on other targets).
+#[inline]
+pub(crate) fn prefetch_arc<T>(a: &Arc<T>) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // The counts are the two words before the value; one line each side covers both.
+        let p = Arc::as_ptr(a).cast::<i8>();
+        // SAFETY: a prefetch is a hint that never faults, whatever the address; `wrapping_*` keep the
+        // pointer arithmetic defined.
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_sub(16));
+            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(std::mem::size_of::<T>()));
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = a;
 }
 
 /// The receive path's pools: copies of datagrams whose DATA samples share them, and reassembly buffers.
