@@ -356,10 +356,12 @@ impl<T: DdsType> std::fmt::Debug for DataWriter<T> {
 /// Runs `f` on a cleared per-thread buffer (a fresh one if the thread's is in use), so that serializing a
 /// sample or its key allocates nothing once the buffer has grown.
 /// Buffers a writer's payload pool keeps: enough for the samples a reliable writer has in flight at the
-/// default flow-control window (512 KiB of 16-byte samples, 20 bytes serialized) and a history of a few
-/// thousand samples. With fewer, a writer of small samples got ahead of its pool and allocated a buffer
-/// per sample. Each buffer costs its capacity plus about 64 bytes (its `Arc` and the allocator's headers).
-const WRITER_POOL_BUFFERS: usize = 32768;
+/// default flow-control window (512 KiB of 128-byte samples) and a history of a few thousand samples.
+/// Smaller samples get further ahead, and the pool then allocates for them: 32 768 buffers (enough at
+/// 16 B) cost more CPU at 16 B in interleaved runs than these allocations, because a buffer reused 26 000
+/// samples after its last use is cold while the allocator hands back the one just freed
+/// (docs/performance.md, session 19).
+const WRITER_POOL_BUFFERS: usize = 4096;
 /// Bytes of capacity a writer's payload pool keeps: the largest flow-control window (4 MiB) four times.
 const WRITER_POOL_BYTES: usize = 16 << 20;
 
