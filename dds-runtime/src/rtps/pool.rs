@@ -12,7 +12,7 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use super::api::Payload;
+use super::api::{prefetch_arc, Payload};
 
 /// A bounded pool of reusable payload buffers.
 #[derive(Debug)]
@@ -88,26 +88,6 @@ impl BufferPool {
         self.bufs.push_back(b);
         p
     }
-}
-
-/// Asks the CPU to bring `a`'s reference counts and value into the cache ahead of use (a hint: no effect
-/// on other targets).
-#[inline]
-pub(crate) fn prefetch_arc<T>(a: &Arc<T>) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        // The counts are the two words before the value; one line each side covers both.
-        let p = Arc::as_ptr(a).cast::<i8>();
-        // SAFETY: a prefetch is a hint that never faults, whatever the address; `wrapping_*` keep the
-        // pointer arithmetic defined.
-        unsafe {
-            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_sub(16));
-            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(std::mem::size_of::<T>()));
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = a;
 }
 
 /// The receive path's pools: copies of datagrams whose DATA samples share them, and reassembly buffers.
