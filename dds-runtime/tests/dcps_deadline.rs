@@ -124,3 +124,26 @@ fn deadline_status_without_listener_counts_changes_until_read() {
     std::thread::sleep(Duration::from_millis(60));
     assert_eq!(w.offered_deadline_missed_status().total_count, before);
 }
+
+#[test]
+fn a_deadline_set_after_writes_counts_from_the_change() {
+    // Writes without a deadline do not read the clock for it (write path): a deadline set later must
+    // count from the set_qos, not from a stale last-write time.
+    let (p1, p2) = (participant(219), participant(219));
+    let (wq, rq) = reliable_keep_all();
+    let (w, _r) = matched::<ShapeType>(&p1, &p2, "Square", &wq, &rq);
+    w.write(&shape("BLUE", 1)).unwrap();
+    std::thread::sleep(PERIOD * 2);
+    let mut q = w.get_qos().unwrap();
+    q.deadline = Deadline(PERIOD);
+    let set = Instant::now();
+    w.set_qos(&q).unwrap();
+    assert!(wait_until(Duration::from_secs(5), || {
+        w.offered_deadline_missed_status().total_count > 0
+    }));
+    let first_miss = set.elapsed();
+    assert!(
+        first_miss >= PERIOD - Duration::from_millis(10),
+        "the first miss came {first_miss:?} after the deadline was set (period {PERIOD:?})"
+    );
+}

@@ -103,6 +103,8 @@ pub(crate) struct Driver {
     /// Sent datagrams (payload buffers and destination lists), handed back to the core at the next
     /// `with_core`.
     spare_buffers: Mutex<Vec<Transmit>>,
+    /// Length of `spare_buffers` (a core call locks it only when it holds some).
+    spare_count: AtomicUsize,
     /// Services watching the core (see [`CoreObserver`]); `has_observers` keeps the sample path free of
     /// the lock while there are none.
     observers: RwLock<Vec<Arc<dyn CoreObserver>>>,
@@ -129,8 +131,10 @@ type Routed = (Vec<Event>, Vec<(EntityId, Arc<dyn Endpoint>)>);
 /// See [`Driver::set_discovery_hook`].
 type DiscoveryHook = Box<dyn Fn(&Event) + Send + Sync>;
 
-/// Most sent buffers kept for recycling.
+/// Most sent buffers kept for recycling in the shared list.
 const MAX_SPARE_BUFFERS: usize = 32;
+/// Sent buffers a thread keeps for its next core call.
+const THREAD_SPARE_BUFFERS: usize = 4;
 
 /// Period of the endpoints' time-driven QoS checks.
 const ENDPOINT_TICK: Duration = Duration::from_millis(50);
@@ -279,6 +283,7 @@ impl Driver {
             timer_thread: Mutex::new(None),
             status: Arc::new(StatusCore::default()),
             spare_buffers: Mutex::new(Vec::new()),
+            spare_count: AtomicUsize::new(0),
             observers: RwLock::new(Vec::new()),
             has_observers: AtomicBool::new(false),
             discovery_hook: OnceLock::new(),
@@ -355,14 +360,23 @@ impl Driver {
         send_shm: bool,
     ) -> R {
         let now = Instant::now();
-        // The batch vector is kept per thread (a nested call, from a listener, gets a fresh one).
+        // The batch vector is kept per thread (a nested call, from a listener, gets a fresh one), with the
+        // datagrams this thread sent last time still in it, for reuse.
         let mut batch: Vec<Transmit> = BATCH.with(|b| std::mem::take(&mut *b.borrow_mut()));
         let (mut deferred, mut touched) = ROUTED.with(|b| std::mem::take(&mut *b.borrow_mut()));
         let (r, next_timeout) = {
             let mut core = lock(&self.core);
-            // Sent datagrams go back to the core for reuse (saves allocations per datagram).
-            for t in lock(&self.spare_buffers).drain(..) {
+            // Sent datagrams go back to the core for reuse (saves allocations per datagram): this thread's
+            // own without a lock, the shared list's when other threads left some there.
+            for t in batch.drain(..) {
                 core.recycle_transmit(t);
+            }
+            if self.spare_count.load(Ordering::Acquire) > 0 {
+                let mut spare = lock(&self.spare_buffers);
+                self.spare_count.store(0, Ordering::Release);
+                for t in spare.drain(..) {
+                    core.recycle_transmit(t);
+                }
             }
             let r = f(&mut core, now);
             while let Some(t) = core.poll_transmit(now) {
@@ -386,20 +400,28 @@ impl Driver {
         #[cfg(not(feature = "shm"))]
         let _ = send_shm;
         self.send_batch(&batch);
-        {
-            let mut spare = lock(&self.spare_buffers);
-            for t in batch.drain(..) {
-                if spare.len() < MAX_SPARE_BUFFERS {
-                    spare.push(t);
-                }
-            }
-        }
+        self.keep_sent(&mut batch);
         BATCH.with(|b| *b.borrow_mut() = batch);
         self.after_unlock(&mut deferred, &mut touched, next_timeout, progress);
         // Only non-sample events are deferred: a discovery burst must not pin its room for good.
         deferred.shrink_to(crate::rtps::KEPT_QUEUE_ROOM);
         ROUTED.with(|b| *b.borrow_mut() = (deferred, touched));
         r
+    }
+
+    /// Keeps the datagrams just sent for reuse: a few in `batch`, which stays with the thread (a write
+    /// takes no lock for them), the rest in the shared list, up to its bound.
+    fn keep_sent(&self, batch: &mut Vec<Transmit>) {
+        if batch.len() <= THREAD_SPARE_BUFFERS {
+            return;
+        }
+        let mut spare = lock(&self.spare_buffers);
+        for t in batch.drain(THREAD_SPARE_BUFFERS..) {
+            if spare.len() < MAX_SPARE_BUFFERS {
+                spare.push(t);
+            }
+        }
+        self.spare_count.store(spare.len(), Ordering::Release);
     }
 
     /// Under the core lock: samples go to their reader's queue (keeps order); the rest is deferred.

@@ -179,10 +179,12 @@ impl Publisher {
             content_filter: None,
             internal: false,
         };
+        let fixed = WritePath::new(version, &wq.reliability);
+        fixed.set_deadline(&wq);
         let inner = Arc::new(WriterInner::<T> {
             state: EndpointState::new(driver.clone()),
             current: RwLock::new(wq.clone()),
-            fixed: WritePath::new(version, &wq.reliability),
+            fixed,
             instances: Mutex::new(WriterInstances::default()),
             filters: Mutex::new(WriterFilters::default()),
             payloads: Mutex::new(BufferPool::new(WRITER_POOL_BUFFERS, WRITER_POOL_BYTES)),
@@ -228,6 +230,9 @@ impl Publisher {
 struct WritePath {
     xcdr2: AtomicBool,
     max_block_nanos: AtomicU64,
+    /// Whether an offered deadline is set (DEADLINE, changeable): only then does a write read the clock
+    /// for its instance's last-write time.
+    deadline: AtomicBool,
 }
 
 impl WritePath {
@@ -235,9 +240,21 @@ impl WritePath {
         let p = WritePath {
             xcdr2: AtomicBool::new(false),
             max_block_nanos: AtomicU64::new(0),
+            deadline: AtomicBool::new(false),
         };
         p.set(version, reliability);
         p
+    }
+
+    /// Records whether `qos` sets an offered deadline.
+    fn set_deadline(&self, qos: &DataWriterQos) {
+        let period = qos.deadline.0;
+        let on = period != crate::qos::INFINITE && !period.is_zero();
+        self.deadline.store(on, AtomicOrdering::Release);
+    }
+
+    fn has_deadline(&self) -> bool {
+        self.deadline.load(AtomicOrdering::Acquire)
     }
 
     fn set(&self, version: XcdrVersion, reliability: &Reliability) {
@@ -340,6 +357,10 @@ impl<T: DdsType> std::fmt::Debug for DataWriter<T> {
 /// sample or its key allocates nothing once the buffer has grown.
 /// Buffers a writer's payload pool keeps: enough for the samples a reliable writer has in flight at the
 /// default flow-control window (512 KiB of 128-byte samples) and a history of a few thousand samples.
+/// Smaller samples get further ahead, and the pool then allocates for them: 32 768 buffers (enough at
+/// 16 B) cost more CPU at 16 B in interleaved runs than these allocations, because a buffer reused 26 000
+/// samples after its last use is cold while the allocator hands back the one just freed
+/// (docs/performance.md, session 19).
 const WRITER_POOL_BUFFERS: usize = 4096;
 /// Bytes of capacity a writer's payload pool keeps: the largest flow-control window (4 MiB) four times.
 const WRITER_POOL_BYTES: usize = 16 << 20;
@@ -405,14 +426,9 @@ impl<T: DdsType> DataWriter<T> {
     /// Serializes straight into a buffer of the writer's pool, which the payload shares: no copy, and
     /// no allocation once the pool holds the buffers the history has released.
     fn serialize(&self, sample: &T) -> DdsResult<Payload> {
-        let mut buf = lock(&self.inner.payloads).take();
-        cdr::serialize(
-            sample,
-            self.inner.fixed.version(),
-            ByteOrder::NATIVE,
-            Arc::make_mut(&mut buf),
-        )?;
-        Ok(lock(&self.inner.payloads).share(buf))
+        let version = self.inner.fixed.version();
+        Ok(lock(&self.inner.payloads)
+            .fill(|buf| cdr::serialize(sample, version, ByteOrder::NATIVE, buf))?)
     }
 
     fn key_hash(&self, sample: &T) -> DdsResult<Option<[u8; 16]>> {
@@ -518,7 +534,11 @@ impl<T: DdsType> DataWriter<T> {
         if T::IS_KEYED {
             Ok(self.instance_of(sample, true, true)?.and_then(|(_, kh)| kh))
         } else {
-            lock(&self.inner.instances).keyless_last_write = Some(Instant::now());
+            let mut inst = lock(&self.inner.instances);
+            // Without an offered deadline only the first write reads the clock (whether it wrote).
+            if self.inner.fixed.has_deadline() || inst.keyless_last_write.is_none() {
+                inst.keyless_last_write = Some(Instant::now());
+            }
             Ok(None)
         }
     }
@@ -540,7 +560,8 @@ impl<T: DdsType> DataWriter<T> {
             let Some(i) = inst.by_handle.get_mut(&h) else {
                 return Ok(None);
             };
-            if written {
+            // Only the offered deadline reads the last-write time: no clock read without one.
+            if written && self.inner.fixed.has_deadline() {
                 i.last_write = Instant::now();
             }
             Ok(Some((h, i.key_hash)))
@@ -768,6 +789,20 @@ impl<T: DdsType> DataWriter<T> {
 }
 
 impl<T: DdsType> WriterInner<T> {
+    /// Applies `qos`'s offered deadline to the write path. Writes made without one did not record their
+    /// time, so a deadline set now counts from now for every instance written so far.
+    fn set_deadline(&self, qos: &DataWriterQos) {
+        if !self.fixed.has_deadline() {
+            let now = Instant::now();
+            let mut inst = lock(&self.instances);
+            inst.by_handle.values_mut().for_each(|i| i.last_write = now);
+            if inst.keyless_last_write.is_some() {
+                inst.keyless_last_write = Some(now);
+            }
+        }
+        self.fixed.set_deadline(qos);
+    }
+
     fn unregister_kind(&self) -> ChangeKind {
         if read(&self.current)
             .writer_data_lifecycle

@@ -12,7 +12,7 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use super::api::Payload;
+use super::api::{prefetch_arc, Payload};
 
 /// A bounded pool of reusable payload buffers.
 #[derive(Debug)]
@@ -40,12 +40,20 @@ impl BufferPool {
 
     /// An empty buffer referenced by nobody else: a free one from the pool, else a new one (with the
     /// capacity of the last buffer shared, so that filling it does not regrow it step by step).
+    ///
+    /// The next buffer in line is prefetched: a writer with thousands of samples in flight reuses a buffer
+    /// long after it last touched it, and reading its reference counts cold was a tenth of a 64-byte
+    /// publisher's time.
     pub(crate) fn take(&mut self) -> Arc<Vec<u8>> {
         if let Some(front) = self.bufs.front_mut() {
             if let Some(v) = Arc::get_mut(front) {
                 v.clear();
                 self.bytes -= v.capacity();
-                return self.bufs.pop_front().unwrap_or_default();
+                let b = self.bufs.pop_front().unwrap_or_default();
+                if let Some(next) = self.bufs.front() {
+                    prefetch_arc(next);
+                }
+                return b;
             }
         }
         Arc::new(Vec::with_capacity(self.last_len))

@@ -119,12 +119,23 @@ impl EntityId {
 }
 
 /// A globally unique entity id (§8.2.4.1): participant prefix plus entity id.
-#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub struct Guid {
     /// The participant's GUID prefix.
     pub prefix: GuidPrefix,
     /// The entity within the participant.
     pub entity_id: EntityId,
+}
+
+/// Hashed as one 128-bit word, not as two length-prefixed byte arrays: the receive path looks a writer's
+/// GUID up for every sample. Equal GUIDs have equal bytes, so this agrees with `Eq`.
+impl std::hash::Hash for Guid {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        let mut b = [0u8; 16];
+        b[..12].copy_from_slice(&self.prefix.0);
+        b[12..].copy_from_slice(&self.entity_id.0);
+        state.write_u128(u128::from_ne_bytes(b));
+    }
 }
 
 impl Guid {

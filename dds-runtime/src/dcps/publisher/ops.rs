@@ -344,6 +344,7 @@ impl<T: DdsType> DataWriter<T> {
             return self.respecify(new);
         }
         *write(&self.inner.current) = new.clone();
+        self.inner.set_deadline(&new);
         self.announce(new)
     }
 
@@ -367,6 +368,7 @@ impl<T: DdsType> DataWriter<T> {
             .driver
             .with_core(|c, _| c.respecify_disabled_writer(id, wq))?;
         self.inner.fixed.set(version, &new.reliability);
+        self.inner.set_deadline(&new);
         *write(&self.inner.current) = new;
         Ok(())
     }

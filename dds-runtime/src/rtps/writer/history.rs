@@ -174,11 +174,25 @@ impl HistoryCache {
     }
 
     /// Drops every change below `sn` (volatile writers, once acknowledged by all).
+    /// Their payloads' reference counts were last touched when they were sent, so each is prefetched a few
+    /// changes ahead of its drop.
     pub(crate) fn remove_below(&mut self, sn: SequenceNumber) {
+        const AHEAD: i64 = 8;
+        let prefetch = |h: &Self, at: SequenceNumber| {
+            if at < sn {
+                if let Some(c) = h.changes.get(at) {
+                    c.payload.prefetch();
+                }
+            }
+        };
+        if let Some(first) = self.first_sn() {
+            (0..AHEAD).for_each(|k| prefetch(self, SequenceNumber(first.0.saturating_add(k))));
+        }
         while let Some(first) = self.first_sn() {
             if first >= sn {
                 break;
             }
+            prefetch(self, SequenceNumber(first.0.saturating_add(AHEAD)));
             self.remove(first);
         }
     }
