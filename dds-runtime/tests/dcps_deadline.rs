@@ -129,7 +129,7 @@ fn deadline_status_without_listener_counts_changes_until_read() {
 fn a_deadline_set_after_writes_counts_from_the_change() {
     // Writes without a deadline do not read the clock for it (write path): a deadline set later must
     // count from the set_qos, not from a stale last-write time.
-    let (p1, p2) = (participant(219), participant(219));
+    let (p1, p2) = (participant(13), participant(13));
     let (wq, rq) = reliable_keep_all();
     let (w, _r) = matched::<ShapeType>(&p1, &p2, "Square", &wq, &rq);
     w.write(&shape("BLUE", 1)).unwrap();
