@@ -60,7 +60,8 @@ fn builtin_readers_see_entities_come_and_go() {
     }));
     // The remote writer arrives: the read condition and the listener fire.
     assert!(!ws.wait(MATCH_TIMEOUT).unwrap().is_empty());
-    assert!(calls.load(Ordering::SeqCst) >= 1);
+    // The WaitSet may wake before the listener has run (another thread).
+    assert!(wait_until(MATCH_TIMEOUT, || calls.load(Ordering::SeqCst) >= 1));
     let got = pubs.read_w_condition(&new_pub).unwrap();
     let wd = got
         .iter()
