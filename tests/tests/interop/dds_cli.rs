@@ -16,8 +16,8 @@ use crate::check;
 const DOMAIN: u32 = 170;
 const WAIT: Duration = Duration::from_secs(20);
 
-/// A Cyclone participant with a writer on "Square" and a reader on "Circle", both of type ShapeType.
-const PEER: &str = r#"
+/// What the Python peers start with: the binding's imports and the type of [`IDL`].
+const PY_SHAPE: &str = r#"
 import os, sys, time
 from dataclasses import dataclass
 from cyclonedds.domain import DomainParticipant
@@ -38,6 +38,20 @@ class ShapeType(IdlStruct, typename="ShapeType"):
     y: int32
     shapesize: int32
 
+"#;
+
+/// A Cyclone peer that runs `body` after [`PY_SHAPE`], on [`DOMAIN`].
+fn python_peer(body: &str) -> Command {
+    let mut c = Command::new("python3");
+    c.arg("-u")
+        .arg("-c")
+        .arg(format!("{PY_SHAPE}{body}"))
+        .arg(DOMAIN.to_string());
+    c
+}
+
+/// A Cyclone participant with a writer on "Square" and a reader on "Circle", both of type ShapeType.
+const PEER: &str = r#"
 dp = DomainParticipant(int(sys.argv[1]))
 w = DataWriter(dp, Topic(dp, "Square", ShapeType))
 r = DataReader(dp, Topic(dp, "Circle", ShapeType), qos=Qos(Policy.Reliability.Reliable(duration(seconds=1))))
@@ -70,9 +84,7 @@ fn idl_file() -> std::path::PathBuf {
 fn peer() -> Result<(Proc, String), Skip> {
     require_netns()?;
     cyclone_peer()?;
-    let mut c = Command::new("python3");
-    c.arg("-u").arg("-c").arg(PEER).arg(DOMAIN.to_string());
-    let p = Proc::spawn("cyclone peer", c);
+    let p = Proc::spawn("cyclone peer", python_peer(PEER));
     let ready = p.wait_line(WAIT, |l| l.starts_with("ready "));
     check!(ready.is_some(), &[&p], "peer did not start");
     let pid = ready.expect("checked")["ready ".len()..].trim().to_string();
@@ -266,25 +278,6 @@ fn dds_publish_idl_reaches_cyclone_reader() {
 
 /// A Cyclone writer on "Flash" that, once matched, writes and at once disposes three instances.
 const DISPOSER: &str = r#"
-import sys, time
-from dataclasses import dataclass
-from cyclonedds.domain import DomainParticipant
-from cyclonedds.topic import Topic
-from cyclonedds.pub import DataWriter
-from cyclonedds.idl import IdlStruct
-from cyclonedds.idl.types import int32
-from cyclonedds.idl.annotations import key
-from cyclonedds.core import Qos, Policy
-from cyclonedds.util import duration
-
-@dataclass
-class ShapeType(IdlStruct, typename="ShapeType"):
-    color: str
-    key("color")
-    x: int32
-    y: int32
-    shapesize: int32
-
 dp = DomainParticipant(int(sys.argv[1]))
 w = DataWriter(dp, Topic(dp, "Flash", ShapeType), qos=Qos(Policy.Reliability.Reliable(duration(seconds=1))))
 end = time.time() + 20
@@ -315,9 +308,7 @@ fn dds_subscribe_shows_disposes_that_marked_held_samples() {
         .arg(&idl)
         .args(["--domain", &DOMAIN.to_string()]);
     let mut sub = Proc::spawn("dds subscribe", sub);
-    let mut c = Command::new("python3");
-    c.arg("-u").arg("-c").arg(DISPOSER).arg(DOMAIN.to_string());
-    let mut peer = Proc::spawn("cyclone disposer", c);
+    let mut peer = Proc::spawn("cyclone disposer", python_peer(DISPOSER));
     let exit = sub.wait_exit(Duration::from_secs(30));
     let rows = ndjson_rows(&sub.lines().join("\n"));
     let _ = peer.interrupt(WAIT);
