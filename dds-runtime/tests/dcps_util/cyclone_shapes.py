@@ -21,6 +21,8 @@ from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
+from peer import log, wait_match
+
 
 @dataclass
 @appendable
@@ -39,10 +41,6 @@ QOS = Qos(
 )
 
 
-def log(*a):
-    print(*a, file=sys.stderr, flush=True)
-
-
 def main():
     dp = DomainParticipant(int(__import__("os").environ.get("DDS_DOMAIN_ID", "0")))
     mode, topic_name = sys.argv[1], sys.argv[2]
@@ -51,12 +49,7 @@ def main():
     if mode == "pub":
         color, count = sys.argv[3], int(sys.argv[4])
         w = DataWriter(dp, tp, qos=QOS)
-        while w.get_publication_matched_status().current_count == 0:
-            if time.time() > deadline:
-                log("pub: no match")
-                sys.exit(2)
-            time.sleep(0.05)
-        log("pub: matched")
+        wait_match(w.get_publication_matched_status, "pub")
         for i in range(count):
             w.write(ShapeType(color=color, x=i, y=2 * i, shapesize=30))
             time.sleep(0.01)

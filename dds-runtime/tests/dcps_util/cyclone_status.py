@@ -21,6 +21,8 @@ from cyclonedds.pub import DataWriter
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
+from peer import log, wait_match
+
 
 @dataclass
 @final
@@ -28,10 +30,6 @@ class Beat(IdlStruct, typename="xs::Beat"):
     id: int32
     key("id")
     n: int32
-
-
-def log(*a):
-    print(*a, file=sys.stderr, flush=True)
 
 
 def main():
@@ -44,13 +42,7 @@ def main():
         Policy.Liveliness.ManualByTopic(duration(milliseconds=600)),
     )
     w = DataWriter(dp, tp, qos=qos)
-    deadline = time.time() + 20
-    while w.get_publication_matched_status().current_count == 0:
-        if time.time() > deadline:
-            log("pub: no match")
-            sys.exit(2)
-        time.sleep(0.05)
-    log("pub: matched")
+    wait_match(w.get_publication_matched_status, "pub")
     for n in range(5):
         w.write(Beat(id=1, n=n))
         time.sleep(0.1)

@@ -24,6 +24,8 @@ from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
+from peer import log, wait_match
+
 
 @final
 class Choice(IdlUnion, discriminator=int32, typename="xu::Choice"):
@@ -44,20 +46,6 @@ QOS = Qos(
     Policy.Durability.TransientLocal,
     Policy.History.KeepLast(10),
 )
-
-
-def log(*a):
-    print(*a, file=sys.stderr, flush=True)
-
-
-def wait_match(status, what):
-    deadline = time.time() + 20
-    while status().current_count == 0:
-        if time.time() > deadline:
-            log(f"{what}: no match")
-            sys.exit(2)
-        time.sleep(0.05)
-    log(f"{what}: matched")
 
 
 def publish(dp, tp):

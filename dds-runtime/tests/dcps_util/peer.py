@@ -1,0 +1,18 @@
+"""What the Cyclone DDS peer scripts beside it share (they run by path, so this directory is on sys.path)."""
+import sys
+import time
+
+
+def log(*a):
+    print(*a, file=sys.stderr, flush=True)
+
+
+def wait_match(status, what, seconds=20):
+    """Waits until `status()` (a matched status getter) counts a match; exits with 2 after `seconds`."""
+    deadline = time.time() + seconds
+    while status().current_count == 0:
+        if time.time() > deadline:
+            log(f"{what}: no match")
+            sys.exit(2)
+        time.sleep(0.05)
+    log(f"{what}: matched")
