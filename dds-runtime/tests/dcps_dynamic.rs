@@ -481,3 +481,93 @@ fn dynamic_reader_listener_and_status_condition() {
     assert!(r.sample_rejected_status().total_count >= 1);
     assert_eq!(r.take().len(), 2, "max_samples_per_instance");
 }
+
+impl DynamicWriterListener for Calls {
+    fn on_publication_matched(&self, _: &DynamicWriter, _: PublicationMatchedStatus) {
+        self.0.lock().unwrap().push("matched");
+    }
+    fn on_offered_deadline_missed(&self, _: &DynamicWriter, _: DeadlineMissedStatus) {
+        self.0.lock().unwrap().push("deadline");
+    }
+    fn on_offered_incompatible_qos(&self, _: &DynamicWriter, _: IncompatibleQosStatus) {
+        self.0.lock().unwrap().push("incompatible");
+    }
+}
+
+/// A dynamic writer's listener and status condition, against typed readers: publication matched (a reader
+/// appears), offered deadline missed (the writer stops writing its instance), offered incompatible QoS (a
+/// reader requesting a shorter deadline); `*_status` reset the counts and clear the condition.
+#[test]
+fn dynamic_writer_listener_and_status_condition() {
+    let ty = shape_from_builder();
+    let (p1, p2) = (participant(14), participant(14));
+    let topic = p1
+        .create_dynamic_topic("Square", ty.clone(), &TopicQos::default())
+        .unwrap();
+    let calls = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let wq = DataWriterQos::builder()
+        .reliability(reliable())
+        .deadline(Duration::from_millis(100))
+        .history(History::KeepAll)
+        .build();
+    let w = p1
+        .create_publisher(&PublisherQos::default())
+        .and_then(|p| {
+            p.create_dynamic_writer_with_listener(
+                &topic,
+                &wq,
+                Box::new(Calls(calls.clone())),
+                StatusMask::all(),
+            )
+        })
+        .unwrap();
+    let cond = w.status_condition();
+    cond.set_enabled_statuses(StatusMask::PUBLICATION_MATCHED);
+    let ws = WaitSet::new();
+    ws.attach_condition(cond.clone());
+    let requested = |deadline| {
+        DataReaderQos::builder()
+            .reliability(reliable())
+            .deadline(deadline)
+            .history(History::KeepAll)
+            .build()
+    };
+    let _r = reader::<ShapeType>(&p2, "Square", &requested(Duration::from_millis(200)));
+    assert!(!ws.wait(MATCH_TIMEOUT).unwrap().is_empty(), "no match");
+    let m = w.publication_matched_status();
+    assert_eq!((m.current_count, m.total_count), (1, 1));
+    assert!(!cond.trigger_value(), "reading the status clears it");
+    assert_eq!(w.publication_matched_status().total_count_change, 0);
+    w.write(&dynamic_shape(&ty, "RED", 1)).unwrap();
+    cond.set_enabled_statuses(StatusMask::OFFERED_DEADLINE_MISSED);
+    assert!(
+        !ws.wait(Duration::from_secs(5)).unwrap().is_empty(),
+        "no deadline"
+    );
+    let d = w.offered_deadline_missed_status();
+    assert!(d.total_count >= 1);
+    assert_ne!(
+        d.last_instance_handle,
+        InstanceHandle::NIL,
+        "keyed instance"
+    );
+    // A reader requesting a 50 ms deadline cannot be served by a writer offering 100 ms.
+    let _short = reader::<ShapeType>(&p2, "Square", &requested(Duration::from_millis(50)));
+    cond.set_enabled_statuses(StatusMask::OFFERED_INCOMPATIBLE_QOS);
+    assert!(
+        !ws.wait(MATCH_TIMEOUT).unwrap().is_empty(),
+        "no incompatible QoS"
+    );
+    let q = w.offered_incompatible_qos_status();
+    assert_eq!(q.total_count, 1);
+    assert_eq!(q.last_policy_id, Some(QosPolicyId::Deadline));
+    assert_eq!(w.matched_readers().len(), 1);
+    // The status condition is raised just before the listener is called: wait for the calls.
+    let all = ["matched", "deadline", "incompatible"];
+    let seen_all = || all.iter().all(|c| calls.lock().unwrap().contains(c));
+    assert!(
+        wait_until(Duration::from_secs(5), seen_all),
+        "listener calls: {:?}",
+        calls.lock().unwrap()
+    );
+}

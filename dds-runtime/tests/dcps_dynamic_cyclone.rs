@@ -5,7 +5,7 @@
 //! and exchange samples both ways.
 //! Ignored by default (needs python3 + cyclonedds): run with
 //! `scripts/isolated cargo nextest run -p dds-runtime --features idl,json --test dcps_dynamic_cyclone
-//! --run-ignored ignored-only`. Domains 215, 216, 217 and 218.
+//! --run-ignored ignored-only`. Domains 215, 216, 217, 218 and 15.
 mod dcps_util;
 
 use std::io::{BufRead, BufReader};
@@ -418,4 +418,102 @@ fn dynamic_reader_statuses_from_a_cyclone_writer() {
         by_waitset.all()
     );
     assert!(by_listener.has("liveliness 1 0") && by_waitset.has("liveliness 1 0"));
+}
+
+/// Records a dynamic writer's listener calls.
+#[cfg(feature = "idl")]
+struct WriterRecorder(std::sync::Arc<Seen>);
+
+#[cfg(feature = "idl")]
+impl DynamicWriterListener for WriterRecorder {
+    fn on_publication_matched(&self, _: &DynamicWriter, s: PublicationMatchedStatus) {
+        self.0.push(format!("matched {}", s.current_count));
+    }
+    fn on_offered_deadline_missed(&self, _: &DynamicWriter, s: DeadlineMissedStatus) {
+        self.0.push(format!("deadline {}", s.total_count));
+    }
+    fn on_offered_incompatible_qos(&self, _: &DynamicWriter, s: IncompatibleQosStatus) {
+        self.0.push(format!("incompatible {:?}", s.last_policy_id));
+    }
+}
+
+/// A dynamic writer's listener and status condition against Cyclone 11 readers (`cyclone_status.py sub`):
+/// the reader requesting a 1 s deadline matches, the one requesting 100 ms is reported as offered
+/// incompatible QoS (DEADLINE), and the writer's 300 ms offered deadline is missed once it stops writing.
+#[cfg(feature = "idl")]
+#[test]
+#[ignore = "needs python3 with cyclonedds; run explicitly"]
+fn dynamic_writer_statuses_to_cyclone_readers() {
+    use dds_runtime::xtypes::dynamic::{types_from_idl, DynamicData, Value};
+    use std::sync::Arc;
+    require_netns();
+    let ty = types_from_idl(
+        "b.idl",
+        "module xs { @final struct Beat { @key long id; long n; }; };",
+    )
+    .unwrap()
+    .remove("xs::Beat")
+    .unwrap();
+    let p = participant(15);
+    let t = p
+        .create_dynamic_topic("BeatTopic", ty.clone(), &TopicQos::default())
+        .unwrap();
+    let qos = DataWriterQos::builder()
+        .reliability(reliable())
+        .history(History::KeepLast(1))
+        .deadline(Duration::from_millis(300))
+        .build();
+    let seen = Arc::new(Seen::default());
+    let w = p
+        .create_publisher(&PublisherQos::default())
+        .and_then(|publ| {
+            publ.create_dynamic_writer_with_listener(
+                &t,
+                &qos,
+                Box::new(WriterRecorder(seen.clone())),
+                StatusMask::all(),
+            )
+        })
+        .unwrap();
+    let cond = w.status_condition();
+    cond.set_enabled_statuses(StatusMask::PUBLICATION_MATCHED);
+    let ws = WaitSet::new();
+    ws.attach_condition(cond.clone());
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/dcps_util/cyclone_status.py"
+    );
+    let mut child = Command::new("python3")
+        .arg(script)
+        .arg("sub")
+        .env("CYCLONEDDS_URI", CYCLONE_URI)
+        .env("DDS_DOMAIN_ID", "15")
+        .stdin(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("python3 with cyclonedds");
+    let matched = !ws.wait(Duration::from_secs(20)).unwrap().is_empty();
+    let m = w.publication_matched_status();
+    let mut beat = DynamicData::new(ty);
+    beat.set("id", Value::Int32(1)).unwrap();
+    for n in 0..3 {
+        beat.set("n", Value::Int32(n)).unwrap();
+        w.write(&beat).unwrap();
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    cond.set_enabled_statuses(StatusMask::OFFERED_DEADLINE_MISSED);
+    let missed = !ws.wait(Duration::from_secs(5)).unwrap().is_empty();
+    let d = w.offered_deadline_missed_status();
+    let wanted = ["matched 1", "deadline ", "incompatible Some(Deadline)"];
+    let done = wait_until(Duration::from_secs(10), || {
+        wanted.iter().all(|x| seen.has(x))
+    });
+    let q = w.offered_incompatible_qos_status();
+    drop(child.stdin.take());
+    let _ = child.wait();
+    eprintln!("listener saw {:?}", seen.all());
+    assert!(matched && m.current_count == 1, "no match: {m:?}");
+    assert!(missed && d.total_count >= 1, "no deadline missed: {d:?}");
+    assert!(done, "listener saw {:?}", seen.all());
+    assert_eq!(q.last_policy_id, Some(QosPolicyId::Deadline));
 }

@@ -7,7 +7,7 @@
 //! `set_listener_with_mask`), else its subscriber's or publisher's, else its participant's.
 //! DATA_ON_READERS (subscriber, then participant) takes precedence over DATA_AVAILABLE.
 
-pub use super::dynamic::DynamicReaderListener;
+pub use super::dynamic::{DynamicReaderListener, DynamicWriterListener};
 pub use super::participant::DomainParticipantListener;
 pub use super::publisher::{DataWriterListener, PublisherListener};
 pub use super::subscriber::{DataReaderListener, SubscriberListener};

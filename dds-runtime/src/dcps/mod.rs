@@ -74,6 +74,7 @@ pub use condition::{
 pub use durability::{DurabilityServiceConfig, DurabilityServiceMode};
 pub use dynamic::{
     DynamicReader, DynamicReaderListener, DynamicSample, DynamicTopic, DynamicWriter,
+    DynamicWriterListener,
 };
 pub use error::{DdsError, DdsResult};
 pub use filter::{ContentFilter, FieldValue, FilterError, FilterFields};

@@ -1,5 +1,6 @@
 //! `Publisher` and `DataWriter<T>`.
 
+mod events;
 #[cfg(feature = "shm")]
 mod loan;
 mod ops;
@@ -29,13 +30,16 @@ use super::presentation::CoherentGroup;
 use super::sample::InstanceHandle;
 use super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, LivelinessLostStatus, PublicationMatchedStatus,
-    StatusMask, WriterStatuses,
+    StatusMask,
 };
 use super::sync::{lock, read};
 use super::topic::Topic;
 use super::writer_filter::WriterFilters;
 use crate::rtps::pool::BufferPool;
 
+pub(crate) use events::{
+    check_offered_deadline, on_writer_event, writer_callbacks, WriterCallbacks, WriterState,
+};
 #[cfg(feature = "shm")]
 pub use loan::{LoanError, SampleLoan};
 pub use ops::PublisherListener;
@@ -52,6 +56,8 @@ pub trait DataWriterListener<T: DdsType>: Send + Sync {
     /// The writer did not assert its manual liveliness within its lease.
     fn on_liveliness_lost(&self, writer: &DataWriter<T>, status: LivelinessLostStatus) {}
 }
+
+writer_callbacks!(@T: DdsType; dyn DataWriterListener<T>, DataWriter<T>);
 
 /// Groups writers; carries the partition and presentation QoS.
 #[derive(Clone)]
@@ -292,7 +298,7 @@ struct WriterInstance {
 }
 
 #[derive(Default)]
-struct WriterInstances {
+pub(crate) struct WriterInstances {
     by_key: HashMap<Vec<u8>, InstanceHandle>,
     by_handle: HashMap<InstanceHandle, WriterInstance>,
     next: u64,
@@ -307,7 +313,7 @@ struct WriterOwner<T> {
 }
 
 struct WriterInner<T: DdsType> {
-    state: EndpointState<WriterStatuses, dyn DataWriterListener<T>, WriterOwner<T>>,
+    state: WriterState<dyn DataWriterListener<T>, WriterOwner<T>>,
     /// The QoS in effect (changed by `set_qos`).
     current: RwLock<DataWriterQos>,
     /// What the immutable policies fix for the write path.
@@ -826,80 +832,11 @@ impl<T: DdsType> WriterInner<T> {
 impl<T: DdsType> Endpoint for WriterInner<T> {
     fn tick(self: Arc<Self>, now: Instant) {
         let period = read(&self.current).deadline.0;
-        if period == crate::qos::INFINITE || period.is_zero() {
-            return;
-        }
-        let mut missed = Vec::new();
-        {
-            let mut inst = lock(&self.instances);
-            for (h, i) in inst.by_handle.iter_mut() {
-                if now.saturating_duration_since(i.last_write) >= period {
-                    i.last_write = now;
-                    missed.push(*h);
-                }
-            }
-            if let Some(t) = inst.keyless_last_write.as_mut() {
-                if now.saturating_duration_since(*t) >= period {
-                    *t = now;
-                    missed.push(InstanceHandle::NIL);
-                }
-            }
-        }
-        if missed.is_empty() {
-            return;
-        }
-        self.state.signal_consumed(
-            StatusMask::OFFERED_DEADLINE_MISSED,
-            |st| {
-                st.offered_deadline_missed.record(&missed);
-                &mut st.offered_deadline_missed
-            },
-            self.writer(),
-            |l, w, s| l.on_offered_deadline_missed(w, s),
-        );
+        check_offered_deadline(&self.state, &self.instances, period, now, self.writer());
     }
 
     fn on_event(self: Arc<Self>, ev: &Event) {
-        let id = self.state.id();
-        match ev {
-            Event::PublicationMatched {
-                reader, matched, ..
-            } => {
-                tracing::info!(writer = ?id, ?reader, matched, "publication matched");
-                self.state.record_match(
-                    StatusMask::PUBLICATION_MATCHED,
-                    |st| &mut st.publication_matched,
-                    (*reader, *matched),
-                    self.writer(),
-                    |l, w, s| l.on_publication_matched(w, s),
-                );
-            }
-            Event::OfferedIncompatibleQos { policy, reader, .. } => {
-                tracing::warn!(writer = ?id, ?reader, ?policy, "offered incompatible QoS");
-                self.state.signal(
-                    StatusMask::OFFERED_INCOMPATIBLE_QOS,
-                    |st| {
-                        st.offered_incompatible_qos.record(*policy);
-                        &mut st.offered_incompatible_qos
-                    },
-                    self.writer(),
-                    |l, w, s| l.on_offered_incompatible_qos(w, s),
-                );
-            }
-            Event::LivelinessLost { .. } => {
-                tracing::info!(writer = ?id, "liveliness lost");
-                self.state.signal_consumed(
-                    StatusMask::LIVELINESS_LOST,
-                    |st| {
-                        st.liveliness_lost.record();
-                        &mut st.liveliness_lost
-                    },
-                    self.writer(),
-                    |l, w, s| l.on_liveliness_lost(w, s),
-                );
-            }
-            _ => {}
-        }
+        on_writer_event(&self.state, ev, || self.writer());
     }
 
     /// A deleted writer unregisters its instances, so readers see the state change, not just the unmatch. It

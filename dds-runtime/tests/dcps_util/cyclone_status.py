@@ -5,6 +5,9 @@
   cyclone_status.py pub   -- waits up to 20 s for a match, writes id 1 five times 100 ms apart (each write
                              asserts liveliness), then writes nothing more: the reader's deadline is missed
                              and the writer's liveliness lost. Exits when stdin closes.
+  cyclone_status.py sub   -- two readers of `xs::Beat`: one requesting a 1 s deadline (matches a writer
+                             offering 300 ms), one requesting 100 ms (incompatible: DEADLINE). Logs the
+                             first sample, exits when stdin closes.
 Reliable, volatile, keep-last 1.
 """
 import os
@@ -18,6 +21,7 @@ from cyclonedds.idl import IdlStruct
 from cyclonedds.idl.annotations import final, key
 from cyclonedds.idl.types import int32
 from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
@@ -32,7 +36,33 @@ class Beat(IdlStruct, typename="xs::Beat"):
     n: int32
 
 
+def sub():
+    dp = DomainParticipant(int(os.environ.get("DDS_DOMAIN_ID", "0")))
+    tp = Topic(dp, "BeatTopic", Beat)
+
+    def qos(ms):
+        return Qos(
+            Policy.Reliability.Reliable(duration(seconds=1)),
+            Policy.History.KeepLast(1),
+            Policy.Deadline(duration(milliseconds=ms)),
+        )
+
+    r = DataReader(dp, tp, qos=qos(1000))
+    _short = DataReader(dp, tp, qos=qos(100))
+    log("sub: ready")
+    deadline = time.time() + 20
+    while time.time() < deadline:
+        if r.take():
+            log("sub: data")
+            break
+        time.sleep(0.05)
+    sys.stdin.read()
+
+
 def main():
+    if sys.argv[1:] == ["sub"]:
+        sub()
+        return
     dp = DomainParticipant(int(os.environ.get("DDS_DOMAIN_ID", "0")))
     tp = Topic(dp, "BeatTopic", Beat)
     qos = Qos(

@@ -7,23 +7,22 @@
 //! bytes instead). Samples are [`DynamicData`], byte-identical on the wire to the
 //! derived code for the same type. A dynamic reader runs on the typed reader's machinery: instances, read/take
 //! by state, read and query conditions, statuses, a listener ([`DynamicReaderListener`]) and a status
-//! condition. A dynamic writer writes and disposes.
+//! condition. A dynamic writer writes and disposes, with the typed writer's statuses, a listener
+//! ([`DynamicWriterListener`]) and a status condition.
 
 mod reader;
 mod writer;
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use crate::qos::TopicQos;
 use crate::xtypes::dynamic::{DynamicData, DynamicType};
 
 use super::error::{DdsError, DdsResult};
 use super::participant::DomainParticipant;
-use super::sync::lock;
-use crate::rtps::Guid;
 
 pub use reader::{DynamicReader, DynamicReaderListener, DynamicSample};
-pub use writer::DynamicWriter;
+pub use writer::{DynamicWriter, DynamicWriterListener};
 
 struct TopicInner {
     participant: DomainParticipant,
@@ -161,24 +160,5 @@ impl DynamicTopic {
             self.inner.type_information.as_deref(),
             self.inner.type_mapping.as_deref(),
         );
-    }
-}
-
-/// An incompatible-QoS status so far: a snapshot, its change count reset (as for typed endpoints).
-fn take_incompatible(
-    status: &Mutex<crate::dcps::IncompatibleQosStatus>,
-) -> crate::dcps::IncompatibleQosStatus {
-    let mut s = lock(status);
-    let out = s.clone();
-    s.total_count_change = 0;
-    out
-}
-
-/// Records that `peer` matched (or unmatched) an endpoint whose matched peers are `list`.
-fn record_match(list: &Mutex<Vec<Guid>>, peer: Guid, matched: bool) {
-    let mut m = lock(list);
-    m.retain(|g| *g != peer);
-    if matched {
-        m.push(peer);
     }
 }

@@ -1,19 +1,43 @@
-//! [`DynamicWriter`].
+//! [`DynamicWriter`]: its statuses, listener and status condition are the typed writer's
+//! (`publisher::events`).
 
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant, SystemTime};
 
 use crate::cdr::{ByteOrder, XcdrVersion};
-use crate::dcps::IncompatibleQosStatus;
 use crate::qos::{DataWriterQos, Reliability, WriterQos, XCDR2_DATA_REPRESENTATION};
 use crate::rtps::{ChangeKind, Event, Guid, Payload, Time, WriteChange, WriteError, WriterSpec};
 use crate::xtypes::dynamic::{default_version, DynamicData};
 
+use super::super::condition::StatusCondition;
 use super::super::driver::{Endpoint, EndpointHandle};
 use super::super::error::{DdsError, DdsResult};
-use super::super::publisher::Publisher;
+use super::super::publisher::{
+    check_offered_deadline, on_writer_event, writer_callbacks, Publisher, WriterInstances,
+    WriterState,
+};
+use super::super::status::{
+    DeadlineMissedStatus, IncompatibleQosStatus, LivelinessLostStatus, PublicationMatchedStatus,
+    StatusMask,
+};
 use super::super::sync::lock;
 use super::DynamicTopic;
+
+/// Callbacks of a [`DynamicWriter`], with the same statuses and the same delivery rules as the typed
+/// writer's (see [`crate::dcps::listener`]). Every method has an empty default.
+#[allow(unused_variables)]
+pub trait DynamicWriterListener: Send + Sync {
+    /// A reader matched or unmatched.
+    fn on_publication_matched(&self, writer: &DynamicWriter, status: PublicationMatchedStatus) {}
+    /// A reader was found with incompatible QoS.
+    fn on_offered_incompatible_qos(&self, writer: &DynamicWriter, status: IncompatibleQosStatus) {}
+    /// The writer missed its offered deadline for an instance.
+    fn on_offered_deadline_missed(&self, writer: &DynamicWriter, status: DeadlineMissedStatus) {}
+    /// The writer did not assert its manual liveliness within its lease.
+    fn on_liveliness_lost(&self, writer: &DynamicWriter, status: LivelinessLostStatus) {}
+}
+
+writer_callbacks!(dyn DynamicWriterListener, DynamicWriter);
 
 struct Owner {
     topic: DynamicTopic,
@@ -23,28 +47,42 @@ struct Owner {
 struct Inner {
     version: XcdrVersion,
     max_block: Duration,
-    matched: Mutex<Vec<Guid>>,
+    /// The offered deadline (DEADLINE).
+    deadline: Duration,
+    state: WriterState<dyn DynamicWriterListener, Owner>,
+    /// The instances written, for the offered deadline.
+    instances: Mutex<WriterInstances>,
+    /// Notified on every match change (`wait_for_readers`); guards nothing else.
+    matched_lock: Mutex<()>,
     matched_cv: Condvar,
-    incompatible: Mutex<IncompatibleQosStatus>,
+}
+
+impl Inner {
+    /// The public writer, for listeners.
+    fn writer(self: &Arc<Self>) -> impl FnOnce(Arc<EndpointHandle<Owner>>) -> DynamicWriter {
+        let inner = self.clone();
+        move |handle| DynamicWriter { inner, handle }
+    }
 }
 
 impl Endpoint for Inner {
     fn on_event(self: Arc<Self>, ev: &Event) {
-        match ev {
-            Event::PublicationMatched {
-                reader, matched, ..
-            } => {
-                super::record_match(&self.matched, *reader, *matched);
-                self.matched_cv.notify_all();
-            }
-            Event::OfferedIncompatibleQos { policy, .. } => {
-                lock(&self.incompatible).record(*policy)
-            }
-            _ => {}
+        on_writer_event(&self.state, ev, || self.writer());
+        if matches!(ev, Event::PublicationMatched { .. }) {
+            let _g = lock(&self.matched_lock);
+            self.matched_cv.notify_all();
         }
     }
 
-    fn tick(self: Arc<Self>, _now: Instant) {}
+    fn tick(self: Arc<Self>, now: Instant) {
+        check_offered_deadline(
+            &self.state,
+            &self.instances,
+            self.deadline,
+            now,
+            self.writer(),
+        );
+    }
 }
 
 /// Writes [`DynamicData`] samples of a [`DynamicTopic`]. Cheap to clone; deleted with its last clone.
@@ -69,6 +107,28 @@ impl Publisher {
         &self,
         topic: &DynamicTopic,
         qos: &DataWriterQos,
+    ) -> DdsResult<DynamicWriter> {
+        self.create_dynamic_w(topic, qos, None)
+    }
+
+    /// Creates a writer of a dynamic topic with its listener installed first, enabled for the statuses in
+    /// `mask`: the listener sees every status of the writer from its creation on, including the matches
+    /// with readers already known.
+    pub fn create_dynamic_writer_with_listener(
+        &self,
+        topic: &DynamicTopic,
+        qos: &DataWriterQos,
+        listener: Box<dyn DynamicWriterListener>,
+        mask: StatusMask,
+    ) -> DdsResult<DynamicWriter> {
+        self.create_dynamic_w(topic, qos, Some((Arc::from(listener), mask)))
+    }
+
+    fn create_dynamic_w(
+        &self,
+        topic: &DynamicTopic,
+        qos: &DataWriterQos,
+        listener: Option<(Arc<dyn DynamicWriterListener>, StatusMask)>,
     ) -> DdsResult<DynamicWriter> {
         let driver = self.participant().driver().clone();
         let ty = topic.dynamic_type();
@@ -100,24 +160,27 @@ impl Publisher {
         let inner = Arc::new(Inner {
             version,
             max_block,
-            matched: Mutex::new(Vec::new()),
+            deadline: qos.deadline.0,
+            state: WriterState::new(driver),
+            instances: Mutex::new(WriterInstances::default()),
+            matched_lock: Mutex::new(()),
             matched_cv: Condvar::new(),
-            incompatible: Mutex::new(IncompatibleQosStatus::default()),
         });
-        let sink: Arc<dyn Endpoint> = inner.clone();
-        let id = driver.create_endpoint(sink, |c, now| {
-            topic.register_types(c);
-            c.create_writer(now, spec)
-        })?;
+        if let Some((l, mask)) = listener {
+            inner.state.set_listener_with_mask(Some(l), mask);
+        }
         let owner = Owner {
             topic: topic.clone(),
             _publisher: self.clone(),
         };
+        let sink: Arc<dyn Endpoint> = inner.clone();
+        let handle = inner.state.create(sink, owner, |c, now| {
+            topic.register_types(c);
+            c.create_writer(now, spec)
+        })?;
+        let id = handle.id();
         tracing::info!(topic = topic.name(), type_name = %topic.type_name(), ?id, ?version, "dynamic writer created");
-        Ok(DynamicWriter {
-            inner,
-            handle: Arc::new(EndpointHandle::new(driver, id, owner)),
-        })
+        Ok(DynamicWriter { inner, handle })
     }
 }
 
@@ -143,20 +206,77 @@ impl DynamicWriter {
 
     /// The readers matched now.
     pub fn matched_readers(&self) -> Vec<Guid> {
-        lock(&self.inner.matched).clone()
+        self.inner.state.matched()
     }
 
     /// OFFERED_INCOMPATIBLE_QOS: readers on the topic not matched for a policy (`TypeConsistencyEnforcement`
     /// for a reader type not assignable from the writer's). Resets the change count.
     pub fn offered_incompatible_qos_status(&self) -> IncompatibleQosStatus {
-        super::take_incompatible(&self.inner.incompatible)
+        self.inner
+            .state
+            .take_status(StatusMask::OFFERED_INCOMPATIBLE_QOS, |s| {
+                &mut s.offered_incompatible_qos
+            })
+    }
+
+    /// PUBLICATION_MATCHED (resets the change counts).
+    pub fn publication_matched_status(&self) -> PublicationMatchedStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::PUBLICATION_MATCHED, |s| {
+                &mut s.publication_matched
+            })
+    }
+
+    /// OFFERED_DEADLINE_MISSED (resets the change count). Checked every 50 ms per written instance.
+    pub fn offered_deadline_missed_status(&self) -> DeadlineMissedStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::OFFERED_DEADLINE_MISSED, |s| {
+                &mut s.offered_deadline_missed
+            })
+    }
+
+    /// LIVELINESS_LOST (resets the change count).
+    pub fn liveliness_lost_status(&self) -> LivelinessLostStatus {
+        self.inner
+            .state
+            .take_status(StatusMask::LIVELINESS_LOST, |s| &mut s.liveliness_lost)
+    }
+
+    /// The writer's status condition (for a [`WaitSet`](crate::dcps::WaitSet)).
+    pub fn status_condition(&self) -> StatusCondition {
+        StatusCondition {
+            core: self.inner.state.status_core().clone(),
+        }
+    }
+
+    /// Installs a listener for every status (replacing any previous one).
+    pub fn set_listener(&self, listener: Box<dyn DynamicWriterListener>) {
+        self.inner.state.set_listener(Some(Arc::from(listener)));
+    }
+
+    /// Installs a listener enabled for the statuses in `mask` only (replacing any previous one).
+    pub fn set_listener_with_mask(
+        &self,
+        listener: Box<dyn DynamicWriterListener>,
+        mask: StatusMask,
+    ) {
+        self.inner
+            .state
+            .set_listener_with_mask(Some(Arc::from(listener)), mask);
+    }
+
+    /// Removes the listener.
+    pub fn clear_listener(&self) {
+        self.inner.state.set_listener(None);
     }
 
     /// Waits until at least `n` readers are matched; `false` on timeout.
     pub fn wait_for_readers(&self, n: usize, timeout: Duration) -> bool {
         let end = Instant::now() + timeout;
-        let mut m = lock(&self.inner.matched);
-        while m.len() < n {
+        let mut m = lock(&self.inner.matched_lock);
+        while self.inner.state.matched().len() < n {
             let left = end.saturating_duration_since(Instant::now());
             if left.is_zero() {
                 return false;
@@ -212,6 +332,7 @@ impl DynamicWriter {
         } else {
             None
         };
+        lock(&self.inner.instances).record_hashed_write(key_hash, Instant::now());
         let change = WriteChange {
             kind,
             payload: Payload::from(payload),
