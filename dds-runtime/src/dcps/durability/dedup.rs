@@ -15,6 +15,7 @@ use super::marker;
 use crate::dcps::driver::CoreObserver;
 use crate::dcps::sync::lock;
 use crate::qos::Durability;
+use crate::rtps::discovery::WriterData;
 use crate::rtps::{EntityId, Event, Guid, ReceivedSample, Time};
 
 /// Most (reader, writer) pairs remembered; past it the memory starts over (repeats may then get through).
@@ -70,9 +71,17 @@ impl CoreObserver for ReplayFilter {
     }
 
     fn observe_locked(&self, ev: &Event) {
-        let Event::PublicationDiscovered(w) = ev else {
-            return;
-        };
+        if let Event::PublicationDiscovered(w) = ev {
+            self.learn(w);
+        }
+    }
+}
+
+impl ReplayFilter {
+    /// A discovered writer: a stand-in (and the writer it stands for) or a durable writer, whose samples
+    /// the filter then checks. Also called for the writers the core had discovered before the filter was
+    /// installed (the participant's driver runs before its services are installed).
+    pub(crate) fn learn(&self, w: &WriterData) {
         let mut st = lock(&self.state);
         if let Some(original) = marker::stand_in_for(&w.qos.writer.user_data.0) {
             st.stand_ins.insert(w.guid, original);

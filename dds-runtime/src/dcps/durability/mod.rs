@@ -125,7 +125,11 @@ impl DurabilityServiceConfig {
 
 /// Installs the duplicate filter and, unless off, the service on a new participant's driver.
 pub(crate) fn install(driver: &Arc<Driver>, config: &DurabilityServiceConfig) -> DdsResult<()> {
-    driver.add_observer(Arc::new(dedup::ReplayFilter::default()));
+    let filter = Arc::new(dedup::ReplayFilter::default());
+    driver.add_observer(filter.clone());
+    // The driver already runs: writers it discovered before the filter was in place are learnt here (a
+    // peer's history can arrive right after, as a late joiner's push).
+    driver.query_core(|c| c.publications().for_each(|w| filter.learn(w)));
     let scope = match config.mode {
         DurabilityServiceMode::Off => return Ok(()),
         DurabilityServiceMode::Local => Scope::Local(driver.guid_prefix),

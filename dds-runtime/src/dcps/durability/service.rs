@@ -493,14 +493,18 @@ impl Service {
         let Some(driver) = self.driver.upgrade() else {
             return;
         };
-        let known: Vec<WriterData> = driver.query_core(|c| {
-            c.publications()
-                .filter(|w| self.in_scope(w))
-                .cloned()
-                .collect()
-        });
+        let known: Vec<WriterData> = driver.query_core(|c| c.publications().cloned().collect());
         for w in known {
-            self.adopt(&w, Vec::new(), false);
+            self.discovered(&w);
+        }
+    }
+
+    /// A writer discovered: one in scope is adopted; another service's stand-in is aligned from.
+    fn discovered(&self, w: &WriterData) {
+        if self.in_scope(w) {
+            self.adopt(w, Vec::new(), false);
+        } else if let Some(original) = self.aligns_from(w) {
+            self.align(w, original);
         }
     }
 
@@ -550,12 +554,7 @@ fn write_change(driver: &Driver, id: EntityId, ch: WriteChange) -> Option<Sequen
 impl CoreObserver for Service {
     fn on_event(&self, ev: &Event) {
         match ev {
-            Event::PublicationDiscovered(w) if self.in_scope(w) => self.adopt(w, Vec::new(), false),
-            Event::PublicationDiscovered(w) => {
-                if let Some(original) = self.aligns_from(w) {
-                    self.align(w, original);
-                }
-            }
+            Event::PublicationDiscovered(w) => self.discovered(w),
             Event::PublicationRemoved { guid } => self.writer_gone(guid),
             Event::WriterDeleted { writer } => {
                 if let Some(d) = self.driver.upgrade() {
