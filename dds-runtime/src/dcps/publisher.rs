@@ -728,37 +728,23 @@ impl<T: DdsType> DataWriter<T> {
 
     /// PUBLICATION_MATCHED (resets the change counts).
     pub fn publication_matched_status(&self) -> PublicationMatchedStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::PUBLICATION_MATCHED, |s| {
-                &mut s.publication_matched
-            })
+        self.inner.state.publication_matched_status()
     }
 
     /// OFFERED_INCOMPATIBLE_QOS (resets the change count).
     pub fn offered_incompatible_qos_status(&self) -> IncompatibleQosStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::OFFERED_INCOMPATIBLE_QOS, |s| {
-                &mut s.offered_incompatible_qos
-            })
+        self.inner.state.offered_incompatible_qos_status()
     }
 
     /// OFFERED_DEADLINE_MISSED (resets the change count). Checked every 50 ms per written instance.
     pub fn offered_deadline_missed_status(&self) -> DeadlineMissedStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::OFFERED_DEADLINE_MISSED, |s| {
-                &mut s.offered_deadline_missed
-            })
+        self.inner.state.offered_deadline_missed_status()
     }
 
     /// LIVELINESS_LOST (resets the change count): how often this writer failed to assert its manual
     /// liveliness within its lease.
     pub fn liveliness_lost_status(&self) -> LivelinessLostStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::LIVELINESS_LOST, |s| &mut s.liveliness_lost)
+        self.inner.state.liveliness_lost_status()
     }
 
     /// Handles of the matched readers.

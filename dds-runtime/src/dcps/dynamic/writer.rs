@@ -212,36 +212,22 @@ impl DynamicWriter {
     /// OFFERED_INCOMPATIBLE_QOS: readers on the topic not matched for a policy (`TypeConsistencyEnforcement`
     /// for a reader type not assignable from the writer's). Resets the change count.
     pub fn offered_incompatible_qos_status(&self) -> IncompatibleQosStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::OFFERED_INCOMPATIBLE_QOS, |s| {
-                &mut s.offered_incompatible_qos
-            })
+        self.inner.state.offered_incompatible_qos_status()
     }
 
     /// PUBLICATION_MATCHED (resets the change counts).
     pub fn publication_matched_status(&self) -> PublicationMatchedStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::PUBLICATION_MATCHED, |s| {
-                &mut s.publication_matched
-            })
+        self.inner.state.publication_matched_status()
     }
 
     /// OFFERED_DEADLINE_MISSED (resets the change count). Checked every 50 ms per written instance.
     pub fn offered_deadline_missed_status(&self) -> DeadlineMissedStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::OFFERED_DEADLINE_MISSED, |s| {
-                &mut s.offered_deadline_missed
-            })
+        self.inner.state.offered_deadline_missed_status()
     }
 
     /// LIVELINESS_LOST (resets the change count).
     pub fn liveliness_lost_status(&self) -> LivelinessLostStatus {
-        self.inner
-            .state
-            .take_status(StatusMask::LIVELINESS_LOST, |s| &mut s.liveliness_lost)
+        self.inner.state.liveliness_lost_status()
     }
 
     /// The writer's status condition (for a [`WaitSet`](crate::dcps::WaitSet)).

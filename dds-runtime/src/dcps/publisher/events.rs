@@ -17,6 +17,31 @@ use super::super::status::{
 use super::super::sync::lock;
 use super::WriterInstances;
 
+/// A writer's statuses read by the application (each resets its change counts), for both kinds.
+impl<L: ?Sized, O> EndpointState<WriterStatuses, L, O> {
+    pub(crate) fn publication_matched_status(&self) -> PublicationMatchedStatus {
+        self.take_status(StatusMask::PUBLICATION_MATCHED, |s| {
+            &mut s.publication_matched
+        })
+    }
+
+    pub(crate) fn offered_incompatible_qos_status(&self) -> IncompatibleQosStatus {
+        self.take_status(StatusMask::OFFERED_INCOMPATIBLE_QOS, |s| {
+            &mut s.offered_incompatible_qos
+        })
+    }
+
+    pub(crate) fn offered_deadline_missed_status(&self) -> DeadlineMissedStatus {
+        self.take_status(StatusMask::OFFERED_DEADLINE_MISSED, |s| {
+            &mut s.offered_deadline_missed
+        })
+    }
+
+    pub(crate) fn liveliness_lost_status(&self) -> LivelinessLostStatus {
+        self.take_status(StatusMask::LIVELINESS_LOST, |s| &mut s.liveliness_lost)
+    }
+}
+
 /// The calls a writer makes on its listener, whatever the listener trait (`W` is the public writer).
 pub(crate) trait WriterCallbacks<W> {
     fn publication_matched(&self, w: &W, s: PublicationMatchedStatus);
