@@ -162,6 +162,11 @@ fn presentation_scope_mismatch_cyclone_to_ours_is_incompatible() -> Result<(), S
 
 /// The suite's coherent-set case (`Test_CoherentSets_*` with instances), ours against ours: 3 topics, 4
 /// instances, sets of 3 iterations; every read loop that sees data sees whole sets (36 samples).
+///
+/// The publisher begins its first set before it has matched the reader, so the first two read loops with
+/// data may hold a partial set: a VOLATILE reader matched to one topic's writer before another's sees only
+/// the parts written after its match. Like the suite's own check, the first two loops with data are not
+/// counted, and at least two whole sets must follow them.
 fn coherent_sets_ours(domain: u32, scope: char) -> Result<(), Skip> {
     require_netns()?;
     let mut s = Prog::Ours.spawn(
@@ -178,12 +183,12 @@ fn coherent_sets_ours(domain: u32, scope: char) -> Result<(), Skip> {
              --num-instances 4 --coherent-sample-count 3 --write-period 100 -z 0"
         ),
     )?;
-    let enough = s.wait_lines(WAIT, 36 * 4, |l| {
+    let enough = s.wait_lines(WAIT, 36 * 6, |l| {
         l.starts_with("Square") && l.ends_with(']')
     });
     let _ = p.interrupt(Duration::from_secs(10));
     let _ = s.interrupt(Duration::from_secs(10));
-    check!(enough.is_some(), &[&p, &s], "four sets read");
+    check!(enough.is_some(), &[&p, &s], "six sets read");
     let mut per_loop = Vec::new();
     let mut n = 0;
     for l in s.lines() {
@@ -196,10 +201,11 @@ fn coherent_sets_ours(domain: u32, scope: char) -> Result<(), Skip> {
             n += 1;
         }
     }
+    let settled = per_loop.get(2..).unwrap_or_default();
     check!(
-        per_loop.iter().all(|n| n % 36 == 0),
+        settled.len() >= 2 && settled.iter().all(|n| n % 36 == 0),
         &[&p, &s],
-        "whole sets only: {per_loop:?}"
+        "whole sets only after the first two loops: {per_loop:?}"
     );
     Ok(())
 }
