@@ -23,6 +23,11 @@ pub(super) struct Outlet {
     owed: HashMap<String, (i64, i64)>,
     /// The nodes that said (on the acknowledgement channel) that they are connected to the channel.
     greeted: Vec<String>,
+    /// The awaited nodes found gone at the last liveness check, and when the next check is due: listing
+    /// the host's nodes costs a scan of shared memory, so a flush repeats it at most every
+    /// [`LIVENESS_CHECK`].
+    gone: Vec<String>,
+    next_check: Option<Instant>,
 }
 
 impl Outlet {
@@ -39,6 +44,27 @@ impl Outlet {
                 self.greeted.push(node.to_owned());
             }
         }
+    }
+
+    /// How many of `nodes` are not connected yet. After waiting [`LIVENESS_CHECK`] for them, those whose
+    /// process died are not counted (they never connect); the check itself runs at most every
+    /// [`LIVENESS_CHECK`].
+    fn missing(&mut self, nodes: &[String], waited: Duration, now: Instant) -> usize {
+        let awaited = |n: &&String| !self.greeted.contains(n);
+        if waited >= LIVENESS_CHECK && self.next_check.is_none_or(|t| now >= t) {
+            self.gone = nodes
+                .iter()
+                .filter(awaited)
+                .filter(|n| node_gone(n))
+                .cloned()
+                .collect();
+            self.next_check = Some(now + LIVENESS_CHECK);
+        }
+        nodes
+            .iter()
+            .filter(awaited)
+            .filter(|n| !self.gone.contains(n))
+            .count()
     }
 }
 
@@ -197,6 +223,8 @@ impl ShmLink {
             acks: self.node.subscriber(&ack_channel(&name), &ack_config())?,
             owed: HashMap::new(),
             greeted: Vec::new(),
+            gone: Vec::new(),
+            next_check: None,
         })
     }
 
@@ -218,17 +246,9 @@ impl ShmLink {
             .is_some_and(|n| Arc::ptr_eq(n, &c.nodes))
         {
             out.read_acks();
-            let mut missing = c.nodes.iter().filter(|n| !out.greeted.contains(n)).count();
-            let since = *out.waiting_since.get_or_insert_with(Instant::now);
-            let waited = since.elapsed();
-            if missing > 0 && waited >= LIVENESS_CHECK {
-                // A reader participant that died never connects: do not wait for it.
-                missing = c
-                    .nodes
-                    .iter()
-                    .filter(|n| !out.greeted.contains(n) && !node_gone(n))
-                    .count();
-            }
+            let now = Instant::now();
+            let waited = now - *out.waiting_since.get_or_insert(now);
+            let missing = out.missing(&c.nodes, waited, now);
             if missing > 0 && waited < CONNECT_TIMEOUT {
                 return Ok(false);
             }
@@ -241,6 +261,8 @@ impl ShmLink {
             let _ = out.publisher.update_connections();
             out.connected = Some(c.nodes.clone());
             out.waiting_since = None;
+            out.next_check = None;
+            out.gone.clear();
         }
         if c.loaned {
             let mut parked = lock(&self.parked);
