@@ -5,6 +5,8 @@ use super::flags::*;
 use super::{id, Cursor, ParameterList, WireError};
 use crate::rtps::types::*;
 
+mod body;
+
 /// Submessage flag bits shared by all: E (endianness).
 pub const FLAG_E: u8 = 0x01;
 
@@ -263,71 +265,12 @@ pub enum Submessage<'a> {
 impl<'a> Submessage<'a> {
     /// Decodes a submessage body (the bytes after its 4-byte header).
     pub fn decode(sid: u8, flags: u8, body: &'a [u8]) -> Result<Submessage<'a>, WireError> {
-        let le = flags & FLAG_E != 0;
-        let mut c = Cursor::new(body, le);
+        let c = &mut Cursor::new(body, flags & FLAG_E != 0);
         Ok(match sid {
             id::PAD => Submessage::Pad,
-            id::ACKNACK => {
-                let reader_id = c.entity_id()?;
-                let writer_id = c.entity_id()?;
-                let reader_sn_state = c.sequence_number_set()?;
-                let count = c.i32()?;
-                Submessage::AckNack(AckNack {
-                    reader_id,
-                    writer_id,
-                    reader_sn_state,
-                    count,
-                    final_flag: AckNackFlags::from_bits_retain(flags).contains(AckNackFlags::FINAL),
-                })
-            }
-            id::HEARTBEAT => {
-                let reader_id = c.entity_id()?;
-                let writer_id = c.entity_id()?;
-                let first_sn = c.sequence_number()?;
-                let last_sn = c.sequence_number()?;
-                let count = c.i32()?;
-                // §8.3.7.5.3: first >= 1 and last >= first - 1.
-                if first_sn.0 < 1 || last_sn.0 < first_sn.0 - 1 {
-                    return Err(WireError::Invalid("HEARTBEAT sequence numbers"));
-                }
-                let f = HeartbeatFlags::from_bits_retain(flags);
-                let group_info = if f.contains(HeartbeatFlags::GROUP_INFO) {
-                    Some(HeartbeatGroupInfo {
-                        current_gsn: c.sequence_number()?,
-                        first_gsn: c.sequence_number()?,
-                        last_gsn: c.sequence_number()?,
-                        writer_set: c.array()?,
-                        secure_writer_set: c.array()?,
-                    })
-                } else {
-                    None
-                };
-                Submessage::Heartbeat(Heartbeat {
-                    reader_id,
-                    writer_id,
-                    first_sn,
-                    last_sn,
-                    count,
-                    final_flag: f.contains(HeartbeatFlags::FINAL),
-                    liveliness_flag: f.contains(HeartbeatFlags::LIVELINESS),
-                    group_info,
-                })
-            }
-            id::GAP => {
-                let reader_id = c.entity_id()?;
-                let writer_id = c.entity_id()?;
-                let gap_start = c.sequence_number()?;
-                let gap_list = c.sequence_number_set()?;
-                if gap_start.0 < 1 || gap_list.base < gap_start {
-                    return Err(WireError::Invalid("GAP range"));
-                }
-                Submessage::Gap(Gap {
-                    reader_id,
-                    writer_id,
-                    gap_start,
-                    gap_list,
-                })
-            }
+            id::ACKNACK => Submessage::AckNack(AckNack::read(flags, c)?),
+            id::HEARTBEAT => Submessage::Heartbeat(Heartbeat::read(flags, c)?),
+            id::GAP => Submessage::Gap(Gap::read(c)?),
             id::INFO_TS => {
                 if InfoTsFlags::from_bits_retain(flags).contains(InfoTsFlags::INVALIDATE) {
                     Submessage::InfoTs(None)
@@ -335,81 +278,14 @@ impl<'a> Submessage<'a> {
                     Submessage::InfoTs(Some(c.time()?))
                 }
             }
-            id::INFO_SRC => {
-                c.skip(4)?;
-                let major = c.u8()?;
-                let minor = c.u8()?;
-                let vendor_id = VendorId(c.array()?);
-                let guid_prefix = c.guid_prefix()?;
-                Submessage::InfoSrc(InfoSource {
-                    version: ProtocolVersion { major, minor },
-                    vendor_id,
-                    guid_prefix,
-                })
-            }
+            id::INFO_SRC => Submessage::InfoSrc(InfoSource::read(c)?),
             id::INFO_DST => Submessage::InfoDst(c.guid_prefix()?),
-            id::INFO_REPLY => {
-                let unicast = locator_list(&mut c)?;
-                let multicast = if InfoReplyFlags::from_bits_retain(flags)
-                    .contains(InfoReplyFlags::MULTICAST)
-                {
-                    Some(locator_list(&mut c)?)
-                } else {
-                    None
-                };
-                Submessage::InfoReply(InfoReply {
-                    unicast,
-                    multicast,
-                    little_endian: le,
-                })
-            }
-            id::INFO_REPLY_IP4 => {
-                let unicast = ip4_locator(&mut c)?;
-                let multicast = if InfoReplyFlags::from_bits_retain(flags)
-                    .contains(InfoReplyFlags::MULTICAST)
-                {
-                    Some(ip4_locator(&mut c)?)
-                } else {
-                    None
-                };
-                Submessage::InfoReplyIp4(InfoReplyIp4 { unicast, multicast })
-            }
-            id::DATA => Submessage::Data(decode_data(flags, c)?),
-            id::DATA_FRAG => Submessage::DataFrag(decode_data_frag(flags, c)?),
-            id::HEARTBEAT_FRAG => {
-                let reader_id = c.entity_id()?;
-                let writer_id = c.entity_id()?;
-                let writer_sn = c.sequence_number()?;
-                let last_fragment_num = c.u32()?;
-                let count = c.i32()?;
-                if writer_sn.0 < 1 || last_fragment_num == 0 {
-                    return Err(WireError::Invalid("HEARTBEAT_FRAG"));
-                }
-                Submessage::HeartbeatFrag(HeartbeatFrag {
-                    reader_id,
-                    writer_id,
-                    writer_sn,
-                    last_fragment_num,
-                    count,
-                })
-            }
-            id::NACK_FRAG => {
-                let reader_id = c.entity_id()?;
-                let writer_id = c.entity_id()?;
-                let writer_sn = c.sequence_number()?;
-                let fragment_number_state = c.fragment_number_set()?;
-                let count = c.i32()?;
-                if writer_sn.0 < 1 {
-                    return Err(WireError::Invalid("NACK_FRAG sequence number"));
-                }
-                Submessage::NackFrag(NackFrag {
-                    reader_id,
-                    writer_id,
-                    writer_sn,
-                    fragment_number_state,
-                    count,
-                })
-            }
+            id::INFO_REPLY => Submessage::InfoReply(InfoReply::read(flags, c)?),
+            id::INFO_REPLY_IP4 => Submessage::InfoReplyIp4(InfoReplyIp4::read(flags, c)?),
+            id::DATA => Submessage::Data(Data::read(flags, c)?),
+            id::DATA_FRAG => Submessage::DataFrag(DataFrag::read(flags, c)?),
+            id::HEARTBEAT_FRAG => Submessage::HeartbeatFrag(HeartbeatFrag::read(c)?),
+            id::NACK_FRAG => Submessage::NackFrag(NackFrag::read(c)?),
             _ => Submessage::Unknown {
                 id: sid,
                 flags,
@@ -485,107 +361,25 @@ impl<'a> Submessage<'a> {
         out.push(flags);
         out.extend_from_slice(&[0, 0]);
         let body_start = out.len();
-        let mut p = Put { out, little_endian };
+        let p = &mut Put { out, little_endian };
         match self {
             Submessage::Pad => {}
-            Submessage::AckNack(a) => {
-                p.bytes(&a.reader_id.0);
-                p.bytes(&a.writer_id.0);
-                p.sequence_number_set(&a.reader_sn_state);
-                p.i32(a.count);
-            }
-            Submessage::Heartbeat(h) => {
-                p.bytes(&h.reader_id.0);
-                p.bytes(&h.writer_id.0);
-                p.sequence_number(h.first_sn);
-                p.sequence_number(h.last_sn);
-                p.i32(h.count);
-                if let Some(g) = &h.group_info {
-                    p.sequence_number(g.current_gsn);
-                    p.sequence_number(g.first_gsn);
-                    p.sequence_number(g.last_gsn);
-                    p.bytes(&g.writer_set);
-                    p.bytes(&g.secure_writer_set);
-                }
-            }
-            Submessage::Gap(g) => {
-                p.bytes(&g.reader_id.0);
-                p.bytes(&g.writer_id.0);
-                p.sequence_number(g.gap_start);
-                p.sequence_number_set(&g.gap_list);
-            }
+            Submessage::AckNack(a) => a.write(p),
+            Submessage::Heartbeat(h) => h.write(p),
+            Submessage::Gap(g) => g.write(p),
             Submessage::InfoTs(t) => {
                 if let Some(t) = t {
                     p.time(*t);
                 }
             }
-            Submessage::InfoSrc(s) => {
-                p.u32(0);
-                p.u8(s.version.major);
-                p.u8(s.version.minor);
-                p.bytes(&s.vendor_id.0);
-                p.bytes(&s.guid_prefix.0);
-            }
+            Submessage::InfoSrc(s) => s.write(p),
             Submessage::InfoDst(g) => p.bytes(&g.0),
-            Submessage::InfoReply(r) => {
-                let uc: Vec<Locator> = r.unicast().collect();
-                p.u32(uc.len() as u32);
-                uc.iter().for_each(|l| p.locator(l));
-                if r.multicast.is_some() {
-                    let mc: Vec<Locator> = r.multicast().collect();
-                    p.u32(mc.len() as u32);
-                    mc.iter().for_each(|l| p.locator(l));
-                }
-            }
-            Submessage::InfoReplyIp4(r) => {
-                for l in std::iter::once(&r.unicast).chain(r.multicast.as_ref()) {
-                    let a = l.ipv4().unwrap_or_default();
-                    p.u32(u32::from_be_bytes(a));
-                    p.u32(l.port);
-                }
-            }
-            Submessage::Data(d) => {
-                p.u16(0);
-                p.u16(16);
-                p.bytes(&d.reader_id.0);
-                p.bytes(&d.writer_id.0);
-                p.sequence_number(d.writer_sn);
-                if let Some(q) = &d.inline_qos {
-                    put_inline_qos(&mut p, q);
-                }
-                if let Some(b) = d.payload {
-                    p.bytes(b);
-                }
-            }
-            Submessage::DataFrag(d) => {
-                p.u16(0);
-                p.u16(28);
-                p.bytes(&d.reader_id.0);
-                p.bytes(&d.writer_id.0);
-                p.sequence_number(d.writer_sn);
-                p.u32(d.fragment_starting_num);
-                p.u16(d.fragments_in_submessage);
-                p.u16(d.fragment_size);
-                p.u32(d.sample_size);
-                if let Some(q) = &d.inline_qos {
-                    put_inline_qos(&mut p, q);
-                }
-                p.bytes(d.payload);
-            }
-            Submessage::HeartbeatFrag(h) => {
-                p.bytes(&h.reader_id.0);
-                p.bytes(&h.writer_id.0);
-                p.sequence_number(h.writer_sn);
-                p.u32(h.last_fragment_num);
-                p.i32(h.count);
-            }
-            Submessage::NackFrag(n) => {
-                p.bytes(&n.reader_id.0);
-                p.bytes(&n.writer_id.0);
-                p.sequence_number(n.writer_sn);
-                p.fragment_number_set(&n.fragment_number_state);
-                p.i32(n.count);
-            }
+            Submessage::InfoReply(r) => r.write(p),
+            Submessage::InfoReplyIp4(r) => r.write(p),
+            Submessage::Data(d) => d.write(p),
+            Submessage::DataFrag(d) => d.write(p),
+            Submessage::HeartbeatFrag(h) => h.write(p),
+            Submessage::NackFrag(n) => n.write(p),
             Submessage::Unknown { body, .. } => p.bytes(body),
         }
         // No trailing padding: the exact length lets a last submessage carry an unpadded payload. Whoever
@@ -625,142 +419,4 @@ pub fn append(
     }
     *last_header = Some(out.len());
     sub.encode(out, little_endian);
-}
-
-/// Re-encodes a parameter list in the target byte order (values copied verbatim when the order matches).
-fn put_inline_qos(p: &mut Put<'_>, q: &ParameterList<'_>) {
-    if q.little_endian == p.little_endian {
-        p.bytes(q.data);
-    } else {
-        // Only lengths/pids swap; values are opaque here, which is right for KEY_HASH and STATUS_INFO.
-        for prm in q.iter() {
-            p.u16(prm.id);
-            p.u16(prm.value.len() as u16);
-            p.bytes(prm.value);
-        }
-    }
-    p.u16(super::parameter::pid::SENTINEL);
-    p.u16(0);
-}
-
-fn locator_list<'a>(c: &mut Cursor<'a>) -> Result<&'a [u8], WireError> {
-    let n = c.u32()? as usize;
-    // The length check comes before any use of n, so a huge count costs nothing.
-    let bytes = n.checked_mul(24).ok_or(WireError::Truncated)?;
-    c.bytes(bytes)
-}
-
-fn ip4_locator(c: &mut Cursor<'_>) -> Result<Locator, WireError> {
-    let addr = c.u32()?;
-    let port = c.u32()?;
-    let mut l = Locator::udpv4(addr.to_be_bytes(), 0);
-    l.port = port;
-    Ok(l)
-}
-
-/// Reads extraFlags/octetsToInlineQos and positions at the inline QoS; returns (reader, writer, sn, cursor).
-fn data_prefix<'a>(
-    c: &mut Cursor<'a>,
-    fixed: usize,
-) -> Result<(EntityId, EntityId, SequenceNumber), WireError> {
-    let _extra_flags = c.u16()?;
-    let otiq = c.u16()? as usize;
-    let reader_id = c.entity_id()?;
-    let writer_id = c.entity_id()?;
-    let sn = c.sequence_number()?;
-    if sn.0 < 1 {
-        return Err(WireError::Invalid("writerSN < 1"));
-    }
-    // Inline QoS starts octetsToInlineQos bytes after that field (position 4); it may skip unknown fields.
-    let skip = (4 + otiq)
-        .checked_sub(c.pos())
-        .ok_or(WireError::Invalid("octetsToInlineQos"))?;
-    let _ = fixed;
-    c.skip(skip)?;
-    Ok((reader_id, writer_id, sn))
-}
-
-fn decode_data<'a>(flags: u8, mut c: Cursor<'a>) -> Result<Data<'a>, WireError> {
-    let le = c.little_endian;
-    let (reader_id, writer_id, writer_sn) = data_prefix(&mut c, 20)?;
-    let f = DataFlags::from_bits_retain(flags);
-    let (q, d, k, n) = (
-        f.contains(DataFlags::INLINE_QOS),
-        f.contains(DataFlags::DATA),
-        f.contains(DataFlags::KEY),
-        f.contains(DataFlags::NON_STANDARD),
-    );
-    if d && k {
-        return Err(WireError::Invalid("DATA with both D and K"));
-    }
-    let mut rest = c.rest();
-    let inline_qos = if q {
-        let (pl, r) = ParameterList::parse(rest, le)?;
-        rest = r;
-        Some(pl)
-    } else {
-        None
-    };
-    let payload = if d || k { Some(rest) } else { None };
-    Ok(Data {
-        reader_id,
-        writer_id,
-        writer_sn,
-        inline_qos,
-        payload,
-        key_flag: k,
-        non_standard_flag: n,
-    })
-}
-
-fn decode_data_frag<'a>(flags: u8, mut c: Cursor<'a>) -> Result<DataFrag<'a>, WireError> {
-    let le = c.little_endian;
-    let start = c;
-    let _ = start;
-    // The fixed fields after writerSN sit before the inline QoS; read them first, then honour octetsToInlineQos.
-    let mut f = c;
-    f.skip(20)?;
-    let fragment_starting_num = f.u32()?;
-    let fragments_in_submessage = f.u16()?;
-    let fragment_size = f.u16()?;
-    let sample_size = f.u32()?;
-    let (reader_id, writer_id, writer_sn) = data_prefix(&mut c, 32)?;
-    if c.pos() < 32 {
-        return Err(WireError::Invalid("DATA_FRAG octetsToInlineQos"));
-    }
-    if fragment_starting_num == 0 || fragment_size == 0 || fragments_in_submessage == 0 {
-        return Err(WireError::Invalid("DATA_FRAG fragment fields"));
-    }
-    let first_byte = (fragment_starting_num as u64 - 1) * fragment_size as u64;
-    if first_byte >= sample_size as u64 {
-        return Err(WireError::Invalid("DATA_FRAG beyond sample"));
-    }
-    let flags = DataFragFlags::from_bits_retain(flags);
-    let mut rest = c.rest();
-    let inline_qos = if flags.contains(DataFragFlags::INLINE_QOS) {
-        let (pl, r) = ParameterList::parse(rest, le)?;
-        rest = r;
-        Some(pl)
-    } else {
-        None
-    };
-    // The fragments' bytes: fragmentsInSubmessage * fragmentSize, cut at the sample's end; trailing padding dropped.
-    let want = (fragments_in_submessage as u64 * fragment_size as u64)
-        .min(sample_size as u64 - first_byte) as usize;
-    if rest.len() < want {
-        return Err(WireError::Truncated);
-    }
-    Ok(DataFrag {
-        reader_id,
-        writer_id,
-        writer_sn,
-        fragment_starting_num,
-        fragments_in_submessage,
-        fragment_size,
-        sample_size,
-        inline_qos,
-        payload: &rest[..want],
-        key_flag: flags.contains(DataFragFlags::KEY),
-        non_standard_flag: flags.contains(DataFragFlags::NON_STANDARD),
-    })
 }
