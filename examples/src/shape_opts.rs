@@ -2,6 +2,7 @@
 //! `srcCxx/shape_main.cxx`): same flags, same defaults, same validation messages.
 
 use std::fmt;
+use std::ops::RangeInclusive;
 use std::time::Duration;
 
 /// DURABILITY kinds selectable with `-D`.
@@ -345,6 +346,56 @@ fn first_char(s: &str) -> char {
     s.chars().next().unwrap_or('\0')
 }
 
+/// One option's value as shape_main reads it, and the errors found so far in the command line.
+struct Value<'e> {
+    text: String,
+    /// The first character (`'\0'` when empty): what letter-valued options look at.
+    c0: char,
+    /// The leading integer, as `sscanf("%d")` reads it.
+    num: Option<i64>,
+    errors: &'e mut Vec<String>,
+}
+
+impl Value<'_> {
+    fn error(&mut self, e: String) {
+        self.errors.push(e);
+    }
+
+    /// "unrecognized value for WHAT C": the value is not what the option takes.
+    fn unrecognized(&mut self, what: &str) {
+        let e = format!("unrecognized value for {what} {}", self.c0);
+        self.error(e);
+    }
+
+    /// The number if it is within `range`; otherwise the error `incorrect value for WHAT N` (`hint` after
+    /// WHAT), or [`unrecognized`](Self::unrecognized) when there is none.
+    fn int_in(&mut self, what: &str, hint: &str, range: RangeInclusive<i64>) -> Option<i64> {
+        match self.num {
+            Some(n) if range.contains(&n) => Some(n),
+            Some(n) => {
+                self.error(format!("incorrect value for {what}{hint} {n}"));
+                None
+            }
+            None => {
+                self.unrecognized(what);
+                None
+            }
+        }
+    }
+
+    /// A period in milliseconds (zero after an error).
+    fn ms(&mut self, what: &str) -> Duration {
+        self.int_in(what, "", 0..=i64::MAX)
+            .map_or(Duration::ZERO, |n| Duration::from_millis(n as u64))
+    }
+
+    /// A count of at least 1 (1 after an error).
+    fn positive(&mut self, what: &str) -> u32 {
+        self.int_in(what, ", it must be >=1", 1..=i64::MAX)
+            .map_or(1, |n| n.min(i64::from(u32::MAX)) as u32)
+    }
+}
+
 /// Parses shape_main's command line (argv without the program name).
 pub fn parse(args: &[String]) -> Result<Parsed, ParseError> {
     let tokens = tokenize(args).map_err(|e| ParseError(vec![e]))?;
@@ -352,152 +403,22 @@ pub fn parse(args: &[String]) -> Result<Parsed, ParseError> {
     let mut errors = Vec::new();
     let mut access_scope_set = false;
     for (opt, val) in tokens {
-        let v = val.unwrap_or_default();
-        let c0 = first_char(&v);
-        let num = leading_int(&v);
-        let ms = |errors: &mut Vec<String>, what: &str| -> Duration {
-            match num {
-                None => {
-                    errors.push(format!("unrecognized value for {what} {c0}"));
-                    Duration::ZERO
-                }
-                Some(n) if n < 0 => {
-                    errors.push(format!("incorrect value for {what} {n}"));
-                    Duration::ZERO
-                }
-                Some(n) => Duration::from_millis(n as u64),
-            }
+        if opt == "-h" || opt == "--help" {
+            return Ok(Parsed::Help);
+        }
+        let text = val.unwrap_or_default();
+        let mut v = Value {
+            c0: first_char(&text),
+            num: leading_int(&text),
+            text,
+            errors: &mut errors,
         };
-        let positive = |errors: &mut Vec<String>, what: &str| -> u32 {
-            match num {
-                None => {
-                    errors.push(format!("unrecognized value for {what} {c0}"));
-                    1
-                }
-                Some(n) if n < 1 => {
-                    errors.push(format!("incorrect value for {what}, it must be >=1 {n}"));
-                    1
-                }
-                Some(n) => n.min(i64::from(u32::MAX)) as u32,
-            }
-        };
-        match opt.as_str() {
-            "-h" | "--help" => return Ok(Parsed::Help),
-            "-v" => match c0 {
-                'd' => o.debug = true,
-                'e' => o.debug = false,
-                _ => errors.push(format!("unrecognized value for verbosity {c0}")),
-            },
-            "-w" => o.print_writer_samples = true,
-            "-b" => o.reliable = false,
-            "-r" => o.reliable = true,
-            "-R" => o.use_read = true,
-            "-P" => o.publish = true,
-            "-S" => o.subscribe = true,
-            "-c" => o.color = Some(v),
-            "-t" => o.topic = Some(v),
-            "-p" => o.partition = Some(v),
-            "-d" => match num {
-                Some(n) if (0..=i64::from(u32::MAX)).contains(&n) => o.domain_id = n as u32,
-                Some(n) => errors.push(format!("incorrect value for domain_id {n}")),
-                None => errors.push(format!("unrecognized value for domain_id {c0}")),
-            },
-            "-D" => match c0 {
-                'v' => o.durability = DurabilityArg::Volatile,
-                'l' => o.durability = DurabilityArg::TransientLocal,
-                't' => o.durability = DurabilityArg::Transient,
-                'p' => o.durability = DurabilityArg::Persistent,
-                _ => errors.push(format!("unrecognized value for durability {c0}")),
-            },
-            "-x" => match c0 {
-                '1' => o.xcdr = 1,
-                '2' => o.xcdr = 2,
-                _ => errors.push(format!("unrecognized value for data representation {c0}")),
-            },
-            "-k" => match num {
-                Some(n) if n >= 0 => o.history_depth = Some(n.min(i64::from(u32::MAX)) as u32),
-                Some(n) => errors.push(format!("incorrect value for history_depth {n}")),
-                None => errors.push(format!("unrecognized value for history_depth {c0}")),
-            },
-            "-s" => match num {
-                Some(-1) => o.ownership_strength = None,
-                Some(n) if n >= 0 => o.ownership_strength = Some(n.min(i64::from(i32::MAX)) as i32),
-                Some(n) => errors.push(format!("incorrect value for ownership_strength {n}")),
-                None => errors.push(format!("unrecognized value for ownership_strength {c0}")),
-            },
-            "-z" => match num {
-                Some(n) if n >= 0 => o.shapesize = n.min(i64::from(i32::MAX)) as i32,
-                Some(n) => errors.push(format!("incorrect value for shapesize {n}")),
-                None => errors.push(format!("unrecognized value for shapesize {c0}")),
-            },
-            "-f" => o.deadline = ms(&mut errors, "deadline_interval"),
-            "--time-filter" => o.time_filter = ms(&mut errors, "timebasedfilter_interval"),
-            "--write-period" => o.write_period = ms(&mut errors, "write-period"),
-            "--read-period" => o.read_period = ms(&mut errors, "read-period"),
-            "--lifespan" => o.lifespan = ms(&mut errors, "lifespan"),
-            "--periodic-announcement" => {
-                o.periodic_announcement = ms(&mut errors, "periodic-announcement")
-            }
-            "--num-iterations" => o.num_iterations = positive(&mut errors, "num-iterations"),
-            "--num-instances" => o.num_instances = positive(&mut errors, "num-instances"),
-            "--num-topics" => o.num_topics = positive(&mut errors, "num-topics"),
-            "--additional-payload-size" => {
-                o.additional_payload_size = positive(&mut errors, "additional-payload-size")
-            }
-            "--coherent-sample-count" => match num {
-                Some(n) if n >= 2 => o.coherent_sample_count = n.min(i64::from(u32::MAX)) as u32,
-                Some(n) => errors.push(format!(
-                    "incorrect value for coherent-sample-count, it must be >=2 {n}"
-                )),
-                None => errors.push(format!("unrecognized value for coherent-sample-count {c0}")),
-            },
-            "--final-instance-state" => {
-                let new = match c0 {
-                    'u' => Some(FinalInstanceState::Unregister),
-                    'd' => Some(FinalInstanceState::Dispose),
-                    _ => {
-                        errors.push(format!("unrecognized value for final-instance-state {c0}"));
-                        None
-                    }
-                };
-                if let (Some(old), Some(new)) = (o.final_instance_state, new) {
-                    if old != new {
-                        errors.push(
-                            "error, cannot configure unregister and dispose at the same time"
-                                .into(),
-                        );
-                    }
-                }
-                o.final_instance_state = new.or(o.final_instance_state);
-            }
-            "--access-scope" => {
-                access_scope_set = true;
-                o.access_scope = match c0 {
-                    'i' => Some(AccessScope::Instance),
-                    't' => Some(AccessScope::Topic),
-                    'g' => Some(AccessScope::Group),
-                    _ => {
-                        errors.push(format!("unrecognized value for coherent-sets {c0}"));
-                        None
-                    }
-                };
-            }
-            "--coherent" => o.coherent = true,
-            "--ordered" => o.ordered = true,
-            "--take-read" => o.take_read_next_instance = false,
-            "--datafrag-size" => match num {
-                Some(n) if (0..=65535).contains(&n) => o.datafrag_size = n as u32,
-                Some(n) => errors.push(format!(
-                    "incorrect value for datafrag-size, it must be <= 65535 bytes{n}"
-                )),
-                None => errors.push(format!("unrecognized value for datafrag-size {c0}")),
-            },
-            "--cft" => o.cft_expression = Some(v),
-            "--size-modulo" => match num {
-                Some(n) if n >= 1 => o.size_modulo = n.min(i64::from(i32::MAX)) as i32,
-                _ => errors.push("incorrect value for size-modulo, must be >=1".into()),
-            },
-            _ => errors.push(format!("unhandled option {opt}")),
+        access_scope_set |= opt == "--access-scope";
+        if !(entity_option(&mut o, &opt, &mut v)
+            || qos_option(&mut o, &opt, &mut v)
+            || test_option(&mut o, &opt, &mut v))
+        {
+            errors.push(format!("unhandled option {opt}"));
         }
     }
     if !errors.is_empty() {
@@ -509,6 +430,138 @@ pub fn parse(args: &[String]) -> Result<Parsed, ParseError> {
         options: Box::new(o),
         warnings,
     })
+}
+
+/// The options that choose the entities (role, topic, colour, domain, partition, output); false when `opt`
+/// is not one of them.
+fn entity_option(o: &mut ShapeOptions, opt: &str, v: &mut Value<'_>) -> bool {
+    match opt {
+        "-v" => match v.c0 {
+            'd' => o.debug = true,
+            'e' => o.debug = false,
+            _ => v.unrecognized("verbosity"),
+        },
+        "-w" => o.print_writer_samples = true,
+        "-R" => o.use_read = true,
+        "-P" => o.publish = true,
+        "-S" => o.subscribe = true,
+        "-c" => o.color = Some(std::mem::take(&mut v.text)),
+        "-t" => o.topic = Some(std::mem::take(&mut v.text)),
+        "-p" => o.partition = Some(std::mem::take(&mut v.text)),
+        "-d" => {
+            if let Some(n) = v.int_in("domain_id", "", 0..=i64::from(u32::MAX)) {
+                o.domain_id = n as u32;
+            }
+        }
+        "-z" => {
+            if let Some(n) = v.int_in("shapesize", "", 0..=i64::MAX) {
+                o.shapesize = n.min(i64::from(i32::MAX)) as i32;
+            }
+        }
+        "--num-instances" => o.num_instances = v.positive("num-instances"),
+        "--num-topics" => o.num_topics = v.positive("num-topics"),
+        "--additional-payload-size" => {
+            o.additional_payload_size = v.positive("additional-payload-size")
+        }
+        "--cft" => o.cft_expression = Some(std::mem::take(&mut v.text)),
+        _ => return false,
+    }
+    true
+}
+
+/// The QoS options; false when `opt` is not one of them.
+fn qos_option(o: &mut ShapeOptions, opt: &str, v: &mut Value<'_>) -> bool {
+    match opt {
+        "-b" => o.reliable = false,
+        "-r" => o.reliable = true,
+        "-D" => match v.c0 {
+            'v' => o.durability = DurabilityArg::Volatile,
+            'l' => o.durability = DurabilityArg::TransientLocal,
+            't' => o.durability = DurabilityArg::Transient,
+            'p' => o.durability = DurabilityArg::Persistent,
+            _ => v.unrecognized("durability"),
+        },
+        "-x" => match v.c0 {
+            '1' => o.xcdr = 1,
+            '2' => o.xcdr = 2,
+            _ => v.unrecognized("data representation"),
+        },
+        "-k" => {
+            if let Some(n) = v.int_in("history_depth", "", 0..=i64::MAX) {
+                o.history_depth = Some(n.min(i64::from(u32::MAX)) as u32);
+            }
+        }
+        "-s" => match v.num {
+            Some(-1) => o.ownership_strength = None,
+            _ => {
+                if let Some(n) = v.int_in("ownership_strength", "", 0..=i64::MAX) {
+                    o.ownership_strength = Some(n.min(i64::from(i32::MAX)) as i32);
+                }
+            }
+        },
+        "-f" => o.deadline = v.ms("deadline_interval"),
+        "--time-filter" => o.time_filter = v.ms("timebasedfilter_interval"),
+        "--lifespan" => o.lifespan = v.ms("lifespan"),
+        "--access-scope" => {
+            o.access_scope = match v.c0 {
+                'i' => Some(AccessScope::Instance),
+                't' => Some(AccessScope::Topic),
+                'g' => Some(AccessScope::Group),
+                _ => {
+                    v.unrecognized("coherent-sets");
+                    None
+                }
+            }
+        }
+        "--coherent" => o.coherent = true,
+        "--ordered" => o.ordered = true,
+        "--datafrag-size" => {
+            let hint = ", it must be <= 65535 bytes";
+            if let Some(n) = v.int_in("datafrag-size", hint, 0..=65535) {
+                o.datafrag_size = n as u32;
+            }
+        }
+        _ => return false,
+    }
+    true
+}
+
+/// The options of the test scenario (periods, iterations, coherent sets, final state, filters); false
+/// when `opt` is not one of them.
+fn test_option(o: &mut ShapeOptions, opt: &str, v: &mut Value<'_>) -> bool {
+    match opt {
+        "--write-period" => o.write_period = v.ms("write-period"),
+        "--read-period" => o.read_period = v.ms("read-period"),
+        "--periodic-announcement" => o.periodic_announcement = v.ms("periodic-announcement"),
+        "--num-iterations" => o.num_iterations = v.positive("num-iterations"),
+        "--take-read" => o.take_read_next_instance = false,
+        "--coherent-sample-count" => {
+            let hint = ", it must be >=2";
+            if let Some(n) = v.int_in("coherent-sample-count", hint, 2..=i64::MAX) {
+                o.coherent_sample_count = n.min(i64::from(u32::MAX)) as u32;
+            }
+        }
+        "--final-instance-state" => {
+            let new = match v.c0 {
+                'u' => Some(FinalInstanceState::Unregister),
+                'd' => Some(FinalInstanceState::Dispose),
+                _ => {
+                    v.unrecognized("final-instance-state");
+                    None
+                }
+            };
+            if o.final_instance_state.zip(new).is_some_and(|(a, b)| a != b) {
+                v.error("error, cannot configure unregister and dispose at the same time".into());
+            }
+            o.final_instance_state = new.or(o.final_instance_state);
+        }
+        "--size-modulo" => match v.num {
+            Some(n) if n >= 1 => o.size_modulo = n.min(i64::from(i32::MAX)) as i32,
+            _ => v.error("incorrect value for size-modulo, must be >=1".into()),
+        },
+        _ => return false,
+    }
+    true
 }
 
 /// shape_main's `validate()`: fatal combinations are errors, the rest warnings.

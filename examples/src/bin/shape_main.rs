@@ -244,124 +244,147 @@ impl App {
             topics.push(participant.create_topic::<ShapeType>(&name, &TopicQos::default())?);
         }
         let role = if o.publish {
-            let publisher = participant.create_publisher(
-                &PublisherQos::builder()
-                    .partition(partition(&o.partition))
-                    .presentation(presentation(o))
-                    .build(),
-            )?;
-            let mut qos = DataWriterQos::builder()
-                .reliability(reliability(o))
-                .durability(durability(o))
-                .data_representation(representation(o));
-            if let Some(h) = history(o) {
-                // -D t / -D p: the durability service keeps what the writer keeps.
-                qos = qos.history(h).durability_service(DurabilityService {
-                    history: h,
-                    ..Default::default()
-                });
-            }
-            if let Some(s) = o.ownership_strength {
-                qos = qos
-                    .ownership(Ownership::Exclusive)
-                    .ownership_strength(OwnershipStrength(s));
-            }
-            if !o.deadline.is_zero() {
-                qos = qos.deadline(Deadline(o.deadline));
-            }
-            if !o.lifespan.is_zero() {
-                qos = qos.lifespan(Lifespan(o.lifespan));
-            }
-            if o.final_instance_state == Some(FinalInstanceState::Unregister) {
-                qos = qos.writer_data_lifecycle(WriterDataLifecycle {
-                    autodispose_unregistered_instances: false,
-                });
-            }
-            let qos = qos.build();
-            let mut writers = Vec::new();
-            for t in &topics {
-                println!(
-                    "Create writer for topic: {} color: {}",
-                    t.name(),
-                    o.color.as_deref().unwrap_or("BLUE")
-                );
-                // Created with its listener, so that a match made inside the call is printed too.
-                let w = publisher.create_datawriter_with_listener(
-                    t,
-                    &qos,
-                    Printer::for_topic(t.name()),
-                    StatusMask::all(),
-                )?;
-                writers.push(w);
-            }
-            Role::Publisher(publisher, writers)
+            publisher_role(o, &participant, &topics)?
         } else {
-            let subscriber = participant.create_subscriber(
-                &SubscriberQos::builder()
-                    .partition(partition(&o.partition))
-                    .presentation(presentation(o))
-                    .build(),
-            )?;
-            let mut qos = DataReaderQos::builder()
-                .reliability(reliability(o))
-                .durability(durability(o))
-                .data_representation(representation(o));
-            if let Some(h) = history(o) {
-                qos = qos.history(h);
-            }
-            if o.ownership_strength.is_some() {
-                qos = qos.ownership(Ownership::Exclusive);
-            }
-            if !o.deadline.is_zero() {
-                qos = qos.deadline(Deadline(o.deadline));
-            }
-            if !o.time_filter.is_zero() {
-                qos = qos.time_based_filter(TimeBasedFilter {
-                    minimum_separation: o.time_filter,
-                });
-            }
-            let qos = qos.build();
-            let mut readers = Vec::new();
-            for t in &topics {
-                // shape_main reads a content-filtered topic "<topic>_filtered": `--cft EXPR`, else
-                // `color = %0` when -c is given.
-                let filter = match (&o.cft_expression, &o.color) {
-                    (Some(e), _) => Some((e.as_str(), Vec::new())),
-                    (None, Some(c)) => Some(("color = %0", vec![c.clone()])),
-                    (None, None) => None,
-                };
-                let r = match filter {
-                    Some((expr, params)) => {
-                        let name = format!("{}_filtered", t.name());
-                        println!("Create reader for topic: {name}");
-                        let cft =
-                            participant.create_content_filtered_topic(&name, t, expr, &params)?;
-                        subscriber.create_datareader_with_listener(
-                            &cft,
-                            &qos,
-                            Printer::for_topic(t.name()),
-                            StatusMask::all(),
-                        )?
-                    }
-                    None => {
-                        println!("Create reader for topic: {}", t.name());
-                        subscriber.create_datareader_with_listener(
-                            t,
-                            &qos,
-                            Printer::for_topic(t.name()),
-                            StatusMask::all(),
-                        )?
-                    }
-                };
-                readers.push(r);
-            }
-            Role::Subscriber(subscriber, readers)
+            subscriber_role(o, &participant, &topics)?
         };
         Ok(App {
             _participant: participant,
             role,
         })
     }
+}
+
+/// The writer QoS the options ask for.
+fn writer_qos(o: &ShapeOptions) -> DataWriterQos {
+    let mut qos = DataWriterQos::builder()
+        .reliability(reliability(o))
+        .durability(durability(o))
+        .data_representation(representation(o));
+    if let Some(h) = history(o) {
+        // -D t / -D p: the durability service keeps what the writer keeps.
+        qos = qos.history(h).durability_service(DurabilityService {
+            history: h,
+            ..Default::default()
+        });
+    }
+    if let Some(s) = o.ownership_strength {
+        qos = qos
+            .ownership(Ownership::Exclusive)
+            .ownership_strength(OwnershipStrength(s));
+    }
+    if !o.deadline.is_zero() {
+        qos = qos.deadline(Deadline(o.deadline));
+    }
+    if !o.lifespan.is_zero() {
+        qos = qos.lifespan(Lifespan(o.lifespan));
+    }
+    if o.final_instance_state == Some(FinalInstanceState::Unregister) {
+        qos = qos.writer_data_lifecycle(WriterDataLifecycle {
+            autodispose_unregistered_instances: false,
+        });
+    }
+    qos.build()
+}
+
+/// The reader QoS the options ask for.
+fn reader_qos(o: &ShapeOptions) -> DataReaderQos {
+    let mut qos = DataReaderQos::builder()
+        .reliability(reliability(o))
+        .durability(durability(o))
+        .data_representation(representation(o));
+    if let Some(h) = history(o) {
+        qos = qos.history(h);
+    }
+    if o.ownership_strength.is_some() {
+        qos = qos.ownership(Ownership::Exclusive);
+    }
+    if !o.deadline.is_zero() {
+        qos = qos.deadline(Deadline(o.deadline));
+    }
+    if !o.time_filter.is_zero() {
+        qos = qos.time_based_filter(TimeBasedFilter {
+            minimum_separation: o.time_filter,
+        });
+    }
+    qos.build()
+}
+
+/// A publisher with a writer per topic, each printing its statuses.
+fn publisher_role(
+    o: &ShapeOptions,
+    participant: &DomainParticipant,
+    topics: &[Topic<ShapeType>],
+) -> DdsResult<Role> {
+    let publisher = participant.create_publisher(
+        &PublisherQos::builder()
+            .partition(partition(&o.partition))
+            .presentation(presentation(o))
+            .build(),
+    )?;
+    let qos = writer_qos(o);
+    let mut writers = Vec::new();
+    for t in topics {
+        println!(
+            "Create writer for topic: {} color: {}",
+            t.name(),
+            o.color.as_deref().unwrap_or("BLUE")
+        );
+        // Created with its listener, so that a match made inside the call is printed too.
+        writers.push(publisher.create_datawriter_with_listener(
+            t,
+            &qos,
+            Printer::for_topic(t.name()),
+            StatusMask::all(),
+        )?);
+    }
+    Ok(Role::Publisher(publisher, writers))
+}
+
+/// A subscriber with a reader per topic (of its content-filtered topic when the options filter), each
+/// printing its statuses.
+fn subscriber_role(
+    o: &ShapeOptions,
+    participant: &DomainParticipant,
+    topics: &[Topic<ShapeType>],
+) -> DdsResult<Role> {
+    let subscriber = participant.create_subscriber(
+        &SubscriberQos::builder()
+            .partition(partition(&o.partition))
+            .presentation(presentation(o))
+            .build(),
+    )?;
+    let qos = reader_qos(o);
+    // shape_main reads a content-filtered topic "<topic>_filtered": `--cft EXPR`, else `color = %0`
+    // when -c is given.
+    let filter = match (&o.cft_expression, &o.color) {
+        (Some(e), _) => Some((e.as_str(), Vec::new())),
+        (None, Some(c)) => Some(("color = %0", vec![c.clone()])),
+        (None, None) => None,
+    };
+    let mut readers = Vec::new();
+    for t in topics {
+        let printer = Printer::for_topic(t.name());
+        let r = match &filter {
+            Some((expr, params)) => {
+                let name = format!("{}_filtered", t.name());
+                println!("Create reader for topic: {name}");
+                let cft = participant.create_content_filtered_topic(&name, t, expr, params)?;
+                subscriber.create_datareader_with_listener(
+                    &cft,
+                    &qos,
+                    printer,
+                    StatusMask::all(),
+                )?
+            }
+            None => {
+                println!("Create reader for topic: {}", t.name());
+                subscriber.create_datareader_with_listener(t, &qos, printer, StatusMask::all())?
+            }
+        };
+        readers.push(r);
+    }
+    Ok(Role::Subscriber(subscriber, readers))
 }
 
 /// A small xorshift generator seeded from the clock and pid: positions only need to differ per run.
