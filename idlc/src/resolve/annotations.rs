@@ -191,142 +191,155 @@ impl Resolver<'_> {
                 .last()
                 .map(|p| p.name.to_ascii_lowercase())
                 .unwrap_or_default();
-            let Some((_, places)) = BUILTIN.iter().find(|(n, _)| *n == name) else {
-                if !self.user_annotations.contains(&name) {
-                    let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
-                    let mut d = Diagnostic::warning(
-                        Code::UnknownAnnotation,
-                        format!("unknown annotation `@{}` ignored", a.name.text()),
-                    )
-                    .at(a.loc, "not a built-in annotation");
-                    if let Some(s) = crate::diag::suggest(&name, known) {
-                        d = d.help(format!("did you mean `@{s}`?"));
-                    }
-                    self.diags.push(d);
-                }
-                continue;
-            };
-            let spelled = a.name.parts.last().map_or("", |p| p.name.as_str());
-            if spelled != name {
-                // eProsima's examples write `@Key`; IDL names are case-sensitive and Cyclone rejects it.
-                self.diags.push(
-                    Diagnostic::warning(
-                        Code::AnnotationCase,
-                        format!("`@{spelled}` is not the IDL spelling of `@{name}`"),
-                    )
-                    .at(a.loc, format!("read as `@{name}`"))
-                    .help(format!(
-                        "write `@{name}`: built-in annotation names are lower case, and other compilers reject `@{spelled}`"
-                    )),
-                );
-            }
-            if !places.contains(&place) {
-                let mut d = Diagnostic::warning(
-                    Code::IgnoredAnnotation,
-                    format!("`@{}` has no effect here", a.name.text()),
-                )
-                .at(a.loc, "ignored");
-                if name == "default" && place == Place::Discriminator {
-                    // eProsima's extension: the discriminator value of a default-constructed union.
-                    d = Diagnostic::warning(
-                        Code::IgnoredAnnotation,
-                        format!("`@{}` on a union discriminator is ignored", a.name.text()),
-                    )
-                    .at(a.loc, "ignored")
-                    .help("IDL 4.2 allows `@default` on members only; the union's `Default` selects its first member")
-                    .note("Cyclone's idlc rejects this annotation");
-                }
-                self.diags.push(d);
-                continue;
-            }
-            match name.as_str() {
-                "id" => {
-                    if let Some(e) = self.single(a) {
-                        r.id = self.eval_u64(e, "@id", 0).and_then(|v| self.id_range(a, v));
-                        r.id_loc = Some(a.loc);
-                    }
-                }
-                "autoid" => {
-                    r.autoid = match &a.params {
-                        AnnotationParams::None => Some(AutoId::Hash),
-                        _ => match self.word_param(a).as_deref() {
-                            Some("SEQUENTIAL") => Some(AutoId::Sequential),
-                            Some("HASH") => Some(AutoId::Hash),
-                            _ => {
-                                self.ann_err(a, "`@autoid` takes SEQUENTIAL or HASH".into());
-                                None
-                            }
-                        },
-                    }
-                }
-                "hashid" => {
-                    r.hashid = Some(match &a.params {
-                        AnnotationParams::None => String::new(),
-                        AnnotationParams::Single(e) => self.string_of(e).unwrap_or_default(),
-                        AnnotationParams::Named(_) => String::new(),
-                    })
-                }
-                "key" => {
-                    r.key = self.bool_param(a);
-                    r.key_loc = Some(a.loc);
-                }
-                "optional" => {
-                    r.optional = self.bool_param(a);
-                    r.optional_loc = Some(a.loc);
-                }
-                "external" => r.external = self.bool_param(a),
-                "must_understand" => r.must_understand = self.bool_param(a),
-                "final" | "appendable" | "mutable" | "extensibility" => {
-                    r.extensibility_loc = Some(a.loc);
-                    r.extensibility = self.extensibility(a, &name);
-                }
-                "value" => r.value = self.single(a),
-                "position" => r.position = self.single(a),
-                "bit_bound" => r.bit_bound = self.single(a),
-                "default" => r.default = self.single(a),
-                "default_literal" => r.default_literal = true,
-                "range" => {
-                    r.min = self.named(a, "min");
-                    r.max = self.named(a, "max");
-                }
-                "min" => r.min = self.single(a),
-                "max" => r.max = self.single(a),
-                "unit" => {
-                    if let Some(e) = self.single(a) {
-                        r.unit = self.string_of(e);
-                    }
-                }
-                "nested" => r.nested = Some(self.bool_param(a)),
-                "default_nested" => r.default_nested = Some(self.bool_param(a)),
-                "topic" => r.topic = true,
-                "non_serialized" => r.non_serialized = self.bool_param(a),
-                "verbatim" => {
-                    let lang = self
-                        .named(a, "language")
-                        .and_then(|e| self.string_of(e))
-                        .unwrap_or_else(|| "*".into());
-                    let placement = self
-                        .named(a, "placement")
-                        .and_then(|e| self.string_of(e))
-                        .unwrap_or_else(|| "BEFORE_DECLARATION".into());
-                    let text = match &a.params {
-                        AnnotationParams::Single(e) => self.string_of(e),
-                        _ => self.named(a, "text").and_then(|e| self.string_of(e)),
-                    };
-                    if lang == "*" || lang.eq_ignore_ascii_case("rust") {
-                        if let Some(text) = text {
-                            r.verbatim.push(Verbatim {
-                                placement: placement.to_ascii_uppercase(),
-                                text,
-                            });
-                        }
-                    }
-                }
-                // Accepted and recorded nowhere: they do not change the Rust mapping.
-                _ => {}
+            if self.applies(a, &name, place) {
+                self.apply(&mut r, a, &name);
             }
         }
         r
+    }
+
+    /// Whether the built-in annotation `a` (lower-cased `name`) has an effect at `place`; warns when it
+    /// is unknown, misspelled or out of place.
+    fn applies(&mut self, a: &Annotation, name: &str, place: Place) -> bool {
+        let Some((_, places)) = BUILTIN.iter().find(|(n, _)| *n == name) else {
+            if !self.user_annotations.contains(name) {
+                let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
+                let mut d = Diagnostic::warning(
+                    Code::UnknownAnnotation,
+                    format!("unknown annotation `@{}` ignored", a.name.text()),
+                )
+                .at(a.loc, "not a built-in annotation");
+                if let Some(s) = crate::diag::suggest(name, known) {
+                    d = d.help(format!("did you mean `@{s}`?"));
+                }
+                self.diags.push(d);
+            }
+            return false;
+        };
+        let spelled = a.name.parts.last().map_or("", |p| p.name.as_str());
+        if spelled != name {
+            // eProsima's examples write `@Key`; IDL names are case-sensitive and Cyclone rejects it.
+            self.diags.push(
+                Diagnostic::warning(
+                    Code::AnnotationCase,
+                    format!("`@{spelled}` is not the IDL spelling of `@{name}`"),
+                )
+                .at(a.loc, format!("read as `@{name}`"))
+                .help(format!(
+                    "write `@{name}`: built-in annotation names are lower case, and other compilers reject `@{spelled}`"
+                )),
+            );
+        }
+        if !places.contains(&place) {
+            let mut d = Diagnostic::warning(
+                Code::IgnoredAnnotation,
+                format!("`@{}` has no effect here", a.name.text()),
+            )
+            .at(a.loc, "ignored");
+            if name == "default" && place == Place::Discriminator {
+                // eProsima's extension: the discriminator value of a default-constructed union.
+                d = Diagnostic::warning(
+                    Code::IgnoredAnnotation,
+                    format!("`@{}` on a union discriminator is ignored", a.name.text()),
+                )
+                .at(a.loc, "ignored")
+                .help("IDL 4.2 allows `@default` on members only; the union's `Default` selects its first member")
+                .note("Cyclone's idlc rejects this annotation");
+            }
+            self.diags.push(d);
+            return false;
+        }
+        true
+    }
+
+    /// Records the effect of the built-in annotation `a` (lower-cased `name`) in `r`.
+    fn apply<'a>(&mut self, r: &mut Anns<'a>, a: &'a Annotation, name: &str) {
+        match name {
+            "id" => {
+                if let Some(e) = self.single(a) {
+                    r.id = self.eval_u64(e, "@id", 0).and_then(|v| self.id_range(a, v));
+                    r.id_loc = Some(a.loc);
+                }
+            }
+            "autoid" => {
+                r.autoid = match &a.params {
+                    AnnotationParams::None => Some(AutoId::Hash),
+                    _ => match self.word_param(a).as_deref() {
+                        Some("SEQUENTIAL") => Some(AutoId::Sequential),
+                        Some("HASH") => Some(AutoId::Hash),
+                        _ => {
+                            self.ann_err(a, "`@autoid` takes SEQUENTIAL or HASH".into());
+                            None
+                        }
+                    },
+                }
+            }
+            "hashid" => {
+                r.hashid = Some(match &a.params {
+                    AnnotationParams::None => String::new(),
+                    AnnotationParams::Single(e) => self.string_of(e).unwrap_or_default(),
+                    AnnotationParams::Named(_) => String::new(),
+                })
+            }
+            "key" => {
+                r.key = self.bool_param(a);
+                r.key_loc = Some(a.loc);
+            }
+            "optional" => {
+                r.optional = self.bool_param(a);
+                r.optional_loc = Some(a.loc);
+            }
+            "external" => r.external = self.bool_param(a),
+            "must_understand" => r.must_understand = self.bool_param(a),
+            "final" | "appendable" | "mutable" | "extensibility" => {
+                r.extensibility_loc = Some(a.loc);
+                r.extensibility = self.extensibility(a, name);
+            }
+            "value" => r.value = self.single(a),
+            "position" => r.position = self.single(a),
+            "bit_bound" => r.bit_bound = self.single(a),
+            "default" => r.default = self.single(a),
+            "default_literal" => r.default_literal = true,
+            "range" => {
+                r.min = self.named(a, "min");
+                r.max = self.named(a, "max");
+            }
+            "min" => r.min = self.single(a),
+            "max" => r.max = self.single(a),
+            "unit" => {
+                if let Some(e) = self.single(a) {
+                    r.unit = self.string_of(e);
+                }
+            }
+            "nested" => r.nested = Some(self.bool_param(a)),
+            "default_nested" => r.default_nested = Some(self.bool_param(a)),
+            "topic" => r.topic = true,
+            "non_serialized" => r.non_serialized = self.bool_param(a),
+            "verbatim" => r.verbatim.extend(self.verbatim(a)),
+            // Accepted and recorded nowhere: they do not change the Rust mapping.
+            _ => {}
+        }
+    }
+
+    /// `@verbatim` text for Rust (language `*` or `rust`), with its placement.
+    fn verbatim(&mut self, a: &Annotation) -> Option<Verbatim> {
+        let lang = self
+            .named(a, "language")
+            .and_then(|e| self.string_of(e))
+            .unwrap_or_else(|| "*".into());
+        let placement = self
+            .named(a, "placement")
+            .and_then(|e| self.string_of(e))
+            .unwrap_or_else(|| "BEFORE_DECLARATION".into());
+        let text = match &a.params {
+            AnnotationParams::Single(e) => self.string_of(e),
+            _ => self.named(a, "text").and_then(|e| self.string_of(e)),
+        };
+        let rust = lang == "*" || lang.eq_ignore_ascii_case("rust");
+        text.filter(|_| rust).map(|text| Verbatim {
+            placement: placement.to_ascii_uppercase(),
+            text,
+        })
     }
 
     fn extensibility(&mut self, a: &Annotation, name: &str) -> Option<Extensibility> {
