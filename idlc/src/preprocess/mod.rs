@@ -519,59 +519,68 @@ impl<'a> Preprocessor<'a> {
                     self.token_too_long(file, i, j - i);
                     return to;
                 }
-                let name = &text[i..j];
-                if self.macros.is_defined(name) {
-                    // Find the invocation's extent, then expand just that.
-                    let mut inv_len = name.len();
-                    if self.macros.defs[name].params.is_some() {
-                        let (rest, k, line_to) = invocation_tokens(text, i, to);
-                        match k {
-                            Some(k) if rest[k].is("(") => match macros::collect_args(&rest, k) {
-                                Ok((_, end)) => {
-                                    inv_len = rest[..end].iter().map(|t| t.text.len()).sum();
-                                    if i + inv_len > to {
-                                        // Scanning goes on after the invocation, to the end of its line.
-                                        to = memchr_nl(b, i + inv_len - 1).min(line_to);
-                                    }
-                                }
-                                Err(e) => {
-                                    self.err(
-                                        Code::Macro,
-                                        Loc::new(file, i, j),
-                                        e,
-                                        "in this invocation",
-                                    );
-                                    i = j;
-                                    continue;
-                                }
-                            },
-                            _ => {
-                                i = j;
-                                continue;
-                            }
-                        }
-                    }
-                    let inv_end = i + inv_len;
-                    let inv = lex::lex(&text[i..inv_end]);
-                    let loc = Loc::new(file, i, inv_end);
-                    match self.macros.expand(&inv) {
-                        Ok(toks) => {
-                            self.emit_copy(file, text, copy_from, i);
-                            self.emit_expansion(loc, &toks);
-                            copy_from = inv_end;
-                        }
-                        Err(e) => self.err(Code::Macro, loc, e, "in this macro invocation"),
-                    }
-                    i = inv_end;
+                i = if self.macros.is_defined(&text[i..j]) {
+                    self.expand_at(file, text, i, j, &mut to, &mut copy_from)
                 } else {
-                    i = j;
-                }
+                    j
+                };
             } else {
                 i += 1;
             }
         }
         self.emit_copy(file, text, copy_from, to);
         to
+    }
+
+    /// Expands the invocation of the macro named `text[i..j]`: copies the text before it, then its
+    /// expansion. Returns where scanning goes on; `to` moves to the end of the line where a function-like
+    /// macro's arguments end, and `copy_from` past the invocation.
+    fn expand_at(
+        &mut self,
+        file: FileId,
+        text: &str,
+        i: usize,
+        j: usize,
+        to: &mut usize,
+        copy_from: &mut usize,
+    ) -> usize {
+        let b = text.as_bytes();
+        let name = &text[i..j];
+        // Find the invocation's extent, then expand just that.
+        let mut inv_len = name.len();
+        if self.macros.defs[name].params.is_some() {
+            let (rest, k, line_to) = invocation_tokens(text, i, *to);
+            match k {
+                Some(k) if rest[k].is("(") => match macros::collect_args(&rest, k) {
+                    Ok((_, end)) => {
+                        inv_len = rest[..end].iter().map(|t| t.text.len()).sum();
+                        if i + inv_len > *to {
+                            // Scanning goes on after the invocation, to the end of its line.
+                            *to = memchr_nl(b, i + inv_len - 1).min(line_to);
+                        }
+                    }
+                    Err(e) => {
+                        self.err(Code::Macro, Loc::new(file, i, j), e, "in this invocation");
+                        return j;
+                    }
+                },
+                _ => {
+                    return j;
+                }
+            }
+        }
+        let inv_end = i + inv_len;
+        let inv = lex::lex(&text[i..inv_end]);
+        let loc = Loc::new(file, i, inv_end);
+        match self.macros.expand(&inv) {
+            Ok(toks) => {
+                self.emit_copy(file, text, *copy_from, i);
+                self.emit_expansion(loc, &toks);
+                *copy_from = inv_end;
+            }
+            Err(e) => self.err(Code::Macro, loc, e, "in this macro invocation"),
+        }
+        inv_end
     }
 
     fn token_too_long(&mut self, file: FileId, at: usize, len: usize) {
@@ -608,65 +617,16 @@ impl<'a> Preprocessor<'a> {
         let name_loc = Loc::new(file, name_off, name_off + name.len().max(1));
         match name {
             "if" | "ifdef" | "ifndef" => {
-                let value = if !active {
-                    false
-                } else if name == "if" {
-                    self.eval_cond(rest, loc)
-                } else {
-                    let id: String = rest
-                        .bytes()
-                        .take_while(|c| is_ident_char(*c))
-                        .map(char::from)
-                        .collect();
-                    if id.is_empty() {
-                        self.err(
-                            Code::BadDirective,
-                            loc,
-                            format!("#{name} needs a macro name"),
-                            "here",
-                        );
-                    }
-                    self.macros.is_defined(&id) == (name == "ifdef")
-                };
+                let value = active && self.condition(name, rest, loc);
                 conds.push(Cond {
-                    active: active && value,
+                    active: value,
                     taken: value,
                     seen_else: false,
                     parent_active: active,
                     loc,
                 });
             }
-            "elif" | "else" => {
-                let Some(c) = conds.last_mut() else {
-                    return self.err(
-                        Code::Conditional,
-                        name_loc,
-                        format!("#{name} without #if"),
-                        "no matching #if",
-                    );
-                };
-                if c.seen_else {
-                    return self.err(
-                        Code::Conditional,
-                        name_loc,
-                        format!("#{name} after #else"),
-                        "unexpected here",
-                    );
-                }
-                let parent = c.parent_active;
-                let taken = c.taken;
-                let value = if name == "else" {
-                    c.seen_else = true;
-                    true
-                } else if parent && !taken {
-                    self.eval_cond(rest, loc)
-                } else {
-                    false
-                };
-                let c = conds.last_mut().expect("checked");
-                c.active = parent && !taken && value;
-                c.taken |= value;
-            }
+            "elif" | "else" => self.next_branch(name, rest, loc, name_loc, conds),
             "endif" => {
                 if conds.pop().is_none() {
                     self.err(
@@ -709,6 +669,59 @@ impl<'a> Preprocessor<'a> {
                 "not a directive",
             ),
         }
+    }
+
+    /// The value of the condition of an active `#if`, `#ifdef` or `#ifndef`.
+    fn condition(&mut self, name: &str, rest: &str, loc: Loc) -> bool {
+        if name == "if" {
+            return self.eval_cond(rest, loc);
+        }
+        let id: String = rest
+            .bytes()
+            .take_while(|c| is_ident_char(*c))
+            .map(char::from)
+            .collect();
+        if id.is_empty() {
+            self.err(
+                Code::BadDirective,
+                loc,
+                format!("#{name} needs a macro name"),
+                "here",
+            );
+        }
+        self.macros.is_defined(&id) == (name == "ifdef")
+    }
+
+    /// `#elif` or `#else`: the innermost conditional's next branch is taken if none was before it.
+    fn next_branch(&mut self, name: &str, rest: &str, loc: Loc, name_loc: Loc, conds: &mut [Cond]) {
+        let Some(c) = conds.last_mut() else {
+            return self.err(
+                Code::Conditional,
+                name_loc,
+                format!("#{name} without #if"),
+                "no matching #if",
+            );
+        };
+        if c.seen_else {
+            return self.err(
+                Code::Conditional,
+                name_loc,
+                format!("#{name} after #else"),
+                "unexpected here",
+            );
+        }
+        let (parent, taken) = (c.parent_active, c.taken);
+        let value = if name == "else" {
+            c.seen_else = true;
+            true
+        } else if parent && !taken {
+            self.eval_cond(rest, loc)
+        } else {
+            false
+        };
+        let c = conds.last_mut().expect("checked");
+        c.active = parent && !taken && value;
+        c.taken |= value;
     }
 
     /// `#line N ["name"]`: the next line is line `N` (of `name`) in reported positions.
