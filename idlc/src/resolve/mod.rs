@@ -373,39 +373,12 @@ impl<'a> Resolver<'a> {
             TypeSpec::Map {
                 key, value, bound, ..
             } => {
-                let k = self.lower_type(key);
-                let kr = self.model.resolve_alias(&k);
-                let key_ok = matches!(kr, Type::Prim { prim } if prim.is_integer() || *prim == Prim::Octet)
-                    || matches!(kr, Type::String { .. } | Type::Error);
-                let enum_key = matches!(kr, Type::Named { decl, .. }
-                    if matches!(self.model.decls[*decl].kind, DeclKind::Enum(_)));
-                if enum_key {
-                    let msg = format!(
-                        "map key type `{}` is an enum, which IDL 4.2 does not allow",
-                        self.type_name(&k)
-                    );
-                    self.diags.push(
-                        Diagnostic::warning(Code::Extension, msg)
-                            .at(key.loc(), "accepted as a vendor extension")
-                            .help("IDL 4.2 map keys are integers or strings"),
-                    );
-                } else if !key_ok {
-                    let msg = format!("map key type `{}` is not allowed", self.type_name(&k));
-                    self.diags.push(
-                        Diagnostic::error(Code::BadMemberType, msg)
-                            .at(key.loc(), "map key")
-                            .help("map keys must be integers or strings"),
-                    );
-                }
+                let key = Box::new(self.map_key(key));
                 let value = Box::new(self.lower_type(value));
                 let bound = bound
                     .as_ref()
                     .and_then(|b| self.eval_u64(b, "map bound", 1));
-                Type::Map {
-                    key: Box::new(k),
-                    value,
-                    bound,
-                }
+                Type::Map { key, value, bound }
             }
             TypeSpec::Fixed { digits, scale, loc } => {
                 // Bare `fixed` only occurs as a constant type; the value carries its own digits.
@@ -429,40 +402,74 @@ impl<'a> Resolver<'a> {
                     scale: sv as u32,
                 }
             }
-            TypeSpec::Named(n) => match self.resolve_name(n, "type") {
-                Some(Sym::Decl(id)) => match &self.model.decls[id].kind {
-                    DeclKind::Const(_) => {
-                        let msg = format!("`{}` is a constant, not a type", n.text());
-                        self.diags.push(
-                            Diagnostic::error(Code::NotAType, msg)
-                                .at(n.loc, "expected a type")
-                                .also(self.model.decls[id].loc, "declared here"),
-                        );
-                        Type::Error
-                    }
-                    _ => Type::Named {
-                        decl: id,
-                        name: self.model.decls[id].scoped_name(),
-                    },
-                },
-                Some(sym) => {
-                    let what = match sym {
-                        Sym::Module => "a module",
-                        Sym::Enumerator(..) => "an enumerator",
-                        _ => "not a data type",
-                    };
+            TypeSpec::Named(n) => self.named_type(n),
+        }
+    }
+
+    /// The type a name refers to; an error (and [`Type::Error`]) when it names something else.
+    fn named_type(&mut self, n: &ast::ScopedName) -> Type {
+        match self.resolve_name(n, "type") {
+            Some(Sym::Decl(id)) => match &self.model.decls[id].kind {
+                DeclKind::Const(_) => {
+                    let msg = format!("`{}` is a constant, not a type", n.text());
                     self.diags.push(
-                        Diagnostic::error(
-                            Code::NotAType,
-                            format!("`{}` is {what}, not a type", n.text()),
-                        )
-                        .at(n.loc, "expected a type"),
+                        Diagnostic::error(Code::NotAType, msg)
+                            .at(n.loc, "expected a type")
+                            .also(self.model.decls[id].loc, "declared here"),
                     );
                     Type::Error
                 }
-                None => Type::Error,
+                _ => Type::Named {
+                    decl: id,
+                    name: self.model.decls[id].scoped_name(),
+                },
             },
+            Some(sym) => {
+                let what = match sym {
+                    Sym::Module => "a module",
+                    Sym::Enumerator(..) => "an enumerator",
+                    _ => "not a data type",
+                };
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::NotAType,
+                        format!("`{}` is {what}, not a type", n.text()),
+                    )
+                    .at(n.loc, "expected a type"),
+                );
+                Type::Error
+            }
+            None => Type::Error,
         }
+    }
+
+    /// A map's key type: integers and strings; an enum is accepted as a vendor extension (with a warning).
+    fn map_key(&mut self, key: &TypeSpec) -> Type {
+        let k = self.lower_type(key);
+        let kr = self.model.resolve_alias(&k);
+        let key_ok = matches!(kr, Type::Prim { prim } if prim.is_integer() || *prim == Prim::Octet)
+            || matches!(kr, Type::String { .. } | Type::Error);
+        let enum_key = matches!(kr, Type::Named { decl, .. }
+            if matches!(self.model.decls[*decl].kind, DeclKind::Enum(_)));
+        if enum_key {
+            let msg = format!(
+                "map key type `{}` is an enum, which IDL 4.2 does not allow",
+                self.type_name(&k)
+            );
+            self.diags.push(
+                Diagnostic::warning(Code::Extension, msg)
+                    .at(key.loc(), "accepted as a vendor extension")
+                    .help("IDL 4.2 map keys are integers or strings"),
+            );
+        } else if !key_ok {
+            let msg = format!("map key type `{}` is not allowed", self.type_name(&k));
+            self.diags.push(
+                Diagnostic::error(Code::BadMemberType, msg)
+                    .at(key.loc(), "map key")
+                    .help("map keys must be integers or strings"),
+            );
+        }
+        k
     }
 
     fn with_dims(&mut self, ty: Type, dims: &[ast::ConstExpr]) -> Type {
