@@ -8,9 +8,11 @@ use std::sync::Arc;
 
 use crate::cdr::DdsType;
 use crate::filter::FilterFields;
+use crate::qos::DataReaderQos;
 
 use super::super::decode::{Derived, SampleCodec};
 use super::super::driver::EndpointHandle;
+use super::super::error::DdsResult;
 use super::super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, LivelinessChangedStatus, SampleLostStatus,
     SampleRejectedStatus, SubscriptionMatchedStatus,
@@ -34,6 +36,10 @@ pub(crate) trait ReaderKind: Sized + Send + Sync + 'static {
         inner: Arc<ReaderInner<Self>>,
         handle: Arc<EndpointHandle<Self::Owner>>,
     ) -> Self::Reader;
+    /// Announces `reader` again with `qos` and its subscriber's and topic's QoS now (they changed).
+    fn announce(reader: &Self::Reader, qos: DataReaderQos) -> DdsResult<()>;
+    /// Enables `reader` (`enable`).
+    fn enable(reader: Self::Reader) -> DdsResult<()>;
 }
 
 /// The calls a reader makes on its listener, whatever the listener trait (`R` is the public reader).
@@ -93,5 +99,11 @@ impl<T: DdsType> ReaderKind for Typed<T> {
         handle: Arc<EndpointHandle<ReaderOwner<T>>>,
     ) -> DataReader<T> {
         DataReader { inner, handle }
+    }
+    fn announce(reader: &DataReader<T>, qos: DataReaderQos) -> DdsResult<()> {
+        reader.announce(qos)
+    }
+    fn enable(reader: DataReader<T>) -> DdsResult<()> {
+        reader.enable()
     }
 }
