@@ -575,7 +575,8 @@ fn dynamic_writer_listener_and_status_condition() {
 /// GROUP presentation (coherent and ordered) across a typed and a dynamic endpoint of each side: the
 /// publisher's coherent set spans its typed writer and its dynamic writer; the subscriber's access scope
 /// holds back what arrives for its typed and its dynamic reader until `end_access`; and
-/// `get_datareaders` lists the dynamic reader in the subscriber's sample order.
+/// `get_datareaders` lists the dynamic reader in the subscriber's sample order. Both count among their
+/// publisher's and subscriber's entities until deleted.
 #[test]
 fn dynamic_endpoints_take_part_in_group_presentation() {
     let (p1, p2) = (participant(40), participant(40));
@@ -671,4 +672,25 @@ fn dynamic_endpoints_take_part_in_group_presentation() {
     let handles = [tr.instance_handle(), dr.instance_handle()];
     let want: Vec<InstanceHandle> = writes.iter().map(|&(w, _)| handles[w]).collect();
     assert_eq!(list, want);
+
+    // Explicit deletion: the publisher and subscriber count their dynamic endpoints as children.
+    let other = p1.create_publisher(&PublisherQos::default()).unwrap();
+    assert!(matches!(
+        other.delete_dynamic_writer(&dw),
+        Err(DdsError::PreconditionNotMet(_))
+    ));
+    publ.delete_datawriter(&tw).unwrap();
+    assert!(matches!(
+        p1.delete_publisher(&publ),
+        Err(DdsError::PreconditionNotMet(_))
+    ));
+    publ.delete_dynamic_writer(&dw).unwrap();
+    assert!(matches!(
+        dw.write(&dynamic_shape(&ty, "RED", 9)),
+        Err(DdsError::AlreadyDeleted)
+    ));
+    p1.delete_publisher(&publ).unwrap();
+    sub.delete_datareader(&tr).unwrap();
+    sub.delete_dynamic_reader(&dr).unwrap();
+    p2.delete_subscriber(&sub).unwrap();
 }

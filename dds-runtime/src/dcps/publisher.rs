@@ -134,6 +134,11 @@ impl Publisher {
             .end(self.participant.driver(), Duration::from_secs(1))
     }
 
+    /// Whether `other` is this publisher (a clone of it).
+    pub(crate) fn is(&self, other: &Publisher) -> bool {
+        Arc::ptr_eq(&self.qos, &other.qos)
+    }
+
     /// Makes the new writer `id`, of any kind, take part in this publisher's coherent sets (and, with GROUP
     /// access scope, in its group).
     pub(crate) fn add_to_group(&self, id: EntityId, presentation: &crate::qos::Presentation) {

@@ -262,6 +262,11 @@ impl Subscriber {
         inner
     }
 
+    /// Whether `other` is this subscriber (a clone of it).
+    pub(crate) fn is(&self, other: &Subscriber) -> bool {
+        Arc::ptr_eq(&self.qos, &other.qos)
+    }
+
     /// A reader of any kind was created in the core: it joins the subscriber's access scope (GROUP access)
     /// and the participant's registry (`get_datareaders`, `notify_datareaders`, deletion).
     pub(crate) fn reader_created<K: ReaderKind>(&self, inner: &Arc<ReaderInner<K>>, topic: &str) {

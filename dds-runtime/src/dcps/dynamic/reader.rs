@@ -15,7 +15,7 @@ use super::super::condition::{QueryCondition, ReadCondition, StatusCondition};
 use super::super::decode::SampleCodec;
 use super::super::driver::{Endpoint, EndpointHandle};
 use super::super::endpoint::check_history;
-use super::super::error::DdsResult;
+use super::super::error::{DdsError, DdsResult};
 use super::super::sample::{
     InstanceHandle, InstanceState, InstanceStateMask, Sample, SampleInfo, SampleStateMask,
     ViewStateMask,
@@ -236,6 +236,19 @@ impl Subscriber {
         self.reader_created(&inner, topic.name());
         tracing::info!(topic = topic.name(), type_name = %topic.type_name(), id = ?handle.id(), "dynamic reader created");
         Ok(DynamicReader { inner, handle })
+    }
+}
+
+impl Subscriber {
+    /// Deletes `reader` (`delete_datareader` for a dynamic reader): it leaves SEDP, and reads return nothing
+    /// from then on. `PreconditionNotMet` for a reader of another subscriber.
+    pub fn delete_dynamic_reader(&self, reader: &DynamicReader) -> DdsResult<()> {
+        if !self.is(reader.subscriber()) {
+            return Err(DdsError::PreconditionNotMet(
+                "the reader belongs to another subscriber",
+            ));
+        }
+        reader.inner.state.delete()
     }
 }
 

@@ -218,6 +218,20 @@ impl Publisher {
     }
 }
 
+impl Publisher {
+    /// Deletes `writer` (`delete_datawriter` for a dynamic writer): it unregisters its instances (without
+    /// disposing them), leaves SEDP, and its operations return `AlreadyDeleted` from then on.
+    /// `PreconditionNotMet` for a writer of another publisher.
+    pub fn delete_dynamic_writer(&self, writer: &DynamicWriter) -> DdsResult<()> {
+        if !self.is(writer.publisher()) {
+            return Err(DdsError::PreconditionNotMet(
+                "the writer belongs to another publisher",
+            ));
+        }
+        writer.inner.state.delete()
+    }
+}
+
 fn wire_time(t: SystemTime) -> Time {
     Time::from_unix(t.duration_since(SystemTime::UNIX_EPOCH).unwrap_or_default())
 }
@@ -422,6 +436,7 @@ impl DynamicWriter {
     /// The key of the instance `handle`: a sample whose key members are set and whose other members have
     /// their defaults. `BadParameter` for an unknown handle.
     pub fn get_key_value(&self, handle: InstanceHandle) -> DdsResult<DynamicData> {
+        self.inner.state.check_alive()?;
         let payload = lock(&self.inner.instances).key_payload(handle)?;
         Ok(DynamicData::deserialize_key(
             self.topic().dynamic_type(),
@@ -483,8 +498,8 @@ impl DynamicWriter {
     /// Asserts this writer's liveliness (MANUAL_BY_TOPIC or MANUAL_BY_PARTICIPANT): a HEARTBEAT with the
     /// liveliness flag to its matched readers. Writing a sample asserts it too.
     pub fn assert_liveliness(&self) -> DdsResult<()> {
+        self.inner.state.check_alive()?;
         let driver = self.handle_driver();
-        driver.check_alive()?;
         let id = self.handle.id();
         driver.with_core(|c, now| c.assert_writer_liveliness(now, id));
         Ok(())
@@ -502,7 +517,7 @@ impl DynamicWriter {
     /// change of any other policy is refused with [`DdsError::ImmutablePolicy`]. An empty
     /// `data_representation` keeps the current one. A deadline set where there was none counts from now.
     pub fn set_qos(&self, qos: &DataWriterQos) -> DdsResult<()> {
-        self.handle_driver().check_alive()?;
+        self.inner.state.check_alive()?;
         let (new, immutable) = requested_qos(&read(&self.inner.current), qos);
         if let Some(p) = immutable {
             return Err(DdsError::ImmutablePolicy(p));
@@ -529,7 +544,7 @@ impl DynamicWriter {
         let id = self.handle.id();
         let deadline = Instant::now() + self.inner.max_block;
         loop {
-            driver.check_alive()?;
+            self.inner.state.check_alive()?;
             let seen = driver.progress_generation();
             match driver.with_core_writing(|c, now| c.write(now, id, change.clone())) {
                 Ok(_) => return Ok(()),
