@@ -196,11 +196,6 @@ impl Subscriber {
             credit_limit,
             parent,
         );
-        if T::IS_KEYED {
-            lock(&inner.cache)
-                .cache
-                .set_key_holder_fn(ops::key_holder::<T>);
-        }
         let owner = ReaderOwner {
             topic: t.clone(),
             subscriber: self.clone(),

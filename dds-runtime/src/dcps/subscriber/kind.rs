@@ -40,6 +40,11 @@ pub(crate) trait ReaderKind: Sized + Send + Sync + 'static {
     fn announce(reader: &Self::Reader, qos: DataReaderQos) -> DdsResult<()>;
     /// Enables `reader` (`enable`).
     fn enable(reader: Self::Reader) -> DdsResult<()>;
+    /// What makes the key holder of a new instance from its first sample (for `get_key_value`), if the
+    /// kind's cache keeps one that way.
+    fn key_holder() -> Option<fn(&Self::Data) -> Option<Self::Data>> {
+        None
+    }
 }
 
 /// The calls a reader makes on its listener, whatever the listener trait (`R` is the public reader).
@@ -105,5 +110,8 @@ impl<T: DdsType> ReaderKind for Typed<T> {
     }
     fn enable(reader: DataReader<T>) -> DdsResult<()> {
         reader.enable()
+    }
+    fn key_holder() -> Option<fn(&T) -> Option<T>> {
+        T::IS_KEYED.then_some(super::ops::key_holder::<T>)
     }
 }

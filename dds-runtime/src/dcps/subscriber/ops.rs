@@ -116,6 +116,9 @@ pub(super) fn register_reader<K: ReaderKind>(
     let Ok(group) = s.with_group(|g| g.node.handle) else {
         return;
     };
+    if let Some(f) = K::key_holder() {
+        lock(&inner.cache).cache.set_key_holder_fn(f);
+    }
     let entity: Weak<dyn Registered> = Arc::downgrade(inner) as Weak<ReaderInner<K>>;
     s.participant.registry().add_endpoint(
         false,
