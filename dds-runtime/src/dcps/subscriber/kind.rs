@@ -19,6 +19,9 @@ use super::super::status::{
 };
 use super::{DataReader, DataReaderListener, ReaderInner, ReaderOwner};
 
+/// Makes an instance's key holder (its key members set, the others defaulted) from a sample.
+pub(crate) type KeyHolderFn<T> = fn(&T) -> Option<T>;
+
 /// A flavour of reader.
 pub(crate) trait ReaderKind: Sized + Send + Sync + 'static {
     /// The sample type the cache holds.
@@ -42,7 +45,7 @@ pub(crate) trait ReaderKind: Sized + Send + Sync + 'static {
     fn enable(reader: Self::Reader) -> DdsResult<()>;
     /// What makes the key holder of a new instance from its first sample (for `get_key_value`), if the
     /// kind's cache keeps one that way.
-    fn key_holder() -> Option<fn(&Self::Data) -> Option<Self::Data>> {
+    fn key_holder() -> Option<KeyHolderFn<Self::Data>> {
         None
     }
 }
@@ -111,7 +114,7 @@ impl<T: DdsType> ReaderKind for Typed<T> {
     fn enable(reader: DataReader<T>) -> DdsResult<()> {
         reader.enable()
     }
-    fn key_holder() -> Option<fn(&T) -> Option<T>> {
+    fn key_holder() -> Option<KeyHolderFn<T>> {
         T::IS_KEYED.then_some(super::ops::key_holder::<T>)
     }
 }
