@@ -1,7 +1,7 @@
 //! The dynamic writer's instance, liveliness and QoS operations, and the dynamic endpoints' statuses going
 //! up to their publisher's, subscriber's and participant's listeners, against Cyclone DDS 11 peers (python
 //! `cyclonedds`, `dcps_util/cyclone_dynapi.py`).
-//! Ignored by default (needs python3 + cyclonedds): run with
+//! Ignored by default (needs python3 + cyclonedds); the nextest profile `interop` runs it, or
 //! `scripts/isolated cargo nextest run -p dds-runtime --features idl --test dcps_dynamic_api_cyclone
 //! --run-ignored ignored-only`. Domains 38 and 39.
 mod dcps_util;
