@@ -571,3 +571,126 @@ fn dynamic_writer_listener_and_status_condition() {
         calls.lock().unwrap()
     );
 }
+
+/// GROUP presentation (coherent and ordered) across a typed and a dynamic endpoint of each side: the
+/// publisher's coherent set spans its typed writer and its dynamic writer; the subscriber's access scope
+/// holds back what arrives for its typed and its dynamic reader until `end_access`; and
+/// `get_datareaders` lists the dynamic reader in the subscriber's sample order. Both count among their
+/// publisher's and subscriber's entities until deleted.
+#[test]
+fn dynamic_endpoints_take_part_in_group_presentation() {
+    let (p1, p2) = (participant(40), participant(40));
+    let (wq, rq) = reliable_keep_all();
+    let group = Presentation {
+        access_scope: PresentationAccessScope::Group,
+        coherent_access: true,
+        ordered_access: true,
+    };
+    let publ = p1
+        .create_publisher(&PublisherQos::builder().presentation(group).build())
+        .unwrap();
+    let sub = p2
+        .create_subscriber(&SubscriberQos::builder().presentation(group).build())
+        .unwrap();
+    let ty = shape_from_builder();
+    let tw = publ
+        .create_datawriter(
+            &p1.create_topic::<ShapeType>("Square", &TopicQos::default())
+                .unwrap(),
+            &wq,
+        )
+        .unwrap();
+    let dw = publ
+        .create_dynamic_writer(
+            &p1.create_dynamic_topic("Circle", ty.clone(), &TopicQos::default())
+                .unwrap(),
+            &wq,
+        )
+        .unwrap();
+    let tr = sub
+        .create_datareader::<ShapeType, _>(
+            &p2.create_topic::<ShapeType>("Square", &TopicQos::default())
+                .unwrap(),
+            &rq,
+        )
+        .unwrap();
+    let dr = sub
+        .create_dynamic_reader(
+            &p2.create_dynamic_topic("Circle", ty.clone(), &TopicQos::default())
+                .unwrap(),
+            &rq,
+        )
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        tw.publication_matched_status().current_count == 1
+            && dw.matched_readers().len() == 1
+            && tr.subscription_matched_status().current_count == 1
+            && dr.subscription_matched_status().current_count == 1
+    }));
+    let any = (
+        SampleStateMask::ANY,
+        ViewStateMask::ANY,
+        InstanceStateMask::ANY,
+    );
+    let held = |r: &DynamicReader| r.read_states(any.0, any.1, any.2).len();
+
+    // The access scope holds back a group set until it ends.
+    sub.begin_access().unwrap();
+    publ.begin_coherent_changes().unwrap();
+    tw.write(&shape("RED", 1)).unwrap();
+    dw.write(&dynamic_shape(&ty, "RED", 1)).unwrap();
+    publ.end_coherent_changes().unwrap();
+    tw.wait_for_acknowledgments(Duration::from_secs(10))
+        .unwrap();
+    dw.wait_for_acknowledgments(Duration::from_secs(10))
+        .unwrap();
+    assert_eq!((tr.sample_count(), held(&dr)), (0, 0));
+    sub.end_access().unwrap();
+    assert_eq!((tr.sample_count(), held(&dr)), (1, 1));
+    tr.take().unwrap();
+    dr.take();
+
+    // Ordered access: the readers once per sample, in the order written, the dynamic one included.
+    // (Outside a coherent set: a group set is stored writer by writer.)
+    let writes = [(0, 2), (1, 2), (1, 3), (0, 3)];
+    for &(w, x) in &writes {
+        match w {
+            0 => tw.write(&shape("RED", x)).unwrap(),
+            _ => dw.write(&dynamic_shape(&ty, "RED", x)).unwrap(),
+        }
+    }
+    assert!(wait_until(MATCH_TIMEOUT, || sub
+        .get_datareaders(any.0, any.1, any.2)
+        .unwrap()
+        .len()
+        == writes.len()));
+    sub.begin_access().unwrap();
+    let list = sub
+        .get_datareaders(SampleStateMask::NOT_READ, any.1, any.2)
+        .unwrap();
+    sub.end_access().unwrap();
+    let handles = [tr.instance_handle(), dr.instance_handle()];
+    let want: Vec<InstanceHandle> = writes.iter().map(|&(w, _)| handles[w]).collect();
+    assert_eq!(list, want);
+
+    // Explicit deletion: the publisher and subscriber count their dynamic endpoints as children.
+    let other = p1.create_publisher(&PublisherQos::default()).unwrap();
+    assert!(matches!(
+        other.delete_dynamic_writer(&dw),
+        Err(DdsError::PreconditionNotMet(_))
+    ));
+    publ.delete_datawriter(&tw).unwrap();
+    assert!(matches!(
+        p1.delete_publisher(&publ),
+        Err(DdsError::PreconditionNotMet(_))
+    ));
+    publ.delete_dynamic_writer(&dw).unwrap();
+    assert!(matches!(
+        dw.write(&dynamic_shape(&ty, "RED", 9)),
+        Err(DdsError::AlreadyDeleted)
+    ));
+    p1.delete_publisher(&publ).unwrap();
+    sub.delete_datareader(&tr).unwrap();
+    sub.delete_dynamic_reader(&dr).unwrap();
+    p2.delete_subscriber(&sub).unwrap();
+}

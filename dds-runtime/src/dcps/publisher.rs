@@ -7,7 +7,7 @@ mod ops;
 mod shared;
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering as AtomicOrdering};
-use std::sync::{Arc, Mutex, RwLock};
+use std::sync::{Arc, Mutex, RwLock, Weak};
 use std::time::{Duration, Instant, SystemTime};
 
 use foldhash::HashMap;
@@ -27,6 +27,7 @@ use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
 use super::participant::DomainParticipant;
 use super::presentation::CoherentGroup;
+use super::registry::Registered;
 use super::sample::InstanceHandle;
 use super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, LivelinessLostStatus, PublicationMatchedStatus,
@@ -38,10 +39,12 @@ use super::writer_filter::WriterFilters;
 use crate::rtps::pool::BufferPool;
 
 pub(crate) use events::{
-    check_offered_deadline, on_writer_event, writer_callbacks, WriterCallbacks, WriterState,
+    check_offered_deadline, offers_deadline, on_writer_event, requested_qos, unregister_kind,
+    writer_callbacks, WriterCallbacks, WriterState,
 };
 #[cfg(feature = "shm")]
 pub use loan::{LoanError, SampleLoan};
+pub(crate) use ops::register_writer;
 pub use ops::PublisherListener;
 
 /// Callbacks of a [`DataWriter`] (see [`crate::dcps::listener`]). Every method has an empty default.
@@ -131,6 +134,18 @@ impl Publisher {
             .end(self.participant.driver(), Duration::from_secs(1))
     }
 
+    /// Whether `other` is this publisher (a clone of it).
+    pub(crate) fn is(&self, other: &Publisher) -> bool {
+        Arc::ptr_eq(&self.qos, &other.qos)
+    }
+
+    /// Makes the new writer `id`, of any kind, take part in this publisher's coherent sets (and, with GROUP
+    /// access scope, in its group).
+    pub(crate) fn add_to_group(&self, id: EntityId, presentation: &crate::qos::Presentation) {
+        self.group
+            .add_writer(self.participant.driver(), id, presentation);
+    }
+
     /// Creates a writer. An empty `data_representation` means the type's default (XCDR1 for @final types
     /// without optional members, else XCDR2, as Cyclone DDS does).
     pub fn create_datawriter<T: DdsType>(
@@ -216,9 +231,10 @@ impl Publisher {
                 c.create_writer_disabled(now, spec)
             }
         })?;
-        ops::register_writer(self, &inner, topic.name());
+        let entity: Weak<dyn Registered> = Arc::downgrade(&inner) as Weak<WriterInner<T>>;
+        ops::register_writer(self, &inner.state, entity, topic.name());
         let id = handle.id();
-        self.group.add_writer(&driver, id, &group_qos.presentation);
+        self.add_to_group(id, &group_qos.presentation);
         tracing::info!(
             topic = topic.name(),
             type_name = T::TYPE_NAME,
@@ -254,8 +270,7 @@ impl WritePath {
 
     /// Records whether `qos` sets an offered deadline.
     fn set_deadline(&self, qos: &DataWriterQos) {
-        let period = qos.deadline.0;
-        let on = period != crate::qos::INFINITE && !period.is_zero();
+        let on = events::offers_deadline(qos);
         self.deadline.store(on, AtomicOrdering::Release);
     }
 
@@ -559,32 +574,15 @@ impl<T: DdsType> DataWriter<T> {
     ) -> DdsResult<Option<(InstanceHandle, Option<[u8; 16]>)>> {
         let found = with_scratch(|key| -> DdsResult<_> {
             cdr::instance_key(sample, key)?;
-            let mut inst = lock(&self.inner.instances);
-            let Some(h) = inst.by_key.get(key.as_slice()).copied() else {
-                return Ok(None);
-            };
-            let Some(i) = inst.by_handle.get_mut(&h) else {
-                return Ok(None);
-            };
             // Only the offered deadline reads the last-write time: no clock read without one.
-            if written && self.inner.fixed.has_deadline() {
-                i.last_write = Instant::now();
-            }
-            Ok(Some((h, i.key_hash)))
+            let now = (written && self.inner.fixed.has_deadline()).then(Instant::now);
+            Ok(lock(&self.inner.instances).lookup(key, now))
         })?;
         if found.is_some() || !create {
             return Ok(found);
         }
         let mut key = Vec::new();
         cdr::instance_key(sample, &mut key)?;
-        let now = Instant::now();
-        let mut inst = lock(&self.inner.instances);
-        // Another thread may have registered it since the lookup above.
-        if let Some(h) = inst.by_key.get(&key).copied() {
-            if let Some(i) = inst.by_handle.get(&h) {
-                return Ok(Some((h, i.key_hash)));
-            }
-        }
         let mut kp = Vec::new();
         cdr::serialize_key(
             sample,
@@ -593,19 +591,14 @@ impl<T: DdsType> DataWriter<T> {
             &mut kp,
         )?;
         let kh = self.key_hash(sample)?;
-        inst.next += 1;
-        let h = InstanceHandle(inst.next);
-        inst.by_key.insert(key.clone(), h);
-        inst.by_handle.insert(
-            h,
-            WriterInstance {
-                key,
-                key_payload: Payload::from(kp),
-                key_hash: kh,
-                last_write: now,
-            },
-        );
-        Ok(Some((h, kh)))
+        // Another thread may have registered it since the lookup above: `register` returns that one.
+        let mut inst = lock(&self.inner.instances);
+        Ok(Some(inst.register(
+            key,
+            Payload::from(kp),
+            kh,
+            Instant::now(),
+        )))
     }
 
     /// Registers the instance of `sample` and returns its handle (nothing is sent).
@@ -639,30 +632,9 @@ impl<T: DdsType> DataWriter<T> {
                 .map_or(InstanceHandle::NIL, |(h, _)| h),
             None => handle,
         };
-        let (payload, key_hash) = {
-            let inst = lock(&self.inner.instances);
-            match inst.by_handle.get(&h) {
-                Some(i) => (i.key_payload.clone(), i.key_hash),
-                None => {
-                    return Err(DdsError::BadParameter(format!(
-                        "unknown instance handle {h:?}"
-                    )))
-                }
-            }
-        };
-        let change = WriteChange {
-            kind,
-            payload,
-            key_hash,
-            source_timestamp: Some(wire_time(ts)),
-        };
+        let change = lock(&self.inner.instances).key_change(h, kind, ts)?;
         self.submit(change, None)?;
-        if matches!(kind, ChangeKind::Unregister | ChangeKind::DisposeUnregister) {
-            let mut inst = lock(&self.inner.instances);
-            if let Some(i) = inst.by_handle.remove(&h) {
-                inst.by_key.remove(&i.key);
-            }
-        }
+        lock(&self.inner.instances).key_change_sent(h, kind);
         Ok(())
     }
 
@@ -785,25 +757,13 @@ impl<T: DdsType> WriterInner<T> {
     /// time, so a deadline set now counts from now for every instance written so far.
     fn set_deadline(&self, qos: &DataWriterQos) {
         if !self.fixed.has_deadline() {
-            let now = Instant::now();
-            let mut inst = lock(&self.instances);
-            inst.by_handle.values_mut().for_each(|i| i.last_write = now);
-            if inst.keyless_last_write.is_some() {
-                inst.keyless_last_write = Some(now);
-            }
+            lock(&self.instances).restart_deadlines(Instant::now());
         }
         self.fixed.set_deadline(qos);
     }
 
     fn unregister_kind(&self) -> ChangeKind {
-        if read(&self.current)
-            .writer_data_lifecycle
-            .autodispose_unregistered_instances
-        {
-            ChangeKind::DisposeUnregister
-        } else {
-            ChangeKind::Unregister
-        }
+        events::unregister_kind(&read(&self.current))
     }
 
     /// The public writer, for listeners.
@@ -825,23 +785,10 @@ impl<T: DdsType> Endpoint for WriterInner<T> {
         on_writer_event(&self.state, ev, || self.writer());
     }
 
-    /// A deleted writer unregisters its instances, so readers see the state change, not just the unmatch. It
-    /// does not dispose them, whatever autodispose_unregistered_instances says: DDS 1.4 §2.2.2.4.1.6 allows
-    /// both, and Cyclone DDS (and the OMG suite's `Test_FinalInstanceState_2`, which expects
-    /// NOT_ALIVE_NO_WRITERS from a publisher that simply ends) only unregister, which also leaves TRANSIENT data
-    /// to the durability service.
+    /// A deleted writer unregisters its instances, so readers see the state change, not just the unmatch
+    /// ([`WriterInstances::farewell`]; the OMG suite's `Test_FinalInstanceState_2` expects
+    /// NOT_ALIVE_NO_WRITERS from a publisher that simply ends).
     fn farewell(&self) -> Vec<WriteChange> {
-        let kind = ChangeKind::Unregister;
-        let ts = Some(wire_time(SystemTime::now()));
-        lock(&self.instances)
-            .by_handle
-            .values()
-            .map(|i| WriteChange {
-                kind,
-                payload: i.key_payload.clone(),
-                key_hash: i.key_hash,
-                source_timestamp: ts,
-            })
-            .collect()
+        lock(&self.instances).farewell()
     }
 }

@@ -160,7 +160,6 @@ impl Subscriber {
         qos: &DataReaderQos,
         listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
     ) -> DdsResult<DataReader<T>> {
-        let driver = self.participant.driver().clone();
         let parent = ops::reader_parent(self, topic.topic())?;
         let enabled = self
             .participant
@@ -190,21 +189,17 @@ impl Subscriber {
         let credit_limit = credit_limit(&rq);
         let mut cache = ReaderCache::new(rq.clone(), T::IS_KEYED);
         cache.set_filter(topic.sample_filter());
-        cache.set_instance_order(instance_ordered(&group_qos.presentation));
-
-        let inner = Arc::new(ReaderInner::<Typed<T>>::new(
+        let inner = self.reader_inner::<Typed<T>>(
             super::decode::Derived,
-            driver.clone(),
             cache,
-            group_ordered(&group_qos.presentation).then(|| self.access.order()),
-            group_scoped(&group_qos.presentation).then(|| self.access.clone()),
+            &group_qos.presentation,
             credit_limit,
-        ));
+            parent,
+        );
         let owner = ReaderOwner {
             topic: t.clone(),
             subscriber: self.clone(),
         };
-        inner.state.set_parent(parent);
         let sink: Arc<dyn Endpoint> = inner.clone();
         if !enabled {
             inner.state.set_created_disabled();
@@ -224,11 +219,7 @@ impl Subscriber {
             }
             Ok(id)
         })?;
-        if inner.access.is_some() {
-            let member: Arc<dyn AccessMember> = inner.clone();
-            self.access.join(Arc::downgrade(&member));
-        }
-        ops::register_reader(self, &inner, t.name());
+        self.reader_created(&inner, t.name());
         let id = handle.id();
         topic.reader_created(id);
         tracing::info!(
@@ -238,6 +229,47 @@ impl Subscriber {
             "reader created"
         );
         Ok(DataReader { inner, handle })
+    }
+}
+
+impl Subscriber {
+    /// The state of a new reader of this subscriber, of any kind, under the subscriber's level `parent` of
+    /// the listener chain: `presentation` (the subscriber's) orders its cache by instance and gives it its
+    /// place in the subscriber's order (GROUP ordered access) and access scope (GROUP coherent access).
+    pub(crate) fn reader_inner<K: ReaderKind>(
+        &self,
+        codec: K::Codec,
+        mut cache: ReaderCache<K::Data>,
+        presentation: &crate::qos::Presentation,
+        credit_limit: Option<usize>,
+        parent: Arc<super::chain::ListenerNode>,
+    ) -> Arc<ReaderInner<K>> {
+        cache.set_instance_order(instance_ordered(presentation));
+        let inner = Arc::new(ReaderInner::<K>::new(
+            codec,
+            self.participant.driver().clone(),
+            cache,
+            group_ordered(presentation).then(|| self.access.order()),
+            group_scoped(presentation).then(|| self.access.clone()),
+            credit_limit,
+        ));
+        inner.state.set_parent(parent);
+        inner
+    }
+
+    /// Whether `other` is this subscriber (a clone of it).
+    pub(crate) fn is(&self, other: &Subscriber) -> bool {
+        Arc::ptr_eq(&self.qos, &other.qos)
+    }
+
+    /// A reader of any kind was created in the core: it joins the subscriber's access scope (GROUP access)
+    /// and the participant's registry (`get_datareaders`, `notify_datareaders`, deletion).
+    pub(crate) fn reader_created<K: ReaderKind>(&self, inner: &Arc<ReaderInner<K>>, topic: &str) {
+        if inner.access.is_some() {
+            let member: Arc<dyn AccessMember> = inner.clone();
+            self.access.join(Arc::downgrade(&member));
+        }
+        ops::register_reader(self, inner, topic);
     }
 }
 

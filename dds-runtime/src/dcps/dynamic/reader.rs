@@ -15,7 +15,7 @@ use super::super::condition::{QueryCondition, ReadCondition, StatusCondition};
 use super::super::decode::SampleCodec;
 use super::super::driver::{Endpoint, EndpointHandle};
 use super::super::endpoint::check_history;
-use super::super::error::DdsResult;
+use super::super::error::{DdsError, DdsResult};
 use super::super::sample::{
     InstanceHandle, InstanceState, InstanceStateMask, Sample, SampleInfo, SampleStateMask,
     ViewStateMask,
@@ -109,7 +109,7 @@ reader_callbacks!(dyn DynamicReaderListener, DynamicReader);
 /// What a dynamic reader's handle keeps alive.
 pub(crate) struct Owner {
     topic: DynamicTopic,
-    _subscriber: Subscriber,
+    subscriber: Subscriber,
 }
 
 /// The dynamic flavour of the reader machinery: [`DynamicData`] samples decoded by their [`DynamicType`].
@@ -127,14 +127,29 @@ impl ReaderKind for Dynamic {
     ) -> DynamicReader {
         DynamicReader { inner, handle }
     }
+    fn announce(reader: &DynamicReader, qos: DataReaderQos) -> DdsResult<()> {
+        let rq = ReaderQos::new(qos, &reader.subscriber().get_qos()?, reader.topic().qos());
+        let id = reader.handle.id();
+        reader
+            .inner
+            .state
+            .driver
+            .with_core(|c, now| c.update_reader_qos(now, id, rq))?;
+        Ok(())
+    }
+    /// Dynamic readers are created enabled.
+    fn enable(_: DynamicReader) -> DdsResult<()> {
+        Ok(())
+    }
 }
 
 /// Takes [`DynamicData`] samples of a [`DynamicTopic`]. Cheap to clone; deleted with its last clone.
 ///
 /// It runs on the typed reader's machinery (queue, decoding, cache, statuses, listener, status condition):
-/// what [`DataReader`](crate::dcps::DataReader) documents of its QoS holds here too. Not supported (yet):
-/// the subscriber's and participant's listeners (statuses go to the reader's own listener and status
-/// condition only), GROUP presentation, and the subscriber's `get_datareaders`.
+/// what [`DataReader`](crate::dcps::DataReader) documents of its QoS holds here too. It is one of its
+/// subscriber's readers as a typed reader is: the statuses its own listener does not take go to the
+/// subscriber's and participant's listeners (DATA_ON_READERS first), it takes part in the subscriber's
+/// GROUP presentation (`begin_access`, ordered access) and `get_datareaders` lists it.
 #[derive(Clone)]
 pub struct DynamicReader {
     inner: Arc<ReaderInner<Dynamic>>,
@@ -179,8 +194,9 @@ impl Subscriber {
         qos: &DataReaderQos,
         listener: Option<(Arc<dyn DynamicReaderListener>, StatusMask)>,
     ) -> DdsResult<DynamicReader> {
-        let driver = self.participant().driver().clone();
-        driver.check_alive()?;
+        let parent = self.listener_node()?;
+        // The QoS in effect: the subscriber's may have changed since its creation.
+        let group_qos = self.get_qos()?;
         let mut rq = qos.clone();
         if rq.data_representation.ids().is_empty() {
             rq.data_representation = DataRepresentation::accept_both();
@@ -191,7 +207,7 @@ impl Subscriber {
             topic_name: topic.name().to_string(),
             type_name: topic.type_name(),
             keyed: ty.is_keyed(),
-            qos: ReaderQos::new(rq.clone(), self.qos(), topic.qos()),
+            qos: ReaderQos::new(rq.clone(), &group_qos, topic.qos()),
             type_information: topic.type_information(),
             entity_name: None,
             content_filter: None,
@@ -199,15 +215,14 @@ impl Subscriber {
         };
         let credit = credit_limit(&rq);
         let cache = ReaderCache::new(rq, ty.is_keyed());
-        let inner = Arc::new(ReaderInner::<Dynamic>::new(
-            ty, driver, cache, None, None, credit,
-        ));
+        let inner =
+            self.reader_inner::<Dynamic>(ty, cache, &group_qos.presentation, credit, parent);
         if let Some((l, mask)) = listener {
             inner.state.set_listener_with_mask(Some(l), mask);
         }
         let owner = Owner {
             topic: topic.clone(),
-            _subscriber: self.clone(),
+            subscriber: self.clone(),
         };
         let sink: Arc<dyn Endpoint> = inner.clone();
         let handle = inner.state.create(sink, owner, |c, now| {
@@ -218,8 +233,22 @@ impl Subscriber {
             }
             Ok(id)
         })?;
+        self.reader_created(&inner, topic.name());
         tracing::info!(topic = topic.name(), type_name = %topic.type_name(), id = ?handle.id(), "dynamic reader created");
         Ok(DynamicReader { inner, handle })
+    }
+}
+
+impl Subscriber {
+    /// Deletes `reader` (`delete_datareader` for a dynamic reader): it leaves SEDP, and reads return nothing
+    /// from then on. `PreconditionNotMet` for a reader of another subscriber.
+    pub fn delete_dynamic_reader(&self, reader: &DynamicReader) -> DdsResult<()> {
+        if !self.is(reader.subscriber()) {
+            return Err(DdsError::PreconditionNotMet(
+                "the reader belongs to another subscriber",
+            ));
+        }
+        reader.inner.state.delete()
     }
 }
 
@@ -237,6 +266,11 @@ impl DynamicReader {
     /// The topic.
     pub fn topic(&self) -> &DynamicTopic {
         &self.handle.owner().topic
+    }
+
+    /// The subscriber.
+    pub fn subscriber(&self) -> &Subscriber {
+        &self.handle.owner().subscriber
     }
 
     /// The writers matched now.

@@ -1,7 +1,9 @@
 //! [`DynamicWriter`]: its statuses, listener and status condition are the typed writer's
-//! (`publisher::events`).
+//! (`publisher::events`), and so are its instances (registered by serialized key, unregistered when it is
+//! deleted), its QoS changes and its place under its publisher (listeners, coherent sets, registry).
 
-use std::sync::{Arc, Condvar, Mutex};
+use std::any::Any;
+use std::sync::{Arc, Condvar, Mutex, RwLock, Weak};
 use std::time::{Duration, Instant, SystemTime};
 
 use crate::cdr::{ByteOrder, XcdrVersion};
@@ -13,15 +15,19 @@ use super::super::condition::StatusCondition;
 use super::super::driver::{Endpoint, EndpointHandle};
 use super::super::error::{DdsError, DdsResult};
 use super::super::publisher::{
-    check_offered_deadline, on_writer_event, writer_callbacks, Publisher, WriterInstances,
-    WriterState,
+    check_offered_deadline, offers_deadline, on_writer_event, register_writer, requested_qos,
+    writer_callbacks, Publisher, WriterInstances, WriterState,
 };
+use super::super::registry::Registered;
+use super::super::sample::InstanceHandle;
 use super::super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, LivelinessLostStatus, PublicationMatchedStatus,
     StatusMask,
 };
-use super::super::sync::lock;
+use super::super::sync::{lock, read, write};
 use super::DynamicTopic;
+
+mod instances;
 
 /// Callbacks of a [`DynamicWriter`], with the same statuses and the same delivery rules as the typed
 /// writer's (see [`crate::dcps::listener`]). Every method has an empty default.
@@ -41,16 +47,17 @@ writer_callbacks!(dyn DynamicWriterListener, DynamicWriter);
 
 struct Owner {
     topic: DynamicTopic,
-    _publisher: Publisher,
+    publisher: Publisher,
 }
 
 struct Inner {
     version: XcdrVersion,
     max_block: Duration,
-    /// The offered deadline (DEADLINE).
-    deadline: Duration,
+    /// The QoS in effect (changed by `set_qos`), with the data representation resolved.
+    current: RwLock<DataWriterQos>,
     state: WriterState<dyn DynamicWriterListener, Owner>,
-    /// The instances written, for the offered deadline.
+    /// The instances registered or written: for the offered deadline, dispose and unregister by handle, and
+    /// the unregisters sent when the writer is deleted.
     instances: Mutex<WriterInstances>,
     /// Notified on every match change (`wait_for_readers`); guards nothing else.
     matched_lock: Mutex<()>,
@@ -75,13 +82,36 @@ impl Endpoint for Inner {
     }
 
     fn tick(self: Arc<Self>, now: Instant) {
-        check_offered_deadline(
-            &self.state,
-            &self.instances,
-            self.deadline,
-            now,
-            self.writer(),
-        );
+        let period = read(&self.current).deadline.0;
+        check_offered_deadline(&self.state, &self.instances, period, now, self.writer());
+    }
+
+    /// A deleted writer unregisters its instances, as a typed writer does.
+    fn farewell(&self) -> Vec<WriteChange> {
+        lock(&self.instances).farewell()
+    }
+}
+
+impl Registered for Inner {
+    fn as_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync> {
+        self
+    }
+    fn group_changed(self: Arc<Self>) {
+        if let Some(handle) = self.state.handle() {
+            let qos = read(&self.current).clone();
+            if let Err(e) = (DynamicWriter {
+                inner: self,
+                handle,
+            })
+            .announce(qos)
+            {
+                tracing::debug!(error = %e, "dynamic writer QoS not announced again");
+            }
+        }
+    }
+    /// Dynamic writers are created enabled.
+    fn enable(self: Arc<Self>) -> DdsResult<()> {
+        Ok(())
     }
 }
 
@@ -131,6 +161,8 @@ impl Publisher {
         listener: Option<(Arc<dyn DynamicWriterListener>, StatusMask)>,
     ) -> DdsResult<DynamicWriter> {
         let driver = self.participant().driver().clone();
+        let parent = self.listener_node()?;
+        let group_qos = self.get_qos()?;
         let ty = topic.dynamic_type();
         let mut wq = qos.clone();
         let version = if wq.data_representation.ids().is_empty() {
@@ -151,7 +183,7 @@ impl Publisher {
             topic_name: topic.name().to_string(),
             type_name: topic.type_name(),
             keyed: ty.is_keyed(),
-            qos: WriterQos::new(wq, self.qos(), topic.qos()),
+            qos: WriterQos::new(wq.clone(), &group_qos, topic.qos()),
             type_information: topic.type_information(),
             entity_name: None,
             content_filter: None,
@@ -160,27 +192,45 @@ impl Publisher {
         let inner = Arc::new(Inner {
             version,
             max_block,
-            deadline: qos.deadline.0,
+            current: RwLock::new(wq),
             state: WriterState::new(driver),
             instances: Mutex::new(WriterInstances::default()),
             matched_lock: Mutex::new(()),
             matched_cv: Condvar::new(),
         });
+        inner.state.set_parent(parent);
         if let Some((l, mask)) = listener {
             inner.state.set_listener_with_mask(Some(l), mask);
         }
         let owner = Owner {
             topic: topic.clone(),
-            _publisher: self.clone(),
+            publisher: self.clone(),
         };
         let sink: Arc<dyn Endpoint> = inner.clone();
         let handle = inner.state.create(sink, owner, |c, now| {
             topic.register_types(c);
             c.create_writer(now, spec)
         })?;
+        let entity: Weak<dyn Registered> = Arc::downgrade(&inner) as Weak<Inner>;
+        register_writer(self, &inner.state, entity, topic.name());
         let id = handle.id();
+        self.add_to_group(id, &group_qos.presentation);
         tracing::info!(topic = topic.name(), type_name = %topic.type_name(), ?id, ?version, "dynamic writer created");
         Ok(DynamicWriter { inner, handle })
+    }
+}
+
+impl Publisher {
+    /// Deletes `writer` (`delete_datawriter` for a dynamic writer): it unregisters its instances (without
+    /// disposing them), leaves SEDP, and its operations return `AlreadyDeleted` from then on.
+    /// `PreconditionNotMet` for a writer of another publisher.
+    pub fn delete_dynamic_writer(&self, writer: &DynamicWriter) -> DdsResult<()> {
+        if !self.is(writer.publisher()) {
+            return Err(DdsError::PreconditionNotMet(
+                "the writer belongs to another publisher",
+            ));
+        }
+        writer.inner.state.delete()
     }
 }
 
@@ -197,6 +247,17 @@ impl DynamicWriter {
     /// The topic.
     pub fn topic(&self) -> &DynamicTopic {
         &self.handle.owner().topic
+    }
+
+    /// The writer's handle (as readers see it in `SampleInfo::publication_handle`, and as its
+    /// publisher's and participant's listeners name it).
+    pub fn instance_handle(&self) -> InstanceHandle {
+        InstanceHandle::from_guid(self.guid())
+    }
+
+    /// The publisher.
+    pub fn publisher(&self) -> &Publisher {
+        &self.handle.owner().publisher
     }
 
     /// The XCDR version samples are written with.
@@ -295,41 +356,83 @@ impl DynamicWriter {
 
     /// Publishes `sample` (of the topic's type) with the current time as source timestamp.
     pub fn write(&self, sample: &DynamicData) -> DdsResult<()> {
+        self.write_w_timestamp(sample, SystemTime::now())
+    }
+
+    /// Publishes `sample` with the given source timestamp. Writing a sample of a keyed type registers its
+    /// instance.
+    pub fn write_w_timestamp(&self, sample: &DynamicData, timestamp: SystemTime) -> DdsResult<()> {
         self.check_type(sample)?;
         let mut buf = Vec::new();
         sample.serialize(self.inner.version, ByteOrder::NATIVE, &mut buf)?;
-        self.submit(ChangeKind::Alive, sample, buf)
-    }
-
-    /// Disposes the instance of `sample` (keyed types only).
-    pub fn dispose(&self, sample: &DynamicData) -> DdsResult<()> {
-        self.check_type(sample)?;
-        if !sample.dynamic_type().is_keyed() {
-            return Err(DdsError::PreconditionNotMet("the topic type has no key"));
-        }
-        let mut buf = Vec::new();
-        sample.serialize_key(self.inner.version, ByteOrder::NATIVE, &mut buf)?;
-        self.submit(ChangeKind::Dispose, sample, buf)
-    }
-
-    fn submit(&self, kind: ChangeKind, sample: &DynamicData, payload: Vec<u8>) -> DdsResult<()> {
-        let key_hash = if sample.dynamic_type().is_keyed() {
-            Some(sample.key_hash(self.inner.version)?)
+        let key_hash = if self.keyed() {
+            self.instance_of(sample, true, true)?.and_then(|(_, kh)| kh)
         } else {
+            lock(&self.inner.instances).keyless_written(Instant::now());
             None
         };
-        lock(&self.inner.instances).record_hashed_write(key_hash, Instant::now());
-        let change = WriteChange {
-            kind,
-            payload: Payload::from(payload),
+        self.submit(WriteChange {
+            kind: ChangeKind::Alive,
+            payload: Payload::from(buf),
             key_hash,
-            source_timestamp: Some(wire_time(SystemTime::now())),
-        };
+            source_timestamp: Some(wire_time(timestamp)),
+        })
+    }
+
+    fn keyed(&self) -> bool {
+        self.topic().dynamic_type().is_keyed()
+    }
+
+    /// Asserts this writer's liveliness (MANUAL_BY_TOPIC or MANUAL_BY_PARTICIPANT): a HEARTBEAT with the
+    /// liveliness flag to its matched readers. Writing a sample asserts it too.
+    pub fn assert_liveliness(&self) -> DdsResult<()> {
+        self.inner.state.check_alive()?;
+        let driver = self.handle_driver();
+        let id = self.handle.id();
+        driver.with_core(|c, now| c.assert_writer_liveliness(now, id));
+        Ok(())
+    }
+
+    /// The QoS in effect, with the changes of [`set_qos`](Self::set_qos) and the data representation
+    /// resolved.
+    pub fn qos(&self) -> DataWriterQos {
+        read(&self.inner.current).clone()
+    }
+
+    /// Changes the QoS, as [`DataWriter::set_qos`](crate::dcps::DataWriter::set_qos) does for an enabled
+    /// writer: DEADLINE, LATENCY_BUDGET, TRANSPORT_PRIORITY, LIFESPAN, USER_DATA, OWNERSHIP_STRENGTH and
+    /// WRITER_DATA_LIFECYCLE may change; the writer applies them and announces them again in SEDP. A
+    /// change of any other policy is refused with [`DdsError::ImmutablePolicy`]. An empty
+    /// `data_representation` keeps the current one. A deadline set where there was none counts from now.
+    pub fn set_qos(&self, qos: &DataWriterQos) -> DdsResult<()> {
+        self.inner.state.check_alive()?;
+        let (new, immutable) = requested_qos(&read(&self.inner.current), qos);
+        if let Some(p) = immutable {
+            return Err(DdsError::ImmutablePolicy(p));
+        }
+        let old = std::mem::replace(&mut *write(&self.inner.current), new.clone());
+        if !offers_deadline(&old) {
+            lock(&self.inner.instances).restart_deadlines(Instant::now());
+        }
+        self.announce(new)
+    }
+
+    /// Announces `qos` with the publisher's current QoS and the topic's.
+    fn announce(&self, qos: DataWriterQos) -> DdsResult<()> {
+        let wq = WriterQos::new(qos, &self.publisher().get_qos()?, self.topic().qos());
+        let id = self.handle.id();
+        self.handle_driver()
+            .with_core(|c, now| c.update_writer_qos(now, id, wq))?;
+        Ok(())
+    }
+
+    /// Hands one change to the core, waiting up to max_blocking_time while flow control refuses it.
+    fn submit(&self, change: WriteChange) -> DdsResult<()> {
         let driver = &self.handle_driver();
         let id = self.handle.id();
         let deadline = Instant::now() + self.inner.max_block;
         loop {
-            driver.check_alive()?;
+            self.inner.state.check_alive()?;
             let seen = driver.progress_generation();
             match driver.with_core_writing(|c, now| c.write(now, id, change.clone())) {
                 Ok(_) => return Ok(()),

@@ -3,12 +3,14 @@
 //! [`DynamicWriter`](crate::dcps::DynamicWriter) alike.
 
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::{Duration, Instant, SystemTime};
 
-use crate::rtps::Event;
+use crate::qos::{ChangeableQos, DataWriterQos, QosPolicyId};
+use crate::rtps::{ChangeKind, Event, Payload, WriteChange};
 
 use super::super::driver::EndpointHandle;
 use super::super::endpoint::EndpointState;
+use super::super::error::{DdsError, DdsResult};
 use super::super::sample::InstanceHandle;
 use super::super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, LivelinessLostStatus, PublicationMatchedStatus,
@@ -174,33 +176,144 @@ impl WriterInstances {
     }
 }
 
+/// The instances a writer knows, whatever its kind: each by its serialized key (`instance_key` output), with
+/// the key payload (`serialize_key` output) and key hash that dispose, unregister and the deleted writer's
+/// farewell send.
 impl WriterInstances {
-    /// Records a write at `now`, for the offered deadline, of the instance with key hash `key_hash`
-    /// (`None`: the single instance of a keyless topic), known from then on by its key hash.
-    pub(crate) fn record_hashed_write(&mut self, key_hash: Option<[u8; 16]>, now: Instant) {
-        let Some(kh) = key_hash else {
-            self.keyless_last_write = Some(now);
-            return;
-        };
-        if let Some(i) = self
-            .by_key
-            .get(kh.as_slice())
-            .and_then(|h| self.by_handle.get_mut(h))
-        {
+    /// The instance with serialized key `key` and its key hash, if registered; with `written`, records a
+    /// write at that time (for the offered deadline).
+    pub(crate) fn lookup(
+        &mut self,
+        key: &[u8],
+        written: Option<Instant>,
+    ) -> Option<(InstanceHandle, Option<[u8; 16]>)> {
+        let h = self.by_key.get(key).copied()?;
+        let i = self.by_handle.get_mut(&h)?;
+        if let Some(now) = written {
             i.last_write = now;
-            return;
+        }
+        Some((h, i.key_hash))
+    }
+
+    /// Registers the instance with serialized key `key` (or returns it, when another thread registered it
+    /// first); `key_payload` and `key_hash` are what its key-only changes carry.
+    pub(crate) fn register(
+        &mut self,
+        key: Vec<u8>,
+        key_payload: Payload,
+        key_hash: Option<[u8; 16]>,
+        now: Instant,
+    ) -> (InstanceHandle, Option<[u8; 16]>) {
+        if let Some(found) = self.lookup(&key, None) {
+            return found;
         }
         self.next += 1;
         let h = InstanceHandle(self.next);
-        self.by_key.insert(kh.to_vec(), h);
+        self.by_key.insert(key.clone(), h);
         self.by_handle.insert(
             h,
             super::WriterInstance {
-                key: kh.to_vec(),
-                key_payload: crate::rtps::Payload::default(),
-                key_hash: Some(kh),
+                key,
+                key_payload,
+                key_hash,
                 last_write: now,
             },
         );
+        (h, key_hash)
     }
+
+    /// Counts every instance's offered deadline from `now` (a deadline set by `set_qos` counts from then).
+    pub(crate) fn restart_deadlines(&mut self, now: Instant) {
+        self.by_handle.values_mut().for_each(|i| i.last_write = now);
+        if self.keyless_last_write.is_some() {
+            self.keyless_last_write = Some(now);
+        }
+    }
+
+    /// Records a write of the single instance of a keyless topic at `now`.
+    pub(crate) fn keyless_written(&mut self, now: Instant) {
+        self.keyless_last_write = Some(now);
+    }
+
+    /// The key-only change of `kind` (dispose, unregister) for the instance `h` with source timestamp `ts`;
+    /// `BadParameter` for an instance not registered.
+    pub(crate) fn key_change(
+        &self,
+        h: InstanceHandle,
+        kind: ChangeKind,
+        ts: SystemTime,
+    ) -> DdsResult<WriteChange> {
+        let i = self
+            .by_handle
+            .get(&h)
+            .ok_or_else(|| DdsError::BadParameter(format!("unknown instance handle {h:?}")))?;
+        Ok(WriteChange {
+            kind,
+            payload: i.key_payload.clone(),
+            key_hash: i.key_hash,
+            source_timestamp: Some(super::wire_time(ts)),
+        })
+    }
+
+    /// After a key-only change of `kind` was sent for `h`: an unregistered instance is forgotten.
+    pub(crate) fn key_change_sent(&mut self, h: InstanceHandle, kind: ChangeKind) {
+        if matches!(kind, ChangeKind::Unregister | ChangeKind::DisposeUnregister) {
+            if let Some(i) = self.by_handle.remove(&h) {
+                self.by_key.remove(&i.key);
+            }
+        }
+    }
+
+    /// The key payload of the instance `h` (`get_key_value`); `BadParameter` for an unknown handle.
+    pub(crate) fn key_payload(&self, h: InstanceHandle) -> DdsResult<Payload> {
+        self.by_handle
+            .get(&h)
+            .map(|i| i.key_payload.clone())
+            .ok_or_else(|| DdsError::BadParameter(format!("unknown instance handle {h:?}")))
+    }
+
+    /// What a deleted writer sends (DDS 1.4 §2.2.2.4.1.6): an unregister of every instance it knows, not a
+    /// dispose, whatever `autodispose_unregistered_instances` says (as Cyclone DDS does; it leaves
+    /// TRANSIENT data to the durability service).
+    pub(crate) fn farewell(&self) -> Vec<WriteChange> {
+        let ts = Some(super::wire_time(SystemTime::now()));
+        self.by_handle
+            .values()
+            .map(|i| WriteChange {
+                kind: ChangeKind::Unregister,
+                payload: i.key_payload.clone(),
+                key_hash: i.key_hash,
+                source_timestamp: ts,
+            })
+            .collect()
+    }
+}
+
+/// Whether `qos` offers a deadline (a finite, non-zero DEADLINE period).
+pub(crate) fn offers_deadline(qos: &DataWriterQos) -> bool {
+    let period = qos.deadline.0;
+    period != crate::qos::INFINITE && !period.is_zero()
+}
+
+/// The change an unregister makes with these QoS: a dispose too with `autodispose_unregistered_instances`.
+pub(crate) fn unregister_kind(qos: &DataWriterQos) -> ChangeKind {
+    if qos.writer_data_lifecycle.autodispose_unregistered_instances {
+        ChangeKind::DisposeUnregister
+    } else {
+        ChangeKind::Unregister
+    }
+}
+
+/// The QoS `set_qos(qos)` asks for over `current` (an empty data representation keeps the current one),
+/// and the first immutable policy it changes, if any.
+pub(crate) fn requested_qos(
+    current: &DataWriterQos,
+    qos: &DataWriterQos,
+) -> (DataWriterQos, Option<QosPolicyId>) {
+    let mut new = qos.clone();
+    if new.data_representation.ids().is_empty() {
+        new.data_representation = current.data_representation.clone();
+    }
+    let immutable = current.immutable_change(&new);
+    (new, immutable)
 }

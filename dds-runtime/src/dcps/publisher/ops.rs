@@ -7,7 +7,7 @@ use std::sync::{Arc, Weak};
 use std::time::{Duration, Instant, SystemTime};
 
 use crate::cdr::{self, DdsType};
-use crate::qos::{ChangeableQos, DataWriterQos, PublisherQos, TopicQos, WriterQos};
+use crate::qos::{DataWriterQos, PublisherQos, TopicQos, WriterQos};
 use crate::rtps::EntityId;
 
 use super::super::builtin::SubscriptionBuiltinTopicData;
@@ -21,7 +21,7 @@ use super::super::sample::InstanceHandle;
 use super::super::status::*;
 use super::super::sync::{lock, read, write};
 use super::super::topic::Topic;
-use super::{DataWriter, DataWriterListener, Publisher, WriterInner};
+use super::{DataWriter, DataWriterListener, Publisher, WriterInner, WriterState};
 
 /// Callbacks of a [`Publisher`] for the statuses of its writers that have no listener of their own
 /// enabled for them (DDS 1.4 §2.2.4.1). Writers are identified by their instance handle. Every method has
@@ -69,25 +69,29 @@ pub(super) fn writer_parent<T: DdsType>(
     topic: &Topic<T>,
 ) -> DdsResult<Arc<ListenerNode>> {
     topic.check_alive()?;
-    p.with_group(|g| g.node.clone())
+    p.listener_node()
 }
 
-/// Registers a new writer in its participant.
-pub(super) fn register_writer<T: DdsType>(p: &Publisher, inner: &Arc<WriterInner<T>>, topic: &str) {
+/// Registers a new writer of any kind (`entity`, with its status state `state`) in its participant, so
+/// that its publisher counts it among its writers.
+pub(crate) fn register_writer<L: ?Sized, O>(
+    p: &Publisher,
+    state: &WriterState<L, O>,
+    entity: Weak<dyn Registered>,
+    topic: &str,
+) {
     let Some(group) = p.with_group(|g| g.node.handle).ok() else {
         return;
     };
-    let entity: Weak<dyn Registered> = Arc::downgrade(inner) as Weak<WriterInner<T>>;
     p.participant.registry().add_endpoint(
         true,
         EndpointEntry {
             group,
             topic: topic.to_string(),
-            guid: inner
-                .state
+            guid: state
                 .handle()
                 .map_or(crate::rtps::Guid::UNKNOWN, |h| h.guid()),
-            deleted: Arc::downgrade(inner.state.deleted_flag()),
+            deleted: Arc::downgrade(state.deleted_flag()),
             entity,
         },
     );
@@ -130,6 +134,11 @@ impl DomainParticipant {
 }
 
 impl Publisher {
+    /// This publisher's level of its writers' listener chain; `AlreadyDeleted` once deleted.
+    pub(crate) fn listener_node(&self) -> DdsResult<Arc<ListenerNode>> {
+        self.with_group(|g| g.node.clone())
+    }
+
     /// Runs `f` on this publisher's registry entry; `AlreadyDeleted` once deleted.
     fn with_group<R>(
         &self,
@@ -332,12 +341,8 @@ impl<T: DdsType> DataWriter<T> {
     /// current one.
     pub fn set_qos(&self, qos: &DataWriterQos) -> DdsResult<()> {
         self.inner.state.check_alive()?;
-        let mut new = qos.clone();
-        let current = read(&self.inner.current).clone();
-        if new.data_representation.ids().is_empty() {
-            new.data_representation = current.data_representation.clone();
-        }
-        if let Some(p) = current.immutable_change(&new) {
+        let (new, immutable) = super::requested_qos(&read(&self.inner.current), qos);
+        if let Some(p) = immutable {
             if self.is_enabled() {
                 return Err(DdsError::ImmutablePolicy(p));
             }
@@ -478,11 +483,7 @@ impl<T: DdsType> DataWriter<T> {
     /// other members have their default values. `BadParameter` for an unknown handle.
     pub fn get_key_value(&self, handle: InstanceHandle) -> DdsResult<T> {
         self.inner.state.check_alive()?;
-        let payload = lock(&self.inner.instances)
-            .by_handle
-            .get(&handle)
-            .map(|i| i.key_payload.clone())
-            .ok_or_else(|| DdsError::BadParameter(format!("unknown instance handle {handle:?}")))?;
+        let payload = lock(&self.inner.instances).key_payload(handle)?;
         Ok(cdr::deserialize_key::<T>(&payload)?)
     }
 

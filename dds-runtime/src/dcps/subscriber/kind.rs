@@ -8,14 +8,19 @@ use std::sync::Arc;
 
 use crate::cdr::DdsType;
 use crate::filter::FilterFields;
+use crate::qos::DataReaderQos;
 
 use super::super::decode::{Derived, SampleCodec};
 use super::super::driver::EndpointHandle;
+use super::super::error::DdsResult;
 use super::super::status::{
     DeadlineMissedStatus, IncompatibleQosStatus, LivelinessChangedStatus, SampleLostStatus,
     SampleRejectedStatus, SubscriptionMatchedStatus,
 };
 use super::{DataReader, DataReaderListener, ReaderInner, ReaderOwner};
+
+/// Makes an instance's key holder (its key members set, the others defaulted) from a sample.
+pub(crate) type KeyHolderFn<T> = fn(&T) -> Option<T>;
 
 /// A flavour of reader.
 pub(crate) trait ReaderKind: Sized + Send + Sync + 'static {
@@ -34,6 +39,15 @@ pub(crate) trait ReaderKind: Sized + Send + Sync + 'static {
         inner: Arc<ReaderInner<Self>>,
         handle: Arc<EndpointHandle<Self::Owner>>,
     ) -> Self::Reader;
+    /// Announces `reader` again with `qos` and its subscriber's and topic's QoS now (they changed).
+    fn announce(reader: &Self::Reader, qos: DataReaderQos) -> DdsResult<()>;
+    /// Enables `reader` (`enable`).
+    fn enable(reader: Self::Reader) -> DdsResult<()>;
+    /// What makes the key holder of a new instance from its first sample (for `get_key_value`), if the
+    /// kind's cache keeps one that way.
+    fn key_holder() -> Option<KeyHolderFn<Self::Data>> {
+        None
+    }
 }
 
 /// The calls a reader makes on its listener, whatever the listener trait (`R` is the public reader).
@@ -93,5 +107,14 @@ impl<T: DdsType> ReaderKind for Typed<T> {
         handle: Arc<EndpointHandle<ReaderOwner<T>>>,
     ) -> DataReader<T> {
         DataReader { inner, handle }
+    }
+    fn announce(reader: &DataReader<T>, qos: DataReaderQos) -> DdsResult<()> {
+        reader.announce(qos)
+    }
+    fn enable(reader: DataReader<T>) -> DdsResult<()> {
+        reader.enable()
+    }
+    fn key_holder() -> Option<KeyHolderFn<T>> {
+        T::IS_KEYED.then_some(super::ops::key_holder::<T>)
     }
 }

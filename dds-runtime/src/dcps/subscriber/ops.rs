@@ -22,7 +22,9 @@ use super::super::sample::{InstanceHandle, InstanceStateMask, SampleStateMask, V
 use super::super::status::*;
 use super::super::sync::lock;
 use super::super::topic::Topic;
-use super::{DataReader, DataReaderListener, ReaderInner, Subscriber, Typed};
+use super::{
+    DataReader, DataReaderListener, ReaderCallbacks, ReaderInner, ReaderKind, Subscriber, Typed,
+};
 use crate::rtps::EntityId;
 
 /// Callbacks of a [`Subscriber`] for its readers' statuses that have no listener of their own enabled for
@@ -102,22 +104,22 @@ pub(super) fn reader_parent<T: DdsType>(
     topic: &Topic<T>,
 ) -> DdsResult<Arc<ListenerNode>> {
     topic.check_alive()?;
-    s.with_group(|g| g.node.clone())
+    s.listener_node()
 }
 
-/// Registers a new reader in its participant.
-pub(super) fn register_reader<T: DdsType>(
+/// Registers a new reader of any kind in its participant.
+pub(super) fn register_reader<K: ReaderKind>(
     s: &Subscriber,
-    inner: &Arc<ReaderInner<Typed<T>>>,
+    inner: &Arc<ReaderInner<K>>,
     topic: &str,
 ) {
     let Ok(group) = s.with_group(|g| g.node.handle) else {
         return;
     };
-    if T::IS_KEYED {
-        lock(&inner.cache).cache.set_key_holder_fn(key_holder::<T>);
+    if let Some(f) = K::key_holder() {
+        lock(&inner.cache).cache.set_key_holder_fn(f);
     }
-    let entity: Weak<dyn Registered> = Arc::downgrade(inner) as Weak<ReaderInner<Typed<T>>>;
+    let entity: Weak<dyn Registered> = Arc::downgrade(inner) as Weak<ReaderInner<K>>;
     s.participant.registry().add_endpoint(
         false,
         EndpointEntry {
@@ -134,7 +136,7 @@ pub(super) fn register_reader<T: DdsType>(
 }
 
 /// A sample holding only the key of `data` (its other members defaulted), for `get_key_value`.
-fn key_holder<T: DdsType>(data: &T) -> Option<T> {
+pub(super) fn key_holder<T: DdsType>(data: &T) -> Option<T> {
     let mut buf = Vec::new();
     cdr::serialize_key(
         data,
@@ -146,18 +148,14 @@ fn key_holder<T: DdsType>(data: &T) -> Option<T> {
     cdr::deserialize_key(&buf).ok()
 }
 
-impl<T: DdsType> Registered for ReaderInner<Typed<T>> {
+impl<K: ReaderKind> Registered for ReaderInner<K> {
     fn as_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync> {
         self
     }
     fn group_changed(self: Arc<Self>) {
         if let Some(handle) = self.state.handle() {
             let qos = lock(&self.cache).cache.qos().clone();
-            let r = DataReader {
-                inner: self,
-                handle,
-            };
-            if let Err(e) = r.announce(qos) {
+            if let Err(e) = K::announce(&K::reader(self, handle), qos) {
                 tracing::debug!(error = %e, "reader QoS not announced again");
             }
         }
@@ -178,15 +176,11 @@ impl<T: DdsType> Registered for ReaderInner<Typed<T>> {
     }
     fn notify_data_available(self: Arc<Self>) {
         self.state
-            .call_own_listener(self.reader(), |l, r| l.on_data_available(r));
+            .call_own_listener(self.reader(), |l, r| l.data_available(r));
     }
     fn enable(self: Arc<Self>) -> DdsResult<()> {
         let handle = self.state.handle().ok_or(DdsError::AlreadyDeleted)?;
-        DataReader {
-            inner: self,
-            handle,
-        }
-        .enable()
+        K::enable(K::reader(self, handle))
     }
 }
 
@@ -201,6 +195,11 @@ impl DomainParticipant {
 }
 
 impl Subscriber {
+    /// This subscriber's level of its readers' listener chain; `AlreadyDeleted` once deleted.
+    pub(crate) fn listener_node(&self) -> DdsResult<Arc<ListenerNode>> {
+        self.with_group(|g| g.node.clone())
+    }
+
     /// Runs `f` on this subscriber's registry entry; `AlreadyDeleted` once deleted.
     fn with_group<R>(
         &self,
@@ -479,7 +478,7 @@ impl<T: DdsType> DataReader<T> {
     }
 
     /// Announces `qos` with the subscriber's and topic's current parts.
-    fn announce(&self, qos: DataReaderQos) -> DdsResult<()> {
+    pub(super) fn announce(&self, qos: DataReaderQos) -> DdsResult<()> {
         let sq = self.subscriber().get_qos()?;
         let tq = self.topic().get_qos()?;
         let id = self.handle.id();
