@@ -4,6 +4,7 @@
 
 use std::any::Any;
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicU16, Ordering};
 use std::sync::{Arc, Mutex};
 
 use super::builtin::{
@@ -14,11 +15,16 @@ use super::builtin_cdr::{guid_key_handle, topic_key_handle};
 use super::data_on_readers::DataOnReadersBatch;
 use super::driver::CoreObserver;
 use super::error::DdsResult;
+use super::listener::DataReaderListener;
 use super::participant::DomainParticipant;
 use super::registry::BuiltinReaders;
 use super::sample::InstanceHandle;
-use super::subscriber::{BuiltinGroup, BuiltinReader, DataReader, Subscriber};
+use super::status::StatusMask;
+use super::subscriber::{BuiltinGroup, BuiltinReader, DataReader, Subscriber, UserReaderSpec};
 use super::sync::lock;
+use super::topic::Topic;
+use crate::cdr::DdsType;
+use crate::qos::DataReaderQos;
 use crate::rtps::discovery::{EndpointData, ParticipantData, TopicData};
 use crate::rtps::{EntityId, Event, Guid, GuidPrefix};
 
@@ -105,6 +111,8 @@ pub(crate) struct BuiltinFeed {
     publications: BuiltinReader<PublicationBuiltinTopicData>,
     subscriptions: BuiltinReader<SubscriptionBuiltinTopicData>,
     topics: BuiltinReader<TopicBuiltinTopicData>,
+    /// Numbers the entity ids of the readers the application creates on built-in topics.
+    next_user: AtomicU16,
 }
 
 impl BuiltinReaders for BuiltinFeed {
@@ -171,6 +179,7 @@ impl BuiltinFeed {
             publications,
             subscriptions,
             topics,
+            next_user: AtomicU16::new(0),
         });
         let driver = p.driver();
         // Events from now on; what came before is seeded below (a repeat is only an update).
@@ -236,6 +245,124 @@ impl BuiltinFeed {
     fn reader_gone(&self, g: Guid) {
         self.subscriptions.dispose(g.to_bytes().to_vec());
     }
+}
+
+/// The four built-in topics.
+const BUILTIN_TOPICS: [&str; 4] = [
+    "DCPSParticipant",
+    "DCPSPublication",
+    "DCPSSubscription",
+    "DCPSTopic",
+];
+
+/// The entity kind byte of a reader the application creates on a built-in topic: a built-in reader with
+/// a key. Its entity key starts with 0xdd (no RTPS built-in entity does), then a counter; no RTPS reader
+/// has this id, it only names the reader (instance handle, the driver's endpoint table).
+const USER_READER_PREFIX: u8 = 0xdd;
+
+impl BuiltinFeed {
+    /// Creates the application's reader on a built-in topic (`create_datareader` on `DCPSParticipant`,
+    /// `DCPSPublication`, `DCPSSubscription` or `DCPSTopic` with its built-in type): fed by discovery like
+    /// the built-in subscriber's own reader of the topic, seeded with what discovery knows now. `None`
+    /// when `topic` is not a built-in topic (an ordinary reader is made then).
+    pub(crate) fn user_reader<T: DdsType>(
+        s: &Subscriber,
+        topic: &Topic<T>,
+        qos: &DataReaderQos,
+        listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
+    ) -> DdsResult<Option<DataReader<T>>> {
+        if !BUILTIN_TOPICS.contains(&topic.name()) {
+            return Ok(None);
+        }
+        let p = s.participant();
+        p.get_builtin_subscriber()?;
+        let Some(feed) = lock(&p.registry().builtin)
+            .clone()
+            .and_then(|f| f.as_any().downcast::<BuiltinFeed>().ok())
+        else {
+            return Ok(None);
+        };
+        let n = feed.next_user.fetch_add(1, Ordering::Relaxed).to_be_bytes();
+        let spec: Box<dyn Any> = Box::new(UserReaderSpec {
+            subscriber: s.clone(),
+            topic: topic.clone(),
+            qos: qos.clone(),
+            listener,
+            id: EntityId([USER_READER_PREFIX, n[0], n[1], 0xc7]),
+        });
+        // The reader of the topic whose built-in type is T (another type of the same name: none).
+        let (ps, ws, rs, ts) = seed(p);
+        let mut spec = Some(spec);
+        let made = add_user(&feed.participants, &mut spec, guid_key_handle, ps)
+            .or_else(|| add_user(&feed.publications, &mut spec, guid_key_handle, ws))
+            .or_else(|| add_user(&feed.subscriptions, &mut spec, guid_key_handle, rs))
+            .or_else(|| add_user(&feed.topics, &mut spec, topic_key_handle, ts));
+        match made {
+            None => Ok(None),
+            Some(r) => Ok(r?.downcast::<DataReader<T>>().ok().map(|r| *r)),
+        }
+    }
+}
+
+/// Adds the reader `spec` describes to `reader` when it is a reader of `X`'s topic (`spec` is then taken).
+fn add_user<X: DdsType + Clone>(
+    reader: &BuiltinReader<X>,
+    spec: &mut Option<Box<dyn Any>>,
+    handle_of: fn(&[u8]) -> InstanceHandle,
+    seed: Vec<X>,
+) -> Option<DdsResult<Box<dyn Any>>> {
+    let s = spec.take()?.downcast::<UserReaderSpec<X>>();
+    match s {
+        Ok(s) => Some(
+            reader
+                .add_user_reader(*s, handle_of, seed)
+                .map(|r| Box::new(r) as Box<dyn Any>),
+        ),
+        Err(other) => {
+            *spec = Some(other);
+            None
+        }
+    }
+}
+
+/// What discovery knows now, as built-in topic data: participants (this one included), publications,
+/// subscriptions, and topics (announced, and those of the endpoints, each once).
+#[allow(clippy::type_complexity)]
+fn seed(
+    p: &DomainParticipant,
+) -> (
+    Vec<ParticipantBuiltinTopicData>,
+    Vec<PublicationBuiltinTopicData>,
+    Vec<SubscriptionBuiltinTopicData>,
+    Vec<TopicBuiltinTopicData>,
+) {
+    p.driver().query_core(|c| {
+        let mut ps: Vec<ParticipantBuiltinTopicData> =
+            c.discovered_participants().map(Into::into).collect();
+        ps.push((&c.participant_data()).into());
+        let ws: Vec<PublicationBuiltinTopicData> = c.publications().map(Into::into).collect();
+        let rs: Vec<SubscriptionBuiltinTopicData> = c.subscriptions().map(Into::into).collect();
+        let mut ts: Vec<TopicBuiltinTopicData> = c
+            .discovered_topic_announcements()
+            .map(|t| TopicBuiltinTopicData::new(&t.topic_name, &t.type_name, t.topic_data.clone()))
+            .collect();
+        let endpoints = c
+            .publications()
+            .map(|w| (&w.topic_name, &w.type_name, &w.qos.topic_data.0))
+            .chain(
+                c.subscriptions()
+                    .map(|r| (&r.topic_name, &r.type_name, &r.qos.topic_data.0)),
+            );
+        for (name, type_name, data) in endpoints {
+            if !ts
+                .iter()
+                .any(|t| t.name == *name && t.type_name == *type_name)
+            {
+                ts.push(TopicBuiltinTopicData::new(name, type_name, data.clone()));
+            }
+        }
+        (ps, ws, rs, ts)
+    })
 }
 
 /// The serialized key of the DCPSTopic instance of `name` with `type_name`.
