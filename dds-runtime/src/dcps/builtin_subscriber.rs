@@ -4,7 +4,6 @@
 
 use std::any::Any;
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU16, Ordering};
 use std::sync::{Arc, Mutex};
 
 use super::builtin::{
@@ -15,16 +14,12 @@ use super::builtin_cdr::{guid_key_handle, topic_key_handle};
 use super::data_on_readers::DataOnReadersBatch;
 use super::driver::CoreObserver;
 use super::error::DdsResult;
-use super::listener::DataReaderListener;
 use super::participant::DomainParticipant;
 use super::registry::BuiltinReaders;
 use super::sample::InstanceHandle;
-use super::status::StatusMask;
 use super::subscriber::{BuiltinGroup, BuiltinReader, DataReader, Subscriber, UserReaderSpec};
 use super::sync::lock;
-use super::topic::Topic;
 use crate::cdr::DdsType;
-use crate::qos::DataReaderQos;
 use crate::rtps::discovery::{EndpointData, ParticipantData, TopicData};
 use crate::rtps::{EntityId, Event, Guid, GuidPrefix};
 
@@ -111,8 +106,6 @@ pub(crate) struct BuiltinFeed {
     publications: BuiltinReader<PublicationBuiltinTopicData>,
     subscriptions: BuiltinReader<SubscriptionBuiltinTopicData>,
     topics: BuiltinReader<TopicBuiltinTopicData>,
-    /// Numbers the entity ids of the readers the application creates on built-in topics.
-    next_user: AtomicU16,
 }
 
 impl BuiltinReaders for BuiltinFeed {
@@ -123,6 +116,10 @@ impl BuiltinReaders for BuiltinFeed {
 
     fn as_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync> {
         self
+    }
+
+    fn add_user_reader(&self, spec: Box<dyn Any>) -> Option<DdsResult<Box<dyn Any>>> {
+        self.user_reader(spec)
     }
 }
 
@@ -179,7 +176,6 @@ impl BuiltinFeed {
             publications,
             subscriptions,
             topics,
-            next_user: AtomicU16::new(0),
         });
         let driver = p.driver();
         // Events from now on; what came before is seeded below (a repeat is only an update).
@@ -247,77 +243,46 @@ impl BuiltinFeed {
     }
 }
 
-/// The four built-in topics.
-const BUILTIN_TOPICS: [&str; 4] = [
-    "DCPSParticipant",
-    "DCPSPublication",
-    "DCPSSubscription",
-    "DCPSTopic",
-];
-
-/// The entity kind byte of a reader the application creates on a built-in topic: a built-in reader with
-/// a key. Its entity key starts with 0xdd (no RTPS built-in entity does), then a counter; no RTPS reader
-/// has this id, it only names the reader (instance handle, the driver's endpoint table).
-const USER_READER_PREFIX: u8 = 0xdd;
-
 impl BuiltinFeed {
-    /// Creates the application's reader on a built-in topic (`create_datareader` on `DCPSParticipant`,
-    /// `DCPSPublication`, `DCPSSubscription` or `DCPSTopic` with its built-in type): fed by discovery like
-    /// the built-in subscriber's own reader of the topic, seeded with what discovery knows now. `None`
-    /// when `topic` is not a built-in topic (an ordinary reader is made then).
-    pub(crate) fn user_reader<T: DdsType>(
-        s: &Subscriber,
-        topic: &Topic<T>,
-        qos: &DataReaderQos,
-        listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
-    ) -> DdsResult<Option<DataReader<T>>> {
-        if !BUILTIN_TOPICS.contains(&topic.name()) {
-            return Ok(None);
-        }
-        let p = s.participant();
-        p.get_builtin_subscriber()?;
-        let Some(feed) = lock(&p.registry().builtin)
-            .clone()
-            .and_then(|f| f.as_any().downcast::<BuiltinFeed>().ok())
-        else {
-            return Ok(None);
-        };
-        let n = feed.next_user.fetch_add(1, Ordering::Relaxed).to_be_bytes();
-        let spec: Box<dyn Any> = Box::new(UserReaderSpec {
-            subscriber: s.clone(),
-            topic: topic.clone(),
-            qos: qos.clone(),
-            listener,
-            id: EntityId([USER_READER_PREFIX, n[0], n[1], 0xc7]),
-        });
-        // The reader of the topic whose built-in type is T (another type of the same name: none).
-        let (ps, ws, rs, ts) = seed(p);
+    /// [`BuiltinReaders::add_user_reader`]: the reader of the topic whose built-in type is the spec's,
+    /// seeded with what discovery knows now.
+    fn user_reader(&self, spec: Box<dyn Any>) -> Option<DdsResult<Box<dyn Any>>> {
         let mut spec = Some(spec);
-        let made = add_user(&feed.participants, &mut spec, guid_key_handle, ps)
-            .or_else(|| add_user(&feed.publications, &mut spec, guid_key_handle, ws))
-            .or_else(|| add_user(&feed.subscriptions, &mut spec, guid_key_handle, rs))
-            .or_else(|| add_user(&feed.topics, &mut spec, topic_key_handle, ts));
-        match made {
-            None => Ok(None),
-            Some(r) => Ok(r?.downcast::<DataReader<T>>().ok().map(|r| *r)),
-        }
+        add_user(&self.participants, &mut spec, guid_key_handle, |p| {
+            seed(p).0
+        })
+        .or_else(|| {
+            add_user(&self.publications, &mut spec, guid_key_handle, |p| {
+                seed(p).1
+            })
+        })
+        .or_else(|| {
+            add_user(&self.subscriptions, &mut spec, guid_key_handle, |p| {
+                seed(p).2
+            })
+        })
+        .or_else(|| add_user(&self.topics, &mut spec, topic_key_handle, |p| seed(p).3))
     }
 }
 
-/// Adds the reader `spec` describes to `reader` when it is a reader of `X`'s topic (`spec` is then taken).
+/// Adds the reader `spec` describes to `reader` when it is a reader of `X`'s topic (`spec` is then taken),
+/// seeded with `seed` of its participant.
 fn add_user<X: DdsType + Clone>(
     reader: &BuiltinReader<X>,
     spec: &mut Option<Box<dyn Any>>,
     handle_of: fn(&[u8]) -> InstanceHandle,
-    seed: Vec<X>,
+    seed: fn(&DomainParticipant) -> Vec<X>,
 ) -> Option<DdsResult<Box<dyn Any>>> {
     let s = spec.take()?.downcast::<UserReaderSpec<X>>();
     match s {
-        Ok(s) => Some(
-            reader
-                .add_user_reader(*s, handle_of, seed)
-                .map(|r| Box::new(r) as Box<dyn Any>),
-        ),
+        Ok(s) => {
+            let data = seed(s.subscriber.participant());
+            Some(
+                reader
+                    .add_user_reader(*s, handle_of, data)
+                    .map(|r| Box::new(r) as Box<dyn Any>),
+            )
+        }
         Err(other) => {
             *spec = Some(other);
             None

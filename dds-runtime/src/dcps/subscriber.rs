@@ -160,12 +160,7 @@ impl Subscriber {
         qos: &DataReaderQos,
         listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
     ) -> DdsResult<DataReader<T>> {
-        if let Some(r) = super::builtin_subscriber::BuiltinFeed::user_reader(
-            self,
-            topic.topic(),
-            qos,
-            listener.clone(),
-        )? {
+        if let Some(r) = builtin::user_builtin_reader(self, topic.topic(), qos, listener.clone())? {
             return Ok(r);
         }
         let driver = self.participant.driver().clone();

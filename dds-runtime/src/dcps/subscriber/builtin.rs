@@ -5,6 +5,7 @@
 //! ([`BuiltinReader::add_user_reader`]) is fed the same changes, with its own QoS.
 
 use std::any::Any;
+use std::sync::atomic::{AtomicU16, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::time::{Instant, SystemTime};
 
@@ -12,7 +13,6 @@ use crate::cdr::{self, DdsType};
 use crate::qos::{DataReaderQos, Durability, History, Reliability, ResourceLimits, SubscriberQos};
 use crate::rtps::{ChangeKind, EntityId, Guid};
 
-use super::super::listener::DataReaderListener;
 use super::super::status::StatusMask;
 
 use super::super::cache::{Incoming, Outcome, ReaderCache};
@@ -22,7 +22,9 @@ use super::super::participant::DomainParticipant;
 use super::super::presentation::AccessScope;
 use super::super::sample::{InstanceHandle, InstanceState};
 use super::super::sync::lock;
-use super::{ops, DataReader, ReaderInner, ReaderOwner, Stored, Subscriber, Typed};
+use super::{
+    ops, DataReader, DataReaderListener, ReaderInner, ReaderOwner, Stored, Subscriber, Typed,
+};
 
 /// Most instances one built-in reader keeps, so that hostile discovery data cannot grow it without bound.
 /// At the limit a new entity evicts the one gone longest; only when every kept entity is alive is it
@@ -97,6 +99,53 @@ pub(crate) struct BuiltinReader<T: DdsType> {
     writer: Guid,
     /// Readers the application created on the topic: fed the same changes while they exist.
     users: Mutex<Vec<Weak<ReaderInner<Typed<T>>>>>,
+}
+
+/// The four built-in topics.
+const BUILTIN_TOPICS: [&str; 4] = [
+    "DCPSParticipant",
+    "DCPSPublication",
+    "DCPSSubscription",
+    "DCPSTopic",
+];
+
+/// Numbers the readers the application creates on built-in topics. Their entity id is a built-in reader
+/// kind (0xc7) with the key 0xdd, then this number: no RTPS built-in entity has such a key, and no RTPS
+/// reader has this id; it only names the reader (instance handle, the driver's endpoint table).
+static NEXT_USER_READER: AtomicU16 = AtomicU16::new(0);
+
+/// Creates the application's reader on a built-in topic (`create_datareader` on `DCPSParticipant`,
+/// `DCPSPublication`, `DCPSSubscription` or `DCPSTopic` with its built-in type): fed by discovery like the
+/// built-in subscriber's reader of the topic (`dcps::builtin_subscriber`), seeded with what discovery
+/// knows now. `None` when `topic` is not a built-in topic of type `T` (an ordinary reader is made then).
+pub(crate) fn user_builtin_reader<T: DdsType>(
+    s: &Subscriber,
+    topic: &super::Topic<T>,
+    qos: &DataReaderQos,
+    listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
+) -> DdsResult<Option<DataReader<T>>> {
+    if !BUILTIN_TOPICS.contains(&topic.name()) {
+        return Ok(None);
+    }
+    let p = s.participant();
+    p.get_builtin_subscriber()?;
+    let Some(feed) = lock(&p.registry().builtin).clone() else {
+        return Ok(None);
+    };
+    let n = NEXT_USER_READER
+        .fetch_add(1, Ordering::Relaxed)
+        .to_be_bytes();
+    let spec: Box<dyn Any> = Box::new(UserReaderSpec {
+        subscriber: s.clone(),
+        topic: topic.clone(),
+        qos: qos.clone(),
+        listener,
+        id: EntityId([0xdd, n[0], n[1], 0xc7]),
+    });
+    match feed.add_user_reader(spec) {
+        None => Ok(None),
+        Some(r) => Ok(r?.downcast::<DataReader<T>>().ok().map(|r| *r)),
+    }
 }
 
 /// A reader the application creates on a built-in topic: its subscriber, topic, QoS, listener and the
