@@ -446,4 +446,8 @@ fn application_readers_on_builtin_topics_are_fed_and_builtin_readers_take_set_qo
         pubs.get_qos().unwrap().time_based_filter,
         uq.time_based_filter
     );
+    // Deleted like any reader; the built-in subscriber's reader stays.
+    sub.delete_datareader(&parts).unwrap();
+    sub.delete_datareader(&pubs).unwrap();
+    assert!(b.participant_reader().read().is_ok());
 }
