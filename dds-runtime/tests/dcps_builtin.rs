@@ -6,6 +6,7 @@ mod dcps_util;
 
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Arc;
+use std::time::Duration;
 
 use dcps_util::*;
 use dds_runtime::prelude::*;
@@ -379,4 +380,74 @@ fn builtin_subscriber_is_not_a_contained_entity() {
     assert!(again.participant_reader().read().is_ok());
     drop(again);
     f.delete_participant(&p).unwrap();
+}
+
+/// A reader the application creates on a built-in topic (here in a subscriber of its own, with its own
+/// QoS) is fed like the built-in subscriber's: seeded with what discovery knows when it is created, then
+/// every entity that comes and goes. `set_qos` of a built-in reader applies the policies that may change
+/// and refuses the others with `ImmutablePolicy`.
+#[test]
+fn application_readers_on_builtin_topics_are_fed_and_builtin_readers_take_set_qos() {
+    let p = participant(33);
+    let other = participant(33);
+    let first = writer::<ShapeType>(&other, "UserBuiltinA", &DataWriterQos::default());
+    let b = p.get_builtin_subscriber().unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        alive(&b.publication_reader().read().unwrap())
+            .iter()
+            .any(|d| d.key == first.guid())
+    }));
+    let sub = p.create_subscriber(&SubscriberQos::default()).unwrap();
+    let pubs_topic = p
+        .lookup_topicdescription::<PublicationBuiltinTopicData>("DCPSPublication")
+        .expect("the built-in topic");
+    let rq = DataReaderQos::builder()
+        .history(History::KeepLast(4))
+        .build();
+    let pubs = sub.create_datareader(&pubs_topic, &rq).unwrap();
+    let parts_topic = p
+        .lookup_topicdescription::<ParticipantBuiltinTopicData>("DCPSParticipant")
+        .expect("the built-in topic");
+    let parts = sub.create_datareader(&parts_topic, &rq).unwrap();
+    // Seeded: the writer discovered before, and both participants.
+    assert!(alive(&pubs.read().unwrap())
+        .iter()
+        .any(|d| d.key == first.guid()));
+    assert_eq!(alive(&parts.read().unwrap()).len(), 2);
+    assert_eq!(pubs.get_qos().unwrap().history, History::KeepLast(4));
+    // Fed: a writer that comes, then goes.
+    let second = writer::<ShapeType>(&other, "UserBuiltinB", &DataWriterQos::default());
+    let h = InstanceHandle::from_guid(second.guid());
+    assert!(wait_until(MATCH_TIMEOUT, || pubs.read_instance(h).is_ok()));
+    drop(second);
+    assert!(wait_until(MATCH_TIMEOUT, || {
+        pubs.read_instance(h).is_ok_and(|s| {
+            s.iter()
+                .any(|s| s.info.instance_state == InstanceState::NotAliveDisposed)
+        })
+    }));
+    // The built-in subscriber's reader saw the same, besides.
+    assert!(b.publication_reader().read_instance(h).is_ok());
+    // set_qos: a policy that may change is applied, an immutable one refused.
+    let builtin = b.publication_reader();
+    let mut q = builtin.get_qos().unwrap();
+    q.deadline = Deadline(Duration::from_secs(30));
+    builtin.set_qos(&q).unwrap();
+    assert_eq!(builtin.get_qos().unwrap().deadline, q.deadline);
+    q.history = History::KeepLast(8);
+    assert!(matches!(
+        builtin.set_qos(&q),
+        Err(DdsError::ImmutablePolicy(QosPolicyId::History))
+    ));
+    let mut uq = pubs.get_qos().unwrap();
+    uq.time_based_filter.minimum_separation = Duration::from_millis(10);
+    pubs.set_qos(&uq).unwrap();
+    assert_eq!(
+        pubs.get_qos().unwrap().time_based_filter,
+        uq.time_based_filter
+    );
+    // Deleted like any reader; the built-in subscriber's reader stays.
+    sub.delete_datareader(&parts).unwrap();
+    sub.delete_datareader(&pubs).unwrap();
+    assert!(b.participant_reader().read().is_ok());
 }

@@ -423,6 +423,59 @@ fn group_ordered_access_lists_readers_in_sample_order() {
     assert!(sub.get_datareaders(any.0, any.1, any.2).unwrap().is_empty());
 }
 
+/// GROUP scope with coherent and ordered access: a group coherent set whose writers take turns is handed
+/// over as one, in the order written across the writers. Inside an access scope `get_datareaders` lists
+/// the readers once per sample in that order, and reading one sample from each listed reader in turn gives
+/// the publisher's write order, set after set (before, each writer's part came whole, writer by writer).
+#[test]
+fn group_coherent_set_is_read_in_write_order_across_writers() {
+    let scope = presentation(PresentationAccessScope::Group, true, true);
+    let (_ps, publ, sub, ws, rs) = group_pair(35, scope);
+    let sets: [&[(usize, i32)]; 2] = [
+        &[(0, 1), (1, 1), (0, 2), (1, 2), (1, 3), (0, 3)],
+        &[(1, 4), (0, 4), (0, 5), (1, 5)],
+    ];
+    for set in sets {
+        publ.begin_coherent_changes().unwrap();
+        for &(w, x) in set {
+            ws[w].write(&shape("RED", x)).unwrap();
+        }
+        publ.end_coherent_changes().unwrap();
+    }
+    let writes: Vec<(usize, i32)> = sets.concat();
+    let any = (
+        SampleStateMask::ANY,
+        ViewStateMask::ANY,
+        InstanceStateMask::ANY,
+    );
+    assert!(wait_until(MATCH_TIMEOUT, || sub
+        .get_datareaders(any.0, any.1, any.2)
+        .unwrap()
+        .len()
+        == writes.len()));
+    sub.begin_access().unwrap();
+    let list = sub
+        .get_datareaders(SampleStateMask::NOT_READ, any.1, any.2)
+        .unwrap();
+    let expected: Vec<InstanceHandle> = writes
+        .iter()
+        .map(|&(w, _)| rs[w].instance_handle())
+        .collect();
+    let mut seen = Vec::new();
+    for h in &list {
+        let (i, r) = rs
+            .iter()
+            .enumerate()
+            .find(|(_, r)| r.instance_handle() == *h)
+            .unwrap();
+        let s = r.select().max_samples(1).take().unwrap();
+        seen.push((i, s[0].data.as_ref().unwrap().x));
+    }
+    sub.end_access().unwrap();
+    assert_eq!(list, expected);
+    assert_eq!(seen, writes);
+}
+
 /// GROUP coherent access: inside `begin_access` / `end_access` the subscriber's readers never show part of
 /// a group set. A writer thread ends 300 group sets of one sample per writer as fast as it can while this
 /// thread counts both readers' samples inside an access scope, over and over: the counts are always

@@ -17,8 +17,9 @@ use super::error::DdsResult;
 use super::participant::DomainParticipant;
 use super::registry::BuiltinReaders;
 use super::sample::InstanceHandle;
-use super::subscriber::{BuiltinGroup, BuiltinReader, DataReader, Subscriber};
+use super::subscriber::{BuiltinGroup, BuiltinReader, DataReader, Subscriber, UserReaderSpec};
 use super::sync::lock;
+use crate::cdr::DdsType;
 use crate::rtps::discovery::{EndpointData, ParticipantData, TopicData};
 use crate::rtps::{EntityId, Event, Guid, GuidPrefix};
 
@@ -115,6 +116,10 @@ impl BuiltinReaders for BuiltinFeed {
 
     fn as_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync> {
         self
+    }
+
+    fn add_user_reader(&self, spec: Box<dyn Any>) -> Option<DdsResult<Box<dyn Any>>> {
+        self.user_reader(spec)
     }
 }
 
@@ -236,6 +241,93 @@ impl BuiltinFeed {
     fn reader_gone(&self, g: Guid) {
         self.subscriptions.dispose(g.to_bytes().to_vec());
     }
+}
+
+impl BuiltinFeed {
+    /// [`BuiltinReaders::add_user_reader`]: the reader of the topic whose built-in type is the spec's,
+    /// seeded with what discovery knows now.
+    fn user_reader(&self, spec: Box<dyn Any>) -> Option<DdsResult<Box<dyn Any>>> {
+        let mut spec = Some(spec);
+        add_user(&self.participants, &mut spec, guid_key_handle, |p| {
+            seed(p).0
+        })
+        .or_else(|| {
+            add_user(&self.publications, &mut spec, guid_key_handle, |p| {
+                seed(p).1
+            })
+        })
+        .or_else(|| {
+            add_user(&self.subscriptions, &mut spec, guid_key_handle, |p| {
+                seed(p).2
+            })
+        })
+        .or_else(|| add_user(&self.topics, &mut spec, topic_key_handle, |p| seed(p).3))
+    }
+}
+
+/// Adds the reader `spec` describes to `reader` when it is a reader of `X`'s topic (`spec` is then taken),
+/// seeded with `seed` of its participant.
+fn add_user<X: DdsType + Clone>(
+    reader: &BuiltinReader<X>,
+    spec: &mut Option<Box<dyn Any>>,
+    handle_of: fn(&[u8]) -> InstanceHandle,
+    seed: fn(&DomainParticipant) -> Vec<X>,
+) -> Option<DdsResult<Box<dyn Any>>> {
+    let s = spec.take()?.downcast::<UserReaderSpec<X>>();
+    match s {
+        Ok(s) => {
+            let data = seed(s.subscriber.participant());
+            Some(
+                reader
+                    .add_user_reader(*s, handle_of, data)
+                    .map(|r| Box::new(r) as Box<dyn Any>),
+            )
+        }
+        Err(other) => {
+            *spec = Some(other);
+            None
+        }
+    }
+}
+
+/// What discovery knows now, as built-in topic data: participants (this one included), publications,
+/// subscriptions, and topics (announced, and those of the endpoints, each once).
+#[allow(clippy::type_complexity)]
+fn seed(
+    p: &DomainParticipant,
+) -> (
+    Vec<ParticipantBuiltinTopicData>,
+    Vec<PublicationBuiltinTopicData>,
+    Vec<SubscriptionBuiltinTopicData>,
+    Vec<TopicBuiltinTopicData>,
+) {
+    p.driver().query_core(|c| {
+        let mut ps: Vec<ParticipantBuiltinTopicData> =
+            c.discovered_participants().map(Into::into).collect();
+        ps.push((&c.participant_data()).into());
+        let ws: Vec<PublicationBuiltinTopicData> = c.publications().map(Into::into).collect();
+        let rs: Vec<SubscriptionBuiltinTopicData> = c.subscriptions().map(Into::into).collect();
+        let mut ts: Vec<TopicBuiltinTopicData> = c
+            .discovered_topic_announcements()
+            .map(|t| TopicBuiltinTopicData::new(&t.topic_name, &t.type_name, t.topic_data.clone()))
+            .collect();
+        let endpoints = c
+            .publications()
+            .map(|w| (&w.topic_name, &w.type_name, &w.qos.topic_data.0))
+            .chain(
+                c.subscriptions()
+                    .map(|r| (&r.topic_name, &r.type_name, &r.qos.topic_data.0)),
+            );
+        for (name, type_name, data) in endpoints {
+            if !ts
+                .iter()
+                .any(|t| t.name == *name && t.type_name == *type_name)
+            {
+                ts.push(TopicBuiltinTopicData::new(name, type_name, data.clone()));
+            }
+        }
+        (ps, ws, rs, ts)
+    })
 }
 
 /// The serialized key of the DCPSTopic instance of `name` with `type_name`.

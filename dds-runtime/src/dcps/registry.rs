@@ -81,6 +81,10 @@ pub(crate) trait BuiltinReaders: Send + Sync {
     fn group_handle(&self) -> InstanceHandle;
     /// The readers, for a downcast to their type.
     fn as_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync>;
+    /// Creates the application's reader on a built-in topic: `spec` is a boxed
+    /// `subscriber::UserReaderSpec<T>`, the result a boxed `DataReader<T>`; `None` when `T` is not the
+    /// built-in type of a built-in topic.
+    fn add_user_reader(&self, spec: Box<dyn Any>) -> Option<DdsResult<Box<dyn Any>>>;
 }
 
 /// A reader or writer as the registry sees it.

@@ -41,7 +41,7 @@ use super::sync::{lock, recover};
 use super::topic::{Topic, TopicDescription};
 use crate::filter::ContentFilter;
 
-pub(crate) use builtin::{BuiltinGroup, BuiltinReader};
+pub(crate) use builtin::{BuiltinGroup, BuiltinReader, UserReaderSpec};
 pub(crate) use kind::{reader_callbacks, ReaderCallbacks, ReaderKind, Typed};
 pub use ops::SubscriberListener;
 
@@ -160,6 +160,9 @@ impl Subscriber {
         qos: &DataReaderQos,
         listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
     ) -> DdsResult<DataReader<T>> {
+        if let Some(r) = builtin::user_builtin_reader(self, topic.topic(), qos, listener.clone())? {
+            return Ok(r);
+        }
         let parent = ops::reader_parent(self, topic.topic())?;
         let enabled = self
             .participant

@@ -651,7 +651,8 @@ pub enum Event {
         /// The changes of the set (never empty).
         samples: Vec<ReceivedSample>,
         /// For a writer's part of a group coherent set (GROUP access scope): the set. The parts of one
-        /// group set are delivered one after the other, once every writer's part arrived.
+        /// group set are delivered together, once every writer's part arrived, in group sequence order: a
+        /// part comes in several events (consecutive changes each) when other writers wrote in between.
         group: Option<GroupSetId>,
     },
     /// A local writer matched or unmatched a reader.

@@ -327,3 +327,116 @@ fn a_late_cyclone_reader_gets_the_kept_samples_then_the_final_state() {
 fn a_late_reader_of_ours_gets_the_kept_samples_then_the_final_state() {
     let _ = final_states(Prog::Ours, 't', 199);
 }
+
+/// A TRANSIENT writer in this process (its participant's own service keeps its data, the writer and the
+/// service both KEEP_LAST 3) writes three samples each of BLUE, GREEN and RED on `Once`. A late `reader`
+/// (TRANSIENT_LOCAL) joining while the writer lives matches the writer and the service's stand-in: it must
+/// print each sample exactly once (the stand-in leaves it to the writer), and so for a fourth sample of each
+/// written while it runs. The writer is then deleted, and a second late reader must print each kept
+/// sample (the last three of each) exactly once, from the stand-in; the first prints no repeat.
+fn once_while_the_writer_lives(reader: Prog, domain: u32) -> Result<(), Skip> {
+    use dds_runtime::prelude::*;
+    require_netns()?;
+    let p = super::harness::loopback_participant(domain);
+    let depth = History::KeepLast(3);
+    let qos = DataWriterQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .durability(Durability::Transient)
+        .data_representation(DataRepresentation::xcdr1())
+        .history(depth)
+        .durability_service(DurabilityService {
+            history: depth,
+            ..DurabilityService::default()
+        })
+        .build();
+    let topic = p
+        .create_topic::<ShapeType>("Once", &TopicQos::default())
+        .expect("topic");
+    let publisher = p
+        .create_publisher(&PublisherQos::default())
+        .expect("publisher");
+    let w = publisher.create_datawriter(&topic, &qos).expect("writer");
+    let write = |xs: std::ops::RangeInclusive<i32>| {
+        for x in xs {
+            for color in ["BLUE", "GREEN", "RED"] {
+                let s = ShapeType {
+                    color: color.into(),
+                    x,
+                    y: 2 * x,
+                    shapesize: 30,
+                    additional_payload_size: Vec::new(),
+                };
+                w.write(&s).expect("write");
+            }
+        }
+    };
+    let want = |xs: std::ops::RangeInclusive<i32>| {
+        let mut v: Vec<String> = ["BLUE", "GREEN", "RED"]
+            .iter()
+            .flat_map(|c| {
+                xs.clone()
+                    .map(move |x| format!("{:<10} {c:<10} {x:03} {:03} [30]", "Once", 2 * x))
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let is_data = |l: &str| l.starts_with("Once ") && l.ends_with("[30]");
+    let data = |r: &Proc| {
+        let mut v = r.grep(is_data);
+        v.sort();
+        v
+    };
+    // Waits for `n` samples, then for repeats that would follow.
+    let settle = |r: &Proc, n: usize| {
+        let _ = r.wait_lines(WAIT, n, is_data);
+        std::thread::sleep(Duration::from_secs(2));
+    };
+    write(1..=3);
+    let args = format!("-S -t Once -d {domain} -r -D l -k 0");
+    let mut first = reader.spawn("reader1", &args)?;
+    settle(&first, 9);
+    check!(
+        data(&first) == want(1..=3),
+        &[&first],
+        "history while the writer lives: {:?}",
+        data(&first)
+    );
+    write(4..=4);
+    settle(&first, 12);
+    check!(
+        data(&first) == want(1..=4),
+        &[&first],
+        "live while the writer lives: {:?}",
+        data(&first)
+    );
+    drop(w);
+    std::thread::sleep(Duration::from_millis(500));
+    let mut second = reader.spawn("reader2", &args)?;
+    settle(&second, 9);
+    check!(
+        data(&second) == want(2..=4),
+        &[&second],
+        "after the writer: {:?}",
+        data(&second)
+    );
+    check!(
+        data(&first) == want(1..=4),
+        &[&first],
+        "repeats after the writer: {:?}",
+        data(&first)
+    );
+    let _ = first.interrupt(WAIT);
+    let _ = second.interrupt(WAIT);
+    Ok(())
+}
+
+#[test]
+fn a_cyclone_transient_local_reader_gets_each_sample_once_while_the_writer_lives() {
+    let _ = once_while_the_writer_lives(Prog::Cyclone, 33);
+}
+
+#[test]
+fn a_transient_local_reader_of_ours_gets_each_sample_once_while_the_writer_lives() {
+    let _ = once_while_the_writer_lives(Prog::Ours, 34);
+}

@@ -1,15 +1,19 @@
 //! The readers of the built-in subscriber (DDS 1.4 §2.2.5) as ordinary `DataReader<T>`s: the typed reader's
 //! cache, states, conditions, listeners and subscriber, with no RTPS reader behind them. Discovery feeds
 //! them ([`BuiltinReader::upsert`], [`BuiltinReader::dispose`]); their QoS is the one DDS sets for them
-//! (RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1).
+//! (RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1). A reader the application creates on a built-in topic
+//! ([`BuiltinReader::add_user_reader`]) is fed the same changes, with its own QoS.
 
 use std::any::Any;
-use std::sync::{Arc, Weak};
+use std::sync::atomic::{AtomicU16, Ordering};
+use std::sync::{Arc, Mutex, Weak};
 use std::time::{Instant, SystemTime};
 
 use crate::cdr::{self, DdsType};
 use crate::qos::{DataReaderQos, Durability, History, Reliability, ResourceLimits, SubscriberQos};
 use crate::rtps::{ChangeKind, EntityId, Guid};
+
+use super::super::status::StatusMask;
 
 use super::super::cache::{Incoming, Outcome, ReaderCache};
 use super::super::driver::Endpoint;
@@ -18,7 +22,9 @@ use super::super::participant::DomainParticipant;
 use super::super::presentation::AccessScope;
 use super::super::sample::{InstanceHandle, InstanceState};
 use super::super::sync::lock;
-use super::{ops, DataReader, ReaderInner, ReaderOwner, Stored, Subscriber, Typed};
+use super::{
+    ops, DataReader, DataReaderListener, ReaderInner, ReaderOwner, Stored, Subscriber, Typed,
+};
 
 /// Most instances one built-in reader keeps, so that hostile discovery data cannot grow it without bound.
 /// At the limit a new entity evicts the one gone longest; only when every kept entity is alive is it
@@ -91,9 +97,68 @@ pub(crate) struct BuiltinReader<T: DdsType> {
     topic_name: &'static str,
     /// The writer the reader's changes come from: the participant's built-in writer of the topic.
     writer: Guid,
+    /// Readers the application created on the topic: fed the same changes while they exist.
+    users: Mutex<Vec<Weak<ReaderInner<Typed<T>>>>>,
 }
 
-impl<T: DdsType> BuiltinReader<T> {
+/// The four built-in topics.
+const BUILTIN_TOPICS: [&str; 4] = [
+    "DCPSParticipant",
+    "DCPSPublication",
+    "DCPSSubscription",
+    "DCPSTopic",
+];
+
+/// Numbers the readers the application creates on built-in topics. Their entity id is a built-in reader
+/// kind (0xc7) with the key 0xdd, then this number: no RTPS built-in entity has such a key, and no RTPS
+/// reader has this id; it only names the reader (instance handle, the driver's endpoint table).
+static NEXT_USER_READER: AtomicU16 = AtomicU16::new(0);
+
+/// Creates the application's reader on a built-in topic (`create_datareader` on `DCPSParticipant`,
+/// `DCPSPublication`, `DCPSSubscription` or `DCPSTopic` with its built-in type): fed by discovery like the
+/// built-in subscriber's reader of the topic (`dcps::builtin_subscriber`), seeded with what discovery
+/// knows now. `None` when `topic` is not a built-in topic of type `T` (an ordinary reader is made then).
+pub(crate) fn user_builtin_reader<T: DdsType>(
+    s: &Subscriber,
+    topic: &super::Topic<T>,
+    qos: &DataReaderQos,
+    listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
+) -> DdsResult<Option<DataReader<T>>> {
+    if !BUILTIN_TOPICS.contains(&topic.name()) {
+        return Ok(None);
+    }
+    let p = s.participant();
+    p.get_builtin_subscriber()?;
+    let Some(feed) = lock(&p.registry().builtin).clone() else {
+        return Ok(None);
+    };
+    let n = NEXT_USER_READER
+        .fetch_add(1, Ordering::Relaxed)
+        .to_be_bytes();
+    let spec: Box<dyn Any> = Box::new(UserReaderSpec {
+        subscriber: s.clone(),
+        topic: topic.clone(),
+        qos: qos.clone(),
+        listener,
+        id: EntityId([0xdd, n[0], n[1], 0xc7]),
+    });
+    match feed.add_user_reader(spec) {
+        None => Ok(None),
+        Some(r) => Ok(r?.downcast::<DataReader<T>>().ok().map(|r| *r)),
+    }
+}
+
+/// A reader the application creates on a built-in topic: its subscriber, topic, QoS, listener and the
+/// entity id it gets (no RTPS reader is behind it).
+pub(crate) struct UserReaderSpec<T: DdsType> {
+    pub subscriber: Subscriber,
+    pub topic: super::Topic<T>,
+    pub qos: DataReaderQos,
+    pub listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
+    pub id: EntityId,
+}
+
+impl<T: DdsType + Clone> BuiltinReader<T> {
     /// Creates the reader of `topic_name` in the built-in subscriber `s`, with entity id `id`; changes
     /// come from the writer `writer` of this participant, instance handles from `handle_of` (the key).
     pub(crate) fn create(
@@ -103,17 +168,7 @@ impl<T: DdsType> BuiltinReader<T> {
         handle_of: fn(&[u8]) -> InstanceHandle,
     ) -> DdsResult<(Self, DataReader<T>)> {
         let p = &s.participant;
-        let mut cache = ReaderCache::new(builtin_qos(), true);
-        cache.set_handle_fn(handle_of);
-        cache.set_evict_not_alive(true);
-        let inner = Arc::new(ReaderInner::new(
-            super::super::decode::Derived,
-            p.driver().clone(),
-            cache,
-            None,
-            None,
-            None,
-        ));
+        let inner = fed_reader(p, builtin_qos(), handle_of);
         let topic = p.builtin_topic::<T>(topic_name)?;
         inner.state.set_parent(ops::reader_parent(s, &topic)?);
         let r = BuiltinReader {
@@ -121,6 +176,7 @@ impl<T: DdsType> BuiltinReader<T> {
             id,
             topic_name,
             writer: Guid::new(p.driver().guid_prefix, writer),
+            users: Mutex::default(),
         };
         let reader = r.attach(s, topic)?;
         ops::register_reader(s, &r.inner, topic_name);
@@ -177,7 +233,61 @@ impl<T: DdsType> BuiltinReader<T> {
             == Some(InstanceState::Alive)
     }
 
+    /// Creates a reader of the application on this reader's topic, seeded with `seed` (what discovery
+    /// knows now) and fed from then on like this one. Its QoS is the application's: history, resource
+    /// limits, time-based filter, ... apply as for any reader.
+    pub(crate) fn add_user_reader(
+        &self,
+        spec: UserReaderSpec<T>,
+        handle_of: fn(&[u8]) -> InstanceHandle,
+        seed: Vec<T>,
+    ) -> DdsResult<DataReader<T>> {
+        let s = &spec.subscriber;
+        let mut qos = spec.qos;
+        // Bounded as the built-in subscriber's readers are, whatever the application asked for.
+        let limit = qos.resource_limits.max_instances.unwrap_or(MAX_INSTANCES);
+        qos.resource_limits.max_instances = Some(limit.min(MAX_INSTANCES));
+        let inner = fed_reader(&s.participant, qos, handle_of);
+        inner.state.set_parent(ops::reader_parent(s, &spec.topic)?);
+        if let Some((l, mask)) = spec.listener {
+            inner.state.set_listener_with_mask(Some(l), mask);
+        }
+        let sink: Arc<dyn Endpoint> = inner.clone();
+        let owner = ReaderOwner {
+            topic: spec.topic,
+            subscriber: s.clone(),
+        };
+        let id = spec.id;
+        let handle = inner.state.create(sink, owner, move |_, _| Ok(id))?;
+        ops::register_reader(&spec.subscriber, &inner, self.topic_name);
+        for data in seed {
+            let mut key = Vec::new();
+            if cdr::instance_key(&data, &mut key).is_ok() {
+                self.store(&inner, ChangeKind::Alive, Some(data), key);
+            }
+        }
+        let mut users = lock(&self.users);
+        users.retain(|u| u.strong_count() > 0);
+        users.push(Arc::downgrade(&inner));
+        Ok(DataReader { inner, handle })
+    }
+
     fn apply(&self, kind: ChangeKind, data: Option<T>, key: Vec<u8>) {
+        let users: Vec<_> = lock(&self.users).iter().filter_map(Weak::upgrade).collect();
+        for u in users {
+            self.store(&u, kind, data.clone(), key.clone());
+        }
+        self.store(&self.inner, kind, data, key);
+    }
+
+    /// Stores one change in `inner` and announces it.
+    fn store(
+        &self,
+        inner: &Arc<ReaderInner<Typed<T>>>,
+        kind: ChangeKind,
+        data: Option<T>,
+        key: Vec<u8>,
+    ) {
         let now = SystemTime::now();
         let inc = Incoming {
             writer: self.writer,
@@ -192,11 +302,31 @@ impl<T: DdsType> BuiltinReader<T> {
             expires: None,
         };
         let mut stored = Stored::default();
-        match lock(&self.inner.cache).cache.insert(inc, Instant::now()) {
+        match lock(&inner.cache).cache.insert(inc, Instant::now()) {
             Outcome::Accepted { .. } => stored.any = true,
             Outcome::Filtered => {}
             Outcome::Rejected { reason, handle } => stored.rejected.push((reason, handle)),
         }
-        self.inner.announce_stored(stored);
+        inner.announce_stored(stored);
     }
+}
+
+/// A reader with no RTPS reader behind it, fed by discovery: instances by `handle_of`, disposed ones
+/// evicted.
+fn fed_reader<T: DdsType>(
+    p: &DomainParticipant,
+    qos: DataReaderQos,
+    handle_of: fn(&[u8]) -> InstanceHandle,
+) -> Arc<ReaderInner<Typed<T>>> {
+    let mut cache = ReaderCache::new(qos, true);
+    cache.set_handle_fn(handle_of);
+    cache.set_evict_not_alive(true);
+    Arc::new(ReaderInner::new(
+        super::super::decode::Derived,
+        p.driver().clone(),
+        cache,
+        None,
+        None,
+        None,
+    ))
 }

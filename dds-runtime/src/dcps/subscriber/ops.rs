@@ -477,11 +477,16 @@ impl<T: DdsType> DataReader<T> {
         Ok(())
     }
 
-    /// Announces `qos` with the subscriber's and topic's current parts.
+    /// Announces `qos` with the subscriber's and topic's current parts. A reader of a built-in topic
+    /// (the built-in subscriber's, or one the application created) has no RTPS reader and is announced
+    /// nowhere: its cache alone takes the new QoS.
     pub(super) fn announce(&self, qos: DataReaderQos) -> DdsResult<()> {
+        let id = self.handle.id();
+        if id.is_builtin() {
+            return Ok(());
+        }
         let sq = self.subscriber().get_qos()?;
         let tq = self.topic().get_qos()?;
-        let id = self.handle.id();
         let rq = ReaderQos::new(qos, &sq, &tq);
         self.inner
             .state

@@ -1,6 +1,8 @@
 //! Group coherent sets on the reader side (GROUP access scope, RTPS 2.5 §8.7.6): each writer's part of a
 //! group set arrives whole from its reader (`reader/coherent.rs`); here the parts wait until every writer of
-//! the set delivered its part, then go to the application one after the other, sets in the order written.
+//! the set delivered its part, then go to the application together, in the order written across the
+//! writers (group sequence numbers; a part is cut in pieces where another writer wrote in between), sets in
+//! the order written.
 //!
 //! A part names its set by the group sequence number of the set's first change and the digest of the set's
 //! writers (both from the writer's end-of-set marker). The set is complete when the digest of the writers
@@ -17,7 +19,7 @@
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 
 use super::Participant;
-use crate::rtps::api::{Event, GroupSetId};
+use crate::rtps::api::{Event, GroupSetId, ReceivedSample};
 use crate::rtps::types::{EntityId, Guid, GuidPrefix, SequenceNumber};
 use crate::rtps::writer::writer_set_digest;
 
@@ -62,7 +64,7 @@ impl Publisher {
                 discard(s, out);
                 continue;
             }
-            out.extend(s.parts);
+            interleave(s.parts, out);
             if self.done.len() >= MAX_DONE {
                 self.done.pop_front();
             }
@@ -177,6 +179,61 @@ fn complete(writers: &BTreeSet<EntityId>, digest: [u8; 4], unmatched: &[EntityId
             .map(|(_, w)| *w);
         writer_set_digest(writers.iter().chain(with)) == digest
     })
+}
+
+/// Hands a complete group set over in the order written across its writers: its parts cut into runs of
+/// consecutive group sequence numbers of one part, the runs in group sequence order (a part in several
+/// pieces when another writer wrote in between). The pieces go out together, so a reader still stores its
+/// whole part in one go, and a GROUP-ordered subscriber, which numbers samples in the order handed over,
+/// sees the set in the publisher's write order. Parts with a change lacking a group sequence number go
+/// out as they are.
+fn interleave(parts: Vec<Event>, out: &mut VecDeque<Event>) {
+    let numbered = |e: &Event| match e {
+        Event::CoherentSet { samples, .. } => samples.iter().all(|s| s.group_sequence.is_some()),
+        _ => false,
+    };
+    if parts.len() < 2 || !parts.iter().all(numbered) {
+        out.extend(parts);
+        return;
+    }
+    let mut heads = Vec::with_capacity(parts.len());
+    let mut all = Vec::new();
+    for (i, part) in parts.into_iter().enumerate() {
+        if let Event::CoherentSet {
+            reader,
+            writer,
+            samples,
+            group,
+        } = part
+        {
+            heads.push((reader, writer, group));
+            all.extend(samples.into_iter().map(|s| (s.group_sequence, i, s)));
+        }
+    }
+    all.sort_by_key(|&(g, i, _)| (g, i));
+    let mut run: Option<(usize, Vec<ReceivedSample>)> = None;
+    let mut emit = |(i, samples): (usize, Vec<ReceivedSample>)| {
+        let (reader, writer, group) = heads[i];
+        out.push_back(Event::CoherentSet {
+            reader,
+            writer,
+            samples,
+            group,
+        });
+    };
+    for (_, i, s) in all {
+        match &mut run {
+            Some((j, v)) if *j == i => v.push(s),
+            _ => {
+                if let Some(r) = run.replace((i, vec![s])) {
+                    emit(r);
+                }
+            }
+        }
+    }
+    if let Some(r) = run {
+        emit(r);
+    }
 }
 
 /// Reports a waiting set's parts lost.

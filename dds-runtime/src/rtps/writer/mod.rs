@@ -94,6 +94,9 @@ pub(crate) struct Writer {
     pub filters: ReaderFilters,
     /// The owner decides what the history keeps (see [`Writer::manage_history`]).
     managed: bool,
+    /// The original writer, when this is a durability service's stand-in: readers the original serves are
+    /// suppressed (`ReaderProxy::suppressed`).
+    pub stands_in_for: Option<Guid>,
 }
 
 impl Writer {
@@ -122,6 +125,7 @@ impl Writer {
             group: None,
             filters: ReaderFilters::default(),
             managed: false,
+            stands_in_for: None,
         }
     }
 
@@ -279,6 +283,10 @@ impl Writer {
         out: &mut Outbox,
         ev: &mut VecDeque<Event>,
     ) -> Result<SequenceNumber, WriteError> {
+        if self.stands_in_for.is_some() {
+            let suppressed = self.proxies.values().filter(|p| p.suppressed);
+            rejected.extend(suppressed.map(|p| p.guid));
+        }
         rejected.sort_unstable();
         if self.linger_until.is_some() {
             return Err(WriteError::Deleted);
@@ -456,6 +464,10 @@ impl Writer {
     ) {
         proxy.reliable &= self.params.reliable;
         self.expire(now);
+        if proxy.suppressed {
+            // The original writer serves it the history: GAPs for all of it.
+            proxy.floor = self.next_sn;
+        }
         if !(self.durable() && reader_durable) {
             proxy.floor = self.next_sn;
             proxy.acked = self.next_sn;
