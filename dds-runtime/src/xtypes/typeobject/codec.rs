@@ -257,6 +257,69 @@ impl BodyWriter {
         })
     }
 
+    fn struct_members(
+        &self,
+        w: &mut CdrWriter<'_>,
+        ms: &[StructMember],
+    ) -> Result<(), EncodeError> {
+        seq(w, ms, |w, m| {
+            appendable(w, |w| {
+                w.write_u32(m.id);
+                w.write_u16(m.flags.bits());
+                m.type_id.encode(w)?;
+                self.member_detail(w, &m.detail)
+            })
+        })
+    }
+
+    fn union_members(&self, w: &mut CdrWriter<'_>, ms: &[UnionMember]) -> Result<(), EncodeError> {
+        seq(w, ms, |w, m| {
+            appendable(w, |w| {
+                w.write_u32(m.id);
+                w.write_u16(m.flags.bits());
+                m.type_id.encode(w)?;
+                w.write_len(m.labels.len(), "union labels")?;
+                m.labels.iter().for_each(|l| w.write_u32(*l as u32));
+                self.member_detail(w, &m.detail)
+            })
+        })
+    }
+
+    fn literals(&self, w: &mut CdrWriter<'_>, ls: &[EnumeratedLiteral]) -> Result<(), EncodeError> {
+        seq(w, ls, |w, l| {
+            appendable(w, |w| {
+                appendable(w, |w| {
+                    w.write_u32(l.value as u32);
+                    w.write_u16(l.flags.bits());
+                    Ok(())
+                })?;
+                self.member_detail(w, &l.detail)
+            })
+        })
+    }
+
+    fn bitflags(&self, w: &mut CdrWriter<'_>, fs: &[Bitflag]) -> Result<(), EncodeError> {
+        seq(w, fs, |w, f| {
+            appendable(w, |w| {
+                w.write_u16(f.position);
+                w.write_u16(f.flags.bits());
+                self.member_detail(w, &f.detail)
+            })
+        })
+    }
+
+    fn bitfields(&self, w: &mut CdrWriter<'_>, fs: &[Bitfield]) -> Result<(), EncodeError> {
+        seq(w, fs, |w, f| {
+            appendable(w, |w| {
+                w.write_u16(f.position);
+                w.write_u16(f.flags.bits());
+                w.write_u8(f.bitcount);
+                w.write_u8(f.holder_type);
+                self.member_detail(w, &f.detail)
+            })
+        })
+    }
+
     pub(super) fn body(&self, w: &mut CdrWriter<'_>, b: &TypeBody) -> Result<(), EncodeError> {
         w.write_u8(b.kind());
         match b {
@@ -291,14 +354,7 @@ impl BodyWriter {
                     base.encode(w)?;
                     self.type_detail(w, detail)
                 })?;
-                seq(w, members, |w, m| {
-                    appendable(w, |w| {
-                        w.write_u32(m.id);
-                        w.write_u16(m.flags.bits());
-                        m.type_id.encode(w)?;
-                        self.member_detail(w, &m.detail)
-                    })
-                })
+                self.struct_members(w, members)
             }
             TypeBody::Union {
                 flags,
@@ -322,16 +378,7 @@ impl BodyWriter {
                     }
                     Ok(())
                 })?;
-                seq(w, members, |w, m| {
-                    appendable(w, |w| {
-                        w.write_u32(m.id);
-                        w.write_u16(m.flags.bits());
-                        m.type_id.encode(w)?;
-                        w.write_len(m.labels.len(), "union labels")?;
-                        m.labels.iter().for_each(|l| w.write_u32(*l as u32));
-                        self.member_detail(w, &m.detail)
-                    })
-                })
+                self.union_members(w, members)
             }
             TypeBody::Enum {
                 flags,
@@ -344,16 +391,7 @@ impl BodyWriter {
                     w.write_u16(*bit_bound);
                     self.type_detail(w, detail)
                 })?;
-                seq(w, literals, |w, l| {
-                    appendable(w, |w| {
-                        appendable(w, |w| {
-                            w.write_u32(l.value as u32);
-                            w.write_u16(l.flags.bits());
-                            Ok(())
-                        })?;
-                        self.member_detail(w, &l.detail)
-                    })
-                })
+                self.literals(w, literals)
             }
             TypeBody::Bitmask {
                 flags,
@@ -366,13 +404,7 @@ impl BodyWriter {
                     w.write_u16(*bit_bound);
                     self.type_detail(w, detail)
                 })?;
-                seq(w, bitflags, |w, f| {
-                    appendable(w, |w| {
-                        w.write_u16(f.position);
-                        w.write_u16(f.flags.bits());
-                        self.member_detail(w, &f.detail)
-                    })
-                })
+                self.bitflags(w, bitflags)
             }),
             TypeBody::Bitset {
                 flags,
@@ -381,15 +413,7 @@ impl BodyWriter {
             } => appendable(w, |w| {
                 w.write_u16(flags.bits());
                 appendable(w, |w| self.type_detail(w, detail))?;
-                seq(w, fields, |w, f| {
-                    appendable(w, |w| {
-                        w.write_u16(f.position);
-                        w.write_u16(f.flags.bits());
-                        w.write_u8(f.bitcount);
-                        w.write_u8(f.holder_type);
-                        self.member_detail(w, &f.detail)
-                    })
-                })
+                self.bitfields(w, fields)
             }),
             TypeBody::Sequence {
                 flags,

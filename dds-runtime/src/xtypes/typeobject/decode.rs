@@ -299,154 +299,167 @@ impl BodyReader {
         })
     }
 
+    /// TK_ALIAS: the related type, with its flags and (complete) annotations.
+    fn alias(&self, r: R<'_, '_>) -> Result<TypeBody, DecodeError> {
+        let flags = type_flags(r)?;
+        let detail = appendable(r, "alias header", |r| self.type_detail(r))?;
+        appendable(r, "alias body", |r| {
+            let related_flags = member_flags(r)?;
+            let related_type = type_identifier(r)?;
+            let (ann_builtin, ann_custom) = if self.complete {
+                (
+                    optional(r, "alias annotations", builtin_member_annotations)?,
+                    optional(r, "custom annotations", applied_annotations)?,
+                )
+            } else {
+                (None, None)
+            };
+            Ok(TypeBody::Alias {
+                flags,
+                detail,
+                related_flags,
+                related_type,
+                ann_builtin,
+                ann_custom,
+            })
+        })
+    }
+
+    /// TK_STRUCTURE: the base type, the header detail and the members.
+    fn structure(&self, r: R<'_, '_>) -> Result<TypeBody, DecodeError> {
+        let flags = type_flags(r)?;
+        let (base, detail) = appendable(r, "struct header", |r| {
+            Ok((type_identifier(r)?, self.type_detail(r)?))
+        })?;
+        let members = seq(r, "struct members", 8, |r| {
+            appendable(r, "struct member", |r| {
+                let id = r.read_u32("member id")?;
+                let flags = member_flags(r)?;
+                let type_id = type_identifier(r)?;
+                Ok(StructMember {
+                    id,
+                    flags,
+                    type_id,
+                    detail: self.member_detail(r)?,
+                })
+            })
+        })?;
+        Ok(TypeBody::Struct {
+            flags,
+            base,
+            detail,
+            members,
+        })
+    }
+
+    /// TK_UNION: the discriminator and the members with their case labels.
+    fn union(&self, r: R<'_, '_>) -> Result<TypeBody, DecodeError> {
+        let flags = type_flags(r)?;
+        let detail = appendable(r, "union header", |r| self.type_detail(r))?;
+        let (disc_flags, disc_type, disc_ann_builtin, disc_ann_custom) =
+            appendable(r, "discriminator", |r| {
+                let f = member_flags(r)?;
+                let t = type_identifier(r)?;
+                if self.complete {
+                    let b = optional(r, "discriminator annotations", builtin_type_annotations)?
+                        .flatten();
+                    let c = optional(r, "custom annotations", applied_annotations)?;
+                    Ok((f, t, b, c))
+                } else {
+                    Ok((f, t, None, None))
+                }
+            })?;
+        let members = seq(r, "union members", 8, |r| {
+            appendable(r, "union member", |r| {
+                let id = r.read_u32("member id")?;
+                let flags = member_flags(r)?;
+                let type_id = type_identifier(r)?;
+                let n = r.read_count(4, "case labels")?;
+                let labels = (0..n)
+                    .map(|_| r.read_u32("case label").map(|v| v as i32))
+                    .collect::<Result<_, _>>()?;
+                Ok(UnionMember {
+                    id,
+                    flags,
+                    type_id,
+                    labels,
+                    detail: self.member_detail(r)?,
+                })
+            })
+        })?;
+        Ok(TypeBody::Union {
+            flags,
+            detail,
+            disc_flags,
+            disc_type,
+            disc_ann_builtin,
+            disc_ann_custom,
+            members,
+        })
+    }
+
+    /// TK_ENUM: the bit bound and the enumerators.
+    fn enumeration(&self, r: R<'_, '_>) -> Result<TypeBody, DecodeError> {
+        let flags = type_flags(r)?;
+        let (bit_bound, detail) = appendable(r, "enum header", |r| {
+            Ok((r.read_u16("bit_bound")?, self.type_detail(r)?))
+        })?;
+        let literals = seq(r, "enumerators", 8, |r| {
+            appendable(r, "enumerator", |r| {
+                let (value, flags) = appendable(r, "enumerator value", |r| {
+                    Ok((r.read_u32("enumerator value")? as i32, member_flags(r)?))
+                })?;
+                Ok(EnumeratedLiteral {
+                    value,
+                    flags,
+                    detail: self.member_detail(r)?,
+                })
+            })
+        })?;
+        Ok(TypeBody::Enum {
+            flags,
+            bit_bound,
+            detail,
+            literals,
+        })
+    }
+
+    /// TK_BITMASK: the bit bound and the flags.
+    fn bitmask(&self, r: R<'_, '_>) -> Result<TypeBody, DecodeError> {
+        appendable(r, "bitmask", |r| {
+            let flags = type_flags(r)?;
+            let (bit_bound, detail) = appendable(r, "bitmask header", |r| {
+                Ok((r.read_u16("bit_bound")?, self.type_detail(r)?))
+            })?;
+            let bitflags = seq(r, "bitflags", 8, |r| {
+                appendable(r, "bitflag", |r| {
+                    let position = r.read_u16("bit position")?;
+                    let flags = member_flags(r)?;
+                    Ok(Bitflag {
+                        position,
+                        flags,
+                        detail: self.member_detail(r)?,
+                    })
+                })
+            })?;
+            Ok(TypeBody::Bitmask {
+                flags,
+                bit_bound,
+                detail,
+                bitflags,
+            })
+        })
+    }
     fn body(&self, r: R<'_, '_>) -> Result<TypeBody, DecodeError> {
         let k = r.read_u8("type kind")?;
-        let tflags = |r: R<'_, '_>| r.read_u16("type flags").map(TypeFlag::from_bits_retain);
-        let mflags = |r: R<'_, '_>| r.read_u16("member flags").map(MemberFlag::from_bits_retain);
         Ok(match k {
-            TK_ALIAS => {
-                let flags = tflags(r)?;
-                let detail = appendable(r, "alias header", |r| self.type_detail(r))?;
-                appendable(r, "alias body", |r| {
-                    let related_flags = mflags(r)?;
-                    let related_type = type_identifier(r)?;
-                    let (ann_builtin, ann_custom) = if self.complete {
-                        (
-                            optional(r, "alias annotations", builtin_member_annotations)?,
-                            optional(r, "custom annotations", applied_annotations)?,
-                        )
-                    } else {
-                        (None, None)
-                    };
-                    Ok(TypeBody::Alias {
-                        flags,
-                        detail,
-                        related_flags,
-                        related_type,
-                        ann_builtin,
-                        ann_custom,
-                    })
-                })?
-            }
-            TK_STRUCTURE => {
-                let flags = tflags(r)?;
-                let (base, detail) = appendable(r, "struct header", |r| {
-                    Ok((type_identifier(r)?, self.type_detail(r)?))
-                })?;
-                let members = seq(r, "struct members", 8, |r| {
-                    appendable(r, "struct member", |r| {
-                        let id = r.read_u32("member id")?;
-                        let flags = mflags(r)?;
-                        let type_id = type_identifier(r)?;
-                        Ok(StructMember {
-                            id,
-                            flags,
-                            type_id,
-                            detail: self.member_detail(r)?,
-                        })
-                    })
-                })?;
-                TypeBody::Struct {
-                    flags,
-                    base,
-                    detail,
-                    members,
-                }
-            }
-            TK_UNION => {
-                let flags = tflags(r)?;
-                let detail = appendable(r, "union header", |r| self.type_detail(r))?;
-                let (disc_flags, disc_type, disc_ann_builtin, disc_ann_custom) =
-                    appendable(r, "discriminator", |r| {
-                        let f = mflags(r)?;
-                        let t = type_identifier(r)?;
-                        if self.complete {
-                            let b =
-                                optional(r, "discriminator annotations", builtin_type_annotations)?
-                                    .flatten();
-                            let c = optional(r, "custom annotations", applied_annotations)?;
-                            Ok((f, t, b, c))
-                        } else {
-                            Ok((f, t, None, None))
-                        }
-                    })?;
-                let members = seq(r, "union members", 8, |r| {
-                    appendable(r, "union member", |r| {
-                        let id = r.read_u32("member id")?;
-                        let flags = mflags(r)?;
-                        let type_id = type_identifier(r)?;
-                        let n = r.read_count(4, "case labels")?;
-                        let labels = (0..n)
-                            .map(|_| r.read_u32("case label").map(|v| v as i32))
-                            .collect::<Result<_, _>>()?;
-                        Ok(UnionMember {
-                            id,
-                            flags,
-                            type_id,
-                            labels,
-                            detail: self.member_detail(r)?,
-                        })
-                    })
-                })?;
-                TypeBody::Union {
-                    flags,
-                    detail,
-                    disc_flags,
-                    disc_type,
-                    disc_ann_builtin,
-                    disc_ann_custom,
-                    members,
-                }
-            }
-            TK_ENUM => {
-                let flags = tflags(r)?;
-                let (bit_bound, detail) = appendable(r, "enum header", |r| {
-                    Ok((r.read_u16("bit_bound")?, self.type_detail(r)?))
-                })?;
-                let literals = seq(r, "enumerators", 8, |r| {
-                    appendable(r, "enumerator", |r| {
-                        let (value, flags) = appendable(r, "enumerator value", |r| {
-                            Ok((r.read_u32("enumerator value")? as i32, mflags(r)?))
-                        })?;
-                        Ok(EnumeratedLiteral {
-                            value,
-                            flags,
-                            detail: self.member_detail(r)?,
-                        })
-                    })
-                })?;
-                TypeBody::Enum {
-                    flags,
-                    bit_bound,
-                    detail,
-                    literals,
-                }
-            }
-            TK_BITMASK => appendable(r, "bitmask", |r| {
-                let flags = tflags(r)?;
-                let (bit_bound, detail) = appendable(r, "bitmask header", |r| {
-                    Ok((r.read_u16("bit_bound")?, self.type_detail(r)?))
-                })?;
-                let bitflags = seq(r, "bitflags", 8, |r| {
-                    appendable(r, "bitflag", |r| {
-                        let position = r.read_u16("bit position")?;
-                        let flags = mflags(r)?;
-                        Ok(Bitflag {
-                            position,
-                            flags,
-                            detail: self.member_detail(r)?,
-                        })
-                    })
-                })?;
-                Ok(TypeBody::Bitmask {
-                    flags,
-                    bit_bound,
-                    detail,
-                    bitflags,
-                })
-            })?,
+            TK_ALIAS => self.alias(r)?,
+            TK_STRUCTURE => self.structure(r)?,
+            TK_UNION => self.union(r)?,
+            TK_ENUM => self.enumeration(r)?,
+            TK_BITMASK => self.bitmask(r)?,
             TK_BITSET => appendable(r, "bitset", |r| {
-                let flags = tflags(r)?;
+                let flags = type_flags(r)?;
                 let detail = appendable(r, "bitset header", |r| self.type_detail(r))?;
                 let fields = seq(r, "bitfields", 8, |r| {
                     appendable(r, "bitfield", |r| self.bitfield(r))
@@ -458,7 +471,7 @@ impl BodyReader {
                 })
             })?,
             TK_SEQUENCE => {
-                let flags = tflags(r)?;
+                let flags = type_flags(r)?;
                 let (bound, detail) = self.collection_header(r)?;
                 TypeBody::Sequence {
                     flags,
@@ -469,7 +482,7 @@ impl BodyReader {
             }
             TK_ARRAY => {
                 let read = |r: R<'_, '_>| {
-                    let flags = tflags(r)?;
+                    let flags = type_flags(r)?;
                     let (bounds, detail) = appendable(r, "array header", |r| {
                         Ok((u32_seq(r, "array bounds")?, self.type_detail(r)?))
                     })?;
@@ -487,7 +500,7 @@ impl BodyReader {
                 }
             }
             TK_MAP => {
-                let flags = tflags(r)?;
+                let flags = type_flags(r)?;
                 let (bound, detail) = self.collection_header(r)?;
                 let key = self.element(r)?;
                 TypeBody::Map {
@@ -581,4 +594,12 @@ fn annotation_value(r: R<'_, '_>) -> Result<AnnotationParameterValue, DecodeErro
             ))
         }
     })
+}
+
+fn type_flags(r: R<'_, '_>) -> Result<TypeFlag, DecodeError> {
+    r.read_u16("type flags").map(TypeFlag::from_bits_retain)
+}
+
+fn member_flags(r: R<'_, '_>) -> Result<MemberFlag, DecodeError> {
+    r.read_u16("member flags").map(MemberFlag::from_bits_retain)
 }
