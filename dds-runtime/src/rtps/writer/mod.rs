@@ -825,9 +825,9 @@ const WHOLE_HEADROOM: usize = 256;
 /// `max_message_size` (never less than `fragment_size`). Larger samples go as DATA_FRAGs of
 /// `fragment_size`. A sample of a few KiB sent whole saves, per fragment, a submessage at both ends, and
 /// per sample the reassembly and a HEARTBEAT_FRAG. Above half a datagram the fragments win: those of
-/// consecutive samples fill datagrams, where whole samples would go one per datagram (at 8 KiB, 1.35
-/// datagrams per sample instead of 0.77, and more kernel time than the fragments saved; see
-/// `docs/performance.md`, "4 KiB").
+/// consecutive samples fill datagrams, where whole samples would go one per datagram (at 8 KiB, 1.17
+/// datagrams per sample, both ways, instead of 0.77, and more kernel time than the fragments saved; see
+/// `docs/performance.md`, "Session 20: 4 KiB").
 pub(crate) fn whole_sample_max(max_message_size: usize, fragment_size: usize) -> usize {
     (max_message_size.saturating_sub(WHOLE_HEADROOM) / 2).max(fragment_size)
 }
