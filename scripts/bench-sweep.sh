@@ -24,7 +24,7 @@ fi
 
 secs=${BENCH_SECONDS:-6}
 rounds=${BENCH_ROUNDS:-3}
-sizes=${SIZES:-16 64 256 1k 4k 16k 64k 256k 1M 4M}
+sizes=${SIZES:-16 64 256 1k 2k 4k 8k 16k 64k 256k 1M 4M}
 lat_sizes=${LAT_SIZES:-16 1k 64k}
 stacks=${STACKS:-ours cy11 cy010}
 cy11_root=${CYCLONE11:-../shared/cyclonedds-11.0.1}

@@ -347,7 +347,7 @@ fn repaired_key_only_changes_keep_each_readers_form() {
 // HEARTBEAT_FRAG / NACK_FRAG
 // ---------------------------------------------------------------------------------------------------------
 
-/// 10000 bytes in 1344-byte fragments: 8 fragments.
+/// 10000 bytes in 1344-byte fragments: 8 fragments (more than half a datagram: not sent whole).
 const BIG: usize = 10_000;
 const FRAGS: u32 = 8;
 
@@ -467,6 +467,36 @@ fn heartbeat_frag_repairs_missing_fragments_without_heartbeat() {
         .collect();
     frags.sort();
     assert_eq!(frags, [1, 2, 3, 4, 5, 6, 7, 8]);
+}
+
+/// A user sample of which two fit one datagram goes whole, as one DATA (no DATA_FRAG, no HEARTBEAT_FRAG),
+/// even when it is larger than the fragment size; the reader gets it intact.
+#[test]
+fn a_sample_that_fits_a_datagram_goes_whole() {
+    let (mut sim, w, r) = frag_setup();
+    let mut net = Net::new();
+    let sample: Vec<u8> = big_sample()[..6000].to_vec();
+    let now = sim.now;
+    let sn = sim.nodes[0]
+        .p
+        .write(now, w, WriteChange::alive(sample.clone()))
+        .unwrap();
+    let mut hook = |_: usize, _: usize, m: &[u8]| Some(m.to_vec());
+    let mut got = Vec::new();
+    assert!(
+        net.run_until(&mut sim, Duration::from_secs(1), &mut hook, |s, _| {
+            got.extend(s.take_samples(1, r));
+            !got.is_empty()
+        })
+    );
+    assert_eq!(&got[0].payload[..], &sample[..]);
+    let from_w = subs_between(&net.log, 0, 1);
+    assert!(from_w.iter().any(
+        |s| matches!(s, Submessage::Data(d) if d.writer_id == w && d.writer_sn == sn && d.payload.map(<[u8]>::len) == Some(6000))
+    ));
+    assert!(!from_w
+        .iter()
+        .any(|s| matches!(s, Submessage::DataFrag(_) | Submessage::HeartbeatFrag(_))));
 }
 
 #[test]

@@ -324,7 +324,8 @@ pub struct Config {
     pub spdp_interval: Duration,
     /// Participant lease duration.
     pub lease_duration: Duration,
-    /// Payload bytes per DATA_FRAG fragment.
+    /// Payload bytes per DATA_FRAG fragment. User samples of which two fit one datagram of
+    /// `max_message_size` go whole, as one DATA; larger ones in fragments of this size.
     pub fragment_size: usize,
     /// Largest datagram we send.
     pub max_message_size: usize,

@@ -374,18 +374,18 @@ impl<T: DdsType> std::fmt::Debug for DataWriter<T> {
     }
 }
 
-/// Runs `f` on a cleared per-thread buffer (a fresh one if the thread's is in use), so that serializing a
-/// sample or its key allocates nothing once the buffer has grown.
-/// Buffers a writer's payload pool keeps: enough for the samples a reliable writer has in flight at the
-/// default flow-control window (512 KiB of 128-byte samples) and a history of a few thousand samples.
-/// Smaller samples get further ahead, and the pool then allocates for them: 32 768 buffers (enough at
-/// 16 B) cost more CPU at 16 B in interleaved runs than these allocations, because a buffer reused 26 000
-/// samples after its last use is cold while the allocator hands back the one just freed
-/// (docs/performance.md, session 19).
-const WRITER_POOL_BUFFERS: usize = 4096;
+/// Buffers a writer's payload pool keeps: it grows to the most samples the writer had in flight at once,
+/// up to 65 536 (the default 512 KiB window of 8-byte samples). With 4096 before, a writer further ahead
+/// (a 16 B writer has about 26 000 samples in flight) allocated a buffer per write. A pool of 32 768 had
+/// cost more CPU at 16 B in session 19 (a buffer reused 26 000 samples later is cold), so the pool now
+/// prefetches a buffer's bytes one take ahead as well as its counts (`docs/performance.md`, "Allocations
+/// per sample").
+const WRITER_POOL_BUFFERS: usize = 65_536;
 /// Bytes of capacity a writer's payload pool keeps: the largest flow-control window (4 MiB) four times.
 const WRITER_POOL_BYTES: usize = 16 << 20;
 
+/// Runs `f` on a cleared per-thread buffer (a fresh one if the thread's is in use), so that serializing a
+/// sample or its key allocates nothing once the buffer has grown.
 fn with_scratch<R>(f: impl FnOnce(&mut Vec<u8>) -> R) -> R {
     thread_local! {
         static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };

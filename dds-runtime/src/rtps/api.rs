@@ -312,7 +312,9 @@ participant_config! {
     initial_peers: Vec<Locator> = ref,
     /// Datagram payload limit for packing (default 14720, Cyclone's MaxMessageSize).
     max_message_size: usize = copy,
-    /// Samples larger than this go out as DATA_FRAG with fragments of this size (default 1344; ≤ 65535).
+    /// DATA_FRAG fragment size (default 1344; ≤ 65535). A user writer sends a sample whole, as one DATA,
+    /// when two fit one datagram of [`max_message_size`](Self::max_message_size) (with 256 bytes of headers),
+    /// and in fragments of this size when not; builtin writers fragment every sample larger than this.
     fragment_size: usize = copy,
     /// USER_DATA announced in SPDP.
     user_data: Vec<u8> = ref,

@@ -129,6 +129,7 @@ fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
         heartbeat_period: c.heartbeat_period,
         nack_response_delay: c.nack_response_delay,
         fragment_size: c.fragment_size,
+        whole_max: c.fragment_size,
         // Discovery data is never refused.
         high_watermark: usize::MAX,
         low_watermark: usize::MAX,
@@ -148,6 +149,7 @@ fn user_writer_params(c: &ParticipantConfig, q: &DataWriterQos, keyed: bool) -> 
         heartbeat_period: c.heartbeat_period,
         nack_response_delay: c.nack_response_delay,
         fragment_size: c.fragment_size,
+        whole_max: crate::rtps::writer::whole_sample_max(c.max_message_size, c.fragment_size),
         high_watermark: c.whc_high_watermark.max(1),
         low_watermark: c.whc_low_watermark.min(c.whc_high_watermark),
         max_repair_bytes: c.max_repair_bytes,

@@ -108,6 +108,20 @@ fn ours_pub_to_ddsperf_sub() -> Result<(), Skip> {
     Ok(())
 }
 
+/// 4 KiB samples go whole (one DATA each, larger than the 1344-byte fragment size): Cyclone takes them.
+#[test]
+fn ours_pub_4k_whole_to_ddsperf_sub_no_loss() {
+    let _ = ours_pub_4k_whole_to_ddsperf_sub();
+}
+
+fn ours_pub_4k_whole_to_ddsperf_sub() -> Result<(), Skip> {
+    require_netns()?;
+    let mut s = cyclone("sub", "-i 48 -D 8 sub")?;
+    let mut p = ours("pub", "-i 48 -D 6 pub 20kHz size 4k")?;
+    check_sub(&mut s, &mut p, 20_000);
+    Ok(())
+}
+
 #[test]
 fn ddsperf_pub_unthrottled_to_ours_sub_no_loss() {
     let _ = ddsperf_pub_unthrottled_to_ours_sub();

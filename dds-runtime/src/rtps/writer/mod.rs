@@ -45,6 +45,9 @@ pub(crate) struct WriterParams {
     pub heartbeat_period: Duration,
     pub nack_response_delay: Duration,
     pub fragment_size: usize,
+    /// Largest sample sent whole, as one DATA; larger ones go as DATA_FRAGs of `fragment_size`. At least
+    /// `fragment_size` (see [`whole_sample_max`]).
+    pub whole_max: usize,
     pub high_watermark: usize,
     pub low_watermark: usize,
     pub max_repair_bytes: usize,
@@ -152,6 +155,13 @@ impl Writer {
         self.history = HistoryCache::new(params.history, params.limits);
         self.window = flow::Window::new(params.high_watermark, params.low_watermark);
         self.params = params;
+    }
+
+    fn fragmenting(&self) -> Fragmenting {
+        Fragmenting {
+            size: self.params.fragment_size,
+            whole_max: self.params.whole_max.max(self.params.fragment_size),
+        }
     }
 
     fn durable(&self) -> bool {
@@ -383,7 +393,7 @@ impl Writer {
     /// HEARTBEAT_FRAG when reliable readers are matched.
     fn send_new(&mut self, sn: SequenceNumber, dest: &[Locator], out: &mut Outbox) {
         let wid = self.guid.entity_id;
-        let frag = self.params.fragment_size;
+        let frag = self.fragmenting();
         let Some(c) = self.history.get(sn) else {
             return;
         };
@@ -661,7 +671,7 @@ impl Writer {
 
     /// Sends what one reader asked for (bounded per round), GAPs for what is gone, then a heartbeat to it.
     fn repair(&mut self, now: Instant, g: Guid, out: &mut Outbox) {
-        let frag = self.params.fragment_size;
+        let frag = self.fragmenting();
         let wid = self.guid.entity_id;
         let reliable_writer = self.params.reliable;
         self.expire(now);
@@ -710,7 +720,7 @@ impl Writer {
             };
             if let Some(c) = self.history.get(sn) {
                 resend(c, Some(&frags));
-                budget -= (frags.len() * frag) as isize;
+                budget -= (frags.len() * frag.size) as isize;
             }
         }
         if reliable_writer && p.reliable {
@@ -819,7 +829,30 @@ fn inline_qos(c: &CacheChange, buf: &mut [u8; INLINE_QOS_MAX]) -> usize {
     n
 }
 
-/// Sends one change as DATA, or as DATA_FRAGs (all, or the listed fragments) when larger than `frag`.
+/// Room left in a datagram of `max_message_size` for the headers around one DATA: RTPS header,
+/// INFO_DST, INFO_TS, the DATA submessage header with its inline QoS, and a piggy-backed HEARTBEAT.
+const WHOLE_HEADROOM: usize = 256;
+
+/// The largest sample a user writer sends whole, as one DATA: two such samples fit one datagram of
+/// `max_message_size` (never less than `fragment_size`). Larger samples go as DATA_FRAGs of
+/// `fragment_size`. A sample of a few KiB sent whole saves, per fragment, a submessage at both ends, and
+/// per sample the reassembly and a HEARTBEAT_FRAG. Above half a datagram the fragments win: those of
+/// consecutive samples fill datagrams, where whole samples would go one per datagram (at 8 KiB, 1.17
+/// datagrams per sample, both ways, instead of 0.77, and more kernel time than the fragments saved; see
+/// `docs/performance.md`, "Session 20: 4 KiB").
+pub(crate) fn whole_sample_max(max_message_size: usize, fragment_size: usize) -> usize {
+    (max_message_size.saturating_sub(WHOLE_HEADROOM) / 2).max(fragment_size)
+}
+
+/// How a writer cuts a sample: whole up to `whole_max` bytes, else in fragments of `size`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Fragmenting {
+    pub size: usize,
+    pub whole_max: usize,
+}
+
+/// Sends one change as DATA, or as DATA_FRAGs (all, or the listed fragments) when larger than
+/// `frag.whole_max`.
 /// With `key_hash_only`, a key-only change (dispose/unregister) goes as DATA carrying only its inline QoS
 /// (key hash, status info): no serialized key, neither D nor K flag; the key hash identifies the instance.
 /// Returns the sample's number of fragments when it went as DATA_FRAGs, else 0.
@@ -831,7 +864,7 @@ pub(crate) fn send_change(
     rid: EntityId,
     wid: EntityId,
     c: &CacheChange,
-    frag: usize,
+    frag: Fragmenting,
     only: Option<&BTreeSet<u32>>,
     key_hash_only: bool,
 ) -> u32 {
@@ -856,7 +889,7 @@ pub(crate) fn send_change(
     let ts = Ts::Set(c.source_timestamp);
     let len = c.payload.len();
     let alive = c.kind == ChangeKind::Alive;
-    if len <= frag || frag == 0 || (key_hash_only && !alive) {
+    if len <= frag.whole_max || frag.size == 0 || (key_hash_only && !alive) {
         let marker = c.marks.is_marker();
         let payload = (!marker && (alive || (len > 0 && !key_hash_only))).then_some(&c.payload[..]);
         let d = Submessage::Data(Data {
@@ -871,6 +904,7 @@ pub(crate) fn send_change(
         out.push(dest, dst, ts, &d);
         return 0;
     }
+    let frag = frag.size;
     let total = len.div_ceil(frag) as u32;
     let mut send = |f: u32| {
         if f == 0 || f > total {
