@@ -18,8 +18,8 @@ pub(crate) const DISCOVERY_ACK_DELAY: Duration = Duration::from_millis(5);
 /// How long a user reader's pre-emptive ACKNACK to a newly matched writer waits. A peer's endpoints are
 /// matched one announcement at a time as they come; waiting lets the ACKNACKs of all our readers to one
 /// peer leave together (the first one due takes the others along, `Reader::send_acknacks_along`). Fast
-/// DDS waits 70 ms (`initial_acknack_delay`). Our writers do not need it: they push or announce their
-/// history at matching. A builtin reader's waits [`DISCOVERY_ACK_DELAY`], so that it leaves with the
+/// DDS waits 70 ms (`initial_acknack_delay`). Our volatile writers get none (see
+/// `Participant::add_proxy`). A builtin reader's waits [`DISCOVERY_ACK_DELAY`], so that it leaves with the
 /// acknowledgement of the peer's pushed announcements, which arrive at about the same time.
 pub(crate) const PREEMPTIVE_ACK_DELAY: Duration = Duration::from_millis(20);
 
@@ -146,13 +146,26 @@ impl Reader {
         Some(SequenceNumber(p.next_expected.0 - 1))
     }
 
-    pub(crate) fn add_proxy(&mut self, now: Instant, mut proxy: WriterProxy) {
+    /// Matches a writer; a reliable one gets a pre-emptive ACKNACK.
+    pub(crate) fn add_proxy(&mut self, now: Instant, proxy: WriterProxy) {
+        self.add_proxy_with(now, proxy, true);
+    }
+
+    /// Matches a writer, with or without a pre-emptive ACKNACK. Without: the reader waits for the writer's
+    /// DATA or HEARTBEAT, which is enough with a writer that owes a new reader nothing (volatile) or that
+    /// announces its history to it on matching (ours).
+    pub(crate) fn add_proxy_with(
+        &mut self,
+        now: Instant,
+        mut proxy: WriterProxy,
+        preemptive: bool,
+    ) {
         proxy.reliable &= self.params.reliable;
         proxy.coherent = Assembler::new(SetLimits {
             max_samples: self.params.reorder_max_samples,
             max_bytes: self.params.reorder_max_bytes,
         });
-        if proxy.reliable {
+        if proxy.reliable && preemptive {
             // Pre-emptive ACKNACK: prompts the writer to tell us what it has. Matches come in bursts
             // (a peer's announcements), so it waits for the others to the same peer.
             let wait = if self.guid.entity_id.is_builtin() {
