@@ -1,4 +1,9 @@
-//! Packs outgoing submessages into datagrams per (destinations, INFO_DST) up to max_message_size.
+//! Packs outgoing submessages into datagrams per destination list up to max_message_size.
+//!
+//! Submessages for several participants at one locator share a datagram: an INFO_DST switches the
+//! destination participant between them, as RTPS allows (§8.3.7.7). A submessage for every participant
+//! there (no INFO_DST) never follows one for a single participant in the same message: some receivers do
+//! not take INFO_DST(UNKNOWN) back to "everyone", so such a submessage starts a message of its own.
 //!
 //! Open messages normally close at the next drain. Batched writes (`hold`) leave them open until they
 //! fill up, an explicit flush, any unbatched traffic, or the batch delay runs out, so that a burst of small
@@ -78,6 +83,20 @@ impl Outbox {
         r
     }
 
+    /// The participants that open messages to a single locator are addressed to (INFO_DST in force), and
+    /// that locator, into `into` (cleared first): traffic to them may join those messages.
+    pub(crate) fn open_participants(&self, into: &mut Vec<(GuidPrefix, Locator)>) {
+        into.clear();
+        into.extend(
+            self.pending
+                .iter()
+                .filter_map(|p| match (p.dst, &p.destinations[..]) {
+                    (Some(d), [l]) => Some((d, *l)),
+                    _ => None,
+                }),
+        );
+    }
+
     /// Asks for every open message to be closed at the next drain.
     pub(crate) fn request_flush(&mut self) {
         self.flush_due = true;
@@ -88,14 +107,22 @@ impl Outbox {
         self.held_since.map(|t| t + delay)
     }
 
+    /// The message a submessage for (`destinations`, `dst`) joins: the last one opened for `destinations`
+    /// (so that what goes to one locator keeps its order) when its INFO_DST is `dst` or may switch to it;
+    /// else a new one.
     fn open(&mut self, destinations: &[Locator], dst: Option<GuidPrefix>) -> usize {
-        if let Some(i) = self
+        let last = self
             .pending
             .iter()
-            .position(|p| p.dst == dst && p.destinations == destinations)
-        {
+            .rposition(|p| p.destinations == destinations);
+        if let Some(i) = last.filter(|&i| dst.is_some() || self.pending[i].dst.is_none()) {
             return i;
         }
+        self.fresh(destinations, dst)
+    }
+
+    /// A new message for (`destinations`, `dst`).
+    fn fresh(&mut self, destinations: &[Locator], dst: Option<GuidPrefix>) -> usize {
         let mut buf = self.pool.pop().unwrap_or_default();
         buf.clear();
         self.header.write(&mut buf);
@@ -135,8 +162,9 @@ impl Outbox {
         let i = self.open(destinations, dst);
         let p = &mut self.pending[i];
         let before = p.buf.len();
-        let (ts_before, header_before) = (p.ts, p.last_header);
+        let (ts_before, header_before, dst_before) = (p.ts, p.last_header, p.dst);
         let saved_len = header_before.map(|h| (h, [p.buf[h + 2], p.buf[h + 3]]));
+        write_dst(p, dst);
         write_ts(p, ts);
         append(&mut p.buf, &mut p.last_header, sub, true);
         if p.buf.len() > self.max && before > p.preamble {
@@ -148,12 +176,13 @@ impl Outbox {
             }
             p.ts = ts_before;
             p.last_header = header_before;
+            p.dst = dst_before;
             let done = self.pending.swap_remove(i);
             self.ready.push_back(Transmit {
                 destinations: done.destinations,
                 payload: done.buf,
             });
-            let i = self.open(destinations, dst);
+            let i = self.fresh(destinations, dst);
             let p = &mut self.pending[i];
             write_ts(p, ts);
             append(&mut p.buf, &mut p.last_header, sub, true);
@@ -202,11 +231,88 @@ impl Outbox {
     }
 }
 
+/// Switches the message's destination participant to `dst` (`open` only joins a `Some` to another).
+fn write_dst(p: &mut Pending, dst: Option<GuidPrefix>) {
+    if let (Some(d), true) = (dst, p.dst != dst) {
+        append(
+            &mut p.buf,
+            &mut p.last_header,
+            &Submessage::InfoDst(d),
+            true,
+        );
+        p.dst = dst;
+    }
+}
+
 fn write_ts(p: &mut Pending, ts: Ts) {
     if let Ts::Set(t) = ts {
         if p.ts != t {
             append(&mut p.buf, &mut p.last_header, &Submessage::InfoTs(t), true);
             p.ts = t;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rtps::messages::{Gap, MessageIter};
+
+    fn gap(n: i64) -> Submessage<'static> {
+        Submessage::Gap(Gap {
+            reader_id: EntityId::UNKNOWN,
+            writer_id: EntityId::SEDP_PUBLICATIONS_WRITER,
+            gap_start: SequenceNumber(n),
+            gap_list: SequenceNumberSet::empty(SequenceNumber(n + 1)),
+        })
+    }
+
+    fn outbox() -> Outbox {
+        let header = Header {
+            version: ProtocolVersion::V2_5,
+            vendor_id: VendorId::THIS,
+            guid_prefix: GuidPrefix([9; 12]),
+        };
+        Outbox::new(header, 14720)
+    }
+
+    /// Each datagram as (INFO_DST in force, gap start) per submessage.
+    fn sent(o: &mut Outbox) -> Vec<Vec<(Option<GuidPrefix>, i64)>> {
+        let mut all = Vec::new();
+        while let Some(t) = o.pop(Instant::now(), Duration::ZERO) {
+            let (_, it) = MessageIter::parse(&t.payload).unwrap();
+            let mut dst = None;
+            let mut subs = Vec::new();
+            for s in it.flatten() {
+                match s {
+                    Submessage::InfoDst(d) => dst = Some(d),
+                    Submessage::Gap(g) => subs.push((dst, g.gap_start.0)),
+                    _ => {}
+                }
+            }
+            all.push(subs);
+        }
+        all
+    }
+
+    #[test]
+    fn submessages_for_several_participants_at_one_locator_share_a_datagram() {
+        let l = [Locator::udpv4([10, 0, 0, 1], 7410)];
+        let (a, b) = (Some(GuidPrefix([1; 12])), Some(GuidPrefix([2; 12])));
+        let mut o = outbox();
+        o.push(&l, None, Ts::Any, &gap(1));
+        o.push(&l, a, Ts::Any, &gap(2));
+        o.push(&l, b, Ts::Any, &gap(3));
+        o.push(&l, b, Ts::Any, &gap(4));
+        // For everyone again: not after an INFO_DST, so a message of its own.
+        o.push(&l, None, Ts::Any, &gap(5));
+        o.push(&l, a, Ts::Any, &gap(6));
+        assert_eq!(
+            sent(&mut o),
+            vec![
+                vec![(None, 1), (a, 2), (b, 3), (b, 4)],
+                vec![(None, 5), (a, 6)]
+            ]
+        );
     }
 }

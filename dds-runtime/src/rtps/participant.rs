@@ -74,6 +74,8 @@ pub struct Participant {
     known_topics: HashMap<Guid, super::discovery::TopicData>,
     /// Reused buffer for what readers deliver while a datagram is processed.
     scratch: Vec<Event>,
+    /// Reused by each pass: the participants open messages go to (`timers::reader_timeouts`).
+    open_scratch: Vec<(GuidPrefix, Locator)>,
     /// Reusable buffers of received samples (see `pool.rs`).
     rx_pools: crate::rtps::pool::ReceivePools,
     writers: BTreeMap<EntityId, Writer>,
@@ -167,6 +169,7 @@ fn reader_params(c: &ParticipantConfig, reliable: bool) -> ReaderParams {
     ReaderParams {
         reliable,
         heartbeat_response_delay: c.heartbeat_response_delay,
+        ack_delay: c.heartbeat_response_delay,
         max_sample_size: c.max_sample_size,
         defrag_max_samples: c.defrag_max_samples.max(1),
         defrag_max_bytes: c.defrag_max_bytes,
@@ -194,6 +197,7 @@ impl Participant {
             deferred: Default::default(),
             known_topics: HashMap::new(),
             scratch: Vec::new(),
+            open_scratch: Vec::new(),
             rx_pools: Default::default(),
             writers: BTreeMap::new(),
             readers: BTreeMap::new(),

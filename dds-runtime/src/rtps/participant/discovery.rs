@@ -474,8 +474,17 @@ impl Participant {
                 let reliable = wd.qos.writer.reliability.is_reliable();
                 let liveliness = wd.qos.writer.liveliness;
                 let locators = self.endpoint_locators(wd);
+                // One of our volatile writers owes a new reader nothing, and says so with its first DATA
+                // or HEARTBEAT: no pre-emptive ACKNACK, which at scale is one submessage per match
+                // (docs/performance.md, "Scale"). Other implementations' writers may wait for one.
+                let ours = self
+                    .participants
+                    .get(&remote.prefix)
+                    .is_none_or(|p| p.data.vendor_id == VendorId::THIS);
+                let preemptive = !ours || wd.qos.writer.durability >= Durability::TransientLocal;
                 if let Some(r) = self.readers.get_mut(&id) {
-                    r.add_proxy(now, WriterProxy::new(remote, locators, reliable));
+                    let proxy = WriterProxy::new(remote, locators, reliable);
+                    r.add_proxy_with(now, proxy, preemptive);
                     self.readers_by_writer.clear();
                     self.track_liveliness(now, remote, id, &liveliness);
                 }

@@ -11,6 +11,7 @@ use crate::rtps::discovery::builtin;
 use crate::rtps::messages::parameter::{pid, ParameterWriter};
 use crate::rtps::messages::{Data, ParameterList, Submessage};
 use crate::rtps::outbox::Ts;
+use crate::rtps::reader::{Reader, DISCOVERY_ACK_DELAY};
 use crate::rtps::types::*;
 
 /// Longest the cached timer floor goes without a full pass over the endpoints (a safety net: every path
@@ -146,16 +147,36 @@ impl Participant {
                 w.on_timeout(now, &mut self.out);
             }
         }
-        for r in self.readers.values_mut() {
-            if r.next_timeout().is_some_and(|t| t <= now) {
-                r.on_timeout(now, &mut self.out);
-            }
-        }
+        self.reader_timeouts(now);
         self.last_full_scan = now;
         self.timers_changed();
     }
 
-    /// Sends our SPDP announcement to the SPDP multicast locators and initial peers, or to `to` only.
+    /// Sends the readers' due ACKNACKs. Once one is due, those due within [`DISCOVERY_ACK_DELAY`] leave
+    /// with it: the acknowledgements of all our readers to one peer then share a datagram, where each
+    /// would otherwise leave alone as the heartbeats it answers came in one by one.
+    /// Armed ACKNACKs to a participant that a message of this pass goes to anyway leave in it.
+    fn reader_timeouts(&mut self, now: Instant) {
+        let mut open = std::mem::take(&mut self.open_scratch);
+        self.out.open_participants(&mut open);
+        for &(prefix, to) in &open {
+            for r in self.readers.values_mut() {
+                r.send_acknacks_along(prefix, to, &mut self.out);
+            }
+        }
+        self.open_scratch = open;
+        let due = |r: &Reader, t: Instant| r.next_timeout().is_some_and(|x| x <= t);
+        if !self.readers.values().any(|r| due(r, now)) {
+            return;
+        }
+        let until = now + DISCOVERY_ACK_DELAY;
+        for r in self.readers.values_mut() {
+            if due(r, until) {
+                r.on_timeout(until, &mut self.out);
+            }
+        }
+    }
+
     /// Gives back the room a burst left in the event queues (thousands of SEDP samples arrive in one pass
     /// when a peer with many endpoints appears): done once per SPDP period, so a steady stream does not
     /// shrink and regrow them.
@@ -164,6 +185,7 @@ impl Participant {
         self.events.shrink_to(KEPT_QUEUE_ROOM);
     }
 
+    /// Sends our SPDP announcement to the SPDP multicast locators and initial peers, or to `to` only.
     pub(super) fn send_spdp(&mut self, to: Option<Vec<Locator>>) {
         let dest = to.unwrap_or_else(|| {
             let mut d = self.config.metatraffic_multicast.clone();

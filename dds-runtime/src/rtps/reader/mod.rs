@@ -8,6 +8,21 @@ mod writer_proxy;
 
 pub(crate) use writer_proxy::{PendingChange, Slot, WriterProxy};
 
+/// How long an ACKNACK that asks for nothing waits when it only serves discovery: a builtin reader's
+/// acknowledgement and any reader's pre-emptive ACKNACK to a newly matched writer. The ACKNACKs that
+/// fall due within this window leave in one pass of the participant, so those for one peer share a
+/// datagram (RTPS 2.5 §8.4.12.1, heartbeatResponseDelay; Fast DDS waits 5 ms too). An ACKNACK that asks
+/// for changes is not delayed by it: repair latency is unchanged.
+pub(crate) const DISCOVERY_ACK_DELAY: Duration = Duration::from_millis(5);
+
+/// How long a user reader's pre-emptive ACKNACK to a newly matched writer waits. A peer's endpoints are
+/// matched one announcement at a time as they come; waiting lets the ACKNACKs of all our readers to one
+/// peer leave together (the first one due takes the others along, `Reader::send_acknacks_along`). Fast
+/// DDS waits 70 ms (`initial_acknack_delay`). Our volatile writers get none (see
+/// `Participant::add_proxy`). A builtin reader's waits [`DISCOVERY_ACK_DELAY`], so that it leaves with the
+/// acknowledgement of the peer's pushed announcements, which arrive at about the same time.
+pub(crate) const PREEMPTIVE_ACK_DELAY: Duration = Duration::from_millis(20);
+
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
@@ -40,7 +55,11 @@ fn inline_qos_understood(q: Option<&crate::rtps::messages::ParameterList<'_>>) -
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ReaderParams {
     pub reliable: bool,
+    /// Delay before an ACKNACK that asks for missing changes.
     pub heartbeat_response_delay: Duration,
+    /// Delay before an ACKNACK that asks for nothing (a pure acknowledgement). For a builtin reader it is
+    /// at least [`DISCOVERY_ACK_DELAY`].
+    pub ack_delay: Duration,
     pub max_sample_size: usize,
     pub defrag_max_samples: usize,
     pub defrag_max_bytes: usize,
@@ -63,7 +82,10 @@ pub(crate) struct Reader {
 }
 
 impl Reader {
-    pub(crate) fn new(guid: Guid, params: ReaderParams) -> Self {
+    pub(crate) fn new(guid: Guid, mut params: ReaderParams) -> Self {
+        if guid.entity_id.is_builtin() {
+            params.ack_delay = params.ack_delay.max(DISCOVERY_ACK_DELAY);
+        }
         Reader {
             guid,
             params,
@@ -124,15 +146,34 @@ impl Reader {
         Some(SequenceNumber(p.next_expected.0 - 1))
     }
 
-    pub(crate) fn add_proxy(&mut self, now: Instant, mut proxy: WriterProxy) {
+    /// Matches a writer; a reliable one gets a pre-emptive ACKNACK.
+    pub(crate) fn add_proxy(&mut self, now: Instant, proxy: WriterProxy) {
+        self.add_proxy_with(now, proxy, true);
+    }
+
+    /// Matches a writer, with or without a pre-emptive ACKNACK. Without: the reader waits for the writer's
+    /// DATA or HEARTBEAT, which is enough with a writer that owes a new reader nothing (volatile) or that
+    /// announces its history to it on matching (ours).
+    pub(crate) fn add_proxy_with(
+        &mut self,
+        now: Instant,
+        mut proxy: WriterProxy,
+        preemptive: bool,
+    ) {
         proxy.reliable &= self.params.reliable;
         proxy.coherent = Assembler::new(SetLimits {
             max_samples: self.params.reorder_max_samples,
             max_bytes: self.params.reorder_max_bytes,
         });
-        if proxy.reliable {
-            // Pre-emptive ACKNACK: prompts the writer to tell us what it has.
-            proxy.acknack_due = Some(now);
+        if proxy.reliable && preemptive {
+            // Pre-emptive ACKNACK: prompts the writer to tell us what it has. Matches come in bursts
+            // (a peer's announcements), so it waits for the others to the same peer.
+            let wait = if self.guid.entity_id.is_builtin() {
+                DISCOVERY_ACK_DELAY
+            } else {
+                PREEMPTIVE_ACK_DELAY
+            };
+            proxy.acknack_due = Some(now + wait);
         }
         self.due.arm(proxy.acknack_due, proxy.guid);
         self.proxies.insert(proxy.guid, Box::new(proxy));
@@ -471,7 +512,7 @@ impl Reader {
         out: &mut Vec<Event>,
     ) {
         let rid = self.guid.entity_id;
-        let delay = self.params.heartbeat_response_delay;
+        let (delay, ack_delay) = (self.params.heartbeat_response_delay, self.params.ack_delay);
         let Some(p) = self.proxies.get_mut(&writer) else {
             return;
         };
@@ -510,9 +551,13 @@ impl Reader {
         }
         p.synced = true;
         let missing = p.hb_last >= p.next_expected;
-        if (!hb.final_flag || missing) && p.acknack_due.is_none() {
-            p.acknack_due = Some(now + delay);
-            self.due.arm(p.acknack_due, writer);
+        if !hb.final_flag || missing {
+            // Asking for changes goes soon; a pure acknowledgement may wait for others to share its datagram.
+            let due = now + if missing { delay } else { ack_delay };
+            if p.acknack_due.is_none_or(|t| t > due) {
+                p.acknack_due = Some(due);
+                self.due.arm(p.acknack_due, writer);
+            }
         }
     }
 
@@ -561,21 +606,44 @@ impl Reader {
         self.due.next()
     }
 
-    /// Sends due ACKNACKs (and NACK_FRAGs for partly received samples), and NACK_FRAGs answering
-    /// HEARTBEAT_FRAGs.
+    /// Sends the ACKNACKs (and NACK_FRAGs for partly received samples), and NACK_FRAGs answering
+    /// HEARTBEAT_FRAGs, due by `until`: the participant passes a time a little after now once something
+    /// is due, so that what would fall due shortly leaves in the same pass (and shares datagrams).
     /// Only the proxies whose timer is due are visited (in deadline order), not every proxy.
-    pub(crate) fn on_timeout(&mut self, now: Instant, out: &mut Outbox) {
+    pub(crate) fn on_timeout(&mut self, until: Instant, out: &mut Outbox) {
         let rid = self.guid.entity_id;
-        while let Some(g) = self.due.pop_due(now) {
+        while let Some(g) = self.due.pop_due(until) {
             // A stale entry (timer cleared, proxy gone) finds nothing due.
             let Some(p) = self.proxies.get_mut(&g) else {
                 continue;
             };
-            if p.acknack_due.is_some_and(|t| t <= now) {
+            if p.acknack_due.is_some_and(|t| t <= until) {
                 Self::send_acknack(rid, p, out);
             }
-            if p.nackfrag_due().is_some_and(|t| t <= now) {
+            if p.nackfrag_due().is_some_and(|t| t <= until) {
                 Self::send_requested_nackfrags(rid, p, out);
+            }
+        }
+    }
+
+    /// Sends now the armed ACKNACKs to the writers of participant `prefix` reached at `to`: a message to
+    /// that locator is leaving anyway, and they share it. Visits only that participant's proxies. The
+    /// pre-emptive ACKNACK to a builtin writer we have heard nothing from keeps waiting: that writer
+    /// pushes its history at matching, and an ACKNACK sent after the push acknowledges it, where one sent
+    /// now would cross it and ask for another heartbeat.
+    pub(crate) fn send_acknacks_along(
+        &mut self,
+        prefix: GuidPrefix,
+        to: Locator,
+        out: &mut Outbox,
+    ) {
+        let rid = self.guid.entity_id;
+        let first = Guid::new(prefix, EntityId([0; 4]));
+        let last = Guid::new(prefix, EntityId([0xff; 4]));
+        for p in self.proxies.range_mut(first..=last).map(|(_, p)| p) {
+            let may = p.synced || !p.guid.entity_id.is_builtin();
+            if may && p.acknack_due.is_some() && p.destination() == [to] {
+                Self::send_acknack(rid, p, out);
             }
         }
     }
