@@ -12,8 +12,8 @@ use crate::xtypes::typeobject::{
 
 use super::error::DynamicError;
 use super::types::{
-    BitFlag, BitmaskType, DynamicType, EnumType, Enumerator, Member, Primitive, StructType,
-    TypeKind, UnionCase, UnionType,
+    close_forward, BitFlag, BitmaskType, DynamicType, EnumType, Enumerator, Member, Primitive,
+    StructType, TypeKind, UnionCase, UnionType,
 };
 
 /// Deepest chain of type references followed (a hostile cycle of hashes ends here).
@@ -61,6 +61,16 @@ impl DynamicType {
             &info.minimal.typeid_with_size.type_id
         };
         DynamicType::from_type_identifier(root, &|id| objects.get(id).cloned())
+    }
+}
+
+/// An identifier for messages: its hash (and component index).
+fn describe(id: &TypeIdentifier) -> String {
+    match id {
+        TypeIdentifier::StronglyConnected(c) => {
+            format!("component {:02x?} #{}", c.hash, c.scc_index)
+        }
+        _ => format!("{:02x?}", id.hash().unwrap_or(&[0; 14])),
     }
 }
 
@@ -141,30 +151,45 @@ impl Resolver<'_> {
                 key,
                 ..
             } => DynamicType::map(self.resolve(key, d)?, self.resolve(element, d)?, bound(*b)),
-            TypeIdentifier::StronglyConnected(_) => {
-                return Err(DynamicError::Unresolved(
-                    "recursive types (strongly connected components)".into(),
-                ))
-            }
-            TypeIdentifier::Minimal(_) | TypeIdentifier::Complete(_) => {
-                if let Some(t) = self.done.get(id) {
-                    return Ok(t.clone());
-                }
-                let obj = (self.lookup)(id).ok_or_else(|| {
-                    DynamicError::Unresolved(format!(
-                        "no type object for {:02x?}",
-                        id.hash().unwrap_or(&[0; 14])
-                    ))
-                })?;
-                let body = match &*obj {
-                    TypeObject::Minimal(m) => &m.0,
-                    TypeObject::Complete(c) => &c.0,
-                };
-                let t = self.body(body, d)?;
-                self.done.insert(id.clone(), t.clone());
-                t
-            }
+            TypeIdentifier::StronglyConnected(_)
+            | TypeIdentifier::Minimal(_)
+            | TypeIdentifier::Complete(_) => self.named(id, d)?,
         })
+    }
+
+    /// A hashed type, or one type of a strongly connected component (a recursive type): while its object is
+    /// turned into a type, a reference back to it (a cycle of the component) gets a forward reference, which
+    /// the type then defines.
+    fn named(&mut self, id: &TypeIdentifier, d: u32) -> Result<DynamicType, DynamicError> {
+        if let Some(t) = self.done.get(id) {
+            return Ok(t.clone());
+        }
+        let obj = (self.lookup)(id).ok_or_else(|| {
+            DynamicError::Unresolved(format!("no type object for {}", describe(id)))
+        })?;
+        let body = match &*obj {
+            TypeObject::Minimal(m) => &m.0,
+            TypeObject::Complete(c) => &c.0,
+        };
+        let forward = matches!(id, TypeIdentifier::StronglyConnected(_)).then(|| {
+            let f = DynamicType::forward(type_name(body));
+            self.done.insert(id.clone(), f.clone());
+            f
+        });
+        let t = self.body(body, d);
+        match (&t, forward) {
+            (Ok(t), Some(f)) => {
+                self.done.insert(id.clone(), t.clone());
+                close_forward(f, t)?;
+            }
+            (Ok(t), None) => {
+                self.done.insert(id.clone(), t.clone());
+            }
+            (Err(_), _) => {
+                self.done.remove(id);
+            }
+        }
+        t
     }
 
     fn body(&mut self, body: &TypeBody, d: u32) -> Result<DynamicType, DynamicError> {

@@ -9,10 +9,10 @@ use super::types::{DynamicType, EnumType, StructType, TypeKind, UnionType};
 impl DynamicType {
     /// The type as IDL: every named type it depends on first, each in its modules, then the type itself.
     pub fn to_idl(&self) -> String {
-        let mut order: Vec<DynamicType> = Vec::new();
-        collect(self, &mut order, 0);
+        let mut c = Collector::default();
+        c.collect(self, 0);
         let mut out = String::new();
-        for t in &order {
+        for t in &c.order {
             declare(t, &mut out);
         }
         out
@@ -133,50 +133,75 @@ fn is_named(t: &DynamicType) -> bool {
     )
 }
 
-/// Named types in dependency order (post-order), each once.
-fn collect(t: &DynamicType, order: &mut Vec<DynamicType>, depth: u32) {
-    if depth > 64 || (is_named(t) && order.iter().any(|x| x.name() == t.name())) {
-        return;
-    }
-    match t.kind() {
-        TypeKind::Struct(s) => {
-            if let Some(b) = &s.base {
-                collect(b, order, depth + 1);
-            }
-            for m in s.own_members() {
-                collect(&m.ty, order, depth + 1);
-            }
-        }
-        TypeKind::Union(u) => {
-            collect(&u.discriminator, order, depth + 1);
-            for c in &u.cases {
-                collect(&c.ty, order, depth + 1);
-            }
-        }
-        TypeKind::Alias { target, .. } => collect(target, order, depth + 1),
-        TypeKind::Array { element, .. } => collect(element, order, depth + 1),
-        TypeKind::Sequence { element, .. } => collect_element(element, order, depth + 1),
-        TypeKind::Map { key, value, .. } => {
-            collect_element(key, order, depth + 1);
-            collect_element(value, order, depth + 1);
-        }
-        _ => {}
-    }
-    if is_named(t) {
-        order.push(t.clone());
-    }
+/// Named types in dependency order (post-order), each once; a recursive type used before its declaration
+/// is declared forward first (`struct Node;`: [`TypeKind::Forward`] in `order`).
+#[derive(Default)]
+struct Collector {
+    order: Vec<DynamicType>,
+    /// The named types being collected (their members are being walked).
+    busy: Vec<String>,
 }
 
-/// A sequence's element or a map's key or value: an anonymous array there has no IDL spelling, so it gets a
-/// generated typedef ([`array_typedef_name`]), declared before its first use.
-fn collect_element(t: &DynamicType, order: &mut Vec<DynamicType>, depth: u32) {
-    collect(t, order, depth);
-    if matches!(t.kind(), TypeKind::Array { .. }) {
-        collect(
-            &DynamicType::alias(array_typedef_name(t), t.clone()),
-            order,
-            depth,
-        );
+impl Collector {
+    fn has(&self, name: &str, forward: bool) -> bool {
+        self.order
+            .iter()
+            .any(|x| matches!(x.kind(), TypeKind::Forward(_)) == forward && x.name() == name)
+    }
+
+    fn collect(&mut self, t: &DynamicType, depth: u32) {
+        if depth > 64 || (is_named(t) && self.has(&t.name(), false)) {
+            return;
+        }
+        let d = depth + 1;
+        match t.kind() {
+            TypeKind::Forward(r) => {
+                let busy = self.busy.iter().any(|b| b == r.name());
+                match r.target() {
+                    Some(_) if busy && !self.has(r.name(), true) => self.order.push(t.clone()),
+                    Some(target) if !busy => self.collect(target, d),
+                    _ => {}
+                }
+            }
+            TypeKind::Struct(s) => {
+                self.busy.push(s.name.clone());
+                if let Some(b) = &s.base {
+                    self.collect(b, d);
+                }
+                for m in s.own_members() {
+                    self.collect(&m.ty, d);
+                }
+                self.busy.pop();
+            }
+            TypeKind::Union(u) => {
+                self.busy.push(u.name.clone());
+                self.collect(&u.discriminator, d);
+                for c in &u.cases {
+                    self.collect(&c.ty, d);
+                }
+                self.busy.pop();
+            }
+            TypeKind::Alias { target, .. } => self.collect(target, d),
+            TypeKind::Array { element, .. } => self.collect(element, d),
+            TypeKind::Sequence { element, .. } => self.collect_element(element, d),
+            TypeKind::Map { key, value, .. } => {
+                self.collect_element(key, d);
+                self.collect_element(value, d);
+            }
+            _ => {}
+        }
+        if is_named(t) {
+            self.order.push(t.clone());
+        }
+    }
+
+    /// A sequence's element or a map's key or value: an anonymous array there has no IDL spelling, so it gets a
+    /// generated typedef ([`array_typedef_name`]), declared before its first use.
+    fn collect_element(&mut self, t: &DynamicType, depth: u32) {
+        self.collect(t, depth);
+        if matches!(t.kind(), TypeKind::Array { .. }) {
+            self.collect(&DynamicType::alias(array_typedef_name(t), t.clone()), depth);
+        }
     }
 }
 
@@ -227,7 +252,7 @@ fn spelling(t: &DynamicType) -> String {
             None => format!("map<{}, {}>", spelling(key), spelling(value)),
         },
         TypeKind::Array { .. } => array_typedef_name(t),
-        _ if is_named(t) => scoped(&t.name()),
+        _ if is_named(t) || matches!(t.kind(), TypeKind::Forward(_)) => scoped(&t.name()),
         _ => t.name(),
     }
 }
@@ -283,6 +308,13 @@ fn declare(t: &DynamicType, out: &mut String) {
         }
         TypeKind::Alias { target, .. } => {
             let _ = writeln!(out, "{ind}typedef {};", decl(target, raw));
+        }
+        TypeKind::Forward(r) => {
+            let what = match r.target().map(|t| t.resolved().kind()) {
+                Some(TypeKind::Union(_)) => "union",
+                _ => "struct",
+            };
+            let _ = writeln!(out, "{ind}{what} {local};");
         }
         _ => {}
     }

@@ -88,6 +88,10 @@ impl Lowering {
                 key: Box::new(self.shape(key)?),
                 value: Box::new(self.shape(value)?),
             },
+            TypeKind::Forward(r) => match r.target() {
+                Some(t) => self.shape(t)?,
+                None => return Err(BuildError::Unsupported("an undefined forward reference")),
+            },
             TypeKind::Alias { .. }
             | TypeKind::Enum(_)
             | TypeKind::Bitmask(_)
