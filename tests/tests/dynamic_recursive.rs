@@ -385,3 +385,26 @@ fn forward_references_are_checked() {
         .unwrap();
     assert!(dangling.type_support().is_err());
 }
+
+#[test]
+fn component_objects_that_do_not_hash_to_their_identifier_are_refused() {
+    let (info, map) = golden("Node");
+    let info: TypeInformation = from_bytes(&unhex(&info)).unwrap();
+    let mut map: TypeMapping = from_bytes(&unhex(&map)).unwrap();
+    // Another struct name in the complete object: the component's hash no longer covers it.
+    for p in &mut map.identifier_object_pair_complete {
+        let TypeIdentifier::StronglyConnected(_) = &p.type_identifier else {
+            continue;
+        };
+        let mut bytes = dds_runtime::xtypes::typeobject::to_bytes(&p.type_object).unwrap();
+        let at = bytes
+            .windows(4)
+            .position(|w| w == b"Node")
+            .expect("the name");
+        bytes[at] = b'M';
+        p.type_object = from_bytes(&bytes).unwrap();
+    }
+    map.identifier_object_pair_minimal.clear();
+    let e = DynamicType::from_type_mapping(&info, &map).unwrap_err();
+    assert!(e.to_string().contains("hash"), "{e}");
+}

@@ -18,7 +18,7 @@ use super::typeobject::{
 };
 
 /// Most types in one learnt strongly connected component.
-const MAX_COMPONENT: i32 = 256;
+pub(crate) const MAX_COMPONENT: i32 = 256;
 
 /// Whether the store and the TypeLookup service deal in `id`: a hash, or a strongly connected component's.
 pub fn is_lookup_id(id: &TypeIdentifier) -> bool {
@@ -299,21 +299,8 @@ impl TypeStore {
         if self.contains(&member_id(c, 0)) {
             return Ok(false);
         }
-        let ek = match c.kind {
-            EquivalenceKind::Minimal => kind::EK_MINIMAL,
-            _ => kind::EK_COMPLETE,
-        };
-        let mut sizes = Vec::with_capacity(pairs.len());
-        let mut zeroed = Vec::with_capacity(pairs.len());
-        for o in by_index.iter().flatten() {
-            let bytes = to_bytes(*o).map_err(|_| StoreError::Unencodable)?;
-            sizes.push(bytes.len());
-            zeroed.push(zero_hash(bytes, ek, &c.hash));
-        }
-        let whole = super::build::component_sequence(&zeroed);
-        if super::typeobject::equivalence_hash(&whole) != c.hash {
-            return Err(StoreError::HashMismatch);
-        }
+        let objects: Vec<&TypeObject> = by_index.iter().flatten().copied().collect();
+        let sizes = verify_component(c, &objects)?;
         let total: usize = sizes.iter().sum();
         if self.learnt + pairs.len() > self.limits.max_learnt
             || self.learnt_bytes + total > self.limits.max_learnt_bytes
@@ -350,6 +337,31 @@ impl TypeStore {
         }
         out
     }
+}
+
+/// Checks that the objects of the types of component `c`, by index, hash to its hash (serialized with the
+/// hash zeroed where they name each other, in a sequence: how `TypeSupport` builds them). Their serialized
+/// sizes.
+pub(crate) fn verify_component(
+    c: StronglyConnectedComponentId,
+    objects: &[&TypeObject],
+) -> Result<Vec<usize>, StoreError> {
+    let ek = match c.kind {
+        EquivalenceKind::Minimal => kind::EK_MINIMAL,
+        _ => kind::EK_COMPLETE,
+    };
+    let mut sizes = Vec::with_capacity(objects.len());
+    let mut zeroed = Vec::with_capacity(objects.len());
+    for o in objects {
+        let bytes = to_bytes(*o).map_err(|_| StoreError::Unencodable)?;
+        sizes.push(bytes.len());
+        zeroed.push(zero_hash(bytes, ek, &c.hash));
+    }
+    let whole = super::build::component_sequence(&zeroed);
+    if super::typeobject::equivalence_hash(&whole) != c.hash {
+        return Err(StoreError::HashMismatch);
+    }
+    Ok(sizes)
 }
 
 /// `bytes` with each `ek` octet followed by `hash` (a component identifier naming its own component) turned

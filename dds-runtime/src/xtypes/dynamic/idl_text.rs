@@ -12,8 +12,8 @@ impl DynamicType {
         let mut c = Collector::default();
         c.collect(self, 0);
         let mut out = String::new();
-        for t in &c.order {
-            declare(t, &mut out);
+        for (t, forward) in &c.order {
+            declare(t, *forward, &mut out);
         }
         out
     }
@@ -134,10 +134,10 @@ fn is_named(t: &DynamicType) -> bool {
 }
 
 /// Named types in dependency order (post-order), each once; a recursive type used before its declaration
-/// is declared forward first (`struct Node;`: [`TypeKind::Forward`] in `order`).
+/// is declared forward first (`struct Node;`: `true` in `order`).
 #[derive(Default)]
 struct Collector {
-    order: Vec<DynamicType>,
+    order: Vec<(DynamicType, bool)>,
     /// The named types being collected (their members are being walked).
     busy: Vec<String>,
 }
@@ -146,23 +146,25 @@ impl Collector {
     fn has(&self, name: &str, forward: bool) -> bool {
         self.order
             .iter()
-            .any(|x| matches!(x.kind(), TypeKind::Forward(_)) == forward && x.name() == name)
+            .any(|(x, f)| *f == forward && x.name() == name)
     }
 
     fn collect(&mut self, t: &DynamicType, depth: u32) {
+        let t = t.unforwarded();
         if depth > 64 || (is_named(t) && self.has(&t.name(), false)) {
+            return;
+        }
+        let back_edge = matches!(t.kind(), TypeKind::Struct(_) | TypeKind::Union(_))
+            && self.busy.contains(&t.name());
+        if back_edge {
+            // A recursive type met again while its members are walked: declared forward before its users.
+            if !self.has(&t.name(), true) {
+                self.order.push((t.clone(), true));
+            }
             return;
         }
         let d = depth + 1;
         match t.kind() {
-            TypeKind::Forward(r) => {
-                let busy = self.busy.iter().any(|b| b == r.name());
-                match r.target() {
-                    Some(_) if busy && !self.has(r.name(), true) => self.order.push(t.clone()),
-                    Some(target) if !busy => self.collect(target, d),
-                    _ => {}
-                }
-            }
             TypeKind::Struct(s) => {
                 self.busy.push(s.name.clone());
                 if let Some(b) = &s.base {
@@ -191,7 +193,7 @@ impl Collector {
             _ => {}
         }
         if is_named(t) {
-            self.order.push(t.clone());
+            self.order.push((t.clone(), false));
         }
     }
 
@@ -277,8 +279,8 @@ fn ext_annotation(e: Extensibility) -> &'static str {
     }
 }
 
-/// Writes `t` inside its modules.
-fn declare(t: &DynamicType, out: &mut String) {
+/// Writes `t` inside its modules (only `struct T;` or `union T;` when `forward`).
+fn declare(t: &DynamicType, forward: bool, out: &mut String) {
     let full = t.name();
     let parts: Vec<&str> = full.split("::").collect();
     let (modules, local) = parts.split_at(parts.len() - 1);
@@ -290,6 +292,12 @@ fn declare(t: &DynamicType, out: &mut String) {
     let raw = local[0];
     let local = ident(raw);
     match t.kind() {
+        TypeKind::Struct(_) if forward => {
+            let _ = writeln!(out, "{ind}struct {local};");
+        }
+        TypeKind::Union(_) if forward => {
+            let _ = writeln!(out, "{ind}union {local};");
+        }
         TypeKind::Struct(s) => declare_struct(s, &local, &ind, out),
         TypeKind::Union(u) => declare_union(u, &local, &ind, out),
         TypeKind::Enum(e) => declare_enum(e, &local, &ind, out),
@@ -308,13 +316,6 @@ fn declare(t: &DynamicType, out: &mut String) {
         }
         TypeKind::Alias { target, .. } => {
             let _ = writeln!(out, "{ind}typedef {};", decl(target, raw));
-        }
-        TypeKind::Forward(r) => {
-            let what = match r.target().map(|t| t.resolved().kind()) {
-                Some(TypeKind::Union(_)) => "union",
-                _ => "struct",
-            };
-            let _ = writeln!(out, "{ind}{what} {local};");
         }
         _ => {}
     }

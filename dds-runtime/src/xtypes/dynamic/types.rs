@@ -14,6 +14,13 @@ use super::error::DynamicError;
 #[derive(Clone)]
 pub struct DynamicType(pub(super) Arc<TypeKind>);
 
+/// Most recursive types (defined forward references) one process makes: each is a cycle of shared nodes that
+/// lives as long as the process.
+pub const MAX_RECURSIVE_TYPES: usize = 4096;
+
+/// The recursive types defined so far (see [`MAX_RECURSIVE_TYPES`]).
+static DEFINED: std::sync::Mutex<Vec<DynamicType>> = std::sync::Mutex::new(Vec::new());
+
 thread_local! {
     /// Within one outermost comparison (depth > 0): the pairs of nodes (by address) found equal so far.
     static EQUAL_PAIRS: RefCell<(u32, HashSet<(usize, usize)>)> = RefCell::new((0, HashSet::new()));
@@ -596,8 +603,9 @@ impl DynamicType {
     /// A reference to the struct or union `name`, to be defined later with [`DynamicType::define`]: what a
     /// recursive type's members use to refer back to it. [`DynamicType::recursive`] does both steps.
     ///
-    /// A defined recursive type is a cycle of shared nodes: it lives as long as the process (build each one
-    /// once, as a topic does).
+    /// A defined recursive type is a cycle of shared nodes: it lives as long as the process, and a process
+    /// defines at most [`MAX_RECURSIVE_TYPES`] (build each one once, as a topic does; importing the same
+    /// component identifiers again reuses the type).
     pub fn forward(name: impl Into<String>) -> Self {
         DynamicType::new(TypeKind::Forward(ForwardType {
             name: name.into(),
@@ -634,9 +642,20 @@ impl DynamicType {
                 r.name
             )));
         }
+        // The cycle keeps itself alive: it is kept here too, in a bounded list, so that what lives for the
+        // process is visible and limited.
+        let mut defined = DEFINED.lock().unwrap_or_else(|e| e.into_inner());
+        if defined.len() >= MAX_RECURSIVE_TYPES {
+            return Err(DynamicError::Invalid(format!(
+                "{} is past the {MAX_RECURSIVE_TYPES} recursive types a process may define",
+                r.name
+            )));
+        }
         r.target
-            .set(target)
-            .map_err(|_| DynamicError::Invalid(format!("forward {} is already defined", r.name)))
+            .set(target.clone())
+            .map_err(|_| DynamicError::Invalid(format!("forward {} is already defined", r.name)))?;
+        defined.push(target);
+        Ok(())
     }
 
     /// A recursive struct or union: `build` gets a forward reference to the type (named `name`) to use in its
