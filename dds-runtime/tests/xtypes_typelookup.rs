@@ -359,3 +359,92 @@ fn requests_are_rate_limited_per_participant() {
     assert_eq!(drained, vec![5, 5, 2, 0], "12 waiting, 5 per second");
     assert_eq!(server.next_deferred(), None);
 }
+
+/// The TypeInformation and TypeMapping Cyclone 11's Python binding computes for the recursive `Rec::Holder`
+/// (tests/fixtures/typeinfo-recursive of the workspace): two strongly connected components, `Rec::Node` and
+/// `Rec::A`/`Rec::B`.
+fn binding_holder() -> (TypeInformation, TypeMapping) {
+    let p = format!(
+        "{}/../tests/fixtures/typeinfo-recursive/Holder.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{p}: {e}"));
+    // The file is JSON; the two hex strings are read by their keys (no JSON parser among our dev-dependencies).
+    let hex_of = |key: &str| -> Vec<u8> {
+        let at = text.find(&format!("\"{key}\": \"")).expect(key) + key.len() + 5;
+        let s = &text[at..at + text[at..].find('"').expect("end")];
+        (0..s.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&s[i..i + 2], 16).unwrap())
+            .collect()
+    };
+    (
+        from_bytes(&hex_of("type_information")).unwrap(),
+        from_bytes(&hex_of("type_mapping")).unwrap(),
+    )
+}
+
+/// A recursive type's objects go whole: asked for a component (index 0, as a TypeInformation lists it), the
+/// server answers with every type of it, and the client stores them only once they hash, together, to the
+/// component's hash; a tampered or partial component is refused.
+#[test]
+fn strongly_connected_components_are_fetched_whole_and_verified() {
+    let (info, mapping) = binding_holder();
+    let mut sstore = TypeStore::new(StoreLimits::default());
+    sstore.add_owned(&info, &mapping);
+    let components: Vec<TypeIdentifier> = info
+        .complete
+        .dependent_typeids
+        .iter()
+        .chain(&info.minimal.dependent_typeids)
+        .map(|t| t.type_id.clone())
+        .filter(|id| matches!(id, TypeIdentifier::StronglyConnected(c) if c.scc_index == 0))
+        .collect();
+    assert_eq!(components.len(), 4, "Node and A/B, minimal and complete");
+    let mut server = Server::new(ServerLimits::default());
+    let mut cstore = TypeStore::new(StoreLimits::default());
+    let mut client = Client::new([9; 16], ClientLimits::default());
+    client.want(&cstore, components.iter().cloned());
+    exchange(&mut client, &mut cstore, &mut server, &sstore);
+    for c in &components {
+        assert!(cstore.contains(c), "{c:?}");
+        assert_eq!(cstore.objects_of(c), sstore.objects_of(c));
+    }
+    // Node is one type, A/B two.
+    let lens: Vec<usize> = components
+        .iter()
+        .map(|c| cstore.objects_of(c).unwrap().len())
+        .collect();
+    assert_eq!(lens.iter().sum::<usize>(), 6);
+
+    let pairs: Vec<(TypeIdentifier, dds_runtime::xtypes::typeobject::TypeObject)> = sstore
+        .objects_of(&components[1])
+        .unwrap()
+        .into_iter()
+        .map(|(i, o)| (i, (*o).clone()))
+        .collect();
+    let mut fresh = TypeStore::new(StoreLimits::default());
+    assert_eq!(
+        fresh.insert_component(&pairs[..pairs.len() - 1]),
+        Err(StoreError::Incomplete)
+    );
+    // Another component's hash on the same objects.
+    let mut renamed = pairs.clone();
+    for (id, _) in &mut renamed {
+        if let TypeIdentifier::StronglyConnected(c) = id {
+            c.hash[0] ^= 1;
+        }
+    }
+    assert_eq!(
+        fresh.insert_component(&renamed),
+        Err(StoreError::HashMismatch)
+    );
+    // A single type asked for alone cannot be stored on its own.
+    assert_eq!(
+        fresh.insert_verified(pairs[0].0.clone(), pairs[0].1.clone()),
+        Err(StoreError::NotHashed)
+    );
+    assert_eq!(fresh.insert_component(&pairs), Ok(true));
+    assert_eq!(fresh.insert_component(&pairs), Ok(false));
+    assert!(fresh.contains(&components[1]));
+}

@@ -6,6 +6,9 @@
 //!   objects; the rest of the input is a payload, decoded both dynamically and by the derived code. When both
 //!   decode, they must re-encode to identical bytes in every version and byte order, or to bytes the derived
 //!   code reads as the same value (a differential check of the two decoders; see FINDINGS.md, 2026-11-27).
+//! - `0xf0` and `0xf1`: the recursive types [`RecNode`] (a sequence of itself) and [`RecChain`] (an optional
+//!   member of itself), made dynamic from their strongly connected component objects, decoded both ways as
+//!   above: nesting ends at the depth limit with an error in both decoders.
 //! - otherwise: the type comes from the input too (`u16` length and TypeInformation bytes, `u16` length and
 //!   TypeMapping bytes, then the payload), as a hostile peer would announce it.
 //!
@@ -18,8 +21,27 @@ use dds_runtime::cdr::{self, ByteOrder, DdsType, EncapsulationHeader, XcdrVersio
 use dds_runtime::xtypes::dynamic::{DynamicData, DynamicType};
 use dds_runtime::xtypes::typeobject::{from_bytes, TypeInformation, TypeMapping};
 use dds_runtime::xtypes::XTypesType;
+use dds_runtime::DdsType;
 
 use crate::cdr::{Either, MutOpt, Nest, Outer, ShapeType};
+
+/// `@final struct Node { long value; sequence<Node> children; };`
+#[derive(DdsType, Debug, Clone, PartialEq, Default)]
+#[dds(name = "Rec::Node", final)]
+pub struct RecNode {
+    value: i32,
+    #[dds(recursive)]
+    children: Vec<RecNode>,
+}
+
+/// `@mutable struct Chain { long v; @optional Chain next; };`
+#[derive(DdsType, Debug, Clone, PartialEq, Default)]
+#[dds(name = "Rec::Chain", mutable)]
+pub struct RecChain {
+    v: i32,
+    #[dds(recursive)]
+    next: Option<Box<RecChain>>,
+}
 
 /// Every version and byte order a value is re-encoded in.
 const ENCODINGS: [(XcdrVersion, ByteOrder); 4] = [
@@ -37,8 +59,8 @@ pub(crate) fn dynamic_of<T: XTypesType>() -> DynamicType {
     DynamicType::from_type_mapping(&info, &mapping).expect("own types are dynamic types")
 }
 
-fn known_types() -> &'static [DynamicType; 5] {
-    static TYPES: OnceLock<[DynamicType; 5]> = OnceLock::new();
+fn known_types() -> &'static [DynamicType; 7] {
+    static TYPES: OnceLock<[DynamicType; 7]> = OnceLock::new();
     TYPES.get_or_init(|| {
         [
             dynamic_of::<ShapeType>(),
@@ -46,6 +68,8 @@ fn known_types() -> &'static [DynamicType; 5] {
             dynamic_of::<Nest>(),
             dynamic_of::<Outer>(),
             dynamic_of::<Either>(),
+            dynamic_of::<RecNode>(),
+            dynamic_of::<RecChain>(),
         ]
     })
 }
@@ -162,6 +186,11 @@ pub fn dynamic_one(data: &[u8]) {
         return;
     };
     let types = known_types();
+    match sel {
+        0xf0 => return differential::<RecNode>(&types[5], rest),
+        0xf1 => return differential::<RecChain>(&types[6], rest),
+        _ => {}
+    }
     match sel % 6 {
         0 => differential::<ShapeType>(&types[0], rest),
         1 => differential::<MutOpt>(&types[1], rest),

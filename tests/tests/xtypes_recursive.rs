@@ -10,69 +10,9 @@ use std::path::PathBuf;
 use dds_runtime::cdr::{deserialize, serialize, ByteOrder, DdsType, XcdrVersion};
 use dds_runtime::xtypes::typeobject::TypeIdentifier;
 use dds_runtime::xtypes::XTypesType;
-use dds_runtime::DdsType;
 
-/// `@final struct Node { long value; sequence<Node> children; };`
-#[derive(DdsType, Debug, Clone, PartialEq, Default)]
-#[dds(name = "Rec::Node", final)]
-struct Node {
-    value: i32,
-    #[dds(recursive)]
-    children: Vec<Node>,
-}
-
-/// `@final struct A { long x; sequence<B> bs; };`
-#[derive(DdsType, Debug, Clone, PartialEq, Default)]
-#[dds(name = "Rec::A", final)]
-struct A {
-    x: i32,
-    #[dds(recursive)]
-    bs: Vec<B>,
-}
-
-/// `@final struct B { long y; sequence<A> as_; };`
-#[derive(DdsType, Debug, Clone, PartialEq, Default)]
-#[dds(name = "Rec::B", final)]
-struct B {
-    y: i32,
-    as_: Vec<A>,
-}
-
-/// `@final struct Leaf { string name; };`
-#[derive(DdsType, Debug, Clone, PartialEq, Default)]
-#[dds(name = "Rec::Leaf", final)]
-struct Leaf {
-    name: String,
-}
-
-/// `@appendable struct Tree { long v; Leaf leaf; sequence<Tree, 4> kids; };`
-#[derive(DdsType, Debug, Clone, PartialEq, Default)]
-#[dds(name = "Rec::Tree", appendable)]
-struct Tree {
-    v: i32,
-    leaf: Leaf,
-    #[dds(recursive, bound = 4)]
-    kids: Vec<Tree>,
-}
-
-/// `@final struct Holder { @key long id; Node root; A a; };`
-#[derive(DdsType, Debug, Clone, PartialEq, Default)]
-#[dds(name = "Rec::Holder", final)]
-struct Holder {
-    #[dds(key)]
-    id: i32,
-    root: Node,
-    a: A,
-}
-
-/// `@mutable struct Chain { long v; @optional Chain next; };`
-#[derive(DdsType, Debug, Clone, PartialEq, Default)]
-#[dds(name = "Rec::Chain", mutable)]
-struct Chain {
-    v: i32,
-    #[dds(recursive)]
-    next: Option<Box<Chain>>,
-}
+mod recursive_types;
+use recursive_types::*;
 
 fn fixture(name: &str) -> serde_json::Value {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))

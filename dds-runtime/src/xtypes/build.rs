@@ -301,16 +301,22 @@ fn component_ids(hashes: [EquivalenceHash; 2], len: usize, index: usize) -> [Typ
 /// A component's objects as the binding hashes them: a `@final` struct holding `sequence<TypeObject>`, XCDR2
 /// little endian without encapsulation header (DHEADER, count, each object 4-aligned).
 fn component_bytes(objects: &[TypeObject]) -> Result<Vec<u8>, BuildError> {
+    let serialized: Vec<Vec<u8>> = objects.iter().map(to_bytes).collect::<Result<_, _>>()?;
+    Ok(component_sequence(&serialized))
+}
+
+/// [`component_bytes`] of objects serialized already (each XCDR2 LE, no header).
+pub(super) fn component_sequence(serialized: &[Vec<u8>]) -> Vec<u8> {
     let mut body = Vec::new();
-    for o in objects {
+    for o in serialized {
         body.resize(body.len().next_multiple_of(4), 0);
-        body.extend(to_bytes(o)?);
+        body.extend_from_slice(o);
     }
     let mut out = Vec::with_capacity(body.len() + 8);
     out.extend(((body.len() + 4) as u32).to_le_bytes());
-    out.extend((objects.len() as u32).to_le_bytes());
+    out.extend((serialized.len() as u32).to_le_bytes());
     out.extend(body);
-    Ok(out)
+    out
 }
 
 impl<'a> Builder<'a> {

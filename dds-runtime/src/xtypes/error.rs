@@ -12,8 +12,9 @@ pub enum BuildError {
     /// The type uses something XTypes 1.3 cannot describe.
     #[error("{0}")]
     Unsupported(&'static str),
-    /// Mutually recursive types (strongly connected components) are not built yet.
-    #[error("recursive type {0}: strongly connected components are not supported yet")]
+    /// A type reaches itself outside a strongly connected component (recursive types are built as components;
+    /// this is not expected).
+    #[error("recursive type {0} outside a strongly connected component")]
     Recursive(String),
     /// Two different types of one name reached from a topic type (type objects name each type once).
     #[error("two different types are named {0}")]

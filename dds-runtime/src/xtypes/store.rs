@@ -1,6 +1,9 @@
 //! The participant's type store: every type object we own (the types of our endpoints) or have learnt (from
 //! TypeLookup replies, each checked against its hash), keyed by [`TypeIdentifier`].
 //!
+//! A recursive type's objects (a strongly connected component, XTypes 1.3 §7.3.4.9) are learnt whole: every type
+//! of the component, checked together against the component's hash ([`TypeStore::insert_component`]).
+//!
 //! Bounded: learnt objects are limited in number and in serialized bytes ([`StoreLimits`]); what does not fit
 //! is refused, never evicting an owned type. A hostile peer cannot make the store grow without bound.
 
@@ -10,8 +13,34 @@ use std::sync::Arc;
 use thiserror::Error;
 
 use super::typeobject::{
-    to_bytes, TypeIdentifier, TypeIdentifierWithSize, TypeInformation, TypeMapping, TypeObject,
+    kind, to_bytes, EquivalenceKind, StronglyConnectedComponentId, TypeIdentifier,
+    TypeIdentifierWithSize, TypeInformation, TypeMapping, TypeObject,
 };
+
+/// Most types in one learnt strongly connected component.
+pub(crate) const MAX_COMPONENT: i32 = 256;
+
+/// Whether the store and the TypeLookup service deal in `id`: a hash, or a strongly connected component's.
+pub fn is_lookup_id(id: &TypeIdentifier) -> bool {
+    id.hash().is_some() || matches!(id, TypeIdentifier::StronglyConnected(_))
+}
+
+/// The component `id` names (with its index set to 0: the component as a whole), if it is a component id.
+pub fn component_of(id: &TypeIdentifier) -> Option<StronglyConnectedComponentId> {
+    match id {
+        TypeIdentifier::StronglyConnected(c) => {
+            Some(StronglyConnectedComponentId { scc_index: 0, ..*c })
+        }
+        _ => None,
+    }
+}
+
+fn member_id(c: StronglyConnectedComponentId, index: i32) -> TypeIdentifier {
+    TypeIdentifier::StronglyConnected(StronglyConnectedComponentId {
+        scc_index: index,
+        ..c
+    })
+}
 
 /// Dependencies kept per type (a peer's list beyond it is cut: the store stays bounded).
 const MAX_DEPENDENCIES: usize = 256;
@@ -53,6 +82,9 @@ pub enum StoreError {
     /// The store's limits are reached.
     #[error("type store full")]
     Full,
+    /// A strongly connected component's objects are not all there, repeated, or not of one component.
+    #[error("strongly connected component incomplete or inconsistent")]
+    Incomplete,
 }
 
 #[derive(Debug)]
@@ -87,9 +119,33 @@ impl TypeStore {
         self.objects.get(id).map(|e| e.object.clone())
     }
 
-    /// Whether the store holds the object of `id`.
+    /// Whether the store holds the object of `id` (for a whole component, index 0: the objects of its types).
     pub fn contains(&self, id: &TypeIdentifier) -> bool {
-        self.objects.contains_key(id)
+        match component_of(id) {
+            Some(c) if c.scc_length > 0 => self.objects.contains_key(&member_id(c, 1)),
+            _ => self.objects.contains_key(id),
+        }
+    }
+
+    /// The objects `id` names, with their identifiers: its own, or for any type of a strongly connected
+    /// component (or the component as a whole) those of every type of the component, by index. `None` if any
+    /// is missing.
+    pub fn objects_of(
+        &self,
+        id: &TypeIdentifier,
+    ) -> Option<Vec<(TypeIdentifier, Arc<TypeObject>)>> {
+        let Some(c) = component_of(id) else {
+            return self.get(id).map(|o| vec![(id.clone(), o)]);
+        };
+        if !(1..=MAX_COMPONENT).contains(&c.scc_length) {
+            return None;
+        }
+        (1..=c.scc_length)
+            .map(|i| {
+                let id = member_id(c, i);
+                self.get(&id).map(|o| (id, o))
+            })
+            .collect()
     }
 
     /// Number of objects held (owned and learnt).
@@ -207,6 +263,65 @@ impl TypeStore {
         Ok(true)
     }
 
+    /// Stores the objects of every type of one strongly connected component, received together: each
+    /// identifier is of the component (same kind, hash and length, every index from 1 once), each object of
+    /// its kind, and the objects, serialized with the component's hash zeroed where they name each other and
+    /// put in a sequence by index, hash to the component's hash (how `TypeSupport` builds them). `Ok(false)`:
+    /// already held.
+    pub fn insert_component(
+        &mut self,
+        pairs: &[(TypeIdentifier, TypeObject)],
+    ) -> Result<bool, StoreError> {
+        let c = pairs
+            .first()
+            .and_then(|(id, _)| component_of(id))
+            .ok_or(StoreError::NotHashed)?;
+        if !(1..=MAX_COMPONENT).contains(&c.scc_length) || pairs.len() != c.scc_length as usize {
+            return Err(StoreError::Incomplete);
+        }
+        let mut by_index: Vec<Option<&TypeObject>> = vec![None; pairs.len()];
+        for (id, object) in pairs {
+            let TypeIdentifier::StronglyConnected(m) = id else {
+                return Err(StoreError::Incomplete);
+            };
+            if component_of(id) != Some(c) || m.scc_index < 1 || m.scc_index > c.scc_length {
+                return Err(StoreError::Incomplete);
+            }
+            let minimal = matches!(object, TypeObject::Minimal(_));
+            if minimal != (c.kind == EquivalenceKind::Minimal) {
+                return Err(StoreError::KindMismatch);
+            }
+            let slot = &mut by_index[m.scc_index as usize - 1];
+            if slot.replace(object).is_some() {
+                return Err(StoreError::Incomplete);
+            }
+        }
+        if self.contains(&member_id(c, 0)) {
+            return Ok(false);
+        }
+        let objects: Vec<&TypeObject> = by_index.iter().flatten().copied().collect();
+        let sizes = verify_component(c, &objects)?;
+        let total: usize = sizes.iter().sum();
+        if self.learnt + pairs.len() > self.limits.max_learnt
+            || self.learnt_bytes + total > self.limits.max_learnt_bytes
+        {
+            return Err(StoreError::Full);
+        }
+        for (i, (o, size)) in by_index.into_iter().flatten().zip(sizes).enumerate() {
+            self.learnt += 1;
+            self.learnt_bytes += size;
+            self.objects.insert(
+                member_id(c, i as i32 + 1),
+                Entry {
+                    object: Arc::new(o.clone()),
+                    size,
+                    owned: false,
+                },
+            );
+        }
+        Ok(true)
+    }
+
     /// The hashed identifiers a `TypeInformation` names (both topic types and their listed dependencies)
     /// whose objects the store lacks, each once.
     pub fn missing(&self, information: &TypeInformation) -> Vec<TypeIdentifier> {
@@ -222,4 +337,44 @@ impl TypeStore {
         }
         out
     }
+}
+
+/// Checks that the objects of the types of component `c`, by index, hash to its hash (serialized with the
+/// hash zeroed where they name each other, in a sequence: how `TypeSupport` builds them). Their serialized
+/// sizes.
+pub(crate) fn verify_component(
+    c: StronglyConnectedComponentId,
+    objects: &[&TypeObject],
+) -> Result<Vec<usize>, StoreError> {
+    let ek = match c.kind {
+        EquivalenceKind::Minimal => kind::EK_MINIMAL,
+        _ => kind::EK_COMPLETE,
+    };
+    let mut sizes = Vec::with_capacity(objects.len());
+    let mut zeroed = Vec::with_capacity(objects.len());
+    for o in objects {
+        let bytes = to_bytes(*o).map_err(|_| StoreError::Unencodable)?;
+        sizes.push(bytes.len());
+        zeroed.push(zero_hash(bytes, ek, &c.hash));
+    }
+    let whole = super::build::component_sequence(&zeroed);
+    if super::typeobject::equivalence_hash(&whole) != c.hash {
+        return Err(StoreError::HashMismatch);
+    }
+    Ok(sizes)
+}
+
+/// `bytes` with each `ek` octet followed by `hash` (a component identifier naming its own component) turned
+/// into `ek` and a zero hash: the objects as they were when the component's hash was computed.
+fn zero_hash(mut bytes: Vec<u8>, ek: u8, hash: &[u8; 14]) -> Vec<u8> {
+    let mut i = 0;
+    while i + 15 <= bytes.len() {
+        if bytes[i] == ek && bytes[i + 1..i + 15] == hash[..] {
+            bytes[i + 1..i + 15].fill(0);
+            i += 15;
+        } else {
+            i += 1;
+        }
+    }
+    bytes
 }

@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 
 use crate::cdr::DdsType;
 use crate::rtps::Participant;
+use crate::xtypes::store::is_lookup_id;
 use crate::xtypes::typeobject::{TypeIdentifier, TypeInformation, TypeObject};
 
 use super::super::error::{DdsError, DdsResult};
@@ -59,12 +60,13 @@ pub(crate) fn register_type_bytes(
     }
 }
 
-/// The complete identifiers a `TypeInformation` names: the topic type, then its listed dependencies.
+/// The complete identifiers a `TypeInformation` names: the topic type, then its listed dependencies (hashes,
+/// and strongly connected components).
 fn complete_ids(info: &TypeInformation) -> Vec<TypeIdentifier> {
     std::iter::once(&info.complete.typeid_with_size)
         .chain(&info.complete.dependent_typeids)
         .map(|t| t.type_id.clone())
-        .filter(|id| id.hash().is_some())
+        .filter(is_lookup_id)
         .collect()
 }
 
@@ -131,17 +133,18 @@ impl DomainParticipant {
                 });
                 wanted.extend(more);
             }
+            // A component's id gives the objects of all its types.
             let objects: Vec<_> = self.driver().query_core(|c| {
                 wanted
                     .iter()
-                    .map(|id| (id.clone(), c.type_store().get(id)))
+                    .map(|id| c.type_store().objects_of(id))
                     .collect()
             });
-            if objects.iter().all(|(_, o)| o.is_some()) {
+            if objects.iter().all(Option::is_some) {
                 let mut complete: Vec<(TypeIdentifier, Arc<TypeObject>)> = Vec::new();
-                for (id, o) in objects {
+                for (id, o) in objects.into_iter().flatten().flatten() {
                     if !complete.iter().any(|(i, _)| i == &id) {
-                        complete.push((id, o.expect("checked")));
+                        complete.push((id, o));
                     }
                 }
                 return Ok(DiscoveredType {

@@ -104,7 +104,7 @@ pub(super) fn decode(r: &mut CdrReader<'_>, ty: &DynamicType) -> Result<Value, D
             r.leave();
             Ok(Value::Map(entries))
         }
-        TypeKind::Alias { .. } => Err(invalid(r, "a resolved type", 0)),
+        TypeKind::Alias { .. } | TypeKind::Forward(_) => Err(invalid(r, "a resolved type", 0)),
     }
 }
 

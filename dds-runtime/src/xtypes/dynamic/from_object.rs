@@ -1,19 +1,20 @@
 //! [`DynamicType`] from XTypes type objects: a discovered type (TypeInformation + the objects of a TypeMapping,
 //! a TypeLookup reply or a local store).
 
-use std::collections::HashMap;
-use std::sync::Arc;
+use std::collections::{HashMap, HashSet};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::cdr::Extensibility;
+use crate::xtypes::store::{verify_component, MAX_COMPONENT};
 use crate::xtypes::typeobject::{
-    kind, MemberFlag, MemberName, TypeBody, TypeFlag, TypeIdentifier, TypeInformation, TypeMapping,
-    TypeObject,
+    kind, MemberFlag, MemberName, StronglyConnectedComponentId, TypeBody, TypeFlag, TypeIdentifier,
+    TypeInformation, TypeMapping, TypeObject,
 };
 
 use super::error::DynamicError;
 use super::types::{
-    BitFlag, BitmaskType, DynamicType, EnumType, Enumerator, Member, Primitive, StructType,
-    TypeKind, UnionCase, UnionType,
+    close_forward, BitFlag, BitmaskType, DynamicType, EnumType, Enumerator, Member, Primitive,
+    StructType, TypeKind, UnionCase, UnionType,
 };
 
 /// Deepest chain of type references followed (a hostile cycle of hashes ends here).
@@ -25,7 +26,21 @@ pub type TypeObjectLookup<'a> = dyn Fn(&TypeIdentifier) -> Option<Arc<TypeObject
 struct Resolver<'a> {
     lookup: &'a TypeObjectLookup<'a>,
     done: HashMap<TypeIdentifier, DynamicType>,
+    /// The components whose objects were checked against their hash.
+    verified: HashSet<StronglyConnectedComponentId>,
 }
+
+/// Recursive types imported so far, by the identifier of each type of their component: a component's objects
+/// are checked against its hash before it is imported, so an identifier names one type, and importing it again
+/// (a durability service resolving each writer's type, `dds subscribe` run in a loop) reuses the type instead
+/// of making another cycle that would live as long as the process.
+fn imported() -> &'static Mutex<HashMap<TypeIdentifier, DynamicType>> {
+    static IMPORTED: OnceLock<Mutex<HashMap<TypeIdentifier, DynamicType>>> = OnceLock::new();
+    IMPORTED.get_or_init(|| Mutex::new(HashMap::new()))
+}
+
+/// Most entries of [`imported`] (beyond, types are still imported, each once per resolution).
+const MAX_IMPORTED: usize = 4096;
 
 impl DynamicType {
     /// The type `id` names, its hashed parts found through `lookup`. Complete type objects give names;
@@ -34,11 +49,20 @@ impl DynamicType {
         id: &TypeIdentifier,
         lookup: &TypeObjectLookup<'_>,
     ) -> Result<Self, DynamicError> {
-        Resolver {
+        let mut r = Resolver {
             lookup,
             done: HashMap::new(),
+            verified: HashSet::new(),
+        };
+        let t = r.resolve(id, 0)?;
+        // Only now are the forward references of every component met defined.
+        let mut cache = imported().lock().unwrap_or_else(|e| e.into_inner());
+        for (id, t) in r.done {
+            if matches!(id, TypeIdentifier::StronglyConnected(_)) && cache.len() < MAX_IMPORTED {
+                cache.entry(id).or_insert(t);
+            }
         }
-        .resolve(id, 0)
+        Ok(t)
     }
 
     /// The topic type a `TypeInformation` describes, from the objects of a `TypeMapping` (complete
@@ -61,6 +85,16 @@ impl DynamicType {
             &info.minimal.typeid_with_size.type_id
         };
         DynamicType::from_type_identifier(root, &|id| objects.get(id).cloned())
+    }
+}
+
+/// An identifier for messages: its hash (and component index).
+fn describe(id: &TypeIdentifier) -> String {
+    match id {
+        TypeIdentifier::StronglyConnected(c) => {
+            format!("component {:02x?} #{}", c.hash, c.scc_index)
+        }
+        _ => format!("{:02x?}", id.hash().unwrap_or(&[0; 14])),
     }
 }
 
@@ -141,30 +175,86 @@ impl Resolver<'_> {
                 key,
                 ..
             } => DynamicType::map(self.resolve(key, d)?, self.resolve(element, d)?, bound(*b)),
-            TypeIdentifier::StronglyConnected(_) => {
-                return Err(DynamicError::Unresolved(
-                    "recursive types (strongly connected components)".into(),
-                ))
-            }
-            TypeIdentifier::Minimal(_) | TypeIdentifier::Complete(_) => {
-                if let Some(t) = self.done.get(id) {
-                    return Ok(t.clone());
-                }
-                let obj = (self.lookup)(id).ok_or_else(|| {
-                    DynamicError::Unresolved(format!(
-                        "no type object for {:02x?}",
-                        id.hash().unwrap_or(&[0; 14])
-                    ))
-                })?;
-                let body = match &*obj {
-                    TypeObject::Minimal(m) => &m.0,
-                    TypeObject::Complete(c) => &c.0,
-                };
-                let t = self.body(body, d)?;
-                self.done.insert(id.clone(), t.clone());
-                t
-            }
+            TypeIdentifier::StronglyConnected(_)
+            | TypeIdentifier::Minimal(_)
+            | TypeIdentifier::Complete(_) => self.named(id, d)?,
         })
+    }
+
+    /// A hashed type, or one type of a strongly connected component (a recursive type): while its object is
+    /// turned into a type, a reference back to it (a cycle of the component) gets a forward reference, which
+    /// the type then defines.
+    fn named(&mut self, id: &TypeIdentifier, d: u32) -> Result<DynamicType, DynamicError> {
+        if let Some(t) = self.done.get(id) {
+            return Ok(t.clone());
+        }
+        if let TypeIdentifier::StronglyConnected(c) = id {
+            let known = imported()
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .get(id)
+                .cloned();
+            if let Some(t) = known {
+                return Ok(t);
+            }
+            self.verify(*c)?;
+        }
+        let obj = (self.lookup)(id).ok_or_else(|| {
+            DynamicError::Unresolved(format!("no type object for {}", describe(id)))
+        })?;
+        let body = match &*obj {
+            TypeObject::Minimal(m) => &m.0,
+            TypeObject::Complete(c) => &c.0,
+        };
+        let forward = matches!(id, TypeIdentifier::StronglyConnected(_)).then(|| {
+            let f = DynamicType::forward(type_name(body));
+            self.done.insert(id.clone(), f.clone());
+            f
+        });
+        let t = self.body(body, d);
+        match (&t, forward) {
+            (Ok(t), Some(f)) => {
+                self.done.insert(id.clone(), t.clone());
+                close_forward(f, t)?;
+            }
+            (Ok(t), None) => {
+                self.done.insert(id.clone(), t.clone());
+            }
+            (Err(_), _) => {
+                self.done.remove(id);
+            }
+        }
+        t
+    }
+
+    /// Checks the objects of component `c` against its hash (once per component).
+    fn verify(&mut self, c: StronglyConnectedComponentId) -> Result<(), DynamicError> {
+        let whole = StronglyConnectedComponentId { scc_index: 0, ..c };
+        if self.verified.contains(&whole) {
+            return Ok(());
+        }
+        if !(1..=MAX_COMPONENT).contains(&c.scc_length) {
+            return Err(DynamicError::Unresolved(format!(
+                "a component of {} types",
+                c.scc_length
+            )));
+        }
+        let objects = (1..=c.scc_length)
+            .map(|i| {
+                let id = TypeIdentifier::StronglyConnected(StronglyConnectedComponentId {
+                    scc_index: i,
+                    ..c
+                });
+                (self.lookup)(&id).ok_or_else(|| {
+                    DynamicError::Unresolved(format!("no type object for {}", describe(&id)))
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let refs: Vec<&TypeObject> = objects.iter().map(|o| &**o).collect();
+        verify_component(c, &refs)
+            .map_err(|e| DynamicError::Unresolved(format!("component {:02x?}: {e}", c.hash)))?;
+        self.verified.insert(whole);
+        Ok(())
     }
 
     fn body(&mut self, body: &TypeBody, d: u32) -> Result<DynamicType, DynamicError> {

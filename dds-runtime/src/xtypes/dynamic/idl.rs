@@ -13,7 +13,7 @@ use crate::cdr::Extensibility;
 
 use super::builder::{BitmaskBuilder, EnumBuilder, MemberBuilder, StructBuilder, UnionBuilder};
 use super::error::DynamicError;
-use super::types::{DynamicType, Primitive};
+use super::types::{close_forward, DynamicType, Primitive};
 
 /// Why IDL text gave no types.
 #[derive(Debug, Clone, thiserror::Error)]
@@ -164,8 +164,7 @@ impl Converter<'_> {
         let name = d.scoped_name();
         let t = match &d.kind {
             DeclKind::Alias { ty } => DynamicType::alias(name, self.ty(ty, depth)?),
-            DeclKind::Struct(s) => self.structure(name, s, depth)?,
-            DeclKind::Union(u) => self.union(name, u, depth)?,
+            DeclKind::Struct(_) | DeclKind::Union(_) => return self.recursive(id, name, depth),
             DeclKind::Enum(e) => {
                 let mut b = EnumBuilder::new(name)
                     .default_literal(e.default_index)
@@ -190,6 +189,33 @@ impl Converter<'_> {
         };
         self.done.insert(id, t.clone());
         Ok(t)
+    }
+
+    /// A struct or union, which may refer back to itself (a recursive type): a reference met while its
+    /// members are converted gets a forward reference, which the type then defines.
+    fn recursive(
+        &mut self,
+        id: DeclId,
+        name: String,
+        depth: u32,
+    ) -> Result<DynamicType, DynamicError> {
+        let forward = DynamicType::forward(name.clone());
+        self.done.insert(id, forward.clone());
+        let t = match &self.model.decls[id].kind {
+            DeclKind::Struct(s) => self.structure(name, s, depth),
+            DeclKind::Union(u) => self.union(name, u, depth),
+            _ => Err(unsupported(&name)),
+        };
+        match &t {
+            Ok(t) => {
+                self.done.insert(id, t.clone());
+                close_forward(forward, t)?;
+            }
+            Err(_) => {
+                self.done.remove(&id);
+            }
+        }
+        t
     }
 
     fn structure(

@@ -9,11 +9,11 @@ use super::types::{DynamicType, EnumType, StructType, TypeKind, UnionType};
 impl DynamicType {
     /// The type as IDL: every named type it depends on first, each in its modules, then the type itself.
     pub fn to_idl(&self) -> String {
-        let mut order: Vec<DynamicType> = Vec::new();
-        collect(self, &mut order, 0);
+        let mut c = Collector::default();
+        c.collect(self, 0);
         let mut out = String::new();
-        for t in &order {
-            declare(t, &mut out);
+        for (t, forward) in &c.order {
+            declare(t, *forward, &mut out);
         }
         out
     }
@@ -133,50 +133,77 @@ fn is_named(t: &DynamicType) -> bool {
     )
 }
 
-/// Named types in dependency order (post-order), each once.
-fn collect(t: &DynamicType, order: &mut Vec<DynamicType>, depth: u32) {
-    if depth > 64 || (is_named(t) && order.iter().any(|x| x.name() == t.name())) {
-        return;
-    }
-    match t.kind() {
-        TypeKind::Struct(s) => {
-            if let Some(b) = &s.base {
-                collect(b, order, depth + 1);
-            }
-            for m in s.own_members() {
-                collect(&m.ty, order, depth + 1);
-            }
-        }
-        TypeKind::Union(u) => {
-            collect(&u.discriminator, order, depth + 1);
-            for c in &u.cases {
-                collect(&c.ty, order, depth + 1);
-            }
-        }
-        TypeKind::Alias { target, .. } => collect(target, order, depth + 1),
-        TypeKind::Array { element, .. } => collect(element, order, depth + 1),
-        TypeKind::Sequence { element, .. } => collect_element(element, order, depth + 1),
-        TypeKind::Map { key, value, .. } => {
-            collect_element(key, order, depth + 1);
-            collect_element(value, order, depth + 1);
-        }
-        _ => {}
-    }
-    if is_named(t) {
-        order.push(t.clone());
-    }
+/// Named types in dependency order (post-order), each once; a recursive type used before its declaration
+/// is declared forward first (`struct Node;`: `true` in `order`).
+#[derive(Default)]
+struct Collector {
+    order: Vec<(DynamicType, bool)>,
+    /// The named types being collected (their members are being walked).
+    busy: Vec<String>,
 }
 
-/// A sequence's element or a map's key or value: an anonymous array there has no IDL spelling, so it gets a
-/// generated typedef ([`array_typedef_name`]), declared before its first use.
-fn collect_element(t: &DynamicType, order: &mut Vec<DynamicType>, depth: u32) {
-    collect(t, order, depth);
-    if matches!(t.kind(), TypeKind::Array { .. }) {
-        collect(
-            &DynamicType::alias(array_typedef_name(t), t.clone()),
-            order,
-            depth,
-        );
+impl Collector {
+    fn has(&self, name: &str, forward: bool) -> bool {
+        self.order
+            .iter()
+            .any(|(x, f)| *f == forward && x.name() == name)
+    }
+
+    fn collect(&mut self, t: &DynamicType, depth: u32) {
+        let t = t.unforwarded();
+        if depth > 64 || (is_named(t) && self.has(&t.name(), false)) {
+            return;
+        }
+        let back_edge = matches!(t.kind(), TypeKind::Struct(_) | TypeKind::Union(_))
+            && self.busy.contains(&t.name());
+        if back_edge {
+            // A recursive type met again while its members are walked: declared forward before its users.
+            if !self.has(&t.name(), true) {
+                self.order.push((t.clone(), true));
+            }
+            return;
+        }
+        let d = depth + 1;
+        match t.kind() {
+            TypeKind::Struct(s) => {
+                self.busy.push(s.name.clone());
+                if let Some(b) = &s.base {
+                    self.collect(b, d);
+                }
+                for m in s.own_members() {
+                    self.collect(&m.ty, d);
+                }
+                self.busy.pop();
+            }
+            TypeKind::Union(u) => {
+                self.busy.push(u.name.clone());
+                self.collect(&u.discriminator, d);
+                for c in &u.cases {
+                    self.collect(&c.ty, d);
+                }
+                self.busy.pop();
+            }
+            TypeKind::Alias { target, .. } => self.collect(target, d),
+            TypeKind::Array { element, .. } => self.collect(element, d),
+            TypeKind::Sequence { element, .. } => self.collect_element(element, d),
+            TypeKind::Map { key, value, .. } => {
+                self.collect_element(key, d);
+                self.collect_element(value, d);
+            }
+            _ => {}
+        }
+        if is_named(t) {
+            self.order.push((t.clone(), false));
+        }
+    }
+
+    /// A sequence's element or a map's key or value: an anonymous array there has no IDL spelling, so it gets a
+    /// generated typedef ([`array_typedef_name`]), declared before its first use.
+    fn collect_element(&mut self, t: &DynamicType, depth: u32) {
+        self.collect(t, depth);
+        if matches!(t.kind(), TypeKind::Array { .. }) {
+            self.collect(&DynamicType::alias(array_typedef_name(t), t.clone()), depth);
+        }
     }
 }
 
@@ -227,7 +254,7 @@ fn spelling(t: &DynamicType) -> String {
             None => format!("map<{}, {}>", spelling(key), spelling(value)),
         },
         TypeKind::Array { .. } => array_typedef_name(t),
-        _ if is_named(t) => scoped(&t.name()),
+        _ if is_named(t) || matches!(t.kind(), TypeKind::Forward(_)) => scoped(&t.name()),
         _ => t.name(),
     }
 }
@@ -252,8 +279,8 @@ fn ext_annotation(e: Extensibility) -> &'static str {
     }
 }
 
-/// Writes `t` inside its modules.
-fn declare(t: &DynamicType, out: &mut String) {
+/// Writes `t` inside its modules (only `struct T;` or `union T;` when `forward`).
+fn declare(t: &DynamicType, forward: bool, out: &mut String) {
     let full = t.name();
     let parts: Vec<&str> = full.split("::").collect();
     let (modules, local) = parts.split_at(parts.len() - 1);
@@ -265,6 +292,12 @@ fn declare(t: &DynamicType, out: &mut String) {
     let raw = local[0];
     let local = ident(raw);
     match t.kind() {
+        TypeKind::Struct(_) if forward => {
+            let _ = writeln!(out, "{ind}struct {local};");
+        }
+        TypeKind::Union(_) if forward => {
+            let _ = writeln!(out, "{ind}union {local};");
+        }
         TypeKind::Struct(s) => declare_struct(s, &local, &ind, out),
         TypeKind::Union(u) => declare_union(u, &local, &ind, out),
         TypeKind::Enum(e) => declare_enum(e, &local, &ind, out),

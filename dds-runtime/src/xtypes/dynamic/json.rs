@@ -283,7 +283,7 @@ pub fn from_json(ty: &DynamicType, j: &Json, path: &mut String) -> Result<Value,
             }
             Ok(Value::Map(entries))
         }
-        TypeKind::Alias { .. } => Err(bad(path)),
+        TypeKind::Alias { .. } | TypeKind::Forward(_) => Err(bad(path)),
     }
 }
 

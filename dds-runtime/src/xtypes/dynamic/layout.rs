@@ -1,6 +1,9 @@
 //! What the derive computes at compile time, computed from a [`DynamicType`]: the layout the XCDR rules see,
 //! whether XCDR1 carries it by default, the key-stream size scan and whether a mutable type is on the key path.
 
+use std::collections::HashSet;
+use std::sync::Arc;
+
 use crate::cdr::members::prim_end;
 use crate::cdr::{Extensibility, Layout, XcdrVersion};
 
@@ -31,28 +34,44 @@ pub(super) fn layout(ty: &DynamicType) -> Layout {
                 Layout::Delimited
             }
         }
-        TypeKind::Struct(_) | TypeKind::Union(_) | TypeKind::Alias { .. } => Layout::Other,
+        TypeKind::Struct(_)
+        | TypeKind::Union(_)
+        | TypeKind::Alias { .. }
+        | TypeKind::Forward(_) => Layout::Other,
     }
 }
 
 /// Whether XCDR1 carries the type as Cyclone does by default (final, no optional members, all the way down):
 /// the derive's `XCDR1_PLAIN`. External members count as plain.
 pub(super) fn xcdr1_plain(ty: &DynamicType) -> bool {
-    match ty.resolved().kind() {
+    plain_in(ty, &mut HashSet::new())
+}
+
+/// Whether `ty` was met before in this walk (a struct or union, by address): a recursive type's cycle is
+/// then cut there, its answer being the one the rest of the walk gives (as the derive leaves a recursive
+/// member out of its constants).
+fn met(ty: &DynamicType, seen: &mut HashSet<usize>) -> bool {
+    !seen.insert(Arc::as_ptr(&ty.0) as usize)
+}
+
+fn plain_in(ty: &DynamicType, seen: &mut HashSet<usize>) -> bool {
+    let ty = ty.resolved();
+    match ty.kind() {
+        TypeKind::Struct(_) | TypeKind::Union(_) if met(ty, seen) => true,
         TypeKind::Struct(s) => {
             s.extensibility == Extensibility::Final
                 && s.members
                     .iter()
-                    .all(|m| !m.optional && (m.external || xcdr1_plain(&m.ty)))
+                    .all(|m| !m.optional && (m.external || plain_in(&m.ty, seen)))
         }
         TypeKind::Union(u) => {
             u.extensibility == Extensibility::Final
-                && u.cases.iter().all(|c| c.external || xcdr1_plain(&c.ty))
+                && u.cases.iter().all(|c| c.external || plain_in(&c.ty, seen))
         }
         TypeKind::Sequence { element, .. } | TypeKind::Array { element, .. } => {
-            xcdr1_plain(element)
+            plain_in(element, seen)
         }
-        TypeKind::Map { key, value, .. } => xcdr1_plain(key) && xcdr1_plain(value),
+        TypeKind::Map { key, value, .. } => plain_in(key, seen) && plain_in(value, seen),
         _ => true,
     }
 }
@@ -69,7 +88,13 @@ pub fn default_version(ty: &DynamicType) -> XcdrVersion {
 /// Whether a @mutable type lies on the key path (the derive's `KEY_HAS_MUTABLE`); external members do not
 /// count.
 pub(super) fn key_has_mutable(ty: &DynamicType) -> bool {
-    match ty.resolved().kind() {
+    mutable_in(ty, &mut HashSet::new())
+}
+
+fn mutable_in(ty: &DynamicType, seen: &mut HashSet<usize>) -> bool {
+    let ty = ty.resolved();
+    match ty.kind() {
+        TypeKind::Struct(_) | TypeKind::Union(_) if met(ty, seen) => false,
         TypeKind::Struct(s) => {
             if s.extensibility == Extensibility::Mutable {
                 return true;
@@ -82,7 +107,7 @@ pub(super) fn key_has_mutable(ty: &DynamicType) -> bool {
                 if level
                     .iter()
                     .filter(|m| !own_keys || m.key)
-                    .any(|m| !m.external && key_has_mutable(&m.ty))
+                    .any(|m| !m.external && mutable_in(&m.ty, seen))
                 {
                     return true;
                 }
@@ -94,12 +119,12 @@ pub(super) fn key_has_mutable(ty: &DynamicType) -> bool {
             u.extensibility == Extensibility::Mutable
                 || u.cases
                     .iter()
-                    .any(|c| !c.external && key_has_mutable(&c.ty))
+                    .any(|c| !c.external && mutable_in(&c.ty, seen))
         }
         TypeKind::Sequence { element, .. } | TypeKind::Array { element, .. } => {
-            key_has_mutable(element)
+            mutable_in(element, seen)
         }
-        TypeKind::Map { key, value, .. } => key_has_mutable(key) || key_has_mutable(value),
+        TypeKind::Map { key, value, .. } => mutable_in(key, seen) || mutable_in(value, seen),
         _ => false,
     }
 }
@@ -197,6 +222,6 @@ pub(super) fn key_max_end(
             }
             Some(end)
         }
-        TypeKind::Alias { .. } => None,
+        TypeKind::Alias { .. } | TypeKind::Forward(_) => None,
     }
 }

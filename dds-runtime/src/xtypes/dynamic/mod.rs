@@ -35,7 +35,7 @@ pub use idl::{types_from_idl, types_from_idl_file, IdlError, IdlOptions};
 pub use json::{from_json, to_json};
 pub use layout::default_version;
 pub use types::{
-    BitFlag, BitmaskType, DynamicType, EnumType, Enumerator, Member, Primitive, StructType,
-    TypeKind, UnionCase, UnionType,
+    BitFlag, BitmaskType, DynamicType, EnumType, Enumerator, ForwardType, Member, Primitive,
+    StructType, TypeKind, UnionCase, UnionType, MAX_RECURSIVE_TYPES,
 };
 pub use value::{DynamicData, Value};

@@ -16,7 +16,8 @@ impl DynamicType {
     /// The type objects, identifiers, `TypeInformation` and `TypeMapping` of this topic type (a struct or a
     /// union, possibly behind typedefs), built as for a derived type; every named type it reaches is also
     /// registered for local assignability checks. Two different named types with the same name are an error
-    /// ([`BuildError::Conflict`]), as are recursive types.
+    /// ([`BuildError::Conflict`]); recursive types get strongly connected component identifiers, as derived
+    /// ones do.
     pub fn type_support(&self) -> Result<TypeSupport, BuildError> {
         let root = self.resolved();
         if !matches!(root.kind(), TypeKind::Struct(_) | TypeKind::Union(_)) {
@@ -87,6 +88,10 @@ impl Lowering {
                 bound: bound(b),
                 key: Box::new(self.shape(key)?),
                 value: Box::new(self.shape(value)?),
+            },
+            TypeKind::Forward(r) => match r.target() {
+                Some(t) => self.shape(t)?,
+                None => return Err(BuildError::Unsupported("an undefined forward reference")),
             },
             TypeKind::Alias { .. }
             | TypeKind::Enum(_)

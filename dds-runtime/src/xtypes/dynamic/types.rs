@@ -2,7 +2,7 @@
 
 use std::cell::RefCell;
 use std::collections::HashSet;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use crate::cdr::Extensibility;
 
@@ -14,6 +14,13 @@ use super::error::DynamicError;
 #[derive(Clone)]
 pub struct DynamicType(pub(super) Arc<TypeKind>);
 
+/// Most recursive types (defined forward references) one process makes: each is a cycle of shared nodes that
+/// lives as long as the process.
+pub const MAX_RECURSIVE_TYPES: usize = 4096;
+
+/// The recursive types defined so far (see [`MAX_RECURSIVE_TYPES`]).
+static DEFINED: std::sync::Mutex<Vec<DynamicType>> = std::sync::Mutex::new(Vec::new());
+
 thread_local! {
     /// Within one outermost comparison (depth > 0): the pairs of nodes (by address) found equal so far.
     static EQUAL_PAIRS: RefCell<(u32, HashSet<(usize, usize)>)> = RefCell::new((0, HashSet::new()));
@@ -21,25 +28,29 @@ thread_local! {
 
 impl PartialEq for DynamicType {
     fn eq(&self, other: &Self) -> bool {
-        if Arc::ptr_eq(&self.0, &other.0) {
+        // A defined forward reference is the type it refers to.
+        let (this, other) = (self.unforwarded(), other.unforwarded());
+        if Arc::ptr_eq(&this.0, &other.0) {
             return true;
         }
         // Both trees are borrowed for the whole outermost comparison, so addresses stay unique until the
         // memo is cleared at its end.
         let pair = (
-            Arc::as_ptr(&self.0) as usize,
+            Arc::as_ptr(&this.0) as usize,
             Arc::as_ptr(&other.0) as usize,
         );
+        // A pair is taken as equal while it is being compared (so a recursive type's cycle ends there): if
+        // it is not, the comparison that assumed it fails too, up to the outermost one.
         let known = EQUAL_PAIRS.with(|m| {
             let mut m = m.borrow_mut();
             m.0 += 1;
-            m.1.contains(&pair)
+            !m.1.insert(pair)
         });
-        let same = known || self.0 == other.0;
+        let same = known || this.0 == other.0;
         EQUAL_PAIRS.with(|m| {
             let mut m = m.borrow_mut();
-            if same {
-                m.1.insert(pair);
+            if !same {
+                m.1.remove(&pair);
             }
             m.0 -= 1;
             if m.0 == 0 {
@@ -58,6 +69,7 @@ impl std::fmt::Debug for DynamicType {
             TypeKind::Enum(e) => write!(f, "enum {}", e.name),
             TypeKind::Bitmask(b) => write!(f, "bitmask {}", b.name),
             TypeKind::Alias { name, .. } => write!(f, "typedef {name}"),
+            TypeKind::Forward(r) => r.fmt(f),
             other => other.fmt(f),
         }
     }
@@ -187,6 +199,51 @@ pub enum TypeKind {
         /// Maximum entries, if bounded.
         bound: Option<u32>,
     },
+    /// A named struct or union used before its definition: the back reference that closes a recursive
+    /// type's cycle ([`DynamicType::forward`], [`DynamicType::recursive`]).
+    Forward(ForwardType),
+}
+
+/// The late-bound reference of [`TypeKind::Forward`]: a name, and the type it stands for once defined.
+///
+/// Equality compares the types referred to (names when undefined); `Debug` prints the name only.
+#[derive(Clone)]
+pub struct ForwardType {
+    name: String,
+    target: OnceLock<DynamicType>,
+}
+
+impl ForwardType {
+    /// The name of the type referred to.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The type referred to, once defined.
+    pub fn target(&self) -> Option<&DynamicType> {
+        self.target.get()
+    }
+}
+
+impl std::fmt::Debug for ForwardType {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let state = if self.target.get().is_some() {
+            ""
+        } else {
+            " (undefined)"
+        };
+        write!(f, "forward {}{state}", self.name)
+    }
+}
+
+impl PartialEq for ForwardType {
+    fn eq(&self, other: &Self) -> bool {
+        match (self.target(), other.target()) {
+            (Some(a), Some(b)) => a == b,
+            (None, None) => self.name == other.name,
+            _ => false,
+        }
+    }
 }
 
 /// An enumerator.
@@ -438,6 +495,44 @@ impl UnionType {
     }
 }
 
+/// Ends building a type that `forward` stood for while it was built: the placeholder is defined as `t` if
+/// anything refers to it (the type is recursive), else dropped. The caller has let go of its own copies
+/// (placeholder maps) first.
+pub(super) fn close_forward(forward: DynamicType, t: &DynamicType) -> Result<(), DynamicError> {
+    if Arc::strong_count(&forward.0) > 1 {
+        forward.define(t.clone())
+    } else {
+        Ok(())
+    }
+}
+
+/// Whether a value of `ty` holds a value of the forward reference `fwd` (by address) with nothing in between that
+/// may be empty (sequence, map, optional member): then the type has no finite value.
+fn reaches_by_value(ty: &DynamicType, fwd: &DynamicType) -> bool {
+    let mut seen = HashSet::new();
+    let mut stack = vec![ty];
+    while let Some(t) = stack.pop() {
+        if Arc::ptr_eq(&t.0, &fwd.0) {
+            return true;
+        }
+        if !seen.insert(Arc::as_ptr(&t.0) as usize) {
+            continue;
+        }
+        match t.kind() {
+            TypeKind::Alias { target, .. } => stack.push(target),
+            TypeKind::Forward(r) => stack.extend(r.target()),
+            TypeKind::Array { element, .. } => stack.push(element),
+            TypeKind::Struct(s) => {
+                stack.extend(s.members.iter().filter(|m| !m.optional).map(|m| &m.ty))
+            }
+            // A union's default value is its first case.
+            TypeKind::Union(u) => stack.extend(u.cases.first().map(|c| &c.ty)),
+            _ => {}
+        }
+    }
+    false
+}
+
 pub(super) fn is_signed(p: Primitive) -> bool {
     matches!(
         p,
@@ -505,16 +600,116 @@ impl DynamicType {
         })
     }
 
+    /// A reference to the struct or union `name`, to be defined later with [`DynamicType::define`]: what a
+    /// recursive type's members use to refer back to it. [`DynamicType::recursive`] does both steps.
+    ///
+    /// A defined recursive type is a cycle of shared nodes: it lives as long as the process, and a process
+    /// defines at most [`MAX_RECURSIVE_TYPES`] (build each one once, as a topic does; importing the same
+    /// component identifiers again reuses the type).
+    pub fn forward(name: impl Into<String>) -> Self {
+        DynamicType::new(TypeKind::Forward(ForwardType {
+            name: name.into(),
+            target: OnceLock::new(),
+        }))
+    }
+
+    /// Defines the forward reference `self` ([`DynamicType::forward`]) as `target`, closing the cycle.
+    ///
+    /// Errors: `self` is not an undefined forward reference; `target` is not a struct, union or typedef of the
+    /// reference's name; or the type would have no finite value (a member, array element or
+    /// first union case leads back to it with no sequence, map or optional member in between).
+    pub fn define(&self, target: DynamicType) -> Result<(), DynamicError> {
+        let TypeKind::Forward(r) = self.kind() else {
+            return Err(DynamicError::Invalid(format!(
+                "{self:?} is not a forward reference"
+            )));
+        };
+        let named = target.unforwarded();
+        if named.name() != r.name
+            || !matches!(
+                named.kind(),
+                TypeKind::Struct(_) | TypeKind::Union(_) | TypeKind::Alias { .. }
+            )
+        {
+            return Err(DynamicError::Invalid(format!(
+                "forward {} defined as {target:?}: not a struct, union or typedef of that name",
+                r.name
+            )));
+        }
+        if reaches_by_value(&target, self) {
+            return Err(DynamicError::Invalid(format!(
+                "recursive type {} has no finite value: a sequence, map or optional member must break its cycle",
+                r.name
+            )));
+        }
+        // The cycle keeps itself alive: it is kept here too, in a bounded list, so that what lives for the
+        // process is visible and limited.
+        let mut defined = DEFINED.lock().unwrap_or_else(|e| e.into_inner());
+        if defined.len() >= MAX_RECURSIVE_TYPES {
+            return Err(DynamicError::Invalid(format!(
+                "{} is past the {MAX_RECURSIVE_TYPES} recursive types a process may define",
+                r.name
+            )));
+        }
+        r.target
+            .set(target.clone())
+            .map_err(|_| DynamicError::Invalid(format!("forward {} is already defined", r.name)))?;
+        defined.push(target);
+        Ok(())
+    }
+
+    /// A recursive struct or union: `build` gets a forward reference to the type (named `name`) to use in its
+    /// members, and returns the type, which then defines the reference ([`DynamicType::define`]).
+    ///
+    /// ```
+    /// # use dds_runtime::xtypes::dynamic::*;
+    /// // struct Node { long v; sequence<Node> kids; };
+    /// let node = DynamicType::recursive("Node", |node| {
+    ///     StructBuilder::new("Node")
+    ///         .member("v", DynamicType::primitive(Primitive::Int32))
+    ///         .member("kids", DynamicType::sequence(node, None))
+    ///         .build()
+    /// })?;
+    /// # Ok::<(), DynamicError>(())
+    /// ```
+    pub fn recursive(
+        name: impl Into<String>,
+        build: impl FnOnce(DynamicType) -> Result<DynamicType, DynamicError>,
+    ) -> Result<DynamicType, DynamicError> {
+        let fwd = DynamicType::forward(name);
+        let ty = build(fwd.clone())?;
+        fwd.define(ty.clone())?;
+        Ok(ty)
+    }
+
     /// What the type is.
     pub fn kind(&self) -> &TypeKind {
         &self.0
     }
 
-    /// The type with aliases followed.
+    /// The type with aliases and defined forward references followed.
     pub fn resolved(&self) -> &DynamicType {
         let mut t = self;
-        while let TypeKind::Alias { target, .. } = &*t.0 {
-            t = target;
+        loop {
+            t = match &*t.0 {
+                TypeKind::Alias { target, .. } => target,
+                TypeKind::Forward(r) => match r.target() {
+                    Some(target) => target,
+                    None => return t,
+                },
+                _ => return t,
+            };
+        }
+    }
+
+    /// The type with forward references followed (aliases kept).
+    pub(super) fn unforwarded(&self) -> &DynamicType {
+        let mut t = self;
+        while let TypeKind::Forward(r) = &*t.0 {
+            match r.target() {
+                Some(target) => t = target,
+                None => break,
+            }
         }
         t
     }
@@ -527,6 +722,7 @@ impl DynamicType {
             TypeKind::Enum(e) => e.name.clone(),
             TypeKind::Bitmask(b) => b.name.clone(),
             TypeKind::Alias { name, .. } => name.clone(),
+            TypeKind::Forward(r) => r.name.clone(),
             TypeKind::Primitive(p) => p.idl_name().to_string(),
             TypeKind::String { wide, bound } => {
                 let s = if *wide { "wstring" } else { "string" };

@@ -69,6 +69,8 @@ impl Value {
             TypeKind::Primitive(p) => default_primitive(*p),
             TypeKind::String { .. } => Value::String(String::new()),
             TypeKind::Alias { target, .. } => Value::default_of(target),
+            // Only an undefined reference is left after `resolved`.
+            TypeKind::Forward(_) => Value::Struct(Vec::new()),
             TypeKind::Enum(e) => Value::Enum(e.literals.get(e.default).map_or(0, |l| l.value)),
             TypeKind::Bitmask(_) => Value::Bitmask(0),
             TypeKind::Struct(s) => Value::Struct(

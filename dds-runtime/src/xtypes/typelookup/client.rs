@@ -8,8 +8,8 @@
 use std::collections::{BTreeMap, HashSet, VecDeque};
 use std::time::{Duration, Instant};
 
-use crate::xtypes::store::{StoreError, TypeStore};
-use crate::xtypes::typeobject::TypeIdentifier;
+use crate::xtypes::store::{component_of, is_lookup_id, StoreError, TypeStore};
+use crate::xtypes::typeobject::{TypeIdentifier, TypeIdentifierTypeObjectPair, TypeObject};
 
 use super::messages::*;
 
@@ -108,10 +108,11 @@ impl Client {
         }
     }
 
-    /// Queues the hashed identifiers among `ids` that `store` lacks and no request asks for yet.
+    /// Queues the hashed and component identifiers among `ids` that `store` lacks and no request asks for
+    /// yet.
     pub fn want(&mut self, store: &TypeStore, ids: impl IntoIterator<Item = TypeIdentifier>) {
         for id in ids {
-            if id.hash().is_none()
+            if !is_lookup_id(&id)
                 || store.contains(&id)
                 || self.asked.contains(&id)
                 || self.queued_set.contains(&id)
@@ -205,6 +206,7 @@ impl Client {
         };
         match (&mut f.asked, &reply.return_data) {
             (Asked::Types(asked), Return::GetTypes(Ok(types))) => {
+                store_components(&mut self.asked, store, asked, &types.types, &mut out);
                 for p in &types.types {
                     let Some(i) = asked.iter().position(|a| a == &p.type_identifier) else {
                         continue;
@@ -275,5 +277,42 @@ impl Client {
     /// When [`handle_timeout`](Self::handle_timeout) has something to do.
     pub fn next_timeout(&self) -> Option<Instant> {
         self.in_flight.values().map(|f| f.deadline).min()
+    }
+}
+
+/// The objects of strongly connected components in a reply, each component stored whole if a type of it
+/// was asked for: every asked identifier of a stored component is then answered.
+fn store_components(
+    pending: &mut HashSet<TypeIdentifier>,
+    store: &mut TypeStore,
+    asked: &mut Vec<TypeIdentifier>,
+    pairs: &[TypeIdentifierTypeObjectPair],
+    out: &mut ReplyOutcome,
+) {
+    let mut done = Vec::new();
+    for p in pairs {
+        let Some(c) = component_of(&p.type_identifier) else {
+            continue;
+        };
+        if done.contains(&c) || !asked.iter().any(|a| component_of(a) == Some(c)) {
+            continue;
+        }
+        done.push(c);
+        let members: Vec<(TypeIdentifier, TypeObject)> = pairs
+            .iter()
+            .filter(|q| component_of(&q.type_identifier) == Some(c))
+            .map(|q| (q.type_identifier.clone(), q.type_object.clone()))
+            .collect();
+        match store.insert_component(&members) {
+            Ok(_) => asked.retain(|a| {
+                let answered = component_of(a) == Some(c);
+                if answered {
+                    pending.remove(a);
+                    out.stored.push(a.clone());
+                }
+                !answered
+            }),
+            Err(e) => out.rejected.push((p.type_identifier.clone(), e)),
+        }
     }
 }

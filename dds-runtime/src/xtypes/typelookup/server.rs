@@ -4,7 +4,7 @@
 use std::collections::{HashMap, VecDeque};
 use std::time::{Duration, Instant};
 
-use crate::xtypes::store::TypeStore;
+use crate::xtypes::store::{is_lookup_id, TypeStore};
 use crate::xtypes::typeobject::{TypeIdentifier, TypeIdentifierTypeObjectPair};
 
 use super::messages::*;
@@ -176,21 +176,34 @@ impl Server {
     fn get_types(&self, store: &TypeStore, ids: &[TypeIdentifier]) -> TypesOut {
         let mut out = TypesOut::default();
         let mut bytes = 0usize;
+        // A type of a strongly connected component (or the component, index 0) is answered with every type of
+        // the component: its objects are checked against the component's hash together.
         for id in ids.iter().take(self.limits.max_ids_per_request) {
-            if id.hash().is_none() || out.types.iter().any(|p| &p.type_identifier == id) {
+            if !is_lookup_id(id) || out.types.iter().any(|p| &p.type_identifier == id) {
                 continue;
             }
-            let Some(object) = store.get(id) else {
+            let Some(objects) = store.objects_of(id) else {
                 continue;
             };
-            bytes += store.serialized_size(id);
+            bytes += objects
+                .iter()
+                .map(|(i, _)| store.serialized_size(i))
+                .sum::<usize>();
             if bytes > self.limits.max_reply_bytes && !out.types.is_empty() {
                 break;
             }
-            out.types.push(TypeIdentifierTypeObjectPair {
-                type_identifier: id.clone(),
-                type_object: (*object).clone(),
-            });
+            for (type_identifier, object) in objects {
+                if !out
+                    .types
+                    .iter()
+                    .any(|p| p.type_identifier == type_identifier)
+                {
+                    out.types.push(TypeIdentifierTypeObjectPair {
+                        type_identifier,
+                        type_object: (*object).clone(),
+                    });
+                }
+            }
         }
         out
     }
