@@ -662,7 +662,8 @@ impl Reader {
             sn = sn.next();
         }
         p.acknack_count = p.acknack_count.wrapping_add(1);
-        let dest = p.destination().to_vec();
+        // At most one locator: kept by value, so no allocation per ACKNACK.
+        let dest = p.destination().first().copied();
         let dst = Some(p.guid.prefix);
         let ack = Submessage::AckNack(AckNack {
             reader_id: rid,
@@ -671,7 +672,7 @@ impl Reader {
             count: p.acknack_count,
             final_flag: set.num_bits == 0 && p.synced && !std::mem::take(&mut p.want_heartbeat),
         });
-        out.push(&dest, dst, Ts::Any, &ack);
+        out.push(dest.as_slice(), dst, Ts::Any, &ack);
         let (writer, hb_last) = (p.guid, p.hb_last);
         let Some(b) = p.backlog_if_used_mut() else {
             return;
@@ -689,7 +690,7 @@ impl Reader {
             ) else {
                 continue;
             };
-            out.push(&dest, dst, Ts::Any, &nf);
+            out.push(dest.as_slice(), dst, Ts::Any, &nf);
             // Already asked for all it lacks: a pending HEARTBEAT_FRAG answer for it is redundant.
             b.nackfrag_req.remove(sn);
         }
@@ -698,7 +699,7 @@ impl Reader {
     /// One NACK_FRAG per sample a HEARTBEAT_FRAG asked about and still partly received: the fragments we lack
     /// up to the last one the writer has.
     fn send_requested_nackfrags(rid: EntityId, p: &mut WriterProxy, out: &mut Outbox) {
-        let dest = p.destination().to_vec();
+        let dest = p.destination().first().copied();
         let (writer, dst) = (p.guid, Some(p.guid.prefix));
         let b = p.backlog_mut();
         b.nackfrag_due = None;
@@ -708,7 +709,7 @@ impl Reader {
                 continue;
             };
             if let Some(nf) = nack_frag(rid, writer, &mut b.nackfrag_count, sn, &d.missing(last)) {
-                out.push(&dest, dst, Ts::Any, &nf);
+                out.push(dest.as_slice(), dst, Ts::Any, &nf);
             }
         }
     }

@@ -679,7 +679,7 @@ impl Writer {
             return;
         };
         p.repair_due = None;
-        let dest: Vec<Locator> = p.destination().to_vec();
+        let dest = p.destination().first().copied();
         let dst = Some(g.prefix);
         let key_hash_only = p.key_hash_only_disposes;
         let mut budget = self.params.max_repair_bytes as isize;
@@ -689,7 +689,7 @@ impl Writer {
         let mut resend = |c: &CacheChange, only: Option<&BTreeSet<u32>>| {
             let n = send_change(
                 out,
-                &dest,
+                dest.as_slice(),
                 dst,
                 g.entity_id,
                 wid,
@@ -733,11 +733,11 @@ impl Writer {
                     last_fragment_num: n,
                     count: self.hbfrag_count,
                 });
-                out.push(&dest, dst, Ts::Any, &hf);
+                out.push(dest.as_slice(), dst, Ts::Any, &hf);
             }
         }
         let idle = budget == self.params.max_repair_bytes as isize && gaps.is_empty();
-        send_gaps(out, &dest, dst, g.entity_id, wid, &gaps);
+        send_gaps(out, dest.as_slice(), dst, g.entity_id, wid, &gaps);
         let more = p.has_requests();
         p.release_if_served();
         let reliable = p.reliable;
@@ -751,7 +751,7 @@ impl Writer {
         let caught_up = idle && p.acked >= self.next_sn;
         if reliable && (!caught_up || self.group.is_some()) {
             let hb = self.heartbeat(g.entity_id, false);
-            out.push(&dest, dst, Ts::Any, &hb);
+            out.push(dest.as_slice(), dst, Ts::Any, &hb);
         }
     }
 }
