@@ -13,7 +13,6 @@ mod participant;
 pub(crate) mod pool;
 pub(crate) mod reader;
 pub mod shm;
-pub(crate) mod stand_in;
 pub mod types;
 pub(crate) mod writer;
 

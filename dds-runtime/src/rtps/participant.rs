@@ -382,12 +382,7 @@ impl Participant {
         let data = self.new_endpoint(spec, kinds)?;
         let id = data.guid.entity_id;
         let params = user_writer_params(&self.config, &data.qos.writer, keyed);
-        let mut writer = Writer::new(data.guid, params);
-        if internal {
-            writer.stands_in_for =
-                crate::rtps::stand_in::stand_in_for(&data.qos.writer.user_data.0);
-        }
-        self.writers.insert(id, writer);
+        self.writers.insert(id, Writer::new(data.guid, params));
         self.user_writers.insert(id);
         if internal {
             self.mark_internal(id);

@@ -457,12 +457,10 @@ impl Participant {
                     .participants
                     .get(&remote.prefix)
                     .map_or(VendorId::THIS, |p| p.data.vendor_id);
-                let suppressed = self.original_serves(id, rd);
                 if let Some(w) = self.writers.get_mut(&id) {
-                    let mut proxy = ReaderProxy::new(remote, locators, reliable)
+                    let proxy = ReaderProxy::new(remote, locators, reliable)
                         .with_multicast(multicast)
                         .for_vendor(vendor);
-                    proxy.suppressed = suppressed;
                     w.add_proxy(now, proxy, durable, &mut self.events);
                 }
                 self.refresh_reader_filter(id, remote);

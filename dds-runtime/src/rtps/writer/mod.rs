@@ -97,9 +97,6 @@ pub(crate) struct Writer {
     pub filters: ReaderFilters,
     /// The owner decides what the history keeps (see [`Writer::manage_history`]).
     managed: bool,
-    /// The original writer, when this is a durability service's stand-in: readers the original serves are
-    /// suppressed (`ReaderProxy::suppressed`).
-    pub stands_in_for: Option<Guid>,
 }
 
 impl Writer {
@@ -128,7 +125,6 @@ impl Writer {
             group: None,
             filters: ReaderFilters::default(),
             managed: false,
-            stands_in_for: None,
         }
     }
 
@@ -293,10 +289,6 @@ impl Writer {
         out: &mut Outbox,
         ev: &mut VecDeque<Event>,
     ) -> Result<SequenceNumber, WriteError> {
-        if self.stands_in_for.is_some() {
-            let suppressed = self.proxies.values().filter(|p| p.suppressed);
-            rejected.extend(suppressed.map(|p| p.guid));
-        }
         rejected.sort_unstable();
         if self.linger_until.is_some() {
             return Err(WriteError::Deleted);
@@ -474,10 +466,6 @@ impl Writer {
     ) {
         proxy.reliable &= self.params.reliable;
         self.expire(now);
-        if proxy.suppressed {
-            // The original writer serves it the history: GAPs for all of it.
-            proxy.floor = self.next_sn;
-        }
         if !(self.durable() && reader_durable) {
             proxy.floor = self.next_sn;
             proxy.acked = self.next_sn;

@@ -42,9 +42,6 @@ pub(crate) struct ReaderProxy {
     /// PID_STATUS_INFO) and no serialized key. Set for Fast DDS readers: Fast DDS 2.9 copies a key payload of
     /// up to 16 bytes straight into its instance handle, as if it were the key hash.
     pub key_hash_only_disposes: bool,
-    /// A durability stand-in's reader that the original writer serves: every change, history and new ones,
-    /// goes to it as GAP (set at matching, see `Participant::original_serves`).
-    pub suppressed: bool,
 }
 
 /// What a reader asked to be sent again: the part of a [`ReaderProxy`] only used between a request and its
@@ -78,7 +75,6 @@ impl ReaderProxy {
             last_nackfrag: None,
             repair_due: None,
             key_hash_only_disposes: false,
-            suppressed: false,
         }
     }
 
