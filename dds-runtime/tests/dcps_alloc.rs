@@ -107,30 +107,50 @@ fn run(
     (per(taker.0), per(taker.1), per(total))
 }
 
-#[test]
-fn steady_state_allocations_per_sample() {
-    let (p1, p2) = (participant(83), participant(83));
+/// A reliable KEEP_ALL writer and reader of `Fixed` on `topic` in two participants of `domain`, matched,
+/// both limited to `depth` samples; the writer blocks up to 10 s when its history is full.
+fn kept_full(
+    domain: u32,
+    topic: &str,
+    depth: u32,
+) -> (
+    (DomainParticipant, DomainParticipant),
+    DataWriter<Fixed>,
+    DataReader<Fixed>,
+) {
+    let (p1, p2) = (participant(domain), participant(domain));
     let (mut wq, mut rq) = reliable_keep_all();
     wq.reliability = Reliability::Reliable {
         max_blocking_time: Duration::from_secs(10),
     };
-    wq.resource_limits.max_samples = Some(2000);
-    rq.resource_limits.max_samples = Some(2000);
-    let (w, r) = matched::<Fixed>(&p1, &p2, "Alloc", &wq, &rq);
-    // Warm-up: buffers, pools and maps reach their working sizes. The writer's payload pool grows to the
-    // most samples the writer has had in flight (up to its history's 2000): with nobody taking, the reader's
-    // cache fills (2000) and then holds back its acknowledgements, so the writer's history fills too.
-    let filled = 3900;
+    wq.resource_limits.max_samples = Some(depth);
+    rq.resource_limits.max_samples = Some(depth);
+    let (w, r) = matched::<Fixed>(&p1, &p2, topic, &wq, &rq);
+    ((p1, p2), w, r)
+}
+
+/// Writes `n` samples (seq 0..n) with nobody taking, then takes them all.
+fn write_then_take(w: &DataWriter<Fixed>, r: &DataReader<Fixed>, n: u64) {
     let mut sample = Fixed::default();
-    for seq in 0..filled {
+    for seq in 0..n {
         sample.seq = seq;
         w.write(&sample).unwrap();
     }
     let mut got = 0;
-    while got < filled {
+    while got < n {
         assert!(r.wait_for_data(Duration::from_secs(5)).unwrap());
         got += r.take().unwrap().len() as u64;
     }
+}
+
+#[test]
+fn steady_state_allocations_per_sample() {
+    let (_ps, w, r) = kept_full(83, "Alloc", 2000);
+    // Warm-up: buffers, pools and maps reach their working sizes. The writer's payload pool grows to the
+    // most samples the writer has had in flight (up to its history's 2000): with nobody taking, the reader's
+    // cache fills (2000) and then holds back its acknowledgements, so the writer's history fills too.
+    let filled = 3900;
+    write_then_take(&w, &r, filled);
     run(&w, &r, filled, 10_000, false, 0);
     let n = 20_000;
     let (write, take, total) = run(&w, &r, filled + 10_000, n, false, 0);
@@ -197,27 +217,11 @@ fn steady_state_allocations_with_10000_samples_in_flight() {
     // The taker waits until the writer is this far ahead: the reader's cache is full (10 000) and the
     // writer holds at least 6 000 unacknowledged samples in its history, well past the pool's 4096.
     const LAG: u64 = 16_000;
-    let (p1, p2) = (participant(49), participant(49));
-    let (mut wq, mut rq) = reliable_keep_all();
-    wq.reliability = Reliability::Reliable {
-        max_blocking_time: Duration::from_secs(10),
-    };
-    wq.resource_limits.max_samples = Some(DEPTH);
-    rq.resource_limits.max_samples = Some(DEPTH);
-    let (w, r) = matched::<Fixed>(&p1, &p2, "AllocDeep", &wq, &rq);
+    let (_ps, w, r) = kept_full(49, "AllocDeep", DEPTH);
     // Warm-up: the reader's cache (10 000) and the writer's history (up to the 512 KiB window, about 11 900
     // samples of 44 bytes) fill; pools and maps reach their working sizes.
     let filled = 19_000;
-    let mut sample = Fixed::default();
-    for seq in 0..filled {
-        sample.seq = seq;
-        w.write(&sample).unwrap();
-    }
-    let mut got = 0;
-    while got < filled {
-        assert!(r.wait_for_data(Duration::from_secs(5)).unwrap());
-        got += r.take().unwrap().len() as u64;
-    }
+    write_then_take(&w, &r, filled);
     run(&w, &r, filled, 20_000, false, LAG);
     let n = 30_000;
     let (write, take, total) = run(&w, &r, filled + 20_000, n, false, LAG);

@@ -268,23 +268,6 @@ fn the_bindings_bytes_decode_to_its_values_and_match_the_derive() {
     }
 }
 
-fn node_value() -> Node {
-    let leaf = |value| Node {
-        value,
-        children: vec![],
-    };
-    Node {
-        value: 1,
-        children: vec![
-            leaf(2),
-            Node {
-                value: 3,
-                children: vec![leaf(4)],
-            },
-        ],
-    }
-}
-
 fn a_value() -> A {
     A {
         x: 1,
@@ -317,19 +300,6 @@ fn tree_value() -> Tree {
 fn chain_value() -> Chain {
     let link = |v, next| Chain { v, next };
     link(1, Some(Box::new(link(2, Some(Box::new(link(3, None)))))))
-}
-
-/// A `Node` nested `depth` deep, XCDR1 little endian, written by hand: each level is `value` and a
-/// one-element `children`, the last an empty one.
-fn nested_node_bytes(depth: usize) -> Vec<u8> {
-    let mut b = vec![0x00, 0x01, 0x00, 0x00];
-    for i in 0..depth {
-        b.extend((i as i32).to_le_bytes());
-        b.extend(1u32.to_le_bytes());
-    }
-    b.extend(0i32.to_le_bytes());
-    b.extend(0u32.to_le_bytes());
-    b
 }
 
 #[test]

@@ -93,20 +93,7 @@ fn round_trip<T: DdsType + PartialEq + std::fmt::Debug>(v: &T) {
 
 #[test]
 fn recursive_values_round_trip() {
-    let leaf = |v| Node {
-        value: v,
-        children: vec![],
-    };
-    round_trip(&Node {
-        value: 1,
-        children: vec![
-            leaf(2),
-            Node {
-                value: 3,
-                children: vec![leaf(4)],
-            },
-        ],
-    });
+    round_trip(&node_value());
     round_trip(&A {
         x: 1,
         bs: vec![B {
@@ -123,19 +110,6 @@ fn recursive_values_round_trip() {
         leaf: Leaf { name: "a".into() },
         kids: vec![Tree::default(); 3],
     });
-}
-
-/// A `Node` nested `depth` deep, XCDR1 little endian, written by hand (not by our encoder, which refuses to
-/// write past the depth limit): each level is `value` and a one-element `children`, the last an empty one.
-fn nested_node_bytes(depth: usize) -> Vec<u8> {
-    let mut b = vec![0x00, 0x01, 0x00, 0x00];
-    for i in 0..depth {
-        b.extend((i as i32).to_le_bytes());
-        b.extend(1u32.to_le_bytes());
-    }
-    b.extend(0i32.to_le_bytes());
-    b.extend(0u32.to_le_bytes());
-    b
 }
 
 #[test]

@@ -13,27 +13,15 @@ Reliable, volatile, keep-last 1.
 import os
 import sys
 import time
-from dataclasses import dataclass
 
 from cyclonedds.core import Policy, Qos
 from cyclonedds.domain import DomainParticipant
-from cyclonedds.idl import IdlStruct
-from cyclonedds.idl.annotations import final, key
-from cyclonedds.idl.types import int32
 from cyclonedds.pub import DataWriter
 from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
-from peer import log, wait_match
-
-
-@dataclass
-@final
-class Beat(IdlStruct, typename="xs::Beat"):
-    id: int32
-    key("id")
-    n: int32
+from peer import Beat, log, wait_match
 
 
 def sub():

@@ -1,6 +1,11 @@
 """What the Cyclone DDS peer scripts beside it share (they run by path, so this directory is on sys.path)."""
 import sys
 import time
+from dataclasses import dataclass
+
+from cyclonedds.idl import IdlStruct
+from cyclonedds.idl.annotations import final, key
+from cyclonedds.idl.types import int32
 
 
 def log(*a):
@@ -16,3 +21,12 @@ def wait_match(status, what, seconds=20):
             sys.exit(2)
         time.sleep(0.05)
     log(f"{what}: matched")
+
+
+@dataclass
+@final
+class Beat(IdlStruct, typename="xs::Beat"):
+    """The keyed type of the status and dynamic-API peers (`cyclone_status.py`, `cyclone_dynapi.py`)."""
+    id: int32
+    key("id")
+    n: int32

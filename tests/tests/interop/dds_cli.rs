@@ -365,7 +365,7 @@ mod recursive_types;
 #[test]
 fn dds_typeof_and_subscribe_a_recursive_topic() {
     use dds_runtime::prelude::*;
-    use recursive_types::{Holder, Node, A, B};
+    use recursive_types::{node_value, Holder, A, B};
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::Arc;
 
@@ -382,22 +382,9 @@ fn dds_typeof_and_subscribe_a_recursive_topic() {
         .create_publisher(&PublisherQos::default())
         .and_then(|publ| publ.create_datawriter(&topic, &DataWriterQos::default()))
         .expect("writer");
-    let leaf = |value| Node {
-        value,
-        children: vec![],
-    };
     let sample = Holder {
         id: 7,
-        root: Node {
-            value: 1,
-            children: vec![
-                leaf(2),
-                Node {
-                    value: 3,
-                    children: vec![leaf(4)],
-                },
-            ],
-        },
+        root: node_value(),
         a: A {
             x: 5,
             bs: vec![B {

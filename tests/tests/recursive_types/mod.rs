@@ -63,3 +63,34 @@ pub struct Chain {
     #[dds(recursive)]
     pub next: Option<Box<Chain>>,
 }
+
+/// The `Node` value the golden script serializes and the tests write: `1 [2, 3 [4]]`.
+pub fn node_value() -> Node {
+    let leaf = |value| Node {
+        value,
+        children: vec![],
+    };
+    Node {
+        value: 1,
+        children: vec![
+            leaf(2),
+            Node {
+                value: 3,
+                children: vec![leaf(4)],
+            },
+        ],
+    }
+}
+
+/// A `Node` nested `depth` deep, XCDR1 little endian, written by hand (not by our encoder, which refuses to
+/// write past the depth limit): each level is `value` and a one-element `children`, the last an empty one.
+pub fn nested_node_bytes(depth: usize) -> Vec<u8> {
+    let mut b = vec![0x00, 0x01, 0x00, 0x00];
+    for i in 0..depth {
+        b.extend((i as i32).to_le_bytes());
+        b.extend(1u32.to_le_bytes());
+    }
+    b.extend(0i32.to_le_bytes());
+    b.extend(0u32.to_le_bytes());
+    b
+}
