@@ -180,24 +180,17 @@ impl BuiltinFeed {
         let driver = p.driver();
         // Events from now on; what came before is seeded below (a repeat is only an update).
         driver.add_observer(feed.clone());
-        let (participants, writers, readers, topics) = driver.query_core(|c| {
-            let mut ps: Vec<ParticipantData> = c.discovered_participants().cloned().collect();
-            ps.push(c.participant_data());
-            let ws: Vec<EndpointData<_>> = c.publications().cloned().collect();
-            let rs: Vec<EndpointData<_>> = c.subscriptions().cloned().collect();
-            let ts: Vec<TopicData> = c.discovered_topic_announcements().cloned().collect();
-            (ps, ws, rs, ts)
-        });
-        for t in topics {
+        let known = Known::now(p);
+        for t in known.topics {
             feed.on_event(&Event::TopicDiscovered(Box::new(t)));
         }
-        for p in &participants {
+        for p in &known.participants {
             feed.participant(p);
         }
-        for w in &writers {
+        for w in &known.publications {
             feed.publication(w);
         }
-        for r in &readers {
+        for r in &known.subscriptions {
             feed.subscription(r);
         }
         let s = BuiltinSubscriber {
@@ -248,35 +241,32 @@ impl BuiltinFeed {
     /// seeded with what discovery knows now.
     fn user_reader(&self, spec: Box<dyn Any>) -> Option<DdsResult<Box<dyn Any>>> {
         let mut spec = Some(spec);
-        add_user(&self.participants, &mut spec, guid_key_handle, |p| {
-            seed(p).0
-        })
-        .or_else(|| {
-            add_user(&self.publications, &mut spec, guid_key_handle, |p| {
-                seed(p).1
+        let all = |k: &Known| k.participants.iter().map(Into::into).collect();
+        add_user(&self.participants, &mut spec, guid_key_handle, all)
+            .or_else(|| {
+                let all = |k: &Known| k.publications.iter().map(Into::into).collect();
+                add_user(&self.publications, &mut spec, guid_key_handle, all)
             })
-        })
-        .or_else(|| {
-            add_user(&self.subscriptions, &mut spec, guid_key_handle, |p| {
-                seed(p).2
+            .or_else(|| {
+                let all = |k: &Known| k.subscriptions.iter().map(Into::into).collect();
+                add_user(&self.subscriptions, &mut spec, guid_key_handle, all)
             })
-        })
-        .or_else(|| add_user(&self.topics, &mut spec, topic_key_handle, |p| seed(p).3))
+            .or_else(|| add_user(&self.topics, &mut spec, topic_key_handle, Known::topic_data))
     }
 }
 
 /// Adds the reader `spec` describes to `reader` when it is a reader of `X`'s topic (`spec` is then taken),
-/// seeded with `seed` of its participant.
+/// seeded with `seed` of what its participant's discovery knows now.
 fn add_user<X: DdsType + Clone>(
     reader: &BuiltinReader<X>,
     spec: &mut Option<Box<dyn Any>>,
     handle_of: fn(&[u8]) -> InstanceHandle,
-    seed: fn(&DomainParticipant) -> Vec<X>,
+    seed: impl FnOnce(&Known) -> Vec<X>,
 ) -> Option<DdsResult<Box<dyn Any>>> {
     let s = spec.take()?.downcast::<UserReaderSpec<X>>();
     match s {
         Ok(s) => {
-            let data = seed(s.subscriber.participant());
+            let data = seed(&Known::now(s.subscriber.participant()));
             Some(
                 reader
                     .add_user_reader(*s, handle_of, data)
@@ -290,32 +280,45 @@ fn add_user<X: DdsType + Clone>(
     }
 }
 
-/// What discovery knows now, as built-in topic data: participants (this one included), publications,
-/// subscriptions, and topics (announced, and those of the endpoints, each once).
-#[allow(clippy::type_complexity)]
-fn seed(
-    p: &DomainParticipant,
-) -> (
-    Vec<ParticipantBuiltinTopicData>,
-    Vec<PublicationBuiltinTopicData>,
-    Vec<SubscriptionBuiltinTopicData>,
-    Vec<TopicBuiltinTopicData>,
-) {
-    p.driver().query_core(|c| {
-        let mut ps: Vec<ParticipantBuiltinTopicData> =
-            c.discovered_participants().map(Into::into).collect();
-        ps.push((&c.participant_data()).into());
-        let ws: Vec<PublicationBuiltinTopicData> = c.publications().map(Into::into).collect();
-        let rs: Vec<SubscriptionBuiltinTopicData> = c.subscriptions().map(Into::into).collect();
-        let mut ts: Vec<TopicBuiltinTopicData> = c
-            .discovered_topic_announcements()
+/// What discovery knows now: the participants (this one included), publications, subscriptions and
+/// announced topics. Built-in readers start from it and follow the events after it.
+struct Known {
+    participants: Vec<ParticipantData>,
+    publications: Vec<EndpointData<crate::qos::WriterQos>>,
+    subscriptions: Vec<EndpointData<crate::qos::ReaderQos>>,
+    topics: Vec<TopicData>,
+}
+
+impl Known {
+    fn now(p: &DomainParticipant) -> Known {
+        p.driver().query_core(|c| {
+            let mut participants: Vec<ParticipantData> =
+                c.discovered_participants().cloned().collect();
+            participants.push(c.participant_data());
+            Known {
+                participants,
+                publications: c.publications().cloned().collect(),
+                subscriptions: c.subscriptions().cloned().collect(),
+                topics: c.discovered_topic_announcements().cloned().collect(),
+            }
+        })
+    }
+
+    /// The DCPSTopic data: the announced topics, then those only endpoints name, each once (the rule of
+    /// `BuiltinFeed::topic`).
+    fn topic_data(&self) -> Vec<TopicBuiltinTopicData> {
+        let mut ts: Vec<TopicBuiltinTopicData> = self
+            .topics
+            .iter()
             .map(|t| TopicBuiltinTopicData::new(&t.topic_name, &t.type_name, t.topic_data.clone()))
             .collect();
-        let endpoints = c
-            .publications()
+        let endpoints = self
+            .publications
+            .iter()
             .map(|w| (&w.topic_name, &w.type_name, &w.qos.topic_data.0))
             .chain(
-                c.subscriptions()
+                self.subscriptions
+                    .iter()
                     .map(|r| (&r.topic_name, &r.type_name, &r.qos.topic_data.0)),
             );
         for (name, type_name, data) in endpoints {
@@ -326,8 +329,8 @@ fn seed(
                 ts.push(TopicBuiltinTopicData::new(name, type_name, data.clone()));
             }
         }
-        (ps, ws, rs, ts)
-    })
+        ts
+    }
 }
 
 /// The serialized key of the DCPSTopic instance of `name` with `type_name`.
