@@ -156,7 +156,7 @@ impl Writer {
     fn fragmenting(&self) -> Fragmenting {
         Fragmenting {
             size: self.params.fragment_size,
-            whole_max: self.params.whole_max.max(self.params.fragment_size),
+            whole_max: self.params.whole_max,
         }
     }
 
