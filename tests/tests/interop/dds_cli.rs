@@ -3,7 +3,8 @@
 //! prints what the Cyclone writer writes, `dds publish --idl` reaches the Cyclone reader, and `dds typeof`
 //! without `--idl` says why the discovered type cannot be used yet. `dds subscribe` shows the disposes of a
 //! Cyclone writer that writes and at once disposes each instance (the dispose then usually only marks the
-//! sample still held, as the reader cache does, instead of arriving as a sample of its own).
+//! sample still held, as the reader cache does, instead of arriving as a sample of its own). Against Fast DDS
+//! 2.9, which announces no type information, `dds typeof` says so and `dds subscribe --idl` works.
 
 use std::process::Command;
 use std::time::Duration;
@@ -451,4 +452,60 @@ fn dds_typeof_and_subscribe_a_recursive_topic() {
     });
     assert_eq!(rows.len(), 2, "two samples expected: {text}");
     assert!(rows.iter().all(|r| r == &expected), "{text}");
+}
+
+/// Against Fast DDS 2.9, which announces no XTypes type information: `dds typeof` says so and exits 3 (and
+/// names `--idl`), and `dds subscribe --idl` with the repository's shape IDL prints the Fast DDS writer's
+/// samples.
+#[test]
+fn dds_against_fastdds_needs_idl_and_works_with_it() {
+    use super::harness::{fastdds_peer, root};
+    let Ok(()) = require_netns() else { return };
+    let Ok(fast) = fastdds_peer() else { return };
+    let Ok(bin) = our_bin("dds") else { return };
+    let domain = DOMAIN.to_string();
+    let mut c = Command::new(fast);
+    c.args([
+        "-P", "-t", "Square", "-d", &domain, "-c", "RED", "-r", "-x", "1",
+    ]);
+    let mut p = Proc::spawn("fastdds writer", c);
+    let typeof_ = Command::new(&bin)
+        .args(["typeof", "Square", "--domain", &domain])
+        .output()
+        .expect("running dds");
+    let err = String::from_utf8_lossy(&typeof_.stderr).to_string();
+    check!(
+        typeof_.status.code() == Some(3)
+            && err.contains("no XTypes type information")
+            && err.contains("--idl"),
+        &[&p],
+        "dds typeof against Fast DDS: {typeof_:?}"
+    );
+    let out = Command::new(&bin)
+        .args([
+            "subscribe",
+            "Square",
+            "--ndjson",
+            "-n",
+            "3",
+            "--timeout",
+            "20",
+        ])
+        .arg("--idl")
+        .arg(root().join("idl/shapes.idl"))
+        .args(["--domain", &domain])
+        .output()
+        .expect("running dds");
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    check!(out.status.success(), &[&p], "dds subscribe failed: {out:?}");
+    let rows = ndjson_rows(&text);
+    check!(
+        rows.len() == 3
+            && rows
+                .iter()
+                .all(|r| r["color"] == "RED" && r["x"].as_i64().is_some()),
+        &[&p],
+        "three RED samples expected: {text}"
+    );
+    let _ = p.interrupt(WAIT);
 }
