@@ -2,7 +2,7 @@
 //! form.
 
 use super::error::BuildError;
-use super::shape::{Def, Member, Shape};
+use super::shape::{Case, Def, Member, Shape};
 use super::typeobject::*;
 use crate::cdr::Extensibility;
 
@@ -55,19 +55,10 @@ pub(super) fn body<'a>(
             if *discriminator_key {
                 disc_flags |= MemberFlag::IS_KEY;
             }
-            let mut members = Vec::with_capacity(cases.len());
-            for c in cases {
-                let mut flags = MemberFlag::TRY_CONSTRUCT1;
-                flags.set(MemberFlag::IS_DEFAULT, c.is_default);
-                flags.set(MemberFlag::IS_EXTERNAL, c.external);
-                members.push(UnionMember {
-                    id: c.id,
-                    flags,
-                    type_id: id(&c.ty, complete)?,
-                    labels: c.labels.clone(),
-                    detail: MemberDetail::named(c.name.as_str()),
-                });
-            }
+            let members = cases
+                .iter()
+                .map(|c| Ok(union_member(c, id(&c.ty, complete)?)))
+                .collect::<Result<_, BuildError>>()?;
             TypeBody::Union {
                 flags: type_flags(*extensibility, false, *nested),
                 detail,
@@ -92,23 +83,12 @@ pub(super) fn body<'a>(
             extensibility,
             bit_bound,
             flags,
-        } => {
-            let mut bitflags: Vec<Bitflag> = flags
-                .iter()
-                .map(|(n, p)| Bitflag {
-                    position: *p,
-                    flags: MemberFlag::empty(),
-                    detail: MemberDetail::named(n.as_str()),
-                })
-                .collect();
-            bitflags.sort_by_key(|f| f.position);
-            TypeBody::Bitmask {
-                flags: type_flags(*extensibility, false, false),
-                bit_bound: *bit_bound,
-                detail,
-                bitflags,
-            }
-        }
+        } => TypeBody::Bitmask {
+            flags: type_flags(*extensibility, false, false),
+            bit_bound: *bit_bound,
+            detail,
+            bitflags: bitmask_flags(flags),
+        },
         Def::Alias(t) => TypeBody::Alias {
             flags: TypeFlag::empty(),
             detail,
@@ -118,6 +98,34 @@ pub(super) fn body<'a>(
             ann_custom: None,
         },
     })
+}
+
+/// A union case, its type identifier resolved.
+fn union_member(c: &Case, type_id: TypeIdentifier) -> UnionMember {
+    let mut flags = MemberFlag::TRY_CONSTRUCT1;
+    flags.set(MemberFlag::IS_DEFAULT, c.is_default);
+    flags.set(MemberFlag::IS_EXTERNAL, c.external);
+    UnionMember {
+        id: c.id,
+        flags,
+        type_id,
+        labels: c.labels.clone(),
+        detail: MemberDetail::named(c.name.as_str()),
+    }
+}
+
+/// A bitmask's flags, sorted by position.
+fn bitmask_flags(flags: &[(String, u16)]) -> Vec<Bitflag> {
+    let mut bitflags: Vec<Bitflag> = flags
+        .iter()
+        .map(|(n, p)| Bitflag {
+            position: *p,
+            flags: MemberFlag::empty(),
+            detail: MemberDetail::named(n.as_str()),
+        })
+        .collect();
+    bitflags.sort_by_key(|f| f.position);
+    bitflags
 }
 
 /// A struct member's detail: its name, and `@hashid` in the builtin annotations.

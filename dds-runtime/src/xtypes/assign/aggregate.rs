@@ -84,18 +84,7 @@ impl Checker<'_> {
                 // The member types: KeyErased(m1.type) is-assignable-from KeyErased(m2.type).
                 self.assignable(&m1.type_id, &m2.type_id)?;
             } else {
-                if must_understand(m1.flags) {
-                    return Err(NotAssignable::MustUnderstand { id: m1.id });
-                }
-                if top && m1.flags.contains(MemberFlag::IS_KEY) {
-                    return Err(NotAssignable::Key);
-                }
-                // Final (or prevent_type_widening, for non-optional members): the same member ids.
-                let widening =
-                    self.tce.prevent_type_widening && !m1.flags.contains(MemberFlag::IS_OPTIONAL);
-                if is_final || widening {
-                    return Err(NotAssignable::Member { id: m1.id });
-                }
+                self.reader_member_missing(m1, top, is_final)?;
             }
             // Appendable: members at the same index have the same id and optionality, and the member type is
             // strongly assignable; final: the same, for every index.
@@ -110,24 +99,35 @@ impl Checker<'_> {
                 self.strongly_assignable(&m1.type_id, &p2.type_id)?;
             }
         }
-        for m2 in &m2s {
-            let needed = must_understand(m2.flags)
-                || (top && m2.flags.contains(MemberFlag::IS_KEY))
-                || is_final;
-            if needed && !m1s.iter().any(|m| m.id == m2.id) {
-                return Err(if must_understand(m2.flags) {
-                    NotAssignable::MustUnderstand { id: m2.id }
-                } else {
-                    NotAssignable::Member { id: m2.id }
-                });
-            }
-        }
+        writer_members_known(&m1s, &m2s, top, is_final)?;
         // At least one member in common.
         if any {
             Ok(())
         } else {
             Err(NotAssignable::NoOverlap)
         }
+    }
+
+    /// A reader member the writer's type lacks: allowed unless it must be understood, is a key at the top
+    /// level, or the type is final (or widening is prevented and the member is not optional).
+    fn reader_member_missing(
+        &self,
+        m1: &StructMember,
+        top: bool,
+        is_final: bool,
+    ) -> Result<(), NotAssignable> {
+        if must_understand(m1.flags) {
+            return Err(NotAssignable::MustUnderstand { id: m1.id });
+        }
+        if top && m1.flags.contains(MemberFlag::IS_KEY) {
+            return Err(NotAssignable::Key);
+        }
+        let widening =
+            self.tce.prevent_type_widening && !m1.flags.contains(MemberFlag::IS_OPTIONAL);
+        if is_final || widening {
+            return Err(NotAssignable::Member { id: m1.id });
+        }
+        Ok(())
     }
 
     /// §7.2.4.4.7: T1 (reader) union is-assignable-from T2 (writer) union.
@@ -197,25 +197,33 @@ impl Checker<'_> {
                 }
             }
             // Final or prevent_type_widening: the same labels for the same case.
-            let same_labels = same_id.is_some_and(|m2| {
-                let (mut a, mut b) = (m1.labels.clone(), m2.labels.clone());
-                a.sort_unstable();
-                b.sort_unstable();
-                a == b
-            });
-            if strict && !same_labels {
+            if strict && !same_id.is_some_and(|m2| same_labels(m1, m2)) {
                 return Err(NotAssignable::MissingCase);
             }
             any |= hits;
         }
-        // Every label of T2 that selects a case of T1 (its default included): T1's case type from T2's.
+        self.writer_labels_assignable(m1s, m2s, def1.as_ref())?;
+        // At least one label in common.
+        if any {
+            Ok(())
+        } else {
+            Err(NotAssignable::NoOverlap)
+        }
+    }
+
+    /// Every label of T2 that selects a case of T1 (its default included): T1's case type from T2's.
+    fn writer_labels_assignable(
+        &mut self,
+        m1s: &[UnionMember],
+        m2s: &[UnionMember],
+        def1: Option<&UnionMember>,
+    ) -> Result<(), NotAssignable> {
         for m2 in m2s
             .iter()
             .filter(|m| !m.flags.contains(MemberFlag::IS_DEFAULT))
         {
             for l in &m2.labels {
-                let m1 = m1s.iter().find(|m| m.labels.contains(l)).or(def1.as_ref());
-                match m1 {
+                match m1s.iter().find(|m| m.labels.contains(l)).or(def1) {
                     Some(m1) => self.assignable(&m1.type_id, &m2.type_id)?,
                     None if self.tce.prevent_type_widening => {
                         return Err(NotAssignable::MissingCase)
@@ -224,11 +232,36 @@ impl Checker<'_> {
                 }
             }
         }
-        // At least one label in common.
-        if any {
-            Ok(())
-        } else {
-            Err(NotAssignable::NoOverlap)
+        Ok(())
+    }
+}
+
+/// Every writer member the reader must know (must-understand ones, keys at the top level, all of a final
+/// type) is among the reader's.
+fn writer_members_known(
+    m1s: &[StructMember],
+    m2s: &[StructMember],
+    top: bool,
+    is_final: bool,
+) -> Result<(), NotAssignable> {
+    for m2 in m2s {
+        let needed =
+            must_understand(m2.flags) || (top && m2.flags.contains(MemberFlag::IS_KEY)) || is_final;
+        if needed && !m1s.iter().any(|m| m.id == m2.id) {
+            return Err(if must_understand(m2.flags) {
+                NotAssignable::MustUnderstand { id: m2.id }
+            } else {
+                NotAssignable::Member { id: m2.id }
+            });
         }
     }
+    Ok(())
+}
+
+/// Two cases select the same set of labels.
+fn same_labels(a: &UnionMember, b: &UnionMember) -> bool {
+    let (mut a, mut b) = (a.labels.clone(), b.labels.clone());
+    a.sort_unstable();
+    b.sort_unstable();
+    a == b
 }

@@ -7,7 +7,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 use crate::cdr::Extensibility;
 use crate::xtypes::store::{verify_component, MAX_COMPONENT};
 use crate::xtypes::typeobject::{
-    kind, MemberFlag, MemberName, StronglyConnectedComponentId, TypeBody, TypeFlag, TypeIdentifier,
+    kind, Bitfield, Bitflag, EnumeratedLiteral, MemberFlag, MemberName,
+    StronglyConnectedComponentId, StructMember, TypeBody, TypeFlag, TypeIdentifier,
     TypeInformation, TypeMapping, TypeObject,
 };
 
@@ -140,6 +141,65 @@ fn member_name(n: &MemberName) -> String {
     }
 }
 
+fn enum_type(
+    name: String,
+    flags: TypeFlag,
+    bit_bound: u16,
+    literals: &[EnumeratedLiteral],
+) -> DynamicType {
+    DynamicType::new(TypeKind::Enum(EnumType {
+        name,
+        extensibility: extensibility(flags),
+        bit_bound,
+        default: literals
+            .iter()
+            .position(|l| l.flags.contains(MemberFlag::IS_DEFAULT))
+            .unwrap_or(0),
+        literals: literals
+            .iter()
+            .map(|l| Enumerator {
+                name: member_name(&l.detail.name),
+                value: l.value,
+            })
+            .collect(),
+    }))
+}
+
+/// A bitset is the unsigned integer that holds its bits, as the derive and `types_from_idl` make it.
+fn bitset_type(fields: &[Bitfield]) -> DynamicType {
+    let bits = fields
+        .iter()
+        .map(|f| u32::from(f.position) + u32::from(f.bitcount))
+        .max()
+        .unwrap_or(0);
+    DynamicType::primitive(match bits {
+        0..=8 => Primitive::UInt8,
+        9..=16 => Primitive::UInt16,
+        17..=32 => Primitive::UInt32,
+        _ => Primitive::UInt64,
+    })
+}
+
+fn bitmask_type(
+    name: String,
+    flags: TypeFlag,
+    bit_bound: u16,
+    bitflags: &[Bitflag],
+) -> DynamicType {
+    DynamicType::new(TypeKind::Bitmask(BitmaskType {
+        name,
+        extensibility: extensibility(flags),
+        bit_bound,
+        flags: bitflags
+            .iter()
+            .map(|f| BitFlag {
+                name: member_name(&f.detail.name),
+                position: f.position,
+            })
+            .collect(),
+    }))
+}
+
 fn type_name(body: &TypeBody) -> String {
     match body.type_name() {
         "" => "?".to_string(),
@@ -267,48 +327,7 @@ impl Resolver<'_> {
                 base,
                 members,
                 ..
-            } => {
-                let base = match base {
-                    TypeIdentifier::None => None,
-                    b => Some(self.resolve(b, d)?),
-                };
-                let (mut all, mut levels) = match base.as_ref().map(|b| b.resolved().kind()) {
-                    None => (Vec::new(), Vec::new()),
-                    Some(TypeKind::Struct(s)) => (s.members.clone(), s.levels.clone()),
-                    Some(_) => {
-                        return Err(DynamicError::Invalid(
-                            "a struct's base is not a struct".into(),
-                        ))
-                    }
-                };
-                for m in members {
-                    all.push(Member {
-                        name: member_name(&m.detail.name),
-                        id: m.id,
-                        ty: self.resolve(&m.type_id, d)?,
-                        key: m.flags.contains(MemberFlag::IS_KEY),
-                        optional: m.flags.contains(MemberFlag::IS_OPTIONAL),
-                        external: m.flags.contains(MemberFlag::IS_EXTERNAL),
-                        must_understand: m.flags.contains(MemberFlag::IS_MUST_UNDERSTAND),
-                        hash_id: m
-                            .detail
-                            .ann_builtin
-                            .as_ref()
-                            .and_then(|a| a.hash_id.clone()),
-                        use_default: m.flags.contains(MemberFlag::TRY_CONSTRUCT2),
-                    });
-                }
-                levels.push(all.len());
-                DynamicType::new(TypeKind::Struct(StructType {
-                    name: type_name(body),
-                    extensibility: extensibility(*flags),
-                    base,
-                    members: all,
-                    autoid_hash: flags.contains(TypeFlag::IS_AUTOID_HASH),
-                    nested: flags.contains(TypeFlag::IS_NESTED),
-                    levels,
-                }))
-            }
+            } => self.struct_body(type_name(body), *flags, base, members, d)?,
             TypeBody::Union {
                 flags,
                 disc_flags,
@@ -336,58 +355,6 @@ impl Resolver<'_> {
                     nested: flags.contains(TypeFlag::IS_NESTED),
                 }))
             }
-            TypeBody::Enum {
-                flags,
-                bit_bound,
-                literals,
-                ..
-            } => DynamicType::new(TypeKind::Enum(EnumType {
-                name: type_name(body),
-                extensibility: extensibility(*flags),
-                bit_bound: *bit_bound,
-                default: literals
-                    .iter()
-                    .position(|l| l.flags.contains(MemberFlag::IS_DEFAULT))
-                    .unwrap_or(0),
-                literals: literals
-                    .iter()
-                    .map(|l| Enumerator {
-                        name: member_name(&l.detail.name),
-                        value: l.value,
-                    })
-                    .collect(),
-            })),
-            // A bitset is the unsigned integer that holds its bits, as the derive and `types_from_idl` make it.
-            TypeBody::Bitset { fields, .. } => {
-                let bits = fields
-                    .iter()
-                    .map(|f| u32::from(f.position) + u32::from(f.bitcount))
-                    .max()
-                    .unwrap_or(0);
-                DynamicType::primitive(match bits {
-                    0..=8 => Primitive::UInt8,
-                    9..=16 => Primitive::UInt16,
-                    17..=32 => Primitive::UInt32,
-                    _ => Primitive::UInt64,
-                })
-            }
-            TypeBody::Bitmask {
-                flags,
-                bit_bound,
-                bitflags,
-                ..
-            } => DynamicType::new(TypeKind::Bitmask(BitmaskType {
-                name: type_name(body),
-                extensibility: extensibility(*flags),
-                bit_bound: *bit_bound,
-                flags: bitflags
-                    .iter()
-                    .map(|f| BitFlag {
-                        name: member_name(&f.detail.name),
-                        position: f.position,
-                    })
-                    .collect(),
-            })),
             TypeBody::Sequence {
                 bound: b, element, ..
             } => DynamicType::sequence(self.resolve(&element.type_id, d)?, bound(*b)),
@@ -404,6 +371,70 @@ impl Resolver<'_> {
                 self.resolve(&element.type_id, d)?,
                 bound(*b),
             ),
+            TypeBody::Enum {
+                flags,
+                bit_bound,
+                literals,
+                ..
+            } => enum_type(type_name(body), *flags, *bit_bound, literals),
+            TypeBody::Bitset { fields, .. } => bitset_type(fields),
+            TypeBody::Bitmask {
+                flags,
+                bit_bound,
+                bitflags,
+                ..
+            } => bitmask_type(type_name(body), *flags, *bit_bound, bitflags),
         })
+    }
+
+    /// A struct: its base's members (and inheritance levels) first, then its own.
+    fn struct_body(
+        &mut self,
+        name: String,
+        flags: TypeFlag,
+        base: &TypeIdentifier,
+        members: &[StructMember],
+        d: u32,
+    ) -> Result<DynamicType, DynamicError> {
+        let base = match base {
+            TypeIdentifier::None => None,
+            b => Some(self.resolve(b, d)?),
+        };
+        let (mut all, mut levels) = match base.as_ref().map(|b| b.resolved().kind()) {
+            None => (Vec::new(), Vec::new()),
+            Some(TypeKind::Struct(s)) => (s.members.clone(), s.levels.clone()),
+            Some(_) => {
+                return Err(DynamicError::Invalid(
+                    "a struct's base is not a struct".into(),
+                ))
+            }
+        };
+        for m in members {
+            all.push(Member {
+                name: member_name(&m.detail.name),
+                id: m.id,
+                ty: self.resolve(&m.type_id, d)?,
+                key: m.flags.contains(MemberFlag::IS_KEY),
+                optional: m.flags.contains(MemberFlag::IS_OPTIONAL),
+                external: m.flags.contains(MemberFlag::IS_EXTERNAL),
+                must_understand: m.flags.contains(MemberFlag::IS_MUST_UNDERSTAND),
+                hash_id: m
+                    .detail
+                    .ann_builtin
+                    .as_ref()
+                    .and_then(|a| a.hash_id.clone()),
+                use_default: m.flags.contains(MemberFlag::TRY_CONSTRUCT2),
+            });
+        }
+        levels.push(all.len());
+        Ok(DynamicType::new(TypeKind::Struct(StructType {
+            name,
+            extensibility: extensibility(flags),
+            base,
+            members: all,
+            autoid_hash: flags.contains(TypeFlag::IS_AUTOID_HASH),
+            nested: flags.contains(TypeFlag::IS_NESTED),
+            levels,
+        })))
     }
 }

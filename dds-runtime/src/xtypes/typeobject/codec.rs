@@ -320,6 +320,46 @@ impl BodyWriter {
         })
     }
 
+    /// The builtin and custom annotations that only the complete form carries.
+    fn complete_annotations<B>(
+        &self,
+        w: &mut CdrWriter<'_>,
+        builtin: &Option<B>,
+        custom: &Option<Vec<AppliedAnnotation>>,
+        write_builtin: impl FnOnce(&mut CdrWriter<'_>, &B) -> Result<(), EncodeError>,
+    ) -> Result<(), EncodeError> {
+        if self.complete {
+            optional(w, builtin, write_builtin)?;
+            optional(w, custom, |w, v| seq(w, v, applied_annotation))?;
+        }
+        Ok(())
+    }
+
+    fn array(
+        &self,
+        w: &mut CdrWriter<'_>,
+        flags: super::TypeFlag,
+        bounds: &[u32],
+        detail: &TypeDetail,
+        element: &CollectionElement,
+    ) -> Result<(), EncodeError> {
+        let write = |w: &mut CdrWriter<'_>| {
+            w.write_u16(flags.bits());
+            appendable(w, |w| {
+                w.write_len(bounds.len(), "array bounds")?;
+                bounds.iter().for_each(|b| w.write_u32(*b));
+                self.type_detail(w, detail)
+            })?;
+            self.element(w, element)
+        };
+        // Cyclone's CompleteArrayType is @appendable, its MinimalArrayType @final.
+        if self.complete {
+            appendable(w, write)
+        } else {
+            write(w)
+        }
+    }
+
     pub(super) fn body(&self, w: &mut CdrWriter<'_>, b: &TypeBody) -> Result<(), EncodeError> {
         w.write_u8(b.kind());
         match b {
@@ -336,11 +376,12 @@ impl BodyWriter {
                 appendable(w, |w| {
                     w.write_u16(related_flags.bits());
                     related_type.encode(w)?;
-                    if self.complete {
-                        optional(w, ann_builtin, builtin_member_annotations)?;
-                        optional(w, ann_custom, |w, v| seq(w, v, applied_annotation))?;
-                    }
-                    Ok(())
+                    self.complete_annotations(
+                        w,
+                        ann_builtin,
+                        ann_custom,
+                        builtin_member_annotations,
+                    )
                 })
             }
             TypeBody::Struct {
@@ -370,13 +411,9 @@ impl BodyWriter {
                 appendable(w, |w| {
                     w.write_u16(disc_flags.bits());
                     disc_type.encode(w)?;
-                    if self.complete {
-                        optional(w, disc_ann_builtin, |w, v| {
-                            appendable(w, |w| optional(w, &Some(v), |w, v| verbatim(w, v)))
-                        })?;
-                        optional(w, disc_ann_custom, |w, v| seq(w, v, applied_annotation))?;
-                    }
-                    Ok(())
+                    self.complete_annotations(w, disc_ann_builtin, disc_ann_custom, |w, v| {
+                        appendable(w, |w| optional(w, &Some(v), |w, v| verbatim(w, v)))
+                    })
                 })?;
                 self.union_members(w, members)
             }
@@ -430,23 +467,7 @@ impl BodyWriter {
                 bounds,
                 detail,
                 element,
-            } => {
-                let write = |w: &mut CdrWriter<'_>| {
-                    w.write_u16(flags.bits());
-                    appendable(w, |w| {
-                        w.write_len(bounds.len(), "array bounds")?;
-                        bounds.iter().for_each(|b| w.write_u32(*b));
-                        self.type_detail(w, detail)
-                    })?;
-                    self.element(w, element)
-                };
-                // Cyclone's CompleteArrayType is @appendable, its MinimalArrayType @final.
-                if self.complete {
-                    appendable(w, write)
-                } else {
-                    write(w)
-                }
-            }
+            } => self.array(w, *flags, bounds, detail, element),
             TypeBody::Map {
                 flags,
                 bound,
