@@ -334,6 +334,18 @@ impl Participant {
         Ok(EntityId::new([k[1], k[2], k[3]], kind))
     }
 
+    /// An entity id for a reader that exists only inside this process (an application's reader of a built-in
+    /// topic): a built-in reader kind, never announced, from the same counter as the participant's endpoints.
+    /// Its key starts with a byte in 0x80..=0xbf, which no built-in entity of RTPS or DDS Security uses.
+    pub fn alloc_local_reader_id(&mut self) -> Result<EntityId, CoreError> {
+        if self.next_entity_key >= 1 << 22 {
+            return Err(CoreError::OutOfEntityIds);
+        }
+        let k = (self.next_entity_key | 0x80_0000).to_be_bytes();
+        self.next_entity_key += 1;
+        Ok(EntityId::new([k[1], k[2], k[3]], 0xc7))
+    }
+
     /// Checks a spec and gives the new endpoint an entity id (`kinds`: without key, with key).
     fn new_endpoint<Q>(
         &mut self,

@@ -5,7 +5,6 @@
 //! ([`BuiltinReader::add_user_reader`]) is fed the same changes, with its own QoS.
 
 use std::any::Any;
-use std::sync::atomic::{AtomicU16, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::time::{Instant, SystemTime};
 
@@ -109,11 +108,6 @@ const BUILTIN_TOPICS: [&str; 4] = [
     "DCPSTopic",
 ];
 
-/// Numbers the readers the application creates on built-in topics. Their entity id is a built-in reader
-/// kind (0xc7) with the key 0xdd, then this number: no RTPS built-in entity has such a key, and no RTPS
-/// reader has this id; it only names the reader (instance handle, the driver's endpoint table).
-static NEXT_USER_READER: AtomicU16 = AtomicU16::new(0);
-
 /// Creates the application's reader on a built-in topic (`create_datareader` on `DCPSParticipant`,
 /// `DCPSPublication`, `DCPSSubscription` or `DCPSTopic` with its built-in type): fed by discovery like the
 /// built-in subscriber's reader of the topic (`dcps::builtin_subscriber`), seeded with what discovery
@@ -132,15 +126,11 @@ pub(crate) fn user_builtin_reader<T: DdsType>(
     let Some(feed) = lock(&p.registry().builtin).clone() else {
         return Ok(None);
     };
-    let n = NEXT_USER_READER
-        .fetch_add(1, Ordering::Relaxed)
-        .to_be_bytes();
     let spec: Box<dyn Any> = Box::new(UserReaderSpec {
         subscriber: s.clone(),
         topic: topic.clone(),
         qos: qos.clone(),
         listener,
-        id: EntityId([0xdd, n[0], n[1], 0xc7]),
     });
     match feed.add_user_reader(spec) {
         None => Ok(None),
@@ -148,14 +138,14 @@ pub(crate) fn user_builtin_reader<T: DdsType>(
     }
 }
 
-/// A reader the application creates on a built-in topic: its subscriber, topic, QoS, listener and the
-/// entity id it gets (no RTPS reader is behind it).
+/// A reader the application creates on a built-in topic: its subscriber, topic, QoS and listener. No RTPS
+/// reader is behind it; its entity id only names it (instance handle, the driver's endpoint table), from
+/// `Participant::alloc_local_reader_id`.
 pub(crate) struct UserReaderSpec<T: DdsType> {
     pub subscriber: Subscriber,
     pub topic: super::Topic<T>,
     pub qos: DataReaderQos,
     pub listener: Option<(Arc<dyn DataReaderListener<T>>, StatusMask)>,
-    pub id: EntityId,
 }
 
 impl<T: DdsType + Clone> BuiltinReader<T> {
@@ -257,8 +247,9 @@ impl<T: DdsType + Clone> BuiltinReader<T> {
             topic: spec.topic,
             subscriber: s.clone(),
         };
-        let id = spec.id;
-        let handle = inner.state.create(sink, owner, move |_, _| Ok(id))?;
+        let handle = inner
+            .state
+            .create(sink, owner, |c, _| c.alloc_local_reader_id())?;
         ops::register_reader(&spec.subscriber, &inner, self.topic_name);
         for data in seed {
             let mut key = Vec::new();
