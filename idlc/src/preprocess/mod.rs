@@ -832,30 +832,14 @@ impl<'a> Preprocessor<'a> {
     }
 
     fn include(&mut self, file: FileId, rest: &str, loc: Loc, depth: usize) {
-        let mut spec = rest.to_string();
-        if !(spec.starts_with('"') || spec.starts_with('<')) {
-            if let Ok(t) = self.macros.expand(&lex::lex(rest)) {
-                spec = t
-                    .iter()
-                    .map(|t| t.text.as_str())
-                    .collect::<String>()
-                    .trim()
-                    .to_string();
-            }
-        }
-        let (name, quoted) =
-            if let Some(s) = spec.strip_prefix('"').and_then(|s| s.split('"').next()) {
-                (s.to_string(), true)
-            } else if let Some(s) = spec.strip_prefix('<').and_then(|s| s.split('>').next()) {
-                (s.to_string(), false)
-            } else {
-                return self.err(
-                    Code::BadDirective,
-                    loc,
-                    "#include expects \"FILE\" or <FILE>",
-                    "malformed include",
-                );
-            };
+        let Some((name, quoted)) = self.include_name(rest) else {
+            return self.err(
+                Code::BadDirective,
+                loc,
+                "#include expects \"FILE\" or <FILE>",
+                "malformed include",
+            );
+        };
         if depth >= MAX_INCLUDE_DEPTH {
             return self.diags.push(
                 Diagnostic::error(
@@ -866,42 +850,8 @@ impl<'a> Preprocessor<'a> {
                 .help("this is usually an include cycle: add an include guard or `#pragma once`"),
             );
         }
-        let cur_dir = self
-            .db
-            .get(file)
-            .path
-            .parent()
-            .map(Path::to_path_buf)
-            .unwrap_or_default();
-        let mut candidates: Vec<PathBuf> = Vec::new();
-        if quoted {
-            candidates.push(cur_dir.join(&name));
-        }
-        candidates.extend(self.opts.include_dirs.iter().map(|d| d.join(&name)));
-        if !quoted {
-            candidates.push(cur_dir.join(&name));
-        }
-        let Some(found) = candidates.into_iter().find(|p| self.vfs.exists(p)) else {
-            let mut d = Diagnostic::error(
-                Code::IncludeNotFound,
-                format!("cannot find include file `{name}`"),
-            )
-            .at(loc, "included here");
-            d = if self.opts.include_dirs.is_empty() {
-                d.help("add the directory that holds it with `-I <dir>`")
-            } else {
-                let dirs: Vec<String> = self
-                    .opts
-                    .include_dirs
-                    .iter()
-                    .map(|d| d.display().to_string())
-                    .collect();
-                d.help(format!(
-                    "searched the including file's directory and: {}",
-                    dirs.join(", ")
-                ))
-            };
-            return self.diags.push(d);
+        let Some(found) = self.find_include(file, &name, quoted, loc) else {
+            return;
         };
         let found = normalize(&found);
         if self.once.contains(&found) {
@@ -929,6 +879,77 @@ impl<'a> Preprocessor<'a> {
         self.out.text.push('\n');
         self.out.boundaries.push(self.out.text.len());
         self.in_comment = saved;
+    }
+
+    /// The file an `#include` names (its macros expanded unless it is quoted or bracketed already), and
+    /// whether it was quoted.
+    fn include_name(&self, rest: &str) -> Option<(String, bool)> {
+        let mut spec = rest.to_string();
+        if !(spec.starts_with('"') || spec.starts_with('<')) {
+            if let Ok(t) = self.macros.expand(&lex::lex(rest)) {
+                spec = t
+                    .iter()
+                    .map(|t| t.text.as_str())
+                    .collect::<String>()
+                    .trim()
+                    .to_string();
+            }
+        }
+        if let Some(s) = spec.strip_prefix('"').and_then(|s| s.split('"').next()) {
+            Some((s.to_string(), true))
+        } else {
+            let s = spec.strip_prefix('<').and_then(|s| s.split('>').next())?;
+            Some((s.to_string(), false))
+        }
+    }
+
+    /// Where an included file is: the including file's directory first for a quoted name, last for a
+    /// bracketed one, the `-I` directories in their order. `None`, with a diagnostic, when it is nowhere.
+    fn find_include(
+        &mut self,
+        file: FileId,
+        name: &str,
+        quoted: bool,
+        loc: Loc,
+    ) -> Option<PathBuf> {
+        let cur_dir = self
+            .db
+            .get(file)
+            .path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        let mut candidates: Vec<PathBuf> = Vec::new();
+        if quoted {
+            candidates.push(cur_dir.join(name));
+        }
+        candidates.extend(self.opts.include_dirs.iter().map(|d| d.join(name)));
+        if !quoted {
+            candidates.push(cur_dir.join(name));
+        }
+        if let Some(found) = candidates.into_iter().find(|p| self.vfs.exists(p)) {
+            return Some(found);
+        }
+        let d = Diagnostic::error(
+            Code::IncludeNotFound,
+            format!("cannot find include file `{name}`"),
+        )
+        .at(loc, "included here");
+        self.diags.push(if self.opts.include_dirs.is_empty() {
+            d.help("add the directory that holds it with `-I <dir>`")
+        } else {
+            let dirs: Vec<String> = self
+                .opts
+                .include_dirs
+                .iter()
+                .map(|d| d.display().to_string())
+                .collect();
+            d.help(format!(
+                "searched the including file's directory and: {}",
+                dirs.join(", ")
+            ))
+        });
+        None
     }
 }
 
