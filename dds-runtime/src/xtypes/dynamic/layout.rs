@@ -129,6 +129,24 @@ fn mutable_in(ty: &DynamicType, seen: &mut HashSet<usize>) -> bool {
     }
 }
 
+/// The furthest end of `n` elements in a row from `start` (a sequence's or an array's), or `None` past
+/// [`KEY_SCAN_LIMIT`].
+fn repeated_max_end(
+    element: &DynamicType,
+    start: usize,
+    n: usize,
+    version: XcdrVersion,
+) -> Option<usize> {
+    let mut p = start;
+    for _ in 0..n {
+        p = key_max_end(element, p, version, None)?;
+        if p > KEY_SCAN_LIMIT {
+            return None;
+        }
+    }
+    Some(p)
+}
+
 /// The largest end offset of the plain key stream of `ty` from `start` (`None`: unbounded, or past the scan
 /// limit): the derive's `key_max_end`.
 pub(super) fn key_max_end(
@@ -163,14 +181,7 @@ pub(super) fn key_max_end(
             if start > KEY_SCAN_LIMIT || bound > KEY_SCAN_LIMIT {
                 return None;
             }
-            let mut p = align4(start) + 4;
-            for _ in 0..bound {
-                p = key_max_end(element, p, version, None)?;
-                if p > KEY_SCAN_LIMIT {
-                    return None;
-                }
-            }
-            Some(p)
+            repeated_max_end(element, align4(start) + 4, bound, version)
         }
         TypeKind::Array { element, dims } => {
             let n: usize = dims
@@ -179,27 +190,18 @@ pub(super) fn key_max_end(
             if start > KEY_SCAN_LIMIT || n > KEY_SCAN_LIMIT {
                 return None;
             }
-            let mut p = start;
-            for _ in 0..n {
-                p = key_max_end(element, p, version, None)?;
-                if p > KEY_SCAN_LIMIT {
-                    return None;
-                }
-            }
-            Some(p)
+            repeated_max_end(element, start, n, version)
         }
         TypeKind::Map { .. } => None,
-        TypeKind::Struct(s) => {
-            if start > KEY_SCAN_LIMIT {
-                return None;
-            }
+        TypeKind::Struct(s) if start <= KEY_SCAN_LIMIT => {
             let keys = s.has_keys();
             let mut p = start;
-            for i in s.by_id() {
-                let m = &s.members[i];
-                if keys && !m.key {
-                    continue;
-                }
+            for m in s
+                .by_id()
+                .into_iter()
+                .map(|i| &s.members[i])
+                .filter(|m| !keys || m.key)
+            {
                 if m.optional {
                     p = if version == XcdrVersion::Xcdr2 {
                         p + 1
@@ -211,6 +213,7 @@ pub(super) fn key_max_end(
             }
             Some(p)
         }
+        TypeKind::Struct(_) => None,
         TypeKind::Union(u) => {
             if start > KEY_SCAN_LIMIT {
                 return None;

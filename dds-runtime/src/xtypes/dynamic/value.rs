@@ -192,6 +192,22 @@ fn primitive_matches(p: Primitive, v: &Value) -> bool {
     )
 }
 
+/// Runs `f` with `name` appended to the dotted member path (`a.b.c`), then takes it off again.
+fn within(
+    path: &mut String,
+    name: &str,
+    f: impl FnOnce(&mut String) -> Result<(), DynamicError>,
+) -> Result<(), DynamicError> {
+    let len = path.len();
+    if !path.is_empty() {
+        path.push('.');
+    }
+    path.push_str(name);
+    let r = f(path);
+    path.truncate(len);
+    r
+}
+
 fn check(v: &Value, ty: &DynamicType, path: &mut String) -> Result<(), DynamicError> {
     let bad = |path: &str| DynamicError::mismatch(path, ty.name(), v.kind_name());
     match (ty.resolved().kind(), v) {
@@ -219,17 +235,11 @@ fn check(v: &Value, ty: &DynamicType, path: &mut String) -> Result<(), DynamicEr
         }
         (TypeKind::Struct(s), Value::Struct(vals)) if vals.len() == s.members.len() => {
             for (m, val) in s.members.iter().zip(vals) {
-                let len = path.len();
-                if !path.is_empty() {
-                    path.push('.');
-                }
-                path.push_str(&m.name);
-                match val {
-                    Some(val) => check(val, &m.ty, path)?,
-                    None if m.optional => {}
-                    None => return Err(DynamicError::mismatch(path, m.ty.name(), "nothing")),
-                }
-                path.truncate(len);
+                within(path, &m.name, |path| match val {
+                    Some(val) => check(val, &m.ty, path),
+                    None if m.optional => Ok(()),
+                    None => Err(DynamicError::mismatch(path, m.ty.name(), "nothing")),
+                })?;
             }
             Ok(())
         }
@@ -240,14 +250,9 @@ fn check(v: &Value, ty: &DynamicType, path: &mut String) -> Result<(), DynamicEr
                 value,
             },
         ) => match (u.case_for(*discriminator), value) {
-            (Some(i), Some(val)) => {
-                let len = path.len();
-                path.push('.');
-                path.push_str(&u.cases[i].name);
-                check(val, &u.cases[i].ty, path)?;
-                path.truncate(len);
-                Ok(())
-            }
+            (Some(i), Some(val)) => within(path, &u.cases[i].name, |path| {
+                check(val, &u.cases[i].ty, path)
+            }),
             (None, None) => Ok(()),
             _ => Err(DynamicError::mismatch(
                 path,
