@@ -225,7 +225,7 @@ impl Participant {
         let mut dest = self.config.metatraffic_multicast.clone();
         dest.extend(self.config.initial_peers.iter().copied());
         for p in self.participants.values() {
-            dest.extend(p.data.metatraffic_unicast.first().copied());
+            dest.extend(p.data().metatraffic_unicast.first().copied());
         }
         dest.sort();
         dest.dedup();
