@@ -24,7 +24,6 @@ pub(crate) const KEPT_QUEUE_ROOM: usize = 256;
 const KEPT_DATAGRAMS: usize = 16;
 
 /// Lowers a known timer floor to `t`; an unknown floor stays unknown (it is rescanned anyway).
-
 pub(super) fn lower_floor(floor: &Cell<Option<Instant>>, t: Option<Instant>) {
     if let (Some(f), Some(t)) = (floor.get(), t) {
         if t < f {
