@@ -292,8 +292,7 @@ struct Known {
 impl Known {
     fn now(p: &DomainParticipant) -> Known {
         p.driver().query_core(|c| {
-            let mut participants: Vec<ParticipantData> =
-                c.discovered_participants().cloned().collect();
+            let mut participants: Vec<ParticipantData> = c.discovered_participants().collect();
             participants.push(c.participant_data());
             Known {
                 participants,

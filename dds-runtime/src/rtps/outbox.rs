@@ -223,6 +223,17 @@ impl Outbox {
         }
     }
 
+    /// Gives back what a burst left in the reuse pools and queues beyond `keep` entries each (a burst of
+    /// discovery replies to a few hundred peers fills the datagram pool to its bound of 64 buffers).
+    pub(crate) fn trim(&mut self, keep: usize) {
+        self.pool.truncate(keep);
+        self.pool.shrink_to(keep);
+        self.dest_pool.truncate(keep);
+        self.dest_pool.shrink_to(keep);
+        self.pending.shrink_to(keep);
+        self.ready.shrink_to(keep);
+    }
+
     /// Takes back a sent datagram's destination list for reuse.
     pub(crate) fn recycle_destinations(&mut self, dests: Vec<Locator>) {
         if self.dest_pool.len() < 64 && dests.capacity() <= 64 {
@@ -314,5 +325,34 @@ mod tests {
                 vec![(None, 5), (a, 6)]
             ]
         );
+    }
+
+    #[test]
+    fn a_burst_fills_the_pool_and_trim_gives_it_back() {
+        let mut o = outbox();
+        for port in 0..100u16 {
+            o.push(
+                &[Locator::udpv4([10, 0, 0, 1], 7410 + port)],
+                None,
+                Ts::Any,
+                &gap(1),
+            );
+        }
+        while let Some(t) = o.pop(Instant::now(), Duration::ZERO) {
+            o.recycle(t.payload);
+            o.recycle_destinations(t.destinations);
+        }
+        assert_eq!((o.pool.len(), o.dest_pool.len()), (64, 64));
+        o.trim(16);
+        assert_eq!((o.pool.len(), o.dest_pool.len()), (16, 16));
+        assert!(o.pool.capacity() <= 16 && o.ready.capacity() <= 16);
+        // It still works.
+        o.push(
+            &[Locator::udpv4([10, 0, 0, 1], 7410)],
+            None,
+            Ts::Any,
+            &gap(2),
+        );
+        assert_eq!(sent(&mut o), vec![vec![(None, 2)]]);
     }
 }

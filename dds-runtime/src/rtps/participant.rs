@@ -25,7 +25,7 @@ mod type_lookup;
 
 use std::cell::Cell;
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
 
@@ -39,12 +39,60 @@ use super::writer::{Writer, WriterParams};
 use crate::qos::{DataWriterQos, Durability, History, ReaderQos, ResourceLimits, WriterQos};
 
 /// A discovered remote participant.
+///
+/// Compact (see `docs/performance.md`, "Footprint"): what the core consults often is kept decoded, the whole
+/// announcement only in our own PL-CDR encoding, one allocation of its exact size, decoded when asked for
+/// ([`ProxyParticipant::data`]). The decoded form costs five allocations and about twice the bytes.
 #[derive(Debug)]
 struct ProxyParticipant {
-    data: ParticipantData,
     lease_deadline: Instant,
+    lease_duration: Duration,
+    vendor_id: VendorId,
+    builtin_endpoints: u32,
     /// Its TypeLookup endpoints are matched with ours (done when a request or reply is first exchanged).
     type_lookup_matched: bool,
+    /// Where its builtin endpoints listen: one list, shared with all their proxies.
+    metatraffic: std::sync::Arc<[Locator]>,
+    /// `ParticipantData::encode` of what it announced.
+    announcement: Box<[u8]>,
+}
+
+impl ProxyParticipant {
+    fn new(data: &ParticipantData, lease_deadline: Instant) -> Self {
+        ProxyParticipant {
+            lease_deadline,
+            lease_duration: data.lease_duration,
+            vendor_id: data.vendor_id,
+            builtin_endpoints: data.builtin_endpoints,
+            type_lookup_matched: false,
+            metatraffic: metatraffic(data),
+            announcement: data.encode().into_boxed_slice(),
+        }
+    }
+
+    /// What it announced. Our own encoding of a decoded announcement always decodes again; should it not,
+    /// the fields kept decoded still are.
+    fn data(&self) -> ParticipantData {
+        ParticipantData::decode(&self.announcement).unwrap_or_else(|_| ParticipantData {
+            vendor_id: self.vendor_id,
+            lease_duration: self.lease_duration,
+            builtin_endpoints: self.builtin_endpoints,
+            ..ParticipantData::default()
+        })
+    }
+
+    /// Takes a new announcement of the same participant; whether anything changed.
+    fn update(&mut self, data: &ParticipantData) -> bool {
+        let encoded = data.encode();
+        if *encoded == *self.announcement {
+            return false;
+        }
+        *self = ProxyParticipant {
+            type_lookup_matched: self.type_lookup_matched,
+            ..ProxyParticipant::new(data, self.lease_deadline)
+        };
+        true
+    }
 }
 
 /// Where a discovered participant's builtin endpoints listen: one list for all their proxies.
@@ -581,8 +629,9 @@ impl Participant {
     }
 
     /// Discovered remote participants.
-    pub fn discovered_participants(&self) -> impl Iterator<Item = &ParticipantData> {
-        self.participants.values().map(|p| &p.data)
+    /// Decoded on each call: the core keeps them compact (see `docs/performance.md`, "Footprint").
+    pub fn discovered_participants(&self) -> impl Iterator<Item = ParticipantData> + '_ {
+        self.participants.values().map(|p| p.data())
     }
 
     /// A known publication (remote or local), e.g. for ownership strength or builtin topics.

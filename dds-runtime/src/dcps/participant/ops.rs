@@ -348,7 +348,7 @@ impl DomainParticipant {
             .with_core(|c, _| {
                 c.discovered_participants()
                     .find(|p| participant_handle(p.guid_prefix) == handle)
-                    .map(ParticipantBuiltinTopicData::from)
+                    .map(|p| ParticipantBuiltinTopicData::from(&p))
             })
             .ok_or_else(|| DdsError::BadParameter(format!("no discovered participant {handle:?}")))
     }
@@ -370,7 +370,7 @@ impl DomainParticipant {
     pub fn discovered_participant_data(&self) -> Vec<ParticipantBuiltinTopicData> {
         self.driver.with_core(|c, _| {
             c.discovered_participants()
-                .map(ParticipantBuiltinTopicData::from)
+                .map(|p| ParticipantBuiltinTopicData::from(&p))
                 .collect()
         })
     }

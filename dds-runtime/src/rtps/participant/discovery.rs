@@ -27,7 +27,7 @@ const MAX_ENDPOINTS: usize = 65536;
 impl Participant {
     pub(super) fn refresh_lease(&mut self, now: Instant, prefix: GuidPrefix) {
         if let Some(p) = self.participants.get_mut(&prefix) {
-            p.lease_deadline = now + p.data.lease_duration;
+            p.lease_deadline = now + p.lease_duration;
         }
     }
 
@@ -92,9 +92,7 @@ impl Participant {
         let lease_deadline = now + data.lease_duration;
         if let Some(p) = self.participants.get_mut(&data.guid_prefix) {
             p.lease_deadline = lease_deadline;
-            if p.data != data {
-                p.data = data;
-            }
+            p.update(&data);
             return;
         }
         if self.participants.len() >= MAX_PARTICIPANTS {
@@ -102,20 +100,14 @@ impl Participant {
         }
         let prefix = data.guid_prefix;
         debug!(participant = ?prefix, vendor = ?data.vendor_id, "participant discovered");
+        let proxy = Box::new(ProxyParticipant::new(&data, lease_deadline));
         // One list for all the proxies of its builtin endpoints.
-        let meta = super::metatraffic(&data);
+        let meta = proxy.metatraffic.clone();
         let bits = data.builtin_endpoints;
         let group = self.shared_metatraffic_group(&data);
         self.events
-            .push_back(Event::ParticipantDiscovered(Box::new(data.clone())));
-        self.participants.insert(
-            prefix,
-            Box::new(ProxyParticipant {
-                data,
-                lease_deadline,
-                type_lookup_matched: false,
-            }),
-        );
+            .push_back(Event::ParticipantDiscovered(Box::new(data)));
+        self.participants.insert(prefix, proxy);
         // The TypeLookup endpoints are matched when a request or reply is first exchanged with it.
         let pairs = |ours: EntityId| !super::type_lookup::is_service_endpoint(ours);
         self.match_builtin_pairs(now, prefix, bits, &meta, group, pairs);
@@ -294,13 +286,14 @@ impl Participant {
             return self.config.default_unicast.clone();
         }
         if let Some(p) = self.participants.get(&prefix) {
-            if !p.data.default_unicast.is_empty() {
-                return p.data.default_unicast.clone();
+            let p = p.data();
+            if !p.default_unicast.is_empty() {
+                return p.default_unicast;
             }
             if !mc.is_empty() {
                 return mc.to_vec();
             }
-            return p.data.default_multicast.clone();
+            return p.default_multicast;
         }
         mc.to_vec()
     }
@@ -312,19 +305,15 @@ impl Participant {
             return None;
         }
         let kind = self.config.default_unicast.first()?.kind;
-        let participant = if d.guid.prefix == self.config.guid_prefix {
-            Some(&self.config.default_multicast)
-        } else {
-            self.participants
-                .get(&d.guid.prefix)
-                .map(|p| &p.data.default_multicast)
-        };
         let usable = |l: &&Locator| l.kind == kind && l.is_multicast();
-        d.multicast_locators
-            .iter()
-            .find(usable)
-            .or_else(|| participant?.iter().find(usable))
-            .copied()
+        if let Some(l) = d.multicast_locators.iter().find(usable) {
+            return Some(*l);
+        }
+        if d.guid.prefix == self.config.guid_prefix {
+            return self.config.default_multicast.iter().find(usable).copied();
+        }
+        let p = self.participants.get(&d.guid.prefix)?.data();
+        p.default_multicast.iter().find(usable).copied()
     }
 
     /// Announces a new local endpoint in SEDP and matches it.
@@ -456,7 +445,7 @@ impl Participant {
                 let vendor = self
                     .participants
                     .get(&remote.prefix)
-                    .map_or(VendorId::THIS, |p| p.data.vendor_id);
+                    .map_or(VendorId::THIS, |p| p.vendor_id);
                 if let Some(w) = self.writers.get_mut(&id) {
                     let proxy = ReaderProxy::new(remote, locators, reliable)
                         .with_multicast(multicast)
@@ -478,7 +467,7 @@ impl Participant {
                 let ours = self
                     .participants
                     .get(&remote.prefix)
-                    .is_none_or(|p| p.data.vendor_id == VendorId::THIS);
+                    .is_none_or(|p| p.vendor_id == VendorId::THIS);
                 let preemptive = !ours || wd.qos.writer.durability >= Durability::TransientLocal;
                 if let Some(r) = self.readers.get_mut(&id) {
                     let proxy = WriterProxy::new(remote, locators, reliable);

@@ -12,7 +12,7 @@ use super::Participant;
 use crate::rtps::api::{Event, Payload};
 use crate::rtps::discovery::builtin;
 use crate::rtps::discovery::topics::TOPIC_READER_PAIR;
-use crate::rtps::messages::{id, MessageIter, Submessage};
+use crate::rtps::messages::{id, AckNack, Data, DataFrag, Heartbeat, MessageIter, Submessage};
 use crate::rtps::reader::Reader;
 use crate::rtps::types::*;
 
@@ -39,6 +39,32 @@ fn holds_data(msg: &[u8]) -> bool {
         at += 4 + usize::from(len);
     }
     false
+}
+
+/// The receiver state of one message (§8.3.4): who sent what follows, whether it is for us, the timestamp.
+struct Receiver {
+    src: GuidPrefix,
+    for_us: bool,
+    ts: Option<Time>,
+}
+
+impl Receiver {
+    /// Applies an interpreter submessage (INFO_TS, INFO_SRC, INFO_DST); returns any other one addressed to
+    /// `ours`.
+    fn interpret<'a>(&mut self, sub: Submessage<'a>, ours: GuidPrefix) -> Option<Submessage<'a>> {
+        match sub {
+            Submessage::InfoTs(t) => self.ts = t,
+            Submessage::InfoSrc(s) => {
+                self.src = s.guid_prefix;
+                self.for_us = true;
+                self.ts = None;
+            }
+            Submessage::InfoDst(p) => self.for_us = p == ours || p == GuidPrefix::UNKNOWN,
+            sub if self.for_us => return Some(sub),
+            _ => {}
+        }
+        None
+    }
 }
 
 impl Participant {
@@ -84,115 +110,136 @@ impl Participant {
                 return;
             }
         };
-        let ours = self.config.guid_prefix;
-        let mut src = header.guid_prefix;
-        let mut for_us = true;
-        let mut ts: Option<Time> = None;
-        self.refresh_lease(now, src);
+        let mut rx = Receiver {
+            src: header.guid_prefix,
+            for_us: true,
+            ts: None,
+        };
+        self.refresh_lease(now, rx.src);
         for sub in subs {
             let sub = match sub {
                 Ok(s) => s,
                 Err(e) => {
-                    debug!(error = %e, source = ?src, "invalid submessage; ignoring the rest of the message");
+                    debug!(error = %e, source = ?rx.src, "invalid submessage; ignoring the rest of the message");
                     break;
                 }
             };
-            match sub {
-                Submessage::InfoTs(t) => ts = t,
-                Submessage::InfoSrc(s) => {
-                    src = s.guid_prefix;
-                    for_us = true;
-                    ts = None;
-                }
-                Submessage::InfoDst(p) => for_us = p == ours || p == GuidPrefix::UNKNOWN,
-                _ if !for_us => {}
-                Submessage::Data(d) => {
-                    let wguid = Guid::new(src, d.writer_id);
-                    if d.writer_id == EntityId::SPDP_WRITER {
-                        self.on_spdp(now, src, &d);
-                        self.timers_changed();
-                    } else {
-                        self.service_traffic(now, wguid);
-                        let scratch = &mut self.scratch;
-                        for_readers(
-                            &mut self.readers,
-                            &mut self.readers_by_writer,
-                            d.reader_id,
-                            wguid,
-                            |r| r.on_data(wguid, &d, ts, shared, scratch),
-                        );
-                        self.writer_asserted(now, wguid);
-                    }
-                }
-                Submessage::DataFrag(d) => {
-                    let wguid = Guid::new(src, d.writer_id);
-                    self.service_traffic(now, wguid);
-                    let scratch = &mut self.scratch;
-                    let pool = &mut self.rx_pools.samples;
-                    for_readers(
-                        &mut self.readers,
-                        &mut self.readers_by_writer,
-                        d.reader_id,
-                        wguid,
-                        |r| r.on_data_frag(wguid, &d, ts, pool, scratch),
-                    );
-                    self.writer_asserted(now, wguid);
-                }
-                Submessage::Heartbeat(h) => {
-                    let wguid = Guid::new(src, h.writer_id);
-                    if h.last_sn >= h.first_sn {
-                        // Changes we may have lost: a request or reply.
-                        self.service_traffic(now, wguid);
-                    }
-                    self.for_readers_arming(h.reader_id, wguid, |r, scratch| {
-                        r.on_heartbeat(now, wguid, &h, scratch)
-                    });
-                    self.route_deliveries(now);
-                    self.on_group_heartbeat(wguid, &h);
-                    if h.liveliness_flag {
-                        self.writer_asserted(now, wguid);
-                    }
-                }
-                Submessage::Gap(g) => {
-                    let wguid = Guid::new(src, g.writer_id);
-                    let scratch = &mut self.scratch;
-                    for_readers(
-                        &mut self.readers,
-                        &mut self.readers_by_writer,
-                        g.reader_id,
-                        wguid,
-                        |r| r.on_gap(wguid, &g, scratch),
-                    );
-                }
-                Submessage::HeartbeatFrag(h) => {
-                    let wguid = Guid::new(src, h.writer_id);
-                    self.for_readers_arming(h.reader_id, wguid, |r, _| {
-                        r.on_heartbeat_frag(now, wguid, &h)
-                    });
-                }
-                Submessage::AckNack(a) => {
-                    if let Some(w) = self.writers.get_mut(&a.writer_id) {
-                        w.on_acknack(now, Guid::new(src, a.reader_id), &a, &mut self.events);
-                        if w.linger_until.is_some() {
-                            // An acknowledged lingering writer is finished at the next pass.
-                            self.timer_floor.set(Some(now));
-                        } else {
-                            lower_floor(&self.timer_floor, w.next_timeout());
-                        }
-                    }
-                }
-                Submessage::NackFrag(n) => {
-                    if let Some(w) = self.writers.get_mut(&n.writer_id) {
-                        w.on_nack_frag(now, Guid::new(src, n.reader_id), &n);
-                        lower_floor(&self.timer_floor, w.next_timeout());
-                    }
-                }
-                Submessage::Pad | Submessage::InfoReply(_) | Submessage::InfoReplyIp4(_) => {}
-                Submessage::Unknown { id, .. } => trace!(id, "skipping unknown submessage"),
+            if let Some(sub) = rx.interpret(sub, self.config.guid_prefix) {
+                self.dispatch(now, &rx, sub, shared);
             }
             self.route_deliveries(now);
         }
         self.service(now);
+    }
+
+    /// Hands one submessage addressed to us to the writers or readers it concerns.
+    fn dispatch(
+        &mut self,
+        now: Instant,
+        rx: &Receiver,
+        sub: Submessage<'_>,
+        shared: Option<&Payload>,
+    ) {
+        let src = rx.src;
+        match sub {
+            Submessage::Data(d) if d.writer_id == EntityId::SPDP_WRITER => {
+                self.on_spdp(now, src, &d);
+                self.timers_changed();
+            }
+            Submessage::Data(d) => self.on_data_sub(now, rx, &d, shared),
+            Submessage::DataFrag(d) => self.on_data_frag_sub(now, rx, &d),
+            Submessage::Heartbeat(h) => self.on_heartbeat_sub(now, src, &h),
+            Submessage::Gap(g) => {
+                let wguid = Guid::new(src, g.writer_id);
+                let scratch = &mut self.scratch;
+                let readers = &mut self.readers;
+                for_readers(
+                    readers,
+                    &mut self.readers_by_writer,
+                    g.reader_id,
+                    wguid,
+                    |r| r.on_gap(wguid, &g, scratch),
+                );
+            }
+            Submessage::HeartbeatFrag(h) => {
+                let wguid = Guid::new(src, h.writer_id);
+                self.for_readers_arming(h.reader_id, wguid, |r, _| {
+                    r.on_heartbeat_frag(now, wguid, &h)
+                });
+            }
+            Submessage::AckNack(a) => self.on_acknack_sub(now, src, &a),
+            Submessage::NackFrag(n) => {
+                if let Some(w) = self.writers.get_mut(&n.writer_id) {
+                    w.on_nack_frag(now, Guid::new(src, n.reader_id), &n);
+                    lower_floor(&self.timer_floor, w.next_timeout());
+                }
+            }
+            Submessage::Unknown { id, .. } => trace!(id, "skipping unknown submessage"),
+            Submessage::Pad
+            | Submessage::InfoReply(_)
+            | Submessage::InfoReplyIp4(_)
+            | Submessage::InfoTs(_)
+            | Submessage::InfoSrc(_)
+            | Submessage::InfoDst(_) => {}
+        }
+    }
+
+    fn on_data_sub(&mut self, now: Instant, rx: &Receiver, d: &Data<'_>, shared: Option<&Payload>) {
+        let wguid = Guid::new(rx.src, d.writer_id);
+        self.service_traffic(now, wguid);
+        let (scratch, ts) = (&mut self.scratch, rx.ts);
+        for_readers(
+            &mut self.readers,
+            &mut self.readers_by_writer,
+            d.reader_id,
+            wguid,
+            |r| r.on_data(wguid, d, ts, shared, scratch),
+        );
+        self.writer_asserted(now, wguid);
+    }
+
+    fn on_data_frag_sub(&mut self, now: Instant, rx: &Receiver, d: &DataFrag<'_>) {
+        let wguid = Guid::new(rx.src, d.writer_id);
+        self.service_traffic(now, wguid);
+        let (scratch, ts) = (&mut self.scratch, rx.ts);
+        let pool = &mut self.rx_pools.samples;
+        for_readers(
+            &mut self.readers,
+            &mut self.readers_by_writer,
+            d.reader_id,
+            wguid,
+            |r| r.on_data_frag(wguid, d, ts, pool, scratch),
+        );
+        self.writer_asserted(now, wguid);
+    }
+
+    fn on_heartbeat_sub(&mut self, now: Instant, src: GuidPrefix, h: &Heartbeat) {
+        let wguid = Guid::new(src, h.writer_id);
+        if h.last_sn >= h.first_sn {
+            // Changes we may have lost: a request or reply.
+            self.service_traffic(now, wguid);
+        }
+        self.for_readers_arming(h.reader_id, wguid, |r, scratch| {
+            r.on_heartbeat(now, wguid, h, scratch)
+        });
+        self.route_deliveries(now);
+        self.on_group_heartbeat(wguid, h);
+        if h.liveliness_flag {
+            self.writer_asserted(now, wguid);
+        }
+    }
+
+    fn on_acknack_sub(&mut self, now: Instant, src: GuidPrefix, a: &AckNack) {
+        let Some(w) = self.writers.get_mut(&a.writer_id) else {
+            return;
+        };
+        w.on_acknack(now, Guid::new(src, a.reader_id), a, &mut self.events);
+        if w.linger_until.is_some() {
+            // An acknowledged lingering writer is finished at the next pass.
+            self.timer_floor.set(Some(now));
+        } else {
+            lower_floor(&self.timer_floor, w.next_timeout());
+        }
     }
 
     /// `for_readers` for a submessage that may arm reader timers: the timer floor follows.

@@ -80,7 +80,7 @@ impl Participant {
         let Some(peer) = self.participants.get(&remote.prefix) else {
             return false;
         };
-        if !shm_peers(self.config.properties(), &peer.data.properties) {
+        if !shm_peers(self.config.properties(), &peer.data().properties) {
             return false;
         }
         let own = Guid::new(self.config.guid_prefix, id);
@@ -206,7 +206,7 @@ impl Participant {
         let mut nodes: Vec<String> = self.shm.readers.get(&w).map_or(Vec::new(), |rs| {
             rs.iter()
                 .filter_map(|g| self.participants.get(&g.prefix))
-                .filter_map(|p| shm_node(&p.data.properties).map(str::to_owned))
+                .filter_map(|p| shm_node(&p.data().properties).map(str::to_owned))
                 .collect()
         });
         nodes.sort();

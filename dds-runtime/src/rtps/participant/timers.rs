@@ -18,10 +18,12 @@ use crate::rtps::types::*;
 /// that arms a timer also lowers or clears the floor).
 const FULL_SCAN_INTERVAL: Duration = Duration::from_millis(100);
 
-/// Lowers a known timer floor to `t`; an unknown floor stays unknown (it is rescanned anyway).
 /// The room (in events) the participant's queues keep after a burst; see `Participant::trim_queues`.
 pub(crate) const KEPT_QUEUE_ROOM: usize = 256;
+/// The datagram buffers the outbox keeps for reuse after a burst (it holds up to 64).
+const KEPT_DATAGRAMS: usize = 16;
 
+/// Lowers a known timer floor to `t`; an unknown floor stays unknown (it is rescanned anyway).
 pub(super) fn lower_floor(floor: &Cell<Option<Instant>>, t: Option<Instant>) {
     if let (Some(f), Some(t)) = (floor.get(), t) {
         if t < f {
@@ -183,6 +185,7 @@ impl Participant {
     fn trim_queues(&mut self) {
         self.scratch.shrink_to(KEPT_QUEUE_ROOM);
         self.events.shrink_to(KEPT_QUEUE_ROOM);
+        self.out.trim(KEPT_DATAGRAMS);
     }
 
     /// Sends our SPDP announcement to the SPDP multicast locators and initial peers, or to `to` only.
@@ -225,7 +228,7 @@ impl Participant {
         let mut dest = self.config.metatraffic_multicast.clone();
         dest.extend(self.config.initial_peers.iter().copied());
         for p in self.participants.values() {
-            dest.extend(p.data.metatraffic_unicast.first().copied());
+            dest.extend(p.data().metatraffic_unicast.first().copied());
         }
         dest.sort();
         dest.dedup();

@@ -145,8 +145,8 @@ impl Participant {
             return;
         }
         p.type_lookup_matched = true;
-        let bits = p.data.builtin_endpoints;
-        let meta = super::metatraffic(&p.data);
+        let bits = p.builtin_endpoints;
+        let meta = p.metatraffic.clone();
         trace!(participant = ?prefix, "TypeLookup endpoints matched");
         // Addressed to one participant: never via a shared multicast group.
         self.match_builtin_pairs(now, prefix, bits, &meta, None, is_service_endpoint);

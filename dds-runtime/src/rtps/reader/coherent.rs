@@ -58,13 +58,14 @@ struct OpenSet {
 }
 
 /// One matched writer's open coherent set.
+///
+/// Kept per matched writer, so small (16 bytes, pinned by `tests::assembler_stays_small`): the open set is
+/// boxed (most writers never send one) and the limits are held in 32 bits each.
 #[derive(Debug)]
 pub(crate) struct Assembler {
-    /// Boxed: most writers never send a coherent set, and a proxy is kept per matched writer.
     open: Option<Box<OpenSet>>,
-    limits: SetLimits,
-    /// The group set the closing marker named (taken by `close`).
-    group: Option<GroupSetId>,
+    max_samples: u32,
+    max_bytes: u32,
 }
 
 impl Default for Assembler {
@@ -77,12 +78,13 @@ impl Default for Assembler {
 }
 
 impl Assembler {
-    /// An assembler holding at most `limits` of one set.
+    /// An assembler holding at most `limits` of one set (a limit beyond `u32::MAX` is `u32::MAX`).
     pub(crate) fn new(limits: SetLimits) -> Self {
+        let cap = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
         Assembler {
             open: None,
-            limits,
-            group: None,
+            max_samples: cap(limits.max_samples),
+            max_bytes: cap(limits.max_bytes),
         }
     }
 
@@ -96,16 +98,13 @@ impl Assembler {
     ) {
         match mark {
             None => {
-                self.close(sn, sample.reader, sample.writer, out);
+                self.close(sn, None, sample.reader, sample.writer, out);
                 out.push(Event::Sample(sample));
             }
-            Some(m) if m.end => {
-                self.group = m.group;
-                self.close(sn, sample.reader, sample.writer, out)
-            }
+            Some(m) if m.end => self.close(sn, m.group, sample.reader, sample.writer, out),
             Some(m) => {
                 if self.open.as_ref().is_some_and(|o| o.set != m.set) {
-                    self.close(sn, sample.reader, sample.writer, out);
+                    self.close(sn, None, sample.reader, sample.writer, out);
                 }
                 let o = self.open.get_or_insert_with(|| {
                     Box::new(OpenSet {
@@ -122,7 +121,8 @@ impl Assembler {
                 o.last = sn;
                 o.count += 1;
                 o.bytes += sample.payload.len();
-                if o.samples.len() >= self.limits.max_samples || o.bytes > self.limits.max_bytes {
+                if o.samples.len() >= self.max_samples as usize || o.bytes > self.max_bytes as usize
+                {
                     o.whole = false;
                 }
                 if o.whole {
@@ -135,15 +135,16 @@ impl Assembler {
     }
 
     /// Ends the open set at change `next` (the marker, or the first change not in the set): delivers it when
-    /// nothing is missing between its last change and `next`, else reports its changes lost.
+    /// nothing is missing between its last change and `next`, else reports its changes lost. `group`: the
+    /// group set the closing marker named.
     fn close(
         &mut self,
         next: SequenceNumber,
+        group: Option<GroupSetId>,
         reader: EntityId,
         writer: Guid,
         out: &mut Vec<Event>,
     ) {
-        let group = self.group.take();
         let Some(o) = self.open.take() else {
             return;
         };

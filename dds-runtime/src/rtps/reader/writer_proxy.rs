@@ -192,3 +192,18 @@ impl WriterProxy {
             .is_some_and(|b| b.reorder.contains_key(&sn) || b.defrag.contains_key(&sn))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One proxy per remote builtin writer of every discovered participant (see `docs/performance.md`,
+    /// "Footprint"): 136 bytes on x86-64 before the coherent-set assembler held its limits in 32 bits and
+    /// stopped keeping the closing marker's group set.
+    #[test]
+    #[cfg(target_pointer_width = "64")]
+    fn proxy_stays_small() {
+        assert_eq!(std::mem::size_of::<Assembler>(), 16);
+        assert_eq!(std::mem::size_of::<WriterProxy>(), 104);
+    }
+}
