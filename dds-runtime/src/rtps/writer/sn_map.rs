@@ -53,6 +53,13 @@ impl<V> SnMap<V> {
         if self.slots.is_empty() {
             self.base = sn.0;
         }
+        // The common case, the next number: the value is written once, straight into its slot (a `None`
+        // pushed and then replaced moved the whole value twice more, a tenth of a 16 B writer's time).
+        if self.index(sn) == Some(self.slots.len()) {
+            self.slots.push_back(Some(v));
+            self.len += 1;
+            return;
+        }
         while sn.0 < self.base {
             self.slots.push_front(None);
             self.base -= 1;
@@ -68,7 +75,14 @@ impl<V> SnMap<V> {
 
     pub(super) fn remove(&mut self, sn: SequenceNumber) -> Option<V> {
         let i = self.index(sn)?;
-        let v = self.slots.get_mut(i)?.take()?;
+        // The oldest (the common case) leaves the ring in one move.
+        let v = if i == 0 {
+            let v = self.slots.pop_front()??;
+            self.base += 1;
+            v
+        } else {
+            self.slots.get_mut(i)?.take()?
+        };
         self.len -= 1;
         while matches!(self.slots.front(), Some(None)) {
             self.slots.pop_front();
@@ -78,6 +92,28 @@ impl<V> SnMap<V> {
             self.slots.pop_back();
         }
         Some(v)
+    }
+
+    /// Drops the values below `to` where they lie, without moving them out of the ring; `each` sees every
+    /// one of them first, in order.
+    pub(super) fn drop_below(&mut self, to: SequenceNumber, mut each: impl FnMut(&V)) {
+        let n = to.0.saturating_sub(self.base).max(0) as usize;
+        let n = n.min(self.slots.len());
+        if n == 0 {
+            return;
+        }
+        let mut gone = 0;
+        for v in self.slots.range(..n).flatten() {
+            each(v);
+            gone += 1;
+        }
+        self.len -= gone;
+        self.slots.drain(..n);
+        self.base += n as i64;
+        while matches!(self.slots.front(), Some(None)) {
+            self.slots.pop_front();
+            self.base += 1;
+        }
     }
 
     /// The values at `from` and above, in order.
@@ -142,5 +178,28 @@ mod tests {
         m.remove(sn(3));
         m.remove(sn(8));
         assert_eq!((m.len(), m.first().is_none(), m.slots.len()), (0, true, 0));
+    }
+
+    #[test]
+    fn drop_below_drops_in_place_and_skips_holes() {
+        let mut m = SnMap::new();
+        for n in 1..=6 {
+            m.insert(sn(n), n);
+        }
+        m.remove(sn(2));
+        m.remove(sn(5));
+        let mut seen = Vec::new();
+        m.drop_below(sn(5), |v| seen.push(*v));
+        assert_eq!(seen, [1, 3, 4]);
+        assert_eq!(
+            (m.len(), m.first()),
+            (1, Some((sn(6), &6))),
+            "the hole at 5 went too"
+        );
+        m.drop_below(sn(0), |_| panic!("nothing below"));
+        m.drop_below(sn(100), |v| seen.push(*v));
+        assert_eq!((m.len(), m.first().is_none(), m.slots.len()), (0, true, 0));
+        m.insert(sn(200), 7);
+        assert_eq!(m.keys().collect::<Vec<_>>(), [sn(200)]);
     }
 }
