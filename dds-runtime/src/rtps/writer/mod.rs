@@ -298,20 +298,7 @@ impl Writer {
         }
         let len = change.payload.accounted_len();
         self.window.note(len);
-        if self.has_reliable_proxy() {
-            if self.blocked {
-                self.update_acked(ev);
-                if self.blocked {
-                    self.solicit_acks(now);
-                    return Err(WriteError::WouldBlock);
-                }
-            }
-            if self.unacked_bytes > 0 && self.unacked_bytes + len > self.window.high() {
-                self.blocked = true;
-                self.solicit_acks(now);
-                return Err(WriteError::WouldBlock);
-            }
-        }
+        self.flow_admits(now, len, ev)?;
         self.expire(now);
         let key = change.key_hash.unwrap_or_default();
         if self.history.make_room(&key, self.acked_floor()).is_err() {
@@ -320,7 +307,57 @@ impl Writer {
         }
         let sn = self.next_sn;
         self.next_sn = sn.next();
-        let cc = CacheChange {
+        let cc = self.new_change(now, sn, change, rejected);
+        let filtered = !cc.rejected.is_empty();
+        self.history.add(cc);
+        if !self.data_dest.is_empty() {
+            self.send_written(sn, len, filtered, out);
+        }
+        if self.has_reliable_proxy() {
+            self.unacked_bytes += len;
+            self.hb_due
+                .get_or_insert(now + self.params.heartbeat_period);
+        } else if !self.durable() {
+            self.history.remove_below(self.next_sn);
+        }
+        Ok(sn)
+    }
+
+    /// Flow control for a new change of `len` bytes: `WouldBlock` (and a heartbeat soon) while the
+    /// unacknowledged bytes would pass the high watermark, until they fall to the low one.
+    fn flow_admits(
+        &mut self,
+        now: Instant,
+        len: usize,
+        ev: &mut VecDeque<Event>,
+    ) -> Result<(), WriteError> {
+        if !self.has_reliable_proxy() {
+            return Ok(());
+        }
+        if self.blocked {
+            self.update_acked(ev);
+            if self.blocked {
+                self.solicit_acks(now);
+                return Err(WriteError::WouldBlock);
+            }
+        }
+        if self.unacked_bytes > 0 && self.unacked_bytes + len > self.window.high() {
+            self.blocked = true;
+            self.solicit_acks(now);
+            return Err(WriteError::WouldBlock);
+        }
+        Ok(())
+    }
+
+    /// The history's form of a written change numbered `sn`.
+    fn new_change(
+        &mut self,
+        now: Instant,
+        sn: SequenceNumber,
+        change: WriteChange,
+        rejected: Vec<Guid>,
+    ) -> CacheChange {
+        CacheChange {
             sn,
             kind: change.kind,
             payload: change.payload,
@@ -334,50 +371,49 @@ impl Writer {
             },
             rejected,
             expires: self.params.lifespan.map(|l| now + l),
+        }
+    }
+
+    /// Sends the new change `sn` (`len` bytes) to the matched readers, GAPs to those whose filter rejected
+    /// it (`filtered`), and a piggy-backed heartbeat when one is due.
+    fn send_written(&mut self, sn: SequenceNumber, len: usize, filtered: bool, out: &mut Outbox) {
+        let dest = if filtered {
+            self.send_rejections(sn, out)
+        } else {
+            std::mem::take(&mut self.data_dest)
         };
-        let filtered = !cc.rejected.is_empty();
-        self.history.add(cc);
-        if !self.data_dest.is_empty() {
-            let dest = if filtered {
-                self.send_rejections(sn, out)
-            } else {
-                std::mem::take(&mut self.data_dest)
-            };
-            self.send_new(sn, &dest, out);
-            if self.has_reliable_proxy() {
-                self.bytes_since_nonfinal_hb += len;
-                self.changes_since_nonfinal_hb += 1;
-                self.bytes_since_hb += len;
-                // Ask for acknowledgements every quarter of the high watermark (or of the history's sample
-                // limit), so that flow control keeps moving without waiting for the periodic heartbeat (and
-                // without an ACKNACK per datagram); otherwise the piggy-backed heartbeat only announces.
-                let final_flag =
-                    self.bytes_since_nonfinal_hb < self.window.high() / 4
-                        && self.params.limits.max_samples.is_none_or(|m| {
-                            self.changes_since_nonfinal_hb < (m as usize / 4).max(1)
-                        });
-                if !final_flag || self.bytes_since_hb >= self.params.piggyback_heartbeat_bytes {
-                    if !final_flag {
-                        self.bytes_since_nonfinal_hb = 0;
-                        self.changes_since_nonfinal_hb = 0;
-                    }
-                    self.bytes_since_hb = 0;
-                    let hb = self.heartbeat(EntityId::UNKNOWN, final_flag);
-                    out.push(&dest, None, Ts::Any, &hb);
-                }
-            }
-            if !filtered {
-                self.data_dest = dest;
-            }
-        }
+        self.send_new(sn, &dest, out);
         if self.has_reliable_proxy() {
-            self.unacked_bytes += len;
-            self.hb_due
-                .get_or_insert(now + self.params.heartbeat_period);
-        } else if !self.durable() {
-            self.history.remove_below(self.next_sn);
+            self.piggyback_heartbeat(len, &dest, out);
         }
-        Ok(sn)
+        if !filtered {
+            self.data_dest = dest;
+        }
+    }
+
+    /// Counts a written change of `len` bytes towards the next heartbeat and sends one to `dest` when due.
+    fn piggyback_heartbeat(&mut self, len: usize, dest: &[Locator], out: &mut Outbox) {
+        self.bytes_since_nonfinal_hb += len;
+        self.changes_since_nonfinal_hb += 1;
+        self.bytes_since_hb += len;
+        // Ask for acknowledgements every quarter of the high watermark (or of the history's sample
+        // limit), so that flow control keeps moving without waiting for the periodic heartbeat (and
+        // without an ACKNACK per datagram); otherwise the piggy-backed heartbeat only announces.
+        let final_flag = self.bytes_since_nonfinal_hb < self.window.high() / 4
+            && self
+                .params
+                .limits
+                .max_samples
+                .is_none_or(|m| self.changes_since_nonfinal_hb < (m as usize / 4).max(1));
+        if !final_flag || self.bytes_since_hb >= self.params.piggyback_heartbeat_bytes {
+            if !final_flag {
+                self.bytes_since_nonfinal_hb = 0;
+                self.changes_since_nonfinal_hb = 0;
+            }
+            self.bytes_since_hb = 0;
+            let hb = self.heartbeat(EntityId::UNKNOWN, final_flag);
+            out.push(dest, None, Ts::Any, &hb);
+        }
     }
 
     /// Sends a new change to every matched reader (`dest`): one shared send, except that key-only changes go
