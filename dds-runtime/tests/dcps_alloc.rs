@@ -211,7 +211,8 @@ fn intra_process_write_owned_allocations_per_sample() {
 /// The whole process is near zero too. The reader, its cache full, keeps asking for samples again; the
 /// writer's requested sequence numbers were a `BTreeSet` that grew with each request and was rebuilt
 /// (`split_off`) on every acknowledgement: 4.7 to 6.4 allocations per sample. They are a bitmap window
-/// now (`writer/bit_window.rs`), kept while the reader is behind: 0.16 to 0.20.
+/// now (`writer/bit_window.rs`), kept while the reader is behind: 0.14 to 0.29 (it varies with the number
+/// of repair rounds; the bound leaves room for a loaded machine).
 #[test]
 fn steady_state_allocations_with_10000_samples_in_flight() {
     const DEPTH: u32 = 10_000;
@@ -237,7 +238,7 @@ fn steady_state_allocations_with_10000_samples_in_flight() {
     );
     assert!(take < 0.001, "take: {take:.4} allocations per sample");
     assert!(
-        total < 0.5,
+        total < 1.0,
         "whole process: {total:.3} allocations per sample"
     );
 }
