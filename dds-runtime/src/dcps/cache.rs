@@ -7,7 +7,7 @@ use std::time::{Duration, Instant, SystemTime};
 
 use foldhash::{HashMap, HashMapExt};
 
-use crate::filter::FilterFields;
+use crate::filter::{ContentFilter, FilterFields};
 use crate::qos::{DataReaderQos, DestinationOrder, History, Ownership, INFINITE};
 use crate::rtps::{ChangeKind, Guid};
 
@@ -81,6 +81,51 @@ struct Instance<T> {
     last_accepted: Option<Instant>,
     last_data: Instant,
     not_alive_since: Option<Instant>,
+}
+
+impl<T> Instance<T> {
+    /// A value from `inc` arrived: the instance is alive (a new generation when it was not) and `inc`'s
+    /// writer one of its writers.
+    fn revive(&mut self, inc: &Incoming<T>, now: Instant) {
+        match self.state {
+            InstanceState::Alive => {}
+            InstanceState::NotAliveDisposed => {
+                self.disposed_gen += 1;
+                self.view = ViewState::New;
+            }
+            InstanceState::NotAliveNoWriters => {
+                self.no_writers_gen += 1;
+                self.view = ViewState::New;
+            }
+        }
+        self.state = InstanceState::Alive;
+        self.not_alive_since = None;
+        self.writers.insert(inc.writer, inc.strength);
+        self.last_accepted = Some(now);
+        self.last_data = now;
+        self.newest_source = Some(inc.source_timestamp);
+    }
+
+    /// Appends the sample `inc` numbered `seq`: with its data (`valid`), or as an invalid sample that
+    /// carries a state change.
+    fn push_sample(&mut self, seq: u64, inc: Incoming<T>, valid: bool) {
+        let (data, expires) = if valid {
+            (inc.data, inc.expires)
+        } else {
+            (None, None)
+        };
+        self.samples.push_back(Stored {
+            data,
+            read: false,
+            source_timestamp: inc.source_timestamp,
+            reception_timestamp: inc.reception_timestamp,
+            writer: inc.attributed.unwrap_or(inc.writer),
+            disposed_gen: self.disposed_gen,
+            no_writers_gen: self.no_writers_gen,
+            seq,
+            expires,
+        });
+    }
 }
 
 /// Which samples a read/take returns.
@@ -273,7 +318,6 @@ impl<T: FilterFields> ReaderCache<T> {
         Some(h)
     }
 
-    /// Applies one change. `now` is the monotonic time of reception.
     /// An empty buffer for the next sample's instance key (reusing the last one's allocation).
     pub(crate) fn take_key_buffer(&mut self) -> Vec<u8> {
         let mut k = std::mem::take(&mut self.spare_key);
@@ -281,6 +325,7 @@ impl<T: FilterFields> ReaderCache<T> {
         k
     }
 
+    /// Applies one change. `now` is the monotonic time of reception.
     pub(crate) fn insert(&mut self, mut inc: Incoming<T>, now: Instant) -> Outcome {
         let alive = inc.kind == ChangeKind::Alive;
         if alive {
@@ -290,43 +335,61 @@ impl<T: FilterFields> ReaderCache<T> {
                 _ => {}
             }
         }
+        let handle = match self.instance_of(&mut inc, now) {
+            Ok(h) => h,
+            Err(outcome) => return outcome,
+        };
+        if !self.admits(handle, &mut inc, now) {
+            return Outcome::Filtered;
+        }
+        if alive {
+            self.insert_alive(handle, inc, now)
+        } else {
+            self.insert_state_change(handle, inc, now)
+        }
+    }
+
+    /// The instance of `inc`'s key, made when new; an unregister of an unknown instance is filtered, a new
+    /// instance past the limit rejected.
+    fn instance_of(
+        &mut self,
+        inc: &mut Incoming<T>,
+        now: Instant,
+    ) -> Result<InstanceHandle, Outcome> {
         let key = if self.keyed {
             std::mem::take(&mut inc.key)
         } else {
             Vec::new()
         };
-        let handle = match self.by_key.get(&key) {
+        match self.by_key.get(&key) {
             Some(h) => {
                 let h = *h;
                 self.spare_key = key;
-                h
+                Ok(h)
             }
-            None if !alive && inc.kind == ChangeKind::Unregister => return Outcome::Filtered,
+            None if inc.kind == ChangeKind::Unregister => Err(Outcome::Filtered),
             None => {
                 let holder = inc
                     .key_holder
                     .take()
                     .or_else(|| self.key_of.and_then(|f| inc.data.as_ref().and_then(f)));
-                match self.new_instance(key, holder, now) {
-                    Some(h) => h,
-                    None => {
-                        return Outcome::Rejected {
-                            reason: SampleRejectedReason::ByInstancesLimit,
-                            handle: InstanceHandle::NIL,
-                        }
-                    }
-                }
+                self.new_instance(key, holder, now)
+                    .ok_or(Outcome::Rejected {
+                        reason: SampleRejectedReason::ByInstancesLimit,
+                        handle: InstanceHandle::NIL,
+                    })
             }
-        };
+        }
+    }
+
+    /// Whether `inc` counts for its instance under exclusive ownership and destination order (false also
+    /// for an unknown instance). Records the writer's strength and the instance's owner.
+    fn admits(&mut self, handle: InstanceHandle, inc: &mut Incoming<T>, now: Instant) -> bool {
         let exclusive = self.qos.ownership == Ownership::Exclusive;
         let by_source = self.qos.destination_order == DestinationOrder::BySourceTimestamp;
         let deadline = finite(self.qos.deadline.0);
-        let min_sep = self.qos.time_based_filter.minimum_separation;
-        let history = self.qos.history;
-        let limits = self.qos.resource_limits;
-        let total = self.total;
         let Some(inst) = self.instances.get_mut(&handle) else {
-            return Outcome::Filtered;
+            return false;
         };
         if inst.key_holder.is_none() {
             inst.key_holder = inc.key_holder.take();
@@ -345,7 +408,7 @@ impl<T: FilterFields> ReaderCache<T> {
                 ) {
                     inst.writers.remove(&inc.writer);
                 }
-                return Outcome::Filtered;
+                return false;
             }
             inst.owner = Some((inc.writer, inc.strength));
         }
@@ -353,81 +416,70 @@ impl<T: FilterFields> ReaderCache<T> {
         // Destination order by source timestamp: a value or dispose older than the newest accepted one
         // of the instance is dropped (DDS 1.4 §2.2.3.17); unregisters always count.
         let ordered = matches!(inc.kind, ChangeKind::Alive | ChangeKind::Dispose);
-        if by_source && ordered && !order::in_source_order(inst.newest_source, inc.source_timestamp)
+        !(by_source && ordered && !order::in_source_order(inst.newest_source, inc.source_timestamp))
+    }
+
+    /// Stores a value: subject to the time-based filter and the history and resource limits; revives a
+    /// not-alive instance.
+    fn insert_alive(&mut self, handle: InstanceHandle, inc: Incoming<T>, now: Instant) -> Outcome {
+        let min_sep = self.qos.time_based_filter.minimum_separation;
+        let history = self.qos.history;
+        let limits = self.qos.resource_limits;
+        let total = self.total;
+        let Some(inst) = self.instances.get_mut(&handle) else {
+            return Outcome::Filtered;
+        };
+        if !min_sep.is_zero()
+            && inst
+                .last_accepted
+                .is_some_and(|t| now.saturating_duration_since(t) < min_sep)
         {
             return Outcome::Filtered;
         }
-
-        if alive {
-            if !min_sep.is_zero() {
-                if let Some(t) = inst.last_accepted {
-                    if now.saturating_duration_since(t) < min_sep {
-                        return Outcome::Filtered;
-                    }
-                }
-            }
-            let per_instance = inst.samples.len();
-            if let History::KeepAll = history {
-                if limits
-                    .max_samples_per_instance
-                    .is_some_and(|m| per_instance >= m as usize)
-                {
-                    return Outcome::Rejected {
-                        reason: SampleRejectedReason::BySamplesPerInstanceLimit,
-                        handle,
-                    };
-                }
-            }
-            let evict =
-                matches!(history, History::KeepLast(d) if per_instance >= d.max(1) as usize);
-            if !evict && limits.max_samples.is_some_and(|m| total >= m as usize) {
+        let per_instance = inst.samples.len();
+        if let History::KeepAll = history {
+            if limits
+                .max_samples_per_instance
+                .is_some_and(|m| per_instance >= m as usize)
+            {
                 return Outcome::Rejected {
-                    reason: SampleRejectedReason::BySamplesLimit,
+                    reason: SampleRejectedReason::BySamplesPerInstanceLimit,
                     handle,
                 };
             }
-            match inst.state {
-                InstanceState::Alive => {}
-                InstanceState::NotAliveDisposed => {
-                    inst.disposed_gen += 1;
-                    inst.view = ViewState::New;
-                }
-                InstanceState::NotAliveNoWriters => {
-                    inst.no_writers_gen += 1;
-                    inst.view = ViewState::New;
-                }
-            }
-            inst.state = InstanceState::Alive;
-            inst.not_alive_since = None;
-            inst.writers.insert(inc.writer, inc.strength);
-            inst.last_accepted = Some(now);
-            inst.last_data = now;
-            inst.newest_source = Some(inc.source_timestamp);
-            if evict {
-                if let Some(old) = inst.samples.pop_front() {
-                    drop(old);
-                    self.total -= 1;
-                }
-            }
-            let seq = self.next_seq;
-            self.next_seq += 1;
-            inst.samples.push_back(Stored {
-                data: inc.data,
-                read: false,
-                source_timestamp: inc.source_timestamp,
-                reception_timestamp: inc.reception_timestamp,
-                writer: inc.attributed.unwrap_or(inc.writer),
-                disposed_gen: inst.disposed_gen,
-                no_writers_gen: inst.no_writers_gen,
-                seq,
-                expires: inc.expires,
-            });
-            self.total += 1;
-            return Outcome::Accepted { handle };
         }
+        let evict = matches!(history, History::KeepLast(d) if per_instance >= d.max(1) as usize);
+        if !evict && limits.max_samples.is_some_and(|m| total >= m as usize) {
+            return Outcome::Rejected {
+                reason: SampleRejectedReason::BySamplesLimit,
+                handle,
+            };
+        }
+        inst.revive(&inc, now);
+        if evict {
+            if let Some(old) = inst.samples.pop_front() {
+                drop(old);
+                self.total -= 1;
+            }
+        }
+        let seq = self.next_seq;
+        self.next_seq += 1;
+        inst.push_sample(seq, inc, true);
+        self.total += 1;
+        Outcome::Accepted { handle }
+    }
 
-        // Dispose / unregister: a state change; visible through an invalid sample when no unread sample
-        // of the instance can carry it.
+    /// Dispose / unregister: a state change; visible through an invalid sample when no unread sample of the
+    /// instance can carry it.
+    fn insert_state_change(
+        &mut self,
+        handle: InstanceHandle,
+        inc: Incoming<T>,
+        now: Instant,
+    ) -> Outcome {
+        let Some(inst) = self.instances.get_mut(&handle) else {
+            return Outcome::Filtered;
+        };
         let before = inst.state;
         if matches!(
             inc.kind,
@@ -459,17 +511,7 @@ impl<T: FilterFields> ReaderCache<T> {
         if !has_unread {
             let seq = self.next_seq;
             self.next_seq += 1;
-            inst.samples.push_back(Stored {
-                data: None,
-                read: false,
-                source_timestamp: inc.source_timestamp,
-                reception_timestamp: inc.reception_timestamp,
-                writer: inc.attributed.unwrap_or(inc.writer),
-                disposed_gen: inst.disposed_gen,
-                no_writers_gen: inst.no_writers_gen,
-                seq,
-                expires: None,
-            });
+            inst.push_sample(seq, inc, false);
             self.total += 1;
         }
         Outcome::Accepted { handle }
@@ -590,6 +632,43 @@ impl<T: FilterFields> ReaderCache<T> {
         let (mut touched, mut picked) = std::mem::take(&mut self.collect_scratch);
         touched.clear();
         picked.clear();
+        self.gather(sel, q, &mut touched, &mut picked);
+        // Gathered instance by instance, each in reception order: grouped by instance as it is. Otherwise, in
+        // reception order; without ORDER BY only the first `limit` are wanted: select them, then sort just those.
+        let ordered_by_query = q.is_some_and(|q| q.has_order_by());
+        if !self.instance_order {
+            if !ordered_by_query && picked.len() > limit && limit > 0 {
+                picked.select_nth_unstable_by_key(limit - 1, |p| p.0);
+                picked.truncate(limit);
+            }
+            picked.sort_unstable_by_key(|p| p.0);
+        }
+        self.order_by(q, &mut picked, &touched);
+        picked.truncate(limit);
+        self.emit_picked(&picked, &mut touched, &mut emit);
+        // View state becomes NOT_NEW for every instance touched.
+        for t in touched.iter().filter(|t| t.count > 0) {
+            if let Some(inst) = self.instances.get_mut(&t.handle) {
+                inst.view = ViewState::NotNew;
+            }
+        }
+        if take {
+            self.remove_picked(&mut picked, &touched);
+        }
+        touched.clear();
+        picked.clear();
+        self.collect_scratch = (touched, picked);
+    }
+
+    /// Lists the selected samples as `(seq, touched index, sample index)` in `picked`, and the instances
+    /// that have one in `touched`: instance by instance, each in reception order.
+    fn gather(
+        &self,
+        sel: &Selection,
+        q: Option<&ContentFilter>,
+        touched: &mut Vec<Touched>,
+        picked: &mut Vec<(u64, usize, usize)>,
+    ) {
         let mut gather = |h: InstanceHandle, inst: &Instance<T>| {
             let before = picked.len();
             for (i, s) in inst.samples.iter().enumerate() {
@@ -614,25 +693,22 @@ impl<T: FilterFields> ReaderCache<T> {
             }
             None => self.instances.iter().for_each(|(h, inst)| gather(*h, inst)),
         }
-        // Gathered instance by instance, each in reception order: grouped by instance as it is. Otherwise, in
-        // reception order; without ORDER BY only the first `limit` are wanted: select them, then sort just those.
-        let ordered_by_query = q.is_some_and(|q| q.has_order_by());
-        if !self.instance_order {
-            if !ordered_by_query && picked.len() > limit && limit > 0 {
-                picked.select_nth_unstable_by_key(limit - 1, |p| p.0);
-                picked.truncate(limit);
-            }
-            picked.sort_unstable_by_key(|p| p.0);
-        }
-        self.order_by(q, &mut picked, &touched);
-        picked.truncate(limit);
+    }
+
+    /// Calls `emit` with each picked sample, in `picked`'s order, and marks it read.
+    fn emit_picked(
+        &mut self,
+        picked: &[(u64, usize, usize)],
+        touched: &mut [Touched],
+        emit: &mut impl FnMut(&mut Option<T>, SampleInfo),
+    ) {
         // Ranks count the samples of the same instance later in the collection; the last one (in reception
         // order) is the instance's most recent sample in the collection.
-        for &(_, t, idx) in &picked {
+        for &(_, t, idx) in picked {
             touched[t].count += 1;
             touched[t].last_index = idx;
         }
-        for &(_, t, idx) in &picked {
+        for &(_, t, idx) in picked {
             let tc = &mut touched[t];
             let Some(inst) = self.instances.get_mut(&tc.handle) else {
                 continue;
@@ -670,28 +746,21 @@ impl<T: FilterFields> ReaderCache<T> {
             s.read = true;
             emit(&mut s.data, info);
         }
-        // View state becomes NOT_NEW for every instance touched.
+    }
+
+    /// Removes the picked samples (taken), and the instances left with nothing to remember.
+    fn remove_picked(&mut self, picked: &mut [(u64, usize, usize)], touched: &[Touched]) {
+        // Per instance, ascending index, each instance's samples removed in one pass.
+        picked.sort_unstable_by_key(|p| (p.1, p.2));
+        for group in picked.chunk_by(|a, b| a.1 == b.1) {
+            if let Some(inst) = self.instances.get_mut(&touched[group[0].1].handle) {
+                remove_indices(&mut inst.samples, group.iter().map(|p| p.2));
+            }
+        }
+        self.total -= picked.len();
         for t in touched.iter().filter(|t| t.count > 0) {
-            if let Some(inst) = self.instances.get_mut(&t.handle) {
-                inst.view = ViewState::NotNew;
-            }
+            self.maybe_drop_instance(t.handle);
         }
-        if take {
-            // Per instance, ascending index, each instance's samples removed in one pass.
-            picked.sort_unstable_by_key(|p| (p.1, p.2));
-            for group in picked.chunk_by(|a, b| a.1 == b.1) {
-                if let Some(inst) = self.instances.get_mut(&touched[group[0].1].handle) {
-                    remove_indices(&mut inst.samples, group.iter().map(|p| p.2));
-                }
-            }
-            self.total -= picked.len();
-            for t in touched.iter().filter(|t| t.count > 0) {
-                self.maybe_drop_instance(t.handle);
-            }
-        }
-        touched.clear();
-        picked.clear();
-        self.collect_scratch = (touched, picked);
     }
 
     /// An instance with no samples, no writers and not alive is forgotten.

@@ -6,6 +6,7 @@ mod defrag;
 mod historical;
 mod writer_proxy;
 
+use writer_proxy::Backlog;
 pub(crate) use writer_proxy::{PendingChange, Slot, WriterProxy};
 
 /// How long an ACKNACK that asks for nothing waits when it only serves discovery: a builtin reader's
@@ -49,6 +50,31 @@ fn inline_qos_understood(q: Option<&crate::rtps::messages::ParameterList<'_>>) -
         })
         .is_ok()
     })
+}
+
+/// The change a complete reassembly makes (`None` when its payload cannot be assembled).
+fn assembled(df: Defrag, pool: &mut BufferPool) -> Option<Slot> {
+    let kind = df
+        .status_info
+        .map_or(ChangeKind::Alive, ChangeKind::from_status_info);
+    let key_hash = df.key_hash;
+    let source_timestamp = df.source_timestamp;
+    let group_seq = df.group_seq;
+    let coherent = df.coherent_set.map(|set| SetMark {
+        set,
+        end: false,
+        group: None,
+        group_set: None,
+    });
+    let payload = df.assemble(pool)?;
+    Some(Slot::Change(PendingChange {
+        kind,
+        payload,
+        key_hash,
+        source_timestamp,
+        coherent,
+        group_seq,
+    }))
 }
 
 /// Protocol parameters of one reader.
@@ -399,41 +425,9 @@ impl Reader {
         }
         let reliable = p.reliable;
         let b = p.backlog_mut();
-        if !b.defrag.contains_key(&sn) {
-            if b.defrag.len() >= self.params.defrag_max_samples {
-                // Reliable: keep the oldest (they unblock delivery); best effort: keep the newest.
-                let victim = if reliable {
-                    b.defrag.last_key_value()
-                } else {
-                    b.defrag.first_key_value()
-                };
-                let Some((&v, _)) = victim else { return };
-                if reliable && v < sn {
-                    return;
-                }
-                if let Some(old) = b.defrag.remove(&v) {
-                    b.defrag_bytes -= old.bytes;
-                }
-            }
-            let cost = defrag::cost(d.sample_size, d.fragment_size);
-            if b.defrag_bytes + cost > self.params.defrag_max_bytes {
-                return;
-            }
-            let mut df = Defrag::new(d.sample_size, d.fragment_size, pool.take());
-            b.defrag_bytes += df.bytes;
-            df.status_info = d.inline_qos.and_then(|q| q.status_info());
-            df.key_hash = d.inline_qos.and_then(|q| q.key_hash());
-            df.key_flag = d.key_flag;
-            df.coherent_set = d.inline_qos.and_then(|q| q.coherent_set());
-            df.group_seq = d.inline_qos.and_then(|q| q.group_seq_num());
-            b.defrag.insert(sn, df);
-        }
-        let Some(df) = b.defrag.get_mut(&sn) else {
+        let Some(df) = self.reassembly(b, reliable, d, pool) else {
             return;
         };
-        if df.sample_size != d.sample_size || df.fragment_size != d.fragment_size {
-            return;
-        }
         if df.source_timestamp.is_none() {
             df.source_timestamp = ts;
         }
@@ -446,31 +440,54 @@ impl Reader {
                 return;
             };
             b.defrag_bytes -= df.bytes;
-            let kind = df
-                .status_info
-                .map_or(ChangeKind::Alive, ChangeKind::from_status_info);
-            let key_hash = df.key_hash;
-            let source_timestamp = df.source_timestamp;
-            let group_seq = df.group_seq;
-            let coherent = df.coherent_set.map(|set| SetMark {
-                set,
-                end: false,
-                group: None,
-                group_set: None,
-            });
-            let Some(payload) = df.assemble(pool) else {
-                return;
-            };
-            let slot = Slot::Change(PendingChange {
-                kind,
-                payload,
-                key_hash,
-                source_timestamp,
-                coherent,
-                group_seq,
-            });
-            self.accept(p, sn, slot, out);
+            if let Some(slot) = assembled(df, pool) {
+                self.accept(p, sn, slot, out);
+            }
         }
+    }
+
+    /// The reassembly of the sample `d` is a fragment of: the one under way, or a new one when the limits
+    /// (`defrag_max_samples`, `defrag_max_bytes`) allow. `None` when they do not, or when `d` disagrees with
+    /// the reassembly under way on the sample's or the fragments' size.
+    fn reassembly<'b>(
+        &self,
+        b: &'b mut Backlog,
+        reliable: bool,
+        d: &DataFrag<'_>,
+        pool: &mut BufferPool,
+    ) -> Option<&'b mut Defrag> {
+        let sn = d.writer_sn;
+        if !b.defrag.contains_key(&sn) {
+            if b.defrag.len() >= self.params.defrag_max_samples {
+                // Reliable: keep the oldest (they unblock delivery); best effort: keep the newest.
+                let victim = if reliable {
+                    b.defrag.last_key_value()
+                } else {
+                    b.defrag.first_key_value()
+                };
+                let (&v, _) = victim?;
+                if reliable && v < sn {
+                    return None;
+                }
+                if let Some(old) = b.defrag.remove(&v) {
+                    b.defrag_bytes -= old.bytes;
+                }
+            }
+            let cost = defrag::cost(d.sample_size, d.fragment_size);
+            if b.defrag_bytes + cost > self.params.defrag_max_bytes {
+                return None;
+            }
+            let mut df = Defrag::new(d.sample_size, d.fragment_size, pool.take());
+            b.defrag_bytes += df.bytes;
+            df.status_info = d.inline_qos.and_then(|q| q.status_info());
+            df.key_hash = d.inline_qos.and_then(|q| q.key_hash());
+            df.key_flag = d.key_flag;
+            df.coherent_set = d.inline_qos.and_then(|q| q.coherent_set());
+            df.group_seq = d.inline_qos.and_then(|q| q.group_seq_num());
+            b.defrag.insert(sn, df);
+        }
+        let df = b.defrag.get_mut(&sn)?;
+        (df.sample_size == d.sample_size && df.fragment_size == d.fragment_size).then_some(df)
     }
 
     pub(crate) fn on_gap(&mut self, writer: Guid, g: &Gap, out: &mut Vec<Event>) {

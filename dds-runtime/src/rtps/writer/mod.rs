@@ -1,5 +1,6 @@
 //! Writers: history cache, per-reader state and the reliable/best-effort protocol (§8.4.7, §8.4.9).
 
+mod bit_window;
 mod coherent;
 mod content_filter;
 mod flow;
@@ -20,7 +21,7 @@ pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use liveliness::OwnLeases;
 pub(crate) use reader_proxy::ReaderProxy;
 
-use std::collections::{BTreeMap, BTreeSet, VecDeque};
+use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
 use crate::qos::{Durability, History, ResourceLimits};
@@ -32,7 +33,7 @@ use crate::rtps::messages::{
 };
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::types::*;
-use reader_proxy::MAX_REQUESTED_FRAG_SAMPLES;
+use bit_window::BitWindow;
 
 /// Protocol parameters of one writer.
 #[derive(Debug, Clone, Copy)]
@@ -298,20 +299,7 @@ impl Writer {
         }
         let len = change.payload.accounted_len();
         self.window.note(len);
-        if self.has_reliable_proxy() {
-            if self.blocked {
-                self.update_acked(ev);
-                if self.blocked {
-                    self.solicit_acks(now);
-                    return Err(WriteError::WouldBlock);
-                }
-            }
-            if self.unacked_bytes > 0 && self.unacked_bytes + len > self.window.high() {
-                self.blocked = true;
-                self.solicit_acks(now);
-                return Err(WriteError::WouldBlock);
-            }
-        }
+        self.flow_admits(now, len, ev)?;
         self.expire(now);
         let key = change.key_hash.unwrap_or_default();
         if self.history.make_room(&key, self.acked_floor()).is_err() {
@@ -320,7 +308,57 @@ impl Writer {
         }
         let sn = self.next_sn;
         self.next_sn = sn.next();
-        let cc = CacheChange {
+        let cc = self.new_change(now, sn, change, rejected);
+        let filtered = !cc.rejected.is_empty();
+        self.history.add(cc);
+        if !self.data_dest.is_empty() {
+            self.send_written(sn, len, filtered, out);
+        }
+        if self.has_reliable_proxy() {
+            self.unacked_bytes += len;
+            self.hb_due
+                .get_or_insert(now + self.params.heartbeat_period);
+        } else if !self.durable() {
+            self.history.remove_below(self.next_sn);
+        }
+        Ok(sn)
+    }
+
+    /// Flow control for a new change of `len` bytes: `WouldBlock` (and a heartbeat soon) while the
+    /// unacknowledged bytes would pass the high watermark, until they fall to the low one.
+    fn flow_admits(
+        &mut self,
+        now: Instant,
+        len: usize,
+        ev: &mut VecDeque<Event>,
+    ) -> Result<(), WriteError> {
+        if !self.has_reliable_proxy() {
+            return Ok(());
+        }
+        if self.blocked {
+            self.update_acked(ev);
+            if self.blocked {
+                self.solicit_acks(now);
+                return Err(WriteError::WouldBlock);
+            }
+        }
+        if self.unacked_bytes > 0 && self.unacked_bytes + len > self.window.high() {
+            self.blocked = true;
+            self.solicit_acks(now);
+            return Err(WriteError::WouldBlock);
+        }
+        Ok(())
+    }
+
+    /// The history's form of a written change numbered `sn`.
+    fn new_change(
+        &mut self,
+        now: Instant,
+        sn: SequenceNumber,
+        change: WriteChange,
+        rejected: Vec<Guid>,
+    ) -> CacheChange {
+        CacheChange {
             sn,
             kind: change.kind,
             payload: change.payload,
@@ -334,50 +372,49 @@ impl Writer {
             },
             rejected,
             expires: self.params.lifespan.map(|l| now + l),
+        }
+    }
+
+    /// Sends the new change `sn` (`len` bytes) to the matched readers, GAPs to those whose filter rejected
+    /// it (`filtered`), and a piggy-backed heartbeat when one is due.
+    fn send_written(&mut self, sn: SequenceNumber, len: usize, filtered: bool, out: &mut Outbox) {
+        let dest = if filtered {
+            self.send_rejections(sn, out)
+        } else {
+            std::mem::take(&mut self.data_dest)
         };
-        let filtered = !cc.rejected.is_empty();
-        self.history.add(cc);
-        if !self.data_dest.is_empty() {
-            let dest = if filtered {
-                self.send_rejections(sn, out)
-            } else {
-                std::mem::take(&mut self.data_dest)
-            };
-            self.send_new(sn, &dest, out);
-            if self.has_reliable_proxy() {
-                self.bytes_since_nonfinal_hb += len;
-                self.changes_since_nonfinal_hb += 1;
-                self.bytes_since_hb += len;
-                // Ask for acknowledgements every quarter of the high watermark (or of the history's sample
-                // limit), so that flow control keeps moving without waiting for the periodic heartbeat (and
-                // without an ACKNACK per datagram); otherwise the piggy-backed heartbeat only announces.
-                let final_flag =
-                    self.bytes_since_nonfinal_hb < self.window.high() / 4
-                        && self.params.limits.max_samples.is_none_or(|m| {
-                            self.changes_since_nonfinal_hb < (m as usize / 4).max(1)
-                        });
-                if !final_flag || self.bytes_since_hb >= self.params.piggyback_heartbeat_bytes {
-                    if !final_flag {
-                        self.bytes_since_nonfinal_hb = 0;
-                        self.changes_since_nonfinal_hb = 0;
-                    }
-                    self.bytes_since_hb = 0;
-                    let hb = self.heartbeat(EntityId::UNKNOWN, final_flag);
-                    out.push(&dest, None, Ts::Any, &hb);
-                }
-            }
-            if !filtered {
-                self.data_dest = dest;
-            }
-        }
+        self.send_new(sn, &dest, out);
         if self.has_reliable_proxy() {
-            self.unacked_bytes += len;
-            self.hb_due
-                .get_or_insert(now + self.params.heartbeat_period);
-        } else if !self.durable() {
-            self.history.remove_below(self.next_sn);
+            self.piggyback_heartbeat(len, &dest, out);
         }
-        Ok(sn)
+        if !filtered {
+            self.data_dest = dest;
+        }
+    }
+
+    /// Counts a written change of `len` bytes towards the next heartbeat and sends one to `dest` when due.
+    fn piggyback_heartbeat(&mut self, len: usize, dest: &[Locator], out: &mut Outbox) {
+        self.bytes_since_nonfinal_hb += len;
+        self.changes_since_nonfinal_hb += 1;
+        self.bytes_since_hb += len;
+        // Ask for acknowledgements every quarter of the high watermark (or of the history's sample
+        // limit), so that flow control keeps moving without waiting for the periodic heartbeat (and
+        // without an ACKNACK per datagram); otherwise the piggy-backed heartbeat only announces.
+        let final_flag = self.bytes_since_nonfinal_hb < self.window.high() / 4
+            && self
+                .params
+                .limits
+                .max_samples
+                .is_none_or(|m| self.changes_since_nonfinal_hb < (m as usize / 4).max(1));
+        if !final_flag || self.bytes_since_hb >= self.params.piggyback_heartbeat_bytes {
+            if !final_flag {
+                self.bytes_since_nonfinal_hb = 0;
+                self.changes_since_nonfinal_hb = 0;
+            }
+            self.bytes_since_hb = 0;
+            let hb = self.heartbeat(EntityId::UNKNOWN, final_flag);
+            out.push(dest, None, Ts::Any, &hb);
+        }
     }
 
     /// Sends a new change to every matched reader (`dest`): one shared send, except that key-only changes go
@@ -554,7 +591,7 @@ impl Writer {
             }
         }
         request_past_bitmap(p, &ack.reader_sn_state, next_sn);
-        p.drop_requests_below(p.acked);
+        p.drop_requests_below(p.acked, next_sn);
         // A request, or a reader that is behind without knowing it (e.g. a pre-emptive ACKNACK): answer soon.
         // A group member answers every non-final ACKNACK: its heartbeat tells where the group stands.
         if (p.has_requested()
@@ -585,7 +622,11 @@ impl Writer {
         nf: &crate::rtps::messages::NackFrag,
     ) {
         let delay = self.params.nack_response_delay;
-        let in_history = self.history.get(nf.writer_sn).is_some();
+        let frag_size = self.params.fragment_size.max(1);
+        let fragments = self
+            .history
+            .get(nf.writer_sn)
+            .map(|c| c.payload.len().div_ceil(frag_size).min(u32::MAX as usize) as u32);
         let Some(p) = self.proxies.get_mut(&reader) else {
             return;
         };
@@ -598,16 +639,11 @@ impl Writer {
             return;
         }
         p.last_nackfrag = Some(nf.count);
-        if in_history {
-            let frags = &mut p.repairs_mut().requested_frags;
-            if frags.len() < MAX_REQUESTED_FRAG_SAMPLES || frags.contains_key(&nf.writer_sn) {
-                frags
-                    .entry(nf.writer_sn)
-                    .or_default()
-                    .extend(nf.fragment_number_state.iter());
+        match fragments {
+            Some(total) => p.request_frags(nf.writer_sn, nf.fragment_number_state.iter(), total),
+            None => {
+                p.request(nf.writer_sn);
             }
-        } else {
-            p.request(nf.writer_sn);
         }
         if p.repair_due.is_none() {
             p.repair_due = Some(now + delay);
@@ -659,87 +695,126 @@ impl Writer {
 
     /// Sends what one reader asked for (bounded per round), GAPs for what is gone, then a heartbeat to it.
     fn repair(&mut self, now: Instant, g: Guid, out: &mut Outbox) {
-        let frag = self.fragmenting();
-        let wid = self.guid.entity_id;
-        let reliable_writer = self.params.reliable;
         self.expire(now);
+        let frag = self.fragmenting();
         let Some(p) = self.proxies.get_mut(&g) else {
             return;
         };
         p.repair_due = None;
-        let dest = p.destination().first().copied();
-        let dst = Some(g.prefix);
-        let key_hash_only = p.key_hash_only_disposes;
-        let mut budget = self.params.max_repair_bytes as isize;
-        let mut gaps: Vec<SequenceNumber> = Vec::new();
-        // Fragmented samples sent: each is followed by a HEARTBEAT_FRAG for it (reliable readers).
-        let mut fragmented: Vec<(SequenceNumber, u32)> = Vec::new();
-        let mut resend = |c: &CacheChange, only: Option<&BTreeSet<u32>>| {
-            let n = send_change(
-                out,
-                dest.as_slice(),
-                dst,
-                g.entity_id,
-                wid,
-                c,
-                frag,
-                only,
-                key_hash_only,
-            );
-            if n > 0 {
-                fragmented.push((c.sn, n));
+        let to = RepairTo {
+            dest: p.destination().first().copied(),
+            reader: g,
+            writer: self.guid.entity_id,
+            frag,
+            key_hash_only: p.key_hash_only_disposes,
+        };
+        let served = to.serve(p, &self.history, self.params.max_repair_bytes, out);
+        let more = p.has_requests();
+        p.release_if_served(self.next_sn);
+        let (reliable, acked) = (p.reliable, p.acked);
+        if more {
+            p.repair_due = Some(now + self.params.nack_response_delay);
+            self.repair_queue.arm(p.repair_due, g);
+        }
+        let (dest, dst) = (to.dest.as_slice(), Some(g.prefix));
+        if self.params.reliable && reliable {
+            for &(sn, n) in &served.fragmented {
+                let hf = self.heartbeat_frag(g.entity_id, sn, n);
+                out.push(dest, dst, Ts::Any, &hf);
             }
+        }
+        send_gaps(out, dest, dst, g.entity_id, to.writer, &served.gaps);
+        // A reader that acknowledged everything meanwhile (its ACKNACK crossed our push) needs no heartbeat,
+        // unless the writer is a group member: its heartbeat's GroupInfo tells the reader where the group
+        // stands (an ordered reader asks for it while it holds changes back).
+        let caught_up = served.idle && acked >= self.next_sn;
+        if reliable && (!caught_up || self.group.is_some()) {
+            let hb = self.heartbeat(g.entity_id, false);
+            out.push(dest, dst, Ts::Any, &hb);
+        }
+    }
+}
+
+/// Where and how one repair round sends: to one reader, from one writer.
+struct RepairTo {
+    dest: Option<Locator>,
+    reader: Guid,
+    writer: EntityId,
+    frag: Fragmenting,
+    key_hash_only: bool,
+}
+
+/// What one repair round did besides sending changes.
+struct Served {
+    /// Requested changes that are gone (or not for this reader): answered with GAP.
+    gaps: Vec<SequenceNumber>,
+    /// Fragmented samples sent, with their number of fragments: each is followed by a HEARTBEAT_FRAG.
+    fragmented: Vec<(SequenceNumber, u32)>,
+    /// Nothing was sent nor is gone.
+    idle: bool,
+}
+
+impl RepairTo {
+    /// Sends the changes, then the fragments, `p` asked for, up to about `max_bytes`.
+    fn serve(
+        &self,
+        p: &mut ReaderProxy,
+        history: &HistoryCache,
+        max_bytes: usize,
+        out: &mut Outbox,
+    ) -> Served {
+        let mut budget = max_bytes as isize;
+        let mut served = Served {
+            gaps: Vec::new(),
+            fragmented: Vec::new(),
+            idle: false,
         };
         while budget > 0 {
             let Some(sn) = p.pop_requested() else {
                 break;
             };
-            match self.history.get(sn) {
-                Some(c) if sn >= p.floor && c.rejected.binary_search(&g).is_err() => {
-                    resend(c, None);
+            match history.get(sn) {
+                Some(c) if sn >= p.floor && c.rejected.binary_search(&self.reader).is_err() => {
+                    self.resend(c, None, &mut served, out);
                     budget -= c.payload.len() as isize + 64;
                 }
-                _ => gaps.push(sn),
+                _ => served.gaps.push(sn),
             }
         }
         while budget > 0 {
             let Some((sn, frags)) = p.pop_requested_frags() else {
                 break;
             };
-            if let Some(c) = self.history.get(sn) {
-                resend(c, Some(&frags));
-                budget -= (frags.len() * frag.size) as isize;
+            if let Some(c) = history.get(sn) {
+                self.resend(c, Some(&frags), &mut served, out);
+                budget -= (frags.len() * self.frag.size) as isize;
             }
         }
-        if reliable_writer && p.reliable {
-            for (sn, n) in fragmented {
-                self.hbfrag_count = self.hbfrag_count.wrapping_add(1);
-                let hf = Submessage::HeartbeatFrag(HeartbeatFrag {
-                    reader_id: g.entity_id,
-                    writer_id: wid,
-                    writer_sn: sn,
-                    last_fragment_num: n,
-                    count: self.hbfrag_count,
-                });
-                out.push(dest.as_slice(), dst, Ts::Any, &hf);
-            }
-        }
-        let idle = budget == self.params.max_repair_bytes as isize && gaps.is_empty();
-        send_gaps(out, dest.as_slice(), dst, g.entity_id, wid, &gaps);
-        let more = p.has_requests();
-        p.release_if_served();
-        let reliable = p.reliable;
-        if more {
-            p.repair_due = Some(now + self.params.nack_response_delay);
-            self.repair_queue.arm(p.repair_due, g);
-        }
-        // A reader that acknowledged everything meanwhile (its ACKNACK crossed our push) needs no heartbeat,
-        // unless the writer is a group member: its heartbeat's GroupInfo tells the reader where the group
-        // stands (an ordered reader asks for it while it holds changes back).
-        let caught_up = idle && p.acked >= self.next_sn;
-        if reliable && (!caught_up || self.group.is_some()) {
-            let hb = self.heartbeat(g.entity_id, false);
-            out.push(dest.as_slice(), dst, Ts::Any, &hb);
+        served.idle = budget == max_bytes as isize && served.gaps.is_empty();
+        served
+    }
+
+    /// Sends change `c` again (`only` these fragments of it).
+    fn resend(
+        &self,
+        c: &CacheChange,
+        only: Option<&BitWindow>,
+        served: &mut Served,
+        out: &mut Outbox,
+    ) {
+        let n = send_change(
+            out,
+            self.dest.as_slice(),
+            Some(self.reader.prefix),
+            self.reader.entity_id,
+            self.writer,
+            c,
+            self.frag,
+            only,
+            self.key_hash_only,
+        );
+        if n > 0 {
+            served.fragmented.push((c.sn, n));
         }
     }
 }
@@ -853,7 +928,7 @@ pub(crate) fn send_change(
     wid: EntityId,
     c: &CacheChange,
     frag: Fragmenting,
-    only: Option<&BTreeSet<u32>>,
+    only: Option<&BitWindow>,
     key_hash_only: bool,
 ) -> u32 {
     if dest.is_empty() {
@@ -916,7 +991,7 @@ pub(crate) fn send_change(
         out.push(dest, dst, ts, &d);
     };
     match only {
-        Some(set) => set.iter().for_each(|&f| send(f)),
+        Some(set) => set.iter().for_each(|f| send(u32::try_from(f).unwrap_or(0))),
         None => (1..=total).for_each(send),
     }
     total

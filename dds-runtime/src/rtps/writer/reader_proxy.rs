@@ -2,17 +2,23 @@
 //!
 //! Slim by design: a participant keeps one proxy per remote builtin reader of every discovered participant
 //! (see `docs/performance.md`, "Footprint"), and most of them hold no request most of the time. The requested
-//! changes and fragments are in a [`Repairs`] box made on the first request and dropped once served.
+//! changes and fragments are in a [`Repairs`] box made on the first request and dropped once served and
+//! the reader has acknowledged every change (a reader that is behind keeps it, and its bitmaps' words, from
+//! one repair round to the next).
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::bit_window::BitWindow;
 use crate::rtps::types::*;
 
 /// Bounds on what one remote reader can make us remember.
 pub(crate) const MAX_REQUESTED: usize = 4096;
 pub(crate) const MAX_REQUESTED_FRAG_SAMPLES: usize = 64;
+/// The requested changes span at most this many sequence numbers (a bitmap of 1 KiB): twice what one
+/// ACKNACK read past its bitmap asks for (`MAX_REQUESTED`, after its 256 bits).
+pub(crate) const MAX_REQUESTED_SPAN: usize = 2 * MAX_REQUESTED;
 
 #[derive(Debug, Clone)]
 pub(crate) struct ReaderProxy {
@@ -48,10 +54,10 @@ pub(crate) struct ReaderProxy {
 /// repair.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Repairs {
-    /// Whole changes (at most [`MAX_REQUESTED`]).
-    pub requested: BTreeSet<SequenceNumber>,
+    /// Whole changes by sequence number (at most [`MAX_REQUESTED`], within [`MAX_REQUESTED_SPAN`]).
+    requested: BitWindow,
     /// Fragments of changes (at most [`MAX_REQUESTED_FRAG_SAMPLES`] changes).
-    pub requested_frags: BTreeMap<SequenceNumber, BTreeSet<u32>>,
+    pub requested_frags: BTreeMap<SequenceNumber, BitWindow>,
 }
 
 impl Repairs {
@@ -83,14 +89,39 @@ impl ReaderProxy {
         self.repairs.get_or_insert_with(Box::default)
     }
 
-    /// Asks for the whole change `sn` unless [`MAX_REQUESTED`] are asked for already; false when full.
+    /// Asks for the whole change `sn` unless [`MAX_REQUESTED`] are asked for already, or the requests would
+    /// then span more than [`MAX_REQUESTED_SPAN`] sequence numbers; false when full (or `sn` is not a
+    /// sequence number, below 1).
     pub(crate) fn request(&mut self, sn: SequenceNumber) -> bool {
-        let r = self.repairs_mut();
-        if r.requested.len() >= MAX_REQUESTED {
+        let Some(n) = sn_index(sn) else {
             return false;
+        };
+        let r = self.repairs_mut();
+        r.requested.len() < MAX_REQUESTED && r.requested.insert(n, MAX_REQUESTED_SPAN.div_ceil(64))
+    }
+
+    /// Asks for the fragments `frags` of change `sn`, a sample of `total` fragments (numbers outside
+    /// `1..=total` are ignored), unless fragments of [`MAX_REQUESTED_FRAG_SAMPLES`] other changes are asked
+    /// for already.
+    pub(crate) fn request_frags(
+        &mut self,
+        sn: SequenceNumber,
+        frags: impl Iterator<Item = u32>,
+        total: u32,
+    ) {
+        let mut frags = frags.filter(|f| (1..=total).contains(f)).peekable();
+        if frags.peek().is_none() {
+            return;
         }
-        r.requested.insert(sn);
-        true
+        let all = &mut self.repairs_mut().requested_frags;
+        if all.len() >= MAX_REQUESTED_FRAG_SAMPLES && !all.contains_key(&sn) {
+            return;
+        }
+        let set = all.entry(sn).or_default();
+        let words = (total as usize).div_ceil(64) + 1;
+        for f in frags {
+            set.insert(u64::from(f), words);
+        }
     }
 
     /// Whether whole changes are requested.
@@ -105,31 +136,45 @@ impl ReaderProxy {
         self.repairs.as_ref().is_some_and(|r| !r.is_empty())
     }
 
-    /// Forgets the requests below `acked`.
-    pub(crate) fn drop_requests_below(&mut self, acked: SequenceNumber) {
+    /// Forgets the requests below `acked` (in place: nothing is allocated or freed but the box, see
+    /// [`release_if_served`](Self::release_if_served)).
+    pub(crate) fn drop_requests_below(
+        &mut self,
+        acked: SequenceNumber,
+        writer_next: SequenceNumber,
+    ) {
         if let Some(r) = self.repairs.as_deref_mut() {
-            r.requested = r.requested.split_off(&acked);
-            r.requested_frags = r.requested_frags.split_off(&acked);
+            r.requested.remove_below(sn_index(acked).unwrap_or(0));
+            while r
+                .requested_frags
+                .first_key_value()
+                .is_some_and(|(&sn, _)| sn < acked)
+            {
+                r.requested_frags.pop_first();
+            }
         }
-        self.release_if_served();
+        self.release_if_served(writer_next);
     }
 
     /// Takes the first requested whole change (and forgets fragments asked for it).
     pub(crate) fn pop_requested(&mut self) -> Option<SequenceNumber> {
         let r = self.repairs.as_deref_mut()?;
-        let sn = r.requested.pop_first()?;
+        let sn = SequenceNumber(r.requested.pop_first()? as i64);
         r.requested_frags.remove(&sn);
         Some(sn)
     }
 
     /// Takes the first change fragments are requested of.
-    pub(crate) fn pop_requested_frags(&mut self) -> Option<(SequenceNumber, BTreeSet<u32>)> {
+    pub(crate) fn pop_requested_frags(&mut self) -> Option<(SequenceNumber, BitWindow)> {
         self.repairs.as_deref_mut()?.requested_frags.pop_first()
     }
 
-    /// Drops the requests' box once nothing is left in it.
-    pub(crate) fn release_if_served(&mut self) {
-        if self.repairs.as_ref().is_some_and(|r| r.is_empty()) {
+    /// Drops the requests' box once nothing is left in it and the reader needs no more repairs: it
+    /// acknowledged every change up to `writer_next` (or is best effort). A reader that is behind keeps it
+    /// for its next requests.
+    pub(crate) fn release_if_served(&mut self, writer_next: SequenceNumber) {
+        let done = !self.reliable || self.acked >= writer_next;
+        if done && self.repairs.as_ref().is_some_and(|r| r.is_empty()) {
             self.repairs = None;
         }
     }
@@ -161,6 +206,11 @@ impl ReaderProxy {
     }
 }
 
+/// A sequence number as a bit's number in the requests' window (`None` below 1: no change has it).
+fn sn_index(sn: SequenceNumber) -> Option<u64> {
+    u64::try_from(sn.0).ok().filter(|&n| n > 0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -182,31 +232,50 @@ mod tests {
         let mut p = proxy();
         assert!(p.repairs.is_none() && !p.has_requests());
         assert!(p.request(SequenceNumber(3)) && p.request(SequenceNumber(5)));
-        p.repairs_mut()
-            .requested_frags
-            .entry(SequenceNumber(7))
-            .or_default()
-            .insert(1);
-        p.drop_requests_below(SequenceNumber(4));
+        p.request_frags(SequenceNumber(7), [1, 9].into_iter(), 4);
+        let next = SequenceNumber(20);
+        p.drop_requests_below(SequenceNumber(4), next);
         assert_eq!(p.pop_requested(), Some(SequenceNumber(5)));
         assert!(p.has_requests() && !p.has_requested());
+        let (sn, frags) = p.pop_requested_frags().unwrap();
         assert_eq!(
-            p.pop_requested_frags().map(|(sn, _)| sn),
-            Some(SequenceNumber(7))
+            (sn, frags.iter().collect::<Vec<_>>()),
+            (SequenceNumber(7), vec![1])
         );
-        p.release_if_served();
+        p.release_if_served(next);
+        assert!(p.repairs.is_some(), "a reader that is behind keeps the box");
+        p.acked = next;
+        p.release_if_served(next);
         assert!(p.repairs.is_none());
         p.request(SequenceNumber(9));
-        p.drop_requests_below(SequenceNumber(10));
+        p.acked = SequenceNumber(10);
+        p.drop_requests_below(SequenceNumber(10), SequenceNumber(10));
         assert!(p.repairs.is_none(), "acknowledged requests free the box");
+    }
+
+    /// A hostile reader's requests cannot make the bitmap grow: far apart, or fragments the sample lacks.
+    #[test]
+    fn requests_span_a_bounded_window() {
+        let mut p = proxy();
+        assert!(p.request(SequenceNumber(1_000)));
+        assert!(!p.request(SequenceNumber(1_000 + MAX_REQUESTED_SPAN as i64)));
+        assert!(!p.request(SequenceNumber(-5)) && !p.request(SequenceNumber(0)));
+        p.request_frags(SequenceNumber(1_000), [0, 3, 5, u32::MAX].into_iter(), 4);
+        let (_, frags) = p.pop_requested_frags().unwrap();
+        assert_eq!(frags.iter().collect::<Vec<_>>(), [3]);
+        p.request_frags(SequenceNumber(1_001), [9].into_iter(), 4);
+        assert!(
+            p.pop_requested_frags().is_none(),
+            "nothing valid, nothing asked"
+        );
     }
 
     #[test]
     fn requests_are_bounded() {
         let mut p = proxy();
-        for sn in 0..MAX_REQUESTED as i64 {
+        for sn in 1..=MAX_REQUESTED as i64 {
             assert!(p.request(SequenceNumber(sn)));
         }
-        assert!(!p.request(SequenceNumber(MAX_REQUESTED as i64)));
+        assert!(!p.request(SequenceNumber(MAX_REQUESTED as i64 + 1)));
     }
 }
