@@ -10,6 +10,7 @@ mod local;
 mod multicast;
 mod reader_proxy;
 mod sn_map;
+mod stand_in;
 
 use coherent::CoherentState;
 pub(crate) use coherent::Marks;
@@ -19,6 +20,8 @@ pub use group::WriterGroup;
 pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use liveliness::OwnLeases;
 pub(crate) use reader_proxy::ReaderProxy;
+use stand_in::StandIn;
+pub(crate) use stand_in::{stand_in_for, user_data as stand_in_user_data, Served};
 
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::time::{Duration, Instant};
@@ -97,6 +100,8 @@ pub(crate) struct Writer {
     pub filters: ReaderFilters,
     /// The owner decides what the history keeps (see [`Writer::manage_history`]).
     managed: bool,
+    /// Set when this is a durability service's stand-in (see `stand_in.rs`).
+    stand_in: Option<Box<StandIn>>,
 }
 
 impl Writer {
@@ -125,6 +130,7 @@ impl Writer {
             group: None,
             filters: ReaderFilters::default(),
             managed: false,
+            stand_in: None,
         }
     }
 
@@ -208,6 +214,7 @@ impl Writer {
                 .proxies
                 .iter()
                 .filter(|(_, p)| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
+                .filter(|(g, _)| !StandIn::excludes(&self.stand_in, g))
                 .filter_map(|(g, p)| Some((g.prefix == own, p.data_destination()?)))
                 .collect();
             // Each locator once (a multicast group may serve our own and remote readers), remote ones first.
@@ -466,10 +473,11 @@ impl Writer {
     ) {
         proxy.reliable &= self.params.reliable;
         self.expire(now);
+        let held = self.hold_at_match(now, &mut proxy);
         if !(self.durable() && reader_durable) {
             proxy.floor = self.next_sn;
             proxy.acked = self.next_sn;
-        } else if !self.history.is_empty() {
+        } else if !held && !self.history.is_empty() {
             if proxy.reliable && !self.history_fits_one_push() {
                 // Announce the history; the reader asks for what it lacks.
                 proxy.repair_due = Some(now);
@@ -510,6 +518,7 @@ impl Writer {
 
     pub(crate) fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
         self.filters.set(*guid, None);
+        self.forget_held(guid);
         let had = self.proxies.remove(guid).is_some();
         if self.proxies.is_empty() {
             self.repair_queue.clear();
@@ -695,7 +704,11 @@ impl Writer {
                 break;
             };
             match self.history.get(sn) {
-                Some(c) if sn >= p.floor && c.rejected.binary_search(&g).is_err() => {
+                Some(c)
+                    if sn >= p.floor
+                        && c.rejected.binary_search(&g).is_err()
+                        && !StandIn::served(&self.stand_in, &g, c) =>
+                {
                     resend(c, None);
                     budget -= c.payload.len() as isize + 64;
                 }
