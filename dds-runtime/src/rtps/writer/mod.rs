@@ -287,7 +287,8 @@ impl Writer {
     }
 
     /// [`Writer::write`] of a change that the content filters of the `rejected` readers refused: they get a
-    /// GAP for it (reliable ones), the others the DATA.
+    /// GAP for it (reliable ones), the others the DATA. A key-only change (dispose, unregister) passes every
+    /// filter, in both of its wire forms (see `content_filter.rs`): `rejected` is ignored for it.
     pub(crate) fn write_filtered(
         &mut self,
         now: Instant,
@@ -296,6 +297,9 @@ impl Writer {
         out: &mut Outbox,
         ev: &mut VecDeque<Event>,
     ) -> Result<SequenceNumber, WriteError> {
+        if change.kind != ChangeKind::Alive {
+            rejected.clear();
+        }
         rejected.sort_unstable();
         if self.linger_until.is_some() {
             return Err(WriteError::Deleted);
