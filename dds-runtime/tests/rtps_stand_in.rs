@@ -103,8 +103,13 @@ fn write_both(s: &mut Setup, range: std::ops::Range<u32>) {
 }
 
 fn reader(sim: &mut Sim, node: usize) -> EntityId {
+    reader_with(sim, node, Reliability::RELIABLE)
+}
+
+fn reader_with(sim: &mut Sim, node: usize, reliability: Reliability) -> EntityId {
     let now = sim.now;
-    let (_, rq) = durable_qos();
+    let (_, mut rq) = durable_qos();
+    rq.reliability = reliability;
     sim.nodes[node]
         .p
         .create_reader(now, ReaderSpec::new("T", "M::T", false, rq))
@@ -240,4 +245,17 @@ fn a_remote_original_that_leaves_cleanly_leaves_nothing_to_repeat() {
         again.is_empty(),
         "repeats after a clean departure: {again:?}"
     );
+}
+
+/// A best-effort reader held while the original lives gets the stand-in's history pushed once the
+/// original's participant is lost (as a best-effort reader gets it at matching).
+#[test]
+fn a_held_best_effort_reader_gets_the_history_after_the_original_is_lost() {
+    let mut s = setup(6, Faults::NONE, 3);
+    let sg = s.sim.guid(0, s.stand_in);
+    write_both(&mut s, 0..5);
+    s.sim.nodes[3].up = false;
+    let r1 = reader_with(&mut s.sim, 1, Reliability::BestEffort);
+    let got = collect(&mut s.sim, 1, r1, 5);
+    assert_eq!(got, from(sg, 0..5));
 }

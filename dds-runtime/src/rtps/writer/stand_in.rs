@@ -140,9 +140,17 @@ impl super::Writer {
         tracing::debug!(writer = ?self.guid, ?reader, ?served, "stand-in releases a reader");
         if let Some(p) = self.proxies.get_mut(reader) {
             p.reliable = reliable && self.params.reliable;
+            if !p.reliable {
+                // Best effort: the history is pushed once, as at matching (what was served goes as GAP).
+                for c in self.history.range(p.floor) {
+                    if !p.request(c.sn) {
+                        break;
+                    }
+                }
+            }
+            p.repair_due = Some(since);
+            self.repair_queue.arm(p.repair_due, *reader);
             if p.reliable {
-                p.repair_due = Some(since);
-                self.repair_queue.arm(p.repair_due, *reader);
                 self.hb_due.get_or_insert(since);
             }
         }
