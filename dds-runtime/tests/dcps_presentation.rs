@@ -519,3 +519,77 @@ fn access_scope_holds_back_changes_until_it_ends() {
     sub.end_access().unwrap();
     assert_eq!((rs[0].sample_count(), rs[1].sample_count()), (1, 1));
 }
+
+/// A publisher and a subscriber of the same participant: a coherent set is all or nothing there too, with
+/// TOPIC scope (one writer, two instances) and GROUP scope (two writers on two topics, read by two readers
+/// of one subscriber). Such a pair does not take the intra-process path, which hands samples over as they
+/// are written (`rtps/participant/local.rs`, `pair_qualifies`): it goes through the RTPS reader.
+#[test]
+fn coherent_sets_are_all_or_nothing_within_one_participant() {
+    let p = participant(117);
+    let (wq, rq) = reliable_keep_all();
+    let endpoints = |scope, names: &[&str]| {
+        let pres = presentation(scope, true, false);
+        let publ = p
+            .create_publisher(&PublisherQos::builder().presentation(pres).build())
+            .unwrap();
+        let sub = p
+            .create_subscriber(&SubscriberQos::builder().presentation(pres).build())
+            .unwrap();
+        let mut ws = Vec::new();
+        let mut rs = Vec::new();
+        for name in names {
+            let t = p
+                .create_topic::<ShapeType>(name, &TopicQos::default())
+                .unwrap();
+            ws.push(publ.create_datawriter(&t, &wq).unwrap());
+            rs.push(sub.create_datareader(&t, &rq).unwrap());
+        }
+        assert!(wait_until(MATCH_TIMEOUT, || rs
+            .iter()
+            .all(|r| r.subscription_matched_status().current_count == 1)));
+        (publ, sub, ws, rs)
+    };
+    let (topic_pub, _s1, tw, tr) = endpoints(PresentationAccessScope::Topic, &["SameTopic"]);
+    let (group_pub, _s2, gw, gr) = endpoints(
+        PresentationAccessScope::Group,
+        &["SameGroupA", "SameGroupB"],
+    );
+    let watched: Vec<_> = tr.iter().chain(&gr).map(watch).collect();
+    for round in 0..3usize {
+        topic_pub.begin_coherent_changes().unwrap();
+        group_pub.begin_coherent_changes().unwrap();
+        for i in 0..4 {
+            let x = (round * 10 + i) as i32;
+            tw[0].write(&shape(["RED", "BLUE"][i % 2], x)).unwrap();
+            gw[i % 2].write(&shape("RED", x)).unwrap();
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        for w in tw.iter().chain(&gw) {
+            w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+        }
+        std::thread::sleep(Duration::from_millis(50));
+        let counts =
+            |rs: &[DataReader<ShapeType>]| rs.iter().map(|r| r.sample_count()).collect::<Vec<_>>();
+        assert_eq!(counts(&tr), [4 * round], "round {round}: TOPIC set open");
+        assert_eq!(
+            counts(&gr),
+            [2 * round, 2 * round],
+            "round {round}: GROUP set open"
+        );
+        topic_pub.end_coherent_changes().unwrap();
+        group_pub.end_coherent_changes().unwrap();
+        assert!(wait_until(Duration::from_secs(5), || counts(&tr)
+            == [4 * (round + 1)]
+            && counts(&gr) == [2 * (round + 1), 2 * (round + 1)]));
+    }
+    for (i, (seen, stop)) in watched.iter().enumerate() {
+        stop.store(true, Ordering::Relaxed);
+        let step = if i == 0 { 4 } else { 2 };
+        let seen = seen.lock().unwrap().clone();
+        assert!(
+            seen.iter().all(|n| n % step == 0),
+            "reader {i}: a partial set was visible: {seen:?}"
+        );
+    }
+}

@@ -147,3 +147,78 @@ fn writer_skips_readers_whose_filter_rejects_and_filters_late_joiners_from_then_
         );
     }
 }
+
+/// A key-only change (dispose, unregister) passes every filter, in both wire forms: the serialized key (a
+/// reader of ours) and the key hash alone (a Fast DDS reader). Even when the caller names readers as
+/// rejecting it, both readers get it, as DATA, while a sample they reject reaches neither.
+#[test]
+fn key_only_changes_reach_every_filtering_reader_in_both_wire_forms() {
+    let mut sim = Sim::new(5, Faults::NONE);
+    sim.add(config(0));
+    sim.add(config(1).vendor_id(VendorId::FASTDDS));
+    sim.add(config(2));
+    let now = sim.now;
+    let wq = DataWriterQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .durability(Durability::TransientLocal)
+        .history(History::KeepAll)
+        .build();
+    let w = sim.nodes[0]
+        .p
+        .create_writer(now, WriterSpec::new("T", "M::Tick", true, wq))
+        .unwrap();
+    let spec = || {
+        let mut s = reader_spec(Some(("i >= %0", "10")));
+        s.keyed = true;
+        s
+    };
+    let fast = sim.nodes[1].p.create_reader(now, spec()).unwrap();
+    let ours = sim.nodes[2].p.create_reader(now, spec()).unwrap();
+    assert!(sim.run_until(Duration::from_secs(5), |s| s.nodes[0]
+        .p
+        .writer_matches(w)
+        .len()
+        == 2));
+    let both: Vec<Guid> = sim.nodes[0]
+        .p
+        .writer_reader_filters(w)
+        .into_iter()
+        .map(|(g, _)| g)
+        .collect();
+    assert_eq!(both.len(), 2);
+    let key = [7u8; 16];
+    let write = |sim: &mut Sim, ch: WriteChange| {
+        let now = sim.now;
+        let ch = ch.with_key_hash(key);
+        sim.nodes[0]
+            .p
+            .write_filtered(now, w, ch, both.clone())
+            .unwrap();
+        sim.run_for(Duration::from_millis(50));
+    };
+    write(&mut sim, WriteChange::alive(payload(1)));
+    write(
+        &mut sim,
+        WriteChange::alive(vec![0, 1, 0, 0, 7, 0, 0, 0]).with_kind(ChangeKind::Dispose),
+    );
+    write(
+        &mut sim,
+        WriteChange::alive(vec![0, 1, 0, 0, 7, 0, 0, 0]).with_kind(ChangeKind::Unregister),
+    );
+    assert!(sim.run_until(Duration::from_secs(10), |s| s.nodes[0].p.is_acknowledged(w)));
+    for (node, r) in [(1, fast), (2, ours)] {
+        let got: Vec<(ChangeKind, Option<[u8; 16]>)> = sim
+            .take_samples(node, r)
+            .iter()
+            .map(|s| (s.kind, s.key_hash))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                (ChangeKind::Dispose, Some(key)),
+                (ChangeKind::Unregister, Some(key))
+            ],
+            "node {node}: the rejected sample is skipped, the key-only changes arrive"
+        );
+    }
+}

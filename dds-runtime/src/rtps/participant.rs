@@ -442,7 +442,14 @@ impl Participant {
         let data = self.new_endpoint(spec, kinds)?;
         let id = data.guid.entity_id;
         let params = user_writer_params(&self.config, &data.qos.writer, keyed);
-        self.writers.insert(id, Writer::new(data.guid, params));
+        let mut writer = Writer::new(data.guid, params);
+        if let Some(original) = internal
+            .then(|| crate::rtps::writer::stand_in_for(&data.qos.writer.user_data.0))
+            .flatten()
+        {
+            writer.stand_in_for(original);
+        }
+        self.writers.insert(id, writer);
         self.user_writers.insert(id);
         if internal {
             self.mark_internal(id);
@@ -538,6 +545,7 @@ impl Participant {
         self.user_writers.remove(&id);
         self.own_leases.untrack(id);
         let guid = Guid::new(self.config.guid_prefix, id);
+        self.original_gone(guid);
         if let Some(w) = self.writers.remove(&id) {
             for r in w.matched() {
                 self.events.push_back(Event::PublicationMatched {

@@ -327,3 +327,167 @@ fn a_late_cyclone_reader_gets_the_kept_samples_then_the_final_state() {
 fn a_late_reader_of_ours_gets_the_kept_samples_then_the_final_state() {
     let _ = final_states(Prog::Ours, 't', 199);
 }
+
+/// Sorted `shape_main` sample lines of topic `topic` that `p` printed.
+fn sorted_data(p: &Proc, topic: &str) -> Vec<String> {
+    let prefix = format!("{topic:<10} ");
+    let mut v = p.grep(|l| l.starts_with(&prefix) && l.ends_with("[30]"));
+    v.sort();
+    v
+}
+
+/// The lines a reader prints for BLUE, GREEN and RED at each `x` of `xs` (y = 2x, size 30), sorted.
+fn want_lines(topic: &str, xs: std::ops::RangeInclusive<i32>) -> Vec<String> {
+    let mut v: Vec<String> = ["BLUE", "GREEN", "RED"]
+        .iter()
+        .flat_map(|c| {
+            xs.clone()
+                .map(move |x| format!("{topic:<10} {c:<10} {x:03} {:03} [30]", 2 * x))
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// Waits until `r` printed `n` sample lines of `topic`, then 2 s more for repeats that would follow.
+fn settle(r: &Proc, topic: &str, n: usize) {
+    let prefix = format!("{topic:<10} ");
+    let _ = r.wait_lines(WAIT, n, |l| l.starts_with(&prefix) && l.ends_with("[30]"));
+    std::thread::sleep(Duration::from_secs(2));
+}
+
+/// A TRANSIENT writer in this process (its participant's own service keeps its data, the writer and the
+/// service both KEEP_LAST 3) writes three samples each of BLUE, GREEN and RED on `Once`. A late `reader`
+/// (TRANSIENT_LOCAL) that joins while the writer lives matches the writer and the service's stand-in: it
+/// must print each sample exactly once (the stand-in holds it: another vendor's reader cannot drop the
+/// repeats itself), and so for a fourth sample of each written while it runs. The writer is then deleted:
+/// the first reader prints no repeat (the stand-in releases it with everything served), and a second late
+/// reader prints each kept sample (the last three of each) exactly once, from the stand-in.
+fn once_while_the_writer_lives(reader: Prog, domain: u32) -> Result<(), Skip> {
+    use dds_runtime::prelude::*;
+    require_netns()?;
+    let p = super::harness::loopback_participant(domain);
+    let depth = History::KeepLast(3);
+    let qos = DataWriterQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .durability(Durability::Transient)
+        .data_representation(DataRepresentation::xcdr1())
+        .history(depth)
+        .durability_service(DurabilityService {
+            history: depth,
+            ..DurabilityService::default()
+        })
+        .build();
+    let topic = p
+        .create_topic::<ShapeType>("Once", &TopicQos::default())
+        .expect("topic");
+    let publisher = p
+        .create_publisher(&PublisherQos::default())
+        .expect("publisher");
+    let w = publisher.create_datawriter(&topic, &qos).expect("writer");
+    let write = |xs: std::ops::RangeInclusive<i32>| {
+        for x in xs {
+            for color in ["BLUE", "GREEN", "RED"] {
+                let s = ShapeType {
+                    color: color.into(),
+                    x,
+                    y: 2 * x,
+                    shapesize: 30,
+                    additional_payload_size: Vec::new(),
+                };
+                w.write(&s).expect("write");
+            }
+        }
+    };
+    write(1..=3);
+    let args = format!("-S -t Once -d {domain} -r -D l -k 0");
+    let mut first = reader.spawn("reader1", &args)?;
+    settle(&first, "Once", 9);
+    let got = sorted_data(&first, "Once");
+    check!(
+        got == want_lines("Once", 1..=3),
+        &[&first],
+        "history while the writer lives: {got:?}"
+    );
+    write(4..=4);
+    settle(&first, "Once", 12);
+    let got = sorted_data(&first, "Once");
+    check!(
+        got == want_lines("Once", 1..=4),
+        &[&first],
+        "live while the writer lives: {got:?}"
+    );
+    drop(w);
+    let mut second = reader.spawn("reader2", &args)?;
+    settle(&second, "Once", 9);
+    let got = sorted_data(&second, "Once");
+    check!(
+        got == want_lines("Once", 2..=4),
+        &[&second],
+        "after the writer: {got:?}"
+    );
+    let got = sorted_data(&first, "Once");
+    check!(
+        got == want_lines("Once", 1..=4),
+        &[&first],
+        "repeats after the writer: {got:?}"
+    );
+    let _ = first.interrupt(WAIT);
+    let _ = second.interrupt(WAIT);
+    Ok(())
+}
+
+#[test]
+fn a_cyclone_transient_local_reader_gets_each_sample_once_while_the_writer_lives() {
+    let _ = once_while_the_writer_lives(Prog::Cyclone, 117);
+}
+
+#[test]
+fn a_transient_local_reader_of_ours_gets_each_sample_once_while_the_writer_lives() {
+    let _ = once_while_the_writer_lives(Prog::Ours, 118);
+}
+
+/// `dds-durability` keeps the data of a TRANSIENT `shape_main` writer of ours (without its own service),
+/// which is killed with `kill -9`. A Cyclone TRANSIENT_LOCAL reader joins right after, while the dead
+/// writer's participant is still known (its lease, 10 s, has not expired): the stand-in holds it, since the
+/// original writer still seems to serve it, and releases it when the lease expires. It must then get the
+/// kept samples (the last of each instance: KEEP_LAST 1) from the stand-in.
+#[test]
+fn a_cyclone_reader_joining_after_a_kill_9_of_the_writer_gets_the_history() {
+    let _ = history_after_kill_9(119);
+}
+
+fn history_after_kill_9(domain: u32) -> Result<(), Skip> {
+    require_netns()?;
+    let svc = service_with(domain, None)?;
+    let mut c = Command::new(our_bin("shape_main")?);
+    c.args([
+        "-P", "-t", "Square", "-c", "BLUE", "-r", "-D", "t", "-k", "1", "-w", "-z", "0",
+    ])
+    .args(["-d", &domain.to_string()])
+    .env("DDS_DURABILITY_SERVICE", "off");
+    let writer = Proc::spawn("writer", c);
+    let enough = writer
+        .wait_lines(WAIT, 10, |l| l.starts_with("Square     BLUE"))
+        .is_some();
+    check!(enough, &[&svc, &writer], "writer did not write 10 samples");
+    std::thread::sleep(Duration::from_secs(1));
+    let written = samples(&writer, "BLUE");
+    // kill -9 (Proc's drop sends SIGKILL): the writer's participant stays known until its lease expires.
+    drop(writer);
+    let mut r = Prog::Cyclone.spawn("reader", &format!("-S -t Square -d {domain} -r -D l -k 0"))?;
+    let got_one = r
+        .wait_line(3 * WAIT, |l| l.starts_with("Square     BLUE"))
+        .is_some();
+    std::thread::sleep(Duration::from_secs(2));
+    let got = samples(&r, "BLUE");
+    check!(got_one, &[&svc, &r], "no sample from the service");
+    check!(
+        got.len() == 1,
+        &[&svc, &r],
+        "expected the last sample the service kept (of {} written and more), got {got:?}",
+        written.len()
+    );
+    let _ = r.interrupt(WAIT);
+    Ok(())
+}

@@ -446,7 +446,11 @@ impl Participant {
                     .participants
                     .get(&remote.prefix)
                     .map_or(VendorId::THIS, |p| p.vendor_id);
+                let hold = self.original_serves(id, rd, vendor);
                 if let Some(w) = self.writers.get_mut(&id) {
+                    if hold {
+                        w.hold_next(remote);
+                    }
                     let proxy = ReaderProxy::new(remote, locators, reliable)
                         .with_multicast(multicast)
                         .for_vendor(vendor);
@@ -500,6 +504,7 @@ impl Participant {
 
     /// A known endpoint of direction `Q` is gone: unmatch it from every local endpoint of the other direction.
     pub(super) fn forget_endpoint<Q: Direction>(&mut self, g: Guid) {
+        self.original_gone(g);
         Q::known_mut(self).remove(&g);
         self.readers_by_writer.remove(&g);
         for local in Q::local_peers(self) {

@@ -4,8 +4,9 @@
 //! durable reader that joins late gets the writer's history the same way.
 //!
 //! A pair keeps the wire path when intra-process delivery is off, when the writer's publisher has coherent
-//! access (coherent sets are assembled by the RTPS reader), or when the reader is reliable KEEP_ALL with
-//! `max_samples` (its back-pressure is the RTPS reader's delivery credit).
+//! access (coherent sets are assembled by the RTPS reader: test
+//! `dcps_presentation::coherent_sets_are_all_or_nothing_within_one_participant`), or when the reader is
+//! reliable KEEP_ALL with `max_samples` (its back-pressure is the RTPS reader's delivery credit).
 
 use std::time::Instant;
 

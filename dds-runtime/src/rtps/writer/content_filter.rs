@@ -4,6 +4,15 @@
 //! and hands the readers that rejected it to `Writer::write_filtered`. Such a change goes to the other
 //! readers as DATA and to a rejecting reliable reader as GAP, now and when it is repaired. Readers that
 //! joined after the write have no verdict and get the DATA (and filter it themselves).
+//!
+//! A key-only change (dispose, unregister) is never filtered. A filter is on the data (DDS 1.4 §2.2.2.3.3),
+//! and such a change has none: only the key. The reader must learn of the end of an instance whose earlier
+//! samples passed its filter, and the writer does not track which reader got which instance. Readers that
+//! filter themselves do the same (our reader applies its filter to samples with data only), so writer-side
+//! filtering changes nothing a reader sees. It also keeps both wire forms of such a change alike: the
+//! serialized key for most readers, and the key hash alone for Fast DDS readers
+//! (`ReaderProxy::key_hash_only_disposes`). A reader that never had a sample of the instance may therefore
+//! see its dispose (with our reader: a new instance, `NOT_ALIVE_DISPOSED`), as without writer-side filtering.
 
 use std::collections::BTreeMap;
 
@@ -98,6 +107,9 @@ impl super::Writer {
         };
         let mut dest = Vec::new();
         for p in self.proxies.values() {
+            if super::StandIn::excludes(&self.stand_in, &p.guid) {
+                continue;
+            }
             if c.rejected.binary_search(&p.guid).is_err() {
                 dest.extend(p.destination().first().copied());
             } else if p.reliable {

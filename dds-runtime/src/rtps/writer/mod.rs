@@ -11,6 +11,7 @@ mod local;
 mod multicast;
 mod reader_proxy;
 mod sn_map;
+mod stand_in;
 
 use coherent::CoherentState;
 pub(crate) use coherent::Marks;
@@ -20,6 +21,8 @@ pub use group::WriterGroup;
 pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use liveliness::OwnLeases;
 pub(crate) use reader_proxy::ReaderProxy;
+use stand_in::StandIn;
+pub(crate) use stand_in::{stand_in_for, user_data as stand_in_user_data, Served};
 
 use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
@@ -98,6 +101,8 @@ pub(crate) struct Writer {
     pub filters: ReaderFilters,
     /// The owner decides what the history keeps (see [`Writer::manage_history`]).
     managed: bool,
+    /// Set when this is a durability service's stand-in (see `stand_in.rs`).
+    stand_in: Option<Box<StandIn>>,
 }
 
 impl Writer {
@@ -126,6 +131,7 @@ impl Writer {
             group: None,
             filters: ReaderFilters::default(),
             managed: false,
+            stand_in: None,
         }
     }
 
@@ -209,6 +215,7 @@ impl Writer {
                 .proxies
                 .iter()
                 .filter(|(_, p)| key_hash_only.is_none_or(|k| p.key_hash_only_disposes == k))
+                .filter(|(g, _)| !StandIn::excludes(&self.stand_in, g))
                 .filter_map(|(g, p)| Some((g.prefix == own, p.data_destination()?)))
                 .collect();
             // Each locator once (a multicast group may serve our own and remote readers), remote ones first.
@@ -281,7 +288,8 @@ impl Writer {
     }
 
     /// [`Writer::write`] of a change that the content filters of the `rejected` readers refused: they get a
-    /// GAP for it (reliable ones), the others the DATA.
+    /// GAP for it (reliable ones), the others the DATA. A key-only change (dispose, unregister) passes every
+    /// filter, in both of its wire forms (see `content_filter.rs`): `rejected` is ignored for it.
     pub(crate) fn write_filtered(
         &mut self,
         now: Instant,
@@ -290,6 +298,9 @@ impl Writer {
         out: &mut Outbox,
         ev: &mut VecDeque<Event>,
     ) -> Result<SequenceNumber, WriteError> {
+        if change.kind != ChangeKind::Alive {
+            rejected.clear();
+        }
         rejected.sort_unstable();
         if self.linger_until.is_some() {
             return Err(WriteError::Deleted);
@@ -503,10 +514,11 @@ impl Writer {
     ) {
         proxy.reliable &= self.params.reliable;
         self.expire(now);
+        let held = self.hold_at_match(now, &mut proxy);
         if !(self.durable() && reader_durable) {
             proxy.floor = self.next_sn;
             proxy.acked = self.next_sn;
-        } else if !self.history.is_empty() {
+        } else if !held && !self.history.is_empty() {
             if proxy.reliable && !self.history_fits_one_push() {
                 // Announce the history; the reader asks for what it lacks.
                 proxy.repair_due = Some(now);
@@ -547,6 +559,7 @@ impl Writer {
 
     pub(crate) fn remove_proxy(&mut self, guid: &Guid, ev: &mut VecDeque<Event>) -> bool {
         self.filters.set(*guid, None);
+        self.forget_held(guid);
         let had = self.proxies.remove(guid).is_some();
         if self.proxies.is_empty() {
             self.repair_queue.clear();
@@ -708,7 +721,13 @@ impl Writer {
             frag,
             key_hash_only: p.key_hash_only_disposes,
         };
-        let served = to.serve(p, &self.history, self.params.max_repair_bytes, out);
+        let served = to.serve(
+            p,
+            &self.history,
+            &self.stand_in,
+            self.params.max_repair_bytes,
+            out,
+        );
         let more = p.has_requests();
         p.release_if_served(self.next_sn);
         let (reliable, acked) = (p.reliable, p.acked);
@@ -745,7 +764,7 @@ struct RepairTo {
 }
 
 /// What one repair round did besides sending changes.
-struct Served {
+struct RoundServed {
     /// Requested changes that are gone (or not for this reader): answered with GAP.
     gaps: Vec<SequenceNumber>,
     /// Fragmented samples sent, with their number of fragments: each is followed by a HEARTBEAT_FRAG.
@@ -760,11 +779,12 @@ impl RepairTo {
         &self,
         p: &mut ReaderProxy,
         history: &HistoryCache,
+        stand_in: &Option<Box<StandIn>>,
         max_bytes: usize,
         out: &mut Outbox,
-    ) -> Served {
+    ) -> RoundServed {
         let mut budget = max_bytes as isize;
-        let mut served = Served {
+        let mut served = RoundServed {
             gaps: Vec::new(),
             fragmented: Vec::new(),
             idle: false,
@@ -774,7 +794,11 @@ impl RepairTo {
                 break;
             };
             match history.get(sn) {
-                Some(c) if sn >= p.floor && c.rejected.binary_search(&self.reader).is_err() => {
+                Some(c)
+                    if sn >= p.floor
+                        && c.rejected.binary_search(&self.reader).is_err()
+                        && !StandIn::served(stand_in, &self.reader, c) =>
+                {
                     self.resend(c, None, &mut served, out);
                     budget -= c.payload.len() as isize + 64;
                 }
@@ -799,7 +823,7 @@ impl RepairTo {
         &self,
         c: &CacheChange,
         only: Option<&BitWindow>,
-        served: &mut Served,
+        served: &mut RoundServed,
         out: &mut Outbox,
     ) {
         let n = send_change(
