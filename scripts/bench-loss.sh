@@ -63,7 +63,7 @@ run() {
   echo $! >>"$tmp/pids"
   local sub=$!
   sleep 1
-  ip netns exec "$b" env DDS_INTERFACE="$iface_b" CYCLONEDDS_URI="${uri/IF/$iface_b}" \
+  ip netns exec "$b" env ${PUB_ENV:-} DDS_INTERFACE="$iface_b" CYCLONEDDS_URI="${uri/IF/$iface_b}" \
     "$prog" -D "$secs" pub "${rate}Hz" size "$size" >"$tmp/pub" 2>&1 || true
   wait "$sub" || true
   local got timeouts

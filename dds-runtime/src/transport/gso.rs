@@ -3,8 +3,9 @@
 //! A fragmented sample is such a run: on loopback the receiver then finds all of its datagrams queued at
 //! once (one wake-up, one `recvmmsg`) instead of waking for each `sendto`.
 //!
-//! Kernels or devices that refuse (`EIO`, `EINVAL`, `ENOPROTOOPT`, `EOPNOTSUPP`) turn it off for the
-//! socket's lifetime; the caller then sends one datagram per call.
+//! Kernels or devices that refuse (`EIO`, `ENOPROTOOPT`, `EOPNOTSUPP`) turn it off for the socket's
+//! lifetime; a path whose MTU is below the datagram size (`EMSGSIZE`, or `EINVAL` on older kernels) turns it
+//! off for that destination. The caller then sends one datagram per call, which the kernel fragments.
 
 use std::io;
 use std::net::{SocketAddr, UdpSocket};
@@ -14,11 +15,12 @@ use std::sync::Mutex;
 
 use socket2::SockAddr;
 
-/// Destinations refused by `EINVAL` remembered before segmentation is turned off altogether.
+/// Destinations refused for their MTU remembered before segmentation is turned off altogether.
 const MAX_REFUSED: usize = 64;
 
-/// Whether segmented sends are tried, and to which destinations. `EINVAL` is what a path whose MTU is
-/// below the datagram size gives (the kernel does not segment into IP fragments): that destination keeps
+/// Whether segmented sends are tried, and to which destinations. A path whose MTU is below the datagram
+/// size refuses (the kernel does not segment into IP fragments): `EMSGSIZE` (Linux 5.x and later, as on a
+/// veth pair of MTU 1500 between network namespaces) or `EINVAL` (older kernels). That destination keeps
 /// one send per datagram. Any other refusal turns segmentation off.
 #[derive(Debug)]
 pub(super) struct GsoState {
@@ -45,7 +47,7 @@ impl GsoState {
 
     pub(super) fn refused(&self, dest: SocketAddr, e: &io::Error) {
         let mut refused = self.refused.lock().unwrap_or_else(|e| e.into_inner());
-        if e.raw_os_error() == Some(libc::EINVAL) && refused.len() < MAX_REFUSED {
+        if too_big(e) && refused.len() < MAX_REFUSED {
             tracing::debug!(%dest, error = %e, "no segmented sends to this destination");
             refused.push(dest);
         } else {
@@ -133,13 +135,19 @@ pub(super) fn send_segments(
     }
 }
 
-/// Whether an error of [`send_segments`] says the kernel or the device cannot segment (turn it off), as
-/// opposed to an ordinary send failure.
+/// Whether an error of [`send_segments`] says the kernel, the device or the path cannot segment this run
+/// (send its datagrams one by one), as opposed to an ordinary send failure.
 pub(super) fn unsupported(e: &io::Error) -> bool {
-    matches!(
-        e.raw_os_error(),
-        Some(libc::EIO | libc::EINVAL | libc::ENOPROTOOPT | libc::EOPNOTSUPP)
-    )
+    too_big(e)
+        || matches!(
+            e.raw_os_error(),
+            Some(libc::EIO | libc::ENOPROTOOPT | libc::EOPNOTSUPP)
+        )
+}
+
+/// The segments are larger than the path's MTU allows.
+fn too_big(e: &io::Error) -> bool {
+    matches!(e.raw_os_error(), Some(libc::EMSGSIZE | libc::EINVAL))
 }
 
 #[cfg(test)]
@@ -160,6 +168,40 @@ mod tests {
         let tiny = [0u8; 10];
         let many: Vec<&[u8]> = (0..100).map(|_| &tiny[..]).collect();
         assert_eq!(run_len(&many), MAX_SEGMENTS);
+    }
+
+    /// A route of MTU 1400 (made inside the private namespace the suite runs in, `scripts/isolated`): a
+    /// segmented send of larger datagrams is refused as too big for that destination only, and the
+    /// datagrams then go one by one.
+    #[test]
+    fn segments_above_the_path_mtu_are_refused_for_that_destination_only() {
+        // A local route of its own for one loopback address: other tests' traffic keeps lo's MTU.
+        let route = "route replace local 127.0.0.77/32 dev lo mtu lock 1400 table local";
+        let made = std::process::Command::new("ip")
+            .args(route.split(' '))
+            .status();
+        if !made.is_ok_and(|s| s.success()) {
+            eprintln!("skipped: cannot add a route of MTU 1400 here (run under scripts/isolated, as root)");
+            return;
+        }
+        let rx = UdpSocket::bind("127.0.0.77:0").unwrap();
+        let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let dest = rx.local_addr().unwrap();
+        let payloads: [&[u8]; 3] = [&[1; 2000], &[2; 2000], &[3; 500]];
+        let e = send_segments(&tx, &payloads, dest).unwrap_err();
+        assert!(unsupported(&e), "{e}");
+        let state = GsoState::new(true);
+        state.refused(dest, &e);
+        assert!(!state.allows(dest));
+        assert!(state.allows("127.0.0.1:7400".parse().unwrap()));
+        for p in payloads {
+            tx.send_to(p, dest).unwrap();
+        }
+        let mut buf = [0u8; 4000];
+        for p in payloads {
+            let n = rx.recv(&mut buf).unwrap();
+            assert_eq!(&buf[..n], p);
+        }
     }
 
     #[test]
