@@ -77,17 +77,22 @@ fn write(sim: &mut Sim, w: EntityId, i: u32) {
         .unwrap();
 }
 
+/// A reliable, transient-local, keep-all writer: late joiners get its history.
+fn writer_qos() -> DataWriterQos {
+    DataWriterQos::builder()
+        .reliability(Reliability::RELIABLE)
+        .durability(Durability::TransientLocal)
+        .history(History::KeepAll)
+        .build()
+}
+
 #[test]
 fn writer_skips_readers_whose_filter_rejects_and_filters_late_joiners_from_then_on() {
     for seed in 0..20 {
         let mut sim = Sim::with_participants(seed, Faults::lossy(0.2), 4);
         sim.faults_on_discovery = false;
         let now = sim.now;
-        let wq = DataWriterQos::builder()
-            .reliability(Reliability::RELIABLE)
-            .durability(Durability::TransientLocal)
-            .history(History::KeepAll)
-            .build();
+        let wq = writer_qos();
         let w = sim.nodes[0]
             .p
             .create_writer(now, WriterSpec::new("T", "M::Tick", false, wq))
@@ -158,11 +163,7 @@ fn key_only_changes_reach_every_filtering_reader_in_both_wire_forms() {
     sim.add(config(1).vendor_id(VendorId::FASTDDS));
     sim.add(config(2));
     let now = sim.now;
-    let wq = DataWriterQos::builder()
-        .reliability(Reliability::RELIABLE)
-        .durability(Durability::TransientLocal)
-        .history(History::KeepAll)
-        .build();
+    let wq = writer_qos();
     let w = sim.nodes[0]
         .p
         .create_writer(now, WriterSpec::new("T", "M::Tick", true, wq))

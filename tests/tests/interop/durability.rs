@@ -122,18 +122,7 @@ fn kill_test(domain: u32) -> Result<(), Skip> {
     let store = dir.join("domain.redb");
     let _ = std::fs::remove_file(&store);
     let svc = service(domain, &store)?;
-    // The writer runs without its own in-process service: only dds-durability keeps its data.
-    let mut c = Command::new(our_bin("shape_main")?);
-    c.args([
-        "-P", "-t", "Square", "-c", "GREEN", "-r", "-D", "p", "-k", "0", "-w", "-z", "0",
-    ])
-    .args(["-d", &domain.to_string()])
-    .env("DDS_DURABILITY_SERVICE", "off");
-    let writer = Proc::spawn("writer", c);
-    let enough = writer
-        .wait_lines(WAIT, 30, |l| l.starts_with("Square     GREEN"))
-        .is_some();
-    check!(enough, &[&svc, &writer], "writer did not write 30 samples");
+    let writer = serviceless_writer(domain, "GREEN", "p", "0", 30, &svc)?;
     // kill -9 the writer (Proc's drop sends SIGKILL), keeping what it printed before.
     let written = samples(&writer, "GREEN");
     drop(writer);
@@ -460,17 +449,7 @@ fn a_cyclone_reader_joining_after_a_kill_9_of_the_writer_gets_the_history() {
 fn history_after_kill_9(domain: u32) -> Result<(), Skip> {
     require_netns()?;
     let svc = service_with(domain, None)?;
-    let mut c = Command::new(our_bin("shape_main")?);
-    c.args([
-        "-P", "-t", "Square", "-c", "BLUE", "-r", "-D", "t", "-k", "1", "-w", "-z", "0",
-    ])
-    .args(["-d", &domain.to_string()])
-    .env("DDS_DURABILITY_SERVICE", "off");
-    let writer = Proc::spawn("writer", c);
-    let enough = writer
-        .wait_lines(WAIT, 10, |l| l.starts_with("Square     BLUE"))
-        .is_some();
-    check!(enough, &[&svc, &writer], "writer did not write 10 samples");
+    let writer = serviceless_writer(domain, "BLUE", "t", "1", 10, &svc)?;
     std::thread::sleep(Duration::from_secs(1));
     let written = samples(&writer, "BLUE");
     // kill -9 (Proc's drop sends SIGKILL): the writer's participant stays known until its lease expires.
@@ -490,4 +469,30 @@ fn history_after_kill_9(domain: u32) -> Result<(), Skip> {
     );
     let _ = r.interrupt(WAIT);
     Ok(())
+}
+
+/// Our `shape_main` writing `color` (durability `kind`, history depth `depth`, 0 for keep-all) without an
+/// in-process service, so that only the `dds-durability` of `svc` keeps its data; returned once it has
+/// printed `n` samples.
+fn serviceless_writer(
+    domain: u32,
+    color: &str,
+    kind: &str,
+    depth: &str,
+    n: usize,
+    svc: &Proc,
+) -> Result<Proc, Skip> {
+    let mut c = Command::new(our_bin("shape_main")?);
+    c.args([
+        "-P", "-t", "Square", "-c", color, "-r", "-D", kind, "-k", depth,
+    ])
+    .args(["-w", "-z", "0", "-d", &domain.to_string()])
+    .env("DDS_DURABILITY_SERVICE", "off");
+    let writer = Proc::spawn("writer", c);
+    let prefix = format!("Square     {color}");
+    let enough = writer
+        .wait_lines(WAIT, n, |l| l.starts_with(&prefix))
+        .is_some();
+    check!(enough, &[svc, &writer], "writer did not write {n} samples");
+    Ok(writer)
 }
