@@ -21,8 +21,10 @@ pub use group::WriterGroup;
 pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use liveliness::OwnLeases;
 pub(crate) use reader_proxy::ReaderProxy;
+#[cfg(feature = "net")]
+pub(crate) use stand_in::user_data as stand_in_user_data;
 use stand_in::StandIn;
-pub(crate) use stand_in::{stand_in_for, user_data as stand_in_user_data, Served};
+pub(crate) use stand_in::{stand_in_for, Served};
 
 use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};

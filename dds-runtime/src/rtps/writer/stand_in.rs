@@ -21,6 +21,7 @@ use crate::rtps::types::{Guid, Time};
 const PREFIX: &[u8] = b"dds-rs durability stand-in for ";
 
 /// The USER_DATA of a stand-in for `original`.
+#[cfg(feature = "net")]
 pub(crate) fn user_data(original: &Guid) -> Vec<u8> {
     let mut v = PREFIX.to_vec();
     v.extend_from_slice(&original.to_bytes());
