@@ -326,37 +326,8 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
             } else {
                 String::new()
             };
-            match c {
-                '1' => o.substat_every_second = true,
-                'c' => o.collect_stats = true,
-                'X' => o.extended_stats = true,
-                'l' => o.sublatency = true,
-                'L' => o.match_local = true,
-                'u' => o.reliable = false,
-                'h' => return Ok(PerfCommand::Usage { requested: true }),
-                'd' => return err(format!("-d {val}: network load reporting not supported")),
-                'D' => o.duration = parse_seconds(&val),
-                'i' => {
-                    o.domain_id = Some(
-                        val.parse()
-                            .map_err(|_| ArgError(format!("-i {val}: invalid domain id")))?,
-                    )
-                }
-                'n' => o.nkeyvals = val.parse().unwrap_or(0),
-                'k' => {
-                    o.history_depth = if val == "all" {
-                        0
-                    } else {
-                        val.parse::<i64>().unwrap_or(0).clamp(0, 1 << 30) as u32
-                    }
-                }
-                'T' => {
-                    o.topic = TopicSel::parse(&val)
-                        .ok_or_else(|| ArgError(format!("-T {val}: unknown topic")))?
-                }
-                'Q' => parse_criterion(&mut o, &val)?,
-                'R' | 'K' | 'W' => {}
-                _ => return err(format!("invalid option -- '{c}'")),
+            if let Some(usage) = set_option(&mut o, c, &val)? {
+                return Ok(usage);
             }
         }
     }
@@ -376,6 +347,48 @@ pub fn parse(args: &[String]) -> Result<PerfCommand, ArgError> {
     } else {
         parse_modes(&mut o, modes)?;
     }
+    checked(o)
+}
+
+/// One short option (`c`, with its value `val` when it takes one) of the getopt string; `Some` when it asks for
+/// the usage text.
+fn set_option(o: &mut PerfOptions, c: char, val: &str) -> Result<Option<PerfCommand>, ArgError> {
+    match c {
+        '1' => o.substat_every_second = true,
+        'c' => o.collect_stats = true,
+        'X' => o.extended_stats = true,
+        'l' => o.sublatency = true,
+        'L' => o.match_local = true,
+        'u' => o.reliable = false,
+        'h' => return Ok(Some(PerfCommand::Usage { requested: true })),
+        'd' => return err(format!("-d {val}: network load reporting not supported")),
+        'D' => o.duration = parse_seconds(val),
+        'i' => {
+            o.domain_id = Some(
+                val.parse()
+                    .map_err(|_| ArgError(format!("-i {val}: invalid domain id")))?,
+            )
+        }
+        'n' => o.nkeyvals = val.parse().unwrap_or(0),
+        'k' => {
+            o.history_depth = if val == "all" {
+                0
+            } else {
+                val.parse::<i64>().unwrap_or(0).clamp(0, 1 << 30) as u32
+            }
+        }
+        'T' => {
+            o.topic =
+                TopicSel::parse(val).ok_or_else(|| ArgError(format!("-T {val}: unknown topic")))?
+        }
+        'Q' => parse_criterion(o, val)?,
+        'R' | 'K' | 'W' => {}
+        _ => return err(format!("invalid option -- '{c}'")),
+    }
+    Ok(None)
+}
+/// The options' consistency checks (ddsperf's), and the KS baggage less its fixed part.
+fn checked(mut o: PerfOptions) -> Result<PerfCommand, ArgError> {
     if o.nkeyvals == 0 {
         o.nkeyvals = 1;
     }
@@ -418,100 +431,126 @@ fn parse_modes(o: &mut PerfOptions, a: &[String]) -> Result<(), ArgError> {
     let mut i = 0;
     while i < a.len() {
         let mode = a[i].as_str();
-        i += 1;
+        let end = mode_end(a, i + 1, mode == "pub");
+        let args = &a[i + 1..end];
         match mode {
-            "ping" => {
-                o.ping_interval = Some(Duration::ZERO);
-                while i < a.len() && !is_mode(&a[i]) {
-                    let t = a[i].as_str();
-                    if t == "size" {
-                        let v = a.get(i + 1).ok_or_else(|| {
-                            ArgError("argument missing in size specification".into())
-                        })?;
-                        o.baggage = parse_size(v)
-                            .ok_or_else(|| ArgError(format!("{v}: invalid size specification")))?;
-                        i += 1;
-                    } else if let Some(m) = pingpong_trigger(t) {
-                        o.pingpong_trigger = m;
-                    } else if let Some(r) = parse_rate(t) {
-                        if r < 0.0 {
-                            return err(format!("{t}: invalid ping rate"));
-                        }
-                        o.ping_interval = if r == 0.0 {
-                            None
-                        } else if r.is_infinite() {
-                            Some(Duration::ZERO)
-                        } else {
-                            Some(Duration::from_secs_f64(1.0 / r))
-                        };
-                    } else {
-                        return err(format!("{t}: undefined ping mode"));
-                    }
-                    i += 1;
-                }
-            }
+            "ping" => ping_mode(o, args)?,
             "pong" => {
                 o.pong = true;
-                while i < a.len() && !is_mode(&a[i]) {
-                    let Some(m) = pingpong_trigger(&a[i]) else {
-                        return err(format!("{}: undefined pong mode", a[i]));
-                    };
-                    o.pingpong_trigger = m;
-                    i += 1;
+                for t in args {
+                    o.pingpong_trigger = pingpong_trigger(t)
+                        .ok_or_else(|| ArgError(format!("{t}: undefined pong mode")))?;
                 }
             }
             "sub" => {
                 o.sub = Some(TriggerMode::Listener);
-                while i < a.len() && !is_mode(&a[i]) {
-                    o.sub = Some(match a[i].as_str() {
+                for t in args {
+                    o.sub = Some(match t.as_str() {
                         "listener" => TriggerMode::Listener,
                         "waitset" => TriggerMode::Waitset,
                         "polling" => TriggerMode::Polling,
                         other => return err(format!("{other}: undefined subscription mode")),
                     });
-                    i += 1;
                 }
             }
-            "pub" => {
-                o.pub_rate = Some(f64::INFINITY);
-                o.burst = 1;
-                while i < a.len() && !is_mode(&a[i]) {
-                    let t = a[i].as_str();
-                    if t == "burst" || t == "size" {
-                        let v = a.get(i + 1).ok_or_else(|| {
-                            ArgError(format!("argument missing in {t} specification"))
-                        })?;
-                        let n = if t == "burst" {
-                            v.parse().ok()
-                        } else {
-                            parse_size(v)
-                        };
-                        let n =
-                            n.ok_or_else(|| ArgError(format!("{v}: invalid {t} specification")))?;
-                        if t == "burst" {
-                            o.burst = n.max(1);
-                        } else {
-                            o.baggage = n;
-                        }
-                        i += 1;
-                    } else if let Some(p) = t.strip_suffix('%') {
-                        o.ping_fraction = percent(p)?;
-                    } else if t == "ping" && a.get(i + 1).is_some_and(|n| n.ends_with('%')) {
-                        o.ping_fraction = percent(a[i + 1].trim_end_matches('%'))?;
-                        i += 1;
-                    } else if let Some(r) = parse_rate(t) {
-                        if r < 0.0 {
-                            return err(format!("{t}: invalid publish rate"));
-                        }
-                        o.pub_rate = Some(r);
-                    } else {
-                        return err(format!("{t}: unrecognised publish specification"));
-                    }
-                    i += 1;
-                }
-            }
+            "pub" => pub_mode(o, args)?,
             other => return err(format!("{other}: unrecognized argument")),
         }
+        i = end;
+    }
+    Ok(())
+}
+
+/// Where the arguments of a mode that start at `from` end: at the next mode's name. In `pub`, `ping X%`
+/// is the ping fraction, not the `ping` mode.
+fn mode_end(a: &[String], from: usize, publishing: bool) -> usize {
+    let mut i = from;
+    while i < a.len() {
+        let fraction =
+            publishing && a[i] == "ping" && a.get(i + 1).is_some_and(|n| n.ends_with('%'));
+        if fraction {
+            i += 2;
+        } else if is_mode(&a[i]) {
+            break;
+        } else {
+            i += 1;
+        }
+    }
+    i
+}
+
+/// The value after a `size` or `burst` keyword.
+fn value_of<'a>(args: &'a [String], i: usize, what: &str) -> Result<&'a str, ArgError> {
+    args.get(i + 1)
+        .map(String::as_str)
+        .ok_or_else(|| ArgError(format!("argument missing in {what} specification")))
+}
+
+/// `ping [R[Hz]] [size S] [waitset|listener]`.
+fn ping_mode(o: &mut PerfOptions, args: &[String]) -> Result<(), ArgError> {
+    o.ping_interval = Some(Duration::ZERO);
+    let mut i = 0;
+    while i < args.len() {
+        let t = args[i].as_str();
+        if t == "size" {
+            let v = value_of(args, i, "size")?;
+            o.baggage = parse_size(v)
+                .ok_or_else(|| ArgError(format!("{v}: invalid size specification")))?;
+            i += 1;
+        } else if let Some(m) = pingpong_trigger(t) {
+            o.pingpong_trigger = m;
+        } else if let Some(r) = parse_rate(t) {
+            if r < 0.0 {
+                return err(format!("{t}: invalid ping rate"));
+            }
+            o.ping_interval = if r == 0.0 {
+                None
+            } else if r.is_infinite() {
+                Some(Duration::ZERO)
+            } else {
+                Some(Duration::from_secs_f64(1.0 / r))
+            };
+        } else {
+            return err(format!("{t}: undefined ping mode"));
+        }
+        i += 1;
+    }
+    Ok(())
+}
+
+/// `pub [R[Hz]] [burst N] [size S] [[ping] X%]`.
+fn pub_mode(o: &mut PerfOptions, args: &[String]) -> Result<(), ArgError> {
+    o.pub_rate = Some(f64::INFINITY);
+    o.burst = 1;
+    let mut i = 0;
+    while i < args.len() {
+        let t = args[i].as_str();
+        if t == "burst" {
+            let v = value_of(args, i, t)?;
+            let n: u32 = v
+                .parse()
+                .map_err(|_| ArgError(format!("{v}: invalid burst specification")))?;
+            o.burst = n.max(1);
+            i += 1;
+        } else if t == "size" {
+            let v = value_of(args, i, t)?;
+            o.baggage = parse_size(v)
+                .ok_or_else(|| ArgError(format!("{v}: invalid size specification")))?;
+            i += 1;
+        } else if let Some(p) = t.strip_suffix('%') {
+            o.ping_fraction = percent(p)?;
+        } else if t == "ping" && args.get(i + 1).is_some_and(|n| n.ends_with('%')) {
+            o.ping_fraction = percent(args[i + 1].trim_end_matches('%'))?;
+            i += 1;
+        } else if let Some(r) = parse_rate(t) {
+            if r < 0.0 {
+                return err(format!("{t}: invalid publish rate"));
+            }
+            o.pub_rate = Some(r);
+        } else {
+            return err(format!("{t}: unrecognised publish specification"));
+        }
+        i += 1;
     }
     Ok(())
 }
@@ -554,6 +593,11 @@ mod tests {
         assert_eq!(o.burst, 3);
         assert!((o.ping_fraction - 0.5).abs() < 1e-9);
         assert_eq!(run("pub 100Hz 10%").pub_rate, Some(100.0));
+        // `ping X%` inside `pub` is the ping fraction, not the `ping` mode.
+        let o = run("pub 100Hz ping 20% sub");
+        assert!((o.ping_fraction - 0.2).abs() < 1e-9);
+        assert_eq!(o.ping_interval, None);
+        assert_eq!(o.sub, Some(TriggerMode::Listener));
     }
 
     #[test]
