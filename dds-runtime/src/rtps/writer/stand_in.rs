@@ -183,7 +183,7 @@ impl super::Writer {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "net"))]
 mod tests {
     use super::*;
     use crate::rtps::{EntityId, GuidPrefix};
