@@ -6,6 +6,8 @@
 //! sample still held, as the reader cache does, instead of arriving as a sample of its own). Against Fast DDS
 //! 2.9, which announces no type information, `dds typeof` says so and `dds subscribe --idl` works.
 
+use std::ffi::OsStr;
+use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
@@ -182,22 +184,7 @@ fn dds_typeof_and_subscribe_through_type_discovery() {
         &[&p],
         "typeof printed: {idl}"
     );
-    let out = Command::new(&bin)
-        .args([
-            "subscribe",
-            "Square",
-            "--ndjson",
-            "-n",
-            "3",
-            "--timeout",
-            "20",
-        ])
-        .args(["--domain", &domain])
-        .output()
-        .expect("running dds");
-    let text = String::from_utf8_lossy(&out.stdout).to_string();
-    check!(out.status.success(), &[&p], "dds subscribe failed: {out:?}");
-    let rows = ndjson_rows(&text);
+    let (rows, text) = three_squares(&bin, &domain, &[], &p);
     check!(
         rows.len() == 3 && rows.iter().all(|r| r["color"] == "RED"),
         &[&p],
@@ -211,26 +198,13 @@ fn dds_subscribe_idl_prints_cyclone_samples() {
     let Ok((mut p, _)) = peer() else { return };
     let Ok(bin) = our_bin("dds") else { return };
     let idl = idl_file();
-    let out = Command::new(bin)
-        .args([
-            "subscribe",
-            "Square",
-            "--ndjson",
-            "-n",
-            "3",
-            "--timeout",
-            "20",
-            "--filter",
-            "x >= 0",
-        ])
-        .arg("--idl")
-        .arg(&idl)
-        .args(["--domain", &DOMAIN.to_string()])
-        .output()
-        .expect("running dds");
-    let text = String::from_utf8_lossy(&out.stdout).to_string();
-    check!(out.status.success(), &[&p], "dds subscribe failed: {out:?}");
-    let rows = ndjson_rows(&text);
+    let extra = [
+        "--filter".as_ref(),
+        "x >= 0".as_ref(),
+        "--idl".as_ref(),
+        idl.as_os_str(),
+    ];
+    let (rows, text) = three_squares(&bin, &DOMAIN.to_string(), &extra, &p);
     check!(rows.len() == 3, &[&p], "three samples expected: {text}");
     for r in &rows {
         let x = r["x"].as_i64().unwrap_or(-1);
@@ -348,6 +322,32 @@ fn dds_subscribe_shows_disposes_that_marked_held_samples() {
 }
 
 /// The JSON documents of `dds subscribe --ndjson` output, one per line (other lines skipped).
+/// `dds subscribe Square --ndjson -n 3 --timeout 20` on `domain`, with `extra` arguments: the rows it printed
+/// and its whole output, once it has exited successfully (`peer` is dumped if not).
+fn three_squares(bin: &Path, domain: &str, extra: &[&OsStr], peer: &Proc) -> (Vec<Value>, String) {
+    let out = Command::new(bin)
+        .args([
+            "subscribe",
+            "Square",
+            "--ndjson",
+            "-n",
+            "3",
+            "--timeout",
+            "20",
+        ])
+        .args(extra)
+        .args(["--domain", domain])
+        .output()
+        .expect("running dds");
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    check!(
+        out.status.success(),
+        &[peer],
+        "dds subscribe failed: {out:?}"
+    );
+    (ndjson_rows(&text), text)
+}
+
 fn ndjson_rows(text: &str) -> Vec<Value> {
     text.lines()
         .filter_map(|l| serde_json::from_str(l).ok())
@@ -481,24 +481,8 @@ fn dds_against_fastdds_needs_idl_and_works_with_it() {
         &[&p],
         "dds typeof against Fast DDS: {typeof_:?}"
     );
-    let out = Command::new(&bin)
-        .args([
-            "subscribe",
-            "Square",
-            "--ndjson",
-            "-n",
-            "3",
-            "--timeout",
-            "20",
-        ])
-        .arg("--idl")
-        .arg(root().join("idl/shapes.idl"))
-        .args(["--domain", &domain])
-        .output()
-        .expect("running dds");
-    let text = String::from_utf8_lossy(&out.stdout).to_string();
-    check!(out.status.success(), &[&p], "dds subscribe failed: {out:?}");
-    let rows = ndjson_rows(&text);
+    let idl = root().join("idl/shapes.idl");
+    let (rows, text) = three_squares(&bin, &domain, &["--idl".as_ref(), idl.as_os_str()], &p);
     check!(
         rows.len() == 3
             && rows
