@@ -84,10 +84,7 @@ impl<V> SnMap<V> {
             self.slots.get_mut(i)?.take()?
         };
         self.len -= 1;
-        while matches!(self.slots.front(), Some(None)) {
-            self.slots.pop_front();
-            self.base += 1;
-        }
+        self.trim_front();
         while matches!(self.slots.back(), Some(None)) {
             self.slots.pop_back();
         }
@@ -110,6 +107,11 @@ impl<V> SnMap<V> {
         self.len -= gone;
         self.slots.drain(..n);
         self.base += n as i64;
+        self.trim_front();
+    }
+
+    /// Drops the empty slots at the front: the ring starts at its lowest value.
+    fn trim_front(&mut self) {
         while matches!(self.slots.front(), Some(None)) {
             self.slots.pop_front();
             self.base += 1;
