@@ -228,7 +228,9 @@ impl Participant {
         let mut dest = self.config.metatraffic_multicast.clone();
         dest.extend(self.config.initial_peers.iter().copied());
         for p in self.participants.values() {
-            dest.extend(p.data().metatraffic_unicast.first().copied());
+            // Its first metatraffic unicast locator, from the list kept decoded (which holds its multicast
+            // ones instead when it announced no unicast one): no decoding of its announcement per period.
+            dest.extend(p.metatraffic.first().filter(|l| !l.is_multicast()).copied());
         }
         dest.sort();
         dest.dedup();
