@@ -184,28 +184,82 @@ fn default_of(c: &Container, f: &Field) -> TokenStream {
     }
 }
 
-/// A struct's `CdrType::decode`: members by id (mutable) or in order.
-pub(super) fn struct_decode(c: &Container, ext: Ext) -> TokenStream {
+/// A struct's `CdrType::decode`: members by id (mutable), through the partial struct (a derived struct, or a
+/// key-only payload), or in order straight into the struct.
+pub(super) fn struct_decode(c: &Container, s: &Struct) -> TokenStream {
     let cdr = c.cdr();
-    let ext_t = ext_tokens(c, ext);
+    let ext_t = ext_tokens(c, s.ext);
+    let partial = quote! {
+        let mut st = #cdr::members::begin_decode(r, #ext_t)?;
+        let mut p = <<Self as #cdr::StructMembers>::Partial as ::core::default::Default>::default();
+        if #ext_t == #cdr::Extensibility::Mutable {
+            while let ::core::option::Option::Some(m) = st.next_member(r)? {
+                if <Self as #cdr::StructMembers>::decode_member_by_id(r, m.id, &mut p)? {
+                    #cdr::members::end_member(r, m);
+                } else {
+                    #cdr::members::skip_member(r, m)?;
+                }
+            }
+        } else {
+            <Self as #cdr::StructMembers>::decode_members_in_order(r, &st, &mut p)?;
+        }
+        st.end(r);
+        ::core::result::Result::Ok(<Self as #cdr::StructMembers>::finish(p))
+    };
+    let body = if s.ext == Ext::Mutable || s.base.is_some() {
+        partial
+    } else {
+        let direct = decode_direct(c, s);
+        quote! {
+            if r.key_only() {
+                #partial
+            } else {
+                #direct
+            }
+        }
+    };
     quote! {
         fn decode(r: &mut #cdr::CdrReader<'_>) -> ::core::result::Result<Self, #cdr::DecodeError> {
-            let mut st = #cdr::members::begin_decode(r, #ext_t)?;
-            let mut p = <<Self as #cdr::StructMembers>::Partial as ::core::default::Default>::default();
-            if #ext_t == #cdr::Extensibility::Mutable {
-                while let ::core::option::Option::Some(m) = st.next_member(r)? {
-                    if <Self as #cdr::StructMembers>::decode_member_by_id(r, m.id, &mut p)? {
-                        #cdr::members::end_member(r, m);
-                    } else {
-                        #cdr::members::skip_member(r, m)?;
-                    }
-                }
-            } else {
-                <Self as #cdr::StructMembers>::decode_members_in_order(r, &st, &mut p)?;
-            }
-            st.end(r);
-            ::core::result::Result::Ok(<Self as #cdr::StructMembers>::finish(p))
+            #body
         }
+    }
+}
+
+/// A final or appendable struct without a base decoded member by member into locals, then built: no partial
+/// struct of `Option`s to fill and unwrap. A member an older appendable sample lacks gets its default.
+fn decode_direct(c: &Container, s: &Struct) -> TokenStream {
+    let cdr = c.cdr();
+    let ext_t = ext_tokens(c, s.ext);
+    let local = |i: usize| format_ident!("__dds_m{}", i);
+    let reads = s.fields.iter().enumerate().map(|(i, f)| {
+        let (v, ty, inner) = (local(i), f.ty, f.inner);
+        let d = default_of(c, f);
+        let bound = bound_limit(f.attrs.bound.as_ref());
+        if f.attrs.non_serialized {
+            quote!(let #v = ::core::default::Default::default();)
+        } else if f.optional {
+            quote!(let #v = if st.has_more(r) {
+                #cdr::members::decode_optional::<#inner>(r, #bound)?
+            } else {
+                #d
+            };)
+        } else {
+            quote!(let #v = if st.has_more(r) {
+                <#ty as #cdr::CdrType>::decode_bounded(r, #bound)?
+            } else {
+                #d
+            };)
+        }
+    });
+    let fields = s.fields.iter().enumerate().map(|(i, f)| {
+        let (ident, v) = (f.ident, local(i));
+        quote!(#ident: #v,)
+    });
+    quote! {
+        let st = #cdr::members::begin_decode(r, #ext_t)?;
+        #(#reads)*
+        st.end(r);
+        ::core::result::Result::Ok(Self { #(#fields)* })
     }
 }
 

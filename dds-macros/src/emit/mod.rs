@@ -61,7 +61,7 @@ fn struct_impls(c: &Container, s: &Struct) -> TokenStream {
     let key_has_mutable = key::struct_key_has_mutable(c, s, &m);
     let next_id = layout::next_member_id(c, s);
     let encode = encode::struct_encode(c, s.ext);
-    let decode = decode::struct_decode(c, s.ext);
+    let decode = decode::struct_decode(c, s);
     let decode_in_place = decode::struct_decode_in_place(c, s);
     let default_value = decode::struct_default_value(c, s);
     let key_max_end = key::struct_key_max_end(c, s.ext);

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use super::error::{DecodeError, DecodeErrorKind, EncodeError};
 use super::header::XcdrVersion;
-use super::reader::CdrReader;
+use super::reader::{CdrReader, Limit};
 use super::traits::{CdrType, Layout};
 use super::writer::CdrWriter;
 
@@ -194,8 +194,11 @@ pub(crate) fn decode_seq<T: CdrType>(
     r: &mut CdrReader<'_>,
     bound: usize,
 ) -> Result<Vec<T>, DecodeError> {
-    let mut v = Vec::new();
-    decode_seq_in_place(&mut v, r, bound)?;
+    let (limit, n) = seq_header::<T>(r, bound)?;
+    // Sized once: a fresh `Vec` grown by `reserve` takes the allocator's slower growth path.
+    let mut v = Vec::with_capacity(capacity_for::<T>(n, r.remaining()));
+    T::decode_into(&mut v, n, r)?;
+    seq_end(r, limit);
     Ok(v)
 }
 
@@ -206,18 +209,7 @@ pub(crate) fn decode_seq_in_place<T: CdrType>(
     r: &mut CdrReader<'_>,
     bound: usize,
 ) -> Result<(), DecodeError> {
-    let limit = if !T::LAYOUT.is_primitive() && r.is_xcdr2() {
-        r.enter("sequence")?;
-        let len = r.read_u32("sequence DHEADER")? as usize;
-        Some(r.begin_limit(len, "sequence DHEADER")?)
-    } else {
-        None
-    };
-    let at = r.offset();
-    let n = r.read_count(T::MIN_SIZE, "sequence length")?;
-    if n > bound {
-        return Err(bound_error(r, at, "sequence within its bound", n, bound));
-    }
+    let (limit, n) = seq_header::<T>(r, bound)?;
     // Primitives are copied in bulk; other elements are decoded over the ones already there.
     let keep = if T::LAYOUT.is_primitive() {
         0
@@ -230,11 +222,38 @@ pub(crate) fn decode_seq_in_place<T: CdrType>(
     }
     v.reserve(capacity_for::<T>(n - keep, r.remaining()));
     T::decode_into(v, n - keep, r)?;
+    seq_end(r, limit);
+    Ok(())
+}
+
+/// A sequence's DHEADER (XCDR2, non-primitive elements) and its checked length.
+#[inline(always)]
+fn seq_header<T: CdrType>(
+    r: &mut CdrReader<'_>,
+    bound: usize,
+) -> Result<(Option<Limit>, usize), DecodeError> {
+    let limit = if !T::LAYOUT.is_primitive() && r.is_xcdr2() {
+        r.enter("sequence")?;
+        let len = r.read_u32("sequence DHEADER")? as usize;
+        Some(r.begin_limit(len, "sequence DHEADER")?)
+    } else {
+        None
+    };
+    let at = r.offset();
+    let n = r.read_count(T::MIN_SIZE, "sequence length")?;
+    if n > bound {
+        return Err(bound_error(r, at, "sequence within its bound", n, bound));
+    }
+    Ok((limit, n))
+}
+
+/// Closes what [`seq_header`] opened.
+#[inline(always)]
+fn seq_end(r: &mut CdrReader<'_>, limit: Option<Limit>) {
     if let Some(l) = limit {
         r.end_limit(l);
         r.leave();
     }
-    Ok(())
 }
 
 pub(crate) fn seq_key_max_end<T: CdrType>(

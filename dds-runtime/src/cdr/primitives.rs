@@ -105,7 +105,7 @@ macro_rules! numeric {
                 Ok(a)
             }
 
-            #[inline]
+            #[inline(always)]
             fn decode_into(
                 out: &mut Vec<Self>,
                 n: usize,
