@@ -28,7 +28,11 @@ pub(crate) fn finish_payload(
         return Err(e);
     }
     let pad = (out.len() - start).wrapping_neg() & 3;
-    push_zeros(out, pad);
+    if pad != 0 {
+        // Not unconditionally: `push_zeros` reserves a word, which regrows (and copies) a buffer sized to the
+        // exact payload length.
+        push_zeros(out, pad);
+    }
     if let Some(options) = out.get_mut(start + 3) {
         *options = (*options & !3) | pad as u8;
     }

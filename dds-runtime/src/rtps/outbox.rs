@@ -170,6 +170,7 @@ impl Outbox {
         if p.buf.len() > self.max && before > p.preamble {
             // Did not fit: close the message without it (undoing the alignment padding of the previous
             // submessage) and put it first in a fresh one.
+            let spill = p.buf.len() - before;
             p.buf.truncate(before);
             if let Some((h, len)) = saved_len {
                 p.buf[h + 2..h + 4].copy_from_slice(&len);
@@ -184,6 +185,11 @@ impl Outbox {
             });
             let i = self.fresh(destinations, dst);
             let p = &mut self.pending[i];
+            // A run of submessages that fill datagrams (the fragments of a large sample): room for a full
+            // one and the submessage that will not fit, so that the buffer never regrows (and copies
+            // itself) step by step.
+            p.buf
+                .reserve((self.max + spill).saturating_sub(p.buf.len()));
             write_ts(p, ts);
             append(&mut p.buf, &mut p.last_header, sub, true);
         }

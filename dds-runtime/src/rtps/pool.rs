@@ -66,7 +66,9 @@ impl BufferPool {
                 return b;
             }
         }
-        Arc::new(Vec::with_capacity(self.last_len))
+        // A word more than the last length: encoders reserve a word for their last store and padding, and
+        // a buffer of exactly the last length would regrow, copying itself, at its very end.
+        Arc::new(Vec::with_capacity(self.last_len + 8))
     }
 
     /// A payload of the bytes `fill` appends to a pooled buffer; the pool keeps the buffer for reuse.
