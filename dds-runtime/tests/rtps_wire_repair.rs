@@ -347,9 +347,10 @@ fn repaired_key_only_changes_keep_each_readers_form() {
 // HEARTBEAT_FRAG / NACK_FRAG
 // ---------------------------------------------------------------------------------------------------------
 
-/// 10000 bytes in 1344-byte fragments: 8 fragments (more than half a datagram: not sent whole).
-const BIG: usize = 10_000;
-const FRAGS: u32 = 8;
+/// 40000 bytes in 1344-byte fragments: 30 fragments (more than half a datagram: not sent whole), ten to
+/// a DATA_FRAG with the default datagram size (14 720 bytes): DATA_FRAGs starting at fragments 1, 11 and 21.
+const BIG: usize = 40_000;
+const FRAGS: u32 = 30;
 
 fn big_sample() -> Vec<u8> {
     let mut v: Vec<u8> = (0..BIG).map(|i| (i * 7 % 251) as u8).collect();
@@ -398,9 +399,9 @@ fn heartbeat_frag_repairs_missing_fragments_without_heartbeat() {
         .p
         .write(now, w, WriteChange::alive(big_sample()))
         .unwrap();
-    // Fragments 3 and 5 are lost once; every HEARTBEAT of the writer is lost, so only HEARTBEAT_FRAG can
-    // prompt the repair.
-    let mut lost: BTreeSet<u32> = [3, 5].into();
+    // The DATA_FRAGs of fragments 1-10 and 21-30 are lost once; every HEARTBEAT of the writer is lost, so
+    // only HEARTBEAT_FRAG can prompt the repair.
+    let mut lost: BTreeSet<u32> = [1, 21].into();
     let mut hook = |from: usize, _: usize, m: &[u8]| {
         if from != 0 {
             return Some(m.to_vec());
@@ -455,18 +456,20 @@ fn heartbeat_frag_repairs_missing_fragments_without_heartbeat() {
             .fragment_number_state
             .iter()
             .collect::<Vec<_>>(),
-        [3, 5]
+        (1..=10).chain(21..=30).collect::<Vec<u32>>()
     );
     // Only the missing fragments were sent again.
-    let mut frags: Vec<u32> = from_w
+    let mut frags: Vec<(u32, u16)> = from_w
         .iter()
         .filter_map(|s| match s {
-            Submessage::DataFrag(d) if d.writer_id == w => Some(d.fragment_starting_num),
+            Submessage::DataFrag(d) if d.writer_id == w => {
+                Some((d.fragment_starting_num, d.fragments_in_submessage))
+            }
             _ => None,
         })
         .collect();
     frags.sort();
-    assert_eq!(frags, [1, 2, 3, 4, 5, 6, 7, 8]);
+    assert_eq!(frags, [(1, 10), (11, 10), (21, 10)]);
 }
 
 /// A user sample of which two fit one datagram goes whole, as one DATA (no DATA_FRAG, no HEARTBEAT_FRAG),

@@ -180,6 +180,10 @@ fn builtin_writer_params(c: &ParticipantConfig) -> WriterParams {
         nack_response_delay: c.nack_response_delay,
         fragment_size: c.fragment_size,
         whole_max: c.fragment_size,
+        frags_per_submessage: crate::rtps::writer::fragments_per_submessage(
+            c.max_message_size,
+            c.fragment_size,
+        ),
         // Discovery data is never refused.
         high_watermark: usize::MAX,
         low_watermark: usize::MAX,
@@ -200,6 +204,10 @@ fn user_writer_params(c: &ParticipantConfig, q: &DataWriterQos, keyed: bool) -> 
         nack_response_delay: c.nack_response_delay,
         fragment_size: c.fragment_size,
         whole_max: crate::rtps::writer::whole_sample_max(c.max_message_size, c.fragment_size),
+        frags_per_submessage: crate::rtps::writer::fragments_per_submessage(
+            c.max_message_size,
+            c.fragment_size,
+        ),
         high_watermark: c.whc_high_watermark.max(1),
         low_watermark: c.whc_low_watermark.min(c.whc_high_watermark),
         max_repair_bytes: c.max_repair_bytes,

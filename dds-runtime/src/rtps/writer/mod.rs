@@ -54,6 +54,8 @@ pub(crate) struct WriterParams {
     /// Largest sample sent whole, as one DATA; larger ones go as DATA_FRAGs of `fragment_size`. At least
     /// `fragment_size` (see [`whole_sample_max`]).
     pub whole_max: usize,
+    /// Consecutive fragments carried by one DATA_FRAG (see [`fragments_per_submessage`]).
+    pub frags_per_submessage: usize,
     pub high_watermark: usize,
     pub low_watermark: usize,
     pub max_repair_bytes: usize,
@@ -166,6 +168,7 @@ impl Writer {
         Fragmenting {
             size: self.params.fragment_size,
             whole_max: self.params.whole_max,
+            per_submessage: self.params.frags_per_submessage.max(1),
         }
     }
 
@@ -933,11 +936,25 @@ pub(crate) fn whole_sample_max(max_message_size: usize, fragment_size: usize) ->
     (max_message_size.saturating_sub(WHOLE_HEADROOM) / 2).max(fragment_size)
 }
 
-/// How a writer cuts a sample: whole up to `whole_max` bytes, else in fragments of `size`.
+/// How many consecutive fragments of `fragment_size` one DATA_FRAG carries: as many as fill a datagram of
+/// `max_message_size` with the headers around them, within a submessage's 16-bit length. One fragment per
+/// submessage made a 4 MiB sample 3 121 DATA_FRAGs, each decoded, looked up and reassembled on its own; ten
+/// per submessage (Cyclone's defaults, 14 720 and 1 344 bytes) make 313. Every reader takes any count
+/// (DDSI-RTPS 2.5, 8.3.7.3).
+pub(crate) fn fragments_per_submessage(max_message_size: usize, fragment_size: usize) -> usize {
+    let room = max_message_size
+        .min(usize::from(u16::MAX))
+        .saturating_sub(WHOLE_HEADROOM);
+    (room / fragment_size.max(1)).clamp(1, usize::from(u16::MAX))
+}
+
+/// How a writer cuts a sample: whole up to `whole_max` bytes, else in fragments of `size`, sent
+/// `per_submessage` consecutive ones to a DATA_FRAG.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Fragmenting {
     pub size: usize,
     pub whole_max: usize,
+    pub per_submessage: usize,
 }
 
 /// Sends one change as DATA, or as DATA_FRAGs (all, or the listed fragments) when larger than
@@ -993,20 +1010,18 @@ pub(crate) fn send_change(
         out.push(dest, dst, ts, &d);
         return 0;
     }
-    let frag = frag.size;
+    let (per, frag) = (frag.per_submessage as u32, frag.size);
     let total = len.div_ceil(frag) as u32;
-    let mut send = |f: u32| {
-        if f == 0 || f > total {
-            return;
-        }
+    // `n` fragments from `f` (both checked against the sample) in one DATA_FRAG.
+    let send = |f: u32, n: u32| {
         let start = (f as usize - 1) * frag;
-        let end = (start + frag).min(len);
+        let end = (start + n as usize * frag).min(len);
         let d = Submessage::DataFrag(DataFrag {
             reader_id: rid,
             writer_id: wid,
             writer_sn: c.sn,
             fragment_starting_num: f,
-            fragments_in_submessage: 1,
+            fragments_in_submessage: n as u16,
             fragment_size: frag as u16,
             sample_size: len as u32,
             inline_qos,
@@ -1016,9 +1031,62 @@ pub(crate) fn send_change(
         });
         out.push(dest, dst, ts, &d);
     };
-    match only {
-        Some(set) => set.iter().for_each(|f| send(u32::try_from(f).unwrap_or(0))),
-        None => (1..=total).for_each(send),
+    let requested = only.map(|set| {
+        set.iter()
+            .filter_map(|f| u32::try_from(f).ok())
+            .filter(|&f| f >= 1 && f <= total)
+    });
+    match requested {
+        Some(fs) => for_runs(fs, per, send),
+        None => for_runs(1..=total, per, send),
     }
     total
+}
+
+/// Calls `f(first, count)` for each run of consecutive numbers in the ascending `nums`, runs cut at `max`.
+fn for_runs(nums: impl Iterator<Item = u32>, max: u32, mut f: impl FnMut(u32, u32)) {
+    let mut run: Option<(u32, u32)> = None;
+    for x in nums {
+        match run {
+            Some((first, n)) if x == first + n && n < max => run = Some((first, n + 1)),
+            _ => {
+                if let Some((first, n)) = run {
+                    f(first, n);
+                }
+                run = Some((x, 1));
+            }
+        }
+    }
+    if let Some((first, n)) = run {
+        f(first, n);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{for_runs, fragments_per_submessage};
+
+    fn runs(nums: &[u32], max: u32) -> Vec<(u32, u32)> {
+        let mut v = Vec::new();
+        for_runs(nums.iter().copied(), max, |f, n| v.push((f, n)));
+        v
+    }
+
+    #[test]
+    fn requested_fragments_go_in_runs_of_consecutive_numbers() {
+        assert_eq!(runs(&[], 10), []);
+        assert_eq!(runs(&[3, 5], 10), [(3, 1), (5, 1)]);
+        assert_eq!(runs(&[1, 2, 3, 7, 8], 10), [(1, 3), (7, 2)]);
+        assert_eq!(runs(&[1, 2, 3, 4, 5], 2), [(1, 2), (3, 2), (5, 1)]);
+    }
+
+    #[test]
+    fn a_data_frag_fills_a_datagram_within_a_submessage_length() {
+        // Cyclone's defaults: 14 720-byte datagrams, 1 344-byte fragments.
+        assert_eq!(fragments_per_submessage(14_720, 1_344), 10);
+        // Fragments larger than a datagram still go, one each.
+        assert_eq!(fragments_per_submessage(1_000, 1_344), 1);
+        // A datagram beyond 64 KiB: the submessage's 16-bit length bounds the run.
+        assert_eq!(fragments_per_submessage(1 << 20, 1_000), 65);
+    }
 }
