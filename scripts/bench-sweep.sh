@@ -34,6 +34,7 @@ out=$(mktemp -d)
 trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$out"' EXIT
 
 source scripts/cyclone11.sh
+source scripts/bench-lib.sh
 
 declare -A cmd=([ours]=$ours [cy010]=/usr/bin/ddsperf)
 # BASE=path: another build of dds-perf as stack "base" (before/after comparisons in one interleaved run).
@@ -66,19 +67,7 @@ throughput() {
 }
 
 # latency STACK SIZE DOMAIN -> "p50 p99" (us, medians over the per-second lines)
-latency() {
-  local prog=${cmd[$1]} size=$2 dom=$3
-  "$prog" -i "$dom" -D $((secs + 1)) pong >"$out/pong" 2>&1 &
-  local pong=$!
-  sleep 0.5
-  "$prog" -i "$dom" -D "$secs" ping size "$size" >"$out/ping" 2>&1 || true
-  wait "$pong" || true
-  grep -E ' mean .*us .* cnt ' "$out/ping" | tail -n +2 | awk '
-    { for (i = 1; i <= NF; i++) { if ($i == "50%") p50[n] = $(i+1) + 0; if ($i == "99%") p99[n] = $(i+1) + 0 } n++ }
-    function median(a, n,   i, j, t) { for (i = 0; i < n; i++) for (j = i + 1; j < n; j++) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
-                                       return n ? a[int(n / 2)] : 0 }
-    END { printf "%.1f %.1f\n", median(p50, n), median(p99, n) }'
-}
+latency() { bench_latency "${cmd[$1]}" "$2" "$3"; }
 
 echo "bench-sweep: $rounds rounds, ${secs}s per measurement, stacks ${stacks[*]}, loopback in a private netns," \
   "$(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
@@ -97,12 +86,8 @@ for r in $(seq 1 "$rounds"); do
   echo "round $r done (load $(cut -d' ' -f1 /proc/loadavg))"
 done
 
-# median FILE SIZE STACK COLUMN -> the median of that column over the rounds
-median() {
-  awk -v z="$2" -v s="$3" -v c="$4" '$1 == z && $2 == s { print $c }' "$1" | sort -g |
-    awk '{ v[NR] = $1 } END { if (NR) print v[int((NR + 1) / 2)]; else print 0 }'
-}
-ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.2fx", a / b; else print "n/a" }'; }
+median() { bench_median "$@"; }
+ratio() { bench_ratio "$@"; }
 
 printf '\nthroughput, reliable keep-all, medians over %d rounds (kS/s | Mb/s | CPU s per 1M samples, pub+sub)\n' "$rounds"
 printf '%-6s' size

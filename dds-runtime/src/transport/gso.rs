@@ -89,11 +89,11 @@ pub(super) fn run_len(payloads: &[&[u8]]) -> usize {
 }
 
 /// Sends `payloads` (a run as [`run_len`] chose, at least two) to `dest` in one `sendmsg` with
-/// `UDP_SEGMENT` set to the first one's length.
+/// `UDP_SEGMENT` set to the first one's length; `None`: to the destination `sock` is connected to.
 pub(super) fn send_segments(
     sock: &UdpSocket,
     payloads: &[&[u8]],
-    dest: SocketAddr,
+    dest: Option<SocketAddr>,
 ) -> io::Result<()> {
     debug_assert!(payloads.len() >= 2 && payloads.len() <= MAX_SEGMENTS);
     let mut iovs = [libc::iovec {
@@ -104,14 +104,16 @@ pub(super) fn send_segments(
         iov.iov_base = p.as_ptr().cast_mut().cast();
         iov.iov_len = p.len();
     }
-    let addr = SockAddr::from(dest);
+    let addr = dest.map(SockAddr::from);
     let seg = payloads[0].len() as u16;
     // Room for one cmsghdr with a u16, aligned as the kernel wants (u64 alignment).
     let mut control = [0u64; 4];
     // SAFETY: all-zero is a valid msghdr; every pointer set below outlives the call.
     let mut msg: libc::msghdr = unsafe { std::mem::zeroed() };
-    msg.msg_name = addr.as_ptr().cast_mut().cast();
-    msg.msg_namelen = addr.len();
+    if let Some(addr) = &addr {
+        msg.msg_name = addr.as_ptr().cast_mut().cast();
+        msg.msg_namelen = addr.len();
+    }
     msg.msg_iov = iovs.as_mut_ptr();
     msg.msg_iovlen = payloads.len() as _;
     msg.msg_control = control.as_mut_ptr().cast();
@@ -188,7 +190,7 @@ mod tests {
         let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
         let dest = rx.local_addr().unwrap();
         let payloads: [&[u8]; 3] = [&[1; 2000], &[2; 2000], &[3; 500]];
-        let e = send_segments(&tx, &payloads, dest).unwrap_err();
+        let e = send_segments(&tx, &payloads, Some(dest)).unwrap_err();
         assert!(unsupported(&e), "{e}");
         let state = GsoState::new(true);
         state.refused(dest, &e);
@@ -209,7 +211,7 @@ mod tests {
         let rx = UdpSocket::bind("127.0.0.1:0").unwrap();
         let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
         let payloads: [&[u8]; 3] = [&[1; 1200], &[2; 1200], &[3; 500]];
-        match send_segments(&tx, &payloads, rx.local_addr().unwrap()) {
+        match send_segments(&tx, &payloads, Some(rx.local_addr().unwrap())) {
             Err(e) if unsupported(&e) => return, // no GSO here: the fallback's case
             r => r.unwrap(),
         }

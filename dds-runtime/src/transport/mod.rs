@@ -21,12 +21,16 @@
 //! other family are skipped.
 //!
 //! On Linux, receive threads read with `recvmmsg` (up to 8 datagrams per call) and hand the whole batch to
-//! the receiver, so the core's lock is taken once per batch; elsewhere, or with [`ReceivePath::OneByOne`],
-//! they read one datagram per `recv_from`. Sends are one `sendto` per datagram, except that on Linux a run
-//! of equal-sized datagrams to one destination (a fragmented sample's) leaves in one `sendmsg` with
-//! `UDP_SEGMENT` ([`UdpTransport::send_run`]; `DDS_GSO=off` turns it off). Options that only Linux has
+//! the receiver, so the core's lock is taken once per batch; while the batches hold one datagram each (a
+//! ping/pong), they read with `recvmsg`, which does not try for a second. Elsewhere, or with
+//! [`ReceivePath::OneByOne`], they read one datagram per `recv_from`. Sends are one `sendto` per datagram,
+//! except that a busy unicast destination gets a socket connected to it (`send`, no route lookup per
+//! datagram; at most 8 per participant), and on Linux a run of equal-sized datagrams to one destination (a
+//! fragmented sample's) leaves in one `sendmsg` with `UDP_SEGMENT` ([`UdpTransport::send_run`];
+//! `DDS_GSO=off` turns it off). Options that only Linux has
 //! (`SO_RCVBUFFORCE`, `IP_MULTICAST_ALL`) are set only there.
 
+mod connected;
 mod datagram;
 #[cfg(target_os = "linux")]
 mod gso;

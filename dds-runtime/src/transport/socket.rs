@@ -148,3 +148,21 @@ pub(super) fn multicast_socket(
     }
     Ok(s)
 }
+
+/// A socket that only sends, connected to `dest` (see `connected.rs`): an ephemeral port, the kernel's
+/// smallest receive buffer, a send buffer of `buf` bytes where the kernel allows.
+pub(super) fn connected_socket(
+    iface: &Interface,
+    dest: SocketAddr,
+    buf: usize,
+) -> io::Result<std::net::UdpSocket> {
+    let s = new_udp(iface)?;
+    // The kernel rounds this up to its minimum.
+    let _ = s.set_recv_buffer_size(0);
+    if let Err(e) = s.set_send_buffer_size(buf) {
+        tracing::debug!(error = %e, "SO_SNDBUF not applied");
+    }
+    s.bind(&any(iface, 0).into())?;
+    s.connect(&dest.into())?;
+    Ok(s.into())
+}

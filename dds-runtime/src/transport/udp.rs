@@ -9,6 +9,7 @@ use std::time::Duration;
 
 use socket2::{SockRef, Socket};
 
+use super::connected::{self, Connected};
 use super::datagram::{Channel, Receiver, TransportStats};
 #[cfg(target_os = "linux")]
 use super::gso::{self, GsoState};
@@ -40,6 +41,10 @@ pub struct UdpTransport {
     gso: GsoState,
     /// How long receive threads poll after a batch (`Config::receive_spin`).
     spin: Duration,
+    /// Sockets connected to the busiest unicast destinations.
+    connected: Connected,
+    /// `Config::socket_buffer_size`, for the connected sockets.
+    buf: usize,
 }
 
 impl std::fmt::Debug for UdpTransport {
@@ -187,6 +192,8 @@ impl UdpTransport {
             #[cfg(target_os = "linux")]
             gso: GsoState::new(config.gso),
             spin: config.receive_spin,
+            connected: Connected::new(true),
+            buf,
         };
         tracing::info!(transport = ?t, "transport bound");
         Ok(t)
@@ -228,13 +235,22 @@ impl UdpTransport {
     }
 
     /// Sends one datagram. Multicast destinations are skipped when multicast is off, and destinations of
-    /// the other address family always (a peer may announce both).
+    /// the other address family always (a peer may announce both). A busy unicast destination gets a
+    /// socket of its own, connected to it (`connected.rs`).
     pub fn send_to(&self, payload: &[u8], dest: impl Into<SocketAddr>) {
         let dest = self.scoped(dest.into());
         if (dest.ip().is_multicast() && !self.multicast) || !self.family.contains(dest.ip()) {
             return;
         }
-        match self.meta_uc.send_to(payload, dest) {
+        let r = self
+            .connected
+            .with(dest, &self.iface, self.buf, |s| match s.send(payload) {
+                // An ICMP error of an earlier send to this destination: this one was not sent.
+                Err(e) if connected::stale_error(&e) => s.send(payload),
+                r => r,
+            })
+            .unwrap_or_else(|| self.meta_uc.send_to(payload, dest));
+        match r {
             Ok(_) => {
                 self.stats.sent.fetch_add(1, Ordering::Relaxed);
                 tracing::trace!(%dest, len = payload.len(), "sent");
@@ -275,7 +291,14 @@ impl UdpTransport {
         {
             return 0;
         }
-        match gso::send_segments(&self.meta_uc, &payloads[..n], dest) {
+        let run = &payloads[..n];
+        let sent = self
+            .connected
+            .with(dest, &self.iface, self.buf, |s| {
+                gso::send_segments(s, run, None)
+            })
+            .unwrap_or_else(|| gso::send_segments(&self.meta_uc, run, Some(dest)));
+        match sent {
             Ok(()) => {
                 self.stats.sent.fetch_add(n as u64, Ordering::Relaxed);
                 tracing::trace!(%dest, datagrams = n, len = payloads[0].len(), "sent segmented");
