@@ -7,8 +7,10 @@
 # topic, so nothing matches) or participants appear. The bare participant is ours (`dds-idle`) or Cyclone's
 # (scripts/footprint/bare.py: the binding's libddsc). Its VmRSS is sampled from /proc every 100 ms: before the load
 # (settled), the peak while the load is discovered, and the settled figure after. Reported: KB per entity
-# ((settled after - before) / N) and the peak above the settled figure. A benchmark, not a test; it runs inside
-# scripts/isolated (loopback only). BARE=path/to/dds-idle probes that binary instead of a fresh release build
+# ((settled after - before) / N) and the peak above the settled figure; then the same for RssAnon alone, the
+# anonymous part of it: VmRSS also counts the pages of the program's own code (and its libraries') that the
+# load runs for the first time, a fixed cost that is not per entity (about 130 KB for dds-idle). A benchmark,
+# not a test; it runs inside scripts/isolated (loopback only). BARE=path/to/dds-idle probes that binary instead of a fresh release build
 # (e.g. one built at an older commit, for a before/after comparison); STACKS="ours" or "cyclone" runs one side.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,6 +23,7 @@ export CYCLONEDDS_URI='<CycloneDDS><Domain><General><Interfaces><NetworkInterfac
 export PYTHONDONTWRITEBYTECODE=1
 
 rss_kb() { awk '/^VmRSS/ {print $2}' "/proc/$1/status" 2>/dev/null || echo 0; }
+anon_kb() { awk '/^RssAnon/ {print $2}' "/proc/$1/status" 2>/dev/null || echo 0; }
 
 # Start a program that prints "ready pid N"; echo N.
 start_bare() {
@@ -45,7 +48,7 @@ settle() {
     fi
     sleep 0.1
   done
-  echo "$r $peak"
+  echo "$r $peak $(anon_kb "$pid")"
 }
 
 probe() {
@@ -53,7 +56,8 @@ probe() {
   local tmp pid load before after peak
   tmp=$(mktemp -d)
   pid=$(start_bare "$tmp/bare.log" "$@")
-  read -r before _ < <(settle "$pid")
+  local anon_before anon_after
+  read -r before _ anon_before < <(settle "$pid")
   python3 scripts/footprint/load.py "$domain" "$kind" "$n" 120 >"$tmp/load.log" 2>&1 &
   load=$!
   local early=0 r
@@ -62,12 +66,14 @@ probe() {
     grep -q loaded "$tmp/load.log" && break
     sleep 0.1
   done
-  read -r after peak < <(settle "$pid")
+  read -r after peak anon_after < <(settle "$pid")
   ((early > peak)) && peak=$early
   kill "$load" "$pid" 2>/dev/null; wait "$load" "$pid" 2>/dev/null || true
-  awk -v name="$name" -v b="$before" -v a="$after" -v p="$peak" -v n="$n" -v k="$kind" 'BEGIN {
-    printf "%-12s %6d %-12s  before %7d KB  after %7d KB  %6.2f KB per %s  peak %+6d KB above settled\n",
-      name, n, k, b, a, (a - b) / n, substr(k, 1, length(k) - 1), p - a }'
+  awk -v name="$name" -v b="$before" -v a="$after" -v p="$peak" -v n="$n" -v k="$kind" \
+    -v ab="$anon_before" -v aa="$anon_after" 'BEGIN {
+    printf "%-12s %6d %-12s  before %7d KB  after %7d KB  %6.2f KB per %s  peak %+6d KB above settled" \
+      "  (anonymous: %6.2f KB per %s)\n", name, n, k, b, a, (a - b) / n, substr(k, 1, length(k) - 1), p - a,
+      (aa - ab) / n, substr(k, 1, length(k) - 1) }'
   rm -rf "$tmp"
 }
 

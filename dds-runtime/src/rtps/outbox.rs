@@ -38,6 +38,11 @@ struct Pending {
     last_header: Option<usize>,
 }
 
+/// Datagram buffers kept for reuse. A pass that sends to hundreds of peers (discovery replies, heartbeats)
+/// allocates beyond it; what it would keep is a fixed cost that stays for the participant's life (see
+/// `docs/performance.md`, "Footprint"). Enough for a stream's datagrams in flight.
+const POOLED: usize = 16;
+
 /// Output queue: open messages being packed and finished datagrams.
 #[derive(Debug)]
 pub(crate) struct Outbox {
@@ -224,16 +229,22 @@ impl Outbox {
 
     /// Returns a datagram buffer for reuse.
     pub(crate) fn recycle(&mut self, buf: Vec<u8>) {
-        if self.pool.len() < 64 {
+        if self.pool.len() < POOLED {
             self.pool.push(buf);
         }
     }
 
     /// Gives back what a burst left in the reuse pools and queues beyond `keep` entries each (a burst of
-    /// discovery replies to a few hundred peers fills the datagram pool to its bound of 64 buffers).
-    pub(crate) fn trim(&mut self, keep: usize) {
+    /// discovery replies to a few hundred peers fills the datagram pool to its bound, [`POOLED`]), and
+    /// the room beyond `keep_bytes` of each datagram buffer kept (a few large datagrams leave their
+    /// buffers that large; a stream of them regrows a few buffers once per trim).
+    pub(crate) fn trim(&mut self, keep: usize, keep_bytes: usize) {
         self.pool.truncate(keep);
         self.pool.shrink_to(keep);
+        for b in &mut self.pool {
+            b.clear();
+            b.shrink_to(keep_bytes);
+        }
         self.dest_pool.truncate(keep);
         self.dest_pool.shrink_to(keep);
         self.pending.shrink_to(keep);
@@ -348,10 +359,12 @@ mod tests {
             o.recycle(t.payload);
             o.recycle_destinations(t.destinations);
         }
-        assert_eq!((o.pool.len(), o.dest_pool.len()), (64, 64));
-        o.trim(16);
-        assert_eq!((o.pool.len(), o.dest_pool.len()), (16, 16));
-        assert!(o.pool.capacity() <= 16 && o.ready.capacity() <= 16);
+        assert_eq!((o.pool.len(), o.dest_pool.len()), (POOLED, 64));
+        o.pool[0].reserve(65_536);
+        o.trim(8, 512);
+        assert_eq!((o.pool.len(), o.dest_pool.len()), (8, 8));
+        assert!(o.pool.capacity() <= 8 && o.ready.capacity() <= 8);
+        assert!(o.pool.iter().all(|b| b.is_empty() && b.capacity() <= 512));
         // It still works.
         o.push(
             &[Locator::udpv4([10, 0, 0, 1], 7410)],

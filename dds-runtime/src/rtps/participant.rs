@@ -133,6 +133,9 @@ pub struct Participant {
     user_readers: BTreeSet<EntityId>,
     /// Service-internal endpoints (`internal.rs`).
     internal: BTreeSet<EntityId>,
+    /// Local writers that stand in for another (`rtps/writer/stand_in.rs`): the only ones
+    /// `original_gone` looks at, so forgetting a remote endpoint costs nothing per local writer.
+    stand_ins: BTreeSet<EntityId>,
     /// Boxed: the table keeps spare slots (see `docs/performance.md`, "Footprint").
     participants: HashMap<GuidPrefix, Box<ProxyParticipant>>,
     /// Every known publication and subscription, remote and local (local ones match locally too).
@@ -260,6 +263,7 @@ impl Participant {
             user_writers: BTreeSet::new(),
             user_readers: BTreeSet::new(),
             internal: BTreeSet::new(),
+            stand_ins: BTreeSet::new(),
             participants: HashMap::new(),
             known_writers: HashMap::new(),
             known_readers: HashMap::new(),
@@ -456,6 +460,7 @@ impl Participant {
             .flatten()
         {
             writer.stand_in_for(original);
+            self.stand_ins.insert(id);
         }
         self.writers.insert(id, writer);
         self.user_writers.insert(id);

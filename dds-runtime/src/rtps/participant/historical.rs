@@ -53,7 +53,8 @@ impl Participant {
     /// its stand-ins release the readers they held, with what it served them. A local writer tells from its
     /// readers' acknowledgements; a remote one that left while its participant is still known left cleanly
     /// (it lingered for its acknowledgements: everything); one whose participant was lost may have served
-    /// a held reader nothing, which then gets everything from the stand-in.
+    /// a held reader nothing, which then gets everything from the stand-in. Only the stand-ins are looked
+    /// at (a peer with thousands of endpoints that leaves calls this once for each).
     pub(super) fn original_gone(&mut self, original: Guid) {
         let local = (original.prefix == self.config.guid_prefix)
             .then(|| self.writers.get(&original.entity_id))
@@ -61,7 +62,13 @@ impl Participant {
         let clean = original.prefix == self.config.guid_prefix
             || self.participants.contains_key(&original.prefix);
         let mut released = Vec::new();
-        for (id, w) in &self.writers {
+        let writers = &self.writers;
+        self.stand_ins.retain(|id| writers.contains_key(id));
+        for (id, w) in self
+            .stand_ins
+            .iter()
+            .filter_map(|id| Some((id, writers.get(id)?)))
+        {
             if w.original() == Some(original) {
                 for r in w.held() {
                     let served = match local {

@@ -19,9 +19,11 @@ use crate::rtps::types::*;
 const FULL_SCAN_INTERVAL: Duration = Duration::from_millis(100);
 
 /// The room (in events) the participant's queues keep after a burst; see `Participant::trim_queues`.
-pub(crate) const KEPT_QUEUE_ROOM: usize = 256;
-/// The datagram buffers the outbox keeps for reuse after a burst (it holds up to 64).
-const KEPT_DATAGRAMS: usize = 16;
+pub(crate) const KEPT_QUEUE_ROOM: usize = 64;
+/// The datagram buffers the outbox keeps for reuse after a burst (it holds up to 16), and the room each
+/// keeps: a discovery datagram's (a stream of large samples regrows them, once per SPDP period).
+const KEPT_DATAGRAMS: usize = 8;
+const KEPT_DATAGRAM_BYTES: usize = 1024;
 
 /// Lowers a known timer floor to `t`; an unknown floor stays unknown (it is rescanned anyway).
 pub(super) fn lower_floor(floor: &Cell<Option<Instant>>, t: Option<Instant>) {
@@ -185,7 +187,7 @@ impl Participant {
     fn trim_queues(&mut self) {
         self.scratch.shrink_to(KEPT_QUEUE_ROOM);
         self.events.shrink_to(KEPT_QUEUE_ROOM);
-        self.out.trim(KEPT_DATAGRAMS);
+        self.out.trim(KEPT_DATAGRAMS, KEPT_DATAGRAM_BYTES);
     }
 
     /// Sends our SPDP announcement to the SPDP multicast locators and initial peers, or to `to` only.
