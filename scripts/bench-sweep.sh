@@ -36,6 +36,11 @@ trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$out"' EXIT
 source scripts/cyclone11.sh
 source scripts/bench-lib.sh
 
+# Both Cyclones get the socket buffers ours asks for (DDS_SOCKET_BUFFER_SIZE, 4 MB; the kernel doubles it). With
+# their defaults they starve at 1 MiB and above (4 MiB, Cyclone 11: 0.01 kS/s against 0.22 with these), which
+# is no comparison. Set CYCLONEDDS_URI to compare against something else.
+export CYCLONEDDS_URI=${CYCLONEDDS_URI:-'<CycloneDDS><Domain><Internal><SocketReceiveBufferSize min="4MB"/><SocketSendBufferSize min="4MB"/></Internal></Domain></CycloneDDS>'}
+
 declare -A cmd=([ours]=$ours [cy010]=/usr/bin/ddsperf)
 # BASE=path: another build of dds-perf as stack "base" (before/after comparisons in one interleaved run).
 [[ -n ${BASE:-} ]] && cmd[base]=$BASE
