@@ -7,13 +7,16 @@
 //! writer's history and a reader's deliveries release them; while the oldest is still held, a new buffer
 //! is made. The pool keeps the buffers it made, up to its bounds in buffers and in bytes of capacity, so
 //! that it grows to the most samples ever in flight at once; at its bounds it forgets its oldest buffers
-//! (their holders still free them). A buffer held for long (a sample kept in a reader cache, say) goes to
-//! the back when the next one is free, so it cannot stop reuse for good.
+//! (their holders still free them). Buffers held for long (samples kept in a reader cache, say) go to the
+//! back when one of the next few is free, so they cannot stop reuse for good.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
 
 use super::api::{prefetch_arc, Payload};
+
+/// How many buffers `take` looks at, from the oldest, for a free one before it makes a new buffer.
+const SCAN: usize = 8;
 
 /// A bounded pool of reusable payload buffers.
 #[derive(Debug)]
@@ -46,9 +49,11 @@ impl BufferPool {
     /// long after it last touched it, and reading its reference counts cold was a tenth of a 64-byte
     /// publisher's time.
     pub(crate) fn take(&mut self) -> Arc<Vec<u8>> {
-        if self.bufs.len() >= 2 && !is_free(&self.bufs[0]) && is_free(&self.bufs[1]) {
-            // The oldest is held for long while the next is free: it moves to the back.
-            self.bufs.rotate_left(1);
+        if self.bufs.front().is_some_and(|b| !is_free(b)) {
+            // The oldest are held for long while one just behind them is free: they move to the back.
+            if let Some(i) = self.bufs.iter().take(SCAN).position(is_free) {
+                self.bufs.rotate_left(i);
+            }
         }
         if let Some(front) = self.bufs.front_mut() {
             if let Some(v) = Arc::get_mut(front) {
@@ -78,6 +83,19 @@ impl BufferPool {
         // `take` returns a buffer nobody else references: `make_mut` does not copy.
         fill(Arc::make_mut(&mut b))?;
         Ok(self.share(b))
+    }
+
+    /// `p` itself when it owns its buffer whole, else a copy of its bytes in a pooled buffer: kept for
+    /// long, it then no longer pins the larger buffer it is a slice of (a received datagram), and a steady
+    /// stream of such copies reuses the same buffers instead of allocating.
+    pub(crate) fn compact(&mut self, p: Payload) -> Payload {
+        if !p.is_part() {
+            return p;
+        }
+        let mut b = self.take();
+        // `take` returns a buffer nobody else references: `make_mut` does not copy.
+        Arc::make_mut(&mut b).extend_from_slice(&p);
+        self.share(b)
     }
 
     /// A payload of `b` (filled by the caller); the pool keeps `b` for reuse once the payload is gone.
@@ -204,6 +222,25 @@ mod tests {
     }
 
     #[test]
+    fn compact_copies_a_part_into_a_reused_buffer() {
+        let mut pool = BufferPool::new(4, 1 << 20);
+        let whole = Payload::from(vec![5u8; 100]);
+        let alone = Payload::from(vec![7u8; 10]);
+        assert_eq!(
+            pool.compact(alone.clone()).as_ptr(),
+            alone.as_ptr(),
+            "already whole: kept"
+        );
+        let first = pool.compact(whole.slice(10..20));
+        assert_eq!(&first[..], &[5u8; 10]);
+        assert!(!first.is_part());
+        let ptr = first.as_ptr();
+        drop(first);
+        let again = pool.compact(whole.slice(30..40));
+        assert_eq!(again.as_ptr(), ptr, "the pooled buffer came back");
+    }
+
+    #[test]
     fn a_buffer_held_for_long_does_not_stop_reuse() {
         let mut pool = BufferPool::new(4, 1 << 20);
         let fill = |pool: &mut BufferPool| pool.fill(|v| v.try_reserve(16)).unwrap();
@@ -218,5 +255,19 @@ mod tests {
             "the free buffer behind the held one is reused"
         );
         assert_ne!(kept.as_ptr(), ptr);
+    }
+
+    #[test]
+    fn several_buffers_held_in_front_do_not_stop_reuse() {
+        let mut pool = BufferPool::new(8, 1 << 20);
+        let fill = |pool: &mut BufferPool| pool.fill(|v| v.try_reserve(16)).unwrap();
+        let held = [fill(&mut pool), fill(&mut pool)];
+        let behind = fill(&mut pool);
+        let ptr = behind.as_ptr();
+        drop(behind);
+        let next = fill(&mut pool);
+        assert_eq!(next.as_ptr(), ptr, "the free buffer behind two held ones");
+        assert_eq!(pool.bufs.len(), 3, "no new buffer");
+        drop((held, next));
     }
 }

@@ -4,6 +4,7 @@
 mod coherent;
 mod defrag;
 mod historical;
+mod reorder;
 mod writer_proxy;
 
 use writer_proxy::Backlog;
@@ -281,14 +282,6 @@ impl Reader {
                 if p.held() < self.params.reorder_max_samples
                     && p.held_bytes() + slot.size() <= self.params.reorder_max_bytes
                 {
-                    // Held for a while: it must not pin the whole datagram it arrived in.
-                    let slot = match slot {
-                        Slot::Change(mut c) => {
-                            c.payload = c.payload.compact();
-                            Slot::Change(c)
-                        }
-                        other => other,
-                    };
                     p.hold(sn, slot);
                 }
             }
