@@ -7,8 +7,9 @@ mod historical;
 mod reorder;
 mod writer_proxy;
 
+pub(crate) use reorder::{PendingChange, Slot};
 use writer_proxy::Backlog;
-pub(crate) use writer_proxy::{PendingChange, Slot, WriterProxy};
+pub(crate) use writer_proxy::WriterProxy;
 
 /// How long an ACKNACK that asks for nothing waits when it only serves discovery: a builtin reader's
 /// acknowledgement and any reader's pre-emptive ACKNACK to a newly matched writer. The ACKNACKs that

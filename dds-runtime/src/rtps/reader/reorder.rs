@@ -11,9 +11,39 @@
 
 use std::collections::VecDeque;
 
-use super::writer_proxy::Slot;
+use super::coherent::SetMark;
+use crate::rtps::api::{ChangeKind, Payload};
 use crate::rtps::pool::BufferPool;
-use crate::rtps::types::SequenceNumber;
+use crate::rtps::types::{SequenceNumber, Time};
+
+/// A received change waiting for its turn (or an irrelevant sequence number from a GAP).
+#[derive(Debug, Clone)]
+pub(crate) enum Slot {
+    Change(PendingChange),
+    Irrelevant,
+}
+
+impl Slot {
+    /// Payload bytes the slot holds.
+    pub(crate) fn size(&self) -> usize {
+        match self {
+            Slot::Change(c) => c.payload.len(),
+            Slot::Irrelevant => 0,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct PendingChange {
+    pub kind: ChangeKind,
+    pub payload: Payload,
+    pub key_hash: Option<[u8; 16]>,
+    pub source_timestamp: Option<Time>,
+    /// Membership in a coherent set (`PID_COHERENT_SET`).
+    pub coherent: Option<SetMark>,
+    /// `PID_GROUP_SEQ_NUM`, from members of a GROUP-scope publisher.
+    pub group_seq: Option<SequenceNumber>,
+}
 
 /// Most copies of held payloads the pool keeps for reuse (the default `reorder_max_samples`).
 const POOL_BUFFERS: usize = 1024;
@@ -104,8 +134,6 @@ impl Reorder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rtps::api::{ChangeKind, Payload};
-    use crate::rtps::reader::PendingChange;
 
     fn change(payload: Payload) -> Slot {
         Slot::Change(PendingChange {

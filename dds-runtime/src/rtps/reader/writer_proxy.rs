@@ -9,40 +9,10 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::coherent::{Assembler, SetMark};
+use super::coherent::Assembler;
 use super::defrag::Defrag;
-use super::reorder::Reorder;
-use crate::rtps::api::{ChangeKind, Payload};
+use super::reorder::{Reorder, Slot};
 use crate::rtps::types::*;
-
-/// A received change waiting for its turn (or an irrelevant sequence number from a GAP).
-#[derive(Debug, Clone)]
-pub(crate) enum Slot {
-    Change(PendingChange),
-    Irrelevant,
-}
-
-impl Slot {
-    /// Payload bytes the slot holds.
-    pub(crate) fn size(&self) -> usize {
-        match self {
-            Slot::Change(c) => c.payload.len(),
-            Slot::Irrelevant => 0,
-        }
-    }
-}
-
-#[derive(Debug, Clone)]
-pub(crate) struct PendingChange {
-    pub kind: ChangeKind,
-    pub payload: Payload,
-    pub key_hash: Option<[u8; 16]>,
-    pub source_timestamp: Option<Time>,
-    /// Membership in a coherent set (`PID_COHERENT_SET`).
-    pub coherent: Option<SetMark>,
-    /// `PID_GROUP_SEQ_NUM`, from members of a GROUP-scope publisher.
-    pub group_seq: Option<SequenceNumber>,
-}
 
 #[derive(Debug)]
 pub(crate) struct WriterProxy {
