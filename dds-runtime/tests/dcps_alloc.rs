@@ -286,11 +286,10 @@ fn intra_process_write_owned_allocations_per_sample() {
 /// (`split_off`) on every acknowledgement: 4.7 to 6.4 allocations per sample. They are a bitmap window
 /// now (`writer/bit_window.rs`), kept while the reader is behind: 0.14 to 0.29. Most of the rest was the
 /// reader's: each change it held out of order (the ones after the change its full cache refused) was
-/// copied out of its datagram into a new buffer and put in a `BTreeMap`. Held changes are now a sorted
-/// ring with a pool for the copies (`rtps/reader/reorder.rs`): 0.065 to 0.08 over one window of 30 000.
-/// What is left at depth is periodic: the writer's repair datagrams growing their buffers, a received
-/// SPDP announcement's decode, the timer thread's list of endpoints. The test takes the quietest of four
-/// windows of 8 000 at depth (measured 0.004 to 0.016; the busiest 0.03 to 0.06).
+/// copied out of its datagram into a new buffer. The copies now go into pooled buffers
+/// (`rtps/reader/reorder.rs`). What is left at depth: the reorder map's nodes, the writer's repair
+/// datagrams growing their buffers, a received SPDP announcement's decode, the timer thread's list of
+/// endpoints. The test takes the quietest of four windows of 8 000 at depth (measured 0.024 to 0.043).
 #[test]
 fn steady_state_allocations_with_10000_samples_in_flight() {
     const DEPTH: u32 = 10_000;
@@ -318,7 +317,7 @@ fn steady_state_allocations_with_10000_samples_in_flight() {
     );
     assert!(take < 0.001, "take: {take:.4} allocations per sample");
     assert!(
-        total < 0.05,
+        total < 0.1,
         "whole process: {total:.3} allocations per sample"
     );
 }
