@@ -38,6 +38,15 @@ pub(crate) enum Pending {
 pub(crate) trait Endpoint: Send + Sync {
     /// Queues a change for this reader. Called with the core lock held: must only queue.
     fn enqueue(&self, _item: Pending) {}
+    /// Queues `first`, then each change `more` yields until it yields `None`, in that order: a run of
+    /// changes for this reader, which a reader queues under one lock. Called with the core lock held:
+    /// must only queue.
+    fn enqueue_run(&self, first: Pending, more: &mut dyn FnMut() -> Option<Pending>) {
+        self.enqueue(first);
+        while let Some(item) = more() {
+            self.enqueue(item);
+        }
+    }
     /// Drains the queue into the cache and notifies; called without the core lock.
     fn process(self: Arc<Self>) {}
     /// A status event for this endpoint; called without the core lock.
@@ -382,8 +391,9 @@ impl Driver {
             while let Some(t) = core.poll_transmit(now) {
                 batch.push(t);
             }
-            while let Some(ev) = core.poll_event() {
-                self.route_locked(ev, &mut deferred, &mut touched);
+            let mut next = core.poll_event();
+            while let Some(ev) = next {
+                next = self.route_locked(ev, &mut core, &mut deferred, &mut touched);
             }
             #[cfg(feature = "shm")]
             if let Some(link) = &self.shm {
@@ -424,15 +434,18 @@ impl Driver {
         self.spare_count.store(spare.len(), Ordering::Release);
     }
 
-    /// Under the core lock: samples go to their reader's queue (keeps order); the rest is deferred.
+    /// Under the core lock: samples go to their reader's queue (keeps order); the rest is deferred. A
+    /// sample starts a run: the samples for the same reader that the core has next join its queue at once
+    /// (one lock and one call for the run). Returns the core's next event, if the run read it.
     fn route_locked(
         &self,
         ev: Event,
+        core: &mut Participant,
         deferred: &mut Vec<Event>,
         touched: &mut Vec<(EntityId, Arc<dyn Endpoint>)>,
-    ) {
+    ) -> Option<Event> {
         let (reader, item) = match ev {
-            Event::Sample(s) if !self.admit(&s) => return,
+            Event::Sample(s) if !self.admit(&s) => return core.poll_event(),
             Event::Sample(s) => (s.reader, Pending::Sample(s)),
             Event::CoherentSet {
                 reader, samples, ..
@@ -456,24 +469,59 @@ impl Driver {
                         .for_each(|o| o.observe_locked(&other));
                 }
                 deferred.push(other);
-                return;
+                return core.poll_event();
             }
         };
-        // Runs of samples for one reader (the common case) skip the registry lookup.
-        if let Some((id, r)) = touched.last() {
-            if *id == reader {
-                r.enqueue(item);
-                return;
-            }
-        }
-        if let Some(r) = self.endpoint(reader) {
-            r.enqueue(item);
-            if !touched.iter().any(|(id, _)| *id == reader) {
-                touched.push((reader, r));
-            }
-        } else {
+        let Some(r) = self.touch(reader, touched) else {
             tracing::trace!(?reader, "event for an endpoint not registered: dropped");
+            return core.poll_event();
+        };
+        if !matches!(item, Pending::Sample(_)) {
+            r.enqueue(item);
+            return core.poll_event();
         }
+        let mut after = None;
+        r.enqueue_run(item, &mut || self.next_in_run(core, reader, &mut after));
+        after
+    }
+
+    /// The next sample of a run for `reader` (see [`Driver::route_locked`]): the core's next event when it
+    /// is one; a sample an observer does not admit is dropped on the way. Anything else ends the run and is
+    /// left in `after`.
+    fn next_in_run(
+        &self,
+        core: &mut Participant,
+        reader: EntityId,
+        after: &mut Option<Event>,
+    ) -> Option<Pending> {
+        loop {
+            match core.poll_event()? {
+                Event::Sample(s) if s.reader == reader => {
+                    if self.admit(&s) {
+                        return Some(Pending::Sample(s));
+                    }
+                }
+                other => {
+                    *after = Some(other);
+                    return None;
+                }
+            }
+        }
+    }
+
+    /// The endpoint `reader`, noted in `touched` (processed once the core lock is released). Runs of
+    /// events for one reader (the common case) skip the registry lookup.
+    fn touch(
+        &self,
+        reader: EntityId,
+        touched: &mut Vec<(EntityId, Arc<dyn Endpoint>)>,
+    ) -> Option<Arc<dyn Endpoint>> {
+        if let Some((_, r)) = touched.iter().rev().find(|(id, _)| *id == reader) {
+            return Some(r.clone());
+        }
+        let r = self.endpoint(reader)?;
+        touched.push((reader, r.clone()));
+        Some(r)
     }
 
     /// Sends the datagrams in order; consecutive ones for the same destinations (a fragmented sample's)

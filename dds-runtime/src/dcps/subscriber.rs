@@ -1043,18 +1043,34 @@ impl<K: ReaderKind> ReaderInner<K> {
     }
 }
 
-impl<K: ReaderKind> Endpoint for ReaderInner<K> {
-    fn enqueue(&self, item: Pending) {
-        // Numbered here, under the core lock, in the core's order across the subscriber's readers (they
-        // store their queues one after the other).
-        let place = self.group_order.as_ref().map_or(0, |c| {
-            let n = match &item {
+impl<K: ReaderKind> ReaderInner<K> {
+    /// A queued change's place in the subscriber's order (GROUP ordered access; else 0). Numbered when
+    /// queued, under the core lock, in the core's order across the subscriber's readers (they store their
+    /// queues one after the other).
+    fn place(&self, item: &Pending) -> u64 {
+        self.group_order.as_ref().map_or(0, |c| {
+            let n = match item {
                 Pending::CoherentSet(set) => set.len() as u64,
                 _ => 1,
             };
             c.fetch_add(n, AtomicOrdering::Relaxed)
-        });
+        })
+    }
+}
+
+impl<K: ReaderKind> Endpoint for ReaderInner<K> {
+    fn enqueue(&self, item: Pending) {
+        let place = self.place(&item);
         lock(&self.pending).push_back((place, item));
+    }
+
+    fn enqueue_run(&self, first: Pending, more: &mut dyn FnMut() -> Option<Pending>) {
+        let mut queue = lock(&self.pending);
+        let mut item = Some(first);
+        while let Some(it) = item {
+            queue.push_back((self.place(&it), it));
+            item = more();
+        }
     }
 
     fn process(self: Arc<Self>) {

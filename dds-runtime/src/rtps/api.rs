@@ -165,10 +165,17 @@ impl Payload {
     /// The same bytes, copied into a buffer of their own if they are a slice of a larger one, so that
     /// keeping them does not keep the rest alive.
     pub fn compact(self) -> Payload {
+        if self.is_part() {
+            Payload::copy_from_slice(&self)
+        } else {
+            self
+        }
+    }
+    /// Whether the bytes are a slice of a larger buffer (which keeping them keeps alive whole).
+    pub(crate) fn is_part(&self) -> bool {
         match &self.buf {
-            Some(Buf::Local(_)) => self,
-            Some(b) if b.bytes().len() > self.len() => Payload::copy_from_slice(&self),
-            _ => self,
+            Some(Buf::Local(_)) | None => false,
+            Some(b) => b.bytes().len() > self.len(),
         }
     }
     /// A sub-range sharing the same buffer; clamps out-of-range bounds.

@@ -82,6 +82,19 @@ impl BufferPool {
         Ok(self.share(b))
     }
 
+    /// `p` itself when it owns its buffer whole, else a copy of its bytes in a pooled buffer: kept for
+    /// long, it then no longer pins the larger buffer it is a slice of (a received datagram), and a steady
+    /// stream of such copies reuses the same buffers instead of allocating.
+    pub(crate) fn compact(&mut self, p: Payload) -> Payload {
+        if !p.is_part() {
+            return p;
+        }
+        let mut b = self.take();
+        // `take` returns a buffer nobody else references: `make_mut` does not copy.
+        Arc::make_mut(&mut b).extend_from_slice(&p);
+        self.share(b)
+    }
+
     /// A payload of `b` (filled by the caller); the pool keeps `b` for reuse once the payload is gone.
     pub(crate) fn share(&mut self, b: Arc<Vec<u8>>) -> Payload {
         let p = Payload::from_shared_vec(b.clone());
@@ -203,6 +216,25 @@ mod tests {
         let more: Vec<Payload> = (0..6).map(|_| fill(&mut pool)).collect();
         assert_eq!(pool.bufs.len(), 8, "bounded");
         drop((again, more));
+    }
+
+    #[test]
+    fn compact_copies_a_part_into_a_reused_buffer() {
+        let mut pool = BufferPool::new(4, 1 << 20);
+        let whole = Payload::from(vec![5u8; 100]);
+        let alone = Payload::from(vec![7u8; 10]);
+        assert_eq!(
+            pool.compact(alone.clone()).as_ptr(),
+            alone.as_ptr(),
+            "already whole: kept"
+        );
+        let first = pool.compact(whole.slice(10..20));
+        assert_eq!(&first[..], &[5u8; 10]);
+        assert!(!first.is_part());
+        let ptr = first.as_ptr();
+        drop(first);
+        let again = pool.compact(whole.slice(30..40));
+        assert_eq!(again.as_ptr(), ptr, "the pooled buffer came back");
     }
 
     #[test]

@@ -4,10 +4,12 @@
 mod coherent;
 mod defrag;
 mod historical;
+mod reorder;
 mod writer_proxy;
 
+pub(crate) use reorder::{PendingChange, Slot};
 use writer_proxy::Backlog;
-pub(crate) use writer_proxy::{PendingChange, Slot, WriterProxy};
+pub(crate) use writer_proxy::WriterProxy;
 
 /// How long an ACKNACK that asks for nothing waits when it only serves discovery: a builtin reader's
 /// acknowledgement and any reader's pre-emptive ACKNACK to a newly matched writer. The ACKNACKs that
@@ -281,14 +283,6 @@ impl Reader {
                 if p.held() < self.params.reorder_max_samples
                     && p.held_bytes() + slot.size() <= self.params.reorder_max_bytes
                 {
-                    // Held for a while: it must not pin the whole datagram it arrived in.
-                    let slot = match slot {
-                        Slot::Change(mut c) => {
-                            c.payload = c.payload.compact();
-                            Slot::Change(c)
-                        }
-                        other => other,
-                    };
                     p.hold(sn, slot);
                 }
             }

@@ -9,39 +9,10 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::coherent::{Assembler, SetMark};
+use super::coherent::Assembler;
 use super::defrag::Defrag;
-use crate::rtps::api::{ChangeKind, Payload};
+use super::reorder::{Reorder, Slot};
 use crate::rtps::types::*;
-
-/// A received change waiting for its turn (or an irrelevant sequence number from a GAP).
-#[derive(Debug, Clone)]
-pub(crate) enum Slot {
-    Change(PendingChange),
-    Irrelevant,
-}
-
-impl Slot {
-    /// Payload bytes the slot holds.
-    pub(crate) fn size(&self) -> usize {
-        match self {
-            Slot::Change(c) => c.payload.len(),
-            Slot::Irrelevant => 0,
-        }
-    }
-}
-
-#[derive(Debug, Clone)]
-pub(crate) struct PendingChange {
-    pub kind: ChangeKind,
-    pub payload: Payload,
-    pub key_hash: Option<[u8; 16]>,
-    pub source_timestamp: Option<Time>,
-    /// Membership in a coherent set (`PID_COHERENT_SET`).
-    pub coherent: Option<SetMark>,
-    /// `PID_GROUP_SEQ_NUM`, from members of a GROUP-scope publisher.
-    pub group_seq: Option<SequenceNumber>,
-}
 
 #[derive(Debug)]
 pub(crate) struct WriterProxy {
@@ -70,9 +41,8 @@ pub(crate) struct WriterProxy {
 /// The part of a [`WriterProxy`] only used once changes arrive out of order or in fragments.
 #[derive(Debug, Default)]
 pub(crate) struct Backlog {
-    pub reorder: BTreeMap<SequenceNumber, Slot>,
-    /// Payload bytes held in `reorder`.
-    pub reorder_bytes: usize,
+    /// Changes held out of order.
+    pub reorder: Reorder,
     pub last_hbfrag_count: Option<i32>,
     /// Partly received samples a HEARTBEAT_FRAG asked about: sequence number -> last fragment the writer
     /// has. Answered with NACK_FRAG at `nackfrag_due` (bounded: samples held in `defrag`, at most
@@ -128,24 +98,17 @@ impl WriterProxy {
 
     /// Payload bytes held out of order.
     pub(crate) fn held_bytes(&self) -> usize {
-        self.backlog().map_or(0, |b| b.reorder_bytes)
+        self.backlog().map_or(0, |b| b.reorder.bytes())
     }
 
-    /// Holds `slot` for `sn` until its turn.
+    /// Holds `slot` for `sn` until its turn (its payload copied out of the datagram it arrived in).
     pub(crate) fn hold(&mut self, sn: SequenceNumber, slot: Slot) {
-        let b = self.backlog_mut();
-        b.reorder_bytes += slot.size();
-        if let Some(old) = b.reorder.insert(sn, slot) {
-            b.reorder_bytes -= old.size();
-        }
+        self.backlog_mut().reorder.hold(sn, slot);
     }
 
     /// Marks `sn` irrelevant unless something is held for it already.
     pub(crate) fn hold_irrelevant(&mut self, sn: SequenceNumber) {
-        self.backlog_mut()
-            .reorder
-            .entry(sn)
-            .or_insert(Slot::Irrelevant);
+        self.backlog_mut().reorder.hold_irrelevant(sn);
     }
 
     /// Takes the first held change when `take(sn, slot)` says so.
@@ -154,13 +117,11 @@ impl WriterProxy {
         take: impl FnOnce(SequenceNumber, &Slot) -> bool,
     ) -> Option<(SequenceNumber, Slot)> {
         let b = self.backlog.as_deref_mut()?;
-        let e = b.reorder.first_entry()?;
-        if !take(*e.key(), e.get()) {
+        let (sn, slot) = b.reorder.first()?;
+        if !take(sn, slot) {
             return None;
         }
-        let (sn, slot) = e.remove_entry();
-        b.reorder_bytes -= slot.size();
-        Some((sn, slot))
+        b.reorder.pop_first()
     }
 
     /// The time the next NACK_FRAG answering a HEARTBEAT_FRAG is due.
@@ -183,13 +144,13 @@ impl WriterProxy {
 
     /// Whether `sn` was delivered, skipped or is held (whole).
     pub(crate) fn has(&self, sn: SequenceNumber) -> bool {
-        sn < self.next_expected || self.backlog().is_some_and(|b| b.reorder.contains_key(&sn))
+        sn < self.next_expected || self.backlog().is_some_and(|b| b.reorder.contains(sn))
     }
 
     /// Whether `sn` is held whole or partly (fragments).
     pub(crate) fn holds_any_of(&self, sn: SequenceNumber) -> bool {
         self.backlog()
-            .is_some_and(|b| b.reorder.contains_key(&sn) || b.defrag.contains_key(&sn))
+            .is_some_and(|b| b.reorder.contains(sn) || b.defrag.contains_key(&sn))
     }
 }
 

@@ -80,6 +80,8 @@ pub(crate) struct Writer {
     /// (`ReaderProxy::key_hash_only_disposes`), and the rest. `key_hash_dest` empty: no split needed.
     key_hash_dest: Vec<Locator>,
     full_key_dest: Vec<Locator>,
+    /// Where the periodic heartbeat goes (kept for reuse).
+    hb_dest: Vec<Locator>,
     hb_count: i32,
     /// HEARTBEAT_FRAG count: its own sequence, separate from HEARTBEAT's (§8.3.7.6).
     hbfrag_count: i32,
@@ -118,6 +120,7 @@ impl Writer {
             next_sn: SequenceNumber(1),
             proxies: BTreeMap::new(),
             data_dest: Vec::new(),
+            hb_dest: Vec::new(),
             key_hash_dest: Vec::new(),
             full_key_dest: Vec::new(),
             hb_count: 0,
@@ -699,11 +702,14 @@ impl Writer {
         }
         if self.hb_due.is_some_and(|t| t <= now) {
             if self.has_reliable_proxy() && !self.is_acknowledged() {
-                let dest = self.heartbeat_destinations();
+                // The list is kept: a heartbeat per period allocates nothing.
+                let mut dest = std::mem::take(&mut self.hb_dest);
+                self.heartbeat_destinations(&mut dest);
                 let hb = self.heartbeat(EntityId::UNKNOWN, false);
                 self.bytes_since_nonfinal_hb = 0;
                 self.changes_since_nonfinal_hb = 0;
                 out.push(&dest, None, Ts::Any, &hb);
+                self.hb_dest = dest;
                 self.hb_due = Some(now + self.heartbeat_interval());
             } else {
                 self.hb_due = None;

@@ -37,8 +37,8 @@ impl Writer {
     /// A heartbeat sent to the group asks every reader there for an ACKNACK, so a group of n readers in
     /// which k lag costs 1 + n datagrams by multicast against 2k by unicast. While many participants
     /// discover each other, a few new readers lag at any time among a hundred that do not: the heartbeat
-    /// then goes to those few alone.
-    pub(super) fn heartbeat_destinations(&self) -> Vec<Locator> {
+    /// then goes to those few alone. The list replaces what `d` held (a vector the writer keeps).
+    pub(super) fn heartbeat_destinations(&self, d: &mut Vec<Locator>) {
         let unacked = || {
             self.proxies
                 .values()
@@ -53,16 +53,14 @@ impl Writer {
                 g.0 += usize::from(p.reliable && p.acked < self.next_sn);
             }
         }
-        let mut d: Vec<Locator> = unacked()
-            .filter_map(|p| match p.data_destination() {
-                Some(m) if groups.get(&m).is_some_and(|&(k, n)| k < 2 || 2 * k <= n) => {
-                    p.destination().first().copied().or(Some(m))
-                }
-                other => other,
-            })
-            .collect();
+        d.clear();
+        d.extend(unacked().filter_map(|p| match p.data_destination() {
+            Some(m) if groups.get(&m).is_some_and(|&(k, n)| k < 2 || 2 * k <= n) => {
+                p.destination().first().copied().or(Some(m))
+            }
+            other => other,
+        }));
         d.sort();
         d.dedup();
-        d
     }
 }
