@@ -21,7 +21,10 @@ fn system_time(t: Option<crate::rtps::Time>) -> Option<SystemTime> {
 
 /// The sample itself when the payload carries it (intra-process delivery of `write_owned`/`write_shared`:
 /// no serialization), else read in place when the type can (`dcps::InPlace`), else decoded from the bytes.
-fn local_or_deserialize<T: DdsType>(payload: &mut Payload) -> Result<T, cdr::DecodeError> {
+fn local_or_deserialize<T: DdsType>(
+    payload: &mut Payload,
+    spare: &mut Vec<T>,
+) -> Result<T, cdr::DecodeError> {
     if payload.is_local() {
         let mut slot: Option<T> = None;
         match std::mem::take(payload).take_local_into(&mut slot) {
@@ -36,7 +39,41 @@ fn local_or_deserialize<T: DdsType>(payload: &mut Payload) -> Result<T, cdr::Dec
     if let Some(d) = T::decode_shared(&*payload) {
         return Ok(d);
     }
-    cdr::deserialize::<T>(payload)
+    match spare.pop() {
+        Some(mut v) => cdr::deserialize_into(payload, &mut v).map(|()| v),
+        None => cdr::deserialize::<T>(payload),
+    }
+}
+
+/// Most values given back by the application ([`DataReader::recycle`](super::DataReader::recycle)) that a
+/// reader keeps for decoding later samples into.
+pub(crate) const MAX_SPARE_VALUES: usize = 1024;
+
+/// What a reader's decoding keeps from one change to the next.
+pub(crate) struct Decoding<T> {
+    /// Key hash → serialized key, learnt from samples that carried both (for key-hash-only disposes).
+    pub(crate) by_hash: HashMap<[u8; 16], Vec<u8>>,
+    /// Values the application gave back, to decode into: their strings and sequences keep their buffers.
+    spare: Vec<T>,
+}
+
+impl<T> Decoding<T> {
+    pub(crate) fn new() -> Self {
+        Decoding {
+            by_hash: HashMap::default(),
+            spare: Vec::new(),
+        }
+    }
+
+    /// Whether another given-back value would be kept.
+    pub(crate) fn has_room(&self) -> bool {
+        self.spare.len() < MAX_SPARE_VALUES
+    }
+
+    /// Keeps `v` to decode a later sample into (the caller checked [`Self::has_room`]).
+    pub(crate) fn keep(&mut self, v: T) {
+        self.spare.push(v);
+    }
 }
 
 /// What a reader needs to know of its sample type `T` to decode changes and identify instances: derived
@@ -45,8 +82,8 @@ fn local_or_deserialize<T: DdsType>(payload: &mut Payload) -> Result<T, cdr::Dec
 pub(crate) trait SampleCodec<T> {
     /// The type has key members.
     fn keyed(&self) -> bool;
-    /// A sample from its payload.
-    fn decode(&self, payload: &mut Payload) -> Result<T, cdr::DecodeError>;
+    /// A sample from its payload, decoded into one of the `spare` values where the codec can reuse them.
+    fn decode(&self, payload: &mut Payload, spare: &mut Vec<T>) -> Result<T, cdr::DecodeError>;
     /// A sample holding the key values, from a key payload.
     fn decode_key(&self, payload: &[u8]) -> Result<T, cdr::DecodeError>;
     /// The serialized key that identifies the sample's instance.
@@ -62,8 +99,8 @@ impl<T: DdsType> SampleCodec<T> for Derived {
     fn keyed(&self) -> bool {
         T::IS_KEYED
     }
-    fn decode(&self, payload: &mut Payload) -> Result<T, cdr::DecodeError> {
-        local_or_deserialize::<T>(payload)
+    fn decode(&self, payload: &mut Payload, spare: &mut Vec<T>) -> Result<T, cdr::DecodeError> {
+        local_or_deserialize::<T>(payload, spare)
     }
     fn decode_key(&self, payload: &[u8]) -> Result<T, cdr::DecodeError> {
         cdr::deserialize_key::<T>(payload)
@@ -81,12 +118,12 @@ impl<T: DdsType> SampleCodec<T> for Derived {
 pub(crate) fn decode_change<T: DdsType>(
     s: ReceivedSample,
     info: RemoteWriterInfo,
-    by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
+    decoding: &mut Decoding<T>,
     key: Vec<u8>,
     now: Instant,
     rx_time: SystemTime,
 ) -> Option<Incoming<T>> {
-    decode_change_with(&Derived, s, info, by_hash, key, now, rx_time)
+    decode_change_with(&Derived, s, info, decoding, key, now, rx_time)
 }
 
 /// Turns a received change into a cache input; `None` (logged) when it cannot be decoded or mapped to an
@@ -97,18 +134,19 @@ pub(crate) fn decode_change_with<T, C: SampleCodec<T>>(
     codec: &C,
     mut s: ReceivedSample,
     info: RemoteWriterInfo,
-    by_hash: &mut HashMap<[u8; 16], Vec<u8>>,
+    decoding: &mut Decoding<T>,
     mut key: Vec<u8>,
     now: Instant,
     rx_time: SystemTime,
 ) -> Option<Incoming<T>> {
     let source_timestamp = system_time(s.source_timestamp);
     let kind = s.kind;
+    let Decoding { by_hash, spare } = decoding;
     key.clear();
     let mut data = None;
     let mut key_holder = None;
     if kind == ChangeKind::Alive {
-        let d = match codec.decode(&mut s.payload) {
+        let d = match codec.decode(&mut s.payload, spare) {
             Ok(d) => d,
             Err(e) => {
                 tracing::warn!(writer = ?s.writer, seq = s.sequence.0, error = %e, "dropping undecodable sample");
@@ -187,7 +225,6 @@ mod tests {
     use super::*;
     use crate::cdr::{ByteOrder, XcdrVersion};
     use crate::rtps::{EntityId, Guid, GuidPrefix, Payload, SequenceNumber};
-    use foldhash::HashMapExt;
 
     #[derive(dds_macros::DdsType, Debug, Clone, PartialEq, Default)]
     #[dds(name = "test::K", appendable)]
@@ -211,12 +248,12 @@ mod tests {
     }
 
     /// `decode_change` from a writer with default QoS, now.
-    fn decode(s: ReceivedSample, by_hash: &mut HashMap<[u8; 16], Vec<u8>>) -> Option<Incoming<K>> {
+    fn decode(s: ReceivedSample, decoding: &mut Decoding<K>) -> Option<Incoming<K>> {
         let now = Instant::now();
         decode_change::<K>(
             s,
             RemoteWriterInfo::default(),
-            by_hash,
+            decoding,
             Vec::new(),
             now,
             SystemTime::now(),
@@ -225,7 +262,7 @@ mod tests {
 
     #[test]
     fn key_only_changes_map_by_key_payload_or_known_hash() {
-        let mut by_hash = HashMap::new();
+        let mut by_hash = Decoding::new();
         let s = K {
             id: "a".into(),
             v: 1,
@@ -272,7 +309,7 @@ mod tests {
         let mut expected = Vec::new();
         cdr::instance_key(&s, &mut expected).unwrap();
         for version in [XcdrVersion::Xcdr1, XcdrVersion::Xcdr2] {
-            let mut by_hash = HashMap::new();
+            let mut by_hash = Decoding::new();
             let mut buf = Vec::new();
             cdr::serialize(&s, version, ByteOrder::NATIVE, &mut buf).unwrap();
             decode(rs(ChangeKind::Alive, buf, None), &mut by_hash).unwrap();
@@ -282,5 +319,40 @@ mod tests {
             assert_eq!(d.key, expected);
             assert_eq!(d.kind, ChangeKind::Dispose);
         }
+    }
+
+    /// A value given back is decoded into (its string keeps its buffer), and the sample is the new one.
+    #[test]
+    fn a_kept_value_is_decoded_into() {
+        let mut decoding = Decoding::new();
+        let mut old = K {
+            id: String::with_capacity(64),
+            v: 0,
+        };
+        old.id.push_str("old");
+        let buffer = old.id.as_ptr();
+        assert!(decoding.has_room());
+        decoding.keep(old);
+        let s = K {
+            id: "new".into(),
+            v: 7,
+        };
+        let mut buf = Vec::new();
+        cdr::serialize(&s, XcdrVersion::Xcdr2, ByteOrder::NATIVE, &mut buf).unwrap();
+        let d = decode(rs(ChangeKind::Alive, buf.clone(), None), &mut decoding).unwrap();
+        let d = d.data.unwrap();
+        assert_eq!(d, s);
+        assert_eq!(
+            d.id.as_ptr(),
+            buffer,
+            "decoded into the kept value's string"
+        );
+        // None left: the next one is a fresh value.
+        let d2 = decode(rs(ChangeKind::Alive, buf, None), &mut decoding).unwrap();
+        assert_eq!(d2.data.unwrap(), s);
+        for _ in 0..MAX_SPARE_VALUES {
+            decoding.keep(s.clone());
+        }
+        assert!(!decoding.has_room());
     }
 }

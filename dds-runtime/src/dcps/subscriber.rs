@@ -11,8 +11,6 @@ use std::sync::{Arc, Condvar, Mutex};
 use std::task::{Context, Poll, Waker};
 use std::time::{Duration, Instant, SystemTime};
 
-use foldhash::{HashMap, HashMapExt};
-
 use crate::cdr::{self, DdsType};
 use crate::qos::{DataReaderQos, DataRepresentation, ReaderQos, SubscriberQos};
 use crate::rtps::{Event, Guid, ReaderSpec, ReceivedSample};
@@ -22,7 +20,7 @@ use super::cache::{to_sample, Outcome, ReaderCache, Selection};
 use super::condition::{
     QueryCondition, ReadCondition, ReadConditionSource, Signal, StatusCondition,
 };
-use super::decode::decode_change_with;
+use super::decode::{decode_change_with, Decoding};
 use super::driver::{Endpoint, EndpointHandle, Pending, RemoteWriterInfo};
 use super::endpoint::{check_history, EndpointState};
 use super::error::{DdsError, DdsResult};
@@ -292,8 +290,8 @@ pub(crate) fn credit_limit(q: &DataReaderQos) -> Option<usize> {
 
 pub(crate) struct CacheState<T> {
     pub(crate) cache: ReaderCache<T>,
-    /// Key hash → serialized key, learnt from samples that carried both (for key-hash-only disposes).
-    by_hash: HashMap<[u8; 16], Vec<u8>>,
+    /// What decoding keeps between changes: key hashes, values given back to decode into.
+    decoding: Decoding<T>,
     /// The queue being processed, swapped with `pending` (one lock round per batch, buffers reused).
     batch: VecDeque<(u64, Pending)>,
 }
@@ -524,6 +522,41 @@ impl<T: DdsType> DataReader<T> {
     /// ```
     pub fn take_into(&self, out: &mut Vec<Sample<T>>) -> DdsResult<usize> {
         self.select().take_into(out)
+    }
+
+    /// Gives taken samples back to the reader, which decodes later samples into their values: strings and
+    /// sequences keep their buffers, so a loop of [`take_into`](Self::take_into) and `recycle` over large
+    /// samples allocates nothing per sample, and a multi-megabyte sample is decoded into memory already
+    /// mapped. The reader keeps up to 1024 values (the rest are dropped, as are samples without data) until
+    /// it decodes into them or is deleted: give back only as many as the memory they hold is worth keeping
+    /// (`reader.recycle(batch.drain(..).take(n))`). Samples of another reader of the same type serve as well.
+    ///
+    /// ```no_run
+    /// # use dds_runtime::prelude::*;
+    /// # fn f<T: DdsType>(reader: &DataReader<T>) -> dds_runtime::dcps::DdsResult<()> {
+    /// let mut batch = Vec::new();
+    /// loop {
+    ///     reader.take_into(&mut batch)?;
+    ///     for s in &batch { /* ... */ }
+    ///     reader.recycle(batch.drain(..));
+    /// #   break;
+    /// }
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn recycle(&self, samples: impl IntoIterator<Item = Sample<T>>) {
+        let mut rest = samples.into_iter();
+        {
+            let mut st = lock(&self.inner.cache);
+            while st.decoding.has_room() {
+                let Some(s) = rest.next() else { break };
+                if let Some(v) = s.data {
+                    st.decoding.keep(v);
+                }
+            }
+        }
+        // What is not kept is dropped outside the lock.
+        drop(rest);
     }
 
     /// Reads the oldest not-read sample.
@@ -822,7 +855,7 @@ impl<K: ReaderKind> ReaderInner<K> {
             committed: Mutex::default(),
             cache: Mutex::new(CacheState {
                 cache,
-                by_hash: HashMap::new(),
+                decoding: Decoding::new(),
                 batch: VecDeque::new(),
             }),
             data_cv: Condvar::new(),
@@ -959,7 +992,7 @@ impl<K: ReaderKind> ReaderInner<K> {
             &self.codec,
             s,
             info,
-            &mut st.by_hash,
+            &mut st.decoding,
             key,
             pass.now,
             pass.rx_time,

@@ -577,24 +577,26 @@ impl<T: PerfSample> DataReaderListener<T> for OnData<T> {
 /// Answers pings: echo on the pinging participant's pong writer with the timestamp's lsb set.
 fn answer_pings<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
     let Ok(samples) = reader.take() else { return };
-    for s in samples {
-        let Some(d) = s.data else { continue };
+    for s in &samples {
+        let Some(d) = &s.data else { continue };
         if ctx.is_local(&s.info.publication_guid.to_bytes()) && !ctx.o.match_local {
             continue;
         }
         if let Some(w) = ctx.pong_writer_for(&s.info.publication_guid.to_bytes()) {
-            let _ = w.write_w_timestamp(&d, ts(ns_of(s.info.source_timestamp) | 1));
+            let _ = w.write_w_timestamp(d, ts(ns_of(s.info.source_timestamp) | 1));
             w.flush();
         }
     }
+    // As ddsperf reuses its sample buffers: large samples are then decoded into warm memory.
+    reader.recycle(samples);
 }
 
 /// Receives pongs: half the round trip per answering writer; the next ping once all answered.
 fn receive_pongs<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
     let Ok(samples) = reader.take() else { return };
     let now = now_ns();
-    for s in samples {
-        let Some(d) = s.data else { continue };
+    for s in &samples {
+        let Some(d) = &s.data else { continue };
         let sent = ns_of(s.info.source_timestamp);
         let isping = sent & 1 == 1;
         let half_rtt = (now - sent) / 2;
@@ -634,6 +636,7 @@ fn receive_pongs<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
             ctx.send_ping(seq);
         }
     }
+    reader.recycle(samples);
 }
 
 /// `sub` mode: sequence checking per writer and key, optional latency, and pongs for pinged data.
@@ -680,18 +683,19 @@ fn receive_batch<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) -> bool {
         }
     }
     drop(stats);
-    for s in samples {
+    for s in &samples {
         let sent = ns_of(s.info.source_timestamp);
         if sent & 1 == 1 {
             if let (Some(d), Some(w)) = (
-                s.data,
+                &s.data,
                 ctx.pong_writer_for(&s.info.publication_guid.to_bytes()),
             ) {
-                let _ = w.write_w_timestamp(&d, ts(sent - 1));
+                let _ = w.write_w_timestamp(d, ts(sent - 1));
                 w.flush();
             }
         }
     }
+    reader.recycle(samples);
     true
 }
 

@@ -69,7 +69,11 @@ impl SampleCodec<DynamicData> for DynamicType {
     fn keyed(&self) -> bool {
         self.is_keyed()
     }
-    fn decode(&self, payload: &mut Payload) -> Result<DynamicData, DecodeError> {
+    fn decode(
+        &self,
+        payload: &mut Payload,
+        _spare: &mut Vec<DynamicData>,
+    ) -> Result<DynamicData, DecodeError> {
         DynamicData::deserialize(self, payload)
     }
     fn decode_key(&self, payload: &[u8]) -> Result<DynamicData, DecodeError> {
