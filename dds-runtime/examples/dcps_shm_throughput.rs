@@ -187,8 +187,9 @@ fn subscriber<T: Bench>(domain: u32, shm: bool) -> Result<(), Box<dyn std::error
             return Err("no data for 30 s".into());
         }
         let mut end = false;
-        for s in r.take()? {
-            let Some(d) = s.data else { continue };
+        let samples = r.take()?;
+        for s in &samples {
+            let Some(d) = &s.data else { continue };
             if d.seq() == LAST {
                 end = true;
                 continue;
@@ -197,6 +198,8 @@ fn subscriber<T: Bench>(domain: u32, shm: bool) -> Result<(), Box<dyn std::error
             last = Instant::now();
             got += 1;
         }
+        // Later samples are decoded into these (a sample read in place goes back to its writer).
+        r.recycle(samples);
         if end {
             break;
         }

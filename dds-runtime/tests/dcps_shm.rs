@@ -602,6 +602,22 @@ fn plain_samples_are_read_in_place_and_a_reader_keeping_them_never_stalls_the_wr
         seqs.extend(got.iter().map(|s| s.seq));
     }
     assert_eq!(seqs, (40..60).collect::<Vec<_>>());
+    // Samples read in place and given back (`recycle`) are not kept to decode into: their buffers go
+    // back to the writer. Kept, the fourth batch would pass the 12 frames a participant holds in place.
+    for batch in 0..4 {
+        loan_write(&w, 60 + batch * 5..65 + batch * 5);
+        let mut got = Vec::new();
+        wait_until(MATCH_TIMEOUT, || {
+            r.take_into(&mut got).unwrap();
+            got.len() >= 5
+        });
+        assert!(
+            got.iter()
+                .all(|s| s.data.as_ref().is_some_and(|d| d.in_shared_memory())),
+            "batch {batch} not read in place"
+        );
+        r.recycle(got);
+    }
 }
 
 /// A writer that sends a burst as soon as it matched: iceoryx2 skips a subscriber that has not connected

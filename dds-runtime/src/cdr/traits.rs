@@ -232,4 +232,11 @@ pub trait DdsType: CdrType + crate::filter::FilterFields + Send + Sync + 'static
         let _ = shared;
         None
     }
+
+    /// Whether this value holds a received buffer it reads in place (see [`Self::decode_shared`]), which
+    /// must go back to its sender rather than be kept for decoding into (`DataReader::recycle`).
+    #[doc(hidden)]
+    fn holds_received_buffer(&self) -> bool {
+        false
+    }
 }

@@ -247,4 +247,8 @@ impl<T: DdsType + Pod> DdsType for InPlace<T> {
     fn decode_shared(shared: &dyn Any) -> Option<Self> {
         InPlace::from_payload(shared.downcast_ref::<Payload>()?)
     }
+
+    fn holds_received_buffer(&self) -> bool {
+        matches!(self.repr, Repr::Shared { .. })
+    }
 }

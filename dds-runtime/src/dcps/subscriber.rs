@@ -546,16 +546,21 @@ impl<T: DdsType> DataReader<T> {
     /// ```
     pub fn recycle(&self, samples: impl IntoIterator<Item = Sample<T>>) {
         let mut rest = samples.into_iter();
+        let mut held = Vec::new();
         {
             let mut st = lock(&self.inner.cache);
             while st.decoding.has_room() {
                 let Some(s) = rest.next() else { break };
-                if let Some(v) = s.data {
-                    st.decoding.keep(v);
+                match s.data {
+                    Some(v) if !v.holds_received_buffer() => st.decoding.keep(v),
+                    // Read in place: its buffer goes back to the sender, outside the lock.
+                    Some(v) => held.push(v),
+                    None => {}
                 }
             }
         }
         // What is not kept is dropped outside the lock.
+        drop(held);
         drop(rest);
     }
 
