@@ -94,19 +94,20 @@ fn peer() -> Result<(Proc, String), Skip> {
     Ok((p, pid))
 }
 
+/// Runs `cmd` (a `dds` command) to completion and returns its stdout; fails the test, dumping `peer`,
+/// when it did not exit successfully.
+fn run_dds(cmd: &mut Command, peer: &Proc) -> String {
+    let out = cmd.output().expect("running dds");
+    check!(out.status.success(), &[peer], "{cmd:?} failed: {out:?}");
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
 /// Runs `dds ARGS --domain DOMAIN` to completion and parses its stdout as JSON.
 fn dds_json(args: &[&str], peer: &Proc) -> Result<Value, Skip> {
-    let out = Command::new(our_bin("dds")?)
-        .args(args)
-        .args(["--domain", &DOMAIN.to_string(), "--wait", "3", "--json"])
-        .output()
-        .expect("running dds");
-    let text = String::from_utf8_lossy(&out.stdout).to_string();
-    check!(
-        out.status.success(),
-        &[peer],
-        "dds {args:?} failed: {out:?}"
-    );
+    let mut cmd = Command::new(our_bin("dds")?);
+    cmd.args(args)
+        .args(["--domain", &DOMAIN.to_string(), "--wait", "3", "--json"]);
+    let text = run_dds(&mut cmd, peer);
     Ok(serde_json::from_str(&text)
         .unwrap_or_else(|e| panic!("dds {args:?}: not JSON ({e}): {text}")))
 }
@@ -325,26 +326,19 @@ fn dds_subscribe_shows_disposes_that_marked_held_samples() {
 /// `dds subscribe Square --ndjson -n 3 --timeout 20` on `domain`, with `extra` arguments: the rows it printed
 /// and its whole output, once it has exited successfully (`peer` is dumped if not).
 fn three_squares(bin: &Path, domain: &str, extra: &[&OsStr], peer: &Proc) -> (Vec<Value>, String) {
-    let out = Command::new(bin)
-        .args([
-            "subscribe",
-            "Square",
-            "--ndjson",
-            "-n",
-            "3",
-            "--timeout",
-            "20",
-        ])
-        .args(extra)
-        .args(["--domain", domain])
-        .output()
-        .expect("running dds");
-    let text = String::from_utf8_lossy(&out.stdout).to_string();
-    check!(
-        out.status.success(),
-        &[peer],
-        "dds subscribe failed: {out:?}"
-    );
+    let mut cmd = Command::new(bin);
+    cmd.args([
+        "subscribe",
+        "Square",
+        "--ndjson",
+        "-n",
+        "3",
+        "--timeout",
+        "20",
+    ])
+    .args(extra)
+    .args(["--domain", domain]);
+    let text = run_dds(&mut cmd, peer);
     (ndjson_rows(&text), text)
 }
 
