@@ -349,8 +349,10 @@ participant_config! {
     defrag_max_samples: usize = copy,
     /// Per remote writer: bytes held in fragments, overhead counted (default 16 MiB).
     defrag_max_bytes: usize = copy,
-    /// Per remote writer: out-of-order samples held for reordering (default 1024); beyond it, later samples
-    /// are dropped and requested again once the gap is filled.
+    /// Per remote writer: out-of-order samples held for reordering (default 32 768); beyond it, later
+    /// samples are dropped and requested again once the gap is filled. The default holds a whole window of
+    /// small samples (512 KiB of 16-byte samples is 26 000), so that one lost or late datagram costs one
+    /// repair, not a repair of everything the writer sent after it.
     reorder_max_samples: usize = copy,
     /// Per remote writer: bytes of out-of-order samples held for reordering (default 64 MiB).
     reorder_max_bytes: usize = copy,
@@ -416,7 +418,7 @@ impl ParticipantConfig {
             max_sample_size: 64 * 1024 * 1024,
             defrag_max_samples: 8,
             defrag_max_bytes: 16 * 1024 * 1024,
-            reorder_max_samples: 1024,
+            reorder_max_samples: 32 * 1024,
             reorder_max_bytes: 64 * 1024 * 1024,
             writer_linger_duration: Duration::from_secs(1),
             max_repair_bytes: 256 * 1024,

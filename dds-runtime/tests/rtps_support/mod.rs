@@ -87,6 +87,9 @@ pub(crate) struct Sim {
     pub(crate) faults_on_discovery: bool,
     /// When `Some`, every datagram sent is logged here.
     pub(crate) trace: Option<Vec<Sent>>,
+    /// When `Some((node, d))`, the next user datagram that node sends arrives `d` late (once): a datagram
+    /// overtaken by those sent after it.
+    pub(crate) delay_next_user: Option<(usize, Duration)>,
 }
 
 /// A datagram as sent: (sending node, destinations, payload).
@@ -120,6 +123,7 @@ impl Sim {
             datagrams_sent: 0,
             faults_on_discovery: true,
             trace: None,
+            delay_next_user: None,
         }
     }
 
@@ -176,6 +180,13 @@ impl Sim {
                 if !self.nodes[i].up {
                     targets.clear();
                 }
+                let late = match self.delay_next_user {
+                    Some((from, d)) if from == i && user => {
+                        self.delay_next_user = None;
+                        d
+                    }
+                    _ => Duration::ZERO,
+                };
                 for to in targets {
                     let f = if user || self.faults_on_discovery {
                         self.faults
@@ -192,7 +203,7 @@ impl Sim {
                         } else {
                             self.rng.below(f.jitter.as_nanos() as u64)
                         };
-                        let at = self.now + f.latency + Duration::from_nanos(jitter);
+                        let at = self.now + f.latency + late + Duration::from_nanos(jitter);
                         self.seq += 1;
                         self.queue.push(Reverse(InFlight {
                             at,

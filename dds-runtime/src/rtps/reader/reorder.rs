@@ -45,7 +45,7 @@ pub(crate) struct PendingChange {
     pub group_seq: Option<SequenceNumber>,
 }
 
-/// Most copies of held payloads the pool keeps for reuse (the default `reorder_max_samples`).
+/// Most copies of held payloads the pool keeps for reuse.
 const POOL_BUFFERS: usize = 1024;
 /// Most capacity, in bytes, those copies keep in all.
 const POOL_BYTES: usize = 1 << 20;
