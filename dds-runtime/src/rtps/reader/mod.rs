@@ -619,6 +619,11 @@ impl Reader {
         }
     }
 
+    /// Gives back the room a burst of armed timers left in the timer queue (see `DueQueue::trim`).
+    pub(crate) fn trim_timers(&mut self) {
+        self.due.trim(crate::rtps::due::KEPT_TIMER_ROOM);
+    }
+
     pub(crate) fn next_timeout(&self) -> Option<Instant> {
         self.due.next()
     }

@@ -672,6 +672,11 @@ impl Writer {
         }
     }
 
+    /// Gives back the room a burst of armed timers left in the timer queue (see `DueQueue::trim`).
+    pub(crate) fn trim_timers(&mut self) {
+        self.repair_queue.trim(crate::rtps::due::KEPT_TIMER_ROOM);
+    }
+
     pub(crate) fn next_timeout(&self) -> Option<Instant> {
         match (self.repair_queue.next(), self.hb_due) {
             (Some(a), Some(b)) => Some(a.min(b)),
