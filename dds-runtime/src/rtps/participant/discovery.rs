@@ -16,7 +16,7 @@ use crate::rtps::messages::parameter::pid;
 use crate::rtps::messages::Data;
 use crate::rtps::reader::WriterProxy;
 use crate::rtps::types::*;
-use crate::rtps::writer::ReaderProxy;
+use crate::rtps::writer::{locators_with_multicast, ReaderProxy};
 use crate::xtypes::assign::{local_types, TypeResolver};
 use crate::xtypes::typeobject::TypeIdentifier;
 
@@ -129,11 +129,16 @@ impl Participant {
         group: Option<Locator>,
         which: impl Fn(EntityId) -> bool,
     ) {
+        // One list (the metatraffic locators, then the group) for the proxies of its builtin readers.
+        let readers_at = match group {
+            Some(_) => locators_with_multicast(meta, group),
+            None => meta.clone(),
+        };
         for (ours, theirs, bit) in builtin::WRITER_PAIRS {
             if bits & bit != 0 && which(ours) {
                 if let Some(w) = self.writers.get_mut(&ours) {
-                    let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true)
-                        .with_multicast(group);
+                    let proxy = ReaderProxy::new(Guid::new(prefix, theirs), readers_at.clone(), true)
+                        .with_multicast_last(group.is_some());
                     w.add_proxy(now, proxy, true, &mut self.events);
                 }
             }

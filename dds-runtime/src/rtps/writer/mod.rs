@@ -20,7 +20,7 @@ pub(crate) use group::writer_set_digest;
 pub use group::WriterGroup;
 pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use liveliness::OwnLeases;
-pub(crate) use reader_proxy::ReaderProxy;
+pub(crate) use reader_proxy::{locators_with_multicast, ReaderProxy};
 #[cfg(feature = "net")]
 pub(crate) use stand_in::user_data as stand_in_user_data;
 use stand_in::StandIn;
@@ -595,12 +595,9 @@ impl Writer {
         if !p.reliable {
             return;
         }
-        if p.last_acknack
-            .is_some_and(|c| ack.count.wrapping_sub(c) <= 0)
-        {
+        if !p.take_acknack_count(ack.count) {
             return;
         }
-        p.last_acknack = Some(ack.count);
         let base = ack.reader_sn_state.base.min(next_sn);
         let progressed = base > p.acked;
         if progressed {
@@ -654,12 +651,9 @@ impl Writer {
         if !p.reliable || nf.writer_sn < p.acked {
             return;
         }
-        if p.last_nackfrag
-            .is_some_and(|c| nf.count.wrapping_sub(c) <= 0)
-        {
+        if !p.take_nackfrag_count(nf.count) {
             return;
         }
-        p.last_nackfrag = Some(nf.count);
         match fragments {
             Some(total) => p.request_frags(nf.writer_sn, nf.fragment_number_state.iter(), total),
             None => {
