@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use crate::rtps::types::Guid;
 
-/// The room (in entries) a timer queue keeps beyond what is queued once trimmed.
+/// The room (in entries) a timer queue, or an endpoint's proxy map, keeps beyond what it holds once trimmed.
 pub(crate) const KEPT_TIMER_ROOM: usize = 16;
 
 /// Proxy timers of one endpoint, earliest first. An entry may be stale (its timer cleared, its proxy gone):

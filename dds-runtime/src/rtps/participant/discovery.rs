@@ -137,8 +137,9 @@ impl Participant {
         for (ours, theirs, bit) in builtin::WRITER_PAIRS {
             if bits & bit != 0 && which(ours) {
                 if let Some(w) = self.writers.get_mut(&ours) {
-                    let proxy = ReaderProxy::new(Guid::new(prefix, theirs), readers_at.clone(), true)
-                        .with_multicast_last(group.is_some());
+                    let proxy =
+                        ReaderProxy::new(Guid::new(prefix, theirs), readers_at.clone(), true)
+                            .with_multicast_last(group.is_some());
                     w.add_proxy(now, proxy, true, &mut self.events);
                 }
             }

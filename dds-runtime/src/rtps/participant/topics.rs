@@ -97,8 +97,8 @@ impl Participant {
         let (ours, theirs, bit) = TOPIC_WRITER_PAIR;
         if bits & bit != 0 {
             if let Some(w) = self.writers.get_mut(&ours) {
-                let proxy =
-                    ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true).with_multicast(group);
+                let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true)
+                    .with_multicast(group);
                 w.add_proxy(now, proxy, true, &mut self.events);
             }
         }

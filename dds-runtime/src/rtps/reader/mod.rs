@@ -26,7 +26,6 @@ pub(crate) const DISCOVERY_ACK_DELAY: Duration = Duration::from_millis(5);
 /// acknowledgement of the peer's pushed announcements, which arrive at about the same time.
 pub(crate) const PREEMPTIVE_ACK_DELAY: Duration = Duration::from_millis(20);
 
-use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use crate::rtps::api::{ChangeKind, Event, Payload, ReceivedSample};
@@ -36,6 +35,7 @@ use crate::rtps::messages::{
 };
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::pool::BufferPool;
+use crate::rtps::proxy_map::ProxyMap;
 use crate::rtps::types::*;
 use coherent::{group_set, Assembler, SetLimits, SetMark};
 use defrag::Defrag;
@@ -100,8 +100,8 @@ pub(crate) struct ReaderParams {
 pub(crate) struct Reader {
     pub guid: Guid,
     params: ReaderParams,
-    /// Boxed: a map node then holds pointers, not whole proxies (see `docs/performance.md`, "Footprint").
-    proxies: BTreeMap<Guid, Box<WriterProxy>>,
+    /// Sorted boxes (see `ProxyMap`, and `docs/performance.md`, "Footprint").
+    proxies: ProxyMap<WriterProxy>,
     /// The proxies whose `acknack_due` or `nackfrag_due` is armed, in deadline order.
     due: DueQueue,
     /// Back-pressure: how many more changes reliable proxies may deliver (`None`: no limit). A change
@@ -117,7 +117,7 @@ impl Reader {
         Reader {
             guid,
             params,
-            proxies: BTreeMap::new(),
+            proxies: ProxyMap::new(),
             due: DueQueue::default(),
             credit: std::cell::Cell::new(None),
         }
@@ -204,7 +204,7 @@ impl Reader {
             proxy.acknack_due = Some(now + wait);
         }
         self.due.arm(proxy.acknack_due, proxy.guid);
-        self.proxies.insert(proxy.guid, Box::new(proxy));
+        self.proxies.insert(Box::new(proxy));
     }
 
     pub(crate) fn remove_proxy(&mut self, g: &Guid) -> bool {
@@ -319,8 +319,8 @@ impl Reader {
 
     /// Runs `f` on the proxy of `writer`, with the rest of the reader borrowed shared (`accept` borrows
     /// `self`). The map is taken out (O(1)) rather than the proxy removed and re-inserted, and put back
-    /// without dropping the empty map that stood in for it: that drop (a `BTreeMap`'s `IntoIter`, even
-    /// empty) was 5% of a 4 MiB subscriber's time, once per fragment.
+    /// without dropping the empty map that stood in for it: that drop (when it was a `BTreeMap`, its
+    /// `IntoIter`, even empty) was 5% of a 4 MiB subscriber's time, once per fragment.
     fn with_proxy(&mut self, writer: Guid, f: impl FnOnce(&Self, &mut WriterProxy)) {
         let mut proxies = std::mem::take(&mut self.proxies);
         if let Some(p) = proxies.get_mut(&writer) {
@@ -328,7 +328,7 @@ impl Reader {
         }
         let stand_in = std::mem::replace(&mut self.proxies, proxies);
         debug_assert!(stand_in.is_empty());
-        // An empty `BTreeMap` owns no allocation: forgetting it leaks nothing.
+        // An empty map owns no allocation: forgetting it leaks nothing.
         std::mem::forget(stand_in);
     }
 
@@ -619,9 +619,11 @@ impl Reader {
         }
     }
 
-    /// Gives back the room a burst of armed timers left in the timer queue (see `DueQueue::trim`).
-    pub(crate) fn trim_timers(&mut self) {
+    /// Gives back the room a burst (many matches, many armed timers) left in the proxies and the timer
+    /// queue (see `DueQueue::trim`).
+    pub(crate) fn trim_room(&mut self) {
         self.due.trim(crate::rtps::due::KEPT_TIMER_ROOM);
+        self.proxies.trim(crate::rtps::due::KEPT_TIMER_ROOM);
     }
 
     pub(crate) fn next_timeout(&self) -> Option<Instant> {
@@ -662,7 +664,7 @@ impl Reader {
         let rid = self.guid.entity_id;
         let first = Guid::new(prefix, EntityId([0; 4]));
         let last = Guid::new(prefix, EntityId([0xff; 4]));
-        for p in self.proxies.range_mut(first..=last).map(|(_, p)| p) {
+        for p in self.proxies.range_mut(first..=last) {
             let may = p.synced || !p.guid.entity_id.is_builtin();
             if may && p.acknack_due.is_some() && p.destination() == [to] {
                 Self::send_acknack(rid, p, out);

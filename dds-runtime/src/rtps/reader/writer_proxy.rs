@@ -154,6 +154,12 @@ impl WriterProxy {
     }
 }
 
+impl crate::rtps::proxy_map::Keyed for WriterProxy {
+    fn key(&self) -> &Guid {
+        &self.guid
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

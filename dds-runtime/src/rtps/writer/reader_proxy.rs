@@ -268,8 +268,17 @@ impl ReaderProxy {
 }
 
 /// A proxy's locator list: `unicast`, then `multicast` if any (see [`ReaderProxy::with_multicast_last`]).
-pub(crate) fn locators_with_multicast(unicast: &[Locator], multicast: Option<Locator>) -> Arc<[Locator]> {
+pub(crate) fn locators_with_multicast(
+    unicast: &[Locator],
+    multicast: Option<Locator>,
+) -> Arc<[Locator]> {
     unicast.iter().copied().chain(multicast).collect()
+}
+
+impl crate::rtps::proxy_map::Keyed for ReaderProxy {
+    fn key(&self) -> &Guid {
+        &self.guid
+    }
 }
 
 /// A sequence number as a bit's number in the requests' window (`None` below 1: no change has it).
