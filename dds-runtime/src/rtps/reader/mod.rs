@@ -37,7 +37,7 @@ use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::pool::BufferPool;
 use crate::rtps::proxy_map::ProxyMap;
 use crate::rtps::types::*;
-use coherent::{group_set, Assembler, SetLimits, SetMark};
+use coherent::{group_set, SetLimits, SetMark};
 use defrag::Defrag;
 
 /// Whether every must-understand inline QoS parameter is one we know.
@@ -127,9 +127,10 @@ impl Reader {
     pub(crate) fn set_credit(&mut self, credit: Option<usize>, out: &mut Vec<Event>) {
         self.credit.set(credit);
         let rid = self.guid.entity_id;
+        let to = (rid, self.set_limits());
         for p in self.proxies.values_mut() {
             if p.reliable {
-                Self::drain(rid, p, &self.credit, out);
+                Self::drain(to, p, &self.credit, out);
             }
         }
     }
@@ -189,10 +190,6 @@ impl Reader {
         preemptive: bool,
     ) {
         proxy.reliable &= self.params.reliable;
-        proxy.coherent = Assembler::new(SetLimits {
-            max_samples: self.params.reorder_max_samples,
-            max_bytes: self.params.reorder_max_bytes,
-        });
         if proxy.reliable && preemptive {
             // Pre-emptive ACKNACK: prompts the writer to tell us what it has. Matches come in bursts
             // (a peer's announcements), so it waits for the others to the same peer.
@@ -215,8 +212,16 @@ impl Reader {
         had
     }
 
+    /// What one writer's coherent set may hold.
+    fn set_limits(&self) -> SetLimits {
+        SetLimits {
+            max_samples: self.params.reorder_max_samples,
+            max_bytes: self.params.reorder_max_bytes,
+        }
+    }
+
     fn deliver(
-        reader: EntityId,
+        (reader, limits): (EntityId, SetLimits),
         p: &mut WriterProxy,
         sn: SequenceNumber,
         slot: Slot,
@@ -233,16 +238,17 @@ impl Reader {
                 source_timestamp: c.source_timestamp,
                 group_sequence: c.group_seq,
             };
-            if c.coherent.is_none() && !p.coherent.is_open() {
+            if c.coherent.is_none() && !p.coherent_open() {
                 out.push(Event::Sample(s));
             } else {
-                p.coherent.offer(sn, c.coherent, s, out);
+                let coherent = &mut p.backlog_mut().coherent;
+                coherent.offer(sn, c.coherent, s, limits, out);
             }
         }
     }
 
     fn drain(
-        reader: EntityId,
+        reader: (EntityId, SetLimits),
         p: &mut WriterProxy,
         credit: &std::cell::Cell<Option<usize>>,
         out: &mut Vec<Event>,
@@ -266,6 +272,7 @@ impl Reader {
     /// Puts one received change (or irrelevant number) into sequence.
     fn accept(&self, p: &mut WriterProxy, sn: SequenceNumber, slot: Slot, out: &mut Vec<Event>) {
         let rid = self.guid.entity_id;
+        let to = (rid, self.set_limits());
         if p.reliable {
             if p.has(sn) {
                 return;
@@ -276,9 +283,9 @@ impl Reader {
                     // No room downstream: treat it as not received, so it is NACKed again later.
                     return;
                 }
-                Self::deliver(rid, p, sn, slot, out);
+                Self::deliver(to, p, sn, slot, out);
                 p.next_expected = sn.next();
-                Self::drain(rid, p, &self.credit, out);
+                Self::drain(to, p, &self.credit, out);
             } else {
                 if p.held() < self.params.reorder_max_samples
                     && p.held_bytes() + slot.size() <= self.params.reorder_max_bytes
@@ -298,7 +305,7 @@ impl Reader {
                 });
             }
             p.synced = true;
-            Self::deliver(rid, p, sn, slot, out);
+            Self::deliver(to, p, sn, slot, out);
             p.next_expected = sn.next();
         }
         p.drop_stale_defrag();
@@ -492,6 +499,7 @@ impl Reader {
 
     pub(crate) fn on_gap(&mut self, writer: Guid, g: &Gap, out: &mut Vec<Event>) {
         let rid = self.guid.entity_id;
+        let to = (rid, self.set_limits());
         let cap = self.params.reorder_max_samples;
         let Some(p) = self.proxies.get_mut(&writer) else {
             return;
@@ -502,7 +510,7 @@ impl Reader {
             // Nothing below base will come any more. What we already hold of it was published and is delivered
             // in order; the rest is irrelevant (not lost).
             while let Some((sn, slot)) = p.take_first_if(|sn, _| sn < base) {
-                Self::deliver(rid, p, sn, slot, out);
+                Self::deliver(to, p, sn, slot, out);
             }
             p.next_expected = base;
         } else if g.gap_start > p.next_expected && base.0 - g.gap_start.0 <= 256 {
@@ -517,7 +525,7 @@ impl Reader {
                 p.hold_irrelevant(sn);
             }
         }
-        Self::drain(rid, p, &self.credit, out);
+        Self::drain(to, p, &self.credit, out);
         p.drop_stale_defrag();
     }
 
@@ -529,6 +537,7 @@ impl Reader {
         out: &mut Vec<Event>,
     ) {
         let rid = self.guid.entity_id;
+        let to = (rid, self.set_limits());
         let (delay, ack_delay) = (self.params.heartbeat_response_delay, self.params.ack_delay);
         let Some(p) = self.proxies.get_mut(&writer) else {
             return;
@@ -550,7 +559,7 @@ impl Reader {
             while let Some((k, slot)) = p.take_first_if(|k, _| k < hb.first_sn) {
                 if matches!(slot, Slot::Change(_)) {
                     lost += (k.0 - sn.0) as u64;
-                    Self::deliver(rid, p, k, slot, out);
+                    Self::deliver(to, p, k, slot, out);
                     sn = k.next();
                 }
             }
@@ -563,7 +572,7 @@ impl Reader {
                 });
             }
             p.next_expected = hb.first_sn;
-            Self::drain(rid, p, &self.credit, out);
+            Self::drain(to, p, &self.credit, out);
             p.drop_stale_defrag();
         }
         p.synced = true;
