@@ -16,7 +16,7 @@ use crate::rtps::messages::parameter::pid;
 use crate::rtps::messages::Data;
 use crate::rtps::reader::WriterProxy;
 use crate::rtps::types::*;
-use crate::rtps::writer::{locators_with_multicast, ReaderProxy};
+use crate::rtps::writer::ReaderProxy;
 use crate::xtypes::assign::{local_types, TypeResolver};
 use crate::xtypes::typeobject::TypeIdentifier;
 
@@ -90,9 +90,10 @@ impl Participant {
             return;
         }
         let lease_deadline = now + data.lease_duration;
+        let group = self.shared_metatraffic_group(&data);
         if let Some(p) = self.participants.get_mut(&data.guid_prefix) {
             p.lease_deadline = lease_deadline;
-            p.update(&data);
+            p.update(&data, group);
             return;
         }
         if self.participants.len() >= MAX_PARTICIPANTS {
@@ -100,11 +101,10 @@ impl Participant {
         }
         let prefix = data.guid_prefix;
         debug!(participant = ?prefix, vendor = ?data.vendor_id, "participant discovered");
-        let proxy = Box::new(ProxyParticipant::new(&data, lease_deadline));
-        // One list for all the proxies of its builtin endpoints.
+        let proxy = Box::new(ProxyParticipant::new(&data, lease_deadline, group));
+        // One list for all the proxies of its builtin endpoints (the group last).
         let meta = proxy.metatraffic.clone();
         let bits = data.builtin_endpoints;
-        let group = self.shared_metatraffic_group(&data);
         self.events
             .push_back(Event::ParticipantDiscovered(Box::new(data)));
         self.participants.insert(prefix, proxy);
@@ -119,7 +119,9 @@ impl Participant {
     }
 
     /// Matches those builtin endpoints of ours that `which` selects with the ones the participant `prefix`
-    /// announces in `bits`. `group`: see [`Self::shared_metatraffic_group`].
+    /// announces in `bits`, at `meta` (its metatraffic locators, with `group` last when there is one).
+    /// `group`: see [`Self::shared_metatraffic_group`]; `None` for endpoints addressed to one participant
+    /// (their proxies then use the first locator only).
     pub(super) fn match_builtin_pairs(
         &mut self,
         now: Instant,
@@ -129,17 +131,11 @@ impl Participant {
         group: Option<Locator>,
         which: impl Fn(EntityId) -> bool,
     ) {
-        // One list (the metatraffic locators, then the group) for the proxies of its builtin readers.
-        let readers_at = match group {
-            Some(_) => locators_with_multicast(meta, group),
-            None => meta.clone(),
-        };
         for (ours, theirs, bit) in builtin::WRITER_PAIRS {
             if bits & bit != 0 && which(ours) {
                 if let Some(w) = self.writers.get_mut(&ours) {
-                    let proxy =
-                        ReaderProxy::new(Guid::new(prefix, theirs), readers_at.clone(), true)
-                            .with_multicast_last(group.is_some());
+                    let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true)
+                        .with_multicast_last(group.is_some());
                     w.add_proxy(now, proxy, true, &mut self.events);
                 }
             }

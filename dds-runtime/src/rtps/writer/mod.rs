@@ -20,7 +20,7 @@ pub(crate) use group::writer_set_digest;
 pub use group::WriterGroup;
 pub(crate) use history::{CacheChange, HistoryCache};
 pub(crate) use liveliness::OwnLeases;
-pub(crate) use reader_proxy::{locators_with_multicast, ReaderProxy};
+pub(crate) use reader_proxy::ReaderProxy;
 #[cfg(feature = "net")]
 pub(crate) use stand_in::user_data as stand_in_user_data;
 use stand_in::StandIn;

@@ -268,7 +268,7 @@ impl ReaderProxy {
 }
 
 /// A proxy's locator list: `unicast`, then `multicast` if any (see [`ReaderProxy::with_multicast_last`]).
-pub(crate) fn locators_with_multicast(
+fn locators_with_multicast(
     unicast: &[Locator],
     multicast: Option<Locator>,
 ) -> Arc<[Locator]> {
