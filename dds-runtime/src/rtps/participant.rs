@@ -51,6 +51,8 @@ struct ProxyParticipant {
     builtin_endpoints: u32,
     /// Its TypeLookup endpoints are matched with ours (done when a request or reply is first exchanged).
     type_lookup_matched: bool,
+    /// Its participant-message endpoints are matched with ours (done when a message is first exchanged).
+    messages_matched: bool,
     /// Where its builtin endpoints listen: one list, shared with all their proxies. When its builtin readers
     /// share a metatraffic multicast group with us, the group is the last entry (for the proxies of its
     /// readers, `ReaderProxy::with_multicast_last`; the others use the first entry only).
@@ -68,6 +70,7 @@ impl ProxyParticipant {
             vendor_id: data.vendor_id,
             builtin_endpoints: data.builtin_endpoints,
             type_lookup_matched: false,
+            messages_matched: false,
             metatraffic: metatraffic(data, group),
             announcement: data.encode().into_boxed_slice(),
         }
@@ -93,6 +96,7 @@ impl ProxyParticipant {
         }
         *self = ProxyParticipant {
             type_lookup_matched: self.type_lookup_matched,
+            messages_matched: self.messages_matched,
             ..ProxyParticipant::new(data, self.lease_deadline, group)
         };
         true

@@ -108,9 +108,16 @@ impl Participant {
         self.events
             .push_back(Event::ParticipantDiscovered(Box::new(data)));
         self.participants.insert(prefix, proxy);
-        // The TypeLookup endpoints are matched when a request or reply is first exchanged with it.
-        let pairs = |ours: EntityId| !super::type_lookup::is_service_endpoint(ours);
+        // The TypeLookup endpoints are matched when a request or reply is first exchanged with it, the
+        // participant-message ones when a message is (see `match_messages`).
+        let pairs = |ours: EntityId| {
+            !super::type_lookup::is_service_endpoint(ours)
+                && !super::liveliness::is_message_endpoint(ours)
+        };
         self.match_builtin_pairs(now, prefix, bits, &meta, group, pairs);
+        if self.messages_written() {
+            self.match_messages(now, prefix);
+        }
         self.match_topic_builtins(now, prefix, bits, &meta, group);
         // Answer directly so the newcomer need not wait for our next periodic announcement.
         if !meta.is_empty() {
@@ -151,6 +158,15 @@ impl Participant {
                 }
             }
         }
+    }
+
+    /// The shared group a discovered participant's metatraffic list `meta` ends with, if any (see
+    /// `ProxyParticipant::metatraffic`): its last entry when that is one of our metatraffic multicast
+    /// locators (it is the group then: without a group, such a locator would have been chosen as one).
+    pub(super) fn metatraffic_group(&self, meta: &[Locator]) -> Option<Locator> {
+        meta.last()
+            .filter(|l| l.is_multicast() && self.config.metatraffic_multicast.contains(l))
+            .copied()
     }
 
     /// The metatraffic multicast group a discovered participant shares with us, if any. Our SEDP (topics,

@@ -3,11 +3,19 @@
 
 use std::time::{Duration, Instant};
 
+use tracing::trace;
+
 use super::Participant;
 use crate::qos::Liveliness;
 use crate::rtps::api::WriteChange;
 use crate::rtps::discovery::builtin;
-use crate::rtps::types::{EntityId, Guid};
+use crate::rtps::types::{EntityId, Guid, GuidPrefix, SequenceNumber};
+
+/// Whether `id` is one of our participant-message endpoints: matched with a peer's on first use (see
+/// [`Participant::match_messages`]), not at discovery.
+pub(super) fn is_message_endpoint(id: EntityId) -> bool {
+    id == EntityId::P2P_MESSAGE_WRITER || id == EntityId::P2P_MESSAGE_READER
+}
 
 impl Participant {
     /// Something arrived from `writer` (DATA, or a HEARTBEAT with the liveliness flag): it is alive.
@@ -85,6 +93,7 @@ impl Participant {
 
     /// Writes a ParticipantMessageData of `kind` (no data) on the builtin participant-message writer.
     pub(super) fn send_participant_message(&mut self, now: Instant, kind: [u8; 4]) {
+        self.match_messages_all(now);
         let prefix = self.config.guid_prefix;
         let change = WriteChange::alive(builtin::encode_participant_message(&prefix, kind, &[]))
             .with_key_hash(builtin::participant_message_key(&prefix, kind));
@@ -106,5 +115,62 @@ impl Participant {
             w.send_liveliness(&mut self.out);
         }
         self.assert_liveliness_shm(writer);
+    }
+
+    /// Matches our participant-message endpoints with those of the participant `prefix`, unless done
+    /// already. A participant writes such a message only for writers with an AUTOMATIC lease (ours, and
+    /// Cyclone's, write none otherwise) or MANUAL_BY_PARTICIPANT liveliness, so most peers never send one:
+    /// the two proxies are made when the peer's writer first sends (DATA, or a HEARTBEAT announcing
+    /// changes, before it is handled), when we first write one (to every peer), or at discovery once we
+    /// have written one (our writer keeps the last of each kind for late joiners). See
+    /// `docs/performance.md`, "Footprint".
+    pub(super) fn match_messages(&mut self, now: Instant, prefix: GuidPrefix) {
+        let Some(p) = self.participants.get_mut(&prefix) else {
+            return;
+        };
+        if p.messages_matched {
+            return;
+        }
+        p.messages_matched = true;
+        let (bits, meta) = (p.builtin_endpoints, p.metatraffic.clone());
+        let group = self.metatraffic_group(&meta);
+        trace!(participant = ?prefix, "participant-message endpoints matched");
+        self.match_builtin_pairs(now, prefix, bits, &meta, group, is_message_endpoint);
+    }
+
+    /// The remote endpoints our builtin endpoint `id` is matched with (discovery, participant message,
+    /// TypeLookup: see `docs/performance.md`, "Footprint", for which are matched when).
+    pub fn builtin_matches(&self, id: EntityId) -> Vec<Guid> {
+        if !id.is_builtin() {
+            return Vec::new();
+        }
+        let writer = self.writers.get(&id).map(|w| w.matched().copied());
+        let reader = self.readers.get(&id).map(|r| r.matched().copied());
+        writer
+            .into_iter()
+            .flatten()
+            .chain(reader.into_iter().flatten())
+            .collect()
+    }
+
+    /// Whether we ever wrote a participant message.
+    pub(super) fn messages_written(&self) -> bool {
+        self.writers
+            .get(&EntityId::P2P_MESSAGE_WRITER)
+            .is_some_and(|w| w.last_sn() > SequenceNumber(0))
+    }
+
+    /// Matches the participant-message endpoints of every discovered participant: what we write goes to
+    /// all of them.
+    fn match_messages_all(&mut self, now: Instant) {
+        let pending: Vec<GuidPrefix> = self
+            .participants
+            .iter()
+            .filter(|(_, p)| !p.messages_matched)
+            .map(|(prefix, _)| *prefix)
+            .collect();
+        for prefix in pending {
+            self.match_messages(now, prefix);
+        }
     }
 }

@@ -268,10 +268,7 @@ impl ReaderProxy {
 }
 
 /// A proxy's locator list: `unicast`, then `multicast` if any (see [`ReaderProxy::with_multicast_last`]).
-fn locators_with_multicast(
-    unicast: &[Locator],
-    multicast: Option<Locator>,
-) -> Arc<[Locator]> {
+fn locators_with_multicast(unicast: &[Locator], multicast: Option<Locator>) -> Arc<[Locator]> {
     unicast.iter().copied().chain(multicast).collect()
 }
 
