@@ -51,8 +51,9 @@ struct ProxyParticipant {
     builtin_endpoints: u32,
     /// Its TypeLookup endpoints are matched with ours (done when a request or reply is first exchanged).
     type_lookup_matched: bool,
-    /// Its participant-message endpoints are matched with ours (done when a message is first exchanged).
-    messages_matched: bool,
+    /// Which of its participant-message endpoints are matched with ours (done on first use, see
+    /// `Participant::match_messages`): bits `MESSAGES_IN` (its writer) and `MESSAGES_OUT` (its reader).
+    messages_matched: u8,
     /// Where its builtin endpoints listen: one list, shared with all their proxies. When its builtin readers
     /// share a metatraffic multicast group with us, the group is the last entry (for the proxies of its
     /// readers, `ReaderProxy::with_multicast_last`; the others use the first entry only).
@@ -70,7 +71,7 @@ impl ProxyParticipant {
             vendor_id: data.vendor_id,
             builtin_endpoints: data.builtin_endpoints,
             type_lookup_matched: false,
-            messages_matched: false,
+            messages_matched: 0,
             metatraffic: metatraffic(data, group),
             announcement: data.encode().into_boxed_slice(),
         }

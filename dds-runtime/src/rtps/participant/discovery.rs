@@ -116,7 +116,7 @@ impl Participant {
         };
         self.match_builtin_pairs(now, prefix, bits, &meta, group, pairs);
         if self.messages_written() {
-            self.match_messages(now, prefix);
+            self.match_messages(now, prefix, super::liveliness::MESSAGES_OUT);
         }
         self.match_topic_builtins(now, prefix, bits, &meta, group);
         // Answer directly so the newcomer need not wait for our next periodic announcement.

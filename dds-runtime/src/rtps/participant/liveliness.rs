@@ -17,6 +17,11 @@ pub(super) fn is_message_endpoint(id: EntityId) -> bool {
     id == EntityId::P2P_MESSAGE_WRITER || id == EntityId::P2P_MESSAGE_READER
 }
 
+/// [`Participant::match_messages`]: our participant-message reader with a peer's writer.
+pub(super) const MESSAGES_IN: u8 = 1;
+/// [`Participant::match_messages`]: our participant-message writer with a peer's reader.
+pub(super) const MESSAGES_OUT: u8 = 2;
+
 impl Participant {
     /// Something arrived from `writer` (DATA, or a HEARTBEAT with the liveliness flag): it is alive.
     pub(super) fn writer_asserted(&mut self, now: Instant, writer: Guid) {
@@ -117,25 +122,32 @@ impl Participant {
         self.assert_liveliness_shm(writer);
     }
 
-    /// Matches our participant-message endpoints with those of the participant `prefix`, unless done
-    /// already. A participant writes such a message only for writers with an AUTOMATIC lease (ours, and
-    /// Cyclone's, write none otherwise) or MANUAL_BY_PARTICIPANT liveliness, so most peers never send one:
-    /// the two proxies are made when the peer's writer first sends (DATA, or a HEARTBEAT announcing
-    /// changes, before it is handled), when we first write one (to every peer), or at discovery once we
-    /// have written one (our writer keeps the last of each kind for late joiners). See
+    /// Matches our participant-message reader (`which` holds [`MESSAGES_IN`]) or writer ([`MESSAGES_OUT`])
+    /// with the participant `prefix`'s, unless done already. A participant writes such a message only for
+    /// writers with an AUTOMATIC lease (ours write none otherwise) or MANUAL_BY_PARTICIPANT liveliness, so
+    /// many peers never send one, and we often never write one: each proxy is made on first use. Our
+    /// reader's when the peer's writer first sends (DATA, or a HEARTBEAT announcing changes, before it is
+    /// handled); our writer's with every peer before we first write, and at discovery once we have
+    /// written (our writer keeps the last message of each kind for late joiners). See
     /// `docs/performance.md`, "Footprint".
-    pub(super) fn match_messages(&mut self, now: Instant, prefix: GuidPrefix) {
+    pub(super) fn match_messages(&mut self, now: Instant, prefix: GuidPrefix, which: u8) {
         let Some(p) = self.participants.get_mut(&prefix) else {
             return;
         };
-        if p.messages_matched {
+        let todo = which & !p.messages_matched;
+        if todo == 0 {
             return;
         }
-        p.messages_matched = true;
+        p.messages_matched |= todo;
         let (bits, meta) = (p.builtin_endpoints, p.metatraffic.clone());
         let group = self.metatraffic_group(&meta);
-        trace!(participant = ?prefix, "participant-message endpoints matched");
-        self.match_builtin_pairs(now, prefix, bits, &meta, group, is_message_endpoint);
+        trace!(participant = ?prefix, todo, "participant-message endpoints matched");
+        let ours = move |id: EntityId| match id {
+            EntityId::P2P_MESSAGE_READER => todo & MESSAGES_IN != 0,
+            EntityId::P2P_MESSAGE_WRITER => todo & MESSAGES_OUT != 0,
+            _ => false,
+        };
+        self.match_builtin_pairs(now, prefix, bits, &meta, group, ours);
     }
 
     /// The remote endpoints our builtin endpoint `id` is matched with (discovery, participant message,
@@ -160,17 +172,17 @@ impl Participant {
             .is_some_and(|w| w.last_sn() > SequenceNumber(0))
     }
 
-    /// Matches the participant-message endpoints of every discovered participant: what we write goes to
-    /// all of them.
+    /// Matches our participant-message writer with every discovered participant's reader: what we write
+    /// goes to all of them.
     fn match_messages_all(&mut self, now: Instant) {
         let pending: Vec<GuidPrefix> = self
             .participants
             .iter()
-            .filter(|(_, p)| !p.messages_matched)
+            .filter(|(_, p)| p.messages_matched & MESSAGES_OUT == 0)
             .map(|(prefix, _)| *prefix)
             .collect();
         for prefix in pending {
-            self.match_messages(now, prefix);
+            self.match_messages(now, prefix, MESSAGES_OUT);
         }
     }
 }

@@ -159,7 +159,7 @@ impl Participant {
         if is_service_writer(writer.entity_id) {
             self.match_type_lookup(now, writer.prefix);
         } else if writer.entity_id == EntityId::P2P_MESSAGE_WRITER {
-            self.match_messages(now, writer.prefix);
+            self.match_messages(now, writer.prefix, super::liveliness::MESSAGES_IN);
         }
     }
 
