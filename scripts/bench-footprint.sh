@@ -12,6 +12,7 @@
 # load runs for the first time, a fixed cost that is not per entity (about 130 KB for dds-idle). A benchmark,
 # not a test; it runs inside scripts/isolated (loopback only). BARE=path/to/dds-idle probes that binary instead of a fresh release build
 # (e.g. one built at an older commit, for a before/after comparison); STACKS="ours" or "cyclone" runs one side.
+# DOMAIN=N: the DDS domain of our probe (default 41; Cyclone's bare participant uses N+1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [[ -z ${DDS_ISOLATED:-} ]]; then
@@ -78,6 +79,7 @@ probe() {
 }
 
 stacks=${STACKS:-ours cyclone}
-[[ $stacks == *ours* ]] && probe ours 41 "${BARE:-target/release/dds-idle}" -d 41
-[[ $stacks == *cyclone* ]] && probe cyclone-11 42 python3 scripts/footprint/bare.py 42
+domain=${DOMAIN:-41}
+[[ $stacks == *ours* ]] && probe ours "$domain" "${BARE:-target/release/dds-idle}" -d "$domain"
+[[ $stacks == *cyclone* ]] && probe cyclone-11 $((domain + 1)) python3 scripts/footprint/bare.py $((domain + 1))
 exit 0

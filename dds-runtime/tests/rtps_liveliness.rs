@@ -55,3 +55,46 @@ fn automatic_writer_keeps_its_liveliness_on_time_and_loses_it_when_the_timers_ru
     sim.run_for(Duration::from_secs(1));
     assert_eq!(lost(&sim.nodes[0].events, w), 0, "lost again once on time");
 }
+
+/// Participant-message endpoints are matched on first use, not at discovery (docs/performance.md,
+/// "Footprint"): quiet peers have no proxies for them; a participant that asserts its liveliness matches
+/// its writer with every peer first (and they match their readers with it as its message arrives), and
+/// then with each peer it discovers later; a reader is matched only with a writer that sent.
+#[test]
+fn participant_message_endpoints_are_matched_on_first_use() {
+    let (pw, pr) = (EntityId::P2P_MESSAGE_WRITER, EntityId::P2P_MESSAGE_READER);
+    let mut sim = Sim::with_participants(3, Faults::NONE, 2);
+    sim.run_for(Duration::from_secs(2));
+    for n in 0..2 {
+        let p = &sim.nodes[n].p;
+        assert_eq!(
+            p.builtin_matches(EntityId::SEDP_PUBLICATIONS_WRITER).len(),
+            1
+        );
+        assert!(p.builtin_matches(pw).is_empty() && p.builtin_matches(pr).is_empty());
+    }
+    let now = sim.now;
+    sim.nodes[0].p.assert_liveliness(now);
+    sim.run_for(Duration::from_secs(1));
+    assert_eq!(sim.nodes[0].p.builtin_matches(pw), [sim.guid(1, pr)]);
+    assert_eq!(sim.nodes[1].p.builtin_matches(pr), [sim.guid(0, pw)]);
+    assert!(
+        sim.nodes[0].p.builtin_matches(pr).is_empty(),
+        "node 1 wrote nothing"
+    );
+    let late = sim.add(config(2));
+    sim.run_for(Duration::from_secs(2));
+    let mut to = sim.nodes[0].p.builtin_matches(pw);
+    to.sort();
+    assert_eq!(to, [sim.guid(1, pr), sim.guid(late, pr)]);
+    assert_eq!(
+        sim.nodes[late].p.builtin_matches(pr),
+        [sim.guid(0, pw)],
+        "the kept message reached it"
+    );
+    assert!(sim.nodes[late].p.builtin_matches(pw).is_empty());
+    assert!(
+        sim.nodes[1].p.builtin_matches(pr).len() == 1,
+        "nodes 1 and 2 exchanged none"
+    );
+}

@@ -17,6 +17,9 @@ use std::time::Instant;
 
 use crate::rtps::types::Guid;
 
+/// The room (in entries) a timer queue, or an endpoint's proxy map, keeps beyond what it holds once trimmed.
+pub(crate) const KEPT_TIMER_ROOM: usize = 16;
+
 /// Proxy timers of one endpoint, earliest first. An entry may be stale (its timer cleared, its proxy gone):
 /// the caller checks the proxy's own timer.
 #[derive(Debug, Default)]
@@ -48,6 +51,13 @@ impl DueQueue {
     pub(crate) fn clear(&mut self) {
         self.0 = BinaryHeap::new();
     }
+
+    /// Gives back the room a burst left (a builtin endpoint arms one timer per new peer when many appear at
+    /// once), keeping room for `keep` entries beyond those queued. Call it now and then, not per pass, so
+    /// that a steady stream does not shrink and regrow the queue.
+    pub(crate) fn trim(&mut self, keep: usize) {
+        self.0.shrink_to(self.0.len() + keep);
+    }
 }
 
 #[cfg(test)]
@@ -77,5 +87,21 @@ mod tests {
         assert_eq!(q.next(), Some(t0 + ms(5)));
         q.clear();
         assert_eq!(q.next(), None);
+    }
+
+    /// A burst of armings leaves room for them all; `trim` gives it back and keeps what is queued.
+    #[test]
+    fn trim_gives_back_the_room_of_a_burst() {
+        let t0 = Instant::now();
+        let mut q = DueQueue::default();
+        for i in 0..200u8 {
+            q.arm(Some(t0), g(i));
+        }
+        while q.pop_due(t0).is_some() {}
+        q.arm(Some(t0), g(1));
+        assert!(q.0.capacity() >= 200);
+        q.trim(4);
+        assert!(q.0.capacity() <= 8, "capacity {}", q.0.capacity());
+        assert_eq!(q.pop_due(t0), Some(g(1)));
     }
 }

@@ -11,6 +11,7 @@ pub mod messages;
 mod outbox;
 mod participant;
 pub(crate) mod pool;
+mod proxy_map;
 pub(crate) mod reader;
 pub mod shm;
 pub mod types;

@@ -51,21 +51,28 @@ struct ProxyParticipant {
     builtin_endpoints: u32,
     /// Its TypeLookup endpoints are matched with ours (done when a request or reply is first exchanged).
     type_lookup_matched: bool,
-    /// Where its builtin endpoints listen: one list, shared with all their proxies.
+    /// Which of its participant-message endpoints are matched with ours (done on first use, see
+    /// `Participant::match_messages`): bits `MESSAGES_IN` (its writer) and `MESSAGES_OUT` (its reader).
+    messages_matched: u8,
+    /// Where its builtin endpoints listen: one list, shared with all their proxies. When its builtin readers
+    /// share a metatraffic multicast group with us, the group is the last entry (for the proxies of its
+    /// readers, `ReaderProxy::with_multicast_last`; the others use the first entry only).
     metatraffic: std::sync::Arc<[Locator]>,
     /// `ParticipantData::encode` of what it announced.
     announcement: Box<[u8]>,
 }
 
 impl ProxyParticipant {
-    fn new(data: &ParticipantData, lease_deadline: Instant) -> Self {
+    /// `group`: the metatraffic multicast group it shares with us, if any (kept last in `metatraffic`).
+    fn new(data: &ParticipantData, lease_deadline: Instant, group: Option<Locator>) -> Self {
         ProxyParticipant {
             lease_deadline,
             lease_duration: data.lease_duration,
             vendor_id: data.vendor_id,
             builtin_endpoints: data.builtin_endpoints,
             type_lookup_matched: false,
-            metatraffic: metatraffic(data),
+            messages_matched: 0,
+            metatraffic: metatraffic(data, group),
             announcement: data.encode().into_boxed_slice(),
         }
     }
@@ -81,27 +88,31 @@ impl ProxyParticipant {
         })
     }
 
-    /// Takes a new announcement of the same participant; whether anything changed.
-    fn update(&mut self, data: &ParticipantData) -> bool {
+    /// Takes a new announcement of the same participant (`group`: see [`ProxyParticipant::new`]); whether
+    /// anything changed.
+    fn update(&mut self, data: &ParticipantData, group: Option<Locator>) -> bool {
         let encoded = data.encode();
         if *encoded == *self.announcement {
             return false;
         }
         *self = ProxyParticipant {
             type_lookup_matched: self.type_lookup_matched,
-            ..ProxyParticipant::new(data, self.lease_deadline)
+            messages_matched: self.messages_matched,
+            ..ProxyParticipant::new(data, self.lease_deadline, group)
         };
         true
     }
 }
 
-/// Where a discovered participant's builtin endpoints listen: one list for all their proxies.
-fn metatraffic(data: &ParticipantData) -> std::sync::Arc<[Locator]> {
-    if data.metatraffic_unicast.is_empty() {
-        data.metatraffic_multicast.as_slice().into()
+/// Where a discovered participant's builtin endpoints listen: one list for all their proxies, the shared
+/// multicast `group` last if there is one.
+fn metatraffic(data: &ParticipantData, group: Option<Locator>) -> std::sync::Arc<[Locator]> {
+    let first = if data.metatraffic_unicast.is_empty() {
+        &data.metatraffic_multicast
     } else {
-        data.metatraffic_unicast.as_slice().into()
-    }
+        &data.metatraffic_unicast
+    };
+    first.iter().copied().chain(group).collect()
 }
 
 /// A sans-I/O RTPS participant. See `docs/rtps-core.md`.

@@ -90,9 +90,10 @@ impl Participant {
             return;
         }
         let lease_deadline = now + data.lease_duration;
+        let group = self.shared_metatraffic_group(&data);
         if let Some(p) = self.participants.get_mut(&data.guid_prefix) {
             p.lease_deadline = lease_deadline;
-            p.update(&data);
+            p.update(&data, group);
             return;
         }
         if self.participants.len() >= MAX_PARTICIPANTS {
@@ -100,17 +101,23 @@ impl Participant {
         }
         let prefix = data.guid_prefix;
         debug!(participant = ?prefix, vendor = ?data.vendor_id, "participant discovered");
-        let proxy = Box::new(ProxyParticipant::new(&data, lease_deadline));
-        // One list for all the proxies of its builtin endpoints.
+        let proxy = Box::new(ProxyParticipant::new(&data, lease_deadline, group));
+        // One list for all the proxies of its builtin endpoints (the group last).
         let meta = proxy.metatraffic.clone();
         let bits = data.builtin_endpoints;
-        let group = self.shared_metatraffic_group(&data);
         self.events
             .push_back(Event::ParticipantDiscovered(Box::new(data)));
         self.participants.insert(prefix, proxy);
-        // The TypeLookup endpoints are matched when a request or reply is first exchanged with it.
-        let pairs = |ours: EntityId| !super::type_lookup::is_service_endpoint(ours);
+        // The TypeLookup endpoints are matched when a request or reply is first exchanged with it, the
+        // participant-message ones when a message is (see `match_messages`).
+        let pairs = |ours: EntityId| {
+            !super::type_lookup::is_service_endpoint(ours)
+                && !super::liveliness::is_message_endpoint(ours)
+        };
         self.match_builtin_pairs(now, prefix, bits, &meta, group, pairs);
+        if self.messages_written() {
+            self.match_messages(now, prefix, super::liveliness::MESSAGES_OUT);
+        }
         self.match_topic_builtins(now, prefix, bits, &meta, group);
         // Answer directly so the newcomer need not wait for our next periodic announcement.
         if !meta.is_empty() {
@@ -119,7 +126,9 @@ impl Participant {
     }
 
     /// Matches those builtin endpoints of ours that `which` selects with the ones the participant `prefix`
-    /// announces in `bits`. `group`: see [`Self::shared_metatraffic_group`].
+    /// announces in `bits`, at `meta` (its metatraffic locators, with `group` last when there is one).
+    /// `group`: see [`Self::shared_metatraffic_group`]; `None` for endpoints addressed to one participant
+    /// (their proxies then use the first locator only).
     pub(super) fn match_builtin_pairs(
         &mut self,
         now: Instant,
@@ -133,7 +142,7 @@ impl Participant {
             if bits & bit != 0 && which(ours) {
                 if let Some(w) = self.writers.get_mut(&ours) {
                     let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true)
-                        .with_multicast(group);
+                        .with_multicast_last(group.is_some());
                     w.add_proxy(now, proxy, true, &mut self.events);
                 }
             }
@@ -149,6 +158,15 @@ impl Participant {
                 }
             }
         }
+    }
+
+    /// The shared group a discovered participant's metatraffic list `meta` ends with, if any (see
+    /// `ProxyParticipant::metatraffic`): its last entry when that is one of our metatraffic multicast
+    /// locators (it is the group then: without a group, such a locator would have been chosen as one).
+    pub(super) fn metatraffic_group(&self, meta: &[Locator]) -> Option<Locator> {
+        meta.last()
+            .filter(|l| l.is_multicast() && self.config.metatraffic_multicast.contains(l))
+            .copied()
     }
 
     /// The metatraffic multicast group a discovered participant shares with us, if any. Our SEDP (topics,

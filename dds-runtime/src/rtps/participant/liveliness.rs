@@ -3,11 +3,24 @@
 
 use std::time::{Duration, Instant};
 
+use tracing::trace;
+
 use super::Participant;
 use crate::qos::Liveliness;
 use crate::rtps::api::WriteChange;
 use crate::rtps::discovery::builtin;
-use crate::rtps::types::{EntityId, Guid};
+use crate::rtps::types::{EntityId, Guid, GuidPrefix, SequenceNumber};
+
+/// Whether `id` is one of our participant-message endpoints: matched with a peer's on first use (see
+/// [`Participant::match_messages`]), not at discovery.
+pub(super) fn is_message_endpoint(id: EntityId) -> bool {
+    id == EntityId::P2P_MESSAGE_WRITER || id == EntityId::P2P_MESSAGE_READER
+}
+
+/// [`Participant::match_messages`]: our participant-message reader with a peer's writer.
+pub(super) const MESSAGES_IN: u8 = 1;
+/// [`Participant::match_messages`]: our participant-message writer with a peer's reader.
+pub(super) const MESSAGES_OUT: u8 = 2;
 
 impl Participant {
     /// Something arrived from `writer` (DATA, or a HEARTBEAT with the liveliness flag): it is alive.
@@ -85,6 +98,7 @@ impl Participant {
 
     /// Writes a ParticipantMessageData of `kind` (no data) on the builtin participant-message writer.
     pub(super) fn send_participant_message(&mut self, now: Instant, kind: [u8; 4]) {
+        self.match_messages_all(now);
         let prefix = self.config.guid_prefix;
         let change = WriteChange::alive(builtin::encode_participant_message(&prefix, kind, &[]))
             .with_key_hash(builtin::participant_message_key(&prefix, kind));
@@ -106,5 +120,69 @@ impl Participant {
             w.send_liveliness(&mut self.out);
         }
         self.assert_liveliness_shm(writer);
+    }
+
+    /// Matches our participant-message reader (`which` holds [`MESSAGES_IN`]) or writer ([`MESSAGES_OUT`])
+    /// with the participant `prefix`'s, unless done already. A participant writes such a message only for
+    /// writers with an AUTOMATIC lease (ours write none otherwise) or MANUAL_BY_PARTICIPANT liveliness, so
+    /// many peers never send one, and we often never write one: each proxy is made on first use. Our
+    /// reader's when the peer's writer first sends (DATA, or a HEARTBEAT announcing changes, before it is
+    /// handled); our writer's with every peer before we first write, and at discovery once we have
+    /// written (our writer keeps the last message of each kind for late joiners). See
+    /// `docs/performance.md`, "Footprint".
+    pub(super) fn match_messages(&mut self, now: Instant, prefix: GuidPrefix, which: u8) {
+        let Some(p) = self.participants.get_mut(&prefix) else {
+            return;
+        };
+        let todo = which & !p.messages_matched;
+        if todo == 0 {
+            return;
+        }
+        p.messages_matched |= todo;
+        let (bits, meta) = (p.builtin_endpoints, p.metatraffic.clone());
+        let group = self.metatraffic_group(&meta);
+        trace!(participant = ?prefix, todo, "participant-message endpoints matched");
+        let ours = move |id: EntityId| match id {
+            EntityId::P2P_MESSAGE_READER => todo & MESSAGES_IN != 0,
+            EntityId::P2P_MESSAGE_WRITER => todo & MESSAGES_OUT != 0,
+            _ => false,
+        };
+        self.match_builtin_pairs(now, prefix, bits, &meta, group, ours);
+    }
+
+    /// The remote endpoints our builtin endpoint `id` is matched with (discovery, participant message,
+    /// TypeLookup: see `docs/performance.md`, "Footprint", for which are matched when).
+    pub fn builtin_matches(&self, id: EntityId) -> Vec<Guid> {
+        if !id.is_builtin() {
+            return Vec::new();
+        }
+        let writer = self.writers.get(&id).map(|w| w.matched().copied());
+        let reader = self.readers.get(&id).map(|r| r.matched().copied());
+        writer
+            .into_iter()
+            .flatten()
+            .chain(reader.into_iter().flatten())
+            .collect()
+    }
+
+    /// Whether we ever wrote a participant message.
+    pub(super) fn messages_written(&self) -> bool {
+        self.writers
+            .get(&EntityId::P2P_MESSAGE_WRITER)
+            .is_some_and(|w| w.last_sn() > SequenceNumber(0))
+    }
+
+    /// Matches our participant-message writer with every discovered participant's reader: what we write
+    /// goes to all of them.
+    fn match_messages_all(&mut self, now: Instant) {
+        let pending: Vec<GuidPrefix> = self
+            .participants
+            .iter()
+            .filter(|(_, p)| p.messages_matched & MESSAGES_OUT == 0)
+            .map(|(prefix, _)| *prefix)
+            .collect();
+        for prefix in pending {
+            self.match_messages(now, prefix, MESSAGES_OUT);
+        }
     }
 }

@@ -188,6 +188,8 @@ impl Participant {
         self.scratch.shrink_to(KEPT_QUEUE_ROOM);
         self.events.shrink_to(KEPT_QUEUE_ROOM);
         self.out.trim(KEPT_DATAGRAMS, KEPT_DATAGRAM_BYTES);
+        self.writers.values_mut().for_each(|w| w.trim_room());
+        self.readers.values_mut().for_each(|r| r.trim_room());
     }
 
     /// Sends our SPDP announcement to the SPDP multicast locators and initial peers, or to `to` only.

@@ -84,8 +84,8 @@ impl Participant {
         );
     }
 
-    /// A participant announcing the builtin-endpoint-set `bits` at `meta` was discovered: pairs our topic
-    /// endpoints with its own.
+    /// A participant announcing the builtin-endpoint-set `bits` at `meta` (with `group` last when there is
+    /// one) was discovered: pairs our topic endpoints with its own.
     pub(super) fn match_topic_builtins(
         &mut self,
         now: Instant,
@@ -98,7 +98,7 @@ impl Participant {
         if bits & bit != 0 {
             if let Some(w) = self.writers.get_mut(&ours) {
                 let proxy = ReaderProxy::new(Guid::new(prefix, theirs), meta.clone(), true)
-                    .with_multicast(group);
+                    .with_multicast_last(group.is_some());
                 w.add_proxy(now, proxy, true, &mut self.events);
             }
         }

@@ -152,11 +152,14 @@ impl Participant {
         self.match_builtin_pairs(now, prefix, bits, &meta, None, is_service_endpoint);
     }
 
-    /// A submessage from `writer` arrived: if it is a remote service writer's and may carry (or announce) a
-    /// request or reply, its participant's service endpoints are matched before it is handled.
+    /// A submessage from `writer` arrived that may carry (or announce) a change: if it is a remote service
+    /// writer's (a request or reply) or participant-message writer's, the endpoints of its participant of
+    /// that kind are matched before it is handled (see also `Participant::match_messages`).
     pub(super) fn service_traffic(&mut self, now: Instant, writer: Guid) {
         if is_service_writer(writer.entity_id) {
             self.match_type_lookup(now, writer.prefix);
+        } else if writer.entity_id == EntityId::P2P_MESSAGE_WRITER {
+            self.match_messages(now, writer.prefix, super::liveliness::MESSAGES_IN);
         }
     }
 

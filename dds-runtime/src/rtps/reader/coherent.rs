@@ -55,45 +55,29 @@ struct OpenSet {
     samples: Vec<ReceivedSample>,
     /// The group set the changes named (`PID_GROUP_COHERENT_SET`), if any.
     group_set: Option<SequenceNumber>,
-}
-
-/// One matched writer's open coherent set.
-///
-/// Kept per matched writer, so small (16 bytes, pinned by `tests::assembler_stays_small`): the open set is
-/// boxed (most writers never send one) and the limits are held in 32 bits each.
-#[derive(Debug)]
-pub(crate) struct Assembler {
-    open: Option<Box<OpenSet>>,
+    /// The reader's limits on what the set may hold.
     max_samples: u32,
     max_bytes: u32,
 }
 
-impl Default for Assembler {
-    fn default() -> Self {
-        Assembler::new(SetLimits {
-            max_samples: 4096,
-            max_bytes: 16 << 20,
-        })
-    }
+/// One matched writer's open coherent set.
+///
+/// Kept in a matched writer's backlog (made on first use), so small (8 bytes): the open set is boxed (most
+/// writers never send one) and holds the limits it was opened with.
+#[derive(Debug, Default)]
+pub(crate) struct Assembler {
+    open: Option<Box<OpenSet>>,
 }
 
 impl Assembler {
-    /// An assembler holding at most `limits` of one set (a limit beyond `u32::MAX` is `u32::MAX`).
-    pub(crate) fn new(limits: SetLimits) -> Self {
-        let cap = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
-        Assembler {
-            open: None,
-            max_samples: cap(limits.max_samples),
-            max_bytes: cap(limits.max_bytes),
-        }
-    }
-
-    /// Takes the next change delivered in order from the writer, `sn` being its sequence number.
+    /// Takes the next change delivered in order from the writer, `sn` being its sequence number; a set it
+    /// opens holds at most `limits` (a limit beyond `u32::MAX` is `u32::MAX`).
     pub(crate) fn offer(
         &mut self,
         sn: SequenceNumber,
         mark: Option<SetMark>,
         sample: ReceivedSample,
+        limits: SetLimits,
         out: &mut Vec<Event>,
     ) {
         match mark {
@@ -106,8 +90,11 @@ impl Assembler {
                 if self.open.as_ref().is_some_and(|o| o.set != m.set) {
                     self.close(sn, None, sample.reader, sample.writer, out);
                 }
+                let cap = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
                 let o = self.open.get_or_insert_with(|| {
                     Box::new(OpenSet {
+                        max_samples: cap(limits.max_samples),
+                        max_bytes: cap(limits.max_bytes),
                         set: m.set,
                         last: SequenceNumber(m.set.0 - 1),
                         whole: true,
@@ -121,8 +108,7 @@ impl Assembler {
                 o.last = sn;
                 o.count += 1;
                 o.bytes += sample.payload.len();
-                if o.samples.len() >= self.max_samples as usize || o.bytes > self.max_bytes as usize
-                {
+                if o.samples.len() >= o.max_samples as usize || o.bytes > o.max_bytes as usize {
                     o.whole = false;
                 }
                 if o.whole {

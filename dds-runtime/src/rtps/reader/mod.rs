@@ -26,7 +26,6 @@ pub(crate) const DISCOVERY_ACK_DELAY: Duration = Duration::from_millis(5);
 /// acknowledgement of the peer's pushed announcements, which arrive at about the same time.
 pub(crate) const PREEMPTIVE_ACK_DELAY: Duration = Duration::from_millis(20);
 
-use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use crate::rtps::api::{ChangeKind, Event, Payload, ReceivedSample};
@@ -36,8 +35,9 @@ use crate::rtps::messages::{
 };
 use crate::rtps::outbox::{Outbox, Ts};
 use crate::rtps::pool::BufferPool;
+use crate::rtps::proxy_map::ProxyMap;
 use crate::rtps::types::*;
-use coherent::{group_set, Assembler, SetLimits, SetMark};
+use coherent::{group_set, SetLimits, SetMark};
 use defrag::Defrag;
 
 /// Whether every must-understand inline QoS parameter is one we know.
@@ -100,8 +100,8 @@ pub(crate) struct ReaderParams {
 pub(crate) struct Reader {
     pub guid: Guid,
     params: ReaderParams,
-    /// Boxed: a map node then holds pointers, not whole proxies (see `docs/performance.md`, "Footprint").
-    proxies: BTreeMap<Guid, Box<WriterProxy>>,
+    /// Sorted boxes (see `ProxyMap`, and `docs/performance.md`, "Footprint").
+    proxies: ProxyMap<WriterProxy>,
     /// The proxies whose `acknack_due` or `nackfrag_due` is armed, in deadline order.
     due: DueQueue,
     /// Back-pressure: how many more changes reliable proxies may deliver (`None`: no limit). A change
@@ -117,7 +117,7 @@ impl Reader {
         Reader {
             guid,
             params,
-            proxies: BTreeMap::new(),
+            proxies: ProxyMap::new(),
             due: DueQueue::default(),
             credit: std::cell::Cell::new(None),
         }
@@ -127,9 +127,10 @@ impl Reader {
     pub(crate) fn set_credit(&mut self, credit: Option<usize>, out: &mut Vec<Event>) {
         self.credit.set(credit);
         let rid = self.guid.entity_id;
+        let to = (rid, self.set_limits());
         for p in self.proxies.values_mut() {
             if p.reliable {
-                Self::drain(rid, p, &self.credit, out);
+                Self::drain(to, p, &self.credit, out);
             }
         }
     }
@@ -189,10 +190,6 @@ impl Reader {
         preemptive: bool,
     ) {
         proxy.reliable &= self.params.reliable;
-        proxy.coherent = Assembler::new(SetLimits {
-            max_samples: self.params.reorder_max_samples,
-            max_bytes: self.params.reorder_max_bytes,
-        });
         if proxy.reliable && preemptive {
             // Pre-emptive ACKNACK: prompts the writer to tell us what it has. Matches come in bursts
             // (a peer's announcements), so it waits for the others to the same peer.
@@ -204,7 +201,7 @@ impl Reader {
             proxy.acknack_due = Some(now + wait);
         }
         self.due.arm(proxy.acknack_due, proxy.guid);
-        self.proxies.insert(proxy.guid, Box::new(proxy));
+        self.proxies.insert(Box::new(proxy));
     }
 
     pub(crate) fn remove_proxy(&mut self, g: &Guid) -> bool {
@@ -215,8 +212,16 @@ impl Reader {
         had
     }
 
+    /// What one writer's coherent set may hold.
+    fn set_limits(&self) -> SetLimits {
+        SetLimits {
+            max_samples: self.params.reorder_max_samples,
+            max_bytes: self.params.reorder_max_bytes,
+        }
+    }
+
     fn deliver(
-        reader: EntityId,
+        (reader, limits): (EntityId, SetLimits),
         p: &mut WriterProxy,
         sn: SequenceNumber,
         slot: Slot,
@@ -233,16 +238,17 @@ impl Reader {
                 source_timestamp: c.source_timestamp,
                 group_sequence: c.group_seq,
             };
-            if c.coherent.is_none() && !p.coherent.is_open() {
+            if c.coherent.is_none() && !p.coherent_open() {
                 out.push(Event::Sample(s));
             } else {
-                p.coherent.offer(sn, c.coherent, s, out);
+                let coherent = &mut p.backlog_mut().coherent;
+                coherent.offer(sn, c.coherent, s, limits, out);
             }
         }
     }
 
     fn drain(
-        reader: EntityId,
+        reader: (EntityId, SetLimits),
         p: &mut WriterProxy,
         credit: &std::cell::Cell<Option<usize>>,
         out: &mut Vec<Event>,
@@ -266,6 +272,7 @@ impl Reader {
     /// Puts one received change (or irrelevant number) into sequence.
     fn accept(&self, p: &mut WriterProxy, sn: SequenceNumber, slot: Slot, out: &mut Vec<Event>) {
         let rid = self.guid.entity_id;
+        let to = (rid, self.set_limits());
         if p.reliable {
             if p.has(sn) {
                 return;
@@ -276,9 +283,9 @@ impl Reader {
                     // No room downstream: treat it as not received, so it is NACKed again later.
                     return;
                 }
-                Self::deliver(rid, p, sn, slot, out);
+                Self::deliver(to, p, sn, slot, out);
                 p.next_expected = sn.next();
-                Self::drain(rid, p, &self.credit, out);
+                Self::drain(to, p, &self.credit, out);
             } else {
                 if p.held() < self.params.reorder_max_samples
                     && p.held_bytes() + slot.size() <= self.params.reorder_max_bytes
@@ -298,7 +305,7 @@ impl Reader {
                 });
             }
             p.synced = true;
-            Self::deliver(rid, p, sn, slot, out);
+            Self::deliver(to, p, sn, slot, out);
             p.next_expected = sn.next();
         }
         p.drop_stale_defrag();
@@ -319,8 +326,8 @@ impl Reader {
 
     /// Runs `f` on the proxy of `writer`, with the rest of the reader borrowed shared (`accept` borrows
     /// `self`). The map is taken out (O(1)) rather than the proxy removed and re-inserted, and put back
-    /// without dropping the empty map that stood in for it: that drop (a `BTreeMap`'s `IntoIter`, even
-    /// empty) was 5% of a 4 MiB subscriber's time, once per fragment.
+    /// without dropping the empty map that stood in for it: that drop (when it was a `BTreeMap`, its
+    /// `IntoIter`, even empty) was 5% of a 4 MiB subscriber's time, once per fragment.
     fn with_proxy(&mut self, writer: Guid, f: impl FnOnce(&Self, &mut WriterProxy)) {
         let mut proxies = std::mem::take(&mut self.proxies);
         if let Some(p) = proxies.get_mut(&writer) {
@@ -328,7 +335,7 @@ impl Reader {
         }
         let stand_in = std::mem::replace(&mut self.proxies, proxies);
         debug_assert!(stand_in.is_empty());
-        // An empty `BTreeMap` owns no allocation: forgetting it leaks nothing.
+        // An empty map owns no allocation: forgetting it leaks nothing.
         std::mem::forget(stand_in);
     }
 
@@ -492,6 +499,7 @@ impl Reader {
 
     pub(crate) fn on_gap(&mut self, writer: Guid, g: &Gap, out: &mut Vec<Event>) {
         let rid = self.guid.entity_id;
+        let to = (rid, self.set_limits());
         let cap = self.params.reorder_max_samples;
         let Some(p) = self.proxies.get_mut(&writer) else {
             return;
@@ -502,7 +510,7 @@ impl Reader {
             // Nothing below base will come any more. What we already hold of it was published and is delivered
             // in order; the rest is irrelevant (not lost).
             while let Some((sn, slot)) = p.take_first_if(|sn, _| sn < base) {
-                Self::deliver(rid, p, sn, slot, out);
+                Self::deliver(to, p, sn, slot, out);
             }
             p.next_expected = base;
         } else if g.gap_start > p.next_expected && base.0 - g.gap_start.0 <= 256 {
@@ -517,7 +525,7 @@ impl Reader {
                 p.hold_irrelevant(sn);
             }
         }
-        Self::drain(rid, p, &self.credit, out);
+        Self::drain(to, p, &self.credit, out);
         p.drop_stale_defrag();
     }
 
@@ -529,6 +537,7 @@ impl Reader {
         out: &mut Vec<Event>,
     ) {
         let rid = self.guid.entity_id;
+        let to = (rid, self.set_limits());
         let (delay, ack_delay) = (self.params.heartbeat_response_delay, self.params.ack_delay);
         let Some(p) = self.proxies.get_mut(&writer) else {
             return;
@@ -550,7 +559,7 @@ impl Reader {
             while let Some((k, slot)) = p.take_first_if(|k, _| k < hb.first_sn) {
                 if matches!(slot, Slot::Change(_)) {
                     lost += (k.0 - sn.0) as u64;
-                    Self::deliver(rid, p, k, slot, out);
+                    Self::deliver(to, p, k, slot, out);
                     sn = k.next();
                 }
             }
@@ -563,7 +572,7 @@ impl Reader {
                 });
             }
             p.next_expected = hb.first_sn;
-            Self::drain(rid, p, &self.credit, out);
+            Self::drain(to, p, &self.credit, out);
             p.drop_stale_defrag();
         }
         p.synced = true;
@@ -619,6 +628,13 @@ impl Reader {
         }
     }
 
+    /// Gives back the room a burst (many matches, many armed timers) left in the proxies and the timer
+    /// queue (see `DueQueue::trim`).
+    pub(crate) fn trim_room(&mut self) {
+        self.due.trim(crate::rtps::due::KEPT_TIMER_ROOM);
+        self.proxies.trim(crate::rtps::due::KEPT_TIMER_ROOM);
+    }
+
     pub(crate) fn next_timeout(&self) -> Option<Instant> {
         self.due.next()
     }
@@ -657,7 +673,7 @@ impl Reader {
         let rid = self.guid.entity_id;
         let first = Guid::new(prefix, EntityId([0; 4]));
         let last = Guid::new(prefix, EntityId([0xff; 4]));
-        for p in self.proxies.range_mut(first..=last).map(|(_, p)| p) {
+        for p in self.proxies.range_mut(first..=last) {
             let may = p.synced || !p.guid.entity_id.is_builtin();
             if may && p.acknack_due.is_some() && p.destination() == [to] {
                 Self::send_acknack(rid, p, out);

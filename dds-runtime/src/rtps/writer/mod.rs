@@ -26,7 +26,7 @@ pub(crate) use stand_in::user_data as stand_in_user_data;
 use stand_in::StandIn;
 pub(crate) use stand_in::{stand_in_for, Served};
 
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use crate::qos::{Durability, History, ResourceLimits};
@@ -37,6 +37,7 @@ use crate::rtps::messages::{
     Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, ParameterList, Submessage,
 };
 use crate::rtps::outbox::{Outbox, Ts};
+use crate::rtps::proxy_map::ProxyMap;
 use crate::rtps::types::*;
 use bit_window::BitWindow;
 
@@ -72,8 +73,8 @@ pub(crate) struct Writer {
     params: WriterParams,
     history: HistoryCache,
     next_sn: SequenceNumber,
-    /// Boxed: a map node then holds pointers, not whole proxies (see `docs/performance.md`, "Footprint").
-    proxies: BTreeMap<Guid, Box<ReaderProxy>>,
+    /// Sorted boxes (see `ProxyMap`, and `docs/performance.md`, "Footprint").
+    proxies: ProxyMap<ReaderProxy>,
     /// One locator per matched reader, deduplicated: where new data goes.
     data_dest: Vec<Locator>,
     /// `data_dest` split for key-only changes: readers that want them without serialized key
@@ -118,7 +119,7 @@ impl Writer {
             history: HistoryCache::new(params.history, params.limits),
             params,
             next_sn: SequenceNumber(1),
-            proxies: BTreeMap::new(),
+            proxies: ProxyMap::new(),
             data_dest: Vec::new(),
             hb_dest: Vec::new(),
             key_hash_dest: Vec::new(),
@@ -543,7 +544,7 @@ impl Writer {
         }
         let behind = proxy.reliable && proxy.acked < self.next_sn;
         self.repair_queue.arm(proxy.repair_due, proxy.guid);
-        self.proxies.insert(proxy.guid, Box::new(proxy));
+        self.proxies.insert(Box::new(proxy));
         self.rebuild_dest();
         self.update_acked(ev);
         if behind {
@@ -595,12 +596,9 @@ impl Writer {
         if !p.reliable {
             return;
         }
-        if p.last_acknack
-            .is_some_and(|c| ack.count.wrapping_sub(c) <= 0)
-        {
+        if !p.take_acknack_count(ack.count) {
             return;
         }
-        p.last_acknack = Some(ack.count);
         let base = ack.reader_sn_state.base.min(next_sn);
         let progressed = base > p.acked;
         if progressed {
@@ -657,12 +655,9 @@ impl Writer {
         if !p.reliable || nf.writer_sn < p.acked {
             return;
         }
-        if p.last_nackfrag
-            .is_some_and(|c| nf.count.wrapping_sub(c) <= 0)
-        {
+        if !p.take_nackfrag_count(nf.count) {
             return;
         }
-        p.last_nackfrag = Some(nf.count);
         match fragments {
             Some(total) => p.request_frags(nf.writer_sn, nf.fragment_number_state.iter(), total),
             None => {
@@ -673,6 +668,13 @@ impl Writer {
             p.repair_due = Some(now + delay);
             self.repair_queue.arm(p.repair_due, reader);
         }
+    }
+
+    /// Gives back the room a burst (many matches, many armed timers) left in the proxies and the timer
+    /// queue (see `DueQueue::trim`).
+    pub(crate) fn trim_room(&mut self) {
+        self.repair_queue.trim(crate::rtps::due::KEPT_TIMER_ROOM);
+        self.proxies.trim(crate::rtps::due::KEPT_TIMER_ROOM);
     }
 
     pub(crate) fn next_timeout(&self) -> Option<Instant> {

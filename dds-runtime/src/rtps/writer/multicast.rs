@@ -1,6 +1,6 @@
 //! Which matched readers get new data by multicast.
 //!
-//! A reader that can be reached on a multicast locator (`ReaderProxy::multicast`, set at matching only when
+//! A reader that can be reached on a multicast locator (`ReaderProxy::multicast()`, set at matching only when
 //! the participant allows multicast user data) receives new samples and periodic heartbeats there when
 //! readers at two or more different unicast locators share that multicast locator: the sample then leaves
 //! once for all of them instead of once per unicast locator. Readers alone on their group (or all behind
@@ -18,7 +18,7 @@ impl Writer {
     pub(super) fn choose_multicast(&mut self) {
         let mut sharing: BTreeMap<Locator, BTreeSet<Option<Locator>>> = BTreeMap::new();
         for p in self.proxies.values() {
-            if let Some(m) = p.multicast {
+            if let Some(m) = p.multicast() {
                 sharing
                     .entry(m)
                     .or_default()
@@ -26,8 +26,8 @@ impl Writer {
             }
         }
         for p in self.proxies.values_mut() {
-            p.via_multicast = p.multicast.is_some_and(|m| {
-                p.locators.is_empty() || sharing.get(&m).is_some_and(|u| u.len() >= 2)
+            p.via_multicast = p.multicast().is_some_and(|m| {
+                p.unicast().is_empty() || sharing.get(&m).is_some_and(|u| u.len() >= 2)
             });
         }
     }
@@ -47,7 +47,7 @@ impl Writer {
         // Per group: (lagging readers, readers served by it).
         let mut groups: BTreeMap<Locator, (usize, usize)> = BTreeMap::new();
         for p in self.proxies.values().filter(|p| p.via_multicast) {
-            if let Some(m) = p.multicast {
+            if let Some(m) = p.multicast() {
                 let g = groups.entry(m).or_default();
                 g.1 += 1;
                 g.0 += usize::from(p.reliable && p.acked < self.next_sn);

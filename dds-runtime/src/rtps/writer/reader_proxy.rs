@@ -23,14 +23,17 @@ pub(crate) const MAX_REQUESTED_SPAN: usize = 2 * MAX_REQUESTED;
 #[derive(Debug, Clone)]
 pub(crate) struct ReaderProxy {
     pub guid: Guid,
-    /// Where to send; the first is used. Shared with the other proxies made from the same announcement (one
-    /// list per remote participant for its builtin readers).
-    pub locators: Arc<[Locator]>,
-    /// A multicast locator the reader listens on, when multicast user data is on (see
-    /// `ParticipantConfig::multicast_data`).
-    pub multicast: Option<Locator>,
-    /// New data (and the periodic heartbeat) goes to `multicast` instead of `locators`: set by the writer
-    /// when another matched reader shares that multicast locator.
+    /// Where to send: the reader's unicast locators (the first is used), then, when `multicast_last` is set,
+    /// a multicast locator it listens on (when multicast user data is on, see
+    /// `ParticipantConfig::multicast_data`). Shared with the other proxies made from the same announcement
+    /// (one list per remote participant for its builtin readers). See [`unicast`](Self::unicast) and
+    /// [`multicast`](Self::multicast).
+    locators: Arc<[Locator]>,
+    /// The last of `locators` is a multicast locator, not a unicast one. Kept in the list rather than in a
+    /// slot of its own: the proxy then fits a 96-byte allocation (see `proxy_stays_small`).
+    multicast_last: bool,
+    /// New data (and the periodic heartbeat) goes to the multicast locator instead of the unicast one: set
+    /// by the writer when another matched reader shares that multicast locator.
     pub via_multicast: bool,
     /// Reliable protocol with this reader (both sides reliable).
     pub reliable: bool,
@@ -40,8 +43,12 @@ pub(crate) struct ReaderProxy {
     pub floor: SequenceNumber,
     /// Changes and fragments the reader asked for: `None` while nothing is requested.
     repairs: Option<Box<Repairs>>,
-    pub last_acknack: Option<i32>,
-    pub last_nackfrag: Option<i32>,
+    /// The count of the last ACKNACK taken (meaningful once `acknack_seen`).
+    last_acknack: i32,
+    /// The count of the last NACK_FRAG taken (meaningful once `nackfrag_seen`).
+    last_nackfrag: i32,
+    acknack_seen: bool,
+    nackfrag_seen: bool,
     /// When to send requested repairs (and a heartbeat addressed to this reader).
     pub repair_due: Option<Instant>,
     /// Send dispose/unregister (key-only changes) as DATA with only inline QoS (PID_KEY_HASH,
@@ -71,17 +78,39 @@ impl ReaderProxy {
         ReaderProxy {
             guid,
             locators: locators.into(),
-            multicast: None,
+            multicast_last: false,
             via_multicast: false,
             reliable,
             acked: SequenceNumber(1),
             floor: SequenceNumber(1),
             repairs: None,
-            last_acknack: None,
-            last_nackfrag: None,
+            last_acknack: 0,
+            last_nackfrag: 0,
+            acknack_seen: false,
+            nackfrag_seen: false,
             repair_due: None,
             key_hash_only_disposes: false,
         }
+    }
+
+    /// Whether an ACKNACK numbered `count` is newer than the last one taken (counts wrap); if so it is
+    /// taken: a repeated or reordered ACKNACK is ignored (§8.4.15.7).
+    pub(crate) fn take_acknack_count(&mut self, count: i32) -> bool {
+        let newer = !self.acknack_seen || count.wrapping_sub(self.last_acknack) > 0;
+        if newer {
+            (self.last_acknack, self.acknack_seen) = (count, true);
+        }
+        newer
+    }
+
+    /// Whether a NACK_FRAG numbered `count` is newer than the last one taken; if so it is taken (see
+    /// [`take_acknack_count`](Self::take_acknack_count)).
+    pub(crate) fn take_nackfrag_count(&mut self, count: i32) -> bool {
+        let newer = !self.nackfrag_seen || count.wrapping_sub(self.last_nackfrag) > 0;
+        if newer {
+            (self.last_nackfrag, self.nackfrag_seen) = (count, true);
+        }
+        newer
     }
 
     /// The requests, made on first use.
@@ -185,24 +214,67 @@ impl ReaderProxy {
         self
     }
 
+    /// The reader's unicast locators.
+    pub(crate) fn unicast(&self) -> &[Locator] {
+        let n = self.locators.len() - usize::from(self.multicast_last && !self.locators.is_empty());
+        &self.locators[..n]
+    }
+
+    /// The multicast locator the reader can be reached on, if any.
+    pub(crate) fn multicast(&self) -> Option<Locator> {
+        self.multicast_last
+            .then(|| self.locators.last().copied())
+            .flatten()
+    }
+
     /// Where to send what is for this reader alone (repairs, GAPs): its first unicast locator.
     pub(crate) fn destination(&self) -> &[Locator] {
-        &self.locators[..self.locators.len().min(1)]
+        let unicast = self.unicast();
+        &unicast[..unicast.len().min(1)]
     }
 
     /// Where new data for this reader goes: the shared multicast locator when the writer chose it, else
     /// [`destination`](Self::destination).
     pub(crate) fn data_destination(&self) -> Option<Locator> {
-        match self.multicast {
+        match self.multicast() {
             Some(m) if self.via_multicast => Some(m),
             _ => self.destination().first().copied(),
         }
     }
 
-    /// Gives the reader a multicast locator it can be reached on (none: unicast only).
-    pub(crate) fn with_multicast(mut self, multicast: Option<Locator>) -> Self {
-        self.multicast = multicast;
+    /// Gives the reader a multicast locator it can be reached on (none: unicast only): the locator list
+    /// is copied with it appended. Proxies that share a list use
+    /// [`with_multicast_last`](Self::with_multicast_last) instead.
+    pub(crate) fn with_multicast(self, multicast: Option<Locator>) -> Self {
+        match multicast {
+            Some(m) => {
+                let list = locators_with_multicast(self.unicast(), Some(m));
+                ReaderProxy {
+                    locators: list,
+                    multicast_last: true,
+                    ..self
+                }
+            }
+            None => self,
+        }
+    }
+
+    /// Says that the last of the locators the proxy was made with is a multicast locator the reader can be
+    /// reached on (a list made by [`locators_with_multicast`], shared by several proxies).
+    pub(crate) fn with_multicast_last(mut self, multicast_last: bool) -> Self {
+        self.multicast_last = multicast_last && !self.locators.is_empty();
         self
+    }
+}
+
+/// A proxy's locator list: `unicast`, then `multicast` if any (see [`ReaderProxy::with_multicast_last`]).
+fn locators_with_multicast(unicast: &[Locator], multicast: Option<Locator>) -> Arc<[Locator]> {
+    unicast.iter().copied().chain(multicast).collect()
+}
+
+impl crate::rtps::proxy_map::Keyed for ReaderProxy {
+    fn key(&self) -> &Guid {
+        &self.guid
     }
 }
 
@@ -220,11 +292,45 @@ mod tests {
     }
 
     /// One proxy per remote builtin reader of every discovered participant: the requests' sets are boxed
-    /// (160 bytes on x86-64 before).
+    /// (160 bytes on x86-64 before), the multicast locator is in the shared list and the counts are plain
+    /// (120 bytes before, a 128-byte allocation; 88 takes 96).
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn proxy_stays_small() {
-        assert_eq!(std::mem::size_of::<ReaderProxy>(), 120);
+        assert_eq!(std::mem::size_of::<ReaderProxy>(), 88);
+    }
+
+    fn loc(port: u16) -> Locator {
+        Locator::udpv4([127, 0, 0, 1], port)
+    }
+
+    #[test]
+    fn the_multicast_locator_is_last_in_the_list() {
+        let mc = Locator::udpv4([239, 255, 0, 1], 7400);
+        let p = proxy().with_multicast(Some(mc));
+        assert_eq!((p.unicast(), p.destination()), (&[][..], &[][..]));
+        assert_eq!((p.multicast(), p.data_destination()), (Some(mc), None));
+        let list = locators_with_multicast(&[loc(1), loc(2)], Some(mc));
+        let mut p = ReaderProxy::new(Guid::default(), list.clone(), true).with_multicast_last(true);
+        assert_eq!(p.unicast(), [loc(1), loc(2)]);
+        assert_eq!((p.destination(), p.multicast()), (&[loc(1)][..], Some(mc)));
+        assert_eq!(p.data_destination(), Some(loc(1)));
+        p.via_multicast = true;
+        assert_eq!(p.data_destination(), Some(mc));
+        let p = ReaderProxy::new(Guid::default(), list, true).with_multicast(None);
+        assert_eq!((p.unicast().len(), p.multicast()), (3, None));
+        let p = proxy().with_multicast_last(true);
+        assert_eq!((p.unicast(), p.multicast()), (&[][..], None));
+    }
+
+    #[test]
+    fn repeated_and_older_counts_are_ignored_and_counts_wrap() {
+        let mut p = proxy();
+        assert!(p.take_acknack_count(-7), "any first count is taken");
+        assert!(!p.take_acknack_count(-7) && !p.take_acknack_count(-8));
+        assert!(p.take_acknack_count(-6));
+        assert!(p.take_nackfrag_count(i32::MAX) && p.take_nackfrag_count(i32::MIN));
+        assert!(!p.take_nackfrag_count(i32::MAX));
     }
 
     #[test]
