@@ -13,6 +13,7 @@ mod participant;
 pub(crate) mod pool;
 pub(crate) mod reader;
 pub mod shm;
+mod transmit;
 pub mod types;
 pub(crate) mod writer;
 
@@ -22,5 +23,6 @@ pub use api::*;
 pub use participant::Participant;
 #[cfg(feature = "net")]
 pub(crate) use participant::KEPT_QUEUE_ROOM;
+pub use transmit::{SharedPart, Transmit};
 pub use types::*;
 pub use writer::WriterGroup;
