@@ -155,20 +155,6 @@ struct TimerState {
     waiting_until: Option<Instant>,
 }
 
-/// Slices of samples of at least this many bytes go into datagrams without a copy (scatter-gather
-/// sends; see `docs/performance.md`, "Session 23"): the fragments of a large sample, ten of 1 344 bytes to
-/// a DATA_FRAG by default.
-const GATHER_MIN: usize = 2048;
-
-/// The gathering threshold: [`GATHER_MIN`], or `DDS_GATHER_MIN` (a byte count, or `off`).
-fn gather_min() -> Option<usize> {
-    match std::env::var("DDS_GATHER_MIN") {
-        Ok(v) if v == "off" => None,
-        Ok(v) => Some(v.parse().unwrap_or(GATHER_MIN)),
-        Err(_) => Some(GATHER_MIN),
-    }
-}
-
 fn to_socket(l: &Locator) -> Option<SocketAddr> {
     l.to_socket_addr()
 }
@@ -284,7 +270,8 @@ impl Driver {
         let shm_properties = Vec::new();
         let pc = core_config(&config, &transport, prefix, user_data, name, shm_properties)?;
         let mut core = Participant::new(pc, Instant::now());
-        core.gather_sends(gather_min());
+        // Fragments of large samples leave from the samples' own buffers (`send_batch`).
+        core.gather_sends(config.gather_min);
         if !enabled {
             // Created disabled: nothing is sent, not even the first SPDP announcement, until `enable`.
             core.set_enabled(Instant::now(), false);
