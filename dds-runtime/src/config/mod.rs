@@ -781,4 +781,13 @@ mod tests {
         assert_eq!(delay("on"), Some(DEFAULT_WRITE_BATCH_DELAY));
         assert_eq!(delay("250"), Some(Duration::from_micros(250)));
     }
+
+    #[test]
+    fn gather_min_forms() {
+        let min = |v: &str| env(&[("DDS_GATHER_MIN", v)]).map(|c| c.gather_min);
+        assert_eq!(Config::default().gather_min, Some(2048));
+        assert_eq!(min("off").unwrap(), None);
+        assert_eq!(min("8192").unwrap(), Some(8192));
+        assert!(min("lots").is_err());
+    }
 }
