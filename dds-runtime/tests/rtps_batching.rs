@@ -76,7 +76,7 @@ fn write_and_drain(sim: &mut Sim, w: EntityId, i: u32, len: usize) -> Vec<Transm
 }
 
 fn count(t: &Transmit, pred: impl Fn(&Submessage<'_>) -> bool) -> usize {
-    MessageIter::parse(&t.payload)
+    MessageIter::parse(&t.datagram())
         .unwrap()
         .1
         .filter(|s| s.as_ref().is_ok_and(&pred))
@@ -90,7 +90,7 @@ fn is_data(s: &Submessage<'_>) -> bool {
 fn deliver(sim: &mut Sim, grams: &[Transmit]) {
     let now = sim.now;
     for t in grams {
-        sim.nodes[1].p.handle_datagram(now, &t.payload);
+        sim.nodes[1].p.handle_datagram(now, &t.datagram());
     }
 }
 
@@ -166,7 +166,7 @@ fn full_datagrams_leave_without_waiting_and_carry_few_heartbeats() {
     }
     // 200 KiB in datagrams of at most max_message_size: the full ones left during the writes.
     assert!(grams.len() >= 200 * 1024 / max, "{} datagrams", grams.len());
-    assert!(grams.iter().all(|t| t.payload.len() <= max));
+    assert!(grams.iter().all(|t| t.len() <= max));
     let data: usize = grams.iter().map(|t| count(t, is_data)).sum();
     let heartbeats: usize = grams
         .iter()

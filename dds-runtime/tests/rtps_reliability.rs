@@ -468,9 +468,9 @@ fn samples_are_packed_into_datagrams() {
     }
     // 100 × ~250 bytes in datagrams of at most 14720 bytes: 2 of them, each within the limit.
     assert!(datagrams.len() <= 3, "{} datagrams", datagrams.len());
-    assert!(datagrams.iter().all(|t| t.payload.len() <= max));
+    assert!(datagrams.iter().all(|t| t.len() <= max));
     for t in datagrams {
-        s.sim.nodes[1].p.handle_datagram(now, &t.payload);
+        s.sim.nodes[1].p.handle_datagram(now, &t.datagram());
     }
     s.sim.pump();
     let got = s.sim.take_samples(1, s.r);
@@ -597,11 +597,11 @@ fn core_throughput() {
             }
         }
         while let Some(t) = a.p.poll_transmit(now) {
-            b.p.handle_datagram(now, &t.payload);
-            a.p.recycle(t.payload);
+            b.p.handle_datagram(now, &t.datagram());
+            a.p.recycle_transmit(t);
         }
         while let Some(t) = b.p.poll_transmit(now) {
-            a.p.handle_datagram(now, &t.payload);
+            a.p.handle_datagram(now, &t.datagram());
         }
         while let Some(e) = b.p.poll_event() {
             if let Event::Sample(x) = e {

@@ -64,7 +64,7 @@ impl Net {
                 to.sort();
                 to.dedup();
                 for j in to {
-                    if let Some(payload) = hook(i, j, &t.payload) {
+                    if let Some(payload) = hook(i, j, &t.datagram()) {
                         self.seq += 1;
                         let at = sim.now + Duration::from_micros(100);
                         let sent = Sent {

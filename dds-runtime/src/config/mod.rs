@@ -20,6 +20,7 @@
 //! | `DDS_SOCKET_BUFFER_SIZE` | requested SO_RCVBUF / SO_SNDBUF | bytes | `4194304` |
 //! | `DDS_INTRA_PROCESS` | deliver to readers of the same participant directly (no serialization for them, no socket) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_GSO` | on Linux, a fragmented sample's datagrams to one destination leave in one `UDP_SEGMENT` send | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
+//! | `DDS_GATHER_MIN` | fragments of large samples of at least this many bytes per DATA_FRAG leave without a copy (scatter-gather sends of the sample's own buffer) | bytes, or `off` | `2048` |
 //! | `DDS_RECEIVE_SPIN_US` | adaptive busy polling: while datagrams arrive less than this apart, a receive thread polls its socket this long after each batch instead of sleeping (saves a wake-up per datagram; pays only with a core to spare) | microseconds, `0` = off | `0` |
 //! | `DDS_SHM` | with the `shm` feature: shared memory with peers on this host (their readers get our writers' samples through it, not UDP) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_WRITE_BATCH` | write batching: samples share datagrams until full, flushed, or this delay has passed | `off`, `on` (1 ms), or a delay in microseconds | `off` |
@@ -340,6 +341,10 @@ pub struct Config {
     /// Segmented sends (Linux `UDP_SEGMENT`, `DDS_GSO`, default on): a run of equal-sized datagrams to one
     /// destination, as a fragmented sample makes, leaves in one system call. Ignored elsewhere.
     pub gso: bool,
+    /// Scatter-gather sends (`DDS_GATHER_MIN`, default 2048 bytes): a DATA_FRAG's slice of a sample of at
+    /// least this many bytes goes to the socket from the sample's own buffer, not copied into the
+    /// datagram. `None`: every datagram is copied together.
+    pub gather_min: Option<usize>,
     /// Adaptive busy polling of the receive sockets (`DDS_RECEIVE_SPIN_US`, default 0: off). While datagrams
     /// arrive less than this apart, a receive thread polls its socket for up to this long after each batch
     /// instead of sleeping, which saves a thread wake-up per datagram on a request/reply or a fast stream.
@@ -371,6 +376,7 @@ impl Default for Config {
             write_batch_delay: None,
             intra_process: true,
             gso: true,
+            gather_min: Some(2048),
             receive_spin: Duration::ZERO,
             shm: true,
         }
@@ -485,6 +491,12 @@ impl Config {
         }
         if let Some(v) = lookup("DDS_GSO") {
             c.gso = parse_bool("DDS_GSO", &v)?;
+        }
+        if let Some(v) = lookup("DDS_GATHER_MIN") {
+            c.gather_min = match v.trim() {
+                "off" => None,
+                n => Some(parse_num("DDS_GATHER_MIN", n)?),
+            };
         }
         if let Some(v) = lookup("DDS_RECEIVE_SPIN_US") {
             c.receive_spin = Duration::from_micros(parse_num("DDS_RECEIVE_SPIN_US", &v)?);
@@ -768,5 +780,14 @@ mod tests {
         assert_eq!(delay("0"), None);
         assert_eq!(delay("on"), Some(DEFAULT_WRITE_BATCH_DELAY));
         assert_eq!(delay("250"), Some(Duration::from_micros(250)));
+    }
+
+    #[test]
+    fn gather_min_forms() {
+        let min = |v: &str| env(&[("DDS_GATHER_MIN", v)]).map(|c| c.gather_min);
+        assert_eq!(Config::default().gather_min, Some(2048));
+        assert_eq!(min("off").unwrap(), None);
+        assert_eq!(min("8192").unwrap(), Some(8192));
+        assert!(min("lots").is_err());
     }
 }

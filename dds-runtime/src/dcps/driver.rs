@@ -17,7 +17,7 @@ use crate::rtps::{
     CoreError, EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig,
     ReceivedSample, Transmit, WriteChange,
 };
-use crate::transport::{Channel, Datagram, UdpTransport};
+use crate::transport::{Channel, Datagram, Pieces, UdpTransport};
 
 use super::condition::StatusCore;
 use super::error::{DdsError, DdsResult};
@@ -270,6 +270,8 @@ impl Driver {
         let shm_properties = Vec::new();
         let pc = core_config(&config, &transport, prefix, user_data, name, shm_properties)?;
         let mut core = Participant::new(pc, Instant::now());
+        // Fragments of large samples leave from the samples' own buffers (`send_batch`).
+        core.gather_sends(config.gather_min);
         if !enabled {
             // Created disabled: nothing is sent, not even the first SPDP announcement, until `enable`.
             core.set_enabled(Instant::now(), false);
@@ -410,6 +412,10 @@ impl Driver {
         #[cfg(not(feature = "shm"))]
         let _ = send_shm;
         self.send_batch(&batch);
+        // The shares of samples go now: a pooled sample buffer returns to its pool at once.
+        for t in &mut batch {
+            t.shared.clear();
+        }
         self.keep_sent(&mut batch);
         BATCH.with(|b| *b.borrow_mut() = batch);
         self.after_unlock(&mut deferred, &mut touched, next_timeout, progress);
@@ -525,26 +531,49 @@ impl Driver {
     }
 
     /// Sends the datagrams in order; consecutive ones for the same destinations (a fragmented sample's)
-    /// go to each destination as one run, which the transport may send in one system call.
+    /// go to each destination as one run, which the transport may send in one system call. Datagrams
+    /// that share slices of samples ([`Transmit::shared`]) go in pieces, gathered by the kernel.
     fn send_batch(&self, batch: &[Transmit]) {
         const RUN: usize = 16;
         let mut rest = batch;
         while let Some(first) = rest.first() {
-            let mut run: [&[u8]; RUN] = [&[]; RUN];
-            let mut n = 0;
-            for t in rest.iter().take(RUN) {
-                if t.destinations != first.destinations {
-                    break;
+            let n = rest
+                .iter()
+                .take(RUN)
+                .take_while(|t| t.destinations == first.destinations)
+                .count();
+            let run = &rest[..n];
+            if run.iter().all(|t| t.shared.is_empty()) {
+                let mut bufs: [&[u8]; RUN] = [&[]; RUN];
+                for (b, t) in bufs.iter_mut().zip(run) {
+                    *b = &t.payload;
                 }
-                run[n] = &t.payload;
-                n += 1;
-            }
-            for d in &first.destinations {
-                if let Some(a) = to_socket(d) {
-                    self.transport.send_run(&run[..n], a);
+                self.send_run(&bufs[..n], &first.destinations);
+            } else {
+                let mut pieces: Vec<&[u8]> = Vec::with_capacity(n * 3);
+                let mut ends = [0usize; RUN];
+                for (end, t) in ends.iter_mut().zip(run) {
+                    t.pieces(|p| pieces.push(p));
+                    *end = pieces.len();
                 }
+                let mut grams: [&[&[u8]]; RUN] = [&[]; RUN];
+                let mut from = 0;
+                for (g, &end) in grams.iter_mut().zip(&ends[..n]) {
+                    *g = &pieces[from..end];
+                    from = end;
+                }
+                self.send_run(&grams[..n], &first.destinations);
             }
             rest = &rest[n..];
+        }
+    }
+
+    /// Sends a run of datagrams to each of `destinations`.
+    fn send_run<P: Pieces>(&self, run: &[P], destinations: &[Locator]) {
+        for d in destinations {
+            if let Some(a) = to_socket(d) {
+                self.transport.send_run(run, a);
+            }
         }
     }
 

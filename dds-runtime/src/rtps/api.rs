@@ -473,15 +473,6 @@ impl From<ParticipantConfigBuilder> for ParticipantConfig {
     }
 }
 
-/// One datagram to send to every destination.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Transmit {
-    /// Send the payload to each of these.
-    pub destinations: Vec<Locator>,
-    /// One RTPS message.
-    pub payload: Vec<u8>,
-}
-
 /// What a change does to its instance (PID_STATUS_INFO on the wire).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ChangeKind {

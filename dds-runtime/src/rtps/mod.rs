@@ -14,6 +14,7 @@ pub(crate) mod pool;
 mod proxy_map;
 pub(crate) mod reader;
 pub mod shm;
+mod transmit;
 pub mod types;
 pub(crate) mod writer;
 
@@ -23,5 +24,6 @@ pub use api::*;
 pub use participant::Participant;
 #[cfg(feature = "net")]
 pub(crate) use participant::KEPT_QUEUE_ROOM;
+pub use transmit::{SharedPart, Transmit};
 pub use types::*;
 pub use writer::WriterGroup;

@@ -8,12 +8,17 @@
 //! Open messages normally close at the next drain. Batched writes (`hold`) leave them open until they
 //! fill up, an explicit flush, any unbatched traffic, or the batch delay runs out, so that a burst of small
 //! samples travels in few datagrams.
+//!
+//! With gathering on ([`Outbox::gather_from`]), a large slice of a sample (the fragments of a DATA_FRAG)
+//! is not copied into the datagram: the message keeps a share of the sample's buffer at that offset
+//! ([`SharedPart`]) and the I/O layer sends the pieces with one scatter-gather call.
 
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
-use super::api::Transmit;
+use super::api::Payload;
 use super::messages::{append, Header, Submessage};
+use super::transmit::{SharedPart, Transmit};
 use super::types::*;
 
 /// Whether a submessage depends on the INFO_TS in force.
@@ -36,7 +41,49 @@ struct Pending {
     preamble: usize,
     /// Start of the last submessage, whose length grows when the next one needs alignment padding.
     last_header: Option<usize>,
+    /// Slices of samples that go into the message uncopied, at their offsets in `buf`.
+    shared: Vec<SharedPart>,
+    /// Their total length.
+    shared_len: usize,
 }
+
+impl Pending {
+    /// The message's length on the wire so far.
+    fn len(&self) -> usize {
+        self.buf.len() + self.shared_len
+    }
+
+    /// Appends `part` to the submessage just written (its payload, left empty there) as a shared slice.
+    /// The submessage ends 4-aligned and `part`'s length is a multiple of 4 ([`Outbox::gathers`]), so
+    /// `buf`'s alignment stays that of the message and later padding is computed right.
+    fn attach(&mut self, part: &Payload) {
+        let Some(h) = self.last_header else {
+            return;
+        };
+        let le = self.buf[h + 1] & 0x01 != 0;
+        let field = [self.buf[h + 2], self.buf[h + 3]];
+        let old = if le {
+            u16::from_le_bytes(field)
+        } else {
+            u16::from_be_bytes(field)
+        };
+        // `gathers` keeps the sum within the field (checked again: 0 would mean "to the end").
+        let len = u16::try_from(usize::from(old) + part.len()).unwrap_or(0);
+        self.buf[h + 2..h + 4].copy_from_slice(&if le {
+            len.to_le_bytes()
+        } else {
+            len.to_be_bytes()
+        });
+        self.shared.push(SharedPart {
+            at: self.buf.len(),
+            bytes: part.clone(),
+        });
+        self.shared_len += part.len();
+    }
+}
+
+/// Shared slices must leave room for a submessage's other fields within its 16-bit length.
+const MAX_SHARED: usize = u16::MAX as usize - 1024;
 
 /// Datagram buffers kept for reuse. A pass that sends to hundreds of peers (discovery replies, heartbeats)
 /// allocates beyond it; what it would keep is a fixed cost that stays for the participant's life (see
@@ -51,6 +98,10 @@ pub(crate) struct Outbox {
     pending: Vec<Pending>,
     ready: VecDeque<Transmit>,
     pool: Vec<Vec<u8>>,
+    /// Lists of shared parts of sent datagrams, for reuse.
+    shared_pool: Vec<Vec<SharedPart>>,
+    /// Slices of at least this many bytes are shared, not copied (`None`: always copied).
+    gather_min: Option<usize>,
     /// Destination lists of sent datagrams, for reuse.
     dest_pool: Vec<Vec<Locator>>,
     /// While set, pushes do not ask for the open messages to close at the next drain.
@@ -69,11 +120,29 @@ impl Outbox {
             pending: Vec::new(),
             ready: VecDeque::new(),
             pool: Vec::new(),
+            shared_pool: Vec::new(),
+            gather_min: None,
             dest_pool: Vec::new(),
             holding: false,
             flush_due: false,
             held_since: None,
         }
+    }
+
+    /// Shares slices of samples of at least `min` bytes with the datagrams instead of copying them
+    /// (`None`: copies everything, the default).
+    pub(crate) fn gather_from(&mut self, min: Option<usize>) {
+        self.gather_min = min;
+    }
+
+    /// Whether `n` bytes of `sample` go into a datagram shared ([`Outbox::push_shared`]) rather than
+    /// copied: gathering is on and they are enough, a multiple of 4 (the message's alignment stays that
+    /// of its own bytes), within a submessage's length, and of a buffer (a local sample serializes on
+    /// demand and cannot be sliced).
+    pub(crate) fn gathers(&self, sample: &Payload, n: usize) -> bool {
+        self.gather_min.is_some_and(|min| {
+            n >= min && n.is_multiple_of(4) && n <= MAX_SHARED && !sample.is_local()
+        })
     }
 
     /// Runs `f` with its pushes held back for batching: they leave at the latest `delay` after `now`.
@@ -139,6 +208,7 @@ impl Outbox {
         let mut dests = self.dest_pool.pop().unwrap_or_default();
         dests.clear();
         dests.extend_from_slice(destinations);
+        let shared = self.shared_pool.pop().unwrap_or_default();
         self.pending.push(Pending {
             destinations: dests,
             dst,
@@ -146,6 +216,8 @@ impl Outbox {
             ts: None,
             preamble,
             last_header,
+            shared,
+            shared_len: 0,
         });
         self.pending.len() - 1
     }
@@ -158,6 +230,30 @@ impl Outbox {
         ts: Ts,
         sub: &Submessage<'_>,
     ) {
+        self.push_part(destinations, dst, ts, sub, None);
+    }
+
+    /// Like [`push`](Outbox::push) for a DATA_FRAG written with an empty payload, whose payload is
+    /// `part` (one that [`gathers`](Outbox::gathers)), shared with the datagram instead of copied.
+    pub(crate) fn push_shared(
+        &mut self,
+        destinations: &[Locator],
+        dst: Option<GuidPrefix>,
+        ts: Ts,
+        sub: &Submessage<'_>,
+        part: &Payload,
+    ) {
+        self.push_part(destinations, dst, ts, sub, Some(part));
+    }
+
+    fn push_part(
+        &mut self,
+        destinations: &[Locator],
+        dst: Option<GuidPrefix>,
+        ts: Ts,
+        sub: &Submessage<'_>,
+        part: Option<&Payload>,
+    ) {
         if destinations.is_empty() {
             return;
         }
@@ -166,17 +262,23 @@ impl Outbox {
         }
         let i = self.open(destinations, dst);
         let p = &mut self.pending[i];
-        let before = p.buf.len();
+        let (before, before_len) = (p.buf.len(), p.len());
+        let (shared_before, shared_len_before) = (p.shared.len(), p.shared_len);
         let (ts_before, header_before, dst_before) = (p.ts, p.last_header, p.dst);
         let saved_len = header_before.map(|h| (h, [p.buf[h + 2], p.buf[h + 3]]));
         write_dst(p, dst);
         write_ts(p, ts);
         append(&mut p.buf, &mut p.last_header, sub, true);
-        if p.buf.len() > self.max && before > p.preamble {
+        if let Some(part) = part {
+            p.attach(part);
+        }
+        if p.len() > self.max && before > p.preamble {
             // Did not fit: close the message without it (undoing the alignment padding of the previous
             // submessage) and put it first in a fresh one.
-            let spill = p.buf.len() - before;
+            let spill = p.len() - before_len;
             p.buf.truncate(before);
+            p.shared.truncate(shared_before);
+            p.shared_len = shared_len_before;
             if let Some((h, len)) = saved_len {
                 p.buf[h + 2..h + 4].copy_from_slice(&len);
             }
@@ -187,16 +289,22 @@ impl Outbox {
             self.ready.push_back(Transmit {
                 destinations: done.destinations,
                 payload: done.buf,
+                shared: done.shared,
             });
             let i = self.fresh(destinations, dst);
             let p = &mut self.pending[i];
-            // A run of submessages that fill datagrams (the fragments of a large sample): room for a full
-            // one and the submessage that will not fit, so that the buffer never regrows (and copies
-            // itself) step by step.
-            p.buf
-                .reserve((self.max + spill).saturating_sub(p.buf.len()));
+            if part.is_none() {
+                // A run of submessages that fill datagrams (the fragments of a large sample): room for a
+                // full one and the submessage that will not fit, so that the buffer never regrows (and
+                // copies itself) step by step.
+                p.buf
+                    .reserve((self.max + spill).saturating_sub(p.buf.len()));
+            }
             write_ts(p, ts);
             append(&mut p.buf, &mut p.last_header, sub, true);
+            if let Some(part) = part {
+                p.attach(part);
+            }
         }
     }
 
@@ -209,9 +317,11 @@ impl Outbox {
                 self.ready.push_back(Transmit {
                     destinations: p.destinations,
                     payload: p.buf,
+                    shared: p.shared,
                 });
             } else {
                 self.pool.push(p.buf);
+                self.shared_pool.push(p.shared);
             }
         }
     }
@@ -234,6 +344,14 @@ impl Outbox {
         }
     }
 
+    /// Returns a datagram's list of shared parts for reuse (the shares themselves are dropped).
+    pub(crate) fn recycle_shared(&mut self, mut shared: Vec<SharedPart>) {
+        shared.clear();
+        if shared.capacity() > 0 && self.shared_pool.len() < POOLED {
+            self.shared_pool.push(shared);
+        }
+    }
+
     /// Gives back what a burst left in the reuse pools and queues beyond `keep` entries each (a burst of
     /// discovery replies to a few hundred peers fills the datagram pool to its bound, [`POOLED`]), and
     /// the room beyond `keep_bytes` of each datagram buffer kept (a few large datagrams leave their
@@ -247,6 +365,8 @@ impl Outbox {
         }
         self.dest_pool.truncate(keep);
         self.dest_pool.shrink_to(keep);
+        self.shared_pool.truncate(keep);
+        self.shared_pool.shrink_to(keep);
         self.pending.shrink_to(keep);
         self.ready.shrink_to(keep);
     }
@@ -342,6 +462,65 @@ mod tests {
                 vec![(None, 5), (a, 6)]
             ]
         );
+    }
+
+    /// The fragments of a sample in DATA_FRAGs of `per` fragments (the writer's way), then a GAP, to two
+    /// participants at one locator; slices that [`Outbox::gathers`] go shared when `share`.
+    fn fragment_runs(o: &mut Outbox, sample: &Payload, per: usize, share: bool) -> Vec<Transmit> {
+        use crate::rtps::messages::DataFrag;
+        let l = [Locator::udpv4([10, 0, 0, 1], 7410)];
+        let frag = 1344;
+        let firsts = (0..sample.len().div_ceil(frag)).step_by(per);
+        for (k, first) in firsts.enumerate() {
+            let (start, end) = (first * frag, ((first + per) * frag).min(sample.len()));
+            let shared = share && o.gathers(sample, end - start);
+            let d = Submessage::DataFrag(DataFrag {
+                reader_id: EntityId::UNKNOWN,
+                writer_id: EntityId::SEDP_PUBLICATIONS_WRITER,
+                writer_sn: SequenceNumber(1),
+                fragment_starting_num: first as u32 + 1,
+                fragments_in_submessage: (end - start).div_ceil(frag) as u16,
+                fragment_size: frag as u16,
+                sample_size: sample.len() as u32,
+                inline_qos: None,
+                payload: if shared { &[] } else { &sample[start..end] },
+                key_flag: false,
+                non_standard_flag: false,
+            });
+            let dst = Some(GuidPrefix([1 + (k % 2) as u8; 12]));
+            let ts = Ts::Set(Some(Time {
+                seconds: 5,
+                fraction: 0,
+            }));
+            match shared {
+                true => o.push_shared(&l, dst, ts, &d, &sample.slice(start..end)),
+                false => o.push(&l, dst, ts, &d),
+            }
+        }
+        o.push(&l, None, Ts::Any, &gap(9));
+        std::iter::from_fn(|| o.pop(Instant::now(), Duration::ZERO)).collect()
+    }
+
+    #[test]
+    fn shared_fragments_make_the_same_datagrams_as_copied_ones() {
+        // A last fragment of 3 bytes (not a multiple of 4: copied), runs of 1 and of 10 fragments.
+        let sample = Payload::new((0..40_323u32).map(|i| i as u8).collect::<Vec<u8>>());
+        for (per, max) in [(10, 14_720), (1, 14_720), (3, 14_720), (10, 1_500)] {
+            let mut copied = outbox();
+            copied.max = max;
+            let mut gathered = outbox();
+            gathered.max = max;
+            gathered.gather_from(Some(1_000));
+            let want = fragment_runs(&mut copied, &sample, per, false);
+            let got = fragment_runs(&mut gathered, &sample, per, true);
+            assert!(want.iter().all(|t| t.shared.is_empty()));
+            if max > 1_500 {
+                assert!(got.iter().any(|t| !t.shared.is_empty()), "{per}");
+            }
+            let bytes =
+                |ts: &[Transmit]| ts.iter().map(|t| t.datagram().to_vec()).collect::<Vec<_>>();
+            assert_eq!(bytes(&got), bytes(&want), "{per} per DATA_FRAG, max {max}");
+        }
     }
 
     #[test]

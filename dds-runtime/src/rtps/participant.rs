@@ -34,6 +34,7 @@ use super::discovery::{EndpointData, ParticipantData, ReaderData, WriterData};
 use super::messages::Header;
 use super::outbox::Outbox;
 use super::reader::{Reader, ReaderParams};
+use super::transmit::Transmit;
 use super::types::*;
 use super::writer::{Writer, WriterParams};
 use crate::qos::{DataWriterQos, Durability, History, ReaderQos, ResourceLimits, WriterQos};
@@ -370,7 +371,16 @@ impl Participant {
     /// later datagrams (no allocation per datagram in the steady state).
     pub fn recycle_transmit(&mut self, t: Transmit) {
         self.out.recycle(t.payload);
+        self.out.recycle_shared(t.shared);
         self.out.recycle_destinations(t.destinations);
+    }
+
+    /// Sends slices of samples of at least `min` bytes (the fragments of large samples) without copying
+    /// them: their [`Transmit`]s carry shares of the samples' buffers ([`Transmit::shared`]), for an I/O
+    /// layer that sends with scatter-gather. `None` (the default): every datagram is in
+    /// [`Transmit::payload`] alone.
+    pub fn gather_sends(&mut self, min: Option<usize>) {
+        self.out.gather_from(min);
     }
 
     /// The next event for the DCPS layer, in order.

@@ -1,5 +1,7 @@
 //! Linux UDP generic segmentation offload (`UDP_SEGMENT`): one `sendmsg` hands the kernel a run of
 //! datagrams of one size (the last may be shorter) for one destination, and the kernel cuts them apart.
+//! Datagrams given in pieces ([`Pieces`]) go as one `iovec` per piece: the kernel concatenates them and
+//! cuts every segment size, so the pieces of each datagram must add up to exactly that size.
 //! A fragmented sample is such a run: on loopback the receiver then finds all of its datagrams queued at
 //! once (one wake-up, one `recvmmsg`) instead of waking for each `sendto`.
 //!
@@ -14,6 +16,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 use socket2::SockAddr;
+
+use super::gather::Pieces;
 
 /// Destinations refused for their MTU remembered before segmentation is turned off altogether.
 const MAX_REFUSED: usize = 64;
@@ -65,23 +69,28 @@ pub(super) const MAX_SEGMENTS: usize = 64;
 /// (IPv6 allows 8 more; the smaller bound serves both).
 pub(super) const MAX_BYTES: usize = 65_535 - 20 - 8;
 
+/// Most `iovec`s (pieces of datagrams) one segmented send carries.
+const MAX_IOV: usize = 128;
+
 /// How many of `payloads` (from the first) one segmented send can carry: a run whose datagrams all have
-/// the first one's length, except that the run's last may be shorter, within [`MAX_SEGMENTS`] and
-/// [`MAX_BYTES`]. At least 1.
-pub(super) fn run_len(payloads: &[&[u8]]) -> usize {
+/// the first one's length, except that the run's last may be shorter, within [`MAX_SEGMENTS`],
+/// [`MAX_BYTES`] and `MAX_IOV` pieces. At least 1.
+pub(super) fn run_len<P: Pieces>(payloads: &[P]) -> usize {
     let Some(first) = payloads.first() else {
         return 0;
     };
-    let size = first.len();
-    let mut total = 0;
+    let size = first.total_len();
+    let (mut total, mut pieces) = (0, 0);
     let mut n = 0;
     for p in payloads.iter().take(MAX_SEGMENTS) {
-        if p.len() > size || total + p.len() > MAX_BYTES || p.is_empty() {
+        let len = p.total_len();
+        pieces += p.pieces().len();
+        if len > size || total + len > MAX_BYTES || len == 0 || pieces > MAX_IOV {
             break;
         }
-        total += p.len();
+        total += len;
         n += 1;
-        if p.len() < size {
+        if len < size {
             break;
         }
     }
@@ -90,22 +99,25 @@ pub(super) fn run_len(payloads: &[&[u8]]) -> usize {
 
 /// Sends `payloads` (a run as [`run_len`] chose, at least two) to `dest` in one `sendmsg` with
 /// `UDP_SEGMENT` set to the first one's length; `None`: to the destination `sock` is connected to.
-pub(super) fn send_segments(
+pub(super) fn send_segments<P: Pieces>(
     sock: &UdpSocket,
-    payloads: &[&[u8]],
+    payloads: &[P],
     dest: Option<SocketAddr>,
 ) -> io::Result<()> {
     debug_assert!(payloads.len() >= 2 && payloads.len() <= MAX_SEGMENTS);
     let mut iovs = [libc::iovec {
         iov_base: std::ptr::null_mut(),
         iov_len: 0,
-    }; MAX_SEGMENTS];
-    for (iov, p) in iovs.iter_mut().zip(payloads) {
+    }; MAX_IOV];
+    let pieces = payloads.iter().flat_map(|d| d.pieces());
+    let mut used = 0;
+    for (iov, p) in iovs.iter_mut().zip(pieces) {
         iov.iov_base = p.as_ptr().cast_mut().cast();
         iov.iov_len = p.len();
+        used += 1;
     }
     let addr = dest.map(SockAddr::from);
-    let seg = payloads[0].len() as u16;
+    let seg = payloads[0].total_len() as u16;
     // Room for one cmsghdr with a u16, aligned as the kernel wants (u64 alignment).
     let mut control = [0u64; 4];
     // SAFETY: all-zero is a valid msghdr; every pointer set below outlives the call.
@@ -115,7 +127,7 @@ pub(super) fn send_segments(
         msg.msg_namelen = addr.len();
     }
     msg.msg_iov = iovs.as_mut_ptr();
-    msg.msg_iovlen = payloads.len() as _;
+    msg.msg_iovlen = used as _;
     msg.msg_control = control.as_mut_ptr().cast();
     // SAFETY: CMSG_SPACE only computes a size.
     msg.msg_controllen = unsafe { libc::CMSG_SPACE(std::mem::size_of::<u16>() as u32) } as _;
@@ -158,15 +170,15 @@ mod tests {
 
     #[test]
     fn runs_are_equal_sized_datagrams_with_a_shorter_last() {
-        let a = [0u8; 1000];
-        let b = [0u8; 400];
-        assert_eq!(run_len(&[&a, &a, &a, &b, &a]), 4);
-        assert_eq!(run_len(&[&a, &a]), 2);
-        assert_eq!(run_len(&[&b, &a]), 1);
-        assert_eq!(run_len(&[&a]), 1);
-        let big = [0u8; 14_720];
+        let a: &[u8] = &[0u8; 1000];
+        let b: &[u8] = &[0u8; 400];
+        assert_eq!(run_len(&[a, a, a, b, a]), 4);
+        assert_eq!(run_len(&[a, a]), 2);
+        assert_eq!(run_len(&[b, a]), 1);
+        assert_eq!(run_len(&[a]), 1);
+        let big: &[u8] = &[0u8; 14_720];
         // 4 × 14 720 = 58 880 fits, a fifth would pass 65 507.
-        assert_eq!(run_len(&[&big, &big, &big, &big, &big]), 4);
+        assert_eq!(run_len(&[big, big, big, big, big]), 4);
         let tiny = [0u8; 10];
         let many: Vec<&[u8]> = (0..100).map(|_| &tiny[..]).collect();
         assert_eq!(run_len(&many), MAX_SEGMENTS);
@@ -203,6 +215,36 @@ mod tests {
         for p in payloads {
             let n = rx.recv(&mut buf).unwrap();
             assert_eq!(&buf[..n], p);
+        }
+    }
+
+    #[test]
+    fn runs_of_pieced_datagrams_count_their_whole_lengths() {
+        let (head, body, short): (&[u8], &[u8], &[u8]) = (&[1; 40], &[2; 960], &[3; 360]);
+        let full: &[&[u8]] = &[head, body];
+        let last: &[&[u8]] = &[head, short];
+        assert_eq!(run_len(&[full, full, last, full]), 3);
+        assert_eq!(run_len(&[full, &[head, body, head][..]]), 1);
+        // At most MAX_IOV pieces in one send.
+        let split: Vec<&[u8]> = vec![&[4; 10]; 10];
+        let many = vec![&split[..]; MAX_SEGMENTS];
+        assert_eq!(run_len(&many), MAX_IOV / 10);
+    }
+
+    #[test]
+    fn a_segmented_send_of_pieces_arrives_as_the_datagrams_they_make() {
+        let rx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let (head, body, tail): (&[u8], &[u8], &[u8]) = (&[1; 44], &[2; 1156], &[3; 500]);
+        let grams: [&[&[u8]]; 3] = [&[head, body], &[head, &body[..600], &body[600..]], &[tail]];
+        match send_segments(&tx, &grams, Some(rx.local_addr().unwrap())) {
+            Err(e) if unsupported(&e) => return, // no GSO here: the fallback's case
+            r => r.unwrap(),
+        }
+        let mut buf = [0u8; 2000];
+        for g in grams {
+            let n = rx.recv(&mut buf).unwrap();
+            assert_eq!(&buf[..n], &g.concat()[..]);
         }
     }
 

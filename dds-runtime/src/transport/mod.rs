@@ -27,11 +27,14 @@
 //! except that a busy unicast destination gets a socket connected to it (`send`, no route lookup per
 //! datagram; at most 8 per participant), and on Linux a run of equal-sized datagrams to one destination (a
 //! fragmented sample's) leaves in one `sendmsg` with `UDP_SEGMENT` ([`UdpTransport::send_run`];
-//! `DDS_GSO=off` turns it off). Options that only Linux has
+//! `DDS_GSO=off` turns it off). A datagram may be given in pieces (its headers, then a slice of the
+//! sample), which leave gathered by the kernel (`sendmsg` with one `iovec` each), also within a
+//! segmented run. Options that only Linux has
 //! (`SO_RCVBUFFORCE`, `IP_MULTICAST_ALL`) are set only there.
 
 mod connected;
 mod datagram;
+mod gather;
 #[cfg(target_os = "linux")]
 mod gso;
 pub mod iface;
@@ -49,6 +52,7 @@ mod udp;
 pub(crate) const DELIVERY_STACK: usize = 64 << 20;
 
 pub use datagram::{Channel, Datagram, Receiver, TransportStats};
+pub use gather::Pieces;
 pub use iface::Interface;
 pub use recv::ReceivePath;
 pub use udp::UdpTransport;

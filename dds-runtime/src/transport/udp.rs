@@ -11,6 +11,7 @@ use socket2::{SockRef, Socket};
 
 use super::connected::{self, Connected};
 use super::datagram::{Channel, Receiver, TransportStats};
+use super::gather::{self, Pieces};
 #[cfg(target_os = "linux")]
 use super::gso::{self, GsoState};
 use super::iface::{self, Interface};
@@ -265,13 +266,16 @@ impl UdpTransport {
     /// Sends `payloads` to `dest`, in order. On Linux a run of datagrams of one length (the last may be
     /// shorter) leaves in one `UDP_SEGMENT` send, as a fragmented sample's do, where the kernel and the
     /// path allow it; elsewhere, and after a refusal, one `sendto` per datagram.
-    pub fn send_run(&self, payloads: &[&[u8]], dest: impl Into<SocketAddr>) {
+    ///
+    /// A datagram may be given in pieces (`&[&[u8]]`, [`Pieces`]): they leave as one datagram, gathered by
+    /// the kernel, without a copy here.
+    pub fn send_run<P: Pieces>(&self, payloads: &[P], dest: impl Into<SocketAddr>) {
         let dest = self.scoped(dest.into());
         let mut rest = payloads;
         while !rest.is_empty() {
             let n = self.send_segmented(rest, dest);
             if n == 0 {
-                self.send_to(rest[0], dest);
+                self.send_pieces(rest[0].pieces(), dest);
                 rest = &rest[1..];
             } else {
                 rest = &rest[n..];
@@ -282,7 +286,7 @@ impl UdpTransport {
     /// One segmented send of the run at the head of `payloads`: how many datagrams it took (0: not sent,
     /// send the first one alone).
     #[cfg(target_os = "linux")]
-    fn send_segmented(&self, payloads: &[&[u8]], dest: SocketAddr) -> usize {
+    fn send_segmented<P: Pieces>(&self, payloads: &[P], dest: SocketAddr) -> usize {
         let n = gso::run_len(payloads);
         if n < 2
             || (dest.ip().is_multicast() && !self.multicast)
@@ -301,7 +305,7 @@ impl UdpTransport {
         match sent {
             Ok(()) => {
                 self.stats.sent.fetch_add(n as u64, Ordering::Relaxed);
-                tracing::trace!(%dest, datagrams = n, len = payloads[0].len(), "sent segmented");
+                tracing::trace!(%dest, datagrams = n, len = payloads[0].total_len(), "sent segmented");
                 n
             }
             Err(e) if gso::unsupported(&e) => {
@@ -319,8 +323,38 @@ impl UdpTransport {
     }
 
     #[cfg(not(target_os = "linux"))]
-    fn send_segmented(&self, _: &[&[u8]], _: SocketAddr) -> usize {
+    fn send_segmented<P: Pieces>(&self, _: &[P], _: SocketAddr) -> usize {
         0
+    }
+
+    /// Sends one datagram given in pieces, as [`send_to`](UdpTransport::send_to) does one buffer.
+    fn send_pieces(&self, pieces: &[&[u8]], dest: SocketAddr) {
+        if let [one] = pieces {
+            return self.send_to(one, dest);
+        }
+        if (dest.ip().is_multicast() && !self.multicast) || !self.family.contains(dest.ip()) {
+            return;
+        }
+        let r = self
+            .connected
+            .with(dest, &self.iface, self.buf, |s| {
+                match gather::send_pieces(s, pieces, None) {
+                    Err(e) if connected::stale_error(&e) => gather::send_pieces(s, pieces, None),
+                    r => r,
+                }
+            })
+            .unwrap_or_else(|| gather::send_pieces(&self.meta_uc, pieces, Some(dest)));
+        let len = pieces.total_len();
+        match r {
+            Ok(_) => {
+                self.stats.sent.fetch_add(1, Ordering::Relaxed);
+                tracing::trace!(%dest, len, pieces = pieces.len(), "sent gathered");
+            }
+            Err(e) => {
+                self.stats.send_errors.fetch_add(1, Ordering::Relaxed);
+                tracing::debug!(%dest, len, error = %e, "send failed");
+            }
+        }
     }
 
     /// Sends `payload` to each destination.

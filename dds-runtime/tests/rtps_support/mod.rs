@@ -128,7 +128,9 @@ impl Sim {
     }
 
     pub(crate) fn add(&mut self, config: impl Into<ParticipantConfig>) -> usize {
-        let p = Participant::new(config.into(), self.now);
+        let mut p = Participant::new(config.into(), self.now);
+        // As the DCPS driver does: large fragments travel as shares of the sample, not copies.
+        p.gather_sends(Some(2048));
         self.nodes.push(Node {
             p,
             events: Vec::new(),
@@ -173,9 +175,10 @@ impl Sim {
                     .collect();
                 targets.sort();
                 targets.dedup();
-                let user = is_user_traffic(&t.payload);
+                let bytes = t.datagram().into_owned();
+                let user = is_user_traffic(&bytes);
                 if let Some(log) = &mut self.trace {
-                    log.push((i, t.destinations.clone(), t.payload.clone()));
+                    log.push((i, t.destinations.clone(), bytes.clone()));
                 }
                 if !self.nodes[i].up {
                     targets.clear();
@@ -209,11 +212,11 @@ impl Sim {
                             at,
                             seq: self.seq,
                             to,
-                            payload: t.payload.clone(),
+                            payload: bytes.clone(),
                         }));
                     }
                 }
-                self.nodes[i].p.recycle(t.payload);
+                self.nodes[i].p.recycle_transmit(t);
             }
             while let Some(e) = self.nodes[i].p.poll_event() {
                 self.nodes[i].events.push(e);

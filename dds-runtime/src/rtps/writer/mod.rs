@@ -1042,6 +1042,8 @@ pub(crate) fn send_change(
     let send = |f: u32, n: u32| {
         let start = (f as usize - 1) * frag;
         let end = (start + n as usize * frag).min(len);
+        // Large slices go uncopied (the I/O layer gathers them), small ones into the datagram.
+        let shared = out.gathers(&c.payload, end - start);
         let d = Submessage::DataFrag(DataFrag {
             reader_id: rid,
             writer_id: wid,
@@ -1051,11 +1053,15 @@ pub(crate) fn send_change(
             fragment_size: frag as u16,
             sample_size: len as u32,
             inline_qos,
-            payload: &c.payload[start..end],
+            payload: if shared { &[] } else { &c.payload[start..end] },
             key_flag: c.kind != ChangeKind::Alive,
             non_standard_flag: false,
         });
-        out.push(dest, dst, ts, &d);
+        if shared {
+            out.push_shared(dest, dst, ts, &d, &c.payload.slice(start..end));
+        } else {
+            out.push(dest, dst, ts, &d);
+        }
     };
     let requested = only.map(|set| {
         set.iter()
