@@ -13,6 +13,7 @@ use super::types::Locator;
 /// [`Participant::gather_sends`](super::Participant::gather_sends), `shared` is always empty and `payload`
 /// is the whole message.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct Transmit {
     /// Send the payload to each of these.
     pub destinations: Vec<Locator>,
@@ -24,6 +25,7 @@ pub struct Transmit {
 
 /// A slice of a sample's payload that goes into a datagram as it is.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct SharedPart {
     /// Where it goes: before the byte at this offset of [`Transmit::payload`].
     pub at: usize,

@@ -275,9 +275,12 @@ wait";
     let status = both.wait_exit(Duration::from_secs(60));
     let last = both.grep(is_sub_line).pop();
     let totals = last.as_deref().and_then(sub_totals);
-    // 6 s at 100 Hz: about 600 offered; every one arrives, in order (a reliable stream: no loss reported).
+    // 6 s at 100 Hz: about 600 offered; every one written after the match arrives, in order (a reliable
+    // stream: no loss reported). The writer starts at once and its samples before the match are not for
+    // this reader (volatile): at 5% loss a lost SPDP or SEDP datagram delays the match by up to a second
+    // (seen: 500 received, 0 lost, in about one run in four), hence the margin.
     check!(
-        totals.is_some_and(|(t, lost)| t >= 550 && lost == 0),
+        totals.is_some_and(|(t, lost)| t >= 400 && lost == 0),
         &[&both],
         "samples received, lost: {totals:?}"
     );
