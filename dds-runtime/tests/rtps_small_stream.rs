@@ -63,22 +63,8 @@ fn stream(ms: u32, late_at: u32, late: Duration, reorder_max: usize) -> Outcome 
             .max_repair_bytes(16usize << 10),
     );
     sim.add(config(1).reorder_max_samples(reorder_max));
-    sim.faults_on_discovery = false;
     let (wq, rq) = perf_qos();
-    let now = sim.now;
-    let w = sim.nodes[0]
-        .p
-        .create_writer(now, WriterSpec::new("T", "M::T", false, wq))
-        .unwrap();
-    let r = sim.nodes[1]
-        .p
-        .create_reader(now, ReaderSpec::new("T", "M::T", false, rq))
-        .unwrap();
-    assert!(sim.run_until(Duration::from_secs(5), |s| !s.nodes[0]
-        .p
-        .writer_matches(w)
-        .is_empty()
-        && !s.nodes[1].p.reader_matches(r).is_empty()));
+    let (w, r) = sim.matched_pair(wq, rq);
     let (mut written, mut delivered, mut delivered_late) = (0u32, 0u64, 0u64);
     let start = sim.now;
     for tick in 0..ms {

@@ -295,22 +295,33 @@ impl Sim {
         rq: dds_runtime::qos::DataReaderQos,
     ) -> (Sim, EntityId, EntityId) {
         let mut sim = Sim::with_participants(seed, faults, 2);
-        sim.faults_on_discovery = false;
-        let now = sim.now;
-        let w = sim.nodes[0]
+        let (w, r) = sim.matched_pair(wq, rq);
+        (sim, w, r)
+    }
+
+    /// An unkeyed writer of "T" on node 0 and a reader on node 1, once each has matched the other (without
+    /// faults on discovery from then on; panics after 5 simulated seconds).
+    pub(crate) fn matched_pair(
+        &mut self,
+        wq: dds_runtime::qos::DataWriterQos,
+        rq: dds_runtime::qos::DataReaderQos,
+    ) -> (EntityId, EntityId) {
+        self.faults_on_discovery = false;
+        let now = self.now;
+        let w = self.nodes[0]
             .p
             .create_writer(now, WriterSpec::new("T", "M::T", false, wq))
             .unwrap();
-        let r = sim.nodes[1]
+        let r = self.nodes[1]
             .p
             .create_reader(now, ReaderSpec::new("T", "M::T", false, rq))
             .unwrap();
-        assert!(sim.run_until(Duration::from_secs(5), |s| !s.nodes[0]
+        assert!(self.run_until(Duration::from_secs(5), |s| !s.nodes[0]
             .p
             .writer_matches(w)
             .is_empty()
             && !s.nodes[1].p.reader_matches(r).is_empty()));
-        (sim, w, r)
+        (w, r)
     }
 
     pub(crate) fn elapsed(&self) -> Duration {
