@@ -17,7 +17,9 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use super::api::Payload;
-use super::messages::{append, Header, Submessage};
+use super::messages::{
+    append, octets_to_next_header, set_octets_to_next_header, Header, Submessage,
+};
 use super::transmit::{SharedPart, Transmit};
 use super::types::*;
 
@@ -60,20 +62,9 @@ impl Pending {
         let Some(h) = self.last_header else {
             return;
         };
-        let le = self.buf[h + 1] & 0x01 != 0;
-        let field = [self.buf[h + 2], self.buf[h + 3]];
-        let old = if le {
-            u16::from_le_bytes(field)
-        } else {
-            u16::from_be_bytes(field)
-        };
-        // `gathers` keeps the sum within the field (checked again: 0 would mean "to the end").
-        let len = u16::try_from(usize::from(old) + part.len()).unwrap_or(0);
-        self.buf[h + 2..h + 4].copy_from_slice(&if le {
-            len.to_le_bytes()
-        } else {
-            len.to_be_bytes()
-        });
+        // `gathers` keeps the sum within the field.
+        let len = octets_to_next_header(&self.buf, h) + part.len();
+        set_octets_to_next_header(&mut self.buf, h, len);
         self.shared.push(SharedPart {
             at: self.buf.len(),
             bytes: part.clone(),

@@ -408,15 +408,33 @@ pub fn append(
             out.push(0);
         }
         if let Some(h) = *last_header {
-            let le = out[h + 1] & FLAG_E != 0;
-            let len = u16::try_from(out.len() - h - 4).unwrap_or(0);
-            out[h + 2..h + 4].copy_from_slice(&if le {
-                len.to_le_bytes()
-            } else {
-                len.to_be_bytes()
-            });
+            let len = out.len() - h - 4;
+            set_octets_to_next_header(out, h, len);
         }
     }
     *last_header = Some(out.len());
     sub.encode(out, little_endian);
+}
+
+/// The octetsToNextHeader of the submessage whose header starts at `h` in `msg`, in the byte order its E
+/// flag says.
+pub(crate) fn octets_to_next_header(msg: &[u8], h: usize) -> usize {
+    let field = [msg[h + 2], msg[h + 3]];
+    usize::from(if msg[h + 1] & FLAG_E != 0 {
+        u16::from_le_bytes(field)
+    } else {
+        u16::from_be_bytes(field)
+    })
+}
+
+/// Sets the octetsToNextHeader of the submessage whose header starts at `h` in `msg` to `len`, in the byte
+/// order its E flag says; too long for the field, 0 ("to the end of the message").
+pub(crate) fn set_octets_to_next_header(msg: &mut [u8], h: usize, len: usize) {
+    let len = u16::try_from(len).unwrap_or(0);
+    let b = if msg[h + 1] & FLAG_E != 0 {
+        len.to_le_bytes()
+    } else {
+        len.to_be_bytes()
+    };
+    msg[h + 2..h + 4].copy_from_slice(&b);
 }
