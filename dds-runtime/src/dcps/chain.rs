@@ -174,16 +174,25 @@ impl ListenerNode {
     /// conditions of this level and every level above: a publisher's, subscriber's or participant's
     /// condition triggers when a status of an entity it contains changes.
     pub(crate) fn raise_up(&self, source: InstanceHandle, kind: StatusMask) {
+        self.raise_all_up(&[(source, kind)]);
+    }
+
+    /// [`raise_up`](Self::raise_up) for each `(source, kind)` of `changes`, in one pass over the levels
+    /// (the data path raises two statuses per sample).
+    pub(crate) fn raise_all_up(&self, changes: &[(InstanceHandle, StatusMask)]) {
+        let all = changes.iter().fold(StatusMask::empty(), |acc, (_, k)| acc | *k);
         let mut node = Some(self);
         while let Some(n) = node {
             {
                 let mut p = lock(&n.pending);
-                match p.iter_mut().find(|(h, _)| *h == source) {
-                    Some((_, m)) => *m |= kind,
-                    None => p.push((source, kind)),
+                for &(source, kind) in changes {
+                    match p.iter_mut().find(|(h, _)| *h == source) {
+                        Some((_, m)) => *m |= kind,
+                        None => p.push((source, kind)),
+                    }
                 }
             }
-            n.status.raise_new(kind);
+            n.status.raise_new(all);
             node = n.parent.as_deref();
         }
     }
@@ -192,19 +201,29 @@ impl ListenerNode {
     /// except where another entity still has it pending (reading one writer's status leaves its
     /// publisher's condition raised for a sibling's).
     pub(crate) fn clear_up(&self, source: InstanceHandle, kind: StatusMask) {
+        self.clear_all_up(&[(source, kind)]);
+    }
+
+    /// [`clear_up`](Self::clear_up) for each `(source, kind)` of `changes`, in one pass over the levels.
+    pub(crate) fn clear_all_up(&self, changes: &[(InstanceHandle, StatusMask)]) {
+        let all = changes.iter().fold(StatusMask::empty(), |acc, (_, k)| acc | *k);
         let mut node = Some(self);
         while let Some(n) = node {
             let still = {
                 let mut p = lock(&n.pending);
-                for (h, m) in p.iter_mut() {
-                    if *h == source {
-                        m.remove(kind);
+                let mut still = StatusMask::empty();
+                p.retain_mut(|(h, m)| {
+                    for &(source, kind) in changes {
+                        if *h == source {
+                            m.remove(kind);
+                        }
                     }
-                }
-                p.retain(|(_, m)| !m.is_empty());
-                p.iter().fold(StatusMask::empty(), |acc, (_, m)| acc | *m)
+                    still |= *m;
+                    !m.is_empty()
+                });
+                still
             };
-            n.status.clear(kind - still);
+            n.status.clear(all - still);
             node = n.parent.as_deref();
         }
     }
@@ -227,5 +246,31 @@ impl<L: ?Sized> Clone for MaskedListener<L> {
             listener: self.listener.clone(),
             mask: self.mask,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_status_stays_pending_while_any_entity_has_it() {
+        let core = Arc::new(StatusCore::default());
+        let node = ListenerNode::new(InstanceHandle(1), core.clone(), None);
+        let (a, b) = (InstanceHandle(7), InstanceHandle(3));
+        let da = StatusMask::DATA_AVAILABLE;
+        node.raise_all_up(&[(a, da), (node.handle, StatusMask::DATA_ON_READERS)]);
+        node.raise_up(b, da | StatusMask::SAMPLE_LOST);
+        node.raise_up(b, da);
+        assert_eq!(core.changed(), da | StatusMask::DATA_ON_READERS | StatusMask::SAMPLE_LOST);
+        node.clear_all_up(&[(a, da), (node.handle, StatusMask::DATA_ON_READERS)]);
+        assert_eq!(core.changed(), da | StatusMask::SAMPLE_LOST, "b still has DATA_AVAILABLE");
+        node.clear_up(a, da);
+        assert_eq!(core.changed(), da | StatusMask::SAMPLE_LOST, "clearing twice is harmless");
+        node.clear_up(b, da);
+        assert_eq!(core.changed(), StatusMask::SAMPLE_LOST);
+        node.forget(b);
+        assert_eq!(core.changed(), StatusMask::empty());
+        assert!(lock(&node.pending).is_empty());
     }
 }

@@ -5,7 +5,7 @@
 //! which wakes the waitsets the condition is attached to. `WaitSet::wait` re-evaluates the trigger values
 //! after each wakeup, so spurious notifications are harmless.
 
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, RwLock, Weak};
 use std::time::{Duration, Instant};
 
@@ -35,10 +35,18 @@ impl WaitSetCore {
 #[derive(Debug, Default)]
 pub(crate) struct Signal {
     waitsets: Mutex<Vec<Weak<WaitSetCore>>>,
+    /// How many waitsets `waitsets` holds, read without the lock: most conditions (a reader's data, a
+    /// subscriber's status) have no waitset, and the data path notifies them per sample. Stored under the
+    /// lock, after an attach and before the waitset evaluates its conditions, so a change made before a
+    /// notify that saw 0 is seen by that evaluation (both sides sequentially consistent).
+    attached: AtomicUsize,
 }
 
 impl Signal {
     pub(crate) fn notify(&self) {
+        if self.attached.load(Ordering::SeqCst) == 0 {
+            return;
+        }
         let mut ws = lock(&self.waitsets);
         ws.retain(|w| match w.upgrade() {
             Some(w) => {
@@ -47,13 +55,18 @@ impl Signal {
             }
             None => false,
         });
+        self.attached.store(ws.len(), Ordering::SeqCst);
     }
     fn attach(&self, w: &Arc<WaitSetCore>) {
-        lock(&self.waitsets).push(Arc::downgrade(w));
+        let mut ws = lock(&self.waitsets);
+        ws.push(Arc::downgrade(w));
+        self.attached.store(ws.len(), Ordering::SeqCst);
     }
     fn detach(&self, w: &Arc<WaitSetCore>) {
         let p = Arc::as_ptr(w);
-        lock(&self.waitsets).retain(|x| x.as_ptr() != p);
+        let mut ws = lock(&self.waitsets);
+        ws.retain(|x| x.as_ptr() != p);
+        self.attached.store(ws.len(), Ordering::SeqCst);
     }
 }
 

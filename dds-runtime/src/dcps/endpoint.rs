@@ -210,8 +210,10 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
     /// A read or take: the subscriber's DATA_ON_READERS is reset (DDS 1.4 §2.2.4.1).
     pub(crate) fn data_read(&self) {
         if let Some(parent) = self.parent.get() {
-            parent.clear_up(self.instance(), StatusMask::DATA_AVAILABLE);
-            parent.clear_up(parent.handle, StatusMask::DATA_ON_READERS);
+            parent.clear_all_up(&[
+                (self.instance(), StatusMask::DATA_AVAILABLE),
+                (parent.handle, StatusMask::DATA_ON_READERS),
+            ]);
         }
     }
 
@@ -379,8 +381,10 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
         call: impl FnOnce(&L, &E),
     ) {
         if let Some(parent) = self.parent.get() {
-            parent.raise_up(self.instance(), StatusMask::DATA_AVAILABLE);
-            parent.raise_up(parent.handle, StatusMask::DATA_ON_READERS);
+            parent.raise_all_up(&[
+                (self.instance(), StatusMask::DATA_AVAILABLE),
+                (parent.handle, StatusMask::DATA_ON_READERS),
+            ]);
             if let Some(l) = parent.find(StatusMask::DATA_ON_READERS) {
                 if super::data_on_readers::defer_data_on_readers(parent) {
                     return;

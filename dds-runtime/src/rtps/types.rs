@@ -4,8 +4,27 @@ use std::fmt;
 use std::time::Duration;
 
 /// The 12-byte prefix shared by a participant and all its entities (§8.2.4.3).
-#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct GuidPrefix(pub [u8; 12]);
+
+/// Ordered as the bytes are (lexicographically), compared as one big-endian word: the participant's maps
+/// are searched by GUID per sample, and a byte array's comparison goes byte by byte.
+impl Ord for GuidPrefix {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        let word = |p: &GuidPrefix| {
+            let mut b = [0u8; 16];
+            b[..12].copy_from_slice(&p.0);
+            u128::from_be_bytes(b)
+        };
+        word(self).cmp(&word(other))
+    }
+}
+
+impl PartialOrd for GuidPrefix {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
 
 impl GuidPrefix {
     /// GUIDPREFIX_UNKNOWN.
@@ -25,8 +44,22 @@ impl fmt::Debug for GuidPrefix {
 }
 
 /// The 4-byte id of an entity within its participant (§9.3.1.2): a 3-byte key and a kind octet.
-#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct EntityId(pub [u8; 4]);
+
+/// Ordered as the bytes are, compared as one big-endian word (the participant's endpoint maps are
+/// searched by entity id per sample; a byte array's comparison goes byte by byte).
+impl Ord for EntityId {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        u32::from_be_bytes(self.0).cmp(&u32::from_be_bytes(other.0))
+    }
+}
+
+impl PartialOrd for EntityId {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
 
 impl fmt::Debug for EntityId {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -488,6 +521,20 @@ mod tests {
         let sn = SequenceNumber::from_parts(1, 5);
         assert_eq!(sn.0, (1 << 32) + 5);
         assert_eq!((sn.high(), sn.low()), (1, 5));
+    }
+
+    #[test]
+    fn ids_order_as_their_bytes() {
+        let bytes = [[0u8, 0, 1, 0xc2], [0, 0, 1, 0xc7], [0, 1, 0, 0x02], [0xff, 0, 0, 0], [0, 0, 0, 0]];
+        for a in bytes {
+            for b in bytes {
+                assert_eq!(EntityId(a).cmp(&EntityId(b)), a.cmp(&b));
+                let (mut pa, mut pb) = ([7u8; 12], [7u8; 12]);
+                pa[3..7].copy_from_slice(&a);
+                pb[8..].copy_from_slice(&b);
+                assert_eq!(GuidPrefix(pa).cmp(&GuidPrefix(pb)), pa.cmp(&pb));
+            }
+        }
     }
 
     #[test]

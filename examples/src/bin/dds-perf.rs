@@ -8,7 +8,6 @@
 //!
 //! Exit status: 0 fine, 1 loss or too few samples/round trips, 2 DDS failure, 3 bad arguments.
 
-use std::collections::HashMap;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex, RwLock};
@@ -111,11 +110,15 @@ struct Ctx<T: PerfSample> {
     participant: DomainParticipant,
     pong_topic: Topic<T>,
     pingpong_qos: DataWriterQos,
-    /// One pong writer per remote participant, in that participant's partition.
-    pong_writers: RwLock<HashMap<[u8; 12], DataWriter<T>>>,
+    /// One pong writer per remote participant, in that participant's partition, by GUID prefix (searched
+    /// in order: a handful of participants, and no hashing of the prefix per ping).
+    pong_writers: RwLock<Vec<([u8; 12], DataWriter<T>)>>,
     ping_writer: DataWriter<T>,
     ping: Mutex<PingState>,
     pong_stats: Mutex<Vec<([u8; 16], LatencyStat)>>,
+    /// The samples of one take of pings or pongs, kept between takes (no vector allocated per take);
+    /// a take nested in another (a ping answered on the thread that sent it) uses its own.
+    batch: Mutex<Vec<Sample<T>>>,
     sub_stats: Mutex<SubStats>,
     sub_latency: Mutex<LatencyStat>,
     pub_hist: Mutex<WriteHist>,
@@ -144,17 +147,20 @@ impl<T: PerfSample> Ctx<T> {
     /// Pongs expected per ping: remote participants whose pong reader matched our pong writer for them.
     fn pongs_expected(&self) -> u32 {
         let w = self.pong_writers.read().expect("pong writers");
-        w.values()
-            .filter(|w| w.publication_matched_status().current_count > 0)
+        w.iter()
+            .filter(|(_, w)| w.publication_matched_status().current_count > 0)
             .count() as u32
     }
 
-    fn pong_writer_for(&self, guid: &[u8; 16]) -> Option<DataWriter<T>> {
-        self.pong_writers
-            .read()
-            .expect("pong writers")
-            .get(&prefix_of(guid))
-            .cloned()
+    /// Writes `sample` with `stamp` on the pong writer for the participant of `guid`, if there is one, and
+    /// flushes it (the writer is used in place: no clone of it per pong).
+    fn pong(&self, guid: &[u8; 16], sample: &T, stamp: SystemTime) {
+        let prefix = prefix_of(guid);
+        let writers = self.pong_writers.read().expect("pong writers");
+        if let Some((_, w)) = writers.iter().find(|(p, _)| *p == prefix) {
+            let _ = w.write_w_timestamp(sample, stamp);
+            w.flush();
+        }
     }
 
     /// Creates pong writers for newly discovered participants (and ourselves with -L).
@@ -176,7 +182,8 @@ impl<T: PerfSample> Ctx<T> {
                 .pong_writers
                 .read()
                 .expect("pong writers")
-                .contains_key(&prefix)
+                .iter()
+                .any(|(p, _)| *p == prefix)
             {
                 continue;
             }
@@ -189,7 +196,7 @@ impl<T: PerfSample> Ctx<T> {
             self.pong_writers
                 .write()
                 .expect("pong writers")
-                .insert(prefix, w);
+                .push((prefix, w));
         }
         Ok(())
     }
@@ -307,7 +314,8 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
         participant: participant.clone(),
         pong_topic,
         pingpong_qos: pingpong_w,
-        pong_writers: RwLock::new(HashMap::new()),
+        pong_writers: RwLock::new(Vec::new()),
+        batch: Mutex::new(Vec::new()),
         ping_writer,
         ping: Mutex::new(PingState::default()),
         pong_stats: Mutex::new(Vec::new()),
@@ -576,26 +584,36 @@ impl<T: PerfSample> DataReaderListener<T> for OnData<T> {
 
 /// Answers pings: echo on the pinging participant's pong writer with the timestamp's lsb set.
 fn answer_pings<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
-    let Ok(samples) = reader.take() else { return };
-    for s in &samples {
+    // A pong written from here may come back to this thread (-L): then the batch is in use.
+    let mut kept = ctx.batch.try_lock().ok();
+    let mut own = Vec::new();
+    let samples = kept.as_deref_mut().unwrap_or(&mut own);
+    if reader.take_into(samples).is_err() {
+        return;
+    }
+    for s in samples.iter() {
         let Some(d) = &s.data else { continue };
         if ctx.is_local(&s.info.publication_guid.to_bytes()) && !ctx.o.match_local {
             continue;
         }
-        if let Some(w) = ctx.pong_writer_for(&s.info.publication_guid.to_bytes()) {
-            let _ = w.write_w_timestamp(d, ts(ns_of(s.info.source_timestamp) | 1));
-            w.flush();
-        }
+        let stamp = ts(ns_of(s.info.source_timestamp) | 1);
+        ctx.pong(&s.info.publication_guid.to_bytes(), d, stamp);
     }
     // As ddsperf reuses its sample buffers: large samples are then decoded into warm memory.
-    reader.recycle(samples);
+    reader.recycle(samples.drain(..));
 }
 
 /// Receives pongs: half the round trip per answering writer; the next ping once all answered.
 fn receive_pongs<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
-    let Ok(samples) = reader.take() else { return };
+    // A pong written from here may come back to this thread (-L): then the batch is in use.
+    let mut kept = ctx.batch.try_lock().ok();
+    let mut own = Vec::new();
+    let samples = kept.as_deref_mut().unwrap_or(&mut own);
+    if reader.take_into(samples).is_err() {
+        return;
+    }
     let now = now_ns();
-    for s in &samples {
+    for s in samples.iter() {
         let Some(d) = &s.data else { continue };
         let sent = ns_of(s.info.source_timestamp);
         let isping = sent & 1 == 1;
@@ -636,7 +654,7 @@ fn receive_pongs<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) {
             ctx.send_ping(seq);
         }
     }
-    reader.recycle(samples);
+    reader.recycle(samples.drain(..));
 }
 
 /// `sub` mode: sequence checking per writer and key, optional latency, and pongs for pinged data.
@@ -686,12 +704,8 @@ fn receive_batch<T: PerfSample>(ctx: &Ctx<T>, reader: &DataReader<T>) -> bool {
     for s in &samples {
         let sent = ns_of(s.info.source_timestamp);
         if sent & 1 == 1 {
-            if let (Some(d), Some(w)) = (
-                &s.data,
-                ctx.pong_writer_for(&s.info.publication_guid.to_bytes()),
-            ) {
-                let _ = w.write_w_timestamp(d, ts(sent - 1));
-                w.flush();
+            if let Some(d) = &s.data {
+                ctx.pong(&s.info.publication_guid.to_bytes(), d, ts(sent - 1));
             }
         }
     }
