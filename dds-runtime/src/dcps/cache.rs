@@ -562,6 +562,10 @@ impl<T: FilterFields> ReaderCache<T> {
 
     /// Whether some sample matches the masks (ReadCondition trigger, DATA_AVAILABLE).
     pub(crate) fn has_matching(&self, sel: &Selection) -> bool {
+        // Asked after every take, which usually leaves nothing: then no instance needs a look.
+        if self.total == 0 {
+            return false;
+        }
         let q = read_query(sel);
         self.instances.values().any(|i| {
             i.samples

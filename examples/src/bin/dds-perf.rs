@@ -123,6 +123,8 @@ struct Ctx<T: PerfSample> {
     sub_latency: Mutex<LatencyStat>,
     pub_hist: Mutex<WriteHist>,
     write_timeouts: AtomicU32,
+    /// See [`Ctx::pongs_expected`].
+    expected: AtomicU32,
     stop: AtomicBool,
 }
 
@@ -144,8 +146,22 @@ impl<T: PerfSample> Ctx<T> {
         prefix_of(guid) == self.own_prefix
     }
 
-    /// Pongs expected per ping: remote participants whose pong reader matched our pong writer for them.
+    /// Pongs expected per ping, as last counted by [`count_pongs_expected`](Self::count_pongs_expected)
+    /// (every 50 ms by the discovery loop): read per pong, where counting would read every pong writer's
+    /// matched status.
     fn pongs_expected(&self) -> u32 {
+        self.expected.load(Ordering::Relaxed)
+    }
+
+    /// Counts the pongs expected per ping (remote participants whose pong reader matched our pong writer for
+    /// them) and keeps the count for [`pongs_expected`](Self::pongs_expected).
+    fn count_pongs_expected(&self) -> u32 {
+        let n = self.count_matched_pong_writers();
+        self.expected.store(n, Ordering::Relaxed);
+        n
+    }
+
+    fn count_matched_pong_writers(&self) -> u32 {
         let w = self.pong_writers.read().expect("pong writers");
         w.iter()
             .filter(|(_, w)| w.publication_matched_status().current_count > 0)
@@ -323,6 +339,7 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
         sub_latency: Mutex::new(LatencyStat::new()),
         pub_hist: Mutex::new(WriteHist::default()),
         write_timeouts: AtomicU32::new(0),
+        expected: AtomicU32::new(0),
         stop: AtomicBool::new(false),
     });
     ctx.refresh_pong_writers()?;
@@ -422,7 +439,7 @@ fn main_loop<T: PerfSample>(ctx: &Ctx<T>) -> u8 {
             ok = false;
         }
     }
-    if o.min_match > 0 && ctx.pongs_expected() < o.min_match {
+    if o.min_match > 0 && ctx.count_pongs_expected() < o.min_match {
         println!(
             "[{}] error: too few matching participants ({})",
             ctx.pid,
@@ -522,6 +539,7 @@ fn discovery_loop<T: PerfSample>(ctx: &Ctx<T>) {
         if let Err(e) = ctx.refresh_pong_writers() {
             println!("[{}] creating a pong writer failed: {e}", ctx.pid);
         }
+        ctx.count_pongs_expected();
         thread::sleep(Duration::from_millis(50));
     }
 }

@@ -100,16 +100,23 @@ impl HistoryCache {
         };
         let keep_last = matches!(self.history, History::KeepLast(_));
         if let Some(limit) = per_instance {
-            let n = self.instances.get(key).map_or(0, |q| q.len());
-            if n >= limit {
-                let oldest = self.instances.get(key).and_then(|q| q.front().copied());
-                match oldest {
-                    // KEEP_LAST replaces the oldest sample of the instance, acknowledged or not.
-                    Some(sn) if keep_last || sn < acked => {
-                        self.remove(sn);
+            let oldest = match self.instances.get(key) {
+                Some(q) if q.len() >= limit => q.front().copied(),
+                _ => None,
+            };
+            match oldest {
+                // KEEP_LAST replaces the oldest sample of the instance, acknowledged or not; the
+                // instance's queue stays for the change that replaces it.
+                Some(sn) if keep_last || sn < acked => {
+                    if let Some(c) = self.changes.remove(sn) {
+                        self.bytes -= c.payload.accounted_len();
+                        if let Some(q) = self.instances.get_mut(key) {
+                            q.pop_front();
+                        }
                     }
-                    _ => return Err(HistoryFull::Full),
                 }
+                Some(_) => return Err(HistoryFull::Full),
+                None => {}
             }
         }
         if let Some(limit) = max_total {
@@ -119,7 +126,13 @@ impl HistoryCache {
                     Some(sn) if keep_last || sn < acked => {
                         self.remove(sn);
                     }
-                    _ => return Err(HistoryFull::Full),
+                    _ => {
+                        // No change replaces the one the instance gave up: its queue goes, as `remove`'s.
+                        if self.instances.get(key).is_some_and(|q| q.is_empty()) {
+                            self.instances.remove(key);
+                        }
+                        return Err(HistoryFull::Full);
+                    }
                 }
             }
         }
@@ -334,6 +347,15 @@ mod tests {
             vec![2, 3, 4]
         );
         assert_eq!(h.bytes(), 30);
+        let queue = |h: &HistoryCache, k: u8| h.instances[&[k; 16]].iter().map(|s| s.0).collect::<Vec<_>>();
+        assert_eq!((queue(&h, 1), queue(&h, 2)), (vec![3, 4], vec![2]));
+        // KEEP_LAST 1: each write replaces the last in place.
+        let mut h = HistoryCache::new(History::KeepLast(1), ResourceLimits::default());
+        for sn in 1..5 {
+            h.make_room(&[1; 16], SequenceNumber(1)).unwrap();
+            h.add(ch(sn, 1));
+            assert_eq!((h.len(), queue(&h, 1)), (1, vec![sn]));
+        }
     }
 
     #[test]
