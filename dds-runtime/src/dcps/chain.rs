@@ -108,6 +108,14 @@ pub(crate) trait ParentListener: Send + Sync {
 
 type Slot = Option<(Arc<dyn ParentListener>, StatusMask)>;
 
+/// The statuses of each of a level's two pending lists: the data statuses, then all others.
+const PART: [StatusMask; 2] = [
+    StatusMask::DATA_AVAILABLE.union(StatusMask::DATA_ON_READERS),
+    StatusMask::all()
+        .difference(StatusMask::DATA_AVAILABLE)
+        .difference(StatusMask::DATA_ON_READERS),
+];
+
 /// One level of the chain: its listener with its mask, its status condition, and the level above.
 pub(crate) struct ListenerNode {
     /// The entity of this level.
@@ -119,7 +127,9 @@ pub(crate) struct ListenerNode {
     pub(crate) status: Arc<StatusCore>,
     /// The statuses raised on this level and not read yet, by the entity they belong to (this level's
     /// own, or one it contains): a bit of `status` is cleared only when no entity still has it pending.
-    pending: Mutex<Vec<(InstanceHandle, StatusMask)>>,
+    /// Two lists, by [`PART`]: the data statuses, raised and cleared per sample, are looked up among the
+    /// few readers with unread data, not among every entity with a status never read.
+    pending: [Mutex<Vec<(InstanceHandle, StatusMask)>>; 2],
     parent: Option<Arc<ListenerNode>>,
 }
 
@@ -135,7 +145,7 @@ impl ListenerNode {
             slot: Mutex::new(None),
             any: AtomicBool::new(false),
             status,
-            pending: Mutex::new(Vec::new()),
+            pending: [Mutex::new(Vec::new()), Mutex::new(Vec::new())],
             parent,
         }
     }
@@ -180,12 +190,21 @@ impl ListenerNode {
     /// [`raise_up`](Self::raise_up) for each `(source, kind)` of `changes`, in one pass over the levels
     /// (the data path raises two statuses per sample).
     pub(crate) fn raise_all_up(&self, changes: &[(InstanceHandle, StatusMask)]) {
-        let all = changes.iter().fold(StatusMask::empty(), |acc, (_, k)| acc | *k);
+        let all = changes
+            .iter()
+            .fold(StatusMask::empty(), |acc, (_, k)| acc | *k);
         let mut node = Some(self);
         while let Some(n) = node {
-            {
-                let mut p = lock(&n.pending);
+            for (list, part) in n.pending.iter().zip(PART) {
+                if !all.intersects(part) {
+                    continue;
+                }
+                let mut p = lock(list);
                 for &(source, kind) in changes {
+                    let kind = kind & part;
+                    if kind.is_empty() {
+                        continue;
+                    }
                     match p.iter_mut().find(|(h, _)| *h == source) {
                         Some((_, m)) => *m |= kind,
                         None => p.push((source, kind)),
@@ -206,13 +225,17 @@ impl ListenerNode {
 
     /// [`clear_up`](Self::clear_up) for each `(source, kind)` of `changes`, in one pass over the levels.
     pub(crate) fn clear_all_up(&self, changes: &[(InstanceHandle, StatusMask)]) {
-        let all = changes.iter().fold(StatusMask::empty(), |acc, (_, k)| acc | *k);
+        let all = changes
+            .iter()
+            .fold(StatusMask::empty(), |acc, (_, k)| acc | *k);
         let mut node = Some(self);
         while let Some(n) = node {
-            let still = {
-                let mut p = lock(&n.pending);
-                let mut still = StatusMask::empty();
-                p.retain_mut(|(h, m)| {
+            let mut still = StatusMask::empty();
+            for (list, part) in n.pending.iter().zip(PART) {
+                if !all.intersects(part) {
+                    continue;
+                }
+                lock(list).retain_mut(|(h, m)| {
                     for &(source, kind) in changes {
                         if *h == source {
                             m.remove(kind);
@@ -221,8 +244,7 @@ impl ListenerNode {
                     still |= *m;
                     !m.is_empty()
                 });
-                still
-            };
+            }
             n.status.clear(all - still);
             node = n.parent.as_deref();
         }
@@ -262,15 +284,26 @@ mod tests {
         node.raise_all_up(&[(a, da), (node.handle, StatusMask::DATA_ON_READERS)]);
         node.raise_up(b, da | StatusMask::SAMPLE_LOST);
         node.raise_up(b, da);
-        assert_eq!(core.changed(), da | StatusMask::DATA_ON_READERS | StatusMask::SAMPLE_LOST);
+        assert_eq!(
+            core.changed(),
+            da | StatusMask::DATA_ON_READERS | StatusMask::SAMPLE_LOST
+        );
         node.clear_all_up(&[(a, da), (node.handle, StatusMask::DATA_ON_READERS)]);
-        assert_eq!(core.changed(), da | StatusMask::SAMPLE_LOST, "b still has DATA_AVAILABLE");
+        assert_eq!(
+            core.changed(),
+            da | StatusMask::SAMPLE_LOST,
+            "b still has DATA_AVAILABLE"
+        );
         node.clear_up(a, da);
-        assert_eq!(core.changed(), da | StatusMask::SAMPLE_LOST, "clearing twice is harmless");
+        assert_eq!(
+            core.changed(),
+            da | StatusMask::SAMPLE_LOST,
+            "clearing twice is harmless"
+        );
         node.clear_up(b, da);
         assert_eq!(core.changed(), StatusMask::SAMPLE_LOST);
         node.forget(b);
         assert_eq!(core.changed(), StatusMask::empty());
-        assert!(lock(&node.pending).is_empty());
+        assert!(node.pending.iter().all(|p| lock(p).is_empty()));
     }
 }

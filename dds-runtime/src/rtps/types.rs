@@ -525,7 +525,13 @@ mod tests {
 
     #[test]
     fn ids_order_as_their_bytes() {
-        let bytes = [[0u8, 0, 1, 0xc2], [0, 0, 1, 0xc7], [0, 1, 0, 0x02], [0xff, 0, 0, 0], [0, 0, 0, 0]];
+        let bytes = [
+            [0u8, 0, 1, 0xc2],
+            [0, 0, 1, 0xc7],
+            [0, 1, 0, 0x02],
+            [0xff, 0, 0, 0],
+            [0, 0, 0, 0],
+        ];
         for a in bytes {
             for b in bytes {
                 assert_eq!(EntityId(a).cmp(&EntityId(b)), a.cmp(&b));

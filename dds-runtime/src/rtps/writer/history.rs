@@ -347,7 +347,12 @@ mod tests {
             vec![2, 3, 4]
         );
         assert_eq!(h.bytes(), 30);
-        let queue = |h: &HistoryCache, k: u8| h.instances[&[k; 16]].iter().map(|s| s.0).collect::<Vec<_>>();
+        let queue = |h: &HistoryCache, k: u8| {
+            h.instances[&[k; 16]]
+                .iter()
+                .map(|s| s.0)
+                .collect::<Vec<_>>()
+        };
         assert_eq!((queue(&h, 1), queue(&h, 2)), (vec![3, 4], vec![2]));
         // KEEP_LAST 1: each write replaces the last in place.
         let mut h = HistoryCache::new(History::KeepLast(1), ResourceLimits::default());
