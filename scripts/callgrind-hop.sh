@@ -10,7 +10,9 @@
 #   PING=/tmp/base-dds-perf KEEP=/tmp/hop.cg scripts/callgrind-hop.sh target/release/dds-perf
 #
 # Prints: instructions, round trips, instructions per round trip; with TOP=N also the N costliest functions
-# (inclusive) per round trip. KEEP=FILE keeps the callgrind dump (for callgrind_annotate).
+# (inclusive) per round trip. KEEP=FILE keeps the callgrind dump (for callgrind_annotate). WRITE_FN= names the
+# function whose calls count the round trips (a wrapper around Cyclone's ddsperf: WRITE_FN=process_ping);
+# DOMAIN= (61), WARMUP= (5 s), WINDOW= (8 s).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [[ "${DDS_IN_NETNS:-}" != 1 ]]; then
@@ -28,8 +30,8 @@ cg=${KEEP:-$out/hop.cg}
 trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$out"' EXIT
 
 case $(basename "$prog") in
-  ddsperf*) writefn=process_ping ;;
-  *) writefn=write_w_timestamp ;;
+  ddsperf*) writefn=${WRITE_FN:-process_ping} ;;
+  *) writefn=${WRITE_FN:-write_w_timestamp} ;;
 esac
 total=$((warmup + window + 3))
 
