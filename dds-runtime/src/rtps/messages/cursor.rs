@@ -159,6 +159,35 @@ impl<'a> Cursor<'a> {
     }
 }
 
+/// Fixed-size fields in either byte order, gathered on the stack by [`Put::fixed`].
+#[derive(Debug)]
+pub struct Fixed<const N: usize> {
+    buf: [u8; N],
+    at: usize,
+    little_endian: bool,
+}
+
+impl<const N: usize> Fixed<N> {
+    pub fn bytes(&mut self, b: &[u8]) {
+        self.buf[self.at..self.at + b.len()].copy_from_slice(b);
+        self.at += b.len();
+    }
+    pub fn u16(&mut self, v: u16) {
+        self.bytes(&word16(v, self.little_endian));
+    }
+    pub fn u32(&mut self, v: u32) {
+        self.bytes(&word32(v, self.little_endian));
+    }
+    pub fn sequence_number(&mut self, sn: SequenceNumber) {
+        self.u32(sn.high() as u32);
+        self.u32(sn.low());
+    }
+    pub fn time(&mut self, t: Time) {
+        self.u32(t.seconds as u32);
+        self.u32(t.fraction);
+    }
+}
+
 /// Appends fixed-size fields in either byte order.
 #[derive(Debug)]
 pub struct Put<'a> {
@@ -166,29 +195,48 @@ pub struct Put<'a> {
     pub little_endian: bool,
 }
 
+fn word16(v: u16, little_endian: bool) -> [u8; 2] {
+    if little_endian {
+        v.to_le_bytes()
+    } else {
+        v.to_be_bytes()
+    }
+}
+
+fn word32(v: u32, little_endian: bool) -> [u8; 4] {
+    if little_endian {
+        v.to_le_bytes()
+    } else {
+        v.to_be_bytes()
+    }
+}
+
 impl Put<'_> {
     pub fn u8(&mut self, v: u8) {
         self.out.push(v);
     }
     pub fn u16(&mut self, v: u16) {
-        self.out.extend_from_slice(&if self.little_endian {
-            v.to_le_bytes()
-        } else {
-            v.to_be_bytes()
-        });
+        self.out.extend_from_slice(&word16(v, self.little_endian));
     }
     pub fn u32(&mut self, v: u32) {
-        self.out.extend_from_slice(&if self.little_endian {
-            v.to_le_bytes()
-        } else {
-            v.to_be_bytes()
-        });
+        self.out.extend_from_slice(&word32(v, self.little_endian));
     }
     pub fn i32(&mut self, v: i32) {
         self.u32(v as u32)
     }
     pub fn bytes(&mut self, b: &[u8]) {
         self.out.extend_from_slice(b);
+    }
+    /// Appends the fixed-size fields `f` writes (at most `N` bytes) at once: gathered on the stack, one
+    /// growth check of the vector instead of one per field (the per-sample submessages' fixed parts).
+    pub fn fixed<const N: usize>(&mut self, f: impl FnOnce(&mut Fixed<N>)) {
+        let mut b = Fixed {
+            buf: [0; N],
+            at: 0,
+            little_endian: self.little_endian,
+        };
+        f(&mut b);
+        self.out.extend_from_slice(&b.buf[..b.at]);
     }
     pub fn sequence_number(&mut self, sn: SequenceNumber) {
         self.i32(sn.high());

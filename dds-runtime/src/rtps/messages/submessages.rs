@@ -357,9 +357,7 @@ impl<'a> Submessage<'a> {
     pub fn encode(&self, out: &mut Vec<u8>, little_endian: bool) {
         let start = out.len();
         let (sid, flags) = self.kind_and_flags(little_endian);
-        out.push(sid);
-        out.push(flags);
-        out.extend_from_slice(&[0, 0]);
+        out.extend_from_slice(&[sid, flags, 0, 0]);
         let body_start = out.len();
         let p = &mut Put { out, little_endian };
         match self {
@@ -369,7 +367,7 @@ impl<'a> Submessage<'a> {
             Submessage::Gap(g) => g.write(p),
             Submessage::InfoTs(t) => {
                 if let Some(t) = t {
-                    p.time(*t);
+                    p.fixed::<8>(|f| f.time(*t));
                 }
             }
             Submessage::InfoSrc(s) => s.write(p),

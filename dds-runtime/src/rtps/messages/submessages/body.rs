@@ -58,11 +58,13 @@ impl Heartbeat {
     }
 
     pub(super) fn write(&self, p: &mut Put<'_>) {
-        p.bytes(&self.reader_id.0);
-        p.bytes(&self.writer_id.0);
-        p.sequence_number(self.first_sn);
-        p.sequence_number(self.last_sn);
-        p.i32(self.count);
+        p.fixed::<28>(|f| {
+            f.bytes(&self.reader_id.0);
+            f.bytes(&self.writer_id.0);
+            f.sequence_number(self.first_sn);
+            f.sequence_number(self.last_sn);
+            f.u32(self.count as u32);
+        });
         if let Some(g) = &self.group_info {
             p.sequence_number(g.current_gsn);
             p.sequence_number(g.first_gsn);
@@ -206,11 +208,13 @@ impl<'a> Data<'a> {
     }
 
     pub(super) fn write(&self, p: &mut Put<'_>) {
-        p.u16(0);
-        p.u16(16);
-        p.bytes(&self.reader_id.0);
-        p.bytes(&self.writer_id.0);
-        p.sequence_number(self.writer_sn);
+        p.fixed::<20>(|f| {
+            f.u16(0);
+            f.u16(16);
+            f.bytes(&self.reader_id.0);
+            f.bytes(&self.writer_id.0);
+            f.sequence_number(self.writer_sn);
+        });
         if let Some(q) = &self.inline_qos {
             put_inline_qos(p, q);
         }
