@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use super::error::{DecodeError, DecodeErrorKind, EncodeError};
 use super::header::XcdrVersion;
 use super::reader::{CdrReader, Limit};
+use super::short;
 use super::traits::{CdrType, Layout};
 use super::writer::CdrWriter;
 
@@ -25,6 +26,8 @@ fn check_bound(what: &'static str, len: usize, bound: usize) -> Result<(), Encod
     }
 }
 
+#[cold]
+#[inline(never)]
 fn bound_error(
     r: &CdrReader<'_>,
     at: usize,
@@ -44,80 +47,107 @@ pub(crate) fn encode_str(s: &str, w: &mut CdrWriter<'_>, bound: usize) -> Result
     w.write_string(s.as_bytes())
 }
 
-/// Decodes a string body with one allocation.
+/// Decodes a string body with one allocation, of exactly its length.
+#[inline(always)]
 pub(crate) fn decode_str(r: &mut CdrReader<'_>, bound: usize) -> Result<String, DecodeError> {
-    str_body(r, bound).map(str::to_owned)
+    let body = str_body(r, bound)?;
+    let mut v = Vec::with_capacity(body.text.len());
+    body.copy_to(&mut v)?;
+    // SAFETY: `copy_to` checked that the bytes are UTF-8.
+    Ok(unsafe { String::from_utf8_unchecked(v) })
 }
 
-/// Decodes a string body into `s`, reusing its buffer.
+/// Decodes a string body into `s`, reusing its buffer. On error `s` is empty.
+#[inline]
 pub(crate) fn decode_str_in_place(
     s: &mut String,
     r: &mut CdrReader<'_>,
     bound: usize,
 ) -> Result<(), DecodeError> {
-    let text = str_body(r, bound)?;
-    s.clear();
-    s.push_str(text);
-    Ok(())
+    let body = str_body(r, bound)?;
+    // SAFETY: `copy_to` leaves the vector empty or holding checked UTF-8.
+    let v = unsafe { s.as_mut_vec() };
+    v.clear();
+    v.reserve(body.text.len());
+    body.copy_to(v)
 }
 
-/// The characters of a string body, checked (bound, terminating NUL, no NUL inside, UTF-8).
-fn str_body<'a>(r: &mut CdrReader<'a>, bound: usize) -> Result<&'a str, DecodeError> {
+/// A string body's characters, its terminator and where they are, not yet checked for NULs or UTF-8.
+struct StrBody<'a> {
+    text: &'a [u8],
+    nul: u8,
+    at: usize,
+}
+
+impl StrBody<'_> {
+    /// Appends the characters to `v` (empty, with room for them) and checks them: no NUL inside, a NUL after,
+    /// UTF-8. A short ASCII string is copied and checked on the same few words; anything else takes
+    /// [`str_checked`]. On error `v` stays empty.
+    #[inline(always)]
+    fn copy_to(&self, v: &mut Vec<u8>) -> Result<(), DecodeError> {
+        let n = self.text.len();
+        debug_assert!(v.is_empty() && v.capacity() >= n);
+        let dst = v.as_mut_ptr();
+        // SAFETY: `v` has room for `n` bytes and does not overlap the input.
+        let ascii = n <= short::SHORT && unsafe { short::copy_short_ascii(self.text, dst) };
+        if !(ascii && self.nul == 0) {
+            str_checked(self.text, self.nul, self.at)?;
+            if n > short::SHORT {
+                // SAFETY: as above.
+                unsafe { short::copy_bytes(self.text, dst) };
+            }
+        }
+        // SAFETY: all `n` bytes were written above, and they are checked UTF-8.
+        unsafe { v.set_len(n) };
+        Ok(())
+    }
+}
+
+/// Reads a string body's length (checked against `bound` and the input) and takes its bytes. Inlined: the
+/// common short string is a few instructions here.
+#[inline(always)]
+fn str_body<'a>(r: &mut CdrReader<'a>, bound: usize) -> Result<StrBody<'a>, DecodeError> {
     let at = r.offset();
     let n = r.read_count(1, "string length")?;
     if n == 0 {
         // Some implementations send an empty string as length 0.
-        return Ok("");
+        return Ok(StrBody {
+            text: &[],
+            nul: 0,
+            at,
+        });
     }
     if n - 1 > bound {
         return Err(bound_error(r, at, "string within its bound", n - 1, bound));
     }
-    let body_at = r.offset();
+    let at = r.offset();
     let bytes = r.read_bytes(n, "string characters")?;
     let (text, nul) = bytes.split_at(n - 1);
-    if nul[0] == 0 && short_ascii_without_nul(text) {
-        // SAFETY: ASCII is UTF-8.
-        return Ok(unsafe { std::str::from_utf8_unchecked(text) });
-    }
-    if nul[0] != 0 || text.contains(&0) {
+    Ok(StrBody {
+        text,
+        nul: nul[0],
+        at,
+    })
+}
+
+/// The full checks of a string's characters `text` (at `at`) and its terminator `nul`: out of line, for
+/// strings longer than 16 bytes, non-ASCII ones and invalid input.
+#[inline(never)]
+fn str_checked(text: &[u8], nul: u8, at: usize) -> Result<(), DecodeError> {
+    if nul != 0 || text.contains(&0) {
         return Err(DecodeError::new(
-            body_at,
+            at,
             "NUL-terminated string",
             DecodeErrorKind::MalformedString,
         ));
     }
     match std::str::from_utf8(text) {
-        Ok(s) => Ok(s),
+        Ok(_) => Ok(()),
         Err(e) => Err(DecodeError::new(
-            body_at + e.valid_up_to(),
+            at + e.valid_up_to(),
             "UTF-8 string",
             DecodeErrorKind::MalformedString,
         )),
-    }
-}
-
-/// Whether `b` is at most 16 bytes of ASCII without a NUL, tested on two overlapping words (the common short
-/// string, for which `memchr` and `from_utf8` cost more than the characters); `false` sends the caller to the
-/// full checks.
-#[inline(always)]
-fn short_ascii_without_nul(b: &[u8]) -> bool {
-    const LO: u64 = 0x0101_0101_0101_0101;
-    const HI: u64 = 0x8080_8080_8080_8080;
-    // A byte is 0 or >= 0x80 exactly when the result has its high bit set.
-    let bad = |v: u64, lo: u64, hi: u64| (v.wrapping_sub(lo) | v) & hi != 0;
-    let n = b.len();
-    let word = |s: &[u8]| -> u64 {
-        let mut a = [0u8; 8];
-        a[..s.len()].copy_from_slice(s);
-        u64::from_le_bytes(a)
-    };
-    match n {
-        8..=16 => !(bad(word(&b[..8]), LO, HI) || bad(word(&b[n - 8..]), LO, HI)),
-        4..=7 => {
-            let (lo, hi) = (LO & 0xffff_ffff, HI & 0xffff_ffff);
-            !(bad(word(&b[..4]), lo, hi) || bad(word(&b[n - 4..]), lo, hi))
-        }
-        _ => n < 4 && b.iter().all(|&c| c != 0 && c < 0x80),
     }
 }
 
@@ -148,6 +178,7 @@ impl CdrType for String {
         encode_str(self, w, bound)
     }
 
+    #[inline]
     fn decode_bounded(r: &mut CdrReader<'_>, bound: usize) -> Result<Self, DecodeError> {
         decode_str(r, bound)
     }
@@ -183,13 +214,20 @@ pub(crate) fn encode_seq<T: CdrType>(
     }
 }
 
-/// Capacity to reserve for `n` elements: never more memory than a small multiple of the input left.
-fn capacity_for<T>(n: usize, remaining: usize) -> usize {
+/// Capacity to reserve for `n` elements: never more memory than a small multiple of the input left. When an
+/// element takes no more bytes in memory than its minimum on the wire (the numeric primitives), `n` itself is
+/// within it: `seq_header` checked that `n * MIN_SIZE` bytes follow.
+#[inline(always)]
+fn capacity_for<T: CdrType>(n: usize, remaining: usize) -> usize {
+    if std::mem::size_of::<T>() <= T::MIN_SIZE {
+        return n;
+    }
     let elem = std::mem::size_of::<T>().max(1);
     n.min((remaining.saturating_mul(8) / elem).max(16))
 }
 
 /// Decodes a sequence body; shared by `Vec` and `BoundedSeq`.
+#[inline(always)]
 pub(crate) fn decode_seq<T: CdrType>(
     r: &mut CdrReader<'_>,
     bound: usize,
@@ -304,6 +342,7 @@ impl<T: CdrType> CdrType for Vec<T> {
         encode_seq(self, w, bound)
     }
 
+    #[inline]
     fn decode_bounded(r: &mut CdrReader<'_>, bound: usize) -> Result<Self, DecodeError> {
         decode_seq(r, bound)
     }
@@ -544,7 +583,8 @@ mod string_tests {
     use crate::cdr::ByteOrder;
 
     /// The short-string fast path agrees with the full checks for every length up to 40 and every position
-    /// of a NUL, a byte above 0x7f (invalid alone), and a two-byte UTF-8 character.
+    /// of a NUL, a byte above 0x7f (invalid alone), and a two-byte UTF-8 character; decoding into a reused
+    /// string gives the same.
     #[test]
     fn short_string_checks_agree_with_the_full_ones() {
         let decode = |text: &[u8]| {
@@ -552,7 +592,15 @@ mod string_tests {
             p.extend_from_slice(text);
             p.push(0);
             let mut r = CdrReader::new(&p, 0, XcdrVersion::Xcdr1, ByteOrder::LittleEndian, false);
-            decode_str(&mut r, usize::MAX).ok()
+            let fresh = decode_str(&mut r, usize::MAX).ok();
+            // Into a reused string (with a longer old value): the same result, and empty on error.
+            let mut reused = "an old value longer than forty characters...".to_owned();
+            let mut r = CdrReader::new(&p, 0, XcdrVersion::Xcdr1, ByteOrder::LittleEndian, false);
+            match decode_str_in_place(&mut reused, &mut r, usize::MAX) {
+                Ok(()) => assert_eq!(Some(&reused), fresh.as_ref()),
+                Err(_) => assert!(fresh.is_none() && reused.is_empty()),
+            }
+            fresh
         };
         let reference = |text: &[u8]| {
             (!text.contains(&0))
@@ -562,6 +610,12 @@ mod string_tests {
         for n in 0..=40usize {
             let base: Vec<u8> = (0..n).map(|i| b'A' + (i % 26) as u8).collect();
             assert_eq!(decode(&base), reference(&base), "plain {n}");
+            // A terminator other than NUL.
+            let mut p = ((n + 1) as u32).to_le_bytes().to_vec();
+            p.extend_from_slice(&base);
+            p.push(b'X');
+            let mut r = CdrReader::new(&p, 0, XcdrVersion::Xcdr1, ByteOrder::LittleEndian, false);
+            assert!(decode_str(&mut r, usize::MAX).is_err(), "terminator, {n}");
             for at in 0..n {
                 for b in [0u8, 0x80, 0xff] {
                     let mut t = base.clone();

@@ -155,19 +155,28 @@ pub struct MemberHeader {
     limit: Limit,
 }
 
-/// Starts decoding a struct or union (depth check, XCDR2 DHEADER).
-#[inline]
+/// Starts decoding a struct or union (depth check, XCDR2 DHEADER). Always inlined: without a DHEADER (XCDR1, or
+/// a final type) it is the depth check alone; the DHEADER is read out of line.
+#[inline(always)]
 pub fn begin_decode(
     r: &mut CdrReader<'_>,
     ext: Extensibility,
 ) -> Result<StructDecoder, DecodeError> {
     r.enter("struct")?;
-    let limit = if r.is_xcdr2() && ext != Extensibility::Final {
-        let len = r.read_u32("DHEADER")? as usize;
-        Some(r.begin_limit(len, "DHEADER")?)
-    } else {
-        None
-    };
+    if r.is_xcdr2() && ext != Extensibility::Final {
+        return begin_delimited(r, ext);
+    }
+    Ok(StructDecoder { ext, limit: None })
+}
+
+/// [`begin_decode`] of a DHEADER-delimited aggregate.
+#[inline(never)]
+fn begin_delimited(
+    r: &mut CdrReader<'_>,
+    ext: Extensibility,
+) -> Result<StructDecoder, DecodeError> {
+    let len = r.read_u32("DHEADER")? as usize;
+    let limit = Some(r.begin_limit(len, "DHEADER")?);
     Ok(StructDecoder { ext, limit })
 }
 

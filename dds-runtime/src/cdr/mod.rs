@@ -14,6 +14,7 @@ pub mod members;
 mod payload;
 mod primitives;
 mod reader;
+mod short;
 mod traits;
 mod wrappers;
 mod writer;

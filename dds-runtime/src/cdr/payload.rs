@@ -54,7 +54,9 @@ pub(crate) fn encode_payload<T: DdsType>(
 }
 
 /// A reader of the body of a payload that starts with its encapsulation header (its version and byte order);
-/// `key_only` for a key-only payload.
+/// `key_only` for a key-only payload. Inlined, so the reader is built where it is used rather than returned
+/// through memory and copied.
+#[inline]
 pub(crate) fn payload_reader(payload: &[u8], key_only: bool) -> Result<CdrReader<'_>, DecodeError> {
     let h = EncapsulationHeader::parse(payload)?;
     Ok(CdrReader::new(

@@ -3,6 +3,7 @@
 use super::error::{DecodeError, DecodeErrorKind, EncodeError};
 use super::header::XcdrVersion;
 use super::reader::CdrReader;
+use super::short;
 use super::traits::{CdrType, Layout};
 use super::writer::CdrWriter;
 
@@ -120,13 +121,10 @@ macro_rules! numeric {
                 out.reserve(n);
                 if r.order().is_native() {
                     // SAFETY: `reserve(n)` made room for n more elements; every bit pattern is a valid value of
-                    // this numeric type, and `bytes` holds exactly n of them.
+                    // this numeric type, and `bytes` holds exactly n of them (`len` bytes, not overlapping
+                    // `out`, which the caller owns).
                     unsafe {
-                        std::ptr::copy_nonoverlapping(
-                            bytes.as_ptr(),
-                            out.as_mut_ptr().add(out.len()).cast::<u8>(),
-                            len,
-                        );
+                        short::copy_bytes(bytes, out.as_mut_ptr().add(out.len()).cast::<u8>());
                         out.set_len(out.len() + n);
                     }
                 } else {
@@ -282,13 +280,9 @@ macro_rules! byte_like {
                 let bytes = r.read_bytes(n, $what)?;
                 out.reserve(n);
                 // SAFETY: `reserve(n)` made room for n more elements; a byte is a valid u8/i8, and `bytes`
-                // holds exactly n of them.
+                // holds exactly n of them (not overlapping `out`, which the caller owns).
                 unsafe {
-                    std::ptr::copy_nonoverlapping(
-                        bytes.as_ptr(),
-                        out.as_mut_ptr().add(out.len()).cast::<u8>(),
-                        n,
-                    );
+                    short::copy_bytes(bytes, out.as_mut_ptr().add(out.len()).cast::<u8>());
                     out.set_len(out.len() + n);
                 }
                 Ok(())

@@ -5,6 +5,10 @@ use super::header::{ByteOrder, XcdrVersion};
 use super::MAX_DEPTH;
 
 /// Reads XCDR data. Offsets in errors are positions in the slice given to [`CdrReader::new`].
+///
+/// Invariant: `pos <= end <= data.len()` (`new` starts there, `begin_limit` only narrows `end` to at most the
+/// bytes left, `end_limit` restores an enclosing `end`, and every read checks against `end`), so a range that
+/// ends at or before `end` is inside `data` and needs no second bounds check.
 pub struct CdrReader<'a> {
     data: &'a [u8],
     pos: usize,
@@ -26,16 +30,22 @@ pub struct Limit {
 }
 
 /// Aligned read of a primitive: the in-bounds path is a few instructions and inlines; errors are built out of
-/// line (a `DecodeError` is large, and building it inline kept these readers from inlining).
+/// line (a `DecodeError` is large, and building it inline kept these readers from inlining). Values of 4 bytes
+/// or less align to their size in both versions (the maximum alignment is 4 or 8), so only 8-byte values
+/// consult it; and one comparison against `end` is the only bounds check (see [`CdrReader::bytes_at`]).
 macro_rules! get {
     ($self:ident, $t:ty, $n:expr, $what:expr) => {{
-        let pad = ($self.pos - $self.origin).wrapping_neg() & ($n.min($self.max_align) - 1);
+        let mask = if $n <= 4 {
+            $n - 1
+        } else {
+            $n.min($self.max_align) - 1
+        };
+        let pad = ($self.pos - $self.origin).wrapping_neg() & mask;
         let start = $self.pos + pad;
         if start + $n > $self.end {
             return Err($self.short_read($n, $what));
         }
-        let mut a = [0u8; $n];
-        a.copy_from_slice(&$self.data[start..start + $n]);
+        let a: [u8; $n] = $self.bytes_at(start);
         $self.pos = start + $n;
         Ok(match $self.order {
             ByteOrder::BigEndian => <$t>::from_be_bytes(a),
@@ -131,6 +141,28 @@ impl<'a> CdrReader<'a> {
         self.eof(expected, n)
     }
 
+    /// The `N` bytes at `start`; the caller has checked `start + N <= self.end`.
+    #[inline(always)]
+    fn bytes_at<const N: usize>(&self, start: usize) -> [u8; N] {
+        debug_assert!(start + N <= self.end && self.end <= self.data.len());
+        // SAFETY: `start + N <= end <= data.len()` (the caller's check and the type's invariant).
+        unsafe {
+            self.data
+                .as_ptr()
+                .add(start)
+                .cast::<[u8; N]>()
+                .read_unaligned()
+        }
+    }
+
+    /// The `n` bytes at the current offset; the caller has checked `n <= self.remaining()`.
+    #[inline(always)]
+    fn slice_here(&self, n: usize) -> &'a [u8] {
+        debug_assert!(self.pos + n <= self.end && self.end <= self.data.len());
+        // SAFETY: `pos + n <= end <= data.len()` (the caller's check and the type's invariant).
+        unsafe { self.data.get_unchecked(self.pos..self.pos + n) }
+    }
+
     /// Skips padding to a multiple of `n` (capped at 4 in XCDR2).
     #[inline]
     pub fn align(&mut self, n: usize, expected: &'static str) -> Result<(), DecodeError> {
@@ -153,7 +185,7 @@ impl<'a> CdrReader<'a> {
         if n > self.remaining() {
             return Err(self.eof(expected, n));
         }
-        let b = &self.data[self.pos..self.pos + n];
+        let b = self.slice_here(n);
         self.pos += n;
         Ok(b)
     }
@@ -176,7 +208,7 @@ impl<'a> CdrReader<'a> {
         if self.pos >= self.end {
             return Err(self.eof(expected, 1));
         }
-        let b = self.data[self.pos];
+        let [b] = self.bytes_at::<1>(self.pos);
         self.pos += 1;
         Ok(b)
     }
@@ -211,16 +243,23 @@ impl<'a> CdrReader<'a> {
         let n = self.read_u32(expected)? as usize;
         let need = n.saturating_mul(min_elem_size.max(1));
         if need > self.remaining() {
-            return Err(DecodeError::new(
-                at,
-                expected,
-                DecodeErrorKind::LengthTooLarge {
-                    length: n as u64,
-                    remaining: self.remaining(),
-                },
-            ));
+            return Err(self.count_too_large(at, n, expected));
         }
         Ok(n)
+    }
+
+    /// The error of [`read_count`](Self::read_count): `n` elements (read at `at`) cannot follow.
+    #[cold]
+    #[inline(never)]
+    fn count_too_large(&self, at: usize, n: usize, expected: &'static str) -> DecodeError {
+        DecodeError::new(
+            at,
+            expected,
+            DecodeErrorKind::LengthTooLarge {
+                length: n as u64,
+                remaining: self.remaining(),
+            },
+        )
     }
 
     /// Restricts reading to the next `len` bytes (a DHEADER, EMHEADER or parameter body).
@@ -260,7 +299,8 @@ impl<'a> CdrReader<'a> {
     /// Skips whatever is left of the limited region and restores the enclosing limit.
     pub fn end_limit(&mut self, saved: Limit) {
         self.pos = self.end;
-        self.end = saved.end;
+        // Clamped: a `Limit` of another, longer reader must not lift `end` past this reader's data.
+        self.end = saved.end.min(self.data.len()).max(self.pos);
         self.origin = saved.origin;
     }
 

@@ -2,6 +2,7 @@
 
 use super::error::EncodeError;
 use super::header::{ByteOrder, XcdrVersion};
+use super::short::{copy_short, SHORT};
 use super::MAX_DEPTH;
 
 /// What is being encoded: a full sample, a key-only sample, or the key-hash stream.
@@ -54,50 +55,6 @@ macro_rules! put {
         let pad = $self.padding(bytes.len());
         $self.put_padded(pad, bytes);
     }};
-}
-
-/// Strings and byte runs up to this long are copied with word stores ([`copy_short`]).
-const SHORT: usize = 16;
-
-/// Copies `src` (at most [`SHORT`] bytes) to `dst` with two overlapping word loads and stores (or three byte
-/// copies below 4 bytes), and tells whether `src` holds a NUL, tested on the same words.
-///
-/// # Safety
-/// `dst` must be valid for writes of `src.len()` bytes and must not overlap `src`.
-#[inline(always)]
-unsafe fn copy_short(src: &[u8], dst: *mut u8) -> bool {
-    const LO: u64 = 0x0101_0101_0101_0101;
-    const HI: u64 = 0x8080_8080_8080_8080;
-    let n = src.len();
-    debug_assert!(n <= SHORT);
-    let s = src.as_ptr();
-    // SAFETY (all branches): every load reads inside `src` (offsets 0..n) and every store writes inside
-    // `dst[..n]`, as the caller guarantees.
-    unsafe {
-        if n >= 8 {
-            let a = s.cast::<u64>().read_unaligned();
-            let b = s.add(n - 8).cast::<u64>().read_unaligned();
-            dst.cast::<u64>().write_unaligned(a);
-            dst.add(n - 8).cast::<u64>().write_unaligned(b);
-            let zero = |v: u64| v.wrapping_sub(LO) & !v & HI != 0;
-            zero(a) | zero(b)
-        } else if n >= 4 {
-            let a = s.cast::<u32>().read_unaligned();
-            let b = s.add(n - 4).cast::<u32>().read_unaligned();
-            dst.cast::<u32>().write_unaligned(a);
-            dst.add(n - 4).cast::<u32>().write_unaligned(b);
-            let zero = |v: u32| v.wrapping_sub(LO as u32) & !v & HI as u32 != 0;
-            zero(a) | zero(b)
-        } else if n > 0 {
-            let (a, b, c) = (*s, *s.add(n / 2), *s.add(n - 1));
-            *dst = a;
-            *dst.add(n / 2) = b;
-            *dst.add(n - 1) = c;
-            a == 0 || b == 0 || c == 0
-        } else {
-            false
-        }
-    }
 }
 
 /// The error for a string holding a NUL (out of line: never the hot path).

@@ -17,7 +17,7 @@ use crate::rtps::{
     CoreError, EntityId, Event, Guid, GuidPrefix, Locator, Participant, ParticipantConfig,
     ReceivedSample, Transmit, WriteChange,
 };
-use crate::transport::{Channel, Datagram, Pieces, UdpTransport};
+use crate::transport::{with_run_pieces, Channel, Datagram, Pieces, UdpTransport, RUN};
 
 use super::condition::StatusCore;
 use super::error::{DdsError, DdsResult};
@@ -534,10 +534,9 @@ impl Driver {
     /// go to each destination as one run, which the transport may send in one system call. Datagrams
     /// that share slices of samples ([`Transmit::shared`]) go in pieces, gathered by the kernel.
     fn send_batch(&self, batch: &[Transmit]) {
-        const RUN: usize = 16;
         let mut rest = batch;
         while let Some(first) = rest.first() {
-            let n = rest
+            let mut n = rest
                 .iter()
                 .take(RUN)
                 .take_while(|t| t.destinations == first.destinations)
@@ -550,19 +549,9 @@ impl Driver {
                 }
                 self.send_run(&bufs[..n], &first.destinations);
             } else {
-                let mut pieces: Vec<&[u8]> = Vec::with_capacity(n * 3);
-                let mut ends = [0usize; RUN];
-                for (end, t) in ends.iter_mut().zip(run) {
-                    t.pieces(|p| pieces.push(p));
-                    *end = pieces.len();
-                }
-                let mut grams: [&[&[u8]]; RUN] = [&[]; RUN];
-                let mut from = 0;
-                for (g, &end) in grams.iter_mut().zip(&ends[..n]) {
-                    *g = &pieces[from..end];
-                    from = end;
-                }
-                self.send_run(&grams[..n], &first.destinations);
+                // Gathered on the stack (no allocation per large sample); a run whose pieces do not all fit
+                // is sent in parts.
+                n = with_run_pieces(run, |grams| self.send_run(grams, &first.destinations));
             }
             rest = &rest[n..];
         }

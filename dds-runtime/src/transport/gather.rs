@@ -7,6 +7,8 @@ use std::net::{SocketAddr, UdpSocket};
 
 use socket2::{SockAddr, SockRef};
 
+use crate::rtps::Transmit;
+
 /// A datagram to send: one contiguous buffer, or its pieces in order.
 pub trait Pieces {
     /// The datagram's pieces, in order.
@@ -59,6 +61,50 @@ pub(super) fn send_pieces(
     send(&iov[..pieces.len()])
 }
 
+/// Most datagrams one run (one destination list, consecutive datagrams) hands the transport at once.
+pub(crate) const RUN: usize = 16;
+
+/// Pieces gathered on the stack for one run: four per datagram, more than a fragment has (its headers, the
+/// slice of the sample, at most a header after it).
+const RUN_PIECES: usize = 4 * RUN;
+
+/// Hands `send` the pieces of the first datagrams of `run` (at most [`RUN`], and as many as fit in
+/// [`RUN_PIECES`] pieces), one slice of pieces per datagram, and returns how many datagrams that was (at least
+/// one when `run` is not empty). The pieces are gathered on the stack: nothing is allocated, except for a
+/// datagram alone of more than [`RUN_PIECES`] pieces, which is copied together.
+pub(crate) fn with_run_pieces(run: &[Transmit], send: impl FnOnce(&[&[&[u8]]])) -> usize {
+    let mut pieces: [&[u8]; RUN_PIECES] = [&[]; RUN_PIECES];
+    let mut ends = [0usize; RUN];
+    let (mut len, mut taken) = (0, 0);
+    for t in run.iter().take(RUN) {
+        if len + t.piece_count() > RUN_PIECES {
+            break;
+        }
+        t.pieces(|p| {
+            pieces[len] = p;
+            len += 1;
+        });
+        ends[taken] = len;
+        taken += 1;
+    }
+    if taken == 0 {
+        if let Some(t) = run.first() {
+            let whole = t.datagram();
+            send(&[&[&whole[..]]]);
+            return 1;
+        }
+        return 0;
+    }
+    let mut grams: [&[&[u8]]; RUN] = [&[]; RUN];
+    let mut from = 0;
+    for (g, &end) in grams.iter_mut().zip(&ends[..taken]) {
+        *g = &pieces[from..end];
+        from = end;
+    }
+    send(&grams[..taken]);
+    taken
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -85,5 +131,44 @@ mod tests {
         send_pieces(&tx, &[&head, &body], None).unwrap();
         let n = rx.recv(&mut buf).unwrap();
         assert_eq!(&buf[..n], &[&head[..], &body[..]].concat()[..]);
+    }
+
+    /// A datagram of `n_shared` shared parts, each between two bytes of its own.
+    fn gram(seq: u8, n_shared: usize) -> Transmit {
+        let mut t = Transmit::new(Vec::new(), vec![seq; n_shared + 1]);
+        for i in 0..n_shared {
+            t.shared.push(crate::rtps::SharedPart {
+                at: i + 1,
+                bytes: crate::rtps::Payload::from(vec![seq ^ 0xff; 1000 + i]),
+            });
+        }
+        t
+    }
+
+    /// Each datagram's pieces are what it holds; a run stops where its pieces would not fit on the stack,
+    /// and a datagram of more pieces than that alone is sent whole.
+    #[test]
+    fn runs_gather_their_pieces_on_the_stack() {
+        let check = |run: &[Transmit], expect: usize| {
+            let mut seen = Vec::new();
+            let n = with_run_pieces(run, |grams| {
+                seen = grams.iter().map(|g| g.concat()).collect();
+            });
+            assert_eq!(n, expect);
+            assert_eq!(seen.len(), n);
+            for (s, t) in seen.iter().zip(run) {
+                assert_eq!(&s[..], &t.datagram()[..]);
+            }
+        };
+        // Fragments: header, slice, trailing header; 16 of them fit (48 pieces), the 17th is the next run.
+        let frags: Vec<Transmit> = (0..20).map(|i| gram(i, 1)).collect();
+        check(&frags, RUN);
+        check(&frags[RUN..], 4);
+        // 7 pieces each: 9 fit in 64.
+        let wide: Vec<Transmit> = (0..12).map(|i| gram(i, 3)).collect();
+        check(&wide, RUN_PIECES / 7);
+        // More pieces than the stack holds: alone, copied together.
+        check(&[gram(1, RUN_PIECES)], 1);
+        check(&[], 0);
     }
 }

@@ -53,6 +53,7 @@ pub(crate) const DELIVERY_STACK: usize = 64 << 20;
 
 pub use datagram::{Channel, Datagram, Receiver, TransportStats};
 pub use gather::Pieces;
+pub(crate) use gather::{with_run_pieces, RUN};
 pub use iface::Interface;
 pub use recv::ReceivePath;
 pub use udp::UdpTransport;

@@ -456,9 +456,10 @@ impl Writer {
         let fragments = send_change(out, full, None, rid, wid, c, frag, None, false);
         send_change(out, key_hash, None, rid, wid, c, frag, None, true);
         if fragments > 0 && !full.is_empty() && self.has_reliable_proxy() {
-            let full = full.to_vec();
             let hf = self.heartbeat_frag(rid, sn, fragments);
-            out.push(&full, None, Ts::Any, &hf);
+            // Borrowed again after the count's update (a copy of the list was an allocation per sample).
+            let full = if split { &self.full_key_dest[..] } else { dest };
+            out.push(full, None, Ts::Any, &hf);
         }
     }
 
