@@ -2,6 +2,7 @@
 
 use super::error::EncodeError;
 use super::header::{ByteOrder, XcdrVersion};
+use super::placement::{PlaceRuns, PLACE_MIN};
 use super::MAX_DEPTH;
 
 /// What is being encoded: a full sample, a key-only sample, or the key-hash stream.
@@ -24,6 +25,11 @@ pub struct CdrWriter<'a> {
     max_align: usize,
     mode: EncodeMode,
     depth: u32,
+    /// Where long byte runs go instead of `buf` (`cdr::placement`: a shared-memory frame), if anywhere.
+    place: Option<&'a mut (dyn PlaceRuns + 'a)>,
+    /// Bytes placed there so far: the stream's position is `buf`'s length plus these (`origin` is lowered
+    /// by each run, so that [`position`](CdrWriter::position) needs no addition).
+    placed: usize,
 }
 
 /// A DHEADER or NEXTINT placeholder to patch once the body is written.
@@ -31,6 +37,7 @@ pub struct CdrWriter<'a> {
 #[must_use]
 pub struct LengthSlot {
     at: usize,
+    placed: usize,
 }
 
 /// An XCDR1 parameter header (PID_EXTENDED form) whose length is patched at the end of the member.
@@ -40,6 +47,7 @@ pub struct ParamSlot {
     len_at: usize,
     body: usize,
     saved_origin: usize,
+    placed: usize,
 }
 
 /// An aligned primitive: its padding and its bytes in the writer's byte order, in one append
@@ -145,7 +153,23 @@ impl<'a> CdrWriter<'a> {
             max_align: version.max_align(),
             mode,
             depth: 0,
+            place: None,
+            placed: 0,
         }
+    }
+
+    #[cfg(any(test, feature = "shm"))]
+    /// [`new`](Self::new), with byte runs of at least [`PLACE_MIN`] bytes copied to `place` rather than
+    /// appended to `buf` (when it takes them).
+    pub(crate) fn placing(
+        buf: &'a mut Vec<u8>,
+        version: XcdrVersion,
+        order: ByteOrder,
+        place: &'a mut (dyn PlaceRuns + 'a),
+    ) -> Self {
+        let mut w = Self::new(buf, version, order, EncodeMode::Sample);
+        w.place = Some(place);
+        w
     }
 
     /// The XCDR version being written.
@@ -181,7 +205,8 @@ impl<'a> CdrWriter<'a> {
     /// Bytes written since the alignment origin.
     #[inline]
     pub fn position(&self) -> usize {
-        self.buf.len() - self.origin
+        // `origin` went down by every placed run (and may have wrapped).
+        self.buf.len().wrapping_sub(self.origin)
     }
 
     /// Total bytes in the underlying buffer.
@@ -279,7 +304,9 @@ impl<'a> CdrWriter<'a> {
     pub fn write_bytes(&mut self, bytes: &[u8]) {
         let n = bytes.len();
         if n > SHORT {
-            self.buf.extend_from_slice(bytes);
+            if n < PLACE_MIN || !self.try_place(bytes) {
+                self.buf.extend_from_slice(bytes);
+            }
             return;
         }
         self.buf.reserve(SHORT);
@@ -290,6 +317,23 @@ impl<'a> CdrWriter<'a> {
             copy_short(bytes, self.buf.as_mut_ptr().add(at));
             self.buf.set_len(at + n);
         }
+    }
+
+    /// Copies a long run to the placement, if there is one and it takes it.
+    #[cold]
+    #[inline(never)]
+    fn try_place(&mut self, bytes: &[u8]) -> bool {
+        let at = self.buf.len();
+        if !self
+            .place
+            .as_deref_mut()
+            .is_some_and(|p| p.place(at, bytes))
+        {
+            return false;
+        }
+        self.placed += bytes.len();
+        self.origin = self.origin.wrapping_sub(bytes.len());
+        true
     }
 
     /// Writes an octet.
@@ -333,13 +377,16 @@ impl<'a> CdrWriter<'a> {
         self.align(4);
         let at = self.buf.len();
         self.buf.extend_from_slice(&[0; 4]);
-        LengthSlot { at }
+        LengthSlot {
+            at,
+            placed: self.placed,
+        }
     }
 
     /// Patches `slot` with the number of bytes written since it.
     #[inline]
     pub fn end_length(&mut self, slot: LengthSlot) -> Result<(), EncodeError> {
-        let len = self.buf.len() - slot.at - 4;
+        let len = self.buf.len() - slot.at - 4 + (self.placed - slot.placed);
         let v = u32::try_from(len).map_err(|_| EncodeError::TooLarge {
             what: "DHEADER",
             len: len as u64,
@@ -416,14 +463,16 @@ impl<'a> CdrWriter<'a> {
             len_at,
             body,
             saved_origin,
+            placed: self.placed,
         })
     }
 
     /// Ends a parameter: pads the body to 4 and patches its length.
     pub fn end_param(&mut self, slot: ParamSlot) -> Result<(), EncodeError> {
         self.align(4);
-        self.origin = slot.saved_origin;
-        let len = self.buf.len() - slot.body;
+        let placed = self.placed - slot.placed;
+        self.origin = slot.saved_origin.wrapping_sub(placed);
+        let len = self.buf.len() - slot.body + placed;
         let v = u32::try_from(len).map_err(|_| EncodeError::TooLarge {
             what: "parameter",
             len: len as u64,
