@@ -12,6 +12,7 @@ mod header;
 mod key;
 pub mod members;
 mod payload;
+#[cfg(any(test, feature = "shm"))]
 mod placement;
 mod primitives;
 mod reader;

@@ -4,20 +4,17 @@
 //! into the gaps between the runs at the end. A sample of megabytes is so copied once, not twice (into a
 //! buffer, then into the frame).
 
-#[cfg(any(test, feature = "shm"))]
-use {
-    super::error::EncodeError,
-    super::header::{ByteOrder, XcdrVersion},
-    super::payload::start_payload,
-    super::traits::DdsType,
-    super::writer::{push_zeros, CdrWriter},
-    std::mem::MaybeUninit,
-};
+use std::mem::MaybeUninit;
+
+use super::error::EncodeError;
+use super::header::{ByteOrder, XcdrVersion};
+use super::payload::start_payload;
+use super::traits::DdsType;
+use super::writer::{push_zeros, CdrWriter};
 
 /// Byte runs at least this long are placed; shorter ones are not worth a gap.
 pub(crate) const PLACE_MIN: usize = 4096;
 
-#[cfg(any(test, feature = "shm"))]
 /// Most runs placed per sample; later ones go into the buffer.
 const MAX_RUNS: usize = 8;
 
@@ -28,7 +25,6 @@ pub(crate) trait PlaceRuns {
     fn place(&mut self, at: usize, bytes: &[u8]) -> bool;
 }
 
-#[cfg(any(test, feature = "shm"))]
 /// The destination and the runs placed in it.
 struct Placement<'d> {
     dest: &'d mut [MaybeUninit<u8>],
@@ -38,7 +34,6 @@ struct Placement<'d> {
     placed: usize,
 }
 
-#[cfg(any(test, feature = "shm"))]
 /// Copies `src` to the start of `dst` (which must be at least as long).
 fn copy_to(dst: &mut [MaybeUninit<u8>], src: &[u8]) {
     let dst = &mut dst[..src.len()];
@@ -47,7 +42,6 @@ fn copy_to(dst: &mut [MaybeUninit<u8>], src: &[u8]) {
     unsafe { std::ptr::copy_nonoverlapping(src.as_ptr(), dst.as_mut_ptr().cast(), src.len()) }
 }
 
-#[cfg(any(test, feature = "shm"))]
 impl PlaceRuns for Placement<'_> {
     fn place(&mut self, at: usize, bytes: &[u8]) -> bool {
         let from = at + self.placed;
@@ -65,7 +59,6 @@ impl PlaceRuns for Placement<'_> {
     }
 }
 
-#[cfg(any(test, feature = "shm"))]
 /// Serializes `sample` (encapsulation header, sample, padding, as [`serialize`](super::serialize)) into
 /// the start of `dest`, using `scratch` (cleared first) for what is not placed directly. `Some(len)`: the
 /// payload is `dest[..len]`, every byte of it written. `None`: it does not fit in `dest` (whose bytes

@@ -2,6 +2,7 @@
 
 use super::error::EncodeError;
 use super::header::{ByteOrder, XcdrVersion};
+#[cfg(any(test, feature = "shm"))]
 use super::placement::{PlaceRuns, PLACE_MIN};
 use super::MAX_DEPTH;
 
@@ -26,9 +27,12 @@ pub struct CdrWriter<'a> {
     mode: EncodeMode,
     depth: u32,
     /// Where long byte runs go instead of `buf` (`cdr::placement`: a shared-memory frame), if anywhere.
+    /// Only with feature `shm` (the small-sample encoder keeps its size and instructions without it).
+    #[cfg(any(test, feature = "shm"))]
     place: Option<&'a mut (dyn PlaceRuns + 'a)>,
     /// Bytes placed there so far: the stream's position is `buf`'s length plus these (`origin` is lowered
     /// by each run, so that [`position`](CdrWriter::position) needs no addition).
+    #[cfg(any(test, feature = "shm"))]
     placed: usize,
 }
 
@@ -37,6 +41,7 @@ pub struct CdrWriter<'a> {
 #[must_use]
 pub struct LengthSlot {
     at: usize,
+    #[cfg(any(test, feature = "shm"))]
     placed: usize,
 }
 
@@ -47,6 +52,7 @@ pub struct ParamSlot {
     len_at: usize,
     body: usize,
     saved_origin: usize,
+    #[cfg(any(test, feature = "shm"))]
     placed: usize,
 }
 
@@ -153,14 +159,16 @@ impl<'a> CdrWriter<'a> {
             max_align: version.max_align(),
             mode,
             depth: 0,
+            #[cfg(any(test, feature = "shm"))]
             place: None,
+            #[cfg(any(test, feature = "shm"))]
             placed: 0,
         }
     }
 
-    #[cfg(any(test, feature = "shm"))]
     /// [`new`](Self::new), with byte runs of at least [`PLACE_MIN`] bytes copied to `place` rather than
     /// appended to `buf` (when it takes them).
+    #[cfg(any(test, feature = "shm"))]
     pub(crate) fn placing(
         buf: &'a mut Vec<u8>,
         version: XcdrVersion,
@@ -304,9 +312,11 @@ impl<'a> CdrWriter<'a> {
     pub fn write_bytes(&mut self, bytes: &[u8]) {
         let n = bytes.len();
         if n > SHORT {
-            if n < PLACE_MIN || !self.try_place(bytes) {
-                self.buf.extend_from_slice(bytes);
+            #[cfg(any(test, feature = "shm"))]
+            if n >= PLACE_MIN && self.try_place(bytes) {
+                return;
             }
+            self.buf.extend_from_slice(bytes);
             return;
         }
         self.buf.reserve(SHORT);
@@ -320,6 +330,7 @@ impl<'a> CdrWriter<'a> {
     }
 
     /// Copies a long run to the placement, if there is one and it takes it.
+    #[cfg(any(test, feature = "shm"))]
     #[cold]
     #[inline(never)]
     fn try_place(&mut self, bytes: &[u8]) -> bool {
@@ -379,6 +390,7 @@ impl<'a> CdrWriter<'a> {
         self.buf.extend_from_slice(&[0; 4]);
         LengthSlot {
             at,
+            #[cfg(any(test, feature = "shm"))]
             placed: self.placed,
         }
     }
@@ -386,7 +398,9 @@ impl<'a> CdrWriter<'a> {
     /// Patches `slot` with the number of bytes written since it.
     #[inline]
     pub fn end_length(&mut self, slot: LengthSlot) -> Result<(), EncodeError> {
-        let len = self.buf.len() - slot.at - 4 + (self.placed - slot.placed);
+        let len = self.buf.len() - slot.at - 4;
+        #[cfg(any(test, feature = "shm"))]
+        let len = len + (self.placed - slot.placed);
         let v = u32::try_from(len).map_err(|_| EncodeError::TooLarge {
             what: "DHEADER",
             len: len as u64,
@@ -463,6 +477,7 @@ impl<'a> CdrWriter<'a> {
             len_at,
             body,
             saved_origin,
+            #[cfg(any(test, feature = "shm"))]
             placed: self.placed,
         })
     }
@@ -470,9 +485,15 @@ impl<'a> CdrWriter<'a> {
     /// Ends a parameter: pads the body to 4 and patches its length.
     pub fn end_param(&mut self, slot: ParamSlot) -> Result<(), EncodeError> {
         self.align(4);
-        let placed = self.placed - slot.placed;
-        self.origin = slot.saved_origin.wrapping_sub(placed);
-        let len = self.buf.len() - slot.body + placed;
+        self.origin = slot.saved_origin;
+        let len = self.buf.len() - slot.body;
+        // Runs placed inside the parameter moved the origin, and count in its length.
+        #[cfg(any(test, feature = "shm"))]
+        let len = {
+            let placed = self.placed - slot.placed;
+            self.origin = self.origin.wrapping_sub(placed);
+            len + placed
+        };
         let v = u32::try_from(len).map_err(|_| EncodeError::TooLarge {
             what: "parameter",
             len: len as u64,
