@@ -1,8 +1,8 @@
 //! Serialization into a fixed destination (a loaned shared-memory frame): long byte runs (`Vec<u8>` or
-//! native-order numeric sequences of [`PLACE_MIN`] bytes or more) are copied straight to their place in
-//! the destination as they are encoded; everything else is encoded into a small buffer as usual and copied
-//! into the gaps between the runs at the end. A sample of megabytes is so copied once, not twice (into a
-//! buffer, then into the frame).
+//! native-order numeric sequences of 4 KiB or more, `writer::PLACE_MIN`) are copied straight to their
+//! place in the destination as they are encoded; everything else is encoded into a small buffer as usual
+//! and copied into the gaps between the runs at the end. A sample of megabytes is so copied once, not
+//! twice (into a buffer, then into the frame).
 
 use std::mem::MaybeUninit;
 
@@ -10,20 +10,10 @@ use super::error::EncodeError;
 use super::header::{ByteOrder, XcdrVersion};
 use super::payload::start_payload;
 use super::traits::DdsType;
-use super::writer::{push_zeros, CdrWriter};
-
-/// Byte runs at least this long are placed; shorter ones are not worth a gap.
-pub(crate) const PLACE_MIN: usize = 4096;
+use super::writer::{push_zeros, CdrWriter, PlaceRuns};
 
 /// Most runs placed per sample; later ones go into the buffer.
 const MAX_RUNS: usize = 8;
-
-/// Where an encoder puts long byte runs ([`CdrWriter::placing`]).
-pub(crate) trait PlaceRuns {
-    /// Copies `bytes`, which come in the stream right before byte `at` of the encoder's buffer (after the
-    /// runs placed before), to their place; false (nothing copied) when they do not fit.
-    fn place(&mut self, at: usize, bytes: &[u8]) -> bool;
-}
 
 /// The destination and the runs placed in it.
 struct Placement<'d> {
@@ -104,6 +94,7 @@ pub(crate) fn serialize_placed<T: DdsType>(
 mod tests {
     use super::*;
     use crate::cdr::serialize;
+    use crate::cdr::writer::PLACE_MIN;
 
     /// Encodes `sample` placed and plainly; both must give the same bytes.
     fn same_bytes<T: DdsType>(sample: &T, version: XcdrVersion) {

@@ -2,9 +2,19 @@
 
 use super::error::EncodeError;
 use super::header::{ByteOrder, XcdrVersion};
-#[cfg(any(test, feature = "shm"))]
-use super::placement::{PlaceRuns, PLACE_MIN};
 use super::MAX_DEPTH;
+
+/// Byte runs at least this long are placed ([`CdrWriter::placing`]); shorter ones are not worth a gap.
+#[cfg(any(test, feature = "shm"))]
+pub(crate) const PLACE_MIN: usize = 4096;
+
+/// Where an encoder puts long byte runs ([`CdrWriter::placing`]; `cdr::placement`).
+#[cfg(any(test, feature = "shm"))]
+pub(crate) trait PlaceRuns {
+    /// Copies `bytes`, which come in the stream right before byte `at` of the encoder's buffer (after the
+    /// runs placed before), to their place; false (nothing copied) when they do not fit.
+    fn place(&mut self, at: usize, bytes: &[u8]) -> bool;
+}
 
 /// What is being encoded: a full sample, a key-only sample, or the key-hash stream.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
