@@ -700,3 +700,58 @@ fn a_durable_reader_joining_a_channel_already_read_gets_the_history_first() {
         "the durable reader (joined after {joined_at}) got the history, then the live samples"
     );
 }
+
+/// Writes blobs `ids` of `len(id)` bytes.
+fn write_blobs(w: &DataWriter<Blob>, ids: std::ops::Range<u32>, len: impl Fn(u32) -> usize) {
+    for id in ids {
+        w.write(&blob(id, len(id))).unwrap();
+    }
+}
+
+/// Large samples (from 100 KiB to 1.2 MiB, growing and shrinking) of a writer whose readers are all on
+/// shared memory are serialized straight into its channel (`DataWriter::write_direct`: one buffer of the
+/// last sample's length, a larger one written as usual); a reader on UDP then joins (the writer's
+/// history keeps the bytes for it again), then leaves. Every sample reaches every reader byte for byte,
+/// in order, and `wait_for_acknowledgments` holds in each phase.
+#[test]
+fn large_samples_serialized_into_shared_memory_reach_shared_memory_and_udp_readers_intact() {
+    let p = participant_with(62, with_shm());
+    let near = participant_with(62, with_shm());
+    let (wq, rq) = reliable_keep_all();
+    let (w, r) = matched::<Blob>(&p, &near, "ShmDirect", &wq, &rq);
+    // Sizes that grow (a sample larger than the buffer goes the usual way), shrink (a shorter one leaves
+    // a tail) and repeat (the usual case).
+    let len = |id: u32| [300, 300, 1200, 100, 100, 700, 64, 65, 3][id as usize % 9] * KIB;
+    let n = 36u32;
+    let before = sent(&p);
+    write_blobs(&w, 0..n, len);
+    assert_eq!(
+        take_blobs(&r, n as usize, MATCH_TIMEOUT),
+        (0..n).collect::<Vec<_>>()
+    );
+    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
+    let during = sent(&p) - before;
+    assert!(during < 20, "{during} datagrams sent on shared memory");
+
+    // A reader on UDP: the history needs the bytes, both readers get every sample.
+    let far = participant_with(62, no_shm());
+    let fr = reader::<Blob>(&far, "ShmDirect", &rq);
+    wait_matched(&w, 2);
+    write_blobs(&w, n..2 * n, len);
+    let want: Vec<u32> = (n..2 * n).collect();
+    assert_eq!(take_blobs(&r, n as usize, MATCH_TIMEOUT), want);
+    assert_eq!(take_blobs(&fr, n as usize, MATCH_TIMEOUT), want);
+    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
+
+    // It leaves: straight into shared memory again.
+    drop(fr);
+    far.delete_contained_entities().unwrap();
+    drop(far);
+    wait_matched(&w, 1);
+    write_blobs(&w, 2 * n..3 * n, len);
+    assert_eq!(
+        take_blobs(&r, n as usize, MATCH_TIMEOUT),
+        (2 * n..3 * n).collect::<Vec<_>>()
+    );
+    w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
+}

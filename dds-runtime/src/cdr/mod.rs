@@ -12,6 +12,8 @@ mod header;
 mod key;
 pub mod members;
 mod payload;
+#[cfg(any(test, feature = "shm"))]
+mod placement;
 mod primitives;
 mod reader;
 mod short;
@@ -28,6 +30,8 @@ pub use key::{deserialize_key, instance_key, key_hash, serialize_key};
 pub use members::{DefaultSearch, Discriminator, StructMembers};
 pub use payload::{deserialize, deserialize_into, serialize};
 pub(crate) use payload::{finish_payload, payload_reader};
+#[cfg(feature = "shm")]
+pub(crate) use placement::serialize_placed;
 pub use reader::{CdrReader, Limit};
 pub use traits::{CdrType, DdsType, Layout, MemberDescriptor, TypeDescriptor};
 pub use wrappers::{BoundedSeq, BoundedString, LongDouble, WChar, WString};

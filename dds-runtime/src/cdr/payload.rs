@@ -7,7 +7,11 @@ use super::traits::DdsType;
 use super::writer::{push_zeros, CdrWriter, EncodeMode};
 
 #[inline]
-fn start_payload<T: DdsType>(version: XcdrVersion, order: ByteOrder, out: &mut Vec<u8>) -> usize {
+pub(super) fn start_payload<T: DdsType>(
+    version: XcdrVersion,
+    order: ByteOrder,
+    out: &mut Vec<u8>,
+) -> usize {
     let start = out.len();
     out.extend_from_slice(
         &EncapsulationHeader::for_type(version, T::EXTENSIBILITY, order).to_bytes(),

@@ -5,6 +5,18 @@ use super::header::{ByteOrder, XcdrVersion};
 use super::short::{copy_short, SHORT};
 use super::MAX_DEPTH;
 
+/// Byte runs at least this long are placed ([`CdrWriter::placing`]); shorter ones are not worth a gap.
+#[cfg(any(test, feature = "shm"))]
+pub(crate) const PLACE_MIN: usize = 4096;
+
+/// Where an encoder puts long byte runs ([`CdrWriter::placing`]; `cdr::placement`).
+#[cfg(any(test, feature = "shm"))]
+pub(crate) trait PlaceRuns {
+    /// Copies `bytes`, which come in the stream right before byte `at` of the encoder's buffer (after the
+    /// runs placed before), to their place; false (nothing copied) when they do not fit.
+    fn place(&mut self, at: usize, bytes: &[u8]) -> bool;
+}
+
 /// What is being encoded: a full sample, a key-only sample, or the key-hash stream.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EncodeMode {
@@ -25,6 +37,14 @@ pub struct CdrWriter<'a> {
     max_align: usize,
     mode: EncodeMode,
     depth: u32,
+    /// Where long byte runs go instead of `buf` (`cdr::placement`: a shared-memory frame), if anywhere.
+    /// Only with feature `shm` (the small-sample encoder keeps its size and instructions without it).
+    #[cfg(any(test, feature = "shm"))]
+    place: Option<&'a mut (dyn PlaceRuns + 'a)>,
+    /// Bytes placed there so far: the stream's position is `buf`'s length plus these (`origin` is lowered
+    /// by each run, so that [`position`](CdrWriter::position) needs no addition).
+    #[cfg(any(test, feature = "shm"))]
+    placed: usize,
 }
 
 /// A DHEADER or NEXTINT placeholder to patch once the body is written.
@@ -32,6 +52,8 @@ pub struct CdrWriter<'a> {
 #[must_use]
 pub struct LengthSlot {
     at: usize,
+    #[cfg(any(test, feature = "shm"))]
+    placed: usize,
 }
 
 /// An XCDR1 parameter header (PID_EXTENDED form) whose length is patched at the end of the member.
@@ -41,6 +63,8 @@ pub struct ParamSlot {
     len_at: usize,
     body: usize,
     saved_origin: usize,
+    #[cfg(any(test, feature = "shm"))]
+    placed: usize,
 }
 
 /// An aligned primitive: its padding and its bytes in the writer's byte order, in one append
@@ -102,7 +126,25 @@ impl<'a> CdrWriter<'a> {
             max_align: version.max_align(),
             mode,
             depth: 0,
+            #[cfg(any(test, feature = "shm"))]
+            place: None,
+            #[cfg(any(test, feature = "shm"))]
+            placed: 0,
         }
+    }
+
+    /// [`new`](Self::new), with byte runs of at least [`PLACE_MIN`] bytes copied to `place` rather than
+    /// appended to `buf` (when it takes them).
+    #[cfg(any(test, feature = "shm"))]
+    pub(crate) fn placing(
+        buf: &'a mut Vec<u8>,
+        version: XcdrVersion,
+        order: ByteOrder,
+        place: &'a mut (dyn PlaceRuns + 'a),
+    ) -> Self {
+        let mut w = Self::new(buf, version, order, EncodeMode::Sample);
+        w.place = Some(place);
+        w
     }
 
     /// The XCDR version being written.
@@ -138,7 +180,8 @@ impl<'a> CdrWriter<'a> {
     /// Bytes written since the alignment origin.
     #[inline]
     pub fn position(&self) -> usize {
-        self.buf.len() - self.origin
+        // `origin` went down by every placed run (and may have wrapped).
+        self.buf.len().wrapping_sub(self.origin)
     }
 
     /// Total bytes in the underlying buffer.
@@ -236,6 +279,10 @@ impl<'a> CdrWriter<'a> {
     pub fn write_bytes(&mut self, bytes: &[u8]) {
         let n = bytes.len();
         if n > SHORT {
+            #[cfg(any(test, feature = "shm"))]
+            if n >= PLACE_MIN && self.try_place(bytes) {
+                return;
+            }
             self.buf.extend_from_slice(bytes);
             return;
         }
@@ -247,6 +294,24 @@ impl<'a> CdrWriter<'a> {
             copy_short(bytes, self.buf.as_mut_ptr().add(at));
             self.buf.set_len(at + n);
         }
+    }
+
+    /// Copies a long run to the placement, if there is one and it takes it.
+    #[cfg(any(test, feature = "shm"))]
+    #[cold]
+    #[inline(never)]
+    fn try_place(&mut self, bytes: &[u8]) -> bool {
+        let at = self.buf.len();
+        if !self
+            .place
+            .as_deref_mut()
+            .is_some_and(|p| p.place(at, bytes))
+        {
+            return false;
+        }
+        self.placed += bytes.len();
+        self.origin = self.origin.wrapping_sub(bytes.len());
+        true
     }
 
     /// Writes an octet.
@@ -290,13 +355,19 @@ impl<'a> CdrWriter<'a> {
         self.align(4);
         let at = self.buf.len();
         self.buf.extend_from_slice(&[0; 4]);
-        LengthSlot { at }
+        LengthSlot {
+            at,
+            #[cfg(any(test, feature = "shm"))]
+            placed: self.placed,
+        }
     }
 
     /// Patches `slot` with the number of bytes written since it.
     #[inline]
     pub fn end_length(&mut self, slot: LengthSlot) -> Result<(), EncodeError> {
         let len = self.buf.len() - slot.at - 4;
+        #[cfg(any(test, feature = "shm"))]
+        let len = len + (self.placed - slot.placed);
         let v = u32::try_from(len).map_err(|_| EncodeError::TooLarge {
             what: "DHEADER",
             len: len as u64,
@@ -373,6 +444,8 @@ impl<'a> CdrWriter<'a> {
             len_at,
             body,
             saved_origin,
+            #[cfg(any(test, feature = "shm"))]
+            placed: self.placed,
         })
     }
 
@@ -381,6 +454,13 @@ impl<'a> CdrWriter<'a> {
         self.align(4);
         self.origin = slot.saved_origin;
         let len = self.buf.len() - slot.body;
+        // Runs placed inside the parameter moved the origin, and count in its length.
+        #[cfg(any(test, feature = "shm"))]
+        let len = {
+            let placed = self.placed - slot.placed;
+            self.origin = self.origin.wrapping_sub(placed);
+            len + placed
+        };
         let v = u32::try_from(len).map_err(|_| EncodeError::TooLarge {
             what: "parameter",
             len: len as u64,

@@ -210,6 +210,8 @@ impl Publisher {
             filters: Mutex::new(WriterFilters::default()),
             payloads: Mutex::new(BufferPool::new(WRITER_POOL_BUFFERS, WRITER_POOL_BYTES)),
             bytes_needed: AtomicBool::new(true),
+            #[cfg(feature = "shm")]
+            direct_len: std::sync::atomic::AtomicUsize::new(0),
         });
         let owner = WriterOwner {
             topic: topic.clone(),
@@ -341,6 +343,10 @@ struct WriterInner<T: DdsType> {
     /// Whether the last typed write (`write_owned`, `write_shared`) needed the serialized form (readers
     /// beyond this participant, or a durable history): the next one serializes before taking the lock.
     bytes_needed: AtomicBool,
+    /// The serialized length of the last large sample (0: none), for writing the next one straight into
+    /// a shared-memory buffer of that size (`loan.rs`, `write_direct`).
+    #[cfg(feature = "shm")]
+    direct_len: std::sync::atomic::AtomicUsize,
 }
 
 /// Writes samples of type `T`. Cheap to clone; the writer is deleted when the last clone is dropped (a
@@ -538,7 +544,13 @@ impl<T: DdsType> DataWriter<T> {
 
     /// Publishes `sample` with the given source timestamp.
     pub fn write_w_timestamp(&self, sample: &T, timestamp: SystemTime) -> DdsResult<()> {
+        #[cfg(feature = "shm")]
+        if let Some(done) = self.write_direct(sample, timestamp) {
+            return done;
+        }
         let payload = self.serialize(sample)?;
+        #[cfg(feature = "shm")]
+        self.note_len(payload.len());
         let key_hash = self.written_instance(sample)?;
         let change = WriteChange {
             kind: ChangeKind::Alive,

@@ -9,20 +9,28 @@
 //! A writer with other readers too (on the wire, in its own participant) or a durable history gives the
 //! core a copy of the sample for them; the readers on shared memory still get the loaned buffer.
 
+use std::mem::MaybeUninit;
 use std::ops::{Deref, DerefMut, Range};
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant, SystemTime};
 
 use bytemuck::Pod;
 
-use super::{wire_time, DataWriter};
-use crate::cdr::DdsType;
+use super::{wire_time, with_scratch, DataWriter};
+use crate::cdr::{self, ByteOrder, DdsType};
 use crate::dcps::error::DdsError;
+use crate::dcps::error::DdsResult;
 use crate::dcps::plain::plain_layout_cached;
 use crate::dcps::shm::ShmHost;
-use crate::dcps::sync::lock;
+use crate::dcps::sync::{lock, read};
 use crate::rtps::shm::ShmChange;
-use crate::rtps::{ChangeKind, Payload, WriteChange};
+use crate::rtps::{ChangeKind, Payload, SequenceNumber, WriteChange};
 use crate::transport::shm::{ShmError, ShmLoan};
+
+/// Samples whose serialized form is at least this long are serialized straight into shared memory when
+/// every reader is there ([`DataWriter::write_direct`]); smaller ones cost too little to copy to be worth
+/// a lock of the core to check that.
+const DIRECT_MIN: usize = 64 * 1024;
 
 /// How often a loan is retried while every buffer is taken.
 const LOAN_RETRY: Duration = Duration::from_micros(200);
@@ -143,16 +151,43 @@ impl<T: DdsType + Pod> SampleLoan<T> {
             at,
             payload,
         } = self;
-        let w = &writer;
-        let id = w.id();
         let sample: &T = bytemuck::from_bytes(&buf[at..at + std::mem::size_of::<T>()]);
-        let key_hash = w.written_instance(sample)?;
+        let written = writer.submit_loaned(&buf[payload.clone()], sample, timestamp)?;
+        writer.park_loaned(written, buf, payload);
+        Ok(())
+    }
+
+    /// The loaned sample's serialized bytes (encapsulation header, sample, padding), as readers get them.
+    pub fn serialized(&self) -> &[u8] {
+        &self.buf[self.payload.clone()]
+    }
+}
+
+impl<T: DdsType> DataWriter<T> {
+    /// `bytes` in a buffer of the writer's pool.
+    fn pooled(&self, bytes: &[u8]) -> Payload {
+        let mut b = lock(&self.inner.payloads).take();
+        std::sync::Arc::make_mut(&mut b).extend_from_slice(bytes);
+        lock(&self.inner.payloads).share(b)
+    }
+
+    /// Hands the core the change of `sample`, whose serialized form (`serialized`) is in a buffer loaned
+    /// from the writer's channel: readers on shared memory get that buffer; the core gets a copy only when
+    /// something else needs the bytes ([`Participant::loan_needs_payload`](crate::rtps::Participant::loan_needs_payload)).
+    /// Give the result and the buffer to [`park_loaned`](Self::park_loaned).
+    fn submit_loaned(
+        &self,
+        serialized: &[u8],
+        sample: &T,
+        timestamp: SystemTime,
+    ) -> Result<(SequenceNumber, bool), DdsError> {
+        let id = self.id();
+        let key_hash = self.written_instance(sample)?;
         let mut copy: Option<Payload> = None;
         let mut attempt = |c: &mut crate::rtps::Participant, now| {
-            let rejected = w.rejected_by_filters(c, Some(sample));
+            let rejected = self.rejected_by_filters(c, Some(sample));
             let payload = if c.loan_needs_payload(id) {
-                copy.get_or_insert_with(|| w.pooled(&buf[payload.clone()]))
-                    .clone()
+                copy.get_or_insert_with(|| self.pooled(serialized)).clone()
             } else {
                 Payload::default()
             };
@@ -164,30 +199,82 @@ impl<T: DdsType + Pod> SampleLoan<T> {
             };
             Some(c.write_loaned(now, id, change, rejected))
         };
-        let written = w.submit_with(&mut attempt, || Ok(()))?;
-        // The core queued the change for the channel (its turn may have come already: the change
-        // waited for its buffer, which it gets now).
+        self.submit_with(&mut attempt, || Ok(()))
+    }
+
+    /// After [`submit_loaned`](Self::submit_loaned): when the core queued the change for the channel, its
+    /// buffer waits for its turn there (which may have come already: the change waited for its buffer).
+    fn park_loaned(&self, written: (SequenceNumber, bool), buf: ShmLoan, payload: Range<usize>) {
         if let (sn, true) = written {
-            if let Some(link) = w.inner.state.driver.shm_link() {
-                link.park(id, sn.0, buf, payload);
+            if let Some(link) = self.inner.state.driver.shm_link() {
+                link.park(self.id(), sn.0, buf, payload);
                 link.flush();
             }
         }
-        Ok(())
     }
 
-    /// The loaned sample's serialized bytes (encapsulation header, sample, padding), as readers get them.
-    pub fn serialized(&self) -> &[u8] {
-        &self.buf[self.payload.clone()]
+    /// Records the serialized length of a sample written as usual: the next write of a sample at least
+    /// [`DIRECT_MIN`] long tries [`write_direct`](Self::write_direct) with a buffer of that length.
+    pub(super) fn note_len(&self, len: usize) {
+        if len >= DIRECT_MIN {
+            self.inner.direct_len.store(len, Ordering::Relaxed);
+        }
     }
-}
 
-impl<T: DdsType + Pod> DataWriter<T> {
-    /// `bytes` in a buffer of the writer's pool.
-    fn pooled(&self, bytes: &[u8]) -> Payload {
-        let mut b = lock(&self.inner.payloads).take();
-        std::sync::Arc::make_mut(&mut b).extend_from_slice(bytes);
-        lock(&self.inner.payloads).share(b)
+    /// [`write_w_timestamp`](DataWriter::write_w_timestamp) of a large sample (the last one was at least
+    /// [`DIRECT_MIN`] long) when every reader of the writer is on shared memory and the history keeps no
+    /// bytes (volatile: [`Participant::loan_needs_payload`](crate::rtps::Participant::loan_needs_payload)
+    /// is false): the sample is serialized straight into a buffer loaned from the writer's channel (its
+    /// long byte runs copied once, from the sample to shared memory), and written as a loaned sample.
+    /// `None` (nothing done): write as usual; so when the sample does not fit in a buffer of the last
+    /// length, or no buffer is free.
+    pub(super) fn write_direct(&self, sample: &T, timestamp: SystemTime) -> Option<DdsResult<()>> {
+        let len = self.inner.direct_len.load(Ordering::Relaxed);
+        if len < DIRECT_MIN {
+            return None;
+        }
+        let driver = &self.inner.state.driver;
+        let link = driver.shm_link()?;
+        let id = self.id();
+        if driver.query_core(|c| c.loan_needs_payload(id)) {
+            return None;
+        }
+        let reliable = read(&self.inner.current).reliability.is_reliable();
+        let head = ShmChange::HEADER_LEN;
+        let mut buf = link.loan_uninit(id, reliable, head + len).ok()?;
+        let version = self.data_representation();
+        let placed = with_scratch(|scratch| {
+            cdr::serialize_placed(
+                sample,
+                version,
+                ByteOrder::NATIVE,
+                scratch,
+                &mut buf.buf()[head..],
+            )
+        });
+        let n = match placed {
+            Ok(Some(n)) => n,
+            Ok(None) => {
+                // Larger than the last one: written as usual, which records its length.
+                self.inner.direct_len.store(0, Ordering::Relaxed);
+                return None;
+            }
+            Err(e) => return Some(Err(e.into())),
+        };
+        // A small sample goes the usual way next time (until a large one again).
+        let next = if n >= DIRECT_MIN { n } else { 0 };
+        self.inner.direct_len.store(next, Ordering::Relaxed);
+        // The header is written when the frame is sent; a shorter sample leaves a tail.
+        let bytes = buf.buf();
+        bytes[..head].fill(MaybeUninit::new(0));
+        bytes[head + n..].fill(MaybeUninit::new(0));
+        // SAFETY: the header and the tail were zeroed just above, `serialize_placed` wrote the rest.
+        let buf = unsafe { buf.assume_init() };
+        let payload = head..head + n;
+        Some(
+            self.submit_loaned(&buf[payload.clone()], sample, timestamp)
+                .map(|written| self.park_loaned(written, buf, payload)),
+        )
     }
 }
 

@@ -33,8 +33,8 @@ use crate::rtps::shm::{
 };
 use crate::rtps::{EntityId, Guid, GuidPrefix, Participant, Payload};
 use crate::transport::shm::{
-    host_id, node_status, NodeStatus, ShmChannelConfig, ShmError, ShmListener, ShmLoan, ShmNode,
-    ShmNotifier, ShmPublisher, ShmSample, ShmSubscriber,
+    host_id, node_status, NodeStatus, ShmChannelConfig, ShmError, ShmListener, ShmLoan,
+    ShmLoanUninit, ShmNode, ShmNotifier, ShmPublisher, ShmSample, ShmSubscriber,
 };
 
 /// How long a writer's changes wait for the subscribers of its readers' participants to connect.

@@ -179,22 +179,44 @@ impl ShmLink {
         }
     }
 
-    /// A buffer of `len` bytes from the channel of `writer` (reliable or not), for a sample written in
-    /// place: [`park`](Self::park) it once the core has queued the change.
+    /// A buffer of `len` bytes from the channel of `writer` (reliable or not), zeroed, for a sample
+    /// written in place: [`park`](Self::park) it once the core has queued the change.
     pub(crate) fn loan(
         &self,
         writer: EntityId,
         reliable: bool,
         len: usize,
     ) -> Result<ShmLoan, ShmError> {
-        let mut outlets = lock(&self.outlets);
-        let out = match outlets.entry(writer) {
+        self.outlet(&mut lock(&self.outlets), writer, reliable)?
+            .publisher
+            .loan(len)
+    }
+
+    /// [`loan`](Self::loan), not initialized (for a sample serialized into it).
+    pub(crate) fn loan_uninit(
+        &self,
+        writer: EntityId,
+        reliable: bool,
+        len: usize,
+    ) -> Result<ShmLoanUninit, ShmError> {
+        self.outlet(&mut lock(&self.outlets), writer, reliable)?
+            .publisher
+            .loan_uninit(len)
+    }
+
+    /// The channel of `writer`, opened if it is not yet.
+    fn outlet<'o>(
+        &self,
+        outlets: &'o mut HashMap<EntityId, Outlet>,
+        writer: EntityId,
+        reliable: bool,
+    ) -> Result<&'o mut Outlet, ShmError> {
+        Ok(match outlets.entry(writer) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::hash_map::Entry::Vacant(e) => {
                 e.insert(self.open_outlet(writer, reliable)?)
             }
-        };
-        out.publisher.loan(len)
+        })
     }
 
     /// Under the core lock, right after `Participant::write_loaned` queued change `sequence` of `writer`:
@@ -234,12 +256,7 @@ impl ShmLink {
         outlets: &mut HashMap<EntityId, Outlet>,
         c: &ShmChange,
     ) -> Result<bool, ShmError> {
-        let out = match outlets.entry(c.writer) {
-            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                e.insert(self.open_outlet(c.writer, c.reliable)?)
-            }
-        };
+        let out = self.outlet(outlets, c.writer, c.reliable)?;
         if !out
             .connected
             .as_ref()

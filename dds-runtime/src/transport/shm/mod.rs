@@ -19,6 +19,7 @@
 
 mod discovery;
 
+use std::mem::MaybeUninit;
 use std::ops::{Deref, DerefMut};
 use std::time::Duration;
 
@@ -29,6 +30,7 @@ use iceoryx2::port::{BackpressureAction, BackpressureInfo};
 use iceoryx2::prelude::*;
 use iceoryx2::sample::Sample;
 use iceoryx2::sample_mut::SampleMut;
+use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
 use iceoryx2::service::port_factory::PortFactory as _;
 
@@ -333,17 +335,24 @@ impl ShmPublisher {
         nodes
     }
 
+    /// Loans a buffer of `len` bytes in shared memory, not initialized (no zeroing): fill every byte,
+    /// then [`ShmLoanUninit::assume_init`] and send it.
+    pub fn loan_uninit(&self, len: usize) -> Result<ShmLoanUninit, ShmError> {
+        let sample = self
+            .publisher
+            .loan_slice_uninit(len)
+            .map_err(|e| ShmError::Loan(format!("{e:?}")))?;
+        Ok(ShmLoanUninit { sample })
+    }
+
     /// Sends `parts`, one after the other, as one sample: each is copied once into a loaned buffer, which
     /// is not zeroed first. How many subscribers got it.
     pub fn send_parts(&self, parts: &[&[u8]]) -> Result<usize, ShmError> {
         let len = parts.iter().map(|p| p.len()).sum();
-        let mut sample = self
-            .publisher
-            .loan_slice_uninit(len)
-            .map_err(|e| ShmError::Loan(format!("{e:?}")))?;
+        let mut loan = self.loan_uninit(len)?;
         let mut at = 0;
         for p in parts {
-            let dst = &mut sample.payload_mut()[at..at + p.len()];
+            let dst = &mut loan.buf()[at..at + p.len()];
             // SAFETY: `dst` and `p` have the same length and do not overlap (`dst` is a loaned buffer);
             // `MaybeUninit<u8>` has the layout of `u8`.
             unsafe {
@@ -352,10 +361,7 @@ impl ShmPublisher {
             at += p.len();
         }
         // SAFETY: the loop above wrote all `len` bytes of the payload.
-        let sample = unsafe { sample.assume_init() };
-        sample
-            .send()
-            .map_err(|e| ShmError::Transfer(format!("{e:?}")))
+        unsafe { loan.assume_init() }.send()
     }
 
     /// Connects subscribers that appeared since the last send (sending does it too).
@@ -384,6 +390,35 @@ impl ShmLoan {
         self.sample
             .send()
             .map_err(|e| ShmError::Transfer(format!("{e:?}")))
+    }
+}
+
+/// A buffer loaned from a publisher's segment, not initialized yet ([`ShmPublisher::loan_uninit`]).
+pub struct ShmLoanUninit {
+    sample: SampleMutUninit<ipc_threadsafe::Service, [MaybeUninit<u8>], ()>,
+}
+
+impl std::fmt::Debug for ShmLoanUninit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ShmLoanUninit({} bytes)", self.sample.payload().len())
+    }
+}
+
+impl ShmLoanUninit {
+    /// The buffer, to fill.
+    pub fn buf(&mut self) -> &mut [MaybeUninit<u8>] {
+        self.sample.payload_mut()
+    }
+
+    /// The filled buffer, to send.
+    ///
+    /// # Safety
+    /// Every byte of [`buf`](Self::buf) must have been written.
+    pub unsafe fn assume_init(self) -> ShmLoan {
+        // SAFETY: as the caller guarantees.
+        ShmLoan {
+            sample: unsafe { self.sample.assume_init() },
+        }
     }
 }
 
