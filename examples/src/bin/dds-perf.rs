@@ -230,8 +230,18 @@ impl<T: PerfSample> Ctx<T> {
     }
 }
 
+/// Like ddsperf (which sets it on its participant): our endpoints ignore each other, so the ping end's own
+/// ping reader does not get every ping. `DDS_PERF_IGNORE_LOCAL=none` keeps the DDS behaviour (to measure it).
+fn ignore_local() -> IgnoreLocal {
+    match std::env::var("DDS_PERF_IGNORE_LOCAL").as_deref() {
+        Ok("none") => IgnoreLocal::None,
+        _ => IgnoreLocal::Participant,
+    }
+}
+
 fn data_qos_reader(o: &PerfOptions) -> DataReaderQos {
     let mut q = DataReaderQos::builder()
+        .ignore_local(ignore_local())
         .reliability(reliability(o))
         .history(if o.history_depth == 0 {
             History::KeepAll
@@ -251,6 +261,7 @@ fn data_qos_reader(o: &PerfOptions) -> DataReaderQos {
 
 fn data_qos_writer(o: &PerfOptions) -> DataWriterQos {
     DataWriterQos::builder()
+        .ignore_local(ignore_local())
         .reliability(reliability(o))
         .history(if o.history_depth == 0 {
             History::KeepAll
@@ -301,10 +312,12 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
     let publ = participant.create_publisher(&PublisherQos::default())?;
     let subs = participant.create_subscriber(&SubscriberQos::default())?;
     let pingpong_w = DataWriterQos::builder()
+        .ignore_local(ignore_local())
         .reliability(reliability(o))
         .history(History::KeepLast(1))
         .build();
     let pingpong_r = DataReaderQos::builder()
+        .ignore_local(ignore_local())
         .reliability(reliability(o))
         .history(History::KeepLast(1))
         .build();
