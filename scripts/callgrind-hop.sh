@@ -12,7 +12,8 @@
 # Prints: instructions, round trips, instructions per round trip; with TOP=N also the N costliest functions
 # (inclusive) per round trip. KEEP=FILE keeps the callgrind dump (for callgrind_annotate). WRITE_FN= names the
 # function whose calls count the round trips (a wrapper around Cyclone's ddsperf: WRITE_FN=process_ping);
-# DOMAIN= (61), WARMUP= (5 s), WINDOW= (8 s).
+# DOMAIN= (61), WARMUP= (5 s), WINDOW= (8 s). END=ping measures the ping end instead (PROG under callgrind
+# runs `ping`, PING= names the pong's build then); its round trips are the calls of the ping's write.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [[ "${DDS_IN_NETNS:-}" != 1 ]]; then
@@ -35,12 +36,21 @@ case $(basename "$prog") in
 esac
 total=$((warmup + window + 3))
 
-valgrind --tool=callgrind --callgrind-out-file="$out/cg.%p" --compress-strings=no --compress-pos=no \
-  "$prog" -i "$domain" -D "$total" pong >"$out/pong" 2>"$out/pong.err" &
-pong=$!
-sleep 1
-$ping -i "$domain" -D $((total - 1)) ping size "$size" >"$out/ping" 2>&1 &
-pingp=$!
+end=${END:-pong}
+cgrun=(valgrind --tool=callgrind --callgrind-out-file="$out/cg.%p" --compress-strings=no --compress-pos=no)
+if [[ $end == ping ]]; then
+  $ping -i "$domain" -D "$total" pong >"$out/ping" 2>&1 &
+  pingp=$!
+  sleep 1
+  "${cgrun[@]}" "$prog" -i "$domain" -D $((total - 1)) ping size "$size" >"$out/pong" 2>"$out/pong.err" &
+  pong=$!
+else
+  "${cgrun[@]}" "$prog" -i "$domain" -D "$total" pong >"$out/pong" 2>"$out/pong.err" &
+  pong=$!
+  sleep 1
+  $ping -i "$domain" -D $((total - 1)) ping size "$size" >"$out/ping" 2>&1 &
+  pingp=$!
+fi
 sleep "$warmup"
 callgrind_control -z "$pong" >/dev/null
 sleep "$window"
@@ -57,7 +67,7 @@ instr=$(grep -m1 -E 'PROGRAM TOTALS' <<<"$ann" | awk '{ gsub(",", "", $1); print
 trips=$(awk -v fn="$writefn" '/^cfn=/ { tgt = index($0, fn) > 0 } /^calls=/ { if (tgt) { split($0, a, "[= ]"); n += a[2] } tgt = 0 }
   END { print n + 0 }' "$dump")
 trips=${trips:-0}
-echo "callgrind-hop: $(basename "$prog") pong, $size B, ${window}s window: $instr instructions, $trips round trips," \
+echo "callgrind-hop: $(basename "$prog") $end, $size B, ${window}s window: $instr instructions, $trips round trips," \
   "$(awk -v i="$instr" -v t="$trips" 'BEGIN { if (t > 0) printf "%.0f", i / t; else print "n/a" }') per round trip"
 if [[ -n ${TOP:-} ]]; then
   grep -E '^ *[0-9,]+ ' <<<"$ann" | grep -v 'PROGRAM TOTALS' | head -n "$TOP" |

@@ -8,11 +8,11 @@ pub use crate::dcps::*;
 pub use crate::qos::{
     DataReaderQos, DataReaderQosBuilder, DataRepresentation, DataWriterQos, DataWriterQosBuilder,
     Deadline, DestinationOrder, DomainParticipantFactoryQos, DomainParticipantQos, Durability,
-    DurabilityService, GroupData, History, LatencyBudget, Lifespan, Liveliness, LivelinessKind,
-    Ownership, OwnershipStrength, Partition, Presentation, PresentationAccessScope, PublisherQos,
-    PublisherQosBuilder, QosPolicyId, ReaderDataLifecycle, Reliability, ResourceLimits,
-    SubscriberQos, SubscriberQosBuilder, TimeBasedFilter, TopicData, TopicQos, TopicQosBuilder,
-    TransportPriority, TypeConsistencyEnforcement, TypeConsistencyKind, UserData,
+    DurabilityService, GroupData, History, IgnoreLocal, LatencyBudget, Lifespan, Liveliness,
+    LivelinessKind, Ownership, OwnershipStrength, Partition, Presentation, PresentationAccessScope,
+    PublisherQos, PublisherQosBuilder, QosPolicyId, ReaderDataLifecycle, Reliability,
+    ResourceLimits, SubscriberQos, SubscriberQosBuilder, TimeBasedFilter, TopicData, TopicQos,
+    TopicQosBuilder, TransportPriority, TypeConsistencyEnforcement, TypeConsistencyKind, UserData,
     WriterDataLifecycle, INFINITE, XCDR2_DATA_REPRESENTATION, XCDR_DATA_REPRESENTATION,
     XML_DATA_REPRESENTATION,
 };

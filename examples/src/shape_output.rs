@@ -30,6 +30,7 @@ pub fn policy_name(id: Option<QosPolicyId>) -> &'static str {
         Some(DurabilityService) => "DURABILITYSERVICE",
         Some(DataRepresentation) => "DATAREPRESENTATION",
         Some(TypeConsistencyEnforcement) => "TYPECONSISTENCYENFORCEMENT",
+        Some(IgnoreLocal) => "IGNORELOCAL",
         None => "Unknown",
     }
 }

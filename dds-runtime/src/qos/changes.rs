@@ -31,6 +31,7 @@ impl ChangeableQos for DataWriterQos {
             resource_limits => ResourceLimits,
             ownership => Ownership,
             data_representation => DataRepresentation,
+            ignore_local => IgnoreLocal,
         ])
     }
 }
@@ -47,6 +48,7 @@ impl ChangeableQos for DataReaderQos {
             ownership => Ownership,
             data_representation => DataRepresentation,
             type_consistency => TypeConsistencyEnforcement,
+            ignore_local => IgnoreLocal,
         ])
     }
 }

@@ -110,6 +110,7 @@ qos_set!(
     ownership_strength: OwnershipStrength = OwnershipStrength::default(),
     writer_data_lifecycle: WriterDataLifecycle = WriterDataLifecycle::default(),
     data_representation: DataRepresentation = DataRepresentation::default(),
+    ignore_local: IgnoreLocal = IgnoreLocal::None,
 });
 
 qos_set!(
@@ -129,6 +130,7 @@ qos_set!(
     reader_data_lifecycle: ReaderDataLifecycle = ReaderDataLifecycle::default(),
     data_representation: DataRepresentation = DataRepresentation::default(),
     type_consistency: TypeConsistencyEnforcement = TypeConsistencyEnforcement::default(),
+    ignore_local: IgnoreLocal = IgnoreLocal::None,
 });
 
 impl DataWriterQos {

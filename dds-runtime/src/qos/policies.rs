@@ -59,6 +59,8 @@ pub enum QosPolicyId {
     DataRepresentation = 23,
     /// TYPE_CONSISTENCY_ENFORCEMENT.
     TypeConsistencyEnforcement = 24,
+    /// IGNORE_LOCAL (a vendor extension, see [`IgnoreLocal`]; not a standard id, never on the wire).
+    IgnoreLocal = 0x8001,
 }
 
 /// RELIABILITY: whether lost samples are repaired.
@@ -413,4 +415,21 @@ impl Default for TypeConsistencyEnforcement {
             force_type_validation: false,
         }
     }
+}
+
+/// IGNORE_LOCAL, a vendor extension (Cyclone DDS's `ignorelocal`; ROS 2's `ignore_local_publications`):
+/// which writers and readers of this process an endpoint ignores. A reader and a writer do not match when
+/// either side's policy excludes the other. Local only: never announced (no PID), so remote peers see no
+/// difference; an endpoint of another participant in this process only knows its own policy (it sees a
+/// match the other side refuses, but no data flows). Fixed once the entity is enabled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+#[non_exhaustive]
+pub enum IgnoreLocal {
+    /// Match every endpoint (the DDS behaviour).
+    #[default]
+    None,
+    /// Do not match the endpoints of the same participant.
+    Participant,
+    /// Do not match the endpoints of any participant of the same process.
+    Process,
 }

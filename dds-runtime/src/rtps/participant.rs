@@ -298,6 +298,7 @@ impl Participant {
             config,
         };
         let prefix = p.config.guid_prefix;
+        p.local.join_process(prefix);
         for (w, _, _) in super::discovery::builtin::WRITER_PAIRS {
             let mut params = builtin_writer_params(&p.config);
             if type_lookup::is_service_endpoint(w) {

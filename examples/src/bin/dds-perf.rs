@@ -230,8 +230,21 @@ impl<T: PerfSample> Ctx<T> {
     }
 }
 
+/// Like ddsperf (which sets it on its participant): our endpoints ignore each other, so the ping end's own
+/// ping reader does not get every ping; `-L` matches them. `DDS_PERF_IGNORE_LOCAL=none` matches them too
+/// without `-L`'s switch of the ping/pong readers to a waitset (to measure the difference).
+fn ignore_local(o: &PerfOptions) -> IgnoreLocal {
+    let none = std::env::var("DDS_PERF_IGNORE_LOCAL").is_ok_and(|v| v == "none");
+    if o.match_local || none {
+        IgnoreLocal::None
+    } else {
+        IgnoreLocal::Participant
+    }
+}
+
 fn data_qos_reader(o: &PerfOptions) -> DataReaderQos {
     let mut q = DataReaderQos::builder()
+        .ignore_local(ignore_local(o))
         .reliability(reliability(o))
         .history(if o.history_depth == 0 {
             History::KeepAll
@@ -251,6 +264,7 @@ fn data_qos_reader(o: &PerfOptions) -> DataReaderQos {
 
 fn data_qos_writer(o: &PerfOptions) -> DataWriterQos {
     DataWriterQos::builder()
+        .ignore_local(ignore_local(o))
         .reliability(reliability(o))
         .history(if o.history_depth == 0 {
             History::KeepAll
@@ -301,10 +315,12 @@ fn run<T: PerfSample>(o: &PerfOptions) -> DdsResult<u8> {
     let publ = participant.create_publisher(&PublisherQos::default())?;
     let subs = participant.create_subscriber(&SubscriberQos::default())?;
     let pingpong_w = DataWriterQos::builder()
+        .ignore_local(ignore_local(o))
         .reliability(reliability(o))
         .history(History::KeepLast(1))
         .build();
     let pingpong_r = DataReaderQos::builder()
+        .ignore_local(ignore_local(o))
         .reliability(reliability(o))
         .history(History::KeepLast(1))
         .build();

@@ -404,7 +404,11 @@ impl Participant {
         // TypeLookup), then from the process's own types.
         let store = self.type_store();
         let types = |id: &TypeIdentifier| store.get(id).or_else(|| local_types().resolve(id));
-        let res = match_endpoints_with(wd, rd, &types);
+        let res = if super::local::ignores_local(wd, rd) {
+            MatchResult::Unrelated
+        } else {
+            match_endpoints_with(wd, rd, &types)
+        };
         let Some(has) = self.has_proxy(local, remote) else {
             return;
         };

@@ -7,14 +7,18 @@
 //! access (coherent sets are assembled by the RTPS reader: test
 //! `dcps_presentation::coherent_sets_are_all_or_nothing_within_one_participant`), or when the reader is
 //! reliable KEEP_ALL with `max_samples` (its back-pressure is the RTPS reader's delivery credit).
+//!
+//! The IGNORE_LOCAL policy ([`IgnoreLocal`]) keeps endpoints of this participant, or of this process, from
+//! matching at all: [`ignores_local`], with the process's participants in [`PROCESS_PARTICIPANTS`].
 
+use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
 use foldhash::{HashMap, HashSet};
 
 use super::discovery::Local;
 use super::Participant;
-use crate::qos::{Durability, History, Reliability};
+use crate::qos::{Durability, History, IgnoreLocal, Reliability};
 use crate::rtps::api::{Event, ReceivedSample, WriteChange};
 use crate::rtps::discovery::{ReaderData, WriterData};
 use crate::rtps::types::{EntityId, Guid, GuidPrefix, SequenceNumber};
@@ -26,9 +30,54 @@ use crate::rtps::types::{EntityId, Guid, GuidPrefix, SequenceNumber};
 pub(super) struct LocalMatches {
     readers: HashMap<EntityId, Vec<EntityId>>,
     reader_side: HashSet<(EntityId, EntityId)>,
+    /// This participant's prefix in [`PROCESS_PARTICIPANTS`], removed on drop.
+    member: Option<GuidPrefix>,
+}
+
+/// The prefixes of the participants alive in this process, for `IgnoreLocal::Process` (a prefix does not
+/// say which process made it reliably: the process id in ours may repeat on another host).
+static PROCESS_PARTICIPANTS: Mutex<Vec<GuidPrefix>> = Mutex::new(Vec::new());
+
+fn process_participants() -> std::sync::MutexGuard<'static, Vec<GuidPrefix>> {
+    PROCESS_PARTICIPANTS
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+}
+
+impl Drop for LocalMatches {
+    fn drop(&mut self) {
+        if let Some(me) = self.member {
+            process_participants().retain(|p| *p != me);
+        }
+    }
+}
+
+/// Whether IGNORE_LOCAL keeps `wd` and `rd` from matching: either side excludes the other's participant
+/// (`Participant` or `Process` on the same prefix) or process (`Process` on a participant of this process).
+/// A peer's policy is not announced: it counts as `None`.
+pub(super) fn ignores_local(wd: &WriterData, rd: &ReaderData) -> bool {
+    let (wp, rp) = (wd.qos.writer.ignore_local, rd.qos.reader.ignore_local);
+    if wp == IgnoreLocal::None && rp == IgnoreLocal::None {
+        return false;
+    }
+    let (a, b) = (wd.guid.prefix, rd.guid.prefix);
+    if a == b {
+        return true;
+    }
+    let process = wp == IgnoreLocal::Process || rp == IgnoreLocal::Process;
+    process && {
+        let members = process_participants();
+        members.contains(&a) && members.contains(&b)
+    }
 }
 
 impl LocalMatches {
+    /// Records this participant as one of the process's (see [`ignores_local`]).
+    pub(super) fn join_process(&mut self, prefix: GuidPrefix) {
+        process_participants().push(prefix);
+        self.member = Some(prefix);
+    }
+
     fn has(&self, side: Local, writer: EntityId, reader: EntityId) -> bool {
         match side {
             Local::Writer(_) => self

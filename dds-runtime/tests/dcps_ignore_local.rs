@@ -1,0 +1,133 @@
+//! IGNORE_LOCAL (Cyclone's `ignorelocal`) through the DCPS API (run inside `scripts/isolated`): with
+//! `Participant`, a writer and a reader of one participant do not match while readers of another
+//! participant of the process do; `Process` excludes both; `None` keeps intra-process delivery; the policy
+//! is fixed once the entity is enabled.
+mod dcps_util;
+
+use dcps_util::*;
+use dds_runtime::prelude::*;
+
+fn qos(ignore: IgnoreLocal) -> (DataWriterQos, DataReaderQos) {
+    let (mut wq, mut rq) = reliable_keep_all();
+    wq.ignore_local = ignore;
+    rq.ignore_local = ignore;
+    (wq, rq)
+}
+
+fn xs(r: &DataReader<ShapeType>) -> Vec<i32> {
+    r.take()
+        .unwrap()
+        .iter()
+        .filter_map(|s| s.data.as_ref().map(|d| d.x))
+        .collect()
+}
+
+/// A writer on `p`, a reader on `p` and a reader on another participant `q` of the process, all with
+/// `ignore`; the writer writes 0..10 once discovery settled; what each reader got, and the matches.
+fn exchange(domain: u32, ignore: IgnoreLocal) -> Outcome {
+    let (p, q) = (participant(domain), participant(domain));
+    let (wq, rq) = qos(ignore);
+    // One topic per test: the tests run in parallel, on two domains.
+    let topic = format!("IgnoreLocal{ignore:?}");
+    let w = writer::<ShapeType>(&p, &topic, &wq);
+    let own = reader::<ShapeType>(&p, &topic, &rq);
+    let other = reader::<ShapeType>(&q, &topic, &rq);
+    let e_own = u32::from(ignore == IgnoreLocal::None);
+    let e_other = u32::from(ignore != IgnoreLocal::Process);
+    assert!(
+        wait_until(MATCH_TIMEOUT, || {
+            w.publication_matched_status().current_count == e_own + e_other
+                && own.subscription_matched_status().current_count == e_own
+                && other.subscription_matched_status().current_count == e_other
+        }),
+        "{ignore:?}: writer {:?}, own reader {:?}, other reader {:?}",
+        w.publication_matched_status(),
+        own.subscription_matched_status(),
+        other.subscription_matched_status()
+    );
+    // Discovery has settled (SEDP of all three is long in): nothing more matches later.
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    for x in 0..10 {
+        w.write(&shape("RED", x)).unwrap();
+    }
+    if e_own + e_other > 0 {
+        w.wait_for_acknowledgments(MATCH_TIMEOUT).unwrap();
+    }
+    std::thread::sleep(std::time::Duration::from_millis(200));
+    Outcome {
+        writer_matches: w.matched_subscriptions().len(),
+        own_matches: own.matched_publications().len(),
+        other_matches: other.matched_publications().len(),
+        own: xs(&own),
+        other: xs(&other),
+    }
+}
+
+#[derive(Debug, PartialEq)]
+struct Outcome {
+    writer_matches: usize,
+    own_matches: usize,
+    other_matches: usize,
+    own: Vec<i32>,
+    other: Vec<i32>,
+}
+
+#[test]
+fn participant_ignores_its_own_endpoints_only() {
+    let all: Vec<i32> = (0..10).collect();
+    let o = exchange(61, IgnoreLocal::Participant);
+    assert_eq!(
+        o,
+        Outcome {
+            writer_matches: 1,
+            own_matches: 0,
+            other_matches: 1,
+            own: vec![],
+            other: all,
+        }
+    );
+}
+
+#[test]
+fn process_ignores_every_participant_of_the_process() {
+    let o = exchange(66, IgnoreLocal::Process);
+    assert_eq!(
+        o,
+        Outcome {
+            writer_matches: 0,
+            own_matches: 0,
+            other_matches: 0,
+            own: vec![],
+            other: vec![],
+        }
+    );
+}
+
+#[test]
+fn none_keeps_every_match_and_ignore_local_is_fixed_once_enabled() {
+    let all: Vec<i32> = (0..10).collect();
+    let o = exchange(61, IgnoreLocal::None);
+    assert_eq!(
+        o,
+        Outcome {
+            writer_matches: 2,
+            own_matches: 1,
+            other_matches: 1,
+            own: all.clone(),
+            other: all,
+        }
+    );
+    let p = participant(66);
+    let (wq, rq) = qos(IgnoreLocal::None);
+    let w = writer::<ShapeType>(&p, "IgnoreLocalFixed", &wq);
+    let r = reader::<ShapeType>(&p, "IgnoreLocalFixed", &rq);
+    let (wq2, rq2) = qos(IgnoreLocal::Participant);
+    assert!(matches!(
+        w.set_qos(&wq2),
+        Err(DdsError::ImmutablePolicy(QosPolicyId::IgnoreLocal))
+    ));
+    assert!(matches!(
+        r.set_qos(&rq2),
+        Err(DdsError::ImmutablePolicy(QosPolicyId::IgnoreLocal))
+    ));
+}
