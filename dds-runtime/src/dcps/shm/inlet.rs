@@ -24,6 +24,9 @@ pub(super) struct Inlet {
 /// keep samples in place must not take them all, or the channel would stall.
 const MAX_HELD: usize = 12;
 
+/// Frames at least this long are given to the core one at a time ([`ShmLink::drain`]).
+const ONE_BY_ONE: usize = 64 * 1024;
+
 /// A holder of one frame read from a channel: the owner of the [`Payload`]s the core and the readers
 /// share. Holders are pooled per channel ([`Inlet::payload`]): once no payload refers to a holder any more,
 /// [`Inlet::release`] gives its frame back to the writer and keeps the holder for the next frame, so that
@@ -88,9 +91,9 @@ impl Inlet {
 pub(super) struct Inlets {
     generation: u64,
     pub(super) channels: Vec<Inlet>,
-    /// A drain pass's frames, and the highest sequence number read per channel (kept from pass to pass:
-    /// a pass allocates nothing).
-    frames: Vec<(Guid, Payload)>,
+    /// A drain pass's frames (by channel), and the highest sequence number read per channel (kept from
+    /// pass to pass: a pass allocates nothing).
+    frames: Vec<(usize, Guid, Payload)>,
     highest: Vec<i64>,
 }
 
@@ -136,7 +139,7 @@ impl ShmLink {
                             highest[i] = highest[i].max(h.sequence.0);
                         }
                         let payload = inlet.payload(s);
-                        frames.push((inlet.writer, payload));
+                        frames.push((i, inlet.writer, payload));
                     }
                     Ok(None) => break,
                     Err(e) => {
@@ -152,11 +155,25 @@ impl ShmLink {
             tracing::trace!(frames = n, "shared-memory frames drained");
             // Still under the inlets lock: two threads draining keep the channels' order. Our own
             // changes are not sent from here (see `poll_loop`).
-            driver.with_core_from_shm(&mut |c, now| {
-                for (writer, frame) in frames.drain(..) {
-                    c.receive_shm(now, writer, frame);
+            if frames.iter().any(|(_, _, f)| f.len() >= ONE_BY_ONE) {
+                // Each large frame is decoded on its own and goes back to its writer at once: the
+                // writer's next loan reuses the buffer given back last, still warm in the caches.
+                for (i, writer, frame) in frames.drain(..) {
+                    let mut frame = Some(frame);
+                    driver.with_core_from_shm(&mut |c, now| {
+                        if let Some(f) = frame.take() {
+                            c.receive_shm(now, writer, f);
+                        }
+                    });
+                    channels[i].release();
                 }
-            });
+            } else {
+                driver.with_core_from_shm(&mut |c, now| {
+                    for (_, writer, frame) in frames.drain(..) {
+                        c.receive_shm(now, writer, frame);
+                    }
+                });
+            }
             frames.clear();
             // They are in the readers' caches now: the frames decoded go back to their writers.
             for (inlet, &sn) in channels.iter_mut().zip(highest.iter()) {
