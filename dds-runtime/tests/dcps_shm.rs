@@ -755,3 +755,31 @@ fn large_samples_serialized_into_shared_memory_reach_shared_memory_and_udp_reade
     );
     w.wait_for_acknowledgments(Duration::from_secs(10)).unwrap();
 }
+
+/// Large samples written as soon as the pair matched, before the reader's participant connected to the
+/// channel: the first goes the usual way (a copy into the channel when its turn comes), the next ones are
+/// serialized into buffers loaned from the channel and wait there, behind it, as loans. When every loan
+/// was taken by those, the first found none when its turn came (`ExceedsMaxLoans`) and was dropped: the
+/// reader got ids from 1 on (`dcps_alloc::fragmented_writes_allocate_nothing_per_sample` failed 10 of 10
+/// with `-F shm` that way). A writer now leaves a loan free for it.
+#[test]
+fn a_burst_of_large_samples_before_the_reader_connects_arrives_whole() {
+    for round in 0..3u32 {
+        let p = participant_with(109, with_shm());
+        let near = participant_with(109, with_shm());
+        let (wq, rq) = reliable_keep_all();
+        let n = 24u32;
+        // Made first: the writes must come faster than the reader's participant connects.
+        let blobs: Vec<Blob> = (0..n).map(|id| blob(id, 80 * KIB)).collect();
+        let topic = format!("ShmEarlyBurst{round}");
+        let (w, r) = matched::<Blob>(&p, &near, &topic, &wq, &rq);
+        for b in &blobs {
+            w.write(b).unwrap();
+        }
+        assert_eq!(
+            take_blobs(&r, n as usize, MATCH_TIMEOUT),
+            (0..n).collect::<Vec<_>>(),
+            "round {round}"
+        );
+    }
+}

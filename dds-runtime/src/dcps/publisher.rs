@@ -212,6 +212,8 @@ impl Publisher {
             bytes_needed: AtomicBool::new(true),
             #[cfg(feature = "shm")]
             direct_len: std::sync::atomic::AtomicUsize::new(0),
+            #[cfg(feature = "shm")]
+            direct_ok: AtomicBool::new(false),
         });
         let owner = WriterOwner {
             topic: topic.clone(),
@@ -347,6 +349,10 @@ struct WriterInner<T: DdsType> {
     /// a shared-memory buffer of that size (`loan.rs`, `write_direct`).
     #[cfg(feature = "shm")]
     direct_len: std::sync::atomic::AtomicUsize,
+    /// Whether the last loaned write found that the core needed no copy of the sample (`loan.rs`): the
+    /// next `write_direct` then does not ask before loaning.
+    #[cfg(feature = "shm")]
+    direct_ok: AtomicBool,
 }
 
 /// Writes samples of type `T`. Cheap to clone; the writer is deleted when the last clone is dropped (a

@@ -186,7 +186,9 @@ impl<T: DdsType> DataWriter<T> {
         let mut copy: Option<Payload> = None;
         let mut attempt = |c: &mut crate::rtps::Participant, now| {
             let rejected = self.rejected_by_filters(c, Some(sample));
-            let payload = if c.loan_needs_payload(id) {
+            let needed = c.loan_needs_payload(id);
+            self.inner.direct_ok.store(!needed, Ordering::Relaxed);
+            let payload = if needed {
                 copy.get_or_insert_with(|| self.pooled(serialized)).clone()
             } else {
                 Payload::default()
@@ -224,8 +226,9 @@ impl<T: DdsType> DataWriter<T> {
     /// [`write_w_timestamp`](DataWriter::write_w_timestamp) of a large sample (the last one was at least
     /// [`DIRECT_MIN`] long) when every reader of the writer is on shared memory and the history keeps no
     /// bytes (volatile: [`Participant::loan_needs_payload`](crate::rtps::Participant::loan_needs_payload)
-    /// is false): the sample is serialized straight into a buffer loaned from the writer's channel (its
-    /// long byte runs copied once, from the sample to shared memory), and written as a loaned sample.
+    /// is false; asked before loaning only when the last loaned write found otherwise): the sample is
+    /// serialized straight into a buffer loaned from the writer's channel (its long byte runs copied
+    /// once, from the sample to shared memory), and written as a loaned sample.
     /// `None` (nothing done): write as usual; so when the sample does not fit in a buffer of the last
     /// length, or no buffer is free.
     pub(super) fn write_direct(&self, sample: &T, timestamp: SystemTime) -> Option<DdsResult<()>> {
@@ -236,7 +239,13 @@ impl<T: DdsType> DataWriter<T> {
         let driver = &self.inner.state.driver;
         let link = driver.shm_link()?;
         let id = self.id();
-        if driver.query_core(|c| c.loan_needs_payload(id)) {
+        // The core is asked once per sample: when the last loaned write found that it needed no copy,
+        // the answer comes with this write's (`submit_loaned`, which copies should it have changed).
+        let asked = || driver.query_core(|c| c.loan_needs_payload(id));
+        if !self.inner.direct_ok.load(Ordering::Relaxed) && asked() {
+            return None;
+        }
+        if !link.may_park(id) {
             return None;
         }
         let reliable = read(&self.inner.current).reliability.is_reliable();

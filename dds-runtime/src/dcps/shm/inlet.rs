@@ -12,8 +12,11 @@ pub(super) struct Inlet {
     /// connected (an acknowledgement of 0) once it is. A writer sends nothing before that: iceoryx2
     /// skips a subscriber that is not connected yet once its queue is full, and the samples would be lost.
     greeting_since: Option<Instant>,
-    /// Frames of this channel still held (decoding, or kept in place by readers, `dcps::InPlace`).
-    held: Arc<AtomicUsize>,
+    /// Frames of this channel still held (decoding, or kept in place by readers, `dcps::InPlace`):
+    /// those in `holders`.
+    held: usize,
+    /// The holders of the frames given to the core, reused once released ([`Inlet::release`]).
+    holders: Vec<Arc<HeldFrame>>,
 }
 
 /// Most frames of one channel held at once; past it, frames are copied out of shared memory and given
@@ -21,33 +24,65 @@ pub(super) struct Inlet {
 /// keep samples in place must not take them all, or the channel would stall.
 const MAX_HELD: usize = 12;
 
-/// A frame read from a channel, counted while it is held.
+/// Frames at least this long are given to the core one at a time ([`ShmLink::drain`]).
+const ONE_BY_ONE: usize = 64 * 1024;
+
+/// A holder of one frame read from a channel: the owner of the [`Payload`]s the core and the readers
+/// share. Holders are pooled per channel ([`Inlet::payload`]): once no payload refers to a holder any more,
+/// [`Inlet::release`] gives its frame back to the writer and keeps the holder for the next frame, so that
+/// reading a frame allocates nothing.
 pub(super) struct HeldFrame {
-    frame: ShmSample,
-    held: Arc<AtomicUsize>,
+    frame: Option<ShmSample>,
 }
 
 impl AsRef<[u8]> for HeldFrame {
     fn as_ref(&self) -> &[u8] {
-        &self.frame
-    }
-}
-
-impl Drop for HeldFrame {
-    fn drop(&mut self) {
-        self.held.fetch_sub(1, Ordering::AcqRel);
+        self.frame.as_deref().unwrap_or_default()
     }
 }
 
 impl Inlet {
     /// The frame as a payload: shared in place, or copied when too many frames are held already.
-    fn payload(&self, frame: ShmSample) -> Payload {
-        if self.held.fetch_add(1, Ordering::AcqRel) >= MAX_HELD {
-            self.held.fetch_sub(1, Ordering::AcqRel);
-            return Payload::copy_from_slice(&frame);
+    fn payload(&mut self, frame: ShmSample) -> Payload {
+        if self.held >= MAX_HELD {
+            self.release();
+            if self.held >= MAX_HELD {
+                return Payload::copy_from_slice(&frame);
+            }
         }
-        let held = self.held.clone();
-        Payload::from_owner(Arc::new(HeldFrame { frame, held }))
+        self.held += 1;
+        // A free holder (its frame released), else a new one.
+        let free = self
+            .holders
+            .iter_mut()
+            .position(|h| Arc::get_mut(h).is_some_and(|h| h.frame.is_none()));
+        let slot = match free {
+            Some(i) => &mut self.holders[i],
+            None => {
+                self.holders.push(Arc::new(HeldFrame { frame: None }));
+                self.holders.last_mut().expect("just pushed")
+            }
+        };
+        if let Some(h) = Arc::get_mut(slot) {
+            h.frame = Some(frame);
+        }
+        let owner: Arc<dyn AsRef<[u8]> + Send + Sync> = slot.clone();
+        Payload::from_owner(owner)
+    }
+
+    /// Gives back to the writer the frames no payload refers to any more (their readers decoded them, or
+    /// dropped what they kept in place).
+    fn release(&mut self) {
+        if self.held == 0 {
+            return;
+        }
+        for h in &mut self.holders {
+            if let Some(h) = Arc::get_mut(h) {
+                if h.frame.take().is_some() {
+                    self.held -= 1;
+                }
+            }
+        }
     }
 }
 
@@ -56,6 +91,10 @@ impl Inlet {
 pub(super) struct Inlets {
     generation: u64,
     pub(super) channels: Vec<Inlet>,
+    /// A drain pass's frames (by channel), and the highest sequence number read per channel (kept from
+    /// pass to pass: a pass allocates nothing).
+    frames: Vec<(usize, Guid, Payload)>,
+    highest: Vec<i64>,
 }
 
 impl ShmLink {
@@ -73,10 +112,17 @@ impl ShmLink {
         if inlets.channels.is_empty() {
             return 0;
         }
-        let mut frames: Vec<(Guid, Payload)> = Vec::new();
-        let mut highest = vec![0i64; inlets.channels.len()];
+        let Inlets {
+            channels,
+            frames,
+            highest,
+            ..
+        } = &mut *inlets;
+        highest.clear();
+        highest.resize(channels.len(), 0);
         let mut greeting = false;
-        for (i, inlet) in inlets.channels.iter_mut().enumerate() {
+        for (i, inlet) in channels.iter_mut().enumerate() {
+            inlet.release();
             if let Some(since) = inlet.greeting_since {
                 if inlet.subscriber.has_samples() {
                     inlet.greeting_since = None;
@@ -92,7 +138,8 @@ impl ShmLink {
                         if let Ok(h) = decode_header(&s) {
                             highest[i] = highest[i].max(h.sequence.0);
                         }
-                        frames.push((inlet.writer, inlet.payload(s)));
+                        let payload = inlet.payload(s);
+                        frames.push((i, inlet.writer, payload));
                     }
                     Ok(None) => break,
                     Err(e) => {
@@ -108,14 +155,29 @@ impl ShmLink {
             tracing::trace!(frames = n, "shared-memory frames drained");
             // Still under the inlets lock: two threads draining keep the channels' order. Our own
             // changes are not sent from here (see `poll_loop`).
-            let mut frames = Some(frames);
-            driver.with_core_from_shm(&mut |c, now| {
-                for (writer, frame) in frames.take().into_iter().flatten() {
-                    c.receive_shm(now, writer, frame);
+            if frames.iter().any(|(_, _, f)| f.len() >= ONE_BY_ONE) {
+                // Each large frame is decoded on its own and goes back to its writer at once: the
+                // writer's next loan reuses the buffer given back last, still warm in the caches.
+                for (i, writer, frame) in frames.drain(..) {
+                    let mut frame = Some(frame);
+                    driver.with_core_from_shm(&mut |c, now| {
+                        if let Some(f) = frame.take() {
+                            c.receive_shm(now, writer, f);
+                        }
+                    });
+                    channels[i].release();
                 }
-            });
-            // They are in the readers' caches now.
-            for (inlet, sn) in inlets.channels.iter().zip(highest) {
+            } else {
+                driver.with_core_from_shm(&mut |c, now| {
+                    for (_, writer, frame) in frames.drain(..) {
+                        c.receive_shm(now, writer, frame);
+                    }
+                });
+            }
+            frames.clear();
+            // They are in the readers' caches now: the frames decoded go back to their writers.
+            for (inlet, &sn) in channels.iter_mut().zip(highest.iter()) {
+                inlet.release();
                 if sn > 0 {
                     self.acknowledge(inlet, sn);
                 }
@@ -166,9 +228,9 @@ impl ShmLink {
     }
 
     fn acknowledge(&self, inlet: &Inlet, sn: i64) {
-        let node = self.node.id();
+        let node = &self.node_id;
         let sent = inlet.acks.loan(8 + node.len()).and_then(|mut loan| {
-            encode_ack(sn, &node, &mut loan);
+            encode_ack(sn, node, &mut loan);
             loan.send()
         });
         if let Err(e) = sent {
@@ -192,7 +254,8 @@ impl ShmLink {
                         subscriber,
                         acks: self.node.publisher(&ack_channel(&name), &ack_config())?,
                         greeting_since: Some(Instant::now()),
-                        held: Arc::new(AtomicUsize::new(0)),
+                        held: 0,
+                        holders: Vec::new(),
                     })
                 });
             match opened {

@@ -14,7 +14,7 @@
 //! waits for like RTPS ACKNACKs.
 
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -25,7 +25,7 @@ mod inlet;
 mod outlet;
 
 use inlet::Inlets;
-use outlet::{Outlet, Parked};
+use outlet::{FlushScratch, Outlet, Parked};
 
 use super::sync::lock;
 use crate::rtps::shm::{
@@ -86,6 +86,8 @@ pub(crate) trait ShmHost: Send + Sync + 'static {
 /// A participant's presence in shared memory.
 pub(crate) struct ShmLink {
     node: ShmNode,
+    /// `node`'s identity ([`ShmNode::id`]), which acknowledgements carry.
+    node_id: String,
     prefix: GuidPrefix,
     /// Changes taken from the core (under its lock), in write order, to send.
     pending: Mutex<VecDeque<ShmChange>>,
@@ -102,6 +104,8 @@ pub(crate) struct ShmLink {
     wake_self: Option<ShmNotifier>,
     /// Wakes the reading threads of the participants we send to, by node.
     notifiers: Mutex<HashMap<String, ShmNotifier>>,
+    /// What a flush collects (kept between flushes for its capacity).
+    scratch: Mutex<FlushScratch>,
     /// Loaned changes the core queued, until their turn.
     parked: Mutex<Vec<Parked>>,
     /// Whether a channel we read waits for its first frame and greets its writer (the reading thread
@@ -180,6 +184,7 @@ impl ShmLink {
             .flatten();
         let wake_self = listener.as_ref().and_then(|_| node.notifier(&wake).ok());
         let link = ShmLink {
+            node_id: node.id(),
             node,
             prefix,
             pending: Mutex::new(VecDeque::new()),
@@ -191,6 +196,7 @@ impl ShmLink {
             listener: listener.map(Arc::new),
             wake_self,
             notifiers: Mutex::new(HashMap::new()),
+            scratch: Mutex::new(FlushScratch::default()),
             parked: Mutex::new(Vec::new()),
             greeting: AtomicBool::new(false),
             passes: Mutex::new(0),

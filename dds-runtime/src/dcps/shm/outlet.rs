@@ -12,6 +12,17 @@ pub(super) struct Parked {
     payload: std::ops::Range<usize>,
 }
 
+/// What a flush collects, kept between flushes (empty) for the capacity of its collections.
+#[derive(Default)]
+pub(super) struct FlushScratch {
+    /// Changes of a writer whose readers are not connected yet (or whose loaned buffer is not parked
+    /// yet) wait, with those that follow them.
+    held: VecDeque<ShmChange>,
+    held_writers: Vec<EntityId>,
+    /// The reader participants to wake.
+    woken: Vec<Arc<[String]>>,
+}
+
 /// One writer's channel, the set of nodes last seen connected to it, and its acknowledgements.
 pub(super) struct Outlet {
     publisher: ShmPublisher,
@@ -106,10 +117,13 @@ impl ShmLink {
     }
 
     fn flush_with(&self, outlets: &mut HashMap<EntityId, Outlet>) {
-        // Changes of a writer whose readers are not connected yet wait, with those that follow them.
-        let mut held = VecDeque::new();
-        let mut held_writers: Vec<EntityId> = Vec::new();
-        let mut woken: Vec<Arc<[String]>> = Vec::new();
+        // Kept from flush to flush, empty, for their capacity (the outlets' lock is held): a flush
+        // allocates nothing.
+        let FlushScratch {
+            mut held,
+            mut held_writers,
+            mut woken,
+        } = std::mem::take(&mut *lock(&self.scratch));
         let mut sent = 0usize;
         loop {
             let Some(c) = lock(&self.pending).pop_front() else {
@@ -141,12 +155,19 @@ impl ShmLink {
             }
         }
         self.wake_readers(&woken);
+        woken.clear();
         if !held.is_empty() {
             let mut pending = lock(&self.pending);
             while let Some(c) = held.pop_back() {
                 pending.push_front(c);
             }
         }
+        held_writers.clear();
+        *lock(&self.scratch) = FlushScratch {
+            held,
+            held_writers,
+            woken,
+        };
     }
 
     /// Signals the reading threads of the participants of `nodes` (each once).
@@ -155,12 +176,12 @@ impl ShmLink {
             return;
         }
         let mut notifiers = lock(&self.notifiers);
-        let mut done: Vec<&str> = Vec::new();
-        for n in nodes.iter().flat_map(|n| n.iter()) {
-            if done.contains(&n.as_str()) {
+        let all = || nodes.iter().flat_map(|n| n.iter());
+        for (i, n) in all().enumerate() {
+            // Each once (the lists are short: no set to allocate).
+            if all().take(i).any(|m| m == n) {
                 continue;
             }
-            done.push(n);
             if !notifiers.contains_key(n) {
                 match self.node.notifier(&wake_channel(n)) {
                     Ok(x) => {
@@ -236,6 +257,19 @@ impl ShmLink {
         });
     }
 
+    /// Whether a sample serialized into a buffer loaned from `writer`'s channel may wait there for its
+    /// turn ([`park`](Self::park)): parked buffers are loans, and one loan must stay free for a change
+    /// queued before them that is copied into the channel when its turn comes. When every loan was
+    /// parked, such a change found none (`ExceedsMaxLoans`) and was lost: the first sample of a burst
+    /// written before the reader connected, the others loaned behind it.
+    pub(crate) fn may_park(&self, writer: EntityId) -> bool {
+        let parked = lock(&self.parked)
+            .iter()
+            .filter(|p| p.writer == writer)
+            .count();
+        parked + 1 < channel_config(true).max_loans
+    }
+
     fn open_outlet(&self, writer: EntityId, reliable: bool) -> Result<Outlet, ShmError> {
         let name = shm_channel_name(&Guid::new(self.prefix, writer));
         Ok(Outlet {
@@ -300,8 +334,13 @@ impl ShmLink {
         }
         if !c.liveliness {
             for n in c.nodes.iter() {
-                let owed = out.owed.entry(n.clone()).or_insert((0, 0));
-                owed.0 = owed.0.max(c.sequence.0);
+                // A node's name is copied once, when it first gets a change.
+                match out.owed.get_mut(n) {
+                    Some(owed) => owed.0 = owed.0.max(c.sequence.0),
+                    None => {
+                        out.owed.insert(n.clone(), (c.sequence.0, 0));
+                    }
+                }
             }
         }
         Ok(true)

@@ -518,13 +518,53 @@ impl std::fmt::Debug for ShmListener {
 impl ShmListener {
     /// Waits until a notifier signals or `timeout` passes; whether it was signalled. Signals sent since
     /// the last wait are kept, so a signal sent before the wait starts is not missed.
+    ///
+    /// The listener is a socket: the wait is a `poll(2)` on it, then the signals are taken without
+    /// waiting (iceoryx2's own timed wait formats an error text, an allocation, on every call).
     pub fn wait(&self, timeout: Duration) -> Result<bool, ShmError> {
         let mut woken = false;
+        let take = |woken: &mut bool| {
+            self.listener
+                .try_wait_all(|_| *woken = true)
+                .map_err(|e| ShmError::Transfer(format!("{e:?}")))
+        };
+        take(&mut woken)?;
+        if woken {
+            return Ok(true);
+        }
+        #[cfg(unix)]
+        {
+            // SAFETY: the descriptor belongs to the listener, which outlives this call; it is only read.
+            let fd = unsafe { self.listener.file_descriptor().native_handle() };
+            poll_readable(fd, timeout)?;
+        }
+        #[cfg(not(unix))]
         self.listener
             .timed_wait_all(|_| woken = true, timeout)
             .map_err(|e| ShmError::Transfer(format!("{e:?}")))?;
+        take(&mut woken)?;
         Ok(woken)
     }
+}
+
+/// Waits until `fd` is readable or `timeout` passes (`poll(2)`; an interrupted wait counts as done).
+#[cfg(unix)]
+fn poll_readable(fd: i32, timeout: Duration) -> Result<(), ShmError> {
+    let mut p = libc::pollfd {
+        fd,
+        events: libc::POLLIN,
+        revents: 0,
+    };
+    // Rounded up: a wait shorter than a millisecond still waits.
+    let ms = timeout.as_micros().div_ceil(1000).min(i32::MAX as u128) as i32;
+    // SAFETY: `p` is one valid `pollfd`, as the count says.
+    if unsafe { libc::poll(&mut p, 1, ms) } < 0 {
+        let e = std::io::Error::last_os_error();
+        if e.kind() != std::io::ErrorKind::Interrupted {
+            return Err(ShmError::Transfer(format!("poll: {e}")));
+        }
+    }
+    Ok(())
 }
 
 /// Signals the listener of an event channel ([`ShmNode::notifier`]).
