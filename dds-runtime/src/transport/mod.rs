@@ -40,6 +40,7 @@ mod gso;
 pub mod iface;
 #[cfg(target_os = "linux")]
 mod mmsg;
+mod poll;
 mod recv;
 #[cfg(feature = "shm")]
 pub mod shm;
