@@ -8,8 +8,11 @@
 //! - after a batch that followed the one before within the window (dense traffic; discovery never polls);
 //! - while its polling episodes are not preempted: an involuntary context switch since the last episode
 //!   (the kernel ran something else in its place, or it yielded to a runnable thread) pauses polling,
-//!   for twice as long each time in a row, up to [`MAX_PAUSE`];
-//! - while the host's CPU pressure (Linux PSI, "some avg10") is below [`PRESSURE_LIMIT`];
+//!   for twice as long as the pause before, up to [`MAX_PAUSE`]; an episode without one halves the next
+//!   pause, so that a contended core stays paused most of the time;
+//! - while the host's CPU pressure (Linux PSI, "some avg10") is below [`PRESSURE_LIMIT`]; where it cannot
+//!   be read (not Linux, or a kernel without PSI), never: the thread switches alone were not enough to keep
+//!   a loaded host's 64 KiB round trips from 1 ms tails (`docs/performance.md`, session 25);
 //! - while fewer than all but one of the cores hold a polling thread of this process.
 //!
 //! An episode that ends with nothing arriving halves the next one (down to 1/64 of the window); one that
@@ -19,7 +22,7 @@ use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-/// The first pause after a contended episode; it doubles while the episodes stay contended.
+/// The shortest pause after a contended episode; it doubles per contended episode, halves per other one.
 const FIRST_PAUSE: Duration = Duration::from_millis(1);
 /// The longest pause: under sustained load a thread tries to poll a few times a second at most.
 pub(super) const MAX_PAUSE: Duration = Duration::from_millis(256);
@@ -101,7 +104,7 @@ impl PollPolicy {
             self.paused_until = Some(now + self.pause);
             self.pause = (self.pause * 2).min(MAX_PAUSE);
         } else {
-            self.pause = FIRST_PAUSE;
+            self.pause = (self.pause / 2).max(FIRST_PAUSE);
         }
     }
 }
@@ -123,13 +126,13 @@ pub(super) fn thread_switches() -> Option<u64> {
 
 /// Whether the host's CPU pressure is above [`PRESSURE_LIMIT`]: read from `/proc/pressure/cpu` by whichever
 /// thread finds the last reading older than [`PRESSURE_EVERY`], shared by all through atomics. Where the
-/// file cannot be read, never.
+/// file cannot be read, always.
 pub(super) fn pressured(now: Instant) -> bool {
     static EPOCH: OnceLock<Instant> = OnceLock::new();
     /// Milliseconds after `EPOCH` of the last reading, plus one (0: never read).
     static READ_AT: AtomicU64 = AtomicU64::new(0);
-    /// The last reading ("some avg10" in hundredths of a percent); 0 where there is none.
-    static SOME: AtomicU32 = AtomicU32::new(0);
+    /// The last reading ("some avg10" in hundredths of a percent); `u32::MAX` where there is none.
+    static SOME: AtomicU32 = AtomicU32::new(u32::MAX);
     let epoch = *EPOCH.get_or_init(|| now);
     let ms = now.saturating_duration_since(epoch).as_millis() as u64 + 1;
     let at = READ_AT.load(Ordering::Relaxed);
@@ -139,7 +142,7 @@ pub(super) fn pressured(now: Instant) -> bool {
             .compare_exchange(at, ms, Ordering::Relaxed, Ordering::Relaxed)
             .is_ok()
     {
-        let some = read_pressure().map_or(0, |p| (p * 100.0) as u32);
+        let some = read_pressure().map_or(u32::MAX, |p| (p * 100.0) as u32);
         SOME.store(some, Ordering::Relaxed);
     }
     SOME.load(Ordering::Relaxed) as f32 / 100.0 > PRESSURE_LIMIT
@@ -283,12 +286,13 @@ mod tests {
             pause = (pause * 2).min(MAX_PAUSE);
         }
         assert_eq!(p.pause, MAX_PAUSE);
-        // An uncontended episode: polling goes on, and the next pause is short again.
+        // Uncontended episodes: polling goes on, and the next pause halves per episode.
         assert!(p.after_batch(t, false).is_some());
         p.ended(t, Episode::Productive, Some(n));
-        assert_eq!(p.pause, FIRST_PAUSE);
+        assert_eq!(p.pause, MAX_PAUSE / 2);
         let (polled, _) = run(&mut p, t + GAP, 10, Episode::Productive, &mut || Some(n));
         assert_eq!(polled, 10);
+        assert_eq!(p.pause, FIRST_PAUSE);
     }
 
     #[test]
