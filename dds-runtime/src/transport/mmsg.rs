@@ -235,7 +235,11 @@ impl MmsgBatch {
     /// first datagram, `MSG_DONTWAIT` not to (a poll).
     fn read_as_mode(&mut self, sock: &UdpSocket, flags: libc::c_int) -> io::Result<usize> {
         if self.mode.single() {
-            let one = if flags == libc::MSG_DONTWAIT { flags } else { 0 };
+            let one = if flags == libc::MSG_DONTWAIT {
+                flags
+            } else {
+                0
+            };
             return self.read_one(sock, one);
         }
         let n = self.read(sock, flags)?;

@@ -253,7 +253,10 @@ mod tests {
         let mut p = PollPolicy::new(WINDOW);
         let t = Instant::now();
         let (_, t) = run(&mut p, t, 20, Episode::Empty, &mut || Some(0));
-        assert_eq!(p.after_batch(t, false), Some(t + WINDOW / (1 << MAX_HALVINGS)));
+        assert_eq!(
+            p.after_batch(t, false),
+            Some(t + WINDOW / (1 << MAX_HALVINGS))
+        );
         p.ended(t, Episode::Productive, Some(0));
         let t = t + GAP;
         assert_eq!(p.after_batch(t, false), Some(t + WINDOW));
@@ -315,9 +318,11 @@ mod tests {
 
     #[test]
     fn at_most_all_cores_but_one_poll() {
-        let most = std::thread::available_parallelism()
-            .map_or(1, |n| n.get().saturating_sub(1).max(1));
-        let slots: Vec<_> = std::iter::from_fn(PollerSlot::take).take(most + 5).collect();
+        let most =
+            std::thread::available_parallelism().map_or(1, |n| n.get().saturating_sub(1).max(1));
+        let slots: Vec<_> = std::iter::from_fn(PollerSlot::take)
+            .take(most + 5)
+            .collect();
         // Other tests of this process may hold slots too: never more than `most` in all.
         assert!(slots.len() <= most);
     }
