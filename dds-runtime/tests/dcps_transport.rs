@@ -172,3 +172,11 @@ fn polling_receive_paths_deliver_every_datagram() {
     receives_every_datagram(ReceivePath::Batched, 55, spin);
     receives_every_datagram(ReceivePath::OneByOne, 56, spin);
 }
+
+/// Polling with a window short enough (50 µs) that the receive thread often finds nothing, polls shorter
+/// (`transport/poll.rs`) and waits in the kernel again between bursts: every datagram still arrives once.
+#[test]
+fn short_polling_windows_deliver_every_datagram() {
+    require_netns();
+    receives_every_datagram(ReceivePath::Batched, 110, Duration::from_micros(50));
+}

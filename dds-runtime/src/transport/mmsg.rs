@@ -181,16 +181,11 @@ impl Drop for Slots {
 
 impl RecvBatch for MmsgBatch {
     fn recv(&mut self, sock: &UdpSocket) -> io::Result<usize> {
-        if self.mode.single() {
-            return self.read_one(sock);
-        }
-        let n = self.read(sock, libc::MSG_WAITFORONE)?;
-        self.mode.batched(n);
-        Ok(n)
+        self.read_as_mode(sock, libc::MSG_WAITFORONE)
     }
 
     fn try_recv(&mut self, sock: &UdpSocket) -> io::Result<usize> {
-        self.read(sock, libc::MSG_DONTWAIT)
+        self.read_as_mode(sock, libc::MSG_DONTWAIT)
     }
 
     fn datagram(&self, i: usize) -> Option<Datagram<'_>> {
@@ -236,16 +231,32 @@ impl MmsgBatch {
 }
 
 impl MmsgBatch {
-    /// One `recvmsg` into the first buffer.
-    fn read_one(&mut self, sock: &UdpSocket) -> io::Result<usize> {
+    /// A batch, or one datagram while [`ReadMode`] says so; `flags`: `MSG_WAITFORONE` to block for the
+    /// first datagram, `MSG_DONTWAIT` not to (a poll).
+    fn read_as_mode(&mut self, sock: &UdpSocket, flags: libc::c_int) -> io::Result<usize> {
+        if self.mode.single() {
+            let one = if flags == libc::MSG_DONTWAIT {
+                flags
+            } else {
+                0
+            };
+            return self.read_one(sock, one);
+        }
+        let n = self.read(sock, flags)?;
+        self.mode.batched(n);
+        Ok(n)
+    }
+
+    /// One `recvmsg` into the first buffer, with these flags (0: blocking).
+    fn read_one(&mut self, sock: &UdpSocket, flags: libc::c_int) -> io::Result<usize> {
         let h = &mut self.hdrs[0];
         h.msg_hdr.msg_namelen = std::mem::size_of::<libc::sockaddr_storage>() as libc::socklen_t;
         // SAFETY: the header points at a live buffer of the stated length and a sockaddr_storage.
-        let n = unsafe { libc::recvmsg(sock.as_raw_fd(), &mut h.msg_hdr, 0) };
+        let n = unsafe { libc::recvmsg(sock.as_raw_fd(), &mut h.msg_hdr, flags) };
         if n < 0 {
             let e = io::Error::last_os_error();
-            // As for a batch: a read that timed out means the socket was quiet.
-            if e.kind() == io::ErrorKind::WouldBlock {
+            // As for a batch: a blocking read that timed out means the socket was quiet.
+            if flags == 0 && e.kind() == io::ErrorKind::WouldBlock {
                 self.slots.release();
             }
             return Err(e);
@@ -261,7 +272,7 @@ impl MmsgBatch {
 /// (`scripts/bench-latency.sh`, stacks `floor` and `floorm`): a ping/pong, or a stream the thread keeps up
 /// with, reads one at a time after [`LONE_BATCHES`] such batches in a row. Every [`PROBE_EVERY`]th read is
 /// then a batch again, and one of more than one datagram (a burst, a fragmented sample) goes back to
-/// batches.
+/// batches. Blocking reads and polls (`MSG_DONTWAIT`) follow the same mode.
 #[derive(Debug, Default)]
 struct ReadMode {
     lone: u8,
@@ -345,7 +356,7 @@ mod tests {
         let dest = rx.local_addr().unwrap();
         let mut b = MmsgBatch::new();
         let mut next = 0u8;
-        // One at a time (the batches turn into single reads), then bursts of five.
+        // One at a time (the batches turn into single reads), then bursts of five; odd rounds poll.
         for round in 0..40u8 {
             let burst = if round < 20 { 1 } else { 5 };
             for k in 0..burst {
@@ -353,7 +364,14 @@ mod tests {
             }
             let mut got = 0;
             while got < burst {
-                let n = b.recv(&rx).unwrap();
+                let n = if round % 2 == 1 {
+                    match b.try_recv(&rx) {
+                        Err(e) if e.kind() == io::ErrorKind::WouldBlock => continue,
+                        r => r.unwrap(),
+                    }
+                } else {
+                    b.recv(&rx).unwrap()
+                };
                 for i in 0..n {
                     let d = b.datagram(i).unwrap();
                     assert_eq!(d.data, [round, got]);

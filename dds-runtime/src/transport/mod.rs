@@ -22,7 +22,10 @@
 //!
 //! On Linux, receive threads read with `recvmmsg` (up to 8 datagrams per call) and hand the whole batch to
 //! the receiver, so the core's lock is taken once per batch; while the batches hold one datagram each (a
-//! ping/pong), they read with `recvmsg`, which does not try for a second. Elsewhere, or with
+//! ping/pong), they read with `recvmsg`, which does not try for a second. With
+//! [`Config::receive_spin`](crate::config::Config::receive_spin) (off by default), a receive thread polls
+//! its socket for a while after a batch of dense traffic instead of sleeping, unless the cores are
+//! contended (`poll.rs` decides). Elsewhere, or with
 //! [`ReceivePath::OneByOne`], they read one datagram per `recv_from`. Sends are one `sendto` per datagram,
 //! except that a busy unicast destination gets a socket connected to it (`send`, no route lookup per
 //! datagram; at most 8 per participant), and on Linux a run of equal-sized datagrams to one destination (a
@@ -40,6 +43,7 @@ mod gso;
 pub mod iface;
 #[cfg(target_os = "linux")]
 mod mmsg;
+mod poll;
 mod recv;
 #[cfg(feature = "shm")]
 pub mod shm;

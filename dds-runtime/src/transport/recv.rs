@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 use super::datagram::{
     Channel, Datagram, Receiver, RecvBatch, TransportStats, MAX_BATCH, RECV_BUFFER,
 };
+use super::poll::{self, Episode, PollPolicy, PollerSlot};
 
 /// A placeholder for the unused entries of a batch.
 const NO_DATAGRAM: Datagram<'static> = Datagram {
@@ -76,8 +77,8 @@ impl RecvBatch for SingleRecv {
     }
 }
 
-/// Reads `sock` the chosen way until `stop` is set. The batched path polls for up to `spin` after a batch
-/// that followed the one before it within `spin` (see [`Spin`]).
+/// Reads `sock` the chosen way until `stop` is set. The batched path may poll for up to `spin` after a batch
+/// that followed the one before it within `spin` (see [`Spin`] and [`PollPolicy`]).
 pub(super) fn run(
     path: ReceivePath,
     spin: Duration,
@@ -111,51 +112,66 @@ struct Io<'a> {
     stats: &'a TransportStats,
 }
 
-/// Adaptive busy polling. While datagrams come closer together than `max` (a ping/pong, a fast stream),
-/// the thread polls the socket for up to `max` after each batch instead of sleeping in the kernel, so the
-/// next datagram is handled without a wake-up. Sparse traffic (discovery, a slow stream) never polls, and
-/// the thread yields between polls, so a busy core loses little to it.
+/// Adaptive busy polling. While datagrams come closer together than the window (a ping/pong, a fast
+/// stream), the thread polls the socket for up to the window after each batch instead of sleeping in the
+/// kernel, so the next datagram is handled without a wake-up; it yields between polls. When to poll is
+/// [`PollPolicy`]'s decision: never for sparse traffic, nor while the cores are contended.
 struct Spin {
-    max: Duration,
-    last: Option<Instant>,
+    policy: PollPolicy,
     until: Option<Instant>,
 }
 
 impl Spin {
     fn new(max: Duration) -> Self {
         Spin {
-            max,
-            last: None,
+            policy: PollPolicy::new(max),
             until: None,
         }
     }
 
     /// A batch was just handled.
     fn arrived(&mut self) {
-        if self.max.is_zero() {
-            return;
+        if self.policy.enabled() {
+            let now = Instant::now();
+            self.until = self.policy.after_batch(now, poll::pressured(now));
         }
-        let now = Instant::now();
-        let dense = self.last.is_some_and(|t| now - t <= self.max);
-        self.until = dense.then_some(now + self.max);
-        self.last = Some(now);
     }
 
     /// The next batch: polled for while the window is open, then waited for.
     fn next(&mut self, batch: &mut impl RecvBatch, io: &Io<'_>) -> io::Result<usize> {
         if let Some(until) = self.until.take() {
-            loop {
-                match batch.try_recv(io.sock) {
-                    Err(e) if e.kind() == io::ErrorKind::WouldBlock => {}
-                    r => return r,
+            if let Some(_slot) = PollerSlot::take() {
+                let got = poll_until(batch, io, until);
+                let how = match got {
+                    Some(_) => Episode::Productive,
+                    None => Episode::Empty,
+                };
+                self.policy
+                    .ended(Instant::now(), how, poll::thread_switches());
+                if let Some(r) = got {
+                    return r;
                 }
-                if io.stop.load(Ordering::Relaxed) || Instant::now() >= until {
-                    break;
-                }
-                std::thread::yield_now();
             }
         }
         batch.recv(io.sock)
+    }
+}
+
+/// Polls `batch` until something arrives (or fails), `until`, or `stop`; yields between polls.
+fn poll_until(
+    batch: &mut impl RecvBatch,
+    io: &Io<'_>,
+    until: Instant,
+) -> Option<io::Result<usize>> {
+    loop {
+        match batch.try_recv(io.sock) {
+            Err(e) if e.kind() == io::ErrorKind::WouldBlock => {}
+            r => return Some(r),
+        }
+        if io.stop.load(Ordering::Relaxed) || Instant::now() >= until {
+            return None;
+        }
+        std::thread::yield_now();
     }
 }
 
