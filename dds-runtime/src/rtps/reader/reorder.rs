@@ -55,7 +55,10 @@ pub(crate) struct PendingChange {
     pub group_seq: Option<SequenceNumber>,
 }
 
-/// Most copies of held payloads the pool keeps for reuse.
+/// Most copies of held payloads the pool keeps for reuse: as many as `reorder_max_samples` by default. A
+/// copy stays out of the pool while it is held and then while it is in the reader's cache, so a reader
+/// 10 000 deep that holds changes out of order has more than 10 000 out at once; with 1 024, each one
+/// beyond cost two allocations (session 25). The pool only grows to what was out at once.
 const POOL_BUFFERS: usize = 1 << 15;
 /// Most capacity, in bytes, those copies keep in all.
 const POOL_BYTES: usize = 1 << 20;
