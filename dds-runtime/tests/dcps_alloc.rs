@@ -285,17 +285,25 @@ fn intra_process_write_owned_allocations_per_sample() {
 /// writer's requested sequence numbers were a `BTreeSet` that grew with each request and was rebuilt
 /// (`split_off`) on every acknowledgement: 4.7 to 6.4 allocations per sample. They are a bitmap window
 /// now (`writer/bit_window.rs`), kept while the reader is behind: 0.14 to 0.29. Most of the rest was the
-/// reader's: each change it held out of order (the ones after the change its full cache refused) was
-/// copied out of its datagram into a new buffer. The copies now go into pooled buffers
-/// (`rtps/reader/reorder.rs`). What is left at depth: the reorder map's nodes, the writer's repair
-/// datagrams growing their buffers, a received SPDP announcement's decode, the timer thread's list of
-/// endpoints. The test takes the quietest of four windows of 8 000 at depth (measured 0.024 to 0.043).
+/// reader's: the changes it holds out of order (the ones after the change its full cache refused), copied
+/// out of their datagrams into pooled buffers (`rtps/reader/reorder.rs`). The pool kept 1024 buffers, fewer
+/// than the changes held and then cached at depth: beyond them, two allocations per change held (windows of
+/// 1 to 10 per sample under load, session 25); it keeps up to 32 768 now, and the changes are held in a ring
+/// by sequence number instead of a map that allocated a node every few. What is left at depth: the writer's
+/// repair datagrams beyond the buffers its outbox keeps (a round that resends thousands of samples at
+/// once, under load: windows of 5 to 15 per sample), a pool growing to a depth it never had, a received
+/// SPDP announcement's decode, the timer thread's list of endpoints.
+///
+/// The test takes the quietest of five windows of 6 000 at depth; on a loaded machine a repair round can
+/// land in all five, so a pass over the bounds is measured again, up to three passes. A per-sample
+/// allocation fails all three.
 #[test]
 fn steady_state_allocations_with_10000_samples_in_flight() {
     const DEPTH: u32 = 10_000;
     // The taker waits until the writer is this far ahead: the reader's cache is full (10 000) and the
     // writer holds at least 6 000 unacknowledged samples in its history, well past the pool's 4096.
     const LAG: u64 = 16_000;
+    const PASS: u64 = 48_000;
     let (_ps, w, r) = kept_full(
         (announcing_every_second(49), announcing_every_second(49)),
         "AllocDeep",
@@ -306,20 +314,29 @@ fn steady_state_allocations_with_10000_samples_in_flight() {
     let filled = 19_000;
     write_then_take(&w, &r, filled);
     run(&w, &r, filled, 20_000, false, LAG, 1);
-    let m = run(&w, &r, filled + 20_000, 48_000, false, LAG, 6);
-    m.report("10 000 in flight");
-    let (Window { write, total, .. }, take) = (m.least(), m.take);
-    // The writing thread's quietest window: 0.000 (a window in which the writer's pool grows to a depth
-    // it never had before takes three allocations per new buffer, up to 0.38).
-    assert!(
-        write < 0.02,
-        "write path: {write:.3} allocations per sample"
-    );
-    assert!(take < 0.001, "take: {take:.4} allocations per sample");
-    assert!(
-        total < 0.1,
-        "whole process: {total:.3} allocations per sample"
-    );
+    let mut failed = String::new();
+    for pass in 0..3 {
+        let m = run(&w, &r, filled + 20_000 + pass * PASS, PASS, false, LAG, 8);
+        m.report("10 000 in flight");
+        let (Window { write, total, .. }, take) = (m.least(), m.take);
+        // The writing thread's quietest window: 0.000 (a window in which the writer's pool grows to a
+        // depth it never had before takes three allocations per new buffer, up to 0.38). The whole
+        // process's: 0.000 to 0.012 (session 25, ten runs beside a release build).
+        failed.clear();
+        if write >= 0.02 {
+            failed += &format!("write path: {write:.3} allocations per sample; ");
+        }
+        if take >= 0.001 {
+            failed += &format!("take: {take:.4} allocations per sample; ");
+        }
+        if total >= 0.1 {
+            failed += &format!("whole process: {total:.3} allocations per sample; ");
+        }
+        if failed.is_empty() {
+            return;
+        }
+    }
+    panic!("three passes over the bounds, the last: {failed}");
 }
 
 #[derive(DdsType, Debug, Clone, PartialEq, Default)]

@@ -1,7 +1,8 @@
 //! IGNORE_LOCAL (Cyclone's `ignorelocal`) through the DCPS API (run inside `scripts/isolated`): with
 //! `Participant`, a writer and a reader of one participant do not match while readers of another
 //! participant of the process do; `Process` excludes both; `None` keeps intra-process delivery; the policy
-//! is fixed once the entity is enabled.
+//! is fixed once the entity is enabled; `Process` on either side of two participants of the process is
+//! enough in both.
 mod dcps_util;
 
 use dcps_util::*;
@@ -130,4 +131,34 @@ fn none_keeps_every_match_and_ignore_local_is_fixed_once_enabled() {
         r.set_qos(&rq2),
         Err(DdsError::ImmutablePolicy(QosPolicyId::IgnoreLocal))
     ));
+}
+
+/// Two participants of the process: one side's `Process` is enough, in both participants (as in Cyclone),
+/// although the policy is not announced. A `None` writer on `p` and a `Process` reader on `q`, then a
+/// `Process` writer on `p` and a `None` reader on `q`: neither pair matches on either side, while a `None`
+/// pair beside them does (discovery has run).
+#[test]
+fn process_on_either_side_is_enough_in_both_participants() {
+    let (p, q) = (participant(108), participant(108));
+    let (wq_none, rq_none) = qos(IgnoreLocal::None);
+    let (wq_process, rq_process) = qos(IgnoreLocal::Process);
+    let w_none = writer::<ShapeType>(&p, "IgnoreLocalEither", &wq_none);
+    let w_process = writer::<ShapeType>(&p, "IgnoreLocalEither", &wq_process);
+    let r_none = reader::<ShapeType>(&q, "IgnoreLocalEither", &rq_none);
+    let r_process = reader::<ShapeType>(&q, "IgnoreLocalEither", &rq_process);
+    assert!(
+        wait_until(MATCH_TIMEOUT, || {
+            w_none.publication_matched_status().current_count == 1
+                && r_none.subscription_matched_status().current_count == 1
+        }),
+        "the None pair: writer {:?}, reader {:?}",
+        w_none.publication_matched_status(),
+        r_none.subscription_matched_status()
+    );
+    // Discovery has settled (SEDP of all four is long in): nothing more matches later.
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    assert_eq!(w_none.matched_subscriptions().len(), 1, "None writer");
+    assert_eq!(w_process.matched_subscriptions().len(), 0, "Process writer");
+    assert_eq!(r_none.matched_publications().len(), 1, "None reader");
+    assert_eq!(r_process.matched_publications().len(), 0, "Process reader");
 }

@@ -114,6 +114,10 @@ pub(crate) struct Driver {
     spare_buffers: Mutex<Vec<Transmit>>,
     /// Length of `spare_buffers` (a core call locks it only when it holds some).
     spare_count: AtomicUsize,
+    /// Held from before the core lock is released until a batch is sent: batches leave in the order the
+    /// core made them, so that a writer's datagrams sent from two threads (a write, and the receive
+    /// thread releasing what flow control held) do not overtake each other and arrive out of order.
+    send_order: Mutex<()>,
     /// Services watching the core (see [`CoreObserver`]); `has_observers` keeps the sample path free of
     /// the lock while there are none.
     observers: RwLock<Vec<Arc<dyn CoreObserver>>>,
@@ -295,6 +299,7 @@ impl Driver {
             status: Arc::new(StatusCore::default()),
             spare_buffers: Mutex::new(Vec::new()),
             spare_count: AtomicUsize::new(0),
+            send_order: Mutex::new(()),
             observers: RwLock::new(Vec::new()),
             has_observers: AtomicBool::new(false),
             discovery_hook: OnceLock::new(),
@@ -375,7 +380,7 @@ impl Driver {
         // datagrams this thread sent last time still in it, for reuse.
         let mut batch: Vec<Transmit> = BATCH.with(|b| std::mem::take(&mut *b.borrow_mut()));
         let (mut deferred, mut touched) = ROUTED.with(|b| std::mem::take(&mut *b.borrow_mut()));
-        let (r, next_timeout) = {
+        let (r, next_timeout, order) = {
             let mut core = lock(&self.core);
             // Sent datagrams go back to the core for reuse (saves allocations per datagram): this thread's
             // own without a lock, the shared list's when other threads left some there.
@@ -401,7 +406,9 @@ impl Driver {
             if let Some(link) = &self.shm {
                 link.take_from(&mut core);
             }
-            (r, core.poll_timeout())
+            // Taken before the core lock is released: the next batch the core makes waits for this one.
+            let order = (!batch.is_empty()).then(|| lock(&self.send_order));
+            (r, core.poll_timeout(), order)
         };
         // Shared memory first: what a writer sent there precedes what follows it on the wire (the
         // announcement of its deletion after its last changes, typically).
@@ -412,6 +419,7 @@ impl Driver {
         #[cfg(not(feature = "shm"))]
         let _ = send_shm;
         self.send_batch(&batch);
+        drop(order);
         // The shares of samples go now: a pooled sample buffer returns to its pool at once.
         for t in &mut batch {
             t.shared.clear();

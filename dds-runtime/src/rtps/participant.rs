@@ -475,6 +475,7 @@ impl Participant {
         ];
         let data = self.new_endpoint(spec, kinds)?;
         let id = data.guid.entity_id;
+        local::note_ignore_local(data.guid, data.qos.writer.ignore_local);
         let params = user_writer_params(&self.config, &data.qos.writer, keyed);
         let mut writer = Writer::new(data.guid, params);
         if let Some(original) = internal
@@ -509,6 +510,7 @@ impl Participant {
         let internal = spec.internal;
         let data = self.new_endpoint(spec, kinds)?;
         let id = data.guid.entity_id;
+        local::note_ignore_local(data.guid, data.qos.reader.ignore_local);
         let reliable = data.qos.reader.reliability.is_reliable();
         let params = reader_params(&self.config, reliable);
         self.readers.insert(id, Reader::new(data.guid, params));

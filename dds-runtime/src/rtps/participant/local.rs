@@ -11,6 +11,7 @@
 //! The IGNORE_LOCAL policy ([`IgnoreLocal`]) keeps endpoints of this participant, or of this process, from
 //! matching at all: [`ignores_local`], with the process's participants in [`PROCESS_PARTICIPANTS`].
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
@@ -44,19 +45,59 @@ fn process_participants() -> std::sync::MutexGuard<'static, Vec<GuidPrefix>> {
         .unwrap_or_else(PoisonError::into_inner)
 }
 
+/// The IGNORE_LOCAL policies other than `None` of the user endpoints of this process's participants. The
+/// policy is not announced, so a participant learns another's endpoints' here: either side asking to be
+/// ignored is enough, in both participants (as in Cyclone). An entry goes with its participant (entity
+/// ids are not reused).
+static PROCESS_POLICIES: Mutex<Vec<(Guid, IgnoreLocal)>> = Mutex::new(Vec::new());
+/// Whether `PROCESS_POLICIES` ever held an entry (matching skips its lock until then).
+static ANY_POLICY: AtomicBool = AtomicBool::new(false);
+
+fn process_policies() -> std::sync::MutexGuard<'static, Vec<(Guid, IgnoreLocal)>> {
+    PROCESS_POLICIES
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Records the IGNORE_LOCAL policy of this process's endpoint `guid` for the process's other participants.
+pub(super) fn note_ignore_local(guid: Guid, policy: IgnoreLocal) {
+    if policy != IgnoreLocal::None {
+        process_policies().push((guid, policy));
+        ANY_POLICY.store(true, Ordering::Release);
+    }
+}
+
+/// The policy of endpoint `guid`: `announced` (its own, for this participant's), else what its participant
+/// in this process recorded.
+fn policy_of(guid: Guid, announced: IgnoreLocal) -> IgnoreLocal {
+    if announced != IgnoreLocal::None || !ANY_POLICY.load(Ordering::Acquire) {
+        return announced;
+    }
+    let policies = process_policies();
+    policies
+        .iter()
+        .find(|(g, _)| *g == guid)
+        .map_or(IgnoreLocal::None, |(_, p)| *p)
+}
+
 impl Drop for LocalMatches {
     fn drop(&mut self) {
         if let Some(me) = self.member {
             process_participants().retain(|p| *p != me);
+            if ANY_POLICY.load(Ordering::Acquire) {
+                process_policies().retain(|(g, _)| g.prefix != me);
+            }
         }
     }
 }
 
 /// Whether IGNORE_LOCAL keeps `wd` and `rd` from matching: either side excludes the other's participant
 /// (`Participant` or `Process` on the same prefix) or process (`Process` on a participant of this process).
-/// A peer's policy is not announced: it counts as `None`.
+/// The policy of an endpoint of another participant of this process is the one it recorded
+/// ([`note_ignore_local`]); a peer's in another process is not announced: it counts as `None`.
 pub(super) fn ignores_local(wd: &WriterData, rd: &ReaderData) -> bool {
-    let (wp, rp) = (wd.qos.writer.ignore_local, rd.qos.reader.ignore_local);
+    let wp = policy_of(wd.guid, wd.qos.writer.ignore_local);
+    let rp = policy_of(rd.guid, rd.qos.reader.ignore_local);
     if wp == IgnoreLocal::None && rp == IgnoreLocal::None {
         return false;
     }
