@@ -21,7 +21,7 @@
 //! | `DDS_INTRA_PROCESS` | deliver to readers of the same participant directly (no serialization for them, no socket) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_GSO` | on Linux, a fragmented sample's datagrams to one destination leave in one `UDP_SEGMENT` send | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_GATHER_MIN` | fragments of large samples of at least this many bytes per DATA_FRAG leave without a copy (scatter-gather sends of the sample's own buffer) | bytes, or `off` | `2048` |
-//! | `DDS_RECEIVE_SPIN_US` | adaptive busy polling: while datagrams arrive less than this apart, a receive thread polls its socket up to this long after each batch instead of sleeping (saves a wake-up per datagram); it stops while the cores are contended (Linux CPU pressure, preempted polls) | microseconds, `0` = off | `0` |
+//! | `DDS_RECEIVE_SPIN_US` | adaptive busy polling: while datagrams arrive less than 8 times this apart, a receive thread polls its socket up to this long after each batch instead of sleeping (saves a wake-up per datagram); it stops while the cores are contended (Linux CPU pressure, preempted polls) | microseconds, `0` = off | `50` |
 //! | `DDS_SHM` | with the `shm` feature: shared memory with peers on this host (their readers get our writers' samples through it, not UDP) | `on`/`off`, `true`/`false`, `1`/`0` | `on` |
 //! | `DDS_WRITE_BATCH` | write batching: samples share datagrams until full, flushed, or this delay has passed | `off`, `on` (1 ms), or a delay in microseconds | `off` |
 //!
@@ -345,15 +345,14 @@ pub struct Config {
     /// least this many bytes goes to the socket from the sample's own buffer, not copied into the
     /// datagram. `None`: every datagram is copied together.
     pub gather_min: Option<usize>,
-    /// Adaptive busy polling of the receive sockets (`DDS_RECEIVE_SPIN_US`, default 0: off). While datagrams
-    /// arrive less than this apart, a receive thread polls its socket for up to this long after each batch
+    /// Adaptive busy polling of the receive sockets (`DDS_RECEIVE_SPIN_US`, default 50 µs; 0: off). While datagrams
+    /// arrive less than 8 times this apart, a receive thread polls its socket for up to this long after each batch
     /// instead of sleeping, which saves a thread wake-up per datagram on a request/reply or a fast stream
     /// (50 µs took an idle host's ping/pong hop from about 34 to 4 µs). Sparse traffic never polls, and the
     /// polling thread yields between polls. It pays only with a core to spare, so a thread stops polling
     /// while the cores are contended (the host's CPU pressure is high, or its polls were preempted; where
     /// Linux's CPU pressure cannot be read, it never polls), after polls that found nothing it polls
-    /// shorter, and at most all cores but one of a process poll at once. Off by default: see
-    /// `docs/performance.md`, session 25, for what still goes wrong with it on.
+    /// shorter, and at most all cores but one of a process poll at once (`docs/performance.md`, session 25).
     pub receive_spin: Duration,
     /// Shared memory with peers on this host that can use it (`DDS_SHM`, default on; only with the `shm`
     /// feature, ignored without it): their readers get our writers' samples through shared memory, not
@@ -381,7 +380,7 @@ impl Default for Config {
             intra_process: true,
             gso: true,
             gather_min: Some(2048),
-            receive_spin: Duration::ZERO,
+            receive_spin: Duration::from_micros(50),
             shm: true,
         }
     }

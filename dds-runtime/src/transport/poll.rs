@@ -5,8 +5,10 @@
 //! Polling saves a thread wake-up per datagram (tens of microseconds on an idle host whose cores sleep), but
 //! only while a core is free: on a contended host a polling thread takes the core from the very thread it
 //! waits for (session 18 in `docs/performance.md`). So a thread polls only
-//! - after a batch that followed the one before within the window (dense traffic; discovery never polls);
-//! - while its polling episodes are not preempted: an involuntary context switch since the last episode
+//! - after a batch that followed the one before within [`DENSE`] windows (dense traffic; discovery never
+//!   polls). Wider than the window itself: on an idle host a round trip whose ends sleep takes longer than
+//!   the window (about 65 µs here), and would never start polling, which is what makes it short;
+//! - while its polling episodes are not preempted: an involuntary context switch during an episode
 //!   (the kernel ran something else in its place, or it yielded to a runnable thread) pauses polling,
 //!   for twice as long as the pause before, up to [`MAX_PAUSE`]; an episode without one halves the next
 //!   pause, so that a contended core stays paused most of the time;
@@ -26,6 +28,9 @@ use std::time::{Duration, Instant};
 const FIRST_PAUSE: Duration = Duration::from_millis(1);
 /// The longest pause: under sustained load a thread tries to poll a few times a second at most.
 pub(super) const MAX_PAUSE: Duration = Duration::from_millis(256);
+/// Batches at most this many windows apart are dense traffic, after which a thread may poll. Polling that
+/// finds nothing shrinks fast ([`MAX_HALVINGS`]), so a stream this sparse costs little.
+pub(super) const DENSE: u32 = 8;
 /// An episode is at least the window divided by this (halved per unproductive episode in a row).
 const MAX_HALVINGS: u32 = 6;
 /// CPU pressure (percent of the last 10 s in which some runnable task waited for a core) above which
@@ -53,7 +58,7 @@ pub(super) struct PollPolicy {
     empties: u32,
     /// When the last batch was handled.
     last: Option<Instant>,
-    /// The thread's involuntary context switches at the end of the last episode.
+    /// The thread's involuntary context switches when the current episode began.
     switches: Option<u64>,
     /// No polling before this (after a contended episode).
     paused_until: Option<Instant>,
@@ -85,20 +90,27 @@ impl PollPolicy {
         if !self.enabled() {
             return None;
         }
-        let dense = self.last.is_some_and(|t| now - t <= self.max);
+        let dense = self.last.is_some_and(|t| now - t <= self.max * DENSE);
         self.last = Some(now);
         let paused = self.paused_until.is_some_and(|t| now < t);
         (dense && !paused && !pressured).then(|| now + self.max / (1 << self.empties))
     }
 
+    /// A polling episode begins; `switches`: the thread's involuntary context switches so far (`None` where
+    /// they cannot be read). Only switches during the episode count: between episodes a thread that sends
+    /// is preempted by the very thread it wakes, which says nothing about polling.
+    pub(super) fn began(&mut self, switches: Option<u64>) {
+        self.switches = switches;
+    }
+
     /// A polling episode ended at `now` as `how`; `switches`: the thread's involuntary context switches so
-    /// far (`None` where they cannot be read).
+    /// far.
     pub(super) fn ended(&mut self, now: Instant, how: Episode, switches: Option<u64>) {
         self.empties = match how {
             Episode::Productive => 0,
             Episode::Empty => (self.empties + 1).min(MAX_HALVINGS),
         };
-        let before = std::mem::replace(&mut self.switches, switches);
+        let before = self.switches.take();
         let contended = matches!((before, switches), (Some(b), Some(s)) if s > b);
         if contended {
             self.paused_until = Some(now + self.pause);
@@ -214,6 +226,7 @@ mod tests {
             if let Some(until) = p.after_batch(t, false) {
                 polled += 1;
                 assert!(until > t && until <= t + WINDOW);
+                p.began(switches());
                 p.ended(t + GAP / 2, how, switches());
             }
             t += GAP;
@@ -227,7 +240,7 @@ mod tests {
         let mut t = Instant::now();
         for _ in 0..100 {
             assert_eq!(p.after_batch(t, false), None);
-            t += WINDOW + Duration::from_micros(1);
+            t += WINDOW * DENSE + Duration::from_micros(1);
         }
     }
 
@@ -271,9 +284,9 @@ mod tests {
             Some(n)
         };
         let t = Instant::now();
-        // The first episode has nothing to compare with; the second sees a switch and pauses.
+        // The first episode sees a switch while it polls, and pauses.
         let (polled, t) = run(&mut p, t, 3, Episode::Productive, &mut rising);
-        assert_eq!(polled, 2);
+        assert_eq!(polled, 1);
         let (polled, t) = run(&mut p, t, 50, Episode::Productive, &mut rising);
         assert_eq!(polled, 0, "paused for {FIRST_PAUSE:?}");
         // Contended again after the pause: twice as long, and so on up to the cap.
@@ -282,6 +295,7 @@ mod tests {
         let mut pause = FIRST_PAUSE * 2;
         for _ in 0..12 {
             assert!(p.after_batch(t, false).is_some());
+            p.began(rising());
             p.ended(t, Episode::Productive, rising());
             assert!(p.after_batch(t + GAP, false).is_none());
             assert!(p.after_batch(t + pause - GAP, false).is_none());
@@ -291,6 +305,7 @@ mod tests {
         assert_eq!(p.pause, MAX_PAUSE);
         // Uncontended episodes: polling goes on, and the next pause halves per episode.
         assert!(p.after_batch(t, false).is_some());
+        p.began(Some(n));
         p.ended(t, Episode::Productive, Some(n));
         assert_eq!(p.pause, MAX_PAUSE / 2);
         let (polled, _) = run(&mut p, t + GAP, 10, Episode::Productive, &mut || Some(n));

@@ -78,7 +78,7 @@ impl RecvBatch for SingleRecv {
 }
 
 /// Reads `sock` the chosen way until `stop` is set. The batched path may poll for up to `spin` after a batch
-/// that followed the one before it within `spin` (see [`Spin`] and [`PollPolicy`]).
+/// that followed the one before it within a few `spin` windows (see [`Spin`] and [`PollPolicy`]).
 pub(super) fn run(
     path: ReceivePath,
     spin: Duration,
@@ -112,7 +112,7 @@ struct Io<'a> {
     stats: &'a TransportStats,
 }
 
-/// Adaptive busy polling. While datagrams come closer together than the window (a ping/pong, a fast
+/// Adaptive busy polling. While datagrams come close together (a ping/pong, a fast
 /// stream), the thread polls the socket for up to the window after each batch instead of sleeping in the
 /// kernel, so the next datagram is handled without a wake-up; it yields between polls. When to poll is
 /// [`PollPolicy`]'s decision: never for sparse traffic, nor while the cores are contended.
@@ -141,6 +141,7 @@ impl Spin {
     fn next(&mut self, batch: &mut impl RecvBatch, io: &Io<'_>) -> io::Result<usize> {
         if let Some(until) = self.until.take() {
             if let Some(_slot) = PollerSlot::take() {
+                self.policy.began(poll::thread_switches());
                 let got = poll_until(batch, io, until);
                 let how = match got {
                     Some(_) => Episode::Productive,
