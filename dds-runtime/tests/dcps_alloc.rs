@@ -183,10 +183,7 @@ fn kept_full(
     DataWriter<Fixed>,
     DataReader<Fixed>,
 ) {
-    let (mut wq, mut rq) = reliable_keep_all();
-    wq.reliability = Reliability::Reliable {
-        max_blocking_time: Duration::from_secs(10),
-    };
+    let (mut wq, mut rq) = reliable_keep_all_blocking(Duration::from_secs(10));
     wq.resource_limits.max_samples = Some(depth);
     rq.resource_limits.max_samples = Some(depth);
     let (w, r) = matched::<Fixed>(&p1, &p2, topic, &wq, &rq);
@@ -254,10 +251,7 @@ fn steady_state_allocations_per_sample() {
 #[test]
 fn intra_process_write_owned_allocations_per_sample() {
     let p = participant(84);
-    let (mut wq, rq) = reliable_keep_all();
-    wq.reliability = Reliability::Reliable {
-        max_blocking_time: Duration::from_secs(10),
-    };
+    let (wq, rq) = reliable_keep_all_blocking(Duration::from_secs(10));
     let (w, r) = matched::<Fixed>(&p, &p, "AllocLocal", &wq, &rq);
     run(&w, &r, 0, 10_000, true, 0, 1);
     let m = run(&w, &r, 10_000, 20_000, true, 0, 4);
@@ -413,10 +407,7 @@ fn named_run(
 #[test]
 fn recycled_samples_are_decoded_into_without_allocating() {
     let (p1, p2) = (announcing_every_second(126), announcing_every_second(126));
-    let (mut wq, rq) = reliable_keep_all();
-    wq.reliability = Reliability::Reliable {
-        max_blocking_time: Duration::from_secs(10),
-    };
+    let (wq, rq) = reliable_keep_all_blocking(Duration::from_secs(10));
     let (w, r) = matched::<Named>(&p1, &p2, "AllocNamed", &wq, &rq);
     named_run(&w, &r, 0, 5_000, true);
     let recycled = named_run(&w, &r, 5_000, 10_000, true);
@@ -448,10 +439,7 @@ struct Big {
 #[test]
 fn fragmented_writes_allocate_nothing_per_sample() {
     let (p1, p2) = (participant(63), participant(63));
-    let (mut wq, rq) = reliable_keep_all();
-    wq.reliability = Reliability::Reliable {
-        max_blocking_time: Duration::from_secs(10),
-    };
+    let (wq, rq) = reliable_keep_all_blocking(Duration::from_secs(10));
     let (w, r) = matched::<Big>(&p1, &p2, "AllocBig", &wq, &rq);
     let mut sample = Big {
         seq: 0,
@@ -510,10 +498,7 @@ fn a_shared_memory_pair_writes_and_takes_without_allocating() {
             .expect("participant")
     };
     let (p1, p2) = (shm(), shm());
-    let (mut wq, rq) = reliable_keep_all();
-    wq.reliability = Reliability::Reliable {
-        max_blocking_time: Duration::from_secs(10),
-    };
+    let (wq, rq) = reliable_keep_all_blocking(Duration::from_secs(10));
     let (w, r) = matched::<Named>(&p1, &p2, "AllocShm", &wq, &rq);
     named_run(&w, &r, 0, 5_000, true);
     let sent = || p1.transport_stats().sent.load(Ordering::Relaxed);

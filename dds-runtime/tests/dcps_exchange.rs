@@ -364,10 +364,7 @@ fn data_representation_xcdr1_and_xcdr2_both_reach_a_default_reader() {
 #[test]
 fn flow_control_blocks_and_resumes_without_loss() {
     let (p1, p2) = (participant(29), participant(29));
-    let (mut wq, rq) = reliable_keep_all();
-    wq.reliability = Reliability::Reliable {
-        max_blocking_time: Duration::from_secs(5),
-    };
+    let (wq, rq) = reliable_keep_all_blocking(Duration::from_secs(5));
     let (w, r) = matched::<Blob>(&p1, &p2, "Flow", &wq, &rq);
     // 4 MB in 1 KiB samples: well above the writer's unacknowledged-bytes high watermark.
     const N: u32 = 4000;

@@ -19,10 +19,7 @@ struct Payload {
 #[ignore = "measurement; run in release"]
 fn reliable_keep_all_1k_throughput() {
     let (p1, p2) = (participant(81), participant(81));
-    let (mut wq, rq) = reliable_keep_all();
-    wq.reliability = Reliability::Reliable {
-        max_blocking_time: Duration::from_secs(10),
-    };
+    let (wq, rq) = reliable_keep_all_blocking(Duration::from_secs(10));
     let (w, r) = matched::<Payload>(&p1, &p2, "Throughput", &wq, &rq);
     let run = Duration::from_secs(3);
     let reader = std::thread::spawn(move || {

@@ -127,6 +127,16 @@ pub(crate) fn reliable_keep_all() -> (DataWriterQos, DataReaderQos) {
     (wq, rq)
 }
 
+/// [`reliable_keep_all`], with a writer that blocks up to `max_blocking_time` when flow control or the
+/// reader's resource limits hold it back (a test that writes far ahead of its reader).
+pub(crate) fn reliable_keep_all_blocking(
+    max_blocking_time: Duration,
+) -> (DataWriterQos, DataReaderQos) {
+    let (mut wq, rq) = reliable_keep_all();
+    wq.reliability = Reliability::Reliable { max_blocking_time };
+    (wq, rq)
+}
+
 /// A writer of `topic` on `p`, with default topic and publisher QoS.
 pub(crate) fn writer<T: DdsType>(
     p: &DomainParticipant,
