@@ -858,6 +858,7 @@ impl Driver {
 
     fn timer_loop(self: Arc<Self>) {
         let mut next_tick = Instant::now() + ENDPOINT_TICK;
+        let mut ticked: Vec<Arc<dyn Endpoint>> = Vec::new();
         while !self.stopped.load(Ordering::Acquire) {
             let seen = lock(&self.timer_gen).generation;
             let next_core = lock(&self.core).poll_timeout();
@@ -868,9 +869,9 @@ impl Driver {
             }
             if now >= next_tick {
                 next_tick = now + ENDPOINT_TICK;
-                let endpoints: Vec<Arc<dyn Endpoint>> =
-                    read(&self.endpoints).values().cloned().collect();
-                for e in endpoints {
+                // Copied out (the lock is not held across the ticks) into a vector kept between ticks.
+                ticked.extend(read(&self.endpoints).values().cloned());
+                for e in ticked.drain(..) {
                     e.tick(now);
                 }
                 continue;
