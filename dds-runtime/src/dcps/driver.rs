@@ -241,6 +241,7 @@ fn core_config(
     .fragment_size(config.fragment_size)
     .write_batch_delay(config.write_batch_delay)
     .intra_process(config.intra_process)
+    .ignore_local(config.ignore_local)
     .user_data(user_data)
     .properties(
         super::process_info::properties()

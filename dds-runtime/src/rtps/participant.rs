@@ -485,6 +485,8 @@ impl Participant {
             entity_kind::USER_WRITER_NO_KEY,
             entity_kind::USER_WRITER_WITH_KEY,
         ];
+        let mut spec = spec;
+        local::inherit(&mut spec.qos.writer.ignore_local, self.config.ignore_local);
         let data = self.new_endpoint(spec, kinds)?;
         let id = data.guid.entity_id;
         local::note_ignore_local(data.guid, data.qos.writer.ignore_local);
@@ -520,6 +522,8 @@ impl Participant {
             entity_kind::USER_READER_WITH_KEY,
         ];
         let internal = spec.internal;
+        let mut spec = spec;
+        local::inherit(&mut spec.qos.reader.ignore_local, self.config.ignore_local);
         let data = self.new_endpoint(spec, kinds)?;
         let id = data.guid.entity_id;
         local::note_ignore_local(data.guid, data.qos.reader.ignore_local);
