@@ -13,13 +13,17 @@
 # not a test; it runs inside scripts/isolated (loopback only). BARE=path/to/dds-idle probes that binary instead of a fresh release build
 # (e.g. one built at an older commit, for a before/after comparison); STACKS="ours" or "cyclone" runs one side.
 # DOMAIN=N: the DDS domain of our probe (default 41; Cyclone's bare participant uses N+1).
+# Warm-up (both stacks alike): after a first settled sample, WARMUP (default 10; 0: none) entities of the same
+# kind appear for 3 s and go, then "before" is sampled again, so the code pages and one-time tables that the
+# first remote entities bring are not divided by N. Both figures are printed: per entity after the warm-up,
+# and without it (from the first sample).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [[ -z ${DDS_ISOLATED:-} ]]; then
   [[ -n ${BARE:-} ]] || cargo build -q --release -p dds-examples --bin dds-idle
   exec env DDS_ISOLATED=1 scripts/isolated "$0" "$@"
 fi
-kind=${1:-writers} n=${2:-2000}
+kind=${1:-writers} n=${2:-2000} warm=${WARMUP:-10}
 export CYCLONEDDS_URI='<CycloneDDS><Domain><General><Interfaces><NetworkInterface name="lo"/></Interfaces></General></Domain></CycloneDDS>'
 export PYTHONDONTWRITEBYTECODE=1
 
@@ -57,7 +61,14 @@ probe() {
   local tmp pid load before after peak
   tmp=$(mktemp -d)
   pid=$(start_bare "$tmp/bare.log" "$@")
-  local anon_before anon_after
+  local anon_before anon_after cold anon_cold
+  read -r cold _ anon_cold < <(settle "$pid")
+  # Warm-up: a few entities of the same kind appear and go, so that the code that handles them has run once
+  # (its pages resident) and one-time tables exist; then "before" is sampled again.
+  if ((warm > 0)); then
+    python3 scripts/footprint/load.py "$domain" "$kind" "$warm" 3 >"$tmp/warm.log" 2>&1 || true
+    sleep 2
+  fi
   read -r before _ anon_before < <(settle "$pid")
   python3 scripts/footprint/load.py "$domain" "$kind" "$n" 120 >"$tmp/load.log" 2>&1 &
   load=$!
@@ -71,10 +82,13 @@ probe() {
   ((early > peak)) && peak=$early
   kill "$load" "$pid" 2>/dev/null; wait "$load" "$pid" 2>/dev/null || true
   awk -v name="$name" -v b="$before" -v a="$after" -v p="$peak" -v n="$n" -v k="$kind" \
-    -v ab="$anon_before" -v aa="$anon_after" 'BEGIN {
+    -v ab="$anon_before" -v aa="$anon_after" -v c="$cold" -v ac="$anon_cold" -v w="$warm" 'BEGIN {
+    e = substr(k, 1, length(k) - 1)
     printf "%-12s %6d %-12s  before %7d KB  after %7d KB  %6.2f KB per %s  peak %+6d KB above settled" \
-      "  (anonymous: %6.2f KB per %s)\n", name, n, k, b, a, (a - b) / n, substr(k, 1, length(k) - 1), p - a,
-      (aa - ab) / n, substr(k, 1, length(k) - 1) }'
+      "  (anonymous: %6.2f KB per %s)\n", name, n, k, b, a, (a - b) / n, e, p - a, (aa - ab) / n, e
+    if (w > 0)
+      printf "%-12s %6d %-12s  without the warm-up of %d: before %7d KB  %6.2f KB per %s  (anonymous: %6.2f KB per %s)\n",
+        name, n, k, w, c, (a - c) / n, e, (aa - ac) / n, e }'
   rm -rf "$tmp"
 }
 

@@ -162,3 +162,41 @@ fn process_on_either_side_is_enough_in_both_participants() {
     assert_eq!(r_none.matched_publications().len(), 1, "None reader");
     assert_eq!(r_process.matched_publications().len(), 0, "Process reader");
 }
+
+/// The participant-wide default (`Config::ignore_local`, domain 121): endpoints that leave their policy at
+/// `None` inherit the participant's `Participant`, so its writer and reader do not match, while a reader of
+/// another participant (default configuration) does and gets the data.
+#[test]
+fn endpoints_inherit_the_participant_default() {
+    let p = participant_with(
+        121,
+        dds_runtime::config::Config {
+            ignore_local: IgnoreLocal::Participant,
+            ..dds_runtime::config::Config::default()
+        },
+    );
+    let q = participant(121);
+    let (wq, rq) = qos(IgnoreLocal::None);
+    let w = writer::<ShapeType>(&p, "IgnoreLocalDefault", &wq);
+    let own = reader::<ShapeType>(&p, "IgnoreLocalDefault", &rq);
+    let other = reader::<ShapeType>(&q, "IgnoreLocalDefault", &rq);
+    assert!(
+        wait_until(MATCH_TIMEOUT, || {
+            w.publication_matched_status().current_count == 1
+                && other.subscription_matched_status().current_count == 1
+        }),
+        "writer {:?}, other reader {:?}",
+        w.publication_matched_status(),
+        other.subscription_matched_status()
+    );
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    for x in 0..10 {
+        w.write(&shape("RED", x)).unwrap();
+    }
+    w.wait_for_acknowledgments(MATCH_TIMEOUT).unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(200));
+    assert_eq!(w.matched_subscriptions().len(), 1);
+    assert_eq!(own.matched_publications().len(), 0);
+    assert_eq!(xs(&own), Vec::<i32>::new());
+    assert_eq!(xs(&other), (0..10).collect::<Vec<_>>());
+}

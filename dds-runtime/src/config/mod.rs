@@ -338,6 +338,11 @@ pub struct Config {
     /// Intra-process delivery: a writer gives its samples to readers of the same participant directly,
     /// with no serialization for the reader and no socket (`DDS_INTRA_PROCESS`, default on).
     pub intra_process: bool,
+    /// The IGNORE_LOCAL policy of the user endpoints that leave theirs at
+    /// [`IgnoreLocal::None`](crate::qos::IgnoreLocal::None) (default `None`): a participant-wide default,
+    /// as Cyclone has one per participant in its configuration. An endpoint that sets `Participant` or
+    /// `Process` keeps its own.
+    pub ignore_local: crate::qos::IgnoreLocal,
     /// Segmented sends (Linux `UDP_SEGMENT`, `DDS_GSO`, default on): a run of equal-sized datagrams to one
     /// destination, as a fragmented sample makes, leaves in one system call. Ignored elsewhere.
     pub gso: bool,
@@ -378,6 +383,7 @@ impl Default for Config {
             socket_buffer_size: 4 << 20,
             write_batch_delay: None,
             intra_process: true,
+            ignore_local: crate::qos::IgnoreLocal::None,
             gso: true,
             gather_min: Some(2048),
             receive_spin: Duration::from_micros(50),

@@ -241,6 +241,7 @@ fn core_config(
     .fragment_size(config.fragment_size)
     .write_batch_delay(config.write_batch_delay)
     .intra_process(config.intra_process)
+    .ignore_local(config.ignore_local)
     .user_data(user_data)
     .properties(
         super::process_info::properties()
@@ -858,6 +859,7 @@ impl Driver {
 
     fn timer_loop(self: Arc<Self>) {
         let mut next_tick = Instant::now() + ENDPOINT_TICK;
+        let mut ticked: Vec<Arc<dyn Endpoint>> = Vec::new();
         while !self.stopped.load(Ordering::Acquire) {
             let seen = lock(&self.timer_gen).generation;
             let next_core = lock(&self.core).poll_timeout();
@@ -868,9 +870,9 @@ impl Driver {
             }
             if now >= next_tick {
                 next_tick = now + ENDPOINT_TICK;
-                let endpoints: Vec<Arc<dyn Endpoint>> =
-                    read(&self.endpoints).values().cloned().collect();
-                for e in endpoints {
+                // Copied out (the lock is not held across the ticks) into a vector kept between ticks.
+                ticked.extend(read(&self.endpoints).values().cloned());
+                for e in ticked.drain(..) {
                     e.tick(now);
                 }
                 continue;

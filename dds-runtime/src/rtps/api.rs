@@ -8,7 +8,7 @@ use std::time::Duration;
 use super::discovery::{ports, ContentFilterProperty, ParticipantData, ReaderData, WriterData};
 use super::messages::flags::StatusInfo;
 use super::types::*;
-use crate::qos::{QosPolicyId, ReaderQos, WriterQos};
+use crate::qos::{IgnoreLocal, QosPolicyId, ReaderQos, WriterQos};
 use crate::xtypes::TypeInformation;
 
 /// Immutable shared bytes (a sample's serialized form). Cloning is a reference-count increment.
@@ -374,6 +374,10 @@ participant_config! {
     /// repairs still go to each reader's unicast locator. Off (the default): data goes unicast only. What
     /// *our* readers announce is [`default_multicast`](Self::default_multicast).
     multicast_data: bool = copy,
+    /// The IGNORE_LOCAL policy of the user endpoints whose own is [`IgnoreLocal::None`] (default `None`):
+    /// a participant-wide default, as Cyclone's configuration has one per participant. An endpoint that
+    /// sets `Participant` or `Process` keeps its own; one that leaves `None` inherits this.
+    ignore_local: IgnoreLocal = copy,
 }
 
 impl ParticipantConfig {
@@ -425,6 +429,7 @@ impl ParticipantConfig {
             write_batch_delay: None,
             intra_process: true,
             multicast_data: false,
+            ignore_local: IgnoreLocal::None,
         }))
     }
 

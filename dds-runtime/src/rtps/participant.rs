@@ -59,8 +59,12 @@ struct ProxyParticipant {
     /// share a metatraffic multicast group with us, the group is the last entry (for the proxies of its
     /// readers, `ReaderProxy::with_multicast_last`; the others use the first entry only).
     metatraffic: std::sync::Arc<[Locator]>,
-    /// `ParticipantData::encode` of what it announced.
+    /// What it announced, in our own PL-CDR encoding without the fields kept decoded above and its GUID
+    /// (the table's key): `ParticipantData::encode_without_kept`.
     announcement: Box<[u8]>,
+    /// The digest of the SPDP payload last received from it (`Participant::announcement_digest`; 0 until
+    /// set): a periodic re-announcement that matches is not decoded.
+    received: u64,
 }
 
 impl ProxyParticipant {
@@ -74,26 +78,31 @@ impl ProxyParticipant {
             type_lookup_matched: false,
             messages_matched: 0,
             metatraffic: metatraffic(data, group),
-            announcement: data.encode().into_boxed_slice(),
+            announcement: data.encode_without_kept().into_boxed_slice(),
+            received: 0,
         }
     }
 
-    /// What it announced. Our own encoding of a decoded announcement always decodes again; should it not,
-    /// the fields kept decoded still are.
-    fn data(&self) -> ParticipantData {
-        ParticipantData::decode(&self.announcement).unwrap_or_else(|_| ParticipantData {
+    /// What the participant `prefix` (this one) announced. Our own encoding of a decoded announcement
+    /// always decodes again; should it not, the fields kept decoded still are.
+    fn data(&self, prefix: GuidPrefix) -> ParticipantData {
+        ParticipantData {
+            guid_prefix: prefix,
             vendor_id: self.vendor_id,
             lease_duration: self.lease_duration,
             builtin_endpoints: self.builtin_endpoints,
-            ..ParticipantData::default()
-        })
+            ..ParticipantData::decode_without_kept(&self.announcement).unwrap_or_default()
+        }
     }
 
     /// Takes a new announcement of the same participant (`group`: see [`ProxyParticipant::new`]); whether
     /// anything changed.
     fn update(&mut self, data: &ParticipantData, group: Option<Locator>) -> bool {
-        let encoded = data.encode();
-        if *encoded == *self.announcement {
+        let encoded = data.encode_without_kept();
+        if *encoded == *self.announcement
+            && (data.vendor_id, data.lease_duration, data.builtin_endpoints)
+                == (self.vendor_id, self.lease_duration, self.builtin_endpoints)
+        {
             return false;
         }
         *self = ProxyParticipant {
@@ -160,6 +169,8 @@ pub struct Participant {
     next_entity_key: u32,
     spdp_sn: SequenceNumber,
     spdp_payload: Vec<u8>,
+    /// Where the periodic announcement goes (`send_spdp`), kept between periods.
+    spdp_dest: Vec<Locator>,
     spdp_due: Instant,
     pmd_due: Instant,
     /// Local readers matched with a remote writer, for DATA addressed to any reader (ENTITYID_UNKNOWN). Cleared
@@ -283,6 +294,7 @@ impl Participant {
             next_entity_key: 1,
             spdp_sn: SequenceNumber(1),
             spdp_payload: Vec::new(),
+            spdp_dest: Vec::new(),
             spdp_due: now,
             pmd_due: now,
             readers_by_writer: HashMap::new(),
@@ -473,6 +485,8 @@ impl Participant {
             entity_kind::USER_WRITER_NO_KEY,
             entity_kind::USER_WRITER_WITH_KEY,
         ];
+        let mut spec = spec;
+        local::inherit(&mut spec.qos.writer.ignore_local, self.config.ignore_local);
         let data = self.new_endpoint(spec, kinds)?;
         let id = data.guid.entity_id;
         local::note_ignore_local(data.guid, data.qos.writer.ignore_local);
@@ -508,6 +522,8 @@ impl Participant {
             entity_kind::USER_READER_WITH_KEY,
         ];
         let internal = spec.internal;
+        let mut spec = spec;
+        local::inherit(&mut spec.qos.reader.ignore_local, self.config.ignore_local);
         let data = self.new_endpoint(spec, kinds)?;
         let id = data.guid.entity_id;
         local::note_ignore_local(data.guid, data.qos.reader.ignore_local);
@@ -676,7 +692,7 @@ impl Participant {
     /// Discovered remote participants.
     /// Decoded on each call: the core keeps them compact (see `docs/performance.md`, "Footprint").
     pub fn discovered_participants(&self) -> impl Iterator<Item = ParticipantData> + '_ {
-        self.participants.values().map(|p| p.data())
+        self.participants.iter().map(|(k, p)| p.data(*k))
     }
 
     /// A known publication (remote or local), e.g. for ownership strength or builtin topics.

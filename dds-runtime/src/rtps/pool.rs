@@ -39,6 +39,11 @@ impl BufferPool {
         }
     }
 
+    /// Whether it keeps no buffer.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.bufs.is_empty()
+    }
+
     /// An empty buffer referenced by nobody else: a free one from the pool, else a new one (with the
     /// capacity of the last buffer shared, so that filling it does not regrow it step by step).
     ///

@@ -79,6 +79,17 @@ impl ParticipantData {
 
     /// The serialized payload (PL_CDR_LE encapsulation).
     pub fn encode(&self) -> Vec<u8> {
+        self.encode_parts(true)
+    }
+
+    /// The serialized payload without the GUID, the vendor, the builtin endpoint set and the lease: the
+    /// form a discovered participant is kept in, those fields being kept decoded beside it (see
+    /// `ProxyParticipant`). [`ParticipantData::decode_without_kept`] reads it back.
+    pub(crate) fn encode_without_kept(&self) -> Vec<u8> {
+        self.encode_parts(false)
+    }
+
+    fn encode_parts(&self, whole: bool) -> Vec<u8> {
         let mut out = Vec::with_capacity(256);
         out.extend_from_slice(&PL_CDR_LE);
         let mut w = ParameterWriter::new(&mut out, true);
@@ -86,9 +97,11 @@ impl ParticipantData {
             p.u8(self.protocol_version.major);
             p.u8(self.protocol_version.minor);
         });
-        w.param(pid::VENDORID, |p| p.bytes(&self.vendor_id.0));
-        w.guid(pid::PARTICIPANT_GUID, &self.guid());
-        w.u32(pid::BUILTIN_ENDPOINT_SET, self.builtin_endpoints);
+        if whole {
+            w.param(pid::VENDORID, |p| p.bytes(&self.vendor_id.0));
+            w.guid(pid::PARTICIPANT_GUID, &self.guid());
+            w.u32(pid::BUILTIN_ENDPOINT_SET, self.builtin_endpoints);
+        }
         if let Some(d) = self.domain_id {
             w.u32(pid::DOMAIN_ID, d);
         }
@@ -110,7 +123,9 @@ impl ParticipantData {
         for l in &self.default_multicast {
             w.locator(pid::DEFAULT_MULTICAST_LOCATOR, l);
         }
-        w.duration(pid::PARTICIPANT_LEASE_DURATION, self.lease_duration);
+        if whole {
+            w.duration(pid::PARTICIPANT_LEASE_DURATION, self.lease_duration);
+        }
         if self.manual_liveliness_count != 0 {
             w.i32(
                 pid::PARTICIPANT_MANUAL_LIVELINESS_COUNT,
@@ -148,6 +163,16 @@ impl ParticipantData {
     /// Decodes a serialized SPDP payload. Unknown parameters are skipped, vendor-specific ones ignored, and a
     /// not-understood must-understand parameter rejects the whole sample.
     pub fn decode(payload: &[u8]) -> Result<ParticipantData, WireError> {
+        Self::decode_parts(payload, true)
+    }
+
+    /// Decodes [`ParticipantData::encode_without_kept`]'s form: the fields left out are at their defaults
+    /// (the caller fills them in).
+    pub(crate) fn decode_without_kept(payload: &[u8]) -> Result<ParticipantData, WireError> {
+        Self::decode_parts(payload, false)
+    }
+
+    fn decode_parts(payload: &[u8], need_guid: bool) -> Result<ParticipantData, WireError> {
         let pl = pl_payload(payload)?;
         let mut d = ParticipantData::default();
         let mut have_guid = false;
@@ -205,7 +230,7 @@ impl ParticipantData {
                 _ => {}
             }
         }
-        if !have_guid {
+        if need_guid && !have_guid {
             return Err(WireError::Invalid("SPDP without participant GUID"));
         }
         // Kept as long as the participant is known: no spare capacity.
@@ -252,5 +277,34 @@ mod tests {
         for n in 0..enc.len() {
             let _ = ParticipantData::decode(&enc[..n]);
         }
+    }
+
+    #[test]
+    fn the_kept_form_leaves_out_what_is_kept_decoded() {
+        let d = ParticipantData {
+            guid_prefix: GuidPrefix([1; 12]),
+            vendor_id: VendorId::THIS,
+            domain_id: Some(3),
+            metatraffic_unicast: vec![Locator::udpv4([127, 0, 0, 1], 7410)],
+            lease_duration: Duration::from_secs(10),
+            builtin_endpoints: super::super::builtin::OURS,
+            properties: vec![("a".into(), "bcd".into())],
+            ..Default::default()
+        };
+        let kept = d.encode_without_kept();
+        // GUID (4 + 16), vendor (4 + 4), builtin endpoint set (4 + 4), lease (4 + 8).
+        assert_eq!(d.encode().len() - kept.len(), 48);
+        let back = ParticipantData::decode_without_kept(&kept).unwrap();
+        assert_eq!(
+            ParticipantData {
+                guid_prefix: d.guid_prefix,
+                vendor_id: d.vendor_id,
+                lease_duration: d.lease_duration,
+                builtin_endpoints: d.builtin_endpoints,
+                ..back
+            },
+            d
+        );
+        assert!(ParticipantData::decode(&kept).is_err(), "no GUID");
     }
 }

@@ -126,8 +126,9 @@ impl Participant {
         &mut self,
         now: Instant,
         writer: EntityId,
-        qos: WriterQos,
+        mut qos: WriterQos,
     ) -> Result<(), CoreError> {
+        super::local::inherit(&mut qos.writer.ignore_local, self.config.ignore_local);
         let Some(qos) = self.update_deferred_writer(writer, qos) else {
             return Ok(());
         };
@@ -139,8 +140,9 @@ impl Participant {
         &mut self,
         now: Instant,
         reader: EntityId,
-        qos: ReaderQos,
+        mut qos: ReaderQos,
     ) -> Result<(), CoreError> {
+        super::local::inherit(&mut qos.reader.ignore_local, self.config.ignore_local);
         let Some(qos) = self.update_deferred_reader(reader, qos) else {
             return Ok(());
         };

@@ -72,6 +72,20 @@ impl Participant {
             return;
         }
         let Some(payload) = d.payload else { return };
+        if src == self.config.guid_prefix {
+            return; // our own, looped back by multicast
+        }
+        // The periodic re-announcement of a known participant, byte for byte what it sent last: its lease
+        // is renewed (by the message, `receive`) and nothing else changes. Checked before decoding, so
+        // that the common case allocates nothing.
+        let digest = self.announcement_digest(payload);
+        if self
+            .participants
+            .get(&src)
+            .is_some_and(|p| p.received == digest)
+        {
+            return;
+        }
         let data = match ParticipantData::decode(payload) {
             Ok(x) => x,
             Err(e) => {
@@ -94,6 +108,7 @@ impl Participant {
         if let Some(p) = self.participants.get_mut(&data.guid_prefix) {
             p.lease_deadline = lease_deadline;
             p.update(&data, group);
+            p.received = digest;
             return;
         }
         if self.participants.len() >= MAX_PARTICIPANTS {
@@ -101,7 +116,8 @@ impl Participant {
         }
         let prefix = data.guid_prefix;
         debug!(participant = ?prefix, vendor = ?data.vendor_id, "participant discovered");
-        let proxy = Box::new(ProxyParticipant::new(&data, lease_deadline, group));
+        let mut proxy = Box::new(ProxyParticipant::new(&data, lease_deadline, group));
+        proxy.received = digest;
         // One list for all the proxies of its builtin endpoints (the group last).
         let meta = proxy.metatraffic.clone();
         let bits = data.builtin_endpoints;
@@ -123,6 +139,15 @@ impl Participant {
         if !meta.is_empty() {
             self.send_spdp(Some(meta[..1].to_vec()));
         }
+    }
+
+    /// A keyed 64-bit digest of a received SPDP payload (the participant table's own random hasher), to
+    /// recognise a repeated announcement without decoding or keeping it: equal digests are taken for equal
+    /// bytes. A peer that forged a collision could only keep its own earlier announcement in force (the
+    /// look-up is by the sender's prefix, and equal bytes decode to the same participant).
+    fn announcement_digest(&self, payload: &[u8]) -> u64 {
+        use std::hash::BuildHasher;
+        self.participants.hasher().hash_one(payload)
     }
 
     /// Matches those builtin endpoints of ours that `which` selects with the ones the participant `prefix`
@@ -304,7 +329,7 @@ impl Participant {
             return self.config.default_unicast.clone();
         }
         if let Some(p) = self.participants.get(&prefix) {
-            let p = p.data();
+            let p = p.data(prefix);
             if !p.default_unicast.is_empty() {
                 return p.default_unicast;
             }
@@ -330,7 +355,7 @@ impl Participant {
         if d.guid.prefix == self.config.guid_prefix {
             return self.config.default_multicast.iter().find(usable).copied();
         }
-        let p = self.participants.get(&d.guid.prefix)?.data();
+        let p = self.participants.get(&d.guid.prefix)?.data(d.guid.prefix);
         p.default_multicast.iter().find(usable).copied()
     }
 

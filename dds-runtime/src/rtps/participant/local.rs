@@ -59,6 +59,14 @@ fn process_policies() -> std::sync::MutexGuard<'static, Vec<(Guid, IgnoreLocal)>
         .unwrap_or_else(PoisonError::into_inner)
 }
 
+/// An endpoint's IGNORE_LOCAL: its own, or the participant's default (`ParticipantConfig::ignore_local`)
+/// when its own is `None`.
+pub(super) fn inherit(own: &mut IgnoreLocal, participant_default: IgnoreLocal) {
+    if *own == IgnoreLocal::None {
+        *own = participant_default;
+    }
+}
+
 /// Records the IGNORE_LOCAL policy of this process's endpoint `guid` for the process's other participants.
 pub(super) fn note_ignore_local(guid: Guid, policy: IgnoreLocal) {
     if policy != IgnoreLocal::None {

@@ -80,7 +80,10 @@ impl Participant {
         let Some(peer) = self.participants.get(&remote.prefix) else {
             return false;
         };
-        if !shm_peers(self.config.properties(), &peer.data().properties) {
+        if !shm_peers(
+            self.config.properties(),
+            &peer.data(remote.prefix).properties,
+        ) {
             return false;
         }
         let own = Guid::new(self.config.guid_prefix, id);
@@ -205,8 +208,8 @@ impl Participant {
     fn refresh_shm_nodes(&mut self, w: EntityId) {
         let mut nodes: Vec<String> = self.shm.readers.get(&w).map_or(Vec::new(), |rs| {
             rs.iter()
-                .filter_map(|g| self.participants.get(&g.prefix))
-                .filter_map(|p| shm_node(&p.data().properties).map(str::to_owned))
+                .filter_map(|g| Some((g.prefix, self.participants.get(&g.prefix)?)))
+                .filter_map(|(k, p)| shm_node(&p.data(k).properties).map(str::to_owned))
                 .collect()
         });
         nodes.sort();

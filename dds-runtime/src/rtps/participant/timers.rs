@@ -194,13 +194,19 @@ impl Participant {
 
     /// Sends our SPDP announcement to the SPDP multicast locators and initial peers, or to `to` only.
     pub(super) fn send_spdp(&mut self, to: Option<Vec<Locator>>) {
-        let dest = to.unwrap_or_else(|| {
-            let mut d = self.config.metatraffic_multicast.clone();
-            d.extend(self.config.initial_peers.iter().copied());
-            d.sort();
-            d.dedup();
-            d
-        });
+        let dest: &[Locator] = match &to {
+            Some(to) => to,
+            None => {
+                // Rebuilt in a kept vector: the periodic announcement allocates nothing.
+                let d = &mut self.spdp_dest;
+                d.clear();
+                d.extend_from_slice(&self.config.metatraffic_multicast);
+                d.extend(self.config.initial_peers.iter().copied());
+                d.sort();
+                d.dedup();
+                d
+            }
+        };
         let sn = self.spdp_sn;
         self.spdp_sn = sn.next();
         let data = Submessage::Data(Data {
@@ -212,7 +218,7 @@ impl Participant {
             key_flag: false,
             non_standard_flag: false,
         });
-        self.out.push(&dest, None, Ts::Set(None), &data);
+        self.out.push(dest, None, Ts::Set(None), &data);
     }
 
     pub(super) fn send_spdp_dispose(&mut self) {

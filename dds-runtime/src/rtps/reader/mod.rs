@@ -633,6 +633,7 @@ impl Reader {
     pub(crate) fn trim_room(&mut self) {
         self.due.trim(crate::rtps::due::KEPT_TIMER_ROOM);
         self.proxies.trim(crate::rtps::due::KEPT_TIMER_ROOM);
+        self.proxies.values_mut().for_each(WriterProxy::trim_idle);
     }
 
     pub(crate) fn next_timeout(&self) -> Option<Instant> {

@@ -86,6 +86,8 @@ pub(crate) struct Reorder {
     bytes: usize,
     /// Buffers for the copies of held payloads.
     pool: BufferPool,
+    /// Trims ([`Reorder::trim_idle`]) in a row that found nothing held and nothing held since the last.
+    idle_trims: u8,
 }
 
 /// A ring entry for a number nothing is held for.
@@ -115,9 +117,13 @@ impl Default for Reorder {
             far: BTreeMap::new(),
             bytes: 0,
             pool: BufferPool::new(POOL_BUFFERS, POOL_BYTES),
+            idle_trims: 0,
         }
     }
 }
+
+/// Trims in a row with nothing held after which [`Reorder::trim_idle`] gives the room back.
+const IDLE_TRIMS: u8 = 2;
 
 impl Reorder {
     /// Changes (and irrelevant numbers) held.
@@ -139,6 +145,7 @@ impl Reorder {
     /// Holds `slot` for `sn`, replacing what was held for it. A payload that is a slice of a larger buffer
     /// (the datagram it arrived in) is copied into a pooled buffer, so that it does not pin the datagram.
     pub(crate) fn hold(&mut self, sn: SequenceNumber, mut slot: Slot) {
+        self.idle_trims = 0;
         if let Slot::Change(c) = &mut slot {
             c.payload = self.pool.compact(std::mem::take(&mut c.payload));
         }
@@ -181,6 +188,27 @@ impl Reorder {
             return Some((self.base, slot));
         }
         far.map(|(sn, slot)| (*sn, slot))
+    }
+
+    /// Called periodically (once per SPDP period, with the participant's other trims): once it has found
+    /// nothing held [`IDLE_TRIMS`] times in a row with nothing held in between, gives back the ring (up to
+    /// 128 KiB), the slab and the pool of payload copies, which a burst out of order left at its size: a
+    /// writer that once got thousands of changes ahead does not keep them for the life of the match. The
+    /// next change held out of order makes them again. Whether the room is given back (now or before).
+    pub(crate) fn trim_idle(&mut self) -> bool {
+        if self.len() > 0 {
+            self.idle_trims = 0;
+            return false;
+        }
+        if self.ring.capacity() == 0 && self.slab.capacity() == 0 && self.pool.is_empty() {
+            return true;
+        }
+        self.idle_trims = self.idle_trims.saturating_add(1);
+        if self.idle_trims < IDLE_TRIMS {
+            return false;
+        }
+        *self = Reorder::default();
+        true
     }
 
     /// Takes the lowest sequence number held, and its slot.
@@ -467,6 +495,40 @@ mod tests {
             panic!("held change");
         };
         assert_eq!(c.payload.as_ptr(), ptr, "the same buffer, reused");
+    }
+
+    #[test]
+    fn idle_room_is_given_back_after_two_idle_trims() {
+        let mut r = Reorder::default();
+        let datagram = Payload::from(vec![7u8; 64 * 1024]);
+        // A burst out of order: 20 000 numbers ahead of the first, copies of slices of a datagram.
+        for i in (2..20_002).rev() {
+            r.hold(SequenceNumber(i), change(datagram.slice(0..32)));
+        }
+        r.hold(SequenceNumber(1), change(datagram.slice(0..32)));
+        assert!(r.ring.capacity() >= 20_001 && r.slab.capacity() >= 20_001);
+        // Held: nothing is given back.
+        assert!(!r.trim_idle() && !r.trim_idle() && !r.trim_idle());
+        while r.pop_first().is_some() {}
+        assert!(!r.pool.is_empty());
+        // Drained: the first trim counts, a change held in between starts over, the second in a row frees.
+        assert!(!r.trim_idle());
+        r.hold(SequenceNumber(30_000), change(datagram.slice(0..32)));
+        r.pop_first();
+        assert!(!r.trim_idle());
+        assert!(r.ring.capacity() > 0, "held since the last trim: kept");
+        assert!(r.trim_idle());
+        assert_eq!(
+            (r.ring.capacity(), r.slab.capacity(), r.free.capacity()),
+            (0, 0, 0)
+        );
+        assert!(r.pool.is_empty());
+        assert!(r.trim_idle(), "already empty-cheap");
+        // And it works again afterwards.
+        r.hold(SequenceNumber(30_002), change(datagram.slice(0..4)));
+        r.hold(SequenceNumber(30_001), change(datagram.slice(0..4)));
+        let got: Vec<i64> = order(&mut r).into_iter().map(|(sn, _)| sn).collect();
+        assert_eq!(got, [30_001, 30_002]);
     }
 
     /// What the reorder buffer was before the ring: a map by number.

@@ -92,6 +92,13 @@ impl WriterProxy {
         self.backlog.get_or_insert_with(Box::default)
     }
 
+    /// Periodic: gives back the reorder room of a backlog idle for a while ([`Reorder::trim_idle`]).
+    pub(crate) fn trim_idle(&mut self) {
+        if let Some(b) = self.backlog.as_deref_mut() {
+            b.reorder.trim_idle();
+        }
+    }
+
     /// Whether a coherent set is being assembled.
     pub(crate) fn coherent_open(&self) -> bool {
         self.backlog().is_some_and(|b| b.coherent.is_open())
