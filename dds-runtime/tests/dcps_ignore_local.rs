@@ -163,7 +163,7 @@ fn process_on_either_side_is_enough_in_both_participants() {
     assert_eq!(r_process.matched_publications().len(), 0, "Process reader");
 }
 
-/// The participant-wide default (`Config::ignore_local`, domain 121): endpoints that leave their policy at
+/// The participant-wide default (`Config::ignore_local`, domain 123): endpoints that leave their policy at
 /// `None` inherit the participant's `Participant`, so its writer and reader do not match, while a reader of
 /// another participant (default configuration) does and gets the data.
 #[test]
@@ -175,7 +175,7 @@ fn endpoints_inherit_the_participant_default() {
             ..dds_runtime::config::Config::default()
         },
     );
-    let q = participant(121);
+    let q = participant(123);
     let (wq, rq) = qos(IgnoreLocal::None);
     let w = writer::<ShapeType>(&p, "IgnoreLocalDefault", &wq);
     let own = reader::<ShapeType>(&p, "IgnoreLocalDefault", &rq);
