@@ -14,7 +14,7 @@
 //! waits for like RTPS ACKNACKs.
 
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -25,6 +25,7 @@ mod inlet;
 mod outlet;
 
 use inlet::Inlets;
+pub(crate) use outlet::LoanReservation;
 use outlet::{FlushScratch, Outlet, Parked};
 
 use super::sync::lock;
@@ -108,6 +109,9 @@ pub(crate) struct ShmLink {
     scratch: Mutex<FlushScratch>,
     /// Loaned changes the core queued, until their turn.
     parked: Mutex<Vec<Parked>>,
+    /// By writer: buffers loaned from its channel for a sample written in place and not parked yet
+    /// ([`ShmLink::reserve`]).
+    lent: Mutex<HashMap<EntityId, Arc<AtomicUsize>>>,
     /// Whether a channel we read waits for its first frame and greets its writer (the reading thread
     /// then polls quickly: the writer waits for the greeting).
     greeting: AtomicBool,
@@ -198,6 +202,7 @@ impl ShmLink {
             notifiers: Mutex::new(HashMap::new()),
             scratch: Mutex::new(FlushScratch::default()),
             parked: Mutex::new(Vec::new()),
+            lent: Mutex::new(HashMap::new()),
             greeting: AtomicBool::new(false),
             passes: Mutex::new(0),
             passed: std::sync::Condvar::new(),

@@ -325,6 +325,27 @@ impl ShmPublisher {
         Ok(ShmLoan { sample })
     }
 
+    /// [`loan`](Self::loan) without zeroing: the buffer holds whatever its chunk of the segment holds,
+    /// the bytes of an earlier sample of this publisher or the zeros of a fresh segment. Overwrite every
+    /// byte that readers will look at. For a sample whose every byte is rewritten anyway (a plain-data
+    /// sample written in place), this saves a `memset` of `len` bytes per sample.
+    pub fn loan_unzeroed(&self, len: usize) -> Result<ShmLoan, ShmError> {
+        let sample = self
+            .publisher
+            .loan_slice_uninit(len)
+            .map_err(|e| ShmError::Loan(format!("{e:?}")))?;
+        // SAFETY: the payload of a chunk is initialized memory. A segment is created as a file in
+        // shared memory (`shm_open`, `ftruncate`: zero-filled pages) and mapped; afterwards only this
+        // publisher writes its chunks' payloads (subscribers map it read-only), and it writes them only
+        // as bytes: through `loan` (zeroed by iceoryx2, then `&mut [u8]`), through `loan_uninit`, whose
+        // `assume_init` requires every byte to be written first, or through this function's `&mut [u8]`.
+        // No value with padding or uninitialized bytes is ever stored in a payload, so every byte read
+        // through the `&[u8]` is an initialized `u8` (and every `u8` value is valid).
+        Ok(ShmLoan {
+            sample: unsafe { sample.assume_init() },
+        })
+    }
+
     /// The nodes ([`ShmNode::id`]) of the channel's subscribers.
     pub fn subscriber_nodes(&self) -> Vec<String> {
         let mut nodes = Vec::new();
