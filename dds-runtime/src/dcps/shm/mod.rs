@@ -63,6 +63,10 @@ const MAX_IDLE: Duration = Duration::from_millis(100);
 /// Longest wait of a receive thread for the reading thread ([`ShmLink::drain_first`]).
 const DRAIN_WAIT: Duration = Duration::from_millis(100);
 
+/// How often the reading thread looks again at channels whose frames it left queued because their
+/// readers hold many already.
+const DEFER_POLL: Duration = Duration::from_micros(100);
+
 /// How often changes held for readers that are not connected yet are retried.
 const HELD_RETRY: Duration = Duration::from_millis(1);
 
@@ -115,6 +119,10 @@ pub(crate) struct ShmLink {
     /// Whether a channel we read waits for its first frame and greets its writer (the reading thread
     /// then polls quickly: the writer waits for the greeting).
     greeting: AtomicBool,
+    /// Whether a channel's frames were left in its queue at the last drain pass because its readers
+    /// hold many already (the reading thread then polls every [`DEFER_POLL`]: a reader that drops
+    /// samples does not signal).
+    deferring: AtomicBool,
     /// Drain passes of the reading thread, for [`drain_first`](ShmLink::drain_first).
     passes: Mutex<u64>,
     passed: std::sync::Condvar,
@@ -204,6 +212,7 @@ impl ShmLink {
             parked: Mutex::new(Vec::new()),
             lent: Mutex::new(HashMap::new()),
             greeting: AtomicBool::new(false),
+            deferring: AtomicBool::new(false),
             passes: Mutex::new(0),
             passed: std::sync::Condvar::new(),
         };
@@ -255,13 +264,14 @@ fn poll_loop<H: ShmHost>(driver: Weak<H>) {
         // The thread never waits to send (a peer's queue may be full while its own thread waits on
         // ours): it only sends when no other thread is sending, changes held for connecting readers
         // typically.
-        let (n, held, listener) = match d.shm_link() {
+        let (n, held, deferring, listener) = match d.shm_link() {
             Some(link) if !link.stopped.load(Ordering::Acquire) => {
                 let n = link.drain(&*d);
                 link.count_pass();
                 link.try_flush();
                 let held = !lock(&link.pending).is_empty() || link.greeting.load(Ordering::Acquire);
-                (n, held, link.listener.clone())
+                let deferring = link.deferring.load(Ordering::Acquire);
+                (n, held, deferring, link.listener.clone())
             }
             _ => return,
         };
@@ -272,14 +282,18 @@ fn poll_loop<H: ShmHost>(driver: Weak<H>) {
         }
         match listener {
             Some(l) => {
-                let timeout = if held { HELD_RETRY } else { MAX_IDLE };
+                let timeout = match (deferring, held) {
+                    (true, _) => DEFER_POLL,
+                    (false, true) => HELD_RETRY,
+                    (false, false) => MAX_IDLE,
+                };
                 if let Err(e) = l.wait(timeout) {
                     tracing::debug!(error = %e, "shared-memory wait failed");
                     std::thread::sleep(HELD_RETRY);
                 }
             }
             None => {
-                if held {
+                if held || deferring {
                     idle = Duration::from_micros(20);
                 }
                 std::thread::sleep(idle);
