@@ -576,13 +576,23 @@ fn poll_readable(fd: i32, timeout: Duration) -> Result<(), ShmError> {
         events: libc::POLLIN,
         revents: 0,
     };
-    // `ppoll`: to the microsecond (`poll` counts whole milliseconds).
-    let t = libc::timespec {
-        tv_sec: timeout.as_secs().min(i32::MAX as u64) as libc::time_t,
-        tv_nsec: libc::c_long::from(timeout.subsec_nanos() as i32),
+    // On Linux `ppoll`, to the microsecond; elsewhere `poll`, rounded up to whole milliseconds.
+    #[cfg(target_os = "linux")]
+    let r = {
+        let t = libc::timespec {
+            tv_sec: timeout.as_secs().min(i32::MAX as u64) as libc::time_t,
+            tv_nsec: libc::c_long::from(timeout.subsec_nanos() as i32),
+        };
+        // SAFETY: `p` is one valid `pollfd`, as the count says; `t` is a valid `timespec`; no signal mask.
+        unsafe { libc::ppoll(&mut p, 1, &t, std::ptr::null()) }
     };
-    // SAFETY: `p` is one valid `pollfd`, as the count says; `t` is a valid `timespec`; no signal mask.
-    if unsafe { libc::ppoll(&mut p, 1, &t, std::ptr::null()) } < 0 {
+    #[cfg(not(target_os = "linux"))]
+    // SAFETY: `p` is one valid `pollfd`, as the count says.
+    let r = unsafe {
+        let ms = timeout.as_micros().div_ceil(1000).min(i32::MAX as u128) as i32;
+        libc::poll(&mut p, 1, ms)
+    };
+    if r < 0 {
         let e = std::io::Error::last_os_error();
         if e.kind() != std::io::ErrorKind::Interrupted {
             return Err(ShmError::Transfer(format!("poll: {e}")));
