@@ -9,11 +9,21 @@
 //!
 //! Each measurement: this program runs itself again as the subscriber (a second process), both with
 //! `Config::shm` on or off; the publisher writes samples of SIZE bytes (reliable, KEEP_ALL) for SECONDS;
-//! the subscriber takes them and reports samples/s from its first to its last sample. Three modes per
-//! round, interleaved: `loan` (shared memory, a plain-data sample of SIZE bytes written in place through
-//! `DataWriter::loan`; SIZE 1048576 or 4194304 only), `shm` (shared memory, a `{seq, Vec<u8>}` sample
-//! serialized and copied into the channel) and `udp` (the `Vec<u8>` sample over loopback UDP). Each line
-//! also gives the load average at its start (`/proc/loadavg`).
+//! the subscriber takes them and reports samples/s from its first to its last sample. Modes, interleaved
+//! in each round: `loan` (shared memory, a plain-data sample of SIZE bytes written in place through
+//! `DataWriter::loan_unzeroed`, read in place; SIZE 1048576 or 4194304 only), `shm` (shared memory, a
+//! `{seq, Vec<u8>}` sample serialized and copied into the channel) and `udp` (the `Vec<u8>` sample over
+//! loopback UDP); `loanv` is `loan` with a reader that decodes each sample by value.
+//!
+//! What the writer writes per sample: in the plain modes only the sequence number, as `dds-perf`'s writer
+//! (which sets `seq` and `keyval` and leaves its payload alone): the `shm` and `udp` writers keep one
+//! `Vec` and the `loan` writer writes the `seq` into a loan that holds an earlier sample's bytes. In the
+//! `-fill` modes (`loan-fill`, `shm-fill`, `udp-fill`) every writer writes every byte of each sample
+//! (into the loan, or into its `Vec`): an application that produces SIZE new bytes per sample. Without a
+//! mode list, SIZE 1048576 or 4194304 runs `loan,shm,udp,loan-fill,shm-fill,udp-fill`; every mode's ratio
+//! is to the `udp` mode with the same writes, and the summary gives the medians of the per-round ratios
+//! of `loan`, `shm` to `udp` and of `loan-fill`, `shm-fill` to `udp-fill`. Each line also gives the load
+//! average at its start (`/proc/loadavg`).
 
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
@@ -92,26 +102,31 @@ impl<T: Bench + bytemuck::Pod> Bench for InPlace<T> {
 
 /// A plain sample type that can be loaned.
 trait Loanable: Bench + bytemuck::Pod {
-    fn fill(&mut self, seq: u64);
+    /// Writes the sequence number, and every other byte too when `all`.
+    fn fill(&mut self, seq: u64, all: bool);
 }
 
 impl Loanable for Plain1M {
-    fn fill(&mut self, seq: u64) {
+    fn fill(&mut self, seq: u64, all: bool) {
         self.seq = seq;
-        self.data.fill(seq as u8);
+        if all {
+            self.data.fill(seq as u8);
+        }
     }
 }
 
 impl Loanable for Plain4M {
-    fn fill(&mut self, seq: u64) {
+    fn fill(&mut self, seq: u64, all: bool) {
         self.seq = seq;
-        self.data.fill(seq as u8);
+        if all {
+            self.data.fill(seq as u8);
+        }
     }
 }
 
-/// How a measurement sends its samples.
+/// The way a measurement's samples go.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
-enum Mode {
+enum Path {
     /// Loaned and written in place; the reader reads in place (`InPlace<T>`).
     Loan,
     /// Loaned and written in place; the reader decodes each sample by value (a copy of `T`).
@@ -120,23 +135,45 @@ enum Mode {
     Udp,
 }
 
+/// How a measurement sends its samples.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+struct Mode {
+    path: Path,
+    /// The writer writes every byte of each sample, not only its sequence number.
+    fill: bool,
+}
+
 impl Mode {
-    fn name(self) -> &'static str {
-        match self {
-            Mode::Loan => "loan",
-            Mode::LoanCopy => "loanv",
-            Mode::Shm => "shm",
-            Mode::Udp => "udp",
+    fn name(self) -> String {
+        let path = match self.path {
+            Path::Loan => "loan",
+            Path::LoanCopy => "loanv",
+            Path::Shm => "shm",
+            Path::Udp => "udp",
+        };
+        if self.fill {
+            format!("{path}-fill")
+        } else {
+            path.to_owned()
         }
     }
 
     fn parse(s: &str) -> Mode {
-        match s {
-            "loan" => Mode::Loan,
-            "loanv" => Mode::LoanCopy,
-            "shm" => Mode::Shm,
-            _ => Mode::Udp,
-        }
+        let (path, fill) = match s.strip_suffix("-fill") {
+            Some(p) => (p, true),
+            None => (s, false),
+        };
+        let path = match path {
+            "loan" => Path::Loan,
+            "loanv" => Path::LoanCopy,
+            "shm" => Path::Shm,
+            _ => Path::Udp,
+        };
+        Mode { path, fill }
+    }
+
+    fn shm(self) -> bool {
+        self.path != Path::Udp
     }
 }
 
@@ -223,13 +260,17 @@ fn matched_writer<T: DdsType>(
     Ok(w)
 }
 
-/// Writes `{seq, Vec<u8>}` samples of `size` bytes until `end`, then the end marker.
-fn write_vec(w: &DataWriter<Payload>, size: usize, end: Instant) -> DdsResult<()> {
+/// Writes `{seq, Vec<u8>}` samples of `size` bytes until `end` (rewriting every byte of the `Vec` per
+/// sample when `fill`), then the end marker.
+fn write_vec(w: &DataWriter<Payload>, size: usize, end: Instant, fill: bool) -> DdsResult<()> {
     let mut sample = Payload {
         seq: 0,
         data: vec![0x5a; size],
     };
     while Instant::now() < end {
+        if fill {
+            sample.data.fill(sample.seq as u8);
+        }
         w.write(&sample)?;
         sample.seq += 1;
     }
@@ -238,20 +279,22 @@ fn write_vec(w: &DataWriter<Payload>, size: usize, end: Instant) -> DdsResult<()
     w.write(&sample)
 }
 
-/// Loans, fills and writes plain samples until `end`, then the end marker.
+/// Loans (unzeroed: the buffer holds an earlier sample's bytes), fills (the `seq`, or every byte when
+/// `fill`) and writes plain samples until `end`, then the end marker.
 fn write_loaned<T: Loanable>(
     w: &DataWriter<T>,
     end: Instant,
+    fill: bool,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let mut seq = 0;
     while Instant::now() < end {
-        let mut loan = w.loan()?;
-        loan.fill(seq);
+        let mut loan = w.loan_unzeroed()?;
+        loan.fill(seq, fill);
         loan.write()?;
         seq += 1;
     }
-    let mut loan = w.loan()?;
-    loan.fill(LAST);
+    let mut loan = w.loan_unzeroed()?;
+    loan.fill(LAST, false);
     loan.write()?;
     Ok(())
 }
@@ -264,29 +307,29 @@ fn measure(
     secs: f64,
 ) -> Result<f64, Box<dyn std::error::Error>> {
     let mut child = Command::new(std::env::current_exe()?)
-        .args(["sub", &domain.to_string(), mode.name(), &size.to_string()])
+        .args(["sub", &domain.to_string(), &mode.name(), &size.to_string()])
         .stdout(Stdio::piped())
         .spawn()?;
     let mut out = BufReader::new(child.stdout.take().ok_or("no stdout")?);
     let mut line = String::new();
     out.read_line(&mut line)?;
-    let p = participant(domain, mode != Mode::Udp)?;
+    let p = participant(domain, mode.shm())?;
     let end = |_| Instant::now() + Duration::from_secs_f64(secs);
-    match (mode, size) {
-        (Mode::Loan | Mode::LoanCopy, 1048576) => {
+    match (mode.path, size) {
+        (Path::Loan | Path::LoanCopy, 1048576) => {
             let w = matched_writer::<Plain1M>(&p)?;
-            write_loaned(&w, end(()))?;
+            write_loaned(&w, end(()), mode.fill)?;
         }
-        (Mode::Loan | Mode::LoanCopy, 4194304) => {
+        (Path::Loan | Path::LoanCopy, 4194304) => {
             let w = matched_writer::<Plain4M>(&p)?;
-            write_loaned(&w, end(()))?;
+            write_loaned(&w, end(()), mode.fill)?;
         }
-        (Mode::Loan | Mode::LoanCopy, _) => {
+        (Path::Loan | Path::LoanCopy, _) => {
             return Err("loan modes: SIZE 1048576 or 4194304".into())
         }
         _ => {
             let w = matched_writer::<Payload>(&p)?;
-            write_vec(&w, size, end(()))?;
+            write_vec(&w, size, end(()), mode.fill)?;
         }
     }
     line.clear();
@@ -312,12 +355,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // `loanv` decodes plain samples by value: a stack for a few copies of 4 MiB.
         let sub = std::thread::Builder::new().stack_size(256 << 20).spawn(
             move || -> Result<(), String> {
-                let shm = mode != Mode::Udp;
-                let r = match (mode, size) {
-                    (Mode::Loan, 1048576) => subscriber::<InPlace<Plain1M>>(domain, shm),
-                    (Mode::Loan, _) => subscriber::<InPlace<Plain4M>>(domain, shm),
-                    (Mode::LoanCopy, 1048576) => subscriber::<Plain1M>(domain, shm),
-                    (Mode::LoanCopy, _) => subscriber::<Plain4M>(domain, shm),
+                let shm = mode.shm();
+                let r = match (mode.path, size) {
+                    (Path::Loan, 1048576) => subscriber::<InPlace<Plain1M>>(domain, shm),
+                    (Path::Loan, _) => subscriber::<InPlace<Plain4M>>(domain, shm),
+                    (Path::LoanCopy, 1048576) => subscriber::<Plain1M>(domain, shm),
+                    (Path::LoanCopy, _) => subscriber::<Plain4M>(domain, shm),
                     _ => subscriber::<Payload>(domain, shm),
                 };
                 r.map_err(|e| e.to_string())
@@ -333,8 +376,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rounds: u32 = args.get(2).map_or(Ok(2), |s| s.parse())?;
     let modes: Vec<Mode> = match args.get(3) {
         Some(m) => m.split(',').map(Mode::parse).collect(),
-        None if matches!(size, 1048576 | 4194304) => vec![Mode::Loan, Mode::Shm, Mode::Udp],
-        None => vec![Mode::Shm, Mode::Udp],
+        None if matches!(size, 1048576 | 4194304) => "loan,shm,udp,loan-fill,shm-fill,udp-fill"
+            .split(',')
+            .map(Mode::parse)
+            .collect(),
+        None => vec![Mode::parse("shm"), Mode::parse("udp")],
     };
     let mut rates: Vec<Vec<f64>> = vec![Vec::new(); modes.len()];
     for round in 0..rounds {
@@ -344,29 +390,58 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let rate = measure(domain, *mode, size, secs)?;
             let mbps = rate * size as f64 * 8.0 / 1e9;
             println!(
-                "round {round} {:>4} size {size} B: {rate:.0} samples/s ({mbps:.2} Gb/s), load {load}",
+                "round {round} {:>9} size {size} B: {rate:.0} samples/s ({mbps:.2} Gb/s), load {load}",
                 mode.name()
             );
             rates[i].push(rate);
         }
     }
+    summary(size, &modes, &rates);
+    Ok(())
+}
+
+/// Each mode's mean rate and its per-round ratios to the `udp` mode with the same writes, then the
+/// medians of those ratios.
+fn summary(size: usize, modes: &[Mode], rates: &[Vec<f64>]) {
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-    let udp = modes.iter().position(|m| *m == Mode::Udp);
-    for (mode, r) in modes.iter().zip(&rates) {
-        let ratio = udp.map_or(String::new(), |u| {
-            let per_round: Vec<String> = r
+    let udp = |fill| {
+        modes.iter().position(|m| {
+            *m == Mode {
+                path: Path::Udp,
+                fill,
+            }
+        })
+    };
+    let mut medians = Vec::new();
+    for (mode, r) in modes.iter().zip(rates) {
+        let ratio = udp(mode.fill).map_or(String::new(), |u| {
+            let mut per_round: Vec<f64> = r
                 .iter()
                 .zip(&rates[u])
-                .map(|(x, y)| format!("{:.1}", x / y.max(f64::MIN_POSITIVE)))
+                .map(|(x, y)| x / y.max(f64::MIN_POSITIVE))
                 .collect();
-            let ratio = mean(r) / mean(&rates[u]).max(f64::MIN_POSITIVE);
-            format!(", {ratio:.1}x UDP (per round {})", per_round.join(" / "))
+            let shown: Vec<String> = per_round.iter().map(|x| format!("{x:.1}")).collect();
+            per_round.sort_by(f64::total_cmp);
+            if mode.path != Path::Udp {
+                let udp = Mode {
+                    path: Path::Udp,
+                    ..*mode
+                };
+                let median = per_round[per_round.len() / 2];
+                medians.push(format!("{} / {}: {median:.1}x", mode.name(), udp.name()));
+            }
+            format!(", per round {} x {}", shown.join(" / "), modes[u].name())
         });
         println!(
-            "size {size} B {:>4}: mean {:.0} samples/s{ratio}",
+            "size {size} B {:>9}: mean {:.0} samples/s{ratio}",
             mode.name(),
             mean(r)
         );
     }
-    Ok(())
+    if !medians.is_empty() {
+        println!(
+            "size {size} B medians of per-round ratios: {}",
+            medians.join(", ")
+        );
+    }
 }

@@ -3,7 +3,8 @@
 //! as datagrams; a participant without it (shared memory off) gets the same writer's samples over UDP; a
 //! writer process killed with `SIGKILL` leaks nothing and a new writer works after it. The second process
 //! is this test binary run again with `DCPS_SHM_ROLE` set (see `child`). Plain-data samples written in
-//! place through `DataWriter::loan` and read in place (`InPlace`); a durable reader that joins a writer whose channel its participant
+//! place through `DataWriter::loan` (or `loan_unzeroed`) and read in place (`InPlace`); loans held by the
+//! user leave a buffer for the writer's ordinary writes; a durable reader that joins a writer whose channel its participant
 //! already reads gets the history before the live samples.
 mod dcps_util;
 
@@ -547,6 +548,85 @@ fn loan_write(w: &DataWriter<Plain>, seqs: std::ops::Range<u32>) {
         fill_plain(&mut loan, seq % 3, seq);
         loan.write().unwrap();
     }
+}
+
+/// `DataWriter::loan_unzeroed` gives buffers that hold earlier frames' bytes (it does not zero them);
+/// samples written whole into them reach the reader intact and in order.
+#[test]
+fn samples_loaned_unzeroed_and_fully_written_reach_the_reader_intact() {
+    let p = participant_with(121, with_shm());
+    let near = participant_with(121, with_shm());
+    let (wq, rq) = reliable_keep_all();
+    let w = writer::<Plain>(&p, "ShmUnzeroed", &wq);
+    let r = reader::<Plain>(&near, "ShmUnzeroed", &rq);
+    wait_matched(&w, 1);
+    let n = 40u32;
+    loan_write(&w, 0..n);
+    assert_eq!(
+        take_plain(&r, n as usize, MATCH_TIMEOUT),
+        (0..n).collect::<Vec<_>>()
+    );
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
+    // The buffers come back with the bytes of the samples they carried.
+    let mut stale = 0;
+    for seq in n..3 * n {
+        let mut loan = w.loan_unzeroed().unwrap();
+        if loan.data.iter().any(|b| *b != 0) {
+            stale += 1;
+        }
+        fill_plain(&mut loan, seq % 3, seq);
+        loan.write().unwrap();
+    }
+    assert_eq!(
+        take_plain(&r, 2 * n as usize, MATCH_TIMEOUT),
+        (n..3 * n).collect::<Vec<_>>()
+    );
+    assert!(stale > 0, "no unzeroed loan held an earlier sample's bytes");
+}
+
+/// A user holding every loan a writer lends leaves one buffer for the writer's ordinary writes: they
+/// neither fail nor lose a sample, and the loans written afterwards arrive too.
+#[test]
+fn loans_held_by_the_user_never_starve_an_ordinary_write() {
+    let p = participant_with(122, with_shm());
+    let near = participant_with(122, with_shm());
+    let (wq, rq) = reliable_keep_all_blocking(Duration::from_millis(300));
+    let w = writer::<Plain>(&p, "ShmLoansHeld", &wq);
+    let r = reader::<Plain>(&near, "ShmLoansHeld", &rq);
+    wait_matched(&w, 1);
+    // Loan until the writer lends no more (after its max_blocking_time).
+    let mut held = Vec::new();
+    while let Ok(loan) = w.loan_unzeroed() {
+        held.push(loan);
+        assert!(held.len() < 16, "the writer lends without limit");
+    }
+    assert!(!held.is_empty());
+    let n = 10u32;
+    for seq in 0..n {
+        let mut s = Plain {
+            id: 0,
+            seq: 0,
+            data: [0; 4088],
+        };
+        fill_plain(&mut s, seq % 3, seq);
+        w.write(&s).unwrap();
+    }
+    assert_eq!(
+        take_plain(&r, n as usize, MATCH_TIMEOUT),
+        (0..n).collect::<Vec<_>>()
+    );
+    let m = n + held.len() as u32;
+    for (loan, seq) in held.iter_mut().zip(n..m) {
+        fill_plain(loan, seq % 3, seq);
+    }
+    for loan in held {
+        loan.write().unwrap();
+    }
+    assert_eq!(
+        take_plain(&r, (m - n) as usize, MATCH_TIMEOUT),
+        (n..m).collect::<Vec<_>>()
+    );
+    w.wait_for_acknowledgments(Duration::from_secs(5)).unwrap();
 }
 
 /// A reader of `InPlace<Plain>` reads loaned samples in the writer's shared-memory buffers; a reader on

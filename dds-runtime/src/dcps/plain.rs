@@ -67,8 +67,10 @@ fn plain_layout<T: DdsType + Pod>(version: XcdrVersion) -> Plain {
 /// (same type name, type information and encoding; it matches writers of `T` anywhere), whose samples
 /// dereference to `T`. Each sample keeps its buffer (a shared-memory chunk, or the buffer it was received
 /// in) until it is dropped, which gives the chunk back to the writer: take samples and drop them when
-/// done, as with any loan. A participant copies frames out of shared memory instead once its readers
-/// hold a channel's share of chunks, so a reader that keeps samples never stalls its writers.
+/// done, as with any loan. Once its readers hold a channel's share of chunks, a participant leaves the
+/// channel's next frames queued for a few milliseconds (its writer waits if the queue fills), then copies
+/// frames out of shared memory instead, so a reader that keeps samples holds its writers back only
+/// briefly.
 ///
 /// ```no_run
 /// # #[cfg(feature = "shm")] {

@@ -21,7 +21,7 @@ use crate::cdr::{self, ByteOrder, DdsType};
 use crate::dcps::error::DdsError;
 use crate::dcps::error::DdsResult;
 use crate::dcps::plain::plain_layout_cached;
-use crate::dcps::shm::ShmHost;
+use crate::dcps::shm::{LoanReservation, ShmHost};
 use crate::dcps::sync::{lock, read};
 use crate::rtps::shm::ShmChange;
 use crate::rtps::{ChangeKind, Payload, SequenceNumber, WriteChange};
@@ -50,7 +50,8 @@ pub enum LoanError {
     /// No reader is matched with the writer over shared memory.
     #[error("no reader is matched over shared memory")]
     NoSharedMemoryReader,
-    /// No buffer could be loaned (too many loans held, or out of shared memory).
+    /// No buffer could be loaned (too many loans held, or out of shared memory). A writer lends at most
+    /// `max_loans - 1` buffers at once (3): the last is kept for its ordinary writes.
     #[error(transparent)]
     Shm(#[from] ShmError),
     /// The writer cannot write (not enabled, deleted).
@@ -68,6 +69,8 @@ pub struct SampleLoan<T: DdsType + Pod> {
     at: usize,
     /// The serialized sample in `buf`: the encapsulation header, the sample, the padding.
     payload: Range<usize>,
+    /// Counts `buf` among the writer's lent buffers until it is parked or dropped.
+    reserved: LoanReservation,
 }
 
 impl<T: DdsType + Pod> std::fmt::Debug for SampleLoan<T> {
@@ -90,6 +93,27 @@ impl<T: DdsType + Pod> DataWriter<T> {
     /// shared memory; every buffer stayed taken for the reliability's `max_blocking_time` (changes
     /// waiting for their turn hold theirs).
     pub fn loan(&self) -> Result<SampleLoan<T>, LoanError> {
+        self.lend(true)
+    }
+
+    /// [`loan`](Self::loan) without zeroing the sample: its bytes are unspecified (those of an earlier
+    /// sample of this writer, of another frame of its channel, or zeros). Write every field you publish;
+    /// what you leave is published as found. For a sample that is rewritten whole, or whose large parts
+    /// are meant to stay as they are, this saves a `memset` of the sample's size per loan (1 MiB takes
+    /// about as long to zero as to copy).
+    ///
+    /// Sound because `T` is [`Pod`]: every byte pattern is a valid `T`, and the buffer is initialized
+    /// memory (shared memory only ever written as bytes). The frame's header and the encapsulation
+    /// header are written by the writer, and the padding after the sample (if its encoding has any) is
+    /// zeroed, so readers never see stale bytes outside the sample itself.
+    ///
+    /// Errors: as [`loan`](Self::loan).
+    pub fn loan_unzeroed(&self) -> Result<SampleLoan<T>, LoanError> {
+        self.lend(false)
+    }
+
+    /// [`loan`](Self::loan) (`zeroed`) or [`loan_unzeroed`](Self::loan_unzeroed).
+    fn lend(&self, zeroed: bool) -> Result<SampleLoan<T>, LoanError> {
         self.inner.state.check_enabled()?;
         let (_, pad) =
             plain_layout_cached::<T>(self.data_representation()).ok_or(LoanError::NotPlain)?;
@@ -105,10 +129,15 @@ impl<T: DdsType + Pod> DataWriter<T> {
         let len = first + (align - 1) + size + pad;
         let reliable = self.qos().reliability.is_reliable();
         // Every buffer may be taken by changes waiting for their turn (for readers to connect, or for
-        // room in a reader's queue): wait for them as a write waits for flow control.
+        // room in a reader's queue), or lent (one is always kept for ordinary writes): wait for them as
+        // a write waits for flow control.
         let deadline = Instant::now() + self.inner.fixed.max_block();
-        let buf = loop {
-            match link.loan(id, reliable, len) {
+        let (buf, reserved) = loop {
+            let got = link
+                .reserve(id)
+                .ok_or_else(|| ShmError::Loan("every loan this writer may lend is taken".into()))
+                .and_then(|r| Ok((link.loan(id, reliable, len, zeroed)?, r)));
+            match got {
                 Ok(b) => break b,
                 Err(e) if Instant::now() >= deadline => return Err(e.into()),
                 Err(_) => {
@@ -128,10 +157,15 @@ impl<T: DdsType + Pod> DataWriter<T> {
             buf,
             at,
             payload,
+            reserved,
         };
         let head = plain_layout_cached::<T>(self.data_representation()).map(|(h, _)| h);
-        let start = loan.payload.start;
+        let Range { start, end } = loan.payload;
         loan.buf[start..start + 4].copy_from_slice(&head.unwrap_or_default());
+        // The encoding's padding after the sample is zero (an unzeroed buffer holds older bytes there).
+        // The bytes before the encapsulation header (the frame header, written when the frame is sent,
+        // and the alignment gap) and after the payload are outside the range readers decode.
+        loan.buf[end - pad..end].fill(0);
         Ok(loan)
     }
 }
@@ -150,10 +184,12 @@ impl<T: DdsType + Pod> SampleLoan<T> {
             buf,
             at,
             payload,
+            reserved,
         } = self;
         let sample: &T = bytemuck::from_bytes(&buf[at..at + std::mem::size_of::<T>()]);
         let written = writer.submit_loaned(&buf[payload.clone()], sample, timestamp)?;
         writer.park_loaned(written, buf, payload);
+        drop(reserved);
         Ok(())
     }
 
@@ -245,9 +281,8 @@ impl<T: DdsType> DataWriter<T> {
         if !self.inner.direct_ok.load(Ordering::Relaxed) && asked() {
             return None;
         }
-        if !link.may_park(id) {
-            return None;
-        }
+        // Counts the buffer among the lent ones until it is parked (`None`: it would take the last loan).
+        let reserved = link.reserve(id)?;
         let reliable = read(&self.inner.current).reliability.is_reliable();
         let head = ShmChange::HEADER_LEN;
         let mut buf = link.loan_uninit(id, reliable, head + len).ok()?;
@@ -280,10 +315,11 @@ impl<T: DdsType> DataWriter<T> {
         // SAFETY: the header and the tail were zeroed just above, `serialize_placed` wrote the rest.
         let buf = unsafe { buf.assume_init() };
         let payload = head..head + n;
-        Some(
-            self.submit_loaned(&buf[payload.clone()], sample, timestamp)
-                .map(|written| self.park_loaned(written, buf, payload)),
-        )
+        let done = self
+            .submit_loaned(&buf[payload.clone()], sample, timestamp)
+            .map(|written| self.park_loaned(written, buf, payload));
+        drop(reserved);
+        Some(done)
     }
 }
 

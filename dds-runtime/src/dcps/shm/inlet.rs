@@ -17,12 +17,18 @@ pub(super) struct Inlet {
     held: usize,
     /// The holders of the frames given to the core, reused once released ([`Inlet::release`]).
     holders: Vec<Arc<HeldFrame>>,
+    /// Since when its readers hold [`MAX_HELD`] frames ([`Inlet::defer`]).
+    full_since: Option<Instant>,
 }
 
 /// Most frames of one channel held at once; past it, frames are copied out of shared memory and given
 /// back at once. iceoryx2 lends a subscriber at most the channel's queue depth of frames: readers that
 /// keep samples in place must not take them all, or the channel would stall.
 const MAX_HELD: usize = 12;
+
+/// How long a channel's frames are left in its queue while its readers hold [`MAX_HELD`] frames, before
+/// frames are copied out instead ([`Inlet::defer`]).
+const HOLD_GRACE: Duration = Duration::from_millis(5);
 
 /// Frames at least this long are given to the core one at a time ([`ShmLink::drain`]).
 const ONE_BY_ONE: usize = 64 * 1024;
@@ -68,6 +74,23 @@ impl Inlet {
         }
         let owner: Arc<dyn AsRef<[u8]> + Send + Sync> = slot.clone();
         Payload::from_owner(owner)
+    }
+
+    /// Whether to leave this channel's frames in its queue for now: its readers hold [`MAX_HELD`] frames
+    /// (samples not taken yet, typically: the reading application is behind its writer). For up to
+    /// [`HOLD_GRACE`] the frames wait (a full queue then holds the writer back) rather than being copied
+    /// out of shared memory, which cost a reader of 1 MiB samples read in place more CPU than everything
+    /// else; past it frames are copied as before, so a reader that keeps samples in place holds its
+    /// writer back [`HOLD_GRACE`] at most.
+    fn defer(&mut self, now: Instant) -> bool {
+        if self.held >= MAX_HELD {
+            self.release();
+        }
+        if self.held < MAX_HELD {
+            self.full_since = None;
+            return false;
+        }
+        now - *self.full_since.get_or_insert(now) < HOLD_GRACE
     }
 
     /// Gives back to the writer the frames no payload refers to any more (their readers decoded them, or
@@ -121,6 +144,8 @@ impl ShmLink {
         highest.clear();
         highest.resize(channels.len(), 0);
         let mut greeting = false;
+        let mut deferred = false;
+        let now = Instant::now();
         for (i, inlet) in channels.iter_mut().enumerate() {
             inlet.release();
             if let Some(since) = inlet.greeting_since {
@@ -133,6 +158,10 @@ impl ShmLink {
                 greeting |= since.elapsed() < CONNECT_TIMEOUT;
             }
             for _ in 0..BATCH {
+                if inlet.defer(now) {
+                    deferred = true;
+                    break;
+                }
                 match inlet.subscriber.receive() {
                     Ok(Some(s)) => {
                         if let Ok(h) = decode_header(&s) {
@@ -150,6 +179,7 @@ impl ShmLink {
             }
         }
         self.greeting.store(greeting, Ordering::Release);
+        self.deferring.store(deferred, Ordering::Release);
         let n = frames.len();
         if n > 0 {
             tracing::trace!(frames = n, "shared-memory frames drained");
@@ -256,6 +286,7 @@ impl ShmLink {
                         greeting_since: Some(Instant::now()),
                         held: 0,
                         holders: Vec::new(),
+                        full_since: None,
                     })
                 });
             match opened {

@@ -14,7 +14,7 @@
 //! waits for like RTPS ACKNACKs.
 
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -25,6 +25,7 @@ mod inlet;
 mod outlet;
 
 use inlet::Inlets;
+pub(crate) use outlet::LoanReservation;
 use outlet::{FlushScratch, Outlet, Parked};
 
 use super::sync::lock;
@@ -61,6 +62,10 @@ const MAX_IDLE: Duration = Duration::from_millis(100);
 
 /// Longest wait of a receive thread for the reading thread ([`ShmLink::drain_first`]).
 const DRAIN_WAIT: Duration = Duration::from_millis(100);
+
+/// How often the reading thread looks again at channels whose frames it left queued because their
+/// readers hold many already.
+const DEFER_POLL: Duration = Duration::from_micros(100);
 
 /// How often changes held for readers that are not connected yet are retried.
 const HELD_RETRY: Duration = Duration::from_millis(1);
@@ -108,9 +113,16 @@ pub(crate) struct ShmLink {
     scratch: Mutex<FlushScratch>,
     /// Loaned changes the core queued, until their turn.
     parked: Mutex<Vec<Parked>>,
+    /// By writer: buffers loaned from its channel for a sample written in place and not parked yet
+    /// ([`ShmLink::reserve`]).
+    lent: Mutex<HashMap<EntityId, Arc<AtomicUsize>>>,
     /// Whether a channel we read waits for its first frame and greets its writer (the reading thread
     /// then polls quickly: the writer waits for the greeting).
     greeting: AtomicBool,
+    /// Whether a channel's frames were left in its queue at the last drain pass because its readers
+    /// hold many already (the reading thread then polls every [`DEFER_POLL`]: a reader that drops
+    /// samples does not signal).
+    deferring: AtomicBool,
     /// Drain passes of the reading thread, for [`drain_first`](ShmLink::drain_first).
     passes: Mutex<u64>,
     passed: std::sync::Condvar,
@@ -198,7 +210,9 @@ impl ShmLink {
             notifiers: Mutex::new(HashMap::new()),
             scratch: Mutex::new(FlushScratch::default()),
             parked: Mutex::new(Vec::new()),
+            lent: Mutex::new(HashMap::new()),
             greeting: AtomicBool::new(false),
+            deferring: AtomicBool::new(false),
             passes: Mutex::new(0),
             passed: std::sync::Condvar::new(),
         };
@@ -250,13 +264,14 @@ fn poll_loop<H: ShmHost>(driver: Weak<H>) {
         // The thread never waits to send (a peer's queue may be full while its own thread waits on
         // ours): it only sends when no other thread is sending, changes held for connecting readers
         // typically.
-        let (n, held, listener) = match d.shm_link() {
+        let (n, held, deferring, listener) = match d.shm_link() {
             Some(link) if !link.stopped.load(Ordering::Acquire) => {
                 let n = link.drain(&*d);
                 link.count_pass();
                 link.try_flush();
                 let held = !lock(&link.pending).is_empty() || link.greeting.load(Ordering::Acquire);
-                (n, held, link.listener.clone())
+                let deferring = link.deferring.load(Ordering::Acquire);
+                (n, held, deferring, link.listener.clone())
             }
             _ => return,
         };
@@ -267,14 +282,18 @@ fn poll_loop<H: ShmHost>(driver: Weak<H>) {
         }
         match listener {
             Some(l) => {
-                let timeout = if held { HELD_RETRY } else { MAX_IDLE };
+                let timeout = match (deferring, held) {
+                    (true, _) => DEFER_POLL,
+                    (false, true) => HELD_RETRY,
+                    (false, false) => MAX_IDLE,
+                };
                 if let Err(e) = l.wait(timeout) {
                     tracing::debug!(error = %e, "shared-memory wait failed");
                     std::thread::sleep(HELD_RETRY);
                 }
             }
             None => {
-                if held {
+                if held || deferring {
                     idle = Duration::from_micros(20);
                 }
                 std::thread::sleep(idle);

@@ -12,6 +12,16 @@ pub(super) struct Parked {
     payload: std::ops::Range<usize>,
 }
 
+/// A loan of a writer's channel counted by [`ShmLink::reserve`], until dropped.
+#[derive(Debug)]
+pub(crate) struct LoanReservation(Arc<AtomicUsize>);
+
+impl Drop for LoanReservation {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::Relaxed);
+    }
+}
+
 /// What a flush collects, kept between flushes (empty) for the capacity of its collections.
 #[derive(Default)]
 pub(super) struct FlushScratch {
@@ -200,17 +210,24 @@ impl ShmLink {
         }
     }
 
-    /// A buffer of `len` bytes from the channel of `writer` (reliable or not), zeroed, for a sample
-    /// written in place: [`park`](Self::park) it once the core has queued the change.
+    /// A buffer of `len` bytes from the channel of `writer` (reliable or not), for a sample written in
+    /// place: [`park`](Self::park) it once the core has queued the change. `zeroed`: every byte 0;
+    /// otherwise the bytes are unspecified ([`ShmPublisher::loan_unzeroed`]: an earlier frame's, or
+    /// zeros). Take a [`reserve`](Self::reserve)ation first and keep it until the buffer is parked.
     pub(crate) fn loan(
         &self,
         writer: EntityId,
         reliable: bool,
         len: usize,
+        zeroed: bool,
     ) -> Result<ShmLoan, ShmError> {
-        self.outlet(&mut lock(&self.outlets), writer, reliable)?
-            .publisher
-            .loan(len)
+        let mut outlets = lock(&self.outlets);
+        let publisher = &self.outlet(&mut outlets, writer, reliable)?.publisher;
+        if zeroed {
+            publisher.loan(len)
+        } else {
+            publisher.loan_unzeroed(len)
+        }
     }
 
     /// [`loan`](Self::loan), not initialized (for a sample serialized into it).
@@ -257,17 +274,26 @@ impl ShmLink {
         });
     }
 
-    /// Whether a sample serialized into a buffer loaned from `writer`'s channel may wait there for its
-    /// turn ([`park`](Self::park)): parked buffers are loans, and one loan must stay free for a change
-    /// queued before them that is copied into the channel when its turn comes. When every loan was
-    /// parked, such a change found none (`ExceedsMaxLoans`) and was lost: the first sample of a burst
-    /// written before the reader connected, the others loaned behind it.
-    pub(crate) fn may_park(&self, writer: EntityId) -> bool {
+    /// Leave to loan a buffer of `writer`'s channel for a sample written in place (by the user,
+    /// `DataWriter::loan`, or serialized into it, `DataWriter::write_direct`) that will wait there for its
+    /// turn ([`park`](Self::park)); `None` when that would leave no loan free. Keep it until the buffer
+    /// is parked or dropped. Parked and lent buffers are loans, and one loan must stay free for a change
+    /// that is copied into the channel when its turn comes (an ordinary write, or a change queued before
+    /// the parked ones): when every loan was parked, such a change found none (`ExceedsMaxLoans`) and was
+    /// lost (the first sample of a burst written before the reader connected, the others loaned behind
+    /// it); when a user held every loan, an ordinary write of the same writer was lost the same way.
+    pub(crate) fn reserve(&self, writer: EntityId) -> Option<LoanReservation> {
+        let mut lent = lock(&self.lent);
+        let count = lent.entry(writer).or_default();
         let parked = lock(&self.parked)
             .iter()
             .filter(|p| p.writer == writer)
             .count();
-        parked + 1 < channel_config(true).max_loans
+        if count.load(Ordering::Relaxed) + parked + 1 >= channel_config(true).max_loans {
+            return None;
+        }
+        count.fetch_add(1, Ordering::Relaxed);
+        Some(LoanReservation(count.clone()))
     }
 
     fn open_outlet(&self, writer: EntityId, reliable: bool) -> Result<Outlet, ShmError> {
@@ -398,6 +424,7 @@ impl ShmLink {
     pub(crate) fn close_writer(&self, writer: EntityId) {
         self.flush();
         lock(&self.parked).retain(|p| p.writer != writer);
+        lock(&self.lent).remove(&writer);
         lock(&self.outlets).remove(&writer);
     }
 }

@@ -325,6 +325,27 @@ impl ShmPublisher {
         Ok(ShmLoan { sample })
     }
 
+    /// [`loan`](Self::loan) without zeroing: the buffer holds whatever its chunk of the segment holds,
+    /// the bytes of an earlier sample of this publisher or the zeros of a fresh segment. Overwrite every
+    /// byte that readers will look at. For a sample whose every byte is rewritten anyway (a plain-data
+    /// sample written in place), this saves a `memset` of `len` bytes per sample.
+    pub fn loan_unzeroed(&self, len: usize) -> Result<ShmLoan, ShmError> {
+        let sample = self
+            .publisher
+            .loan_slice_uninit(len)
+            .map_err(|e| ShmError::Loan(format!("{e:?}")))?;
+        // SAFETY: the payload of a chunk is initialized memory. A segment is created as a file in
+        // shared memory (`shm_open`, `ftruncate`: zero-filled pages) and mapped; afterwards only this
+        // publisher writes its chunks' payloads (subscribers map it read-only), and it writes them only
+        // as bytes: through `loan` (zeroed by iceoryx2, then `&mut [u8]`), through `loan_uninit`, whose
+        // `assume_init` requires every byte to be written first, or through this function's `&mut [u8]`.
+        // No value with padding or uninitialized bytes is ever stored in a payload, so every byte read
+        // through the `&[u8]` is an initialized `u8` (and every `u8` value is valid).
+        Ok(ShmLoan {
+            sample: unsafe { sample.assume_init() },
+        })
+    }
+
     /// The nodes ([`ShmNode::id`]) of the channel's subscribers.
     pub fn subscriber_nodes(&self) -> Vec<String> {
         let mut nodes = Vec::new();
@@ -555,10 +576,23 @@ fn poll_readable(fd: i32, timeout: Duration) -> Result<(), ShmError> {
         events: libc::POLLIN,
         revents: 0,
     };
-    // Rounded up: a wait shorter than a millisecond still waits.
-    let ms = timeout.as_micros().div_ceil(1000).min(i32::MAX as u128) as i32;
+    // On Linux `ppoll`, to the microsecond; elsewhere `poll`, rounded up to whole milliseconds.
+    #[cfg(target_os = "linux")]
+    let r = {
+        let t = libc::timespec {
+            tv_sec: timeout.as_secs().min(i32::MAX as u64) as libc::time_t,
+            tv_nsec: libc::c_long::from(timeout.subsec_nanos() as i32),
+        };
+        // SAFETY: `p` is one valid `pollfd`, as the count says; `t` is a valid `timespec`; no signal mask.
+        unsafe { libc::ppoll(&mut p, 1, &t, std::ptr::null()) }
+    };
+    #[cfg(not(target_os = "linux"))]
     // SAFETY: `p` is one valid `pollfd`, as the count says.
-    if unsafe { libc::poll(&mut p, 1, ms) } < 0 {
+    let r = unsafe {
+        let ms = timeout.as_micros().div_ceil(1000).min(i32::MAX as u128) as i32;
+        libc::poll(&mut p, 1, ms)
+    };
+    if r < 0 {
         let e = std::io::Error::last_os_error();
         if e.kind() != std::io::ErrorKind::Interrupted {
             return Err(ShmError::Transfer(format!("poll: {e}")));
