@@ -19,6 +19,7 @@ use super::status::SampleRejectedReason;
 
 mod order;
 mod query;
+mod single;
 use query::read_query;
 pub(crate) use query::SharedFilter;
 
@@ -629,6 +630,9 @@ impl<T: FilterFields> ReaderCache<T> {
         take: bool,
         mut emit: impl FnMut(&mut Option<T>, SampleInfo),
     ) {
+        if self.collect_single(sel, take, &mut emit) {
+            return;
+        }
         let limit = sel.max_samples.unwrap_or(usize::MAX);
         let q = read_query(sel);
         let q = q.as_deref();
@@ -719,34 +723,13 @@ impl<T: FilterFields> ReaderCache<T> {
             };
             tc.emitted += 1;
             let sample_rank = (tc.count - tc.emitted) as u32;
-            let (mrs_dg, mrs_nw) = inst
+            // The generation of the instance's most recent sample in the collection.
+            let mrs_gen = inst
                 .samples
                 .get(tc.last_index)
-                .map(|s| (s.disposed_gen, s.no_writers_gen))
-                .unwrap_or((0, 0));
+                .map_or(0, |s| s.disposed_gen + s.no_writers_gen);
+            let info = sample_info(inst, &inst.samples[idx], tc.handle, sample_rank, mrs_gen);
             let s = &mut inst.samples[idx];
-            let gen = s.disposed_gen + s.no_writers_gen;
-            let info = SampleInfo {
-                sample_state: if s.read {
-                    SampleState::Read
-                } else {
-                    SampleState::NotRead
-                },
-                view_state: inst.view,
-                instance_state: inst.state,
-                source_timestamp: s.source_timestamp,
-                reception_timestamp: s.reception_timestamp,
-                instance_handle: tc.handle,
-                publication_handle: InstanceHandle::from_guid(s.writer),
-                publication_guid: s.writer,
-                disposed_generation_count: s.disposed_gen,
-                no_writers_generation_count: s.no_writers_gen,
-                sample_rank,
-                generation_rank: (mrs_dg + mrs_nw).saturating_sub(gen),
-                absolute_generation_rank: (inst.disposed_gen + inst.no_writers_gen)
-                    .saturating_sub(gen),
-                valid_data: s.data.is_some(),
-            };
             s.read = true;
             emit(&mut s.data, info);
         }
@@ -769,9 +752,7 @@ impl<T: FilterFields> ReaderCache<T> {
 
     /// An instance with no samples, no writers and not alive is forgotten.
     fn maybe_drop_instance(&mut self, h: InstanceHandle) {
-        let drop_it = self.instances.get(&h).is_some_and(|i| {
-            i.samples.is_empty() && i.writers.is_empty() && i.state != InstanceState::Alive
-        });
+        let drop_it = self.instances.get(&h).is_some_and(single::forgettable);
         if drop_it {
             if let Some(i) = self.instances.remove(&h) {
                 self.by_key.remove(&i.key);
@@ -838,6 +819,38 @@ struct Touched {
 
 /// Removes the samples at `indices` (ascending, distinct) from `q`: a prefix (the usual take of the oldest)
 /// with one drain, anything else in one pass over the queue; never an element shift per removed sample.
+/// The `SampleInfo` of `s`, a sample of `inst` (`handle`) with `sample_rank` samples of its instance after
+/// it in the collection, whose most recent one there has generation `mrs_gen` (DDS 1.4 §2.2.2.5.5).
+fn sample_info<T>(
+    inst: &Instance<T>,
+    s: &Stored<T>,
+    handle: InstanceHandle,
+    sample_rank: u32,
+    mrs_gen: u32,
+) -> SampleInfo {
+    let gen = s.disposed_gen + s.no_writers_gen;
+    SampleInfo {
+        sample_state: if s.read {
+            SampleState::Read
+        } else {
+            SampleState::NotRead
+        },
+        view_state: inst.view,
+        instance_state: inst.state,
+        source_timestamp: s.source_timestamp,
+        reception_timestamp: s.reception_timestamp,
+        instance_handle: handle,
+        publication_handle: InstanceHandle::from_guid(s.writer),
+        publication_guid: s.writer,
+        disposed_generation_count: s.disposed_gen,
+        no_writers_generation_count: s.no_writers_gen,
+        sample_rank,
+        generation_rank: mrs_gen.saturating_sub(gen),
+        absolute_generation_rank: (inst.disposed_gen + inst.no_writers_gen).saturating_sub(gen),
+        valid_data: s.data.is_some(),
+    }
+}
+
 fn remove_indices<S>(q: &mut VecDeque<S>, indices: impl ExactSizeIterator<Item = usize> + Clone) {
     let n = indices.len();
     if indices.clone().enumerate().all(|(k, i)| k == i) {

@@ -187,12 +187,11 @@ impl WriterInstances {
         key: &[u8],
         written: Option<Instant>,
     ) -> Option<(InstanceHandle, Option<[u8; 16]>)> {
-        let h = self.by_key.get(key).copied()?;
-        let i = self.by_handle.get_mut(&h)?;
+        let found = self.by_key.get(key).copied()?;
         if let Some(now) = written {
-            i.last_write = now;
+            self.by_handle.get_mut(&found.0)?.last_write = now;
         }
-        Some((h, i.key_hash))
+        Some(found)
     }
 
     /// Registers the instance with serialized key `key` (or returns it, when another thread registered it
@@ -209,7 +208,7 @@ impl WriterInstances {
         }
         self.next += 1;
         let h = InstanceHandle(self.next);
-        self.by_key.insert(key.clone(), h);
+        self.by_key.insert(key.clone(), (h, key_hash));
         self.by_handle.insert(
             h,
             super::WriterInstance {
