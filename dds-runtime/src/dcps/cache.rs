@@ -160,6 +160,9 @@ pub(crate) struct ReaderCache<T> {
     keyed: bool,
     instances: BTreeMap<InstanceHandle, Instance<T>>,
     by_key: HashMap<Vec<u8>, InstanceHandle>,
+    /// The serialized key of the instance a sample was last stored for, and its handle while it is known:
+    /// a stream of one instance compares the key instead of hashing it.
+    last: (Vec<u8>, Option<InstanceHandle>),
     /// The key buffer of the last sample of a known instance, for the next sample's key.
     spare_key: Vec<u8>,
     next_handle: u64,
@@ -205,6 +208,7 @@ impl<T: FilterFields> ReaderCache<T> {
             keyed,
             instances: BTreeMap::new(),
             by_key: HashMap::new(),
+            last: (Vec::new(), None),
             spare_key: Vec::new(),
             next_handle: 1,
             next_seq: 0,
@@ -234,9 +238,8 @@ impl<T: FilterFields> ReaderCache<T> {
         let Some((_, h)) = oldest else {
             return false;
         };
-        if let Some(i) = self.instances.remove(&h) {
+        if let Some(i) = self.forget_instance(h) {
             self.total -= i.samples.len();
-            self.by_key.remove(&i.key);
         }
         true
     }
@@ -362,10 +365,18 @@ impl<T: FilterFields> ReaderCache<T> {
         } else {
             Vec::new()
         };
+        if let (k, Some(h)) = &self.last {
+            if *k == key {
+                let h = *h;
+                self.spare_key = key;
+                return Ok(h);
+            }
+        }
         match self.by_key.get(&key) {
             Some(h) => {
                 let h = *h;
-                self.spare_key = key;
+                self.spare_key = std::mem::replace(&mut self.last.0, key);
+                self.last.1 = Some(h);
                 Ok(h)
             }
             None if inc.kind == ChangeKind::Unregister => Err(Outcome::Filtered),
@@ -754,10 +765,18 @@ impl<T: FilterFields> ReaderCache<T> {
     fn maybe_drop_instance(&mut self, h: InstanceHandle) {
         let drop_it = self.instances.get(&h).is_some_and(single::forgettable);
         if drop_it {
-            if let Some(i) = self.instances.remove(&h) {
-                self.by_key.remove(&i.key);
-            }
+            self.forget_instance(h);
         }
+    }
+
+    /// Removes the instance `h` (returned, with its samples) and its key.
+    fn forget_instance(&mut self, h: InstanceHandle) -> Option<Instance<T>> {
+        let i = self.instances.remove(&h)?;
+        self.by_key.remove(&i.key);
+        if self.last.1 == Some(h) {
+            self.last.1 = None;
+        }
+        Some(i)
     }
 
     /// Time-driven QoS: lifespan expiry, autopurge, deadline. Returns the instances whose deadline was missed.

@@ -320,6 +320,9 @@ struct WriterInstance {
 pub(crate) struct WriterInstances {
     /// Handle and key hash by serialized key: a write without an offered deadline looks here only.
     by_key: HashMap<Vec<u8>, (InstanceHandle, Option<[u8; 16]>)>,
+    /// The serialized key of the instance looked up last, and what `by_key` holds for it: a stream of one
+    /// instance (a ping/pong) compares the key instead of hashing it. Forgotten with the instance.
+    last: (Vec<u8>, Option<(InstanceHandle, Option<[u8; 16]>)>),
     by_handle: HashMap<InstanceHandle, WriterInstance>,
     next: u64,
     /// Last write of a keyless topic (its single instance), for the offered deadline.

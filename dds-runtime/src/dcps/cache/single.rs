@@ -49,9 +49,7 @@ impl<T: FilterFields> ReaderCache<T> {
             inst.samples.clear();
             self.total = 0;
             if forgettable(inst) {
-                if let Some(i) = self.instances.remove(&handle) {
-                    self.by_key.remove(&i.key);
-                }
+                self.forget_instance(handle);
             }
         }
         true

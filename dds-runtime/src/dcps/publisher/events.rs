@@ -187,7 +187,16 @@ impl WriterInstances {
         key: &[u8],
         written: Option<Instant>,
     ) -> Option<(InstanceHandle, Option<[u8; 16]>)> {
-        let found = self.by_key.get(key).copied()?;
+        let found = match &self.last {
+            (k, Some(found)) if k.as_slice() == key => *found,
+            _ => {
+                let found = self.by_key.get(key).copied()?;
+                self.last.0.clear();
+                self.last.0.extend_from_slice(key);
+                self.last.1 = Some(found);
+                found
+            }
+        };
         if let Some(now) = written {
             self.by_handle.get_mut(&found.0)?.last_write = now;
         }
@@ -259,6 +268,9 @@ impl WriterInstances {
         if matches!(kind, ChangeKind::Unregister | ChangeKind::DisposeUnregister) {
             if let Some(i) = self.by_handle.remove(&h) {
                 self.by_key.remove(&i.key);
+                if self.last.1.is_some_and(|(l, _)| l == h) {
+                    self.last.1 = None;
+                }
             }
         }
     }

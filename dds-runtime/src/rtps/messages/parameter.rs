@@ -446,7 +446,11 @@ mod tests {
             assert!(d.coherent_set.is_some());
             assert_eq!(d.group_seq_num, pl.group_seq_num());
             assert_eq!(d.group_seq_num, None, "too short a value");
-            assert_eq!(d.not_understood, Some(0x4ffe), "vendor-specific ones are skipped");
+            assert_eq!(
+                d.not_understood,
+                Some(0x4ffe),
+                "vendor-specific ones are skipped"
+            );
             assert_eq!(
                 pl.check_must_understand(|_| false),
                 Err(WireError::MustUnderstand(0x4ffe))
