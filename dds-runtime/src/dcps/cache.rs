@@ -343,11 +343,16 @@ impl<T: FilterFields> ReaderCache<T> {
             Ok(h) => h,
             Err(outcome) => return outcome,
         };
-        if !self.admits(handle, &mut inc, now) {
+        let Some(inst) = self.instances.get_mut(&handle) else {
+            return Outcome::Filtered;
+        };
+        if !admits(&self.qos, inst, &mut inc, now) {
             return Outcome::Filtered;
         }
         if alive {
-            self.insert_alive(handle, inc, now)
+            // The instance found once for both (where each looked it up).
+            let counts = (&mut self.total, &mut self.next_seq);
+            insert_alive(&self.qos, counts, inst, handle, inc, now)
         } else {
             self.insert_state_change(handle, inc, now)
         }
@@ -392,93 +397,6 @@ impl<T: FilterFields> ReaderCache<T> {
                     })
             }
         }
-    }
-
-    /// Whether `inc` counts for its instance under exclusive ownership and destination order (false also
-    /// for an unknown instance). Records the writer's strength and the instance's owner.
-    fn admits(&mut self, handle: InstanceHandle, inc: &mut Incoming<T>, now: Instant) -> bool {
-        let exclusive = self.qos.ownership == Ownership::Exclusive;
-        let by_source = self.qos.destination_order == DestinationOrder::BySourceTimestamp;
-        let deadline = finite(self.qos.deadline.0);
-        let Some(inst) = self.instances.get_mut(&handle) else {
-            return false;
-        };
-        if inst.key_holder.is_none() {
-            inst.key_holder = inc.key_holder.take();
-        }
-
-        // Exclusive ownership: only the strongest alive writer's changes count (ties: lowest GUID); an
-        // owner that missed the requested deadline of the instance hands it over.
-        if exclusive {
-            inst.writers.insert(inc.writer, inc.strength);
-            let stale =
-                deadline.is_some_and(|d| now.saturating_duration_since(inst.last_data) >= d);
-            if !order::owner_accepts(inst.owner, &inst.writers, inc.writer, inc.strength, stale) {
-                if matches!(
-                    inc.kind,
-                    ChangeKind::Unregister | ChangeKind::DisposeUnregister
-                ) {
-                    inst.writers.remove(&inc.writer);
-                }
-                return false;
-            }
-            inst.owner = Some((inc.writer, inc.strength));
-        }
-
-        // Destination order by source timestamp: a value or dispose older than the newest accepted one
-        // of the instance is dropped (DDS 1.4 §2.2.3.17); unregisters always count.
-        let ordered = matches!(inc.kind, ChangeKind::Alive | ChangeKind::Dispose);
-        !(by_source && ordered && !order::in_source_order(inst.newest_source, inc.source_timestamp))
-    }
-
-    /// Stores a value: subject to the time-based filter and the history and resource limits; revives a
-    /// not-alive instance.
-    fn insert_alive(&mut self, handle: InstanceHandle, inc: Incoming<T>, now: Instant) -> Outcome {
-        let min_sep = self.qos.time_based_filter.minimum_separation;
-        let history = self.qos.history;
-        let limits = self.qos.resource_limits;
-        let total = self.total;
-        let Some(inst) = self.instances.get_mut(&handle) else {
-            return Outcome::Filtered;
-        };
-        if !min_sep.is_zero()
-            && inst
-                .last_accepted
-                .is_some_and(|t| now.saturating_duration_since(t) < min_sep)
-        {
-            return Outcome::Filtered;
-        }
-        let per_instance = inst.samples.len();
-        if let History::KeepAll = history {
-            if limits
-                .max_samples_per_instance
-                .is_some_and(|m| per_instance >= m as usize)
-            {
-                return Outcome::Rejected {
-                    reason: SampleRejectedReason::BySamplesPerInstanceLimit,
-                    handle,
-                };
-            }
-        }
-        let evict = matches!(history, History::KeepLast(d) if per_instance >= d.max(1) as usize);
-        if !evict && limits.max_samples.is_some_and(|m| total >= m as usize) {
-            return Outcome::Rejected {
-                reason: SampleRejectedReason::BySamplesLimit,
-                handle,
-            };
-        }
-        inst.revive(&inc, now);
-        if evict {
-            if let Some(old) = inst.samples.pop_front() {
-                drop(old);
-                self.total -= 1;
-            }
-        }
-        let seq = self.next_seq;
-        self.next_seq += 1;
-        inst.push_sample(seq, inc, true);
-        self.total += 1;
-        Outcome::Accepted { handle }
     }
 
     /// Dispose / unregister: a state change; visible through an invalid sample when no unread sample of the
@@ -868,6 +786,97 @@ fn sample_info<T>(
         absolute_generation_rank: (inst.disposed_gen + inst.no_writers_gen).saturating_sub(gen),
         valid_data: s.data.is_some(),
     }
+}
+
+/// Whether `inc` counts for its instance `inst` under exclusive ownership and destination order. Records
+/// the writer's strength and the instance's owner.
+fn admits<T>(
+    qos: &DataReaderQos,
+    inst: &mut Instance<T>,
+    inc: &mut Incoming<T>,
+    now: Instant,
+) -> bool {
+    let exclusive = qos.ownership == Ownership::Exclusive;
+    let by_source = qos.destination_order == DestinationOrder::BySourceTimestamp;
+    let deadline = finite(qos.deadline.0);
+    if inst.key_holder.is_none() {
+        inst.key_holder = inc.key_holder.take();
+    }
+
+    // Exclusive ownership: only the strongest alive writer's changes count (ties: lowest GUID); an
+    // owner that missed the requested deadline of the instance hands it over.
+    if exclusive {
+        inst.writers.insert(inc.writer, inc.strength);
+        let stale = deadline.is_some_and(|d| now.saturating_duration_since(inst.last_data) >= d);
+        if !order::owner_accepts(inst.owner, &inst.writers, inc.writer, inc.strength, stale) {
+            if matches!(
+                inc.kind,
+                ChangeKind::Unregister | ChangeKind::DisposeUnregister
+            ) {
+                inst.writers.remove(&inc.writer);
+            }
+            return false;
+        }
+        inst.owner = Some((inc.writer, inc.strength));
+    }
+
+    // Destination order by source timestamp: a value or dispose older than the newest accepted one
+    // of the instance is dropped (DDS 1.4 §2.2.3.17); unregisters always count.
+    let ordered = matches!(inc.kind, ChangeKind::Alive | ChangeKind::Dispose);
+    !(by_source && ordered && !order::in_source_order(inst.newest_source, inc.source_timestamp))
+}
+
+/// Stores a value: subject to the time-based filter and the history and resource limits; revives a
+/// not-alive instance.
+fn insert_alive<T>(
+    qos: &DataReaderQos,
+    (total, next_seq): (&mut usize, &mut u64),
+    inst: &mut Instance<T>,
+    handle: InstanceHandle,
+    inc: Incoming<T>,
+    now: Instant,
+) -> Outcome {
+    let min_sep = qos.time_based_filter.minimum_separation;
+    let history = qos.history;
+    let limits = qos.resource_limits;
+    if !min_sep.is_zero()
+        && inst
+            .last_accepted
+            .is_some_and(|t| now.saturating_duration_since(t) < min_sep)
+    {
+        return Outcome::Filtered;
+    }
+    let per_instance = inst.samples.len();
+    if let History::KeepAll = history {
+        if limits
+            .max_samples_per_instance
+            .is_some_and(|m| per_instance >= m as usize)
+        {
+            return Outcome::Rejected {
+                reason: SampleRejectedReason::BySamplesPerInstanceLimit,
+                handle,
+            };
+        }
+    }
+    let evict = matches!(history, History::KeepLast(d) if per_instance >= d.max(1) as usize);
+    if !evict && limits.max_samples.is_some_and(|m| *total >= m as usize) {
+        return Outcome::Rejected {
+            reason: SampleRejectedReason::BySamplesLimit,
+            handle,
+        };
+    }
+    inst.revive(&inc, now);
+    if evict {
+        if let Some(old) = inst.samples.pop_front() {
+            drop(old);
+            *total -= 1;
+        }
+    }
+    let seq = *next_seq;
+    *next_seq += 1;
+    inst.push_sample(seq, inc, true);
+    *total += 1;
+    Outcome::Accepted { handle }
 }
 
 fn remove_indices<S>(q: &mut VecDeque<S>, indices: impl ExactSizeIterator<Item = usize> + Clone) {
