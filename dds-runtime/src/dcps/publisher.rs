@@ -316,13 +316,16 @@ struct WriterInstance {
     last_write: Instant,
 }
 
+/// A writer's instance as a lookup by key finds it: its handle and key hash.
+pub(crate) type FoundInstance = (InstanceHandle, Option<[u8; 16]>);
+
 #[derive(Default)]
 pub(crate) struct WriterInstances {
     /// Handle and key hash by serialized key: a write without an offered deadline looks here only.
-    by_key: HashMap<Vec<u8>, (InstanceHandle, Option<[u8; 16]>)>,
+    by_key: HashMap<Vec<u8>, FoundInstance>,
     /// The serialized key of the instance looked up last, and what `by_key` holds for it: a stream of one
     /// instance (a ping/pong) compares the key instead of hashing it. Forgotten with the instance.
-    last: (Vec<u8>, Option<(InstanceHandle, Option<[u8; 16]>)>),
+    last: (Vec<u8>, Option<FoundInstance>),
     by_handle: HashMap<InstanceHandle, WriterInstance>,
     next: u64,
     /// Last write of a keyless topic (its single instance), for the offered deadline.
