@@ -948,6 +948,51 @@ mod tests {
     }
 
     #[test]
+    fn one_sample_is_read_and_taken_as_among_many() {
+        let mut c = ReaderCache::new(DataReaderQos::default(), true);
+        let now = Instant::now();
+        c.insert(inc(1, ChangeKind::Alive, 1, 10), now);
+        c.insert(inc(1, ChangeKind::Alive, 2, 20), now);
+        let (h1, h2) = (c.lookup(&[1]).unwrap(), c.lookup(&[2]).unwrap());
+        let of = |h| Selection {
+            instance: Some(h),
+            ..all()
+        };
+        assert_eq!(c.collect(&of(h1), true, CP).len(), 1);
+        // From here on the cache holds one sample (the one-sample path).
+        assert!(c.collect(&of(h1), false, CP).is_empty(), "another instance");
+        let none = Selection {
+            max_samples: Some(0),
+            ..all()
+        };
+        assert!(c.collect(&none, false, CP).is_empty());
+        let r = c.collect(&all(), false, CP);
+        assert_eq!(r.len(), 1);
+        let i = &r[0].info;
+        assert_eq!((r[0].data, i.instance_handle), (Some(20), h2));
+        assert_eq!(
+            (i.sample_state, i.view_state),
+            (SampleState::NotRead, ViewState::New)
+        );
+        assert_eq!(
+            (i.sample_rank, i.generation_rank, i.absolute_generation_rank),
+            (0, 0, 0)
+        );
+        let unread = Selection {
+            sample_states: SampleStateMask::NOT_READ,
+            ..all()
+        };
+        assert!(c.collect(&unread, true, CP).is_empty(), "read already");
+        assert_eq!(c.len(), 1);
+        let r = c.collect(&of(h2), true, CP);
+        assert_eq!(r[0].info.sample_state, SampleState::Read);
+        assert_eq!(r[0].info.view_state, ViewState::NotNew);
+        assert_eq!(c.len(), 0);
+        assert!(c.collect(&all(), true, CP).is_empty());
+        assert_eq!(c.lookup(&[2]), Some(h2), "an alive instance stays");
+    }
+
+    #[test]
     fn keep_last_per_instance_and_states() {
         let qos = DataReaderQos {
             history: History::KeepLast(2),
