@@ -19,6 +19,7 @@ use super::status::SampleRejectedReason;
 
 mod order;
 mod query;
+mod single;
 use query::read_query;
 pub(crate) use query::SharedFilter;
 
@@ -159,6 +160,9 @@ pub(crate) struct ReaderCache<T> {
     keyed: bool,
     instances: BTreeMap<InstanceHandle, Instance<T>>,
     by_key: HashMap<Vec<u8>, InstanceHandle>,
+    /// The serialized key of the instance a sample was last stored for, and its handle while it is known:
+    /// a stream of one instance compares the key instead of hashing it.
+    last: (Vec<u8>, Option<InstanceHandle>),
     /// The key buffer of the last sample of a known instance, for the next sample's key.
     spare_key: Vec<u8>,
     next_handle: u64,
@@ -204,6 +208,7 @@ impl<T: FilterFields> ReaderCache<T> {
             keyed,
             instances: BTreeMap::new(),
             by_key: HashMap::new(),
+            last: (Vec::new(), None),
             spare_key: Vec::new(),
             next_handle: 1,
             next_seq: 0,
@@ -233,9 +238,8 @@ impl<T: FilterFields> ReaderCache<T> {
         let Some((_, h)) = oldest else {
             return false;
         };
-        if let Some(i) = self.instances.remove(&h) {
+        if let Some(i) = self.forget_instance(h) {
             self.total -= i.samples.len();
-            self.by_key.remove(&i.key);
         }
         true
     }
@@ -339,11 +343,16 @@ impl<T: FilterFields> ReaderCache<T> {
             Ok(h) => h,
             Err(outcome) => return outcome,
         };
-        if !self.admits(handle, &mut inc, now) {
+        let Some(inst) = self.instances.get_mut(&handle) else {
+            return Outcome::Filtered;
+        };
+        if !admits(&self.qos, inst, &mut inc, now) {
             return Outcome::Filtered;
         }
         if alive {
-            self.insert_alive(handle, inc, now)
+            // The instance found once for both (where each looked it up).
+            let counts = (&mut self.total, &mut self.next_seq);
+            insert_alive(&self.qos, counts, inst, handle, inc, now)
         } else {
             self.insert_state_change(handle, inc, now)
         }
@@ -361,10 +370,18 @@ impl<T: FilterFields> ReaderCache<T> {
         } else {
             Vec::new()
         };
+        if let (k, Some(h)) = &self.last {
+            if *k == key {
+                let h = *h;
+                self.spare_key = key;
+                return Ok(h);
+            }
+        }
         match self.by_key.get(&key) {
             Some(h) => {
                 let h = *h;
-                self.spare_key = key;
+                self.spare_key = std::mem::replace(&mut self.last.0, key);
+                self.last.1 = Some(h);
                 Ok(h)
             }
             None if inc.kind == ChangeKind::Unregister => Err(Outcome::Filtered),
@@ -380,93 +397,6 @@ impl<T: FilterFields> ReaderCache<T> {
                     })
             }
         }
-    }
-
-    /// Whether `inc` counts for its instance under exclusive ownership and destination order (false also
-    /// for an unknown instance). Records the writer's strength and the instance's owner.
-    fn admits(&mut self, handle: InstanceHandle, inc: &mut Incoming<T>, now: Instant) -> bool {
-        let exclusive = self.qos.ownership == Ownership::Exclusive;
-        let by_source = self.qos.destination_order == DestinationOrder::BySourceTimestamp;
-        let deadline = finite(self.qos.deadline.0);
-        let Some(inst) = self.instances.get_mut(&handle) else {
-            return false;
-        };
-        if inst.key_holder.is_none() {
-            inst.key_holder = inc.key_holder.take();
-        }
-
-        // Exclusive ownership: only the strongest alive writer's changes count (ties: lowest GUID); an
-        // owner that missed the requested deadline of the instance hands it over.
-        if exclusive {
-            inst.writers.insert(inc.writer, inc.strength);
-            let stale =
-                deadline.is_some_and(|d| now.saturating_duration_since(inst.last_data) >= d);
-            if !order::owner_accepts(inst.owner, &inst.writers, inc.writer, inc.strength, stale) {
-                if matches!(
-                    inc.kind,
-                    ChangeKind::Unregister | ChangeKind::DisposeUnregister
-                ) {
-                    inst.writers.remove(&inc.writer);
-                }
-                return false;
-            }
-            inst.owner = Some((inc.writer, inc.strength));
-        }
-
-        // Destination order by source timestamp: a value or dispose older than the newest accepted one
-        // of the instance is dropped (DDS 1.4 §2.2.3.17); unregisters always count.
-        let ordered = matches!(inc.kind, ChangeKind::Alive | ChangeKind::Dispose);
-        !(by_source && ordered && !order::in_source_order(inst.newest_source, inc.source_timestamp))
-    }
-
-    /// Stores a value: subject to the time-based filter and the history and resource limits; revives a
-    /// not-alive instance.
-    fn insert_alive(&mut self, handle: InstanceHandle, inc: Incoming<T>, now: Instant) -> Outcome {
-        let min_sep = self.qos.time_based_filter.minimum_separation;
-        let history = self.qos.history;
-        let limits = self.qos.resource_limits;
-        let total = self.total;
-        let Some(inst) = self.instances.get_mut(&handle) else {
-            return Outcome::Filtered;
-        };
-        if !min_sep.is_zero()
-            && inst
-                .last_accepted
-                .is_some_and(|t| now.saturating_duration_since(t) < min_sep)
-        {
-            return Outcome::Filtered;
-        }
-        let per_instance = inst.samples.len();
-        if let History::KeepAll = history {
-            if limits
-                .max_samples_per_instance
-                .is_some_and(|m| per_instance >= m as usize)
-            {
-                return Outcome::Rejected {
-                    reason: SampleRejectedReason::BySamplesPerInstanceLimit,
-                    handle,
-                };
-            }
-        }
-        let evict = matches!(history, History::KeepLast(d) if per_instance >= d.max(1) as usize);
-        if !evict && limits.max_samples.is_some_and(|m| total >= m as usize) {
-            return Outcome::Rejected {
-                reason: SampleRejectedReason::BySamplesLimit,
-                handle,
-            };
-        }
-        inst.revive(&inc, now);
-        if evict {
-            if let Some(old) = inst.samples.pop_front() {
-                drop(old);
-                self.total -= 1;
-            }
-        }
-        let seq = self.next_seq;
-        self.next_seq += 1;
-        inst.push_sample(seq, inc, true);
-        self.total += 1;
-        Outcome::Accepted { handle }
     }
 
     /// Dispose / unregister: a state change; visible through an invalid sample when no unread sample of the
@@ -629,6 +559,9 @@ impl<T: FilterFields> ReaderCache<T> {
         take: bool,
         mut emit: impl FnMut(&mut Option<T>, SampleInfo),
     ) {
+        if self.collect_single(sel, take, &mut emit) {
+            return;
+        }
         let limit = sel.max_samples.unwrap_or(usize::MAX);
         let q = read_query(sel);
         let q = q.as_deref();
@@ -719,34 +652,13 @@ impl<T: FilterFields> ReaderCache<T> {
             };
             tc.emitted += 1;
             let sample_rank = (tc.count - tc.emitted) as u32;
-            let (mrs_dg, mrs_nw) = inst
+            // The generation of the instance's most recent sample in the collection.
+            let mrs_gen = inst
                 .samples
                 .get(tc.last_index)
-                .map(|s| (s.disposed_gen, s.no_writers_gen))
-                .unwrap_or((0, 0));
+                .map_or(0, |s| s.disposed_gen + s.no_writers_gen);
+            let info = sample_info(inst, &inst.samples[idx], tc.handle, sample_rank, mrs_gen);
             let s = &mut inst.samples[idx];
-            let gen = s.disposed_gen + s.no_writers_gen;
-            let info = SampleInfo {
-                sample_state: if s.read {
-                    SampleState::Read
-                } else {
-                    SampleState::NotRead
-                },
-                view_state: inst.view,
-                instance_state: inst.state,
-                source_timestamp: s.source_timestamp,
-                reception_timestamp: s.reception_timestamp,
-                instance_handle: tc.handle,
-                publication_handle: InstanceHandle::from_guid(s.writer),
-                publication_guid: s.writer,
-                disposed_generation_count: s.disposed_gen,
-                no_writers_generation_count: s.no_writers_gen,
-                sample_rank,
-                generation_rank: (mrs_dg + mrs_nw).saturating_sub(gen),
-                absolute_generation_rank: (inst.disposed_gen + inst.no_writers_gen)
-                    .saturating_sub(gen),
-                valid_data: s.data.is_some(),
-            };
             s.read = true;
             emit(&mut s.data, info);
         }
@@ -769,14 +681,20 @@ impl<T: FilterFields> ReaderCache<T> {
 
     /// An instance with no samples, no writers and not alive is forgotten.
     fn maybe_drop_instance(&mut self, h: InstanceHandle) {
-        let drop_it = self.instances.get(&h).is_some_and(|i| {
-            i.samples.is_empty() && i.writers.is_empty() && i.state != InstanceState::Alive
-        });
+        let drop_it = self.instances.get(&h).is_some_and(single::forgettable);
         if drop_it {
-            if let Some(i) = self.instances.remove(&h) {
-                self.by_key.remove(&i.key);
-            }
+            self.forget_instance(h);
         }
+    }
+
+    /// Removes the instance `h` (returned, with its samples) and its key.
+    fn forget_instance(&mut self, h: InstanceHandle) -> Option<Instance<T>> {
+        let i = self.instances.remove(&h)?;
+        self.by_key.remove(&i.key);
+        if self.last.1 == Some(h) {
+            self.last.1 = None;
+        }
+        Some(i)
     }
 
     /// Time-driven QoS: lifespan expiry, autopurge, deadline. Returns the instances whose deadline was missed.
@@ -838,6 +756,129 @@ struct Touched {
 
 /// Removes the samples at `indices` (ascending, distinct) from `q`: a prefix (the usual take of the oldest)
 /// with one drain, anything else in one pass over the queue; never an element shift per removed sample.
+/// The `SampleInfo` of `s`, a sample of `inst` (`handle`) with `sample_rank` samples of its instance after
+/// it in the collection, whose most recent one there has generation `mrs_gen` (DDS 1.4 §2.2.2.5.5).
+fn sample_info<T>(
+    inst: &Instance<T>,
+    s: &Stored<T>,
+    handle: InstanceHandle,
+    sample_rank: u32,
+    mrs_gen: u32,
+) -> SampleInfo {
+    let gen = s.disposed_gen + s.no_writers_gen;
+    SampleInfo {
+        sample_state: if s.read {
+            SampleState::Read
+        } else {
+            SampleState::NotRead
+        },
+        view_state: inst.view,
+        instance_state: inst.state,
+        source_timestamp: s.source_timestamp,
+        reception_timestamp: s.reception_timestamp,
+        instance_handle: handle,
+        publication_handle: InstanceHandle::from_guid(s.writer),
+        publication_guid: s.writer,
+        disposed_generation_count: s.disposed_gen,
+        no_writers_generation_count: s.no_writers_gen,
+        sample_rank,
+        generation_rank: mrs_gen.saturating_sub(gen),
+        absolute_generation_rank: (inst.disposed_gen + inst.no_writers_gen).saturating_sub(gen),
+        valid_data: s.data.is_some(),
+    }
+}
+
+/// Whether `inc` counts for its instance `inst` under exclusive ownership and destination order. Records
+/// the writer's strength and the instance's owner.
+fn admits<T>(
+    qos: &DataReaderQos,
+    inst: &mut Instance<T>,
+    inc: &mut Incoming<T>,
+    now: Instant,
+) -> bool {
+    let exclusive = qos.ownership == Ownership::Exclusive;
+    let by_source = qos.destination_order == DestinationOrder::BySourceTimestamp;
+    let deadline = finite(qos.deadline.0);
+    if inst.key_holder.is_none() {
+        inst.key_holder = inc.key_holder.take();
+    }
+
+    // Exclusive ownership: only the strongest alive writer's changes count (ties: lowest GUID); an
+    // owner that missed the requested deadline of the instance hands it over.
+    if exclusive {
+        inst.writers.insert(inc.writer, inc.strength);
+        let stale = deadline.is_some_and(|d| now.saturating_duration_since(inst.last_data) >= d);
+        if !order::owner_accepts(inst.owner, &inst.writers, inc.writer, inc.strength, stale) {
+            if matches!(
+                inc.kind,
+                ChangeKind::Unregister | ChangeKind::DisposeUnregister
+            ) {
+                inst.writers.remove(&inc.writer);
+            }
+            return false;
+        }
+        inst.owner = Some((inc.writer, inc.strength));
+    }
+
+    // Destination order by source timestamp: a value or dispose older than the newest accepted one
+    // of the instance is dropped (DDS 1.4 §2.2.3.17); unregisters always count.
+    let ordered = matches!(inc.kind, ChangeKind::Alive | ChangeKind::Dispose);
+    !(by_source && ordered && !order::in_source_order(inst.newest_source, inc.source_timestamp))
+}
+
+/// Stores a value: subject to the time-based filter and the history and resource limits; revives a
+/// not-alive instance.
+fn insert_alive<T>(
+    qos: &DataReaderQos,
+    (total, next_seq): (&mut usize, &mut u64),
+    inst: &mut Instance<T>,
+    handle: InstanceHandle,
+    inc: Incoming<T>,
+    now: Instant,
+) -> Outcome {
+    let min_sep = qos.time_based_filter.minimum_separation;
+    let history = qos.history;
+    let limits = qos.resource_limits;
+    if !min_sep.is_zero()
+        && inst
+            .last_accepted
+            .is_some_and(|t| now.saturating_duration_since(t) < min_sep)
+    {
+        return Outcome::Filtered;
+    }
+    let per_instance = inst.samples.len();
+    if let History::KeepAll = history {
+        if limits
+            .max_samples_per_instance
+            .is_some_and(|m| per_instance >= m as usize)
+        {
+            return Outcome::Rejected {
+                reason: SampleRejectedReason::BySamplesPerInstanceLimit,
+                handle,
+            };
+        }
+    }
+    let evict = matches!(history, History::KeepLast(d) if per_instance >= d.max(1) as usize);
+    if !evict && limits.max_samples.is_some_and(|m| *total >= m as usize) {
+        return Outcome::Rejected {
+            reason: SampleRejectedReason::BySamplesLimit,
+            handle,
+        };
+    }
+    inst.revive(&inc, now);
+    if evict {
+        if let Some(old) = inst.samples.pop_front() {
+            drop(old);
+            *total -= 1;
+        }
+    }
+    let seq = *next_seq;
+    *next_seq += 1;
+    inst.push_sample(seq, inc, true);
+    *total += 1;
+    Outcome::Accepted { handle }
+}
+
 fn remove_indices<S>(q: &mut VecDeque<S>, indices: impl ExactSizeIterator<Item = usize> + Clone) {
     let n = indices.len();
     if indices.clone().enumerate().all(|(k, i)| k == i) {
@@ -904,6 +945,51 @@ mod tests {
 
     fn all() -> Selection {
         Selection::default()
+    }
+
+    #[test]
+    fn one_sample_is_read_and_taken_as_among_many() {
+        let mut c = ReaderCache::new(DataReaderQos::default(), true);
+        let now = Instant::now();
+        c.insert(inc(1, ChangeKind::Alive, 1, 10), now);
+        c.insert(inc(1, ChangeKind::Alive, 2, 20), now);
+        let (h1, h2) = (c.lookup(&[1]).unwrap(), c.lookup(&[2]).unwrap());
+        let of = |h| Selection {
+            instance: Some(h),
+            ..all()
+        };
+        assert_eq!(c.collect(&of(h1), true, CP).len(), 1);
+        // From here on the cache holds one sample (the one-sample path).
+        assert!(c.collect(&of(h1), false, CP).is_empty(), "another instance");
+        let none = Selection {
+            max_samples: Some(0),
+            ..all()
+        };
+        assert!(c.collect(&none, false, CP).is_empty());
+        let r = c.collect(&all(), false, CP);
+        assert_eq!(r.len(), 1);
+        let i = &r[0].info;
+        assert_eq!((r[0].data, i.instance_handle), (Some(20), h2));
+        assert_eq!(
+            (i.sample_state, i.view_state),
+            (SampleState::NotRead, ViewState::New)
+        );
+        assert_eq!(
+            (i.sample_rank, i.generation_rank, i.absolute_generation_rank),
+            (0, 0, 0)
+        );
+        let unread = Selection {
+            sample_states: SampleStateMask::NOT_READ,
+            ..all()
+        };
+        assert!(c.collect(&unread, true, CP).is_empty(), "read already");
+        assert_eq!(c.len(), 1);
+        let r = c.collect(&of(h2), true, CP);
+        assert_eq!(r[0].info.sample_state, SampleState::Read);
+        assert_eq!(r[0].info.view_state, ViewState::NotNew);
+        assert_eq!(c.len(), 0);
+        assert!(c.collect(&all(), true, CP).is_empty());
+        assert_eq!(c.lookup(&[2]), Some(h2), "an alive instance stays");
     }
 
     #[test]

@@ -53,6 +53,8 @@ pub(crate) const MAX_SPARE_VALUES: usize = 1024;
 pub(crate) struct Decoding<T> {
     /// Key hash → serialized key, learnt from samples that carried both (for key-hash-only disposes).
     pub(crate) by_hash: HashMap<[u8; 16], Vec<u8>>,
+    /// The key hash indexed last (in `by_hash`): a stream of one instance indexes it once, not per sample.
+    last_hash: Option<[u8; 16]>,
     /// Values the application gave back, to decode into: their strings and sequences keep their buffers.
     spare: Vec<T>,
 }
@@ -61,6 +63,7 @@ impl<T> Decoding<T> {
     pub(crate) fn new() -> Self {
         Decoding {
             by_hash: HashMap::default(),
+            last_hash: None,
             spare: Vec::new(),
         }
     }
@@ -141,7 +144,11 @@ pub(crate) fn decode_change_with<T, C: SampleCodec<T>>(
 ) -> Option<Incoming<T>> {
     let source_timestamp = system_time(s.source_timestamp);
     let kind = s.kind;
-    let Decoding { by_hash, spare } = decoding;
+    let Decoding {
+        by_hash,
+        last_hash,
+        spare,
+    } = decoding;
     key.clear();
     let mut data = None;
     let mut key_holder = None;
@@ -168,10 +175,14 @@ pub(crate) fn decode_change_with<T, C: SampleCodec<T>>(
                 ],
             };
             for kh in hashes.into_iter().flatten() {
+                if *last_hash == Some(kh) {
+                    continue;
+                }
                 if by_hash.len() >= MAX_REMEMBERED_HASHES {
                     by_hash.clear();
                 }
                 by_hash.entry(kh).or_insert_with(|| key.clone());
+                *last_hash = Some(kh);
             }
         }
         data = Some(d);

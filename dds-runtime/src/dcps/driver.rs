@@ -598,8 +598,14 @@ impl Driver {
                 _ => {}
             }
         }
-        for ev in deferred.drain(..) {
-            self.dispatch_event(ev);
+        // Most calls (a write, a datagram without samples) have nothing here: no drain, no batch.
+        if !deferred.is_empty() {
+            for ev in deferred.drain(..) {
+                self.dispatch_event(ev);
+            }
+        }
+        if touched.is_empty() {
+            return;
         }
         let _batch = super::data_on_readers::DataOnReadersBatch::start();
         for (_, r) in touched.drain(..) {

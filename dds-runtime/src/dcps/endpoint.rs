@@ -29,6 +29,8 @@ pub(crate) fn check_history(h: &History) -> DdsResult<()> {
 pub(crate) struct EndpointState<S, L: ?Sized, O> {
     pub(crate) driver: Arc<Driver>,
     id: OnceLock<EntityId>,
+    /// The instance handle of the endpoint's GUID, set with `id` (the data path names it per sample).
+    instance: OnceLock<InstanceHandle>,
     statuses: Mutex<S>,
     status_core: Arc<StatusCore>,
     listener: Mutex<Option<MaskedListener<L>>>,
@@ -54,6 +56,7 @@ impl<S: Default, L: ?Sized, O> EndpointState<S, L, O> {
         EndpointState {
             driver,
             id: OnceLock::new(),
+            instance: OnceLock::new(),
             statuses: Mutex::new(S::default()),
             status_core: Arc::new(StatusCore::default()),
             listener: Mutex::new(None),
@@ -84,6 +87,10 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
             // to listeners only after the lock is released. So a listener installed before creation gets
             // them with a valid handle.
             let _ = self.id.set(id);
+            let _ = self.instance.set(InstanceHandle::from_guid(Guid::new(
+                self.driver.guid_prefix,
+                id,
+            )));
             if let Some(owner) = owner.take() {
                 let h = Arc::new(EndpointHandle::new(self.driver.clone(), id, owner));
                 *lock(&self.handle) = Arc::downgrade(&h);
@@ -224,7 +231,10 @@ impl<S, L: ?Sized, O> EndpointState<S, L, O> {
 
     /// The endpoint's instance handle, as the levels above know it.
     fn instance(&self) -> InstanceHandle {
-        InstanceHandle::from_guid(self.guid())
+        match self.instance.get() {
+            Some(h) => *h,
+            None => InstanceHandle::from_guid(self.guid()),
+        }
     }
 
     /// The GUIDs of the matched remote endpoints.

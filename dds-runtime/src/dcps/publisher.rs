@@ -316,9 +316,16 @@ struct WriterInstance {
     last_write: Instant,
 }
 
+/// A writer's instance as a lookup by key finds it: its handle and key hash.
+pub(crate) type FoundInstance = (InstanceHandle, Option<[u8; 16]>);
+
 #[derive(Default)]
 pub(crate) struct WriterInstances {
-    by_key: HashMap<Vec<u8>, InstanceHandle>,
+    /// Handle and key hash by serialized key: a write without an offered deadline looks here only.
+    by_key: HashMap<Vec<u8>, FoundInstance>,
+    /// The serialized key of the instance looked up last, and what `by_key` holds for it: a stream of one
+    /// instance (a ping/pong) compares the key instead of hashing it. Forgotten with the instance.
+    last: (Vec<u8>, Option<FoundInstance>),
     by_handle: HashMap<InstanceHandle, WriterInstance>,
     next: u64,
     /// Last write of a keyless topic (its single instance), for the offered deadline.
@@ -486,9 +493,15 @@ impl<T: DdsType> DataWriter<T> {
 
     /// The matched readers whose content filters reject `sample` (writer-side filtering).
     fn rejected_by_filters(&self, c: &crate::rtps::Participant, sample: Option<&T>) -> Vec<Guid> {
-        sample
-            .map(|s| lock(&self.inner.filters).rejected(c, self.id(), s))
-            .unwrap_or_default()
+        let Some(s) = sample else {
+            return Vec::new();
+        };
+        // Generation 0: no matched reader ever announced a filter (the common case), so no lock either.
+        let generation = c.writer_filter_generation(self.id());
+        if generation == 0 {
+            return Vec::new();
+        }
+        lock(&self.inner.filters).rejected(c, self.id(), generation, s)
     }
 
     /// [`submit`](Self::submit) with the write done under the core's lock by `attempt`; when it does not

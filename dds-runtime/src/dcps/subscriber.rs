@@ -6,7 +6,7 @@ mod ops;
 
 use std::collections::VecDeque;
 use std::pin::Pin;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering as AtomicOrdering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering as AtomicOrdering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::task::{Context, Poll, Waker};
 use std::time::{Duration, Instant, SystemTime};
@@ -340,6 +340,10 @@ pub(crate) struct ReaderInner<K: ReaderKind> {
     /// change was made under that lock) skips the futex wake only when nobody can be sleeping.
     data_waiters: AtomicUsize,
     wakers: Mutex<Vec<Waker>>,
+    /// Set (for good) when a `SampleStream` first registers a waker, before its second take: `notify_data`
+    /// (after the change, made under the cache lock) skips the wakers' lock while it is clear, as with
+    /// `data_waiters`.
+    has_wakers: AtomicBool,
     data_signal: Signal,
     /// Reliable KEEP_ALL with max_samples: the core delivers (and acknowledges) only what fits
     /// ([`NO_CREDIT_LIMIT`] otherwise). Changes only while the reader is disabled.
@@ -866,6 +870,7 @@ impl<K: ReaderKind> ReaderInner<K> {
             data_cv: Condvar::new(),
             data_waiters: AtomicUsize::new(0),
             wakers: Mutex::new(Vec::new()),
+            has_wakers: AtomicBool::new(false),
             data_signal: Signal::default(),
             credit_limit: AtomicUsize::new(credit_limit.unwrap_or(NO_CREDIT_LIMIT)),
         }
@@ -1070,9 +1075,11 @@ impl<K: ReaderKind> ReaderInner<K> {
         if self.data_waiters.load(AtomicOrdering::SeqCst) > 0 {
             self.data_cv.notify_all();
         }
-        let wakers = std::mem::take(&mut *lock(&self.wakers));
-        for w in wakers {
-            w.wake();
+        if self.has_wakers.load(AtomicOrdering::SeqCst) {
+            let wakers = std::mem::take(&mut *lock(&self.wakers));
+            for w in wakers {
+                w.wake();
+            }
         }
         self.state.status_core().raise(StatusMask::DATA_AVAILABLE);
         self.data_signal.notify();
@@ -1261,6 +1268,7 @@ impl<T: DdsType> futures_core::Stream for SampleStream<T> {
             if !w.iter().any(|x| x.will_wake(cx.waker())) {
                 w.push(cx.waker().clone());
             }
+            r.inner.has_wakers.store(true, AtomicOrdering::SeqCst);
         }
         // A sample may have arrived between the first check and the registration.
         match take() {

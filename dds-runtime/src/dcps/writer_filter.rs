@@ -16,14 +16,15 @@ pub(crate) struct WriterFilters {
 }
 
 impl WriterFilters {
-    /// The matched readers whose filter rejects `sample` (no allocation while none does).
+    /// The matched readers whose filter rejects `sample` (no allocation while none does); `generation` is
+    /// the core's filter generation of `writer` (`Participant::writer_filter_generation`).
     pub(crate) fn rejected<T: FilterFields>(
         &mut self,
         core: &Participant,
         writer: EntityId,
+        generation: u64,
         sample: &T,
     ) -> Vec<Guid> {
-        let generation = core.writer_filter_generation(writer);
         if self.generation != Some(generation) {
             self.generation = Some(generation);
             self.readers = core

@@ -20,6 +20,7 @@
 //! An episode that ends with nothing arriving halves the next one (down to 1/64 of the window); one that
 //! ends with a datagram restores the whole window.
 
+use std::cell::Cell;
 use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
@@ -38,6 +39,8 @@ const MAX_HALVINGS: u32 = 6;
 pub(super) const PRESSURE_LIMIT: f32 = 10.0;
 /// The pressure is read at most this often per process.
 const PRESSURE_EVERY: Duration = Duration::from_millis(500);
+/// A thread looks at the process's last reading at most this often.
+const LOOK_EVERY: Duration = Duration::from_millis(20);
 
 /// How a polling episode ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,8 +59,9 @@ pub(super) struct PollPolicy {
     max: Duration,
     /// Unproductive episodes in a row (the next episode is `max >> empties`).
     empties: u32,
-    /// When the last batch was handled.
-    last: Option<Instant>,
+    /// Until when a batch follows the last one closely enough to count as dense traffic (`DENSE` windows
+    /// after it).
+    dense_until: Option<Instant>,
     /// The thread's involuntary context switches when the current episode began.
     switches: Option<u64>,
     /// No polling before this (after a contended episode).
@@ -72,7 +76,7 @@ impl PollPolicy {
         PollPolicy {
             max,
             empties: 0,
-            last: None,
+            dense_until: None,
             switches: None,
             paused_until: None,
             pause: FIRST_PAUSE,
@@ -90,8 +94,8 @@ impl PollPolicy {
         if !self.enabled() {
             return None;
         }
-        let dense = self.last.is_some_and(|t| now - t <= self.max * DENSE);
-        self.last = Some(now);
+        let dense = self.dense_until.is_some_and(|t| now <= t);
+        self.dense_until = now.checked_add(self.max * DENSE);
         let paused = self.paused_until.is_some_and(|t| now < t);
         (dense && !paused && !pressured).then(|| now + self.max / (1 << self.empties))
     }
@@ -140,6 +144,23 @@ pub(super) fn thread_switches() -> Option<u64> {
 /// thread finds the last reading older than [`PRESSURE_EVERY`], shared by all through atomics. Where the
 /// file cannot be read, always.
 pub(super) fn pressured(now: Instant) -> bool {
+    thread_local! {
+        /// This thread's last answer and when it expires: the shared reading is looked at a few times a
+        /// second per thread, not per batch (a clock subtraction and a 128-bit division each).
+        static LOOKED: Cell<Option<(Instant, bool)>> = const { Cell::new(None) };
+    }
+    LOOKED.with(|l| match l.get() {
+        Some((until, p)) if now < until => p,
+        _ => {
+            let p = pressured_shared(now);
+            l.set(Some((now + LOOK_EVERY, p)));
+            p
+        }
+    })
+}
+
+/// [`pressured`] from the reading shared by the process's threads.
+fn pressured_shared(now: Instant) -> bool {
     static EPOCH: OnceLock<Instant> = OnceLock::new();
     /// Milliseconds after `EPOCH` of the last reading, plus one (0: never read).
     static READ_AT: AtomicU64 = AtomicU64::new(0);

@@ -187,12 +187,20 @@ impl WriterInstances {
         key: &[u8],
         written: Option<Instant>,
     ) -> Option<(InstanceHandle, Option<[u8; 16]>)> {
-        let h = self.by_key.get(key).copied()?;
-        let i = self.by_handle.get_mut(&h)?;
+        let found = match &self.last {
+            (k, Some(found)) if k.as_slice() == key => *found,
+            _ => {
+                let found = self.by_key.get(key).copied()?;
+                self.last.0.clear();
+                self.last.0.extend_from_slice(key);
+                self.last.1 = Some(found);
+                found
+            }
+        };
         if let Some(now) = written {
-            i.last_write = now;
+            self.by_handle.get_mut(&found.0)?.last_write = now;
         }
-        Some((h, i.key_hash))
+        Some(found)
     }
 
     /// Registers the instance with serialized key `key` (or returns it, when another thread registered it
@@ -209,7 +217,7 @@ impl WriterInstances {
         }
         self.next += 1;
         let h = InstanceHandle(self.next);
-        self.by_key.insert(key.clone(), h);
+        self.by_key.insert(key.clone(), (h, key_hash));
         self.by_handle.insert(
             h,
             super::WriterInstance {
@@ -260,6 +268,9 @@ impl WriterInstances {
         if matches!(kind, ChangeKind::Unregister | ChangeKind::DisposeUnregister) {
             if let Some(i) = self.by_handle.remove(&h) {
                 self.by_key.remove(&i.key);
+                if self.last.1.is_some_and(|(l, _)| l == h) {
+                    self.last.1 = None;
+                }
             }
         }
     }

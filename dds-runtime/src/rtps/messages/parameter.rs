@@ -205,13 +205,45 @@ impl<'a> ParameterList<'a> {
         Ok(())
     }
 
+    /// The inline QoS a reader acts on for a DATA, in one pass over the list (where [`key_hash`],
+    /// [`status_info`], [`coherent_set`], [`group_seq_num`] and [`check_must_understand`] walk it once
+    /// each); each field from the first parameter of its id, as those give it.
+    ///
+    /// [`key_hash`]: Self::key_hash
+    /// [`status_info`]: Self::status_info
+    /// [`coherent_set`]: Self::coherent_set
+    /// [`group_seq_num`]: Self::group_seq_num
+    /// [`check_must_understand`]: Self::check_must_understand
+    pub fn data_params(&self, understood: impl Fn(u16) -> bool) -> DataParams {
+        let mut d = DataParams::default();
+        let mut seen = 0u8;
+        let mut first = |bit: u8| {
+            let new = seen & bit == 0;
+            seen |= bit;
+            new
+        };
+        for p in self.iter() {
+            match p.id {
+                pid::KEY_HASH if first(1) => d.key_hash = p.value.get(..16).map(key16),
+                pid::STATUS_INFO if first(2) => d.status_info = p.value.get(3).copied(),
+                pid::COHERENT_SET if first(4) => d.coherent_set = self.sequence_value(p.value),
+                pid::GROUP_SEQ_NUM if first(8) => d.group_seq_num = self.sequence_value(p.value),
+                id if id & pid::VENDOR_SPECIFIC == 0
+                    && id & pid::MUST_UNDERSTAND != 0
+                    && !understood(id)
+                    && d.not_understood.is_none() =>
+                {
+                    d.not_understood = Some(id)
+                }
+                _ => {}
+            }
+        }
+        d
+    }
+
     /// Inline QoS: the key hash.
     pub fn key_hash(&self) -> Option<[u8; 16]> {
-        self.get(pid::KEY_HASH).and_then(|v| v.get(..16)).map(|v| {
-            let mut k = [0u8; 16];
-            k.copy_from_slice(v);
-            k
-        })
+        self.get(pid::KEY_HASH).and_then(|v| v.get(..16)).map(key16)
     }
 
     /// Inline QoS: PID_COHERENT_SET, the first sequence number of the change's coherent set.
@@ -232,7 +264,11 @@ impl<'a> ParameterList<'a> {
 
     /// A parameter holding a `SequenceNumber_t`.
     fn sequence_number(&self, id: u16) -> Option<SequenceNumber> {
-        let v = self.get(id)?;
+        self.sequence_value(self.get(id)?)
+    }
+
+    /// A parameter's value read as a `SequenceNumber_t`.
+    fn sequence_value(&self, v: &[u8]) -> Option<SequenceNumber> {
         let mut c = self.cursor(v);
         let high = c.i32().ok()?;
         let low = c.u32().ok()?;
@@ -249,6 +285,29 @@ impl<'a> ParameterList<'a> {
     pub fn status_info(&self) -> Option<u8> {
         self.get(pid::STATUS_INFO).and_then(|v| v.get(3).copied())
     }
+}
+
+/// The first 16 bytes of `v` (checked by the caller) as a key hash.
+fn key16(v: &[u8]) -> [u8; 16] {
+    let mut k = [0u8; 16];
+    k.copy_from_slice(&v[..16]);
+    k
+}
+
+/// What [`ParameterList::data_params`] reads from a DATA's inline QoS.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct DataParams {
+    /// PID_KEY_HASH.
+    pub key_hash: Option<[u8; 16]>,
+    /// PID_STATUS_INFO's flags (its last byte).
+    pub status_info: Option<u8>,
+    /// PID_COHERENT_SET.
+    pub coherent_set: Option<SequenceNumber>,
+    /// PID_GROUP_SEQ_NUM.
+    pub group_seq_num: Option<SequenceNumber>,
+    /// The first parameter that is not vendor-specific, has the must-understand bit and is not understood.
+    pub not_understood: Option<u16>,
 }
 
 /// Appends a parameter list in the given byte order. Call [`ParameterWriter::finish`] to add the sentinel.
@@ -360,6 +419,49 @@ mod tests {
             assert_eq!(pl.cursor(pl.get(pid::DOMAIN_ID).unwrap()).u32().unwrap(), 7);
             assert!(pl.check_must_understand(|_| false).is_ok());
         }
+    }
+
+    #[test]
+    fn data_params_read_what_the_single_getters_read() {
+        for le in [true, false] {
+            let mut buf = Vec::new();
+            let mut w = ParameterWriter::new(&mut buf, le);
+            w.raw(pid::PAD, &[0; 4]);
+            w.raw(pid::STATUS_INFO, &[0, 0, 0, 3]);
+            w.raw(pid::KEY_HASH, &[7; 16]);
+            w.raw(pid::KEY_HASH, &[8; 16]);
+            w.raw(pid::COHERENT_SET, &[0, 0, 0, 0, 5, 0, 0, 0]);
+            w.raw(pid::GROUP_SEQ_NUM, &[0; 4]);
+            w.raw(0x8fff | pid::MUST_UNDERSTAND, &[0; 4]);
+            w.raw(0x4ffe, &[0; 4]);
+            w.raw(0x4ffd, &[0; 4]);
+            w.finish();
+            let (pl, _) = ParameterList::parse(&buf, le).unwrap();
+            let d = pl.data_params(|_| false);
+            assert_eq!(d.key_hash, pl.key_hash());
+            assert_eq!(d.key_hash, Some([7; 16]), "the first of its id");
+            assert_eq!(d.status_info, pl.status_info());
+            assert_eq!(d.status_info, Some(3));
+            assert_eq!(d.coherent_set, pl.coherent_set());
+            assert!(d.coherent_set.is_some());
+            assert_eq!(d.group_seq_num, pl.group_seq_num());
+            assert_eq!(d.group_seq_num, None, "too short a value");
+            assert_eq!(
+                d.not_understood,
+                Some(0x4ffe),
+                "vendor-specific ones are skipped"
+            );
+            assert_eq!(
+                pl.check_must_understand(|_| false),
+                Err(WireError::MustUnderstand(0x4ffe))
+            );
+            assert_eq!(pl.data_params(|id| id >= 0x4ffd).not_understood, None);
+        }
+        let empty = ParameterList {
+            data: &[],
+            little_endian: true,
+        };
+        assert_eq!(empty.data_params(|_| false), DataParams::default());
     }
 
     #[test]

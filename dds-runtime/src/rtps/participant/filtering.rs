@@ -88,7 +88,8 @@ impl Participant {
     }
 
     /// A number that changes whenever a filter of the writer's matched readers appears, changes or goes
-    /// (0 for unknown writers): compare it before calling [`Participant::writer_reader_filters`] again.
+    /// (0 for unknown writers, and for writers none of whose matched readers ever announced a filter, which
+    /// need no filtering): compare it before calling [`Participant::writer_reader_filters`] again.
     pub fn writer_filter_generation(&self, writer: EntityId) -> u64 {
         self.writers
             .get(&writer)

@@ -42,16 +42,16 @@ use defrag::Defrag;
 
 /// Whether every must-understand inline QoS parameter is one we know.
 fn inline_qos_understood(q: Option<&crate::rtps::messages::ParameterList<'_>>) -> bool {
+    q.is_none_or(|q| q.check_must_understand(understood_pid).is_ok())
+}
+
+/// The must-understand inline QoS parameters a reader knows.
+fn understood_pid(id: u16) -> bool {
     use crate::rtps::messages::parameter::pid;
-    q.is_none_or(|q| {
-        q.check_must_understand(|id| {
-            matches!(
-                id & !pid::MUST_UNDERSTAND,
-                pid::KEY_HASH | pid::STATUS_INFO | pid::TOPIC_NAME
-            )
-        })
-        .is_ok()
-    })
+    matches!(
+        id & !pid::MUST_UNDERSTAND,
+        pid::KEY_HASH | pid::STATUS_INFO | pid::TOPIC_NAME
+    )
 }
 
 /// The change a complete reassembly makes (`None` when its payload cannot be assembled).
@@ -348,16 +348,21 @@ impl Reader {
         datagram: Option<&Payload>,
         out: &mut Vec<Event>,
     ) {
-        if !inline_qos_understood(d.inline_qos.as_ref()) {
+        // One pass over the inline QoS.
+        let q = d
+            .inline_qos
+            .map(|q| q.data_params(understood_pid))
+            .unwrap_or_default();
+        if q.not_understood.is_some() {
             // §9.4.2.11: a sample with a must-understand parameter we do not know is dropped; the sequence
             // number is consumed so a reliable stream does not stall on it.
             self.accept(p, d.writer_sn, Slot::Irrelevant, out);
             return;
         }
-        let status = d.inline_qos.and_then(|q| q.status_info());
+        let status = q.status_info;
         let kind = status.map_or(ChangeKind::Alive, ChangeKind::from_status_info);
-        let key_hash = d.inline_qos.and_then(|q| q.key_hash());
-        let coherent = d.inline_qos.and_then(|q| q.coherent_set()).map(|set| {
+        let key_hash = q.key_hash;
+        let coherent = q.coherent_set.map(|set| {
             // The end-of-set marker: no data, no key, no status.
             let end = d.payload.is_none() && status.is_none();
             SetMark {
@@ -388,7 +393,7 @@ impl Reader {
                 key_hash,
                 source_timestamp: ts,
                 coherent,
-                group_seq: d.inline_qos.and_then(|q| q.group_seq_num()),
+                group_seq: q.group_seq_num,
             }),
         };
         self.accept(p, d.writer_sn, slot, out);

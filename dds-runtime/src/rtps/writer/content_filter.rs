@@ -39,7 +39,8 @@ impl ReaderFilters {
         }
     }
 
-    /// Changes whenever a matched reader's filter appears, changes or goes.
+    /// Changes whenever a matched reader's filter appears, changes or goes; 0 until a first one appears
+    /// (writers use that to skip filtering altogether).
     pub(crate) fn generation(&self) -> u64 {
         self.generation
     }
