@@ -169,7 +169,7 @@ fn process_on_either_side_is_enough_in_both_participants() {
 #[test]
 fn endpoints_inherit_the_participant_default() {
     let p = participant_with(
-        121,
+        123,
         dds_runtime::config::Config {
             ignore_local: IgnoreLocal::Participant,
             ..dds_runtime::config::Config::default()
