@@ -754,8 +754,6 @@ struct Touched {
     last_index: usize,
 }
 
-/// Removes the samples at `indices` (ascending, distinct) from `q`: a prefix (the usual take of the oldest)
-/// with one drain, anything else in one pass over the queue; never an element shift per removed sample.
 /// The `SampleInfo` of `s`, a sample of `inst` (`handle`) with `sample_rank` samples of its instance after
 /// it in the collection, whose most recent one there has generation `mrs_gen` (DDS 1.4 §2.2.2.5.5).
 fn sample_info<T>(
@@ -879,6 +877,8 @@ fn insert_alive<T>(
     Outcome::Accepted { handle }
 }
 
+/// Removes the samples at `indices` (ascending, distinct) from `q`: a prefix (the usual take of the oldest)
+/// with one drain, anything else in one pass over the queue; never an element shift per removed sample.
 fn remove_indices<S>(q: &mut VecDeque<S>, indices: impl ExactSizeIterator<Item = usize> + Clone) {
     let n = indices.len();
     if indices.clone().enumerate().all(|(k, i)| k == i) {
