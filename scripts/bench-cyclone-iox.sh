@@ -3,7 +3,7 @@
 # interleaved, 1 MiB and 4 MiB samples, writer touching only `seq` and writer filling every byte.
 #   scripts/bench-cyclone-iox.sh [ROUNDS] [SECONDS]        (defaults 3 and 3)
 # Needs (installs nothing): cyclonedds-dev 0.10.2 (libddsc + /usr/bin/idlc), iceoryx (iox-roudi), cc,
-# and our release example built with `-F shm` (OURS, default /tmp/s26/dcps_shm_throughput).
+# and our release example built with `-F shm` (OURS, default target/release/examples/dcps_shm_throughput).
 # Cyclone runs twice per size and writer: KEEP_LAST 16 (its writer never waits: the reader loses samples)
 # and KEEP_LAST 1000 (lossless: the writer's loan waits for RouDi's pool; see docs/performance.md).
 # Runs everything, RouDi included, in one scripts/isolated network namespace; the loopback byte
@@ -15,7 +15,7 @@ if [[ "${DDS_IN_NETNS:-}" != 1 ]]; then
 fi
 rounds=${1:-3}
 secs=${2:-3}
-ours=${OURS:-/tmp/s26/dcps_shm_throughput}
+ours=${OURS:-$here/../target/release/examples/dcps_shm_throughput}
 
 missing=()
 [[ -x /usr/bin/idlc ]] || missing+=("/usr/bin/idlc (apt-get install cyclonedds-tools or cyclonedds-dev)")
