@@ -71,16 +71,24 @@ static dds_entity_t bench_topic(dds_entity_t pp, int size, size_t *data_len)
   return tp;
 }
 
+/* The writer (pub) or reader of the topic for `size`, with bench_qos(); says whether Cyclone put it on
+ * shared memory and lends samples. */
+static dds_entity_t bench_endpoint(dds_entity_t pp, int size, int pub, size_t *data_len)
+{
+  dds_entity_t tp = bench_topic(pp, size, data_len);
+  dds_qos_t *qos = bench_qos();
+  dds_entity_t e = pub ? dds_create_writer(pp, tp, qos, NULL) : dds_create_reader(pp, tp, qos, NULL);
+  check(e, pub ? "create_writer" : "create_reader");
+  dds_delete_qos(qos);
+  fprintf(stderr, "%s: shared memory %s, loan %s\n", pub ? "pub" : "sub",
+          dds_is_shared_memory_available(e) ? "yes" : "NO", dds_is_loan_available(e) ? "yes" : "NO");
+  return e;
+}
+
 static int run_pub(dds_entity_t pp, int size, double secs, int fill)
 {
   size_t data_len;
-  dds_entity_t tp = bench_topic(pp, size, &data_len);
-  dds_qos_t *qos = bench_qos();
-  dds_entity_t wr = dds_create_writer(pp, tp, qos, NULL);
-  check(wr, "create_writer");
-  dds_delete_qos(qos);
-  fprintf(stderr, "pub: shared memory %s, loan %s\n", dds_is_shared_memory_available(wr) ? "yes" : "NO",
-          dds_is_loan_available(wr) ? "yes" : "NO");
+  dds_entity_t wr = bench_endpoint(pp, size, 1, &data_len);
   dds_publication_matched_status_t st = { 0 };
   double give_up = now_s() + 10.0;
   while (st.current_count == 0 && now_s() < give_up) {
@@ -164,13 +172,7 @@ static void take_loans(dds_entity_t rd, struct sub_stats *st)
 static int run_sub(dds_entity_t pp, int size)
 {
   size_t data_len;
-  dds_entity_t tp = bench_topic(pp, size, &data_len);
-  dds_qos_t *qos = bench_qos();
-  dds_entity_t rd = dds_create_reader(pp, tp, qos, NULL);
-  check(rd, "create_reader");
-  dds_delete_qos(qos);
-  fprintf(stderr, "sub: shared memory %s, loan %s\n", dds_is_shared_memory_available(rd) ? "yes" : "NO",
-          dds_is_loan_available(rd) ? "yes" : "NO");
+  dds_entity_t rd = bench_endpoint(pp, size, 0, &data_len);
   dds_entity_t ws = dds_create_waitset(pp);
   dds_entity_t rc = dds_create_readcondition(rd, DDS_ANY_STATE);
   check(dds_waitset_attach(ws, rc, 0), "waitset_attach");
