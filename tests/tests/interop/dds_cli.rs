@@ -252,10 +252,13 @@ fn dds_publish_idl_reaches_cyclone_reader() {
     let _ = p.interrupt(WAIT);
 }
 
-/// A Cyclone writer on "Flash" that, once matched, writes and at once disposes three instances.
+/// A Cyclone writer on "Flash" that, once matched, writes and at once disposes three instances. KEEP_ALL: its
+/// side may match before ours does, and then a KEEP_LAST 1 history would hold only each instance's dispose
+/// when our reader asks for what it missed (one CI run showed RED's dispose without its sample).
 const DISPOSER: &str = r#"
 dp = DomainParticipant(int(sys.argv[1]))
-w = DataWriter(dp, Topic(dp, "Flash", ShapeType), qos=Qos(Policy.Reliability.Reliable(duration(seconds=1))))
+w = DataWriter(dp, Topic(dp, "Flash", ShapeType),
+               qos=Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepAll))
 end = time.time() + 20
 while w.get_publication_matched_status().current_count == 0 and time.time() < end:
     time.sleep(0.05)
