@@ -598,12 +598,10 @@ impl Driver {
                 _ => {}
             }
         }
-        // Most calls (a write, a datagram without samples) have nothing here: no drain, no batch.
-        if !deferred.is_empty() {
-            for ev in deferred.drain(..) {
-                self.dispatch_event(ev);
-            }
+        for ev in deferred.drain(..) {
+            self.dispatch_event(ev);
         }
+        // Most calls (a write, a datagram without samples) touch no reader: no batch.
         if touched.is_empty() {
             return;
         }
