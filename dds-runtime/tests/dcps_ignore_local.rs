@@ -249,5 +249,8 @@ fn an_explicit_none_wins_over_the_participant_default() {
     assert_eq!(xs(&own_unset), Vec::<i32>::new());
     assert_eq!(xs(&other), all);
     assert_eq!(w.get_qos().unwrap().ignore_local, IgnoreLocal::None);
-    assert_eq!(own_unset.get_qos().unwrap().ignore_local, IgnoreLocal::Inherit);
+    assert_eq!(
+        own_unset.get_qos().unwrap().ignore_local,
+        IgnoreLocal::Inherit
+    );
 }
