@@ -145,6 +145,78 @@ fn typed_writer_to_dynamic_reader_with_dispose_and_filter() {
     assert_eq!(passed.len(), 2);
 }
 
+/// Takes until `n` samples came (or 10 s passed).
+fn take_n_dynamic(r: &DynamicReader, n: usize) -> Vec<DynamicSample> {
+    let mut got = Vec::new();
+    wait_until(Duration::from_secs(10), || {
+        r.wait_for_data(Duration::from_millis(100));
+        got.extend(r.take());
+        got.len() >= n
+    });
+    got
+}
+
+/// The key members of a dispose or unregister (domain 94): a dispose of an instance the reader never had
+/// data of, and the unregister (disposing) of one it had, both carry the instance's key (the other members defaulted),
+/// although the take forgets each instance at once (not alive, no writers, no samples left); while the
+/// instance lives, `get_key_value` gives the same key. Before session 27 both were `None`: the key was
+/// looked up after the take, and an instance made by data had no key holder in a dynamic reader.
+#[test]
+fn dynamic_reader_invalid_samples_carry_the_key() {
+    let ty = shape_from_builder();
+    let (p1, p2) = (participant(94), participant(94));
+    let (wq, rq) = reliable_keep_all();
+    let w = writer::<ShapeType>(&p1, "Ghost", &wq);
+    let topic = p2
+        .create_dynamic_topic("Ghost", ty.clone(), &TopicQos::default())
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| s.create_dynamic_reader(&topic, &rq))
+        .unwrap();
+    assert!(wait_until(MATCH_TIMEOUT, || w
+        .publication_matched_status()
+        .current_count
+        == 1));
+    assert!(wait_until(MATCH_TIMEOUT, || r.matched_writers().len() == 1));
+    let color = |s: &DynamicSample| s.data.as_ref().and_then(|d| d.get("color").cloned());
+    let x = |s: &DynamicSample| s.data.as_ref().and_then(|d| d.get("x").cloned());
+
+    w.dispose(&shape("PURPLE", 5)).unwrap();
+    let got = take_n_dynamic(&r, 1);
+    assert_eq!(got.len(), 1, "{got:?}");
+    assert_eq!(
+        (got[0].kind, got[0].info.valid_data),
+        (ChangeKind::Dispose, false)
+    );
+    assert_eq!(color(&got[0]), Some(Value::String("PURPLE".into())));
+    assert_eq!(x(&got[0]), Some(Value::Int32(0)), "only the key is known");
+
+    w.write(&shape("RED", 7)).unwrap();
+    let got = take_n_dynamic(&r, 1);
+    assert_eq!(got.len(), 1, "{got:?}");
+    assert_eq!(got[0].data.as_ref(), Some(&dynamic_shape(&ty, "RED", 7)));
+    let red = got[0].info.instance_handle;
+    let key = r.get_key_value(red).expect("RED is alive");
+    assert_eq!(key.get("color"), Some(&Value::String("RED".into())));
+    assert_eq!(key.get("x"), Some(&Value::Int32(0)));
+
+    w.unregister_instance(&shape("RED", 7)).unwrap();
+    let got = take_n_dynamic(&r, 1);
+    assert_eq!(got.len(), 1, "{got:?}");
+    // The writer disposes what it unregisters (autodispose_unregistered_instances, on by default).
+    assert_eq!(
+        (got[0].kind, got[0].info.valid_data),
+        (ChangeKind::Dispose, false)
+    );
+    assert_eq!(got[0].info.instance_handle, red);
+    assert_eq!(color(&got[0]), Some(Value::String("RED".into())));
+    assert!(
+        r.get_key_value(red).is_none(),
+        "the take forgot the instance"
+    );
+}
+
 #[test]
 fn dynamic_types_have_the_derived_type_information() {
     let from_idl = types_from_idl("shape.idl", SHAPE_IDL)

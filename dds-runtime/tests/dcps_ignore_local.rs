@@ -2,7 +2,8 @@
 //! `Participant`, a writer and a reader of one participant do not match while readers of another
 //! participant of the process do; `Process` excludes both; `None` keeps intra-process delivery; the policy
 //! is fixed once the entity is enabled; `Process` on either side of two participants of the process is
-//! enough in both.
+//! enough in both; endpoints that leave the policy unset take the participant's default, an explicit
+//! `None` wins over it.
 mod dcps_util;
 
 use dcps_util::*;
@@ -163,9 +164,9 @@ fn process_on_either_side_is_enough_in_both_participants() {
     assert_eq!(r_process.matched_publications().len(), 0, "Process reader");
 }
 
-/// The participant-wide default (`Config::ignore_local`, domain 123): endpoints that leave their policy at
-/// `None` inherit the participant's `Participant`, so its writer and reader do not match, while a reader of
-/// another participant (default configuration) does and gets the data.
+/// The participant-wide default (`Config::ignore_local`, domain 123): endpoints that leave their policy
+/// unset (`Inherit`, the QoS default) inherit the participant's `Participant`, so its writer and reader do
+/// not match, while a reader of another participant (default configuration) does and gets the data.
 #[test]
 fn endpoints_inherit_the_participant_default() {
     let p = participant_with(
@@ -176,7 +177,8 @@ fn endpoints_inherit_the_participant_default() {
         },
     );
     let q = participant(123);
-    let (wq, rq) = qos(IgnoreLocal::None);
+    let (wq, rq) = reliable_keep_all();
+    assert_eq!(wq.ignore_local, IgnoreLocal::Inherit);
     let w = writer::<ShapeType>(&p, "IgnoreLocalDefault", &wq);
     let own = reader::<ShapeType>(&p, "IgnoreLocalDefault", &rq);
     let other = reader::<ShapeType>(&q, "IgnoreLocalDefault", &rq);
@@ -199,4 +201,56 @@ fn endpoints_inherit_the_participant_default() {
     assert_eq!(own.matched_publications().len(), 0);
     assert_eq!(xs(&own), Vec::<i32>::new());
     assert_eq!(xs(&other), (0..10).collect::<Vec<_>>());
+}
+
+/// An endpoint's explicit `None` wins over the participant default (domain 124, as in Cyclone, where an
+/// explicitly set policy is kept): on a participant whose default is `Process`, a writer and a reader that
+/// set `None` match each other and a reader of another participant of the process, while a reader that
+/// leaves the policy unset inherits `Process` and matches nothing. `get_qos` shows each endpoint's own setting.
+#[test]
+fn an_explicit_none_wins_over_the_participant_default() {
+    let p = participant_with(
+        124,
+        dds_runtime::config::Config {
+            ignore_local: IgnoreLocal::Process,
+            ..dds_runtime::config::Config::default()
+        },
+    );
+    let q = participant(124);
+    let (wq_none, rq_none) = qos(IgnoreLocal::None);
+    let (_, rq_unset) = reliable_keep_all();
+    let topic = "IgnoreLocalExplicitNone";
+    let w = writer::<ShapeType>(&p, topic, &wq_none);
+    let own_none = reader::<ShapeType>(&p, topic, &rq_none);
+    let own_unset = reader::<ShapeType>(&p, topic, &rq_unset);
+    let other = reader::<ShapeType>(&q, topic, &rq_unset);
+    assert!(
+        wait_until(MATCH_TIMEOUT, || {
+            w.publication_matched_status().current_count == 2
+                && own_none.subscription_matched_status().current_count == 1
+                && other.subscription_matched_status().current_count == 1
+        }),
+        "writer {:?}, own None reader {:?}, other reader {:?}",
+        w.publication_matched_status(),
+        own_none.subscription_matched_status(),
+        other.subscription_matched_status()
+    );
+    // Discovery has settled: the unset reader would have matched by now.
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    for x in 0..10 {
+        w.write(&shape("RED", x)).unwrap();
+    }
+    w.wait_for_acknowledgments(MATCH_TIMEOUT).unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(200));
+    let all: Vec<i32> = (0..10).collect();
+    assert_eq!(w.matched_subscriptions().len(), 2);
+    assert_eq!(own_unset.matched_publications().len(), 0);
+    assert_eq!(xs(&own_none), all);
+    assert_eq!(xs(&own_unset), Vec::<i32>::new());
+    assert_eq!(xs(&other), all);
+    assert_eq!(w.get_qos().unwrap().ignore_local, IgnoreLocal::None);
+    assert_eq!(
+        own_unset.get_qos().unwrap().ignore_local,
+        IgnoreLocal::Inherit
+    );
 }

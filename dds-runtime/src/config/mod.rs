@@ -339,9 +339,10 @@ pub struct Config {
     /// with no serialization for the reader and no socket (`DDS_INTRA_PROCESS`, default on).
     pub intra_process: bool,
     /// The IGNORE_LOCAL policy of the user endpoints that leave theirs at
-    /// [`IgnoreLocal::None`](crate::qos::IgnoreLocal::None) (default `None`): a participant-wide default,
-    /// as Cyclone has one per participant in its configuration. An endpoint that sets `Participant` or
-    /// `Process` keeps its own.
+    /// [`IgnoreLocal::Inherit`](crate::qos::IgnoreLocal::Inherit), the QoS default (this default is
+    /// `None`; `Inherit` here means `None`): a participant-wide default, as Cyclone has one per participant
+    /// in its configuration. An endpoint that sets its own keeps it, `None` included (it then matches the
+    /// endpoints this default would ignore).
     pub ignore_local: crate::qos::IgnoreLocal,
     /// Segmented sends (Linux `UDP_SEGMENT`, `DDS_GSO`, default on): a run of equal-sized datagrams to one
     /// destination, as a fragmented sample makes, leaves in one system call. Ignored elsewhere.

@@ -173,6 +173,9 @@ pub(crate) struct ReaderCache<T> {
     instance_order: bool,
     /// Makes the key holder of a new instance from its first data (`get_key_value`).
     key_of: Option<fn(&T) -> Option<T>>,
+    /// Copies an instance's key holder into each sample without data (dispose, unregister) as it is read or
+    /// taken (the dynamic reader's samples carry their key; a take may forget the instance right after).
+    key_in_invalid: Option<fn(&T) -> T>,
     /// Derives an instance's handle from its key (the built-in readers: the entity's handle); else counted.
     handle_of: Option<fn(&[u8]) -> InstanceHandle>,
     /// At `max_instances`, a new instance evicts the instance longest not alive instead of being refused
@@ -183,6 +186,23 @@ pub(crate) struct ReaderCache<T> {
 }
 
 /// The sample a read (copying the data with `copy`, if any) or a take (moving it out) returns for `slot`.
+/// Marks sample `idx` of `inst` read and emits it; one without data is emitted with a copy of the instance's
+/// key holder instead when `key_copy` is set (the sample itself keeps no data).
+fn emit_sample<T>(
+    inst: &mut Instance<T>,
+    idx: usize,
+    key_copy: Option<fn(&T) -> T>,
+    info: SampleInfo,
+    emit: &mut impl FnMut(&mut Option<T>, SampleInfo),
+) {
+    let s = &mut inst.samples[idx];
+    s.read = true;
+    match key_copy {
+        Some(copy) if s.data.is_none() => emit(&mut inst.key_holder.as_ref().map(copy), info),
+        _ => emit(&mut s.data, info),
+    }
+}
+
 pub(crate) fn to_sample<T>(
     slot: &mut Option<T>,
     info: SampleInfo,
@@ -217,6 +237,7 @@ impl<T: FilterFields> ReaderCache<T> {
             instance_order: false,
             collect_scratch: (Vec::new(), Vec::new()),
             key_of: None,
+            key_in_invalid: None,
             handle_of: None,
             evict_not_alive: false,
         }
@@ -658,9 +679,7 @@ impl<T: FilterFields> ReaderCache<T> {
                 .get(tc.last_index)
                 .map_or(0, |s| s.disposed_gen + s.no_writers_gen);
             let info = sample_info(inst, &inst.samples[idx], tc.handle, sample_rank, mrs_gen);
-            let s = &mut inst.samples[idx];
-            s.read = true;
-            emit(&mut s.data, info);
+            emit_sample(inst, idx, self.key_in_invalid, info, emit);
         }
     }
 
@@ -910,6 +929,12 @@ impl<T> ReaderCache<T> {
     /// Gives new instances of received data a key holder made with `f` (once per instance).
     pub(crate) fn set_key_holder_fn(&mut self, f: fn(&T) -> Option<T>) {
         self.key_of = Some(f);
+    }
+
+    /// Gives each sample without data a copy (made with `f`) of its instance's key holder when it is read or
+    /// taken.
+    pub(crate) fn set_key_in_invalid_fn(&mut self, f: fn(&T) -> T) {
+        self.key_in_invalid = Some(f);
     }
 
     /// A sample holding the key of instance `h`, if one was received.

@@ -40,7 +40,7 @@ use super::topic::{Topic, TopicDescription};
 use crate::filter::ContentFilter;
 
 pub(crate) use builtin::{BuiltinGroup, BuiltinReader, UserReaderSpec};
-pub(crate) use kind::{reader_callbacks, ReaderCallbacks, ReaderKind, Typed};
+pub(crate) use kind::{reader_callbacks, KeyHolderFn, ReaderCallbacks, ReaderKind, Typed};
 pub use ops::SubscriberListener;
 
 /// Callbacks of a [`DataReader`] (see [`crate::dcps::listener`]). Every method has an empty default.

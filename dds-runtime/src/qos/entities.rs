@@ -110,7 +110,7 @@ qos_set!(
     ownership_strength: OwnershipStrength = OwnershipStrength::default(),
     writer_data_lifecycle: WriterDataLifecycle = WriterDataLifecycle::default(),
     data_representation: DataRepresentation = DataRepresentation::default(),
-    ignore_local: IgnoreLocal = IgnoreLocal::None,
+    ignore_local: IgnoreLocal = IgnoreLocal::Inherit,
 });
 
 qos_set!(
@@ -130,7 +130,7 @@ qos_set!(
     reader_data_lifecycle: ReaderDataLifecycle = ReaderDataLifecycle::default(),
     data_representation: DataRepresentation = DataRepresentation::default(),
     type_consistency: TypeConsistencyEnforcement = TypeConsistencyEnforcement::default(),
-    ignore_local: IgnoreLocal = IgnoreLocal::None,
+    ignore_local: IgnoreLocal = IgnoreLocal::Inherit,
 });
 
 impl DataWriterQos {

@@ -422,6 +422,11 @@ impl Default for TypeConsistencyEnforcement {
 /// either side's policy excludes the other. Local only: never announced (no PID), so remote peers see no
 /// difference; an endpoint of another participant in this process only knows its own policy (it sees a
 /// match the other side refuses, but no data flows). Fixed once the entity is enabled.
+///
+/// An endpoint's QoS starts at [`Inherit`](IgnoreLocal::Inherit): it takes its participant's default
+/// (`Config::ignore_local`). Any other value is the endpoint's own and wins over that default, `None`
+/// included (as an explicitly set policy does in Cyclone), so an endpoint can match its own participant's
+/// endpoints although the participant ignores local peers by default.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
 #[non_exhaustive]
 pub enum IgnoreLocal {
@@ -432,4 +437,20 @@ pub enum IgnoreLocal {
     Participant,
     /// Do not match the endpoints of any participant of the same process.
     Process,
+    /// Not set on the endpoint: its participant's default applies (`Config::ignore_local`, itself `None`
+    /// unless set). The default of `DataWriterQos::ignore_local` and `DataReaderQos::ignore_local`; as a
+    /// participant default it means `None`.
+    Inherit,
+}
+
+impl IgnoreLocal {
+    /// The policy in effect: `self`, or `default` when `self` is [`Inherit`](IgnoreLocal::Inherit); never
+    /// `Inherit` (an inherited `Inherit` is `None`).
+    pub fn or_inherited(self, default: IgnoreLocal) -> IgnoreLocal {
+        match (self, default) {
+            (IgnoreLocal::Inherit, IgnoreLocal::Inherit) => IgnoreLocal::None,
+            (IgnoreLocal::Inherit, d) => d,
+            (own, _) => own,
+        }
+    }
 }

@@ -374,9 +374,9 @@ participant_config! {
     /// repairs still go to each reader's unicast locator. Off (the default): data goes unicast only. What
     /// *our* readers announce is [`default_multicast`](Self::default_multicast).
     multicast_data: bool = copy,
-    /// The IGNORE_LOCAL policy of the user endpoints whose own is [`IgnoreLocal::None`] (default `None`):
-    /// a participant-wide default, as Cyclone's configuration has one per participant. An endpoint that
-    /// sets `Participant` or `Process` keeps its own; one that leaves `None` inherits this.
+    /// The IGNORE_LOCAL policy of the user endpoints whose own is [`IgnoreLocal::Inherit`] (the QoS
+    /// default; this default is `None`): a participant-wide default, as Cyclone's configuration has one per
+    /// participant. An endpoint that sets its own (`None` included) keeps it.
     ignore_local: IgnoreLocal = copy,
 }
 

@@ -4,7 +4,8 @@
 //! without `--idl` says why the discovered type cannot be used yet. `dds subscribe` shows the disposes of a
 //! Cyclone writer that writes and at once disposes each instance (the dispose then usually only marks the
 //! sample still held, as the reader cache does, instead of arriving as a sample of its own). Against Fast DDS
-//! 2.9, which announces no type information, `dds typeof` says so and `dds subscribe --idl` works.
+//! 2.9, which announces no type information, `dds typeof` says so and `dds subscribe --idl` works. A dispose of
+//! an instance `dds subscribe` never saw shows the key members the dispose carried.
 
 use std::ffi::OsStr;
 use std::path::Path;
@@ -45,11 +46,16 @@ class ShapeType(IdlStruct, typename="ShapeType"):
 
 /// A Cyclone peer that runs `body` after [`PY_SHAPE`], on [`DOMAIN`].
 fn python_peer(body: &str) -> Command {
+    python_peer_on(body, DOMAIN)
+}
+
+/// A Cyclone peer that runs `body` after [`PY_SHAPE`], on `domain` (its `sys.argv[1]`).
+fn python_peer_on(body: &str, domain: u32) -> Command {
     let mut c = Command::new("python3");
     c.arg("-u")
         .arg("-c")
         .arg(format!("{PY_SHAPE}{body}"))
-        .arg(DOMAIN.to_string());
+        .arg(domain.to_string());
     c
 }
 
@@ -318,6 +324,84 @@ fn dds_subscribe_shows_disposes_that_marked_held_samples() {
             ]
         })
         .collect();
+    check!(
+        shown == want,
+        &[&sub, &peer],
+        "dds subscribe showed {shown:?}"
+    );
+}
+
+/// A Cyclone writer on "Ghost" that, once matched, disposes PURPLE, an instance it never wrote, then writes
+/// RED and unregisters it (without autodispose). On [`GHOST_DOMAIN`].
+const GHOST: &str = r#"
+dp = DomainParticipant(int(sys.argv[1]))
+w = DataWriter(dp, Topic(dp, "Ghost", ShapeType),
+               qos=Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepAll,
+                       Policy.WriterDataLifecycle(autodispose=False)))
+end = time.time() + 20
+while w.get_publication_matched_status().current_count == 0 and time.time() < end:
+    time.sleep(0.05)
+print("matched", flush=True)
+time.sleep(0.3)
+w.dispose(ShapeType(color="PURPLE", x=0, y=0, shapesize=0))
+time.sleep(0.3)
+red = ShapeType(color="RED", x=1, y=1, shapesize=30)
+w.write(red)
+time.sleep(0.3)
+w.unregister_instance(red)
+w.wait_for_acks(duration(seconds=5))
+print("done", flush=True)
+time.sleep(3)
+"#;
+
+/// The domain of [`dds_subscribe_shows_the_key_of_a_dispose_of_an_instance_it_never_saw`].
+const GHOST_DOMAIN: u32 = 129;
+
+/// A dispose of an instance the reader never had a sample of carries only the key (Cyclone sends the
+/// serialized key): `dds subscribe` shows its key members (the dynamic reader's invalid samples carry the
+/// instance's key, also when the take forgets the instance at once), as it does for the unregister of an
+/// instance it saw alive. Before session 27 both showed `"key": null`.
+#[test]
+fn dds_subscribe_shows_the_key_of_a_dispose_of_an_instance_it_never_saw() {
+    if require_netns().is_err() || cyclone_peer().is_err() {
+        return;
+    }
+    let Ok(bin) = our_bin("dds") else { return };
+    let idl = idl_file();
+    let mut sub = Command::new(bin);
+    sub.args(["subscribe", "Ghost", "--ndjson", "--reliable", "-n", "3"])
+        .args(["--timeout", "25"])
+        .arg("--idl")
+        .arg(&idl)
+        .args(["--domain", &GHOST_DOMAIN.to_string()]);
+    let mut sub = Proc::spawn("dds subscribe", sub);
+    let mut peer = Proc::spawn(
+        "cyclone ghost disposer",
+        python_peer_on(GHOST, GHOST_DOMAIN),
+    );
+    let exit = sub.wait_exit(Duration::from_secs(30));
+    let rows = ndjson_rows(&sub.lines().join("\n"));
+    let _ = peer.interrupt(WAIT);
+    check!(
+        exit.is_some(),
+        &[&sub, &peer],
+        "dds subscribe did not finish"
+    );
+    let shown: Vec<(&str, &str, Option<i64>)> = rows
+        .iter()
+        .map(|r| {
+            let (kind, v) = match r.get("kind") {
+                Some(k) => (k.as_str().unwrap_or("?"), &r["key"]),
+                None => ("Alive", r),
+            };
+            (kind, v["color"].as_str().unwrap_or("?"), v["x"].as_i64())
+        })
+        .collect();
+    let want = [
+        ("Dispose", "PURPLE", Some(0)),
+        ("Alive", "RED", Some(1)),
+        ("Unregister", "RED", Some(0)),
+    ];
     check!(
         shown == want,
         &[&sub, &peer],

@@ -3,7 +3,7 @@
 //! instances, where the general path (`ReaderCache::collect_with`) looks the instance up four more times
 //! (to emit, to mark it not new, to remove the sample, to drop an emptied instance) and sorts its picks.
 
-use super::{sample_info, Instance, ReaderCache, Selection};
+use super::{emit_sample, sample_info, Instance, ReaderCache, Selection};
 use crate::dcps::sample::{InstanceState, SampleInfo, ViewState};
 use crate::filter::FilterFields;
 
@@ -41,9 +41,7 @@ impl<T: FilterFields> ReaderCache<T> {
             return true;
         }
         let info = sample_info(inst, s, handle, 0, s.disposed_gen + s.no_writers_gen);
-        let s = &mut inst.samples[0];
-        s.read = true;
-        emit(&mut s.data, info);
+        emit_sample(inst, 0, self.key_in_invalid, info, emit);
         inst.view = ViewState::NotNew;
         if take {
             inst.samples.clear();

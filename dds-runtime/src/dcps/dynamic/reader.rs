@@ -5,7 +5,7 @@
 use std::sync::Arc;
 use std::time::{Duration, SystemTime};
 
-use crate::cdr::{DecodeError, EncodeError, XcdrVersion};
+use crate::cdr::{ByteOrder, DecodeError, EncodeError, XcdrVersion};
 use crate::qos::{DataReaderQos, DataRepresentation, ReaderQos};
 use crate::rtps::{ChangeKind, Guid, Payload, ReaderSpec};
 use crate::xtypes::dynamic::{DynamicData, DynamicType};
@@ -25,7 +25,7 @@ use super::super::status::{
     SampleRejectedStatus, StatusMask, SubscriptionMatchedStatus,
 };
 use super::super::subscriber::{
-    credit_limit, reader_callbacks, ReaderInner, ReaderKind, Subscriber,
+    credit_limit, reader_callbacks, KeyHolderFn, ReaderInner, ReaderKind, Subscriber,
 };
 use super::super::sync::lock;
 use super::DynamicTopic;
@@ -33,8 +33,9 @@ use super::DynamicTopic;
 /// One received change, decoded (what [`DynamicReader::take`] returns).
 #[derive(Debug, Clone)]
 pub struct DynamicSample {
-    /// The sample (`Alive`), or the instance's key with defaults elsewhere (dispose, unregister); `None`
-    /// when a key-only change carried no key payload.
+    /// The sample (`Alive`), or the instance's key with defaults elsewhere (dispose, unregister; also for
+    /// an instance the reader never had data of, from the change's key payload); `None` for an unkeyed
+    /// type's unregister.
     pub data: Option<DynamicData>,
     /// What the change did to its instance: `Alive` for data, else the instance's state when it was taken
     /// (`Dispose` for NOT_ALIVE_DISPOSED, `Unregister` for NOT_ALIVE_NO_WRITERS).
@@ -145,6 +146,22 @@ impl ReaderKind for Dynamic {
     fn enable(_: DynamicReader) -> DdsResult<()> {
         Ok(())
     }
+    fn key_holder() -> Option<KeyHolderFn<DynamicData>> {
+        Some(key_holder)
+    }
+}
+
+/// The key holder of `d`'s instance: its key members, the others defaulted (through a key-only payload);
+/// `None` for an unkeyed type.
+fn key_holder(d: &DynamicData) -> Option<DynamicData> {
+    let ty = d.dynamic_type();
+    if !ty.is_keyed() {
+        return None;
+    }
+    let mut key = Vec::new();
+    d.serialize_key(XcdrVersion::Xcdr2, ByteOrder::LittleEndian, &mut key)
+        .ok()?;
+    DynamicData::deserialize_key(ty, &key).ok()
 }
 
 /// Takes [`DynamicData`] samples of a [`DynamicTopic`]. Cheap to clone; deleted with its last clone.
@@ -218,7 +235,9 @@ impl Subscriber {
             internal: false,
         };
         let credit = credit_limit(&rq);
-        let cache = ReaderCache::new(rq, ty.is_keyed());
+        let mut cache = ReaderCache::new(rq, ty.is_keyed());
+        // A dispose or unregister carries its instance's key (`DynamicSample::data`).
+        cache.set_key_in_invalid_fn(DynamicData::clone);
         let inner =
             self.reader_inner::<Dynamic>(ty, cache, &group_qos.presentation, credit, parent);
         if let Some((l, mask)) = listener {
@@ -391,6 +410,13 @@ impl DynamicReader {
         self.collect(Self::of_instance(h), true)
     }
 
+    /// The key of instance `h` (DDS `get_key_value`): its key members, the others defaulted; `None` when
+    /// the reader does not know the instance (any more: a take of the last sample of an instance that is not
+    /// alive and has no writers forgets it, but the samples taken carry the key in their `data`).
+    pub fn get_key_value(&self, h: InstanceHandle) -> Option<DynamicData> {
+        lock(&self.inner.cache).cache.key_holder(h).cloned()
+    }
+
     /// The handle of the instance whose key `key_sample` holds, if the reader knows it.
     pub fn lookup_instance(&self, key_sample: &DynamicData) -> Option<InstanceHandle> {
         let mut key = Vec::new();
@@ -467,8 +493,9 @@ impl DynamicReader {
         }
     }
 
-    /// The selected samples; those without data (dispose, unregister) carry the instance's key values when
-    /// the reader knows them. Empty once the participant is gone.
+    /// The selected samples; those without data (dispose, unregister) carry the instance's key values
+    /// (`valid_data` false), which the cache adds as it emits them: a take may forget the instance at once.
+    /// Empty once the participant is gone.
     fn collect(&self, sel: Selection, take: bool) -> Vec<Sample<DynamicData>> {
         let mut out = Vec::new();
         let visited = self.inner.visit(sel, None, take, |slot, info| {
@@ -476,10 +503,6 @@ impl DynamicReader {
         });
         if visited.is_err() {
             return Vec::new();
-        }
-        let st = lock(&self.inner.cache);
-        for s in out.iter_mut().filter(|s| s.data.is_none()) {
-            s.data = st.cache.key_holder(s.info.instance_handle).cloned();
         }
         out
     }

@@ -60,11 +60,9 @@ fn process_policies() -> std::sync::MutexGuard<'static, Vec<(Guid, IgnoreLocal)>
 }
 
 /// An endpoint's IGNORE_LOCAL: its own, or the participant's default (`ParticipantConfig::ignore_local`)
-/// when its own is `None`.
+/// when its own is `Inherit` (an explicit `None` stays).
 pub(super) fn inherit(own: &mut IgnoreLocal, participant_default: IgnoreLocal) {
-    if *own == IgnoreLocal::None {
-        *own = participant_default;
-    }
+    *own = own.or_inherited(participant_default);
 }
 
 /// Records the IGNORE_LOCAL policy of this process's endpoint `guid` for the process's other participants.
@@ -76,8 +74,9 @@ pub(super) fn note_ignore_local(guid: Guid, policy: IgnoreLocal) {
 }
 
 /// The policy of endpoint `guid`: `announced` (its own, for this participant's), else what its participant
-/// in this process recorded.
+/// in this process recorded. A discovered endpoint's QoS says `Inherit` (no PID carries the policy).
 fn policy_of(guid: Guid, announced: IgnoreLocal) -> IgnoreLocal {
+    let announced = announced.or_inherited(IgnoreLocal::None);
     if announced != IgnoreLocal::None || !ANY_POLICY.load(Ordering::Acquire) {
         return announced;
     }
