@@ -185,7 +185,6 @@ pub(crate) struct ReaderCache<T> {
     collect_scratch: (Vec<Touched>, Vec<(u64, usize, usize)>),
 }
 
-/// The sample a read (copying the data with `copy`, if any) or a take (moving it out) returns for `slot`.
 /// Marks sample `idx` of `inst` read and emits it; one without data is emitted with a copy of the instance's
 /// key holder instead when `key_copy` is set (the sample itself keeps no data).
 fn emit_sample<T>(
@@ -203,6 +202,7 @@ fn emit_sample<T>(
     }
 }
 
+/// The sample a read (copying the data with `copy`, if any) or a take (moving it out) returns for `slot`.
 pub(crate) fn to_sample<T>(
     slot: &mut Option<T>,
     info: SampleInfo,
