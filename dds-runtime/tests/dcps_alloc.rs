@@ -529,14 +529,12 @@ fn a_shared_memory_pair_writes_and_takes_without_allocating() {
     let (p1, p2) = (shm(), shm());
     let (wq, rq) = reliable_keep_all_blocking(Duration::from_secs(10));
     let (w, r) = matched::<Named>(&p1, &p2, "AllocShm", &wq, &rq);
-    named_run(&w, &r, 0, 5_000, true);
+    named_run(&w, &r, 0, 5_000, true, 1);
     let sent = || p1.transport_stats().sent.load(Ordering::Relaxed);
     let before = sent();
     // The quietest of three windows: what is left is periodic (SPDP, the timer thread), and a loaded
     // machine stretches a window over more of it.
-    let windows: Vec<f64> = (0..3)
-        .map(|i| named_run(&w, &r, 5_000 + i * 5_000, 5_000, true))
-        .collect();
+    let windows = named_run(&w, &r, 5_000, 15_000, true, 3);
     let per_sample = windows.iter().copied().fold(f64::INFINITY, f64::min);
     let datagrams = sent() - before;
     eprintln!(
