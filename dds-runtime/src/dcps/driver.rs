@@ -168,30 +168,46 @@ const ENDPOINT_TICK: Duration = Duration::from_millis(50);
 
 /// The instant the timer thread sleeps until, mirrored from [`TimerState::waiting_until`] (written under
 /// its lock) so that a core call whose deadline is no earlier skips the lock: two lock round trips per
-/// ping/pong round trip. The time since `epoch` ([`SleepMark::encode`]); 0 while the timer thread works.
+/// ping/pong round trip. The time since [`sleep_epoch`] ([`encode_instant`]); 0 while the timer thread works.
 struct SleepMark {
-    epoch: Instant,
     until: AtomicU64,
+}
+
+/// The process's origin for [`SleepMark`]s (one for every participant: a thread's last encoding serves all).
+fn sleep_epoch() -> Instant {
+    static EPOCH: OnceLock<Instant> = OnceLock::new();
+    *EPOCH.get_or_init(Instant::now)
+}
+
+/// `t` as a number ordered as the instants are: seconds since [`sleep_epoch`] above bit 30, nanoseconds
+/// below (no multiplication), plus one. A thread's last answer is kept: a core's deadline mostly stays from
+/// one call to the next, and the subtraction of instants costs more than the comparison.
+fn encode_instant(t: Instant) -> u64 {
+    thread_local! {
+        static LAST: std::cell::Cell<Option<(Instant, u64)>> = const { std::cell::Cell::new(None) };
+    }
+    LAST.with(|last| match last.get() {
+        Some((at, e)) if at == t => e,
+        _ => {
+            let d = t.saturating_duration_since(sleep_epoch());
+            let e = (d.as_secs().min(u64::MAX >> 31) << 30 | u64::from(d.subsec_nanos())) + 1;
+            last.set(Some((t, e)));
+            e
+        }
+    })
 }
 
 impl SleepMark {
     fn new() -> Self {
+        sleep_epoch();
         SleepMark {
-            epoch: Instant::now(),
             until: AtomicU64::new(0),
         }
     }
 
-    /// Seconds above bit 30, nanoseconds below (ordered as the instants are, without a multiplication),
-    /// plus one.
-    fn encode(&self, t: Instant) -> u64 {
-        let d = t.saturating_duration_since(self.epoch);
-        (d.as_secs().min(u64::MAX >> 31) << 30 | u64::from(d.subsec_nanos())) + 1
-    }
-
     /// Called with the timer state's lock held, whenever `waiting_until` changes.
     fn set(&self, until: Option<Instant>) {
-        let v = until.map_or(0, |t| self.encode(t));
+        let v = until.map_or(0, encode_instant);
         self.until.store(v, Ordering::SeqCst);
     }
 
@@ -201,7 +217,7 @@ impl SleepMark {
     /// sleeping.
     fn covers(&self, next: Option<Instant>) -> bool {
         let w = self.until.load(Ordering::SeqCst);
-        w != 0 && next.is_none_or(|n| self.encode(n) >= w)
+        w != 0 && next.is_none_or(|n| encode_instant(n) >= w)
     }
 }
 
@@ -1097,5 +1113,36 @@ impl<O> EndpointHandle<O> {
 impl<O> Drop for EndpointHandle<O> {
     fn drop(&mut self) {
         self.driver.delete_endpoint(self.id);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn encoded_instants_order_as_the_instants() {
+        let t = Instant::now();
+        let steps = [
+            Duration::ZERO,
+            Duration::from_nanos(1),
+            Duration::from_nanos(999_999_999),
+            Duration::from_secs(1),
+            Duration::from_millis(1_500),
+            Duration::from_secs(3_600),
+        ];
+        let coded: Vec<u64> = steps.iter().map(|d| encode_instant(t + *d)).collect();
+        assert!(coded.windows(2).all(|w| w[0] < w[1]), "{coded:?}");
+        // The thread's kept answer is for the same instant only.
+        assert_eq!(encode_instant(t), coded[0]);
+        assert!(coded[0] > 0, "0 means no sleep");
+        let mark = SleepMark::new();
+        assert!(!mark.covers(None), "a working timer thread is not covered");
+        mark.set(Some(t + Duration::from_secs(1)));
+        assert!(mark.covers(None));
+        assert!(mark.covers(Some(t + Duration::from_secs(2))));
+        assert!(!mark.covers(Some(t)));
+        mark.set(None);
+        assert!(!mark.covers(Some(t + Duration::from_secs(2))));
     }
 }
