@@ -180,7 +180,8 @@ fn sleep_epoch() -> Instant {
 }
 
 /// `t` as a number ordered as the instants are: seconds since [`sleep_epoch`] above bit 30, nanoseconds
-/// below (no multiplication), plus one. A thread's last answer is kept: a core's deadline mostly stays from
+/// below (no multiplication), plus one; 1 for every instant up to the epoch (the first participant's
+/// creation, before any core's deadline). A thread's last answer is kept: a core's deadline mostly stays from
 /// one call to the next, and the subtraction of instants costs more than the comparison.
 fn encode_instant(t: Instant) -> u64 {
     thread_local! {
@@ -190,7 +191,7 @@ fn encode_instant(t: Instant) -> u64 {
         Some((at, e)) if at == t => e,
         _ => {
             let d = t.saturating_duration_since(sleep_epoch());
-            let e = (d.as_secs().min(u64::MAX >> 31) << 30 | u64::from(d.subsec_nanos())) + 1;
+            let e = ((d.as_secs().min(u64::MAX >> 31) << 30) | u64::from(d.subsec_nanos())) + 1;
             last.set(Some((t, e)));
             e
         }
@@ -217,7 +218,12 @@ impl SleepMark {
     /// sleeping.
     fn covers(&self, next: Option<Instant>) -> bool {
         let w = self.until.load(Ordering::SeqCst);
-        w != 0 && next.is_none_or(|n| encode_instant(n) >= w)
+        // An instant up to the epoch (encoded as 1) is never taken as covered.
+        w != 0
+            && next.is_none_or(|n| {
+                let e = encode_instant(n);
+                e > 1 && e >= w
+            })
     }
 }
 
@@ -1122,7 +1128,9 @@ mod tests {
 
     #[test]
     fn encoded_instants_order_as_the_instants() {
-        let t = Instant::now();
+        let before = Instant::now();
+        let mark = SleepMark::new();
+        let t = Instant::now() + Duration::from_nanos(1);
         let steps = [
             Duration::ZERO,
             Duration::from_nanos(1),
@@ -1136,12 +1144,17 @@ mod tests {
         // The thread's kept answer is for the same instant only.
         assert_eq!(encode_instant(t), coded[0]);
         assert!(coded[0] > 0, "0 means no sleep");
-        let mark = SleepMark::new();
         assert!(!mark.covers(None), "a working timer thread is not covered");
         mark.set(Some(t + Duration::from_secs(1)));
         assert!(mark.covers(None));
         assert!(mark.covers(Some(t + Duration::from_secs(2))));
         assert!(!mark.covers(Some(t)));
+        // An instant up to the epoch (all encoded alike) is not taken as covered (the epoch is the process's:
+        // a test run in one process may have set it before `before`).
+        if encode_instant(before) == 1 {
+            mark.set(Some(before));
+            assert!(!mark.covers(Some(before)));
+        }
         mark.set(None);
         assert!(!mark.covers(Some(t + Duration::from_secs(2))));
     }

@@ -990,7 +990,10 @@ impl<K: ReaderKind> ReaderInner<K> {
 
     /// Decodes one received change and stores it in the cache.
     fn store(&self, st: &mut CacheState<K::Data>, s: ReceivedSample, pass: &mut Pass) {
-        let info = self.state.driver.remote_writer_via(&s.writer, &mut st.writer_info);
+        let info = self
+            .state
+            .driver
+            .remote_writer_via(&s.writer, &mut st.writer_info);
         let key = st.cache.take_key_buffer();
         let Some(inc) = decode_change_with(
             &self.codec,
