@@ -487,8 +487,9 @@ impl Driver {
         let (r, next_timeout, order) = {
             let mut core = lock(&self.core);
             // Sent datagrams go back to the core for reuse (saves allocations per datagram): this thread's
-            // own without a lock, the shared list's when other threads left some there.
-            for t in batch.drain(..) {
+            // own without a lock, the shared list's when other threads left some there. Popped (their order
+            // does not matter): cheaper than a drain.
+            while let Some(t) = batch.pop() {
                 core.recycle_transmit(t);
             }
             if self.spare_count.load(Ordering::Acquire) > 0 {

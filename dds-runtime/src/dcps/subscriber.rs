@@ -1025,7 +1025,8 @@ impl<K: ReaderKind> ReaderInner<K> {
         // Taking the queue under the cache lock keeps the core's order even with several receive threads.
         let mut batch = std::mem::take(&mut st.batch);
         std::mem::swap(&mut batch, &mut *lock(queue));
-        for (place, item) in batch.drain(..) {
+        // Popped from the front (a drain's set-up and drop cost more for the one or two items of a batch).
+        while let Some((place, item)) = batch.pop_front() {
             st.cache.order_from(place);
             match item {
                 Pending::Sample(s) => self.store(st, s, &mut pass),
