@@ -14,7 +14,11 @@
 # function whose calls count the round trips (a wrapper around Cyclone's ddsperf: WRITE_FN=process_ping);
 # DOMAIN= (61), WARMUP= (5 s), WINDOW= (8 s). END=ping measures the ping end instead (PROG under callgrind
 # runs `ping`, PING= names the pong's build then); its round trips are the calls of the ping's write.
+# Receive polling is off (DDS_RECEIVE_SPIN_US=0 unless set): whether the polling guard lets a thread poll
+# depends on the host's load of the moment, and a polling pong end counts its empty `recvmsg` attempts too
+# (about 500 instructions per round trip more, session 27); with it off the count is that of a loaded host.
 set -euo pipefail
+export DDS_RECEIVE_SPIN_US=${DDS_RECEIVE_SPIN_US:-0}
 cd "$(dirname "$0")/.."
 if [[ "${DDS_IN_NETNS:-}" != 1 ]]; then
   exec scripts/isolated "$0" "$@"

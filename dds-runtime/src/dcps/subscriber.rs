@@ -294,14 +294,14 @@ pub(crate) struct CacheState<T> {
     decoding: Decoding<T>,
     /// The queue being processed, swapped with `pending` (one lock round per batch, buffers reused).
     batch: VecDeque<(u64, Pending)>,
+    /// The QoS of the writer of the last change stored, as [`super::driver::Driver::remote_writer_via`] remembers it.
+    writer_info: Option<(u64, Guid, RemoteWriterInfo)>,
 }
 
 /// One pass of `process` over a reader's queue.
 struct Pass {
     now: Instant,
     rx_time: SystemTime,
-    /// Consecutive samples mostly come from one writer: its QoS is looked up once per run.
-    writer_info: Option<(Guid, RemoteWriterInfo)>,
     stored: Stored,
 }
 
@@ -866,6 +866,7 @@ impl<K: ReaderKind> ReaderInner<K> {
                 cache,
                 decoding: Decoding::new(),
                 batch: VecDeque::new(),
+                writer_info: None,
             }),
             data_cv: Condvar::new(),
             data_waiters: AtomicUsize::new(0),
@@ -989,14 +990,10 @@ impl<K: ReaderKind> ReaderInner<K> {
 
     /// Decodes one received change and stores it in the cache.
     fn store(&self, st: &mut CacheState<K::Data>, s: ReceivedSample, pass: &mut Pass) {
-        let info = match pass.writer_info {
-            Some((g, info)) if g == s.writer => info,
-            _ => {
-                let info = self.state.driver.remote_writer(&s.writer);
-                pass.writer_info = Some((s.writer, info));
-                info
-            }
-        };
+        let info = self
+            .state
+            .driver
+            .remote_writer_via(&s.writer, &mut st.writer_info);
         let key = st.cache.take_key_buffer();
         let Some(inc) = decode_change_with(
             &self.codec,
@@ -1021,7 +1018,6 @@ impl<K: ReaderKind> ReaderInner<K> {
         let mut pass = Pass {
             now: Instant::now(),
             rx_time: SystemTime::now(),
-            writer_info: None,
             stored: Stored::default(),
         };
         let mut guard = lock(&self.cache);
@@ -1029,7 +1025,8 @@ impl<K: ReaderKind> ReaderInner<K> {
         // Taking the queue under the cache lock keeps the core's order even with several receive threads.
         let mut batch = std::mem::take(&mut st.batch);
         std::mem::swap(&mut batch, &mut *lock(queue));
-        for (place, item) in batch.drain(..) {
+        // Popped from the front (a drain's set-up and drop cost more for the one or two items of a batch).
+        while let Some((place, item)) = batch.pop_front() {
             st.cache.order_from(place);
             match item {
                 Pending::Sample(s) => self.store(st, s, &mut pass),
@@ -1110,11 +1107,11 @@ impl<K: ReaderKind> Endpoint for ReaderInner<K> {
     }
 
     fn enqueue_run(&self, first: Pending, more: &mut dyn FnMut() -> Option<Pending>) {
+        // Each sample moves once, into the queue (an `Option` around the first was one move more).
         let mut queue = lock(&self.pending);
-        let mut item = Some(first);
-        while let Some(it) = item {
+        queue.push_back((self.place(&first), first));
+        while let Some(it) = more() {
             queue.push_back((self.place(&it), it));
-            item = more();
         }
     }
 

@@ -100,23 +100,20 @@ impl HistoryCache {
         };
         let keep_last = matches!(self.history, History::KeepLast(_));
         if let Some(limit) = per_instance {
-            let oldest = match self.instances.get(key) {
-                Some(q) if q.len() >= limit => q.front().copied(),
-                _ => None,
-            };
-            match oldest {
-                // KEEP_LAST replaces the oldest sample of the instance, acknowledged or not; the
-                // instance's queue stays for the change that replaces it.
-                Some(sn) if keep_last || sn < acked => {
-                    if let Some(c) = self.changes.remove(sn) {
-                        self.bytes -= c.payload.accounted_len();
-                        if let Some(q) = self.instances.get_mut(key) {
+            // One lookup of the instance's queue for the check and the replacement.
+            if let Some(q) = self.instances.get_mut(key).filter(|q| q.len() >= limit) {
+                match q.front().copied() {
+                    // KEEP_LAST replaces the oldest sample of the instance, acknowledged or not; the
+                    // instance's queue stays for the change that replaces it.
+                    Some(sn) if keep_last || sn < acked => {
+                        if let Some(c) = self.changes.remove(sn) {
+                            self.bytes -= c.payload.accounted_len();
                             q.pop_front();
                         }
                     }
+                    Some(_) => return Err(HistoryFull::Full),
+                    None => {}
                 }
-                Some(_) => return Err(HistoryFull::Full),
-                None => {}
             }
         }
         if let Some(limit) = max_total {
@@ -143,11 +140,15 @@ impl HistoryCache {
     pub(crate) fn add(&mut self, change: CacheChange) {
         let key = change.key_hash.unwrap_or_default();
         self.bytes += change.payload.accounted_len();
-        let spare = &mut self.spare_queue;
-        self.instances
-            .entry(key)
-            .or_insert_with(|| spare.take().unwrap_or_default())
-            .push_back(change.sn);
+        // The instance is most often there already (`make_room` just looked it up): no entry's room check.
+        match self.instances.get_mut(&key) {
+            Some(q) => q.push_back(change.sn),
+            None => {
+                let mut q = self.spare_queue.take().unwrap_or_default();
+                q.push_back(change.sn);
+                self.instances.insert(key, q);
+            }
+        }
         self.changes.insert(change.sn, change);
     }
 
