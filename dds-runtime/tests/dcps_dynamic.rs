@@ -86,24 +86,38 @@ fn dynamic_writer_from_idl_to_typed_reader() {
     );
 }
 
+/// A typed `ShapeType` writer on `p1` and a dynamic reader of `ty` on `p2`, on `topic`, reliable KEEP_ALL;
+/// with `wait`, once each has matched the other.
+fn typed_writer_dynamic_reader(
+    (p1, p2): (&DomainParticipant, &DomainParticipant),
+    topic: &str,
+    ty: &DynamicType,
+    wait: bool,
+) -> (DataWriter<ShapeType>, DynamicReader) {
+    let (wq, rq) = reliable_keep_all();
+    let w = writer::<ShapeType>(p1, topic, &wq);
+    let t = p2
+        .create_dynamic_topic(topic, ty.clone(), &TopicQos::default())
+        .unwrap();
+    let r = p2
+        .create_subscriber(&SubscriberQos::default())
+        .and_then(|s| s.create_dynamic_reader(&t, &rq))
+        .unwrap();
+    if wait {
+        assert!(wait_until(MATCH_TIMEOUT, || w
+            .publication_matched_status()
+            .current_count
+            == 1));
+        assert!(wait_until(MATCH_TIMEOUT, || r.matched_writers().len() == 1));
+    }
+    (w, r)
+}
+
 #[test]
 fn typed_writer_to_dynamic_reader_with_dispose_and_filter() {
     let ty = shape_from_builder();
     let (p1, p2) = (participant(92), participant(92));
-    let (wq, rq) = reliable_keep_all();
-    let w = writer::<ShapeType>(&p1, "Circle", &wq);
-    let topic = p2
-        .create_dynamic_topic("Circle", ty.clone(), &TopicQos::default())
-        .unwrap();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .and_then(|s| s.create_dynamic_reader(&topic, &rq))
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
-    assert!(wait_until(MATCH_TIMEOUT, || r.matched_writers().len() == 1));
+    let (w, r) = typed_writer_dynamic_reader((&p1, &p2), "Circle", &ty, true);
     for i in 0..5 {
         w.write(&shape("GREEN", i)).unwrap();
     }
@@ -165,20 +179,7 @@ fn take_n_dynamic(r: &DynamicReader, n: usize) -> Vec<DynamicSample> {
 fn dynamic_reader_invalid_samples_carry_the_key() {
     let ty = shape_from_builder();
     let (p1, p2) = (participant(94), participant(94));
-    let (wq, rq) = reliable_keep_all();
-    let w = writer::<ShapeType>(&p1, "Ghost", &wq);
-    let topic = p2
-        .create_dynamic_topic("Ghost", ty.clone(), &TopicQos::default())
-        .unwrap();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .and_then(|s| s.create_dynamic_reader(&topic, &rq))
-        .unwrap();
-    assert!(wait_until(MATCH_TIMEOUT, || w
-        .publication_matched_status()
-        .current_count
-        == 1));
-    assert!(wait_until(MATCH_TIMEOUT, || r.matched_writers().len() == 1));
+    let (w, r) = typed_writer_dynamic_reader((&p1, &p2), "Ghost", &ty, true);
     let color = |s: &DynamicSample| s.data.as_ref().and_then(|d| d.get("color").cloned());
     let x = |s: &DynamicSample| s.data.as_ref().and_then(|d| d.get("x").cloned());
 
@@ -371,15 +372,7 @@ fn dynamic_writers_match_typed_readers_by_assignability() {
 fn dynamic_reader_read_and_query_conditions() {
     let ty = shape_from_builder();
     let (p1, p2) = (participant(215), participant(215));
-    let (wq, rq) = reliable_keep_all();
-    let w = writer::<ShapeType>(&p1, "DynCond", &wq);
-    let topic = p2
-        .create_dynamic_topic("DynCond", ty.clone(), &TopicQos::default())
-        .unwrap();
-    let r = p2
-        .create_subscriber(&SubscriberQos::default())
-        .and_then(|s| s.create_dynamic_reader(&topic, &rq))
-        .unwrap();
+    let (w, r) = typed_writer_dynamic_reader((&p1, &p2), "DynCond", &ty, false);
     let unread = r.create_readcondition(
         SampleStateMask::NOT_READ,
         ViewStateMask::ANY,

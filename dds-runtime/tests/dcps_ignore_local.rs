@@ -164,18 +164,32 @@ fn process_on_either_side_is_enough_in_both_participants() {
     assert_eq!(r_process.matched_publications().len(), 0, "Process reader");
 }
 
+/// A participant of `domain` whose endpoints inherit `policy` (`Config::ignore_local`).
+fn defaulting_to(domain: u32, policy: IgnoreLocal) -> DomainParticipant {
+    participant_with(
+        domain,
+        dds_runtime::config::Config {
+            ignore_local: policy,
+            ..dds_runtime::config::Config::default()
+        },
+    )
+}
+
+/// RED x = 0..10 from `w`, acknowledged by every matched reader, and a moment for the readers' caches.
+fn write_ten_acknowledged(w: &DataWriter<ShapeType>) {
+    for x in 0..10 {
+        w.write(&shape("RED", x)).unwrap();
+    }
+    w.wait_for_acknowledgments(MATCH_TIMEOUT).unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(200));
+}
+
 /// The participant-wide default (`Config::ignore_local`, domain 123): endpoints that leave their policy
 /// unset (`Inherit`, the QoS default) inherit the participant's `Participant`, so its writer and reader do
 /// not match, while a reader of another participant (default configuration) does and gets the data.
 #[test]
 fn endpoints_inherit_the_participant_default() {
-    let p = participant_with(
-        123,
-        dds_runtime::config::Config {
-            ignore_local: IgnoreLocal::Participant,
-            ..dds_runtime::config::Config::default()
-        },
-    );
+    let p = defaulting_to(123, IgnoreLocal::Participant);
     let q = participant(123);
     let (wq, rq) = reliable_keep_all();
     assert_eq!(wq.ignore_local, IgnoreLocal::Inherit);
@@ -192,11 +206,7 @@ fn endpoints_inherit_the_participant_default() {
         other.subscription_matched_status()
     );
     std::thread::sleep(std::time::Duration::from_millis(500));
-    for x in 0..10 {
-        w.write(&shape("RED", x)).unwrap();
-    }
-    w.wait_for_acknowledgments(MATCH_TIMEOUT).unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(200));
+    write_ten_acknowledged(&w);
     assert_eq!(w.matched_subscriptions().len(), 1);
     assert_eq!(own.matched_publications().len(), 0);
     assert_eq!(xs(&own), Vec::<i32>::new());
@@ -209,13 +219,7 @@ fn endpoints_inherit_the_participant_default() {
 /// leaves the policy unset inherits `Process` and matches nothing. `get_qos` shows each endpoint's own setting.
 #[test]
 fn an_explicit_none_wins_over_the_participant_default() {
-    let p = participant_with(
-        124,
-        dds_runtime::config::Config {
-            ignore_local: IgnoreLocal::Process,
-            ..dds_runtime::config::Config::default()
-        },
-    );
+    let p = defaulting_to(124, IgnoreLocal::Process);
     let q = participant(124);
     let (wq_none, rq_none) = qos(IgnoreLocal::None);
     let (_, rq_unset) = reliable_keep_all();
@@ -237,11 +241,7 @@ fn an_explicit_none_wins_over_the_participant_default() {
     );
     // Discovery has settled: the unset reader would have matched by now.
     std::thread::sleep(std::time::Duration::from_millis(500));
-    for x in 0..10 {
-        w.write(&shape("RED", x)).unwrap();
-    }
-    w.wait_for_acknowledgments(MATCH_TIMEOUT).unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(200));
+    write_ten_acknowledged(&w);
     let all: Vec<i32> = (0..10).collect();
     assert_eq!(w.matched_subscriptions().len(), 2);
     assert_eq!(own_unset.matched_publications().len(), 0);

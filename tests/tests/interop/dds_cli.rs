@@ -285,23 +285,7 @@ fn dds_subscribe_shows_disposes_that_marked_held_samples() {
         return;
     }
     let Ok(bin) = our_bin("dds") else { return };
-    let idl = idl_file();
-    let mut sub = Command::new(bin);
-    sub.args(["subscribe", "Flash", "--ndjson", "--reliable", "-n", "6"])
-        .args(["--timeout", "25"])
-        .arg("--idl")
-        .arg(&idl)
-        .args(["--domain", &DOMAIN.to_string()]);
-    let mut sub = Proc::spawn("dds subscribe", sub);
-    let mut peer = Proc::spawn("cyclone disposer", python_peer(DISPOSER));
-    let exit = sub.wait_exit(Duration::from_secs(30));
-    let rows = ndjson_rows(&sub.lines().join("\n"));
-    let _ = peer.interrupt(WAIT);
-    check!(
-        exit.is_some(),
-        &[&sub, &peer],
-        "dds subscribe did not finish"
-    );
+    let (rows, sub, peer) = subscribe_beside(&bin, "Flash", 6, DOMAIN, DISPOSER);
     let shown: Vec<(String, String)> = rows
         .iter()
         .map(|r| match r.get("kind") {
@@ -367,26 +351,7 @@ fn dds_subscribe_shows_the_key_of_a_dispose_of_an_instance_it_never_saw() {
         return;
     }
     let Ok(bin) = our_bin("dds") else { return };
-    let idl = idl_file();
-    let mut sub = Command::new(bin);
-    sub.args(["subscribe", "Ghost", "--ndjson", "--reliable", "-n", "3"])
-        .args(["--timeout", "25"])
-        .arg("--idl")
-        .arg(&idl)
-        .args(["--domain", &GHOST_DOMAIN.to_string()]);
-    let mut sub = Proc::spawn("dds subscribe", sub);
-    let mut peer = Proc::spawn(
-        "cyclone ghost disposer",
-        python_peer_on(GHOST, GHOST_DOMAIN),
-    );
-    let exit = sub.wait_exit(Duration::from_secs(30));
-    let rows = ndjson_rows(&sub.lines().join("\n"));
-    let _ = peer.interrupt(WAIT);
-    check!(
-        exit.is_some(),
-        &[&sub, &peer],
-        "dds subscribe did not finish"
-    );
+    let (rows, sub, peer) = subscribe_beside(&bin, "Ghost", 3, GHOST_DOMAIN, GHOST);
     let shown: Vec<(&str, &str, Option<i64>)> = rows
         .iter()
         .map(|r| {
@@ -409,7 +374,42 @@ fn dds_subscribe_shows_the_key_of_a_dispose_of_an_instance_it_never_saw() {
     );
 }
 
-/// The JSON documents of `dds subscribe --ndjson` output, one per line (other lines skipped).
+/// `dds subscribe TOPIC --ndjson --reliable -n N` (the shapes IDL, `domain`) beside a Cyclone peer running
+/// the Python `script` on the same domain: the rows it printed once it finished (checked), with both
+/// processes for the caller's checks.
+fn subscribe_beside(
+    bin: &Path,
+    topic: &str,
+    n: u32,
+    domain: u32,
+    script: &str,
+) -> (Vec<Value>, Proc, Proc) {
+    let mut sub = Command::new(bin);
+    sub.args([
+        "subscribe",
+        topic,
+        "--ndjson",
+        "--reliable",
+        "-n",
+        &n.to_string(),
+    ])
+    .args(["--timeout", "25"])
+    .arg("--idl")
+    .arg(idl_file())
+    .args(["--domain", &domain.to_string()]);
+    let mut sub = Proc::spawn("dds subscribe", sub);
+    let mut peer = Proc::spawn("cyclone peer", python_peer_on(script, domain));
+    let exit = sub.wait_exit(Duration::from_secs(30));
+    let rows = ndjson_rows(&sub.lines().join("\n"));
+    let _ = peer.interrupt(WAIT);
+    check!(
+        exit.is_some(),
+        &[&sub, &peer],
+        "dds subscribe did not finish"
+    );
+    (rows, sub, peer)
+}
+
 /// `dds subscribe Square --ndjson -n 3 --timeout 20` on `domain`, with `extra` arguments: the rows it printed
 /// and its whole output, once it has exited successfully (`peer` is dumped if not).
 fn three_squares(bin: &Path, domain: &str, extra: &[&OsStr], peer: &Proc) -> (Vec<Value>, String) {
@@ -429,6 +429,7 @@ fn three_squares(bin: &Path, domain: &str, extra: &[&OsStr], peer: &Proc) -> (Ve
     (ndjson_rows(&text), text)
 }
 
+/// The JSON documents of `dds subscribe --ndjson` output, one per line (other lines skipped).
 fn ndjson_rows(text: &str) -> Vec<Value> {
     text.lines()
         .filter_map(|l| serde_json::from_str(l).ok())
