@@ -265,7 +265,19 @@ fn discard_parts(parts: Vec<Event>, out: &mut VecDeque<Event>) {
 
 impl Participant {
     /// Routes an event for the application: a part of a group coherent set waits for the rest of its set.
+    /// A sample outside group ordering (nearly every one) is queued as it is, without a trip through the
+    /// group ordering's checks and back (inlined for that check: it runs for every delivered sample).
+    #[inline]
     pub(super) fn push_delivery(&mut self, ev: Event) {
+        if matches!(&ev, Event::Sample(s) if s.group_sequence.is_none()) {
+            self.events.push_back(ev);
+        } else {
+            self.push_ordered(ev);
+        }
+    }
+
+    /// [`push_delivery`](Self::push_delivery) of an event group ordering or group coherent sets may hold.
+    fn push_ordered(&mut self, ev: Event) {
         let Some(ev) = self.order_by_group(ev) else {
             return;
         };

@@ -278,11 +278,6 @@ impl Participant {
         let mut batch = std::mem::take(&mut self.scratch);
         for ev in batch.drain(..) {
             match ev {
-                // A user reader's sample outside group ordering goes straight to the queue (what
-                // `push_delivery` does with it, without moving it through the group ordering's checks).
-                Event::Sample(ref s) if s.group_sequence.is_none() && !s.reader.is_builtin() => {
-                    self.events.push_back(ev)
-                }
                 Event::Sample(s) if s.reader.is_builtin() => {
                     self.on_builtin_sample(now, s);
                     self.timers_changed();
